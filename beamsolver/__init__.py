@@ -1,0 +1,12 @@
+"""beamsolver: quasi-static geometrically exact beams on SE(3) with frictional contact."""
+from . import contact, geometry, motion, se3
+from .errors import ConvergenceError, InputError
+from .model import Beam, Model
+from .results import Solution
+from .section import Section
+from .solver import Convergence, solve
+
+__version__ = "0.1.0"
+
+__all__ = ["Model", "Beam", "Section", "Solution", "solve", "Convergence", "InputError",
+           "ConvergenceError", "se3", "geometry", "motion", "contact", "__version__"]

@@ -1,0 +1,401 @@
+"""DOF map, CSR/CSC pattern built once, vectorised scatter of element arrays.
+
+Unknowns (``z``) are six per *representative* node (``6 * node + k``):
+
+- free and prescribed nodes: body increments, ``H <- H exp(hat(z))``;
+- nodes with a partial ``fix``: global increments ``(dx, dtheta)``,
+  ``x <- x + dx``, ``R <- exp(dtheta) R``, so that fixed global directions are
+  single unknowns; their body increments are ``q = M z`` with
+  ``M = diag(R^T, R^T)``;
+- a node joined to a representative has no unknowns of its own:
+  ``H_i = H_rep X_i`` with a constant ``X_i``, so ``q_i = Ad(X_i^-1) M_rep z_rep``.
+
+Residual and tangent in ``z`` are ``M^T r`` and ``M^T K M``, plus for the
+global-type nodes the term ``[[0, -hat(r_u)], [0, -hat(r_w)]]`` from the
+dependence of ``M`` on ``R`` (``r`` in global components), which keeps Newton
+quadratic.
+"""
+import numpy as np
+import scipy.sparse as sp
+
+from . import se3
+from .element import internal_forces, internal_forces_and_tangent
+from .errors import InputError
+from .se3 import skew
+
+__all__ = ["System", "FREE", "GLOBAL", "CLAMPED", "PRESCRIBED"]
+
+FREE, GLOBAL, CLAMPED, PRESCRIBED = 0, 1, 2, 3
+
+
+def _find(parent, i):
+    while parent[i] != i:
+        parent[i] = parent[parent[i]]
+        i = parent[i]
+    return i
+
+
+class System:
+    """Compiled, validated model: DOF map, element table, load arrays, sparse pattern."""
+
+    def __init__(self, model, check_rigid_modes=True):
+        if not model.beams:
+            raise InputError("Model: no beams were added")
+        self.model = model
+        n = model.n_nodes
+        self.n_nodes = n
+        self.enodes, self.L, self.eps0, self.C = model.element_table()
+        self.n_elements = len(self.L)
+        self.poses0 = model.poses0
+        self.length_scale = model.characteristic_length()
+        self._build_reps(model)
+        self._build_loads(model)
+        self._build_pattern()
+        self._build_chains(model)
+        if check_rigid_modes:
+            self._check_rigid_modes(model)
+
+    # ------------------------------------------------------------ chains
+    def _build_chains(self, model):
+        """Cantilever beams: one end clamped/prescribed, nothing else attached.
+
+        Their Newton updates are applied in strain space (``h_e <- h_e + B_e dq``,
+        poses re-chained from the anchored end), a retraction that agrees with
+        ``H exp(dq)`` to first order (so Newton stays quadratic) but carries no
+        axial overshoot: a constant-curvature increment stays exact.
+        """
+        busy = set(self.members.tolist()) | set(self.rep[self.members].tolist())
+        in_contact = {b.id for d in model.contacts for b in d.slave + d.master}
+        chains = []
+        for b in model.beams:
+            if b.id in in_contact or any(int(i) in busy for i in b.nodes):
+                continue
+            k = self.kind[b.nodes]
+            anchored = np.flatnonzero(k != FREE)
+            if len(anchored) != 1 or k[anchored[0]] == GLOBAL:
+                continue
+            if anchored[0] == 0:
+                chains.append((b.nodes, b.elements, False))
+            elif anchored[0] == len(b.nodes) - 1:
+                chains.append((b.nodes[::-1], b.elements[::-1], True))
+        self.chains = chains
+        self.chain_nodes = (np.concatenate([c[0][1:] for c in chains]) if chains
+                            else np.zeros(0, dtype=int))
+
+    # ------------------------------------------------------------ dof map
+    def _build_reps(self, model):
+        n = self.n_nodes
+        parent = list(range(n))
+        cons = model.constraints
+        for a, b in model.joins:
+            ra, rb = _find(parent, a), _find(parent, b)
+            if ra == rb:
+                continue
+            # the constrained node of a group becomes its representative
+            ca, cb = self._group_constraint(parent, ra, cons), self._group_constraint(parent, rb, cons)
+            if ca is not None and cb is not None:
+                raise InputError(f"join({a}, {b}): both joined groups carry constraints "
+                                 f"(nodes {ca} and {cb}); constrain only one node of a joint")
+            if cb is not None:
+                parent[ra] = rb
+            else:
+                parent[rb] = ra
+        rep = np.array([_find(parent, i) for i in range(n)])
+        # a constrained member hands its constraint to the representative
+        kind = np.full(n, FREE)
+        fixed = np.zeros((n, 6), dtype=bool)
+        self.motions = {}
+        for node, c in cons.items():
+            r = rep[node]
+            if r != node:
+                raise InputError(f"node {node}: constrain the representative node {r} of its joint instead")
+            if c[0] == "clamp":
+                kind[r] = CLAMPED
+                fixed[r] = True
+            elif c[0] == "prescribe":
+                kind[r] = PRESCRIBED
+                fixed[r] = True
+                self.motions[r] = c[1]
+            else:
+                kind[r] = GLOBAL
+                fixed[r, sorted(c[1])] = True
+        self.rep = rep
+        self.kind = kind
+        is_rep = rep == np.arange(n)
+        self.is_rep = is_rep
+        P = self.poses0
+        self.members = np.flatnonzero(~is_rep)
+        self.X = se3.relative(P[rep[self.members]], P[self.members])   # H_i = H_rep X_i
+        self.Ad_Xinv = se3.adjoint(se3.inverse(self.X))
+        self.global_nodes = np.flatnonzero(kind == GLOBAL)
+        self.prescribed_nodes = np.array(sorted(self.motions), dtype=int)
+        free = np.repeat(is_rep, 6).reshape(n, 6) & ~fixed
+        self.free = free.ravel()
+        self.fixed_dofs = (np.repeat(is_rep, 6).reshape(n, 6) & fixed).ravel()
+        self.free_dofs = np.flatnonzero(self.free)
+        self.n_free = len(self.free_dofs)
+        self.red = np.full(6 * n, -1)
+        self.red[self.free_dofs] = np.arange(self.n_free)
+        # nodes whose increments are transformed (q = M z)
+        transformed = np.zeros(n, dtype=bool)
+        transformed[self.members] = True
+        transformed[self.global_nodes] = True
+        transformed |= np.isin(rep, self.global_nodes)
+        self.transformed = transformed
+        self.el_transformed = np.flatnonzero(transformed[self.enodes].any(axis=1))
+
+    @staticmethod
+    def _group_constraint(parent, root, cons):
+        for node in cons:
+            if _find(parent, node) == root:
+                return node
+        return None
+
+    def _check_rigid_modes(self, model):
+        """Every connected group (joints, contact) needs 6 independent constraints."""
+        n = self.n_nodes
+        parent = list(range(n))
+
+        def union(a, b):
+            ra, rb = _find(parent, a), _find(parent, b)
+            if ra != rb:
+                parent[ra] = rb
+        for a, b in self.enodes:
+            union(int(a), int(b))
+        for i in range(n):
+            union(i, int(self.rep[i]))
+        for decl in model.contacts:
+            beams = decl.slave + decl.master
+            for b in beams[1:]:
+                union(beams[0].first, b.first)
+        groups = {}
+        for i in range(n):
+            groups.setdefault(_find(parent, i), []).append(i)
+        P = self.poses0
+        for root, nodes in groups.items():
+            rows = []
+            for i in nodes:
+                if not self.is_rep[i] or self.kind[i] == FREE:
+                    continue
+                x = P[i, :3, 3]
+                Rg = np.zeros((6, 6))
+                Rg[:3, :3] = np.eye(3)
+                Rg[:3, 3:] = -skew(x)
+                Rg[3:, 3:] = np.eye(3)
+                fixed = self.fixed_dofs.reshape(n, 6)[i]
+                rows.append(Rg[fixed])
+            rank = np.linalg.matrix_rank(np.concatenate(rows), tol=1e-9 * self.length_scale) if rows else 0
+            if rank < 6:
+                beams = sorted({model.beam_of_node(i).id for i in nodes})
+                raise InputError(f"beam(s) {beams}: {6 - rank} rigid-body mode(s) are not constrained; "
+                                 "clamp, fix or prescribe nodes (or pass check_rigid_modes=False "
+                                 "if contact holds them)")
+
+    # ------------------------------------------------------------ loads
+    def _build_loads(self, model):
+        loads = model.loads
+        self.load_nodes = np.array([ld.node for ld in loads], dtype=int)
+        self.load_F = np.array([ld.force for ld in loads]).reshape(-1, 3)
+        self.load_M = np.array([ld.moment for ld in loads]).reshape(-1, 3)
+        self.load_follower = np.array([ld.follower for ld in loads], dtype=bool)
+        self.load_scales = [ld.scale for ld in loads]
+        self.dead = np.flatnonzero(~self.load_follower)
+
+    def load_factors(self, t):
+        return np.array([float(s(t)) for s in self.load_scales])
+
+    # ------------------------------------------------------------ pattern
+    def _build_pattern(self):
+        n = self.n_nodes
+        k6 = np.arange(6)
+        edofs = (6 * self.rep[self.enodes])[:, :, None] + k6                # (n_el, 2, 6)
+        self.edofs = edofs.reshape(-1, 12)
+        # node blocks: dead-loaded nodes and global-type representatives
+        bn = np.unique(np.concatenate([self.load_nodes[self.dead], self.global_nodes]))
+        self.block_nodes = bn.astype(int)
+        ndofs = (6 * self.rep[self.block_nodes])[:, None] + k6
+        rows = np.concatenate([np.repeat(self.edofs, 12, axis=1).ravel(),
+                               np.repeat(ndofs, 6, axis=1).ravel()])
+        cols = np.concatenate([np.tile(self.edofs, (1, 12)).ravel(), np.tile(ndofs, (1, 6)).ravel()])
+        self.coo_rows, self.coo_cols = rows, cols
+        rr, rc = self.red[rows], self.red[cols]
+        keep = (rr >= 0) & (rc >= 0)
+        nf = self.n_free
+        key = rc[keep].astype(np.int64) * max(nf, 1) + rr[keep]
+        ukey, inv = np.unique(key, return_inverse=True)
+        self.nnz = len(ukey)
+        pos = np.full(len(rows), self.nnz)        # dropped entries go to a dummy slot
+        pos[keep] = inv
+        self.pos = pos
+        self.indices = (ukey % max(nf, 1)).astype(np.int32)
+        counts = np.bincount((ukey // max(nf, 1)).astype(np.int64), minlength=nf)
+        self.indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
+        # entries (free row, prescribed column) for the predictor
+        presc = np.zeros(6 * n, dtype=bool)
+        for r in self.prescribed_nodes:
+            presc[6 * r:6 * r + 6] = True
+        self.fc = np.flatnonzero((rr >= 0) & presc[cols])
+
+    # ------------------------------------------------------------ transforms
+    def node_transforms(self, H):
+        """``M_i`` for the transformed nodes: dict of arrays ``(n, 6, 6)`` (identity elsewhere)."""
+        M = np.broadcast_to(np.eye(6), (self.n_nodes, 6, 6)).copy() if self.transformed.any() else None
+        if M is None:
+            return None
+        g = self.global_nodes
+        if len(g):
+            Rt = np.swapaxes(H[g, :3, :3], 1, 2)
+            M[g] = 0.0
+            M[g, :3, :3] = Rt
+            M[g, 3:, 3:] = Rt
+        if len(self.members):
+            M[self.members] = self.Ad_Xinv @ M[self.rep[self.members]]
+        return M
+
+    # ------------------------------------------------------------ evaluation
+    def evaluate(self, H, load_factors, tangent=True):
+        """Residual ``r = f_int - f_ext`` in ``z`` (``(6 n,)``) and, with ``tangent``, K values.
+
+        Returns ``(r, kvals, info)``: ``kvals`` are COO values aligned with the
+        pattern (``None`` without tangent); ``info`` holds the element state
+        and force levels for the convergence test.
+        """
+        HA, HB = H[self.enodes[:, 0]], H[self.enodes[:, 1]]
+        if tangent:
+            f, K, state = internal_forces_and_tangent(HA, HB, self.L, self.eps0, self.C)
+        else:
+            f, state = internal_forces(HA, HB, self.L, self.eps0, self.C)
+            K = None
+        f_level = np.abs(f[:, [0, 1, 2, 6, 7, 8]]).max(initial=0.0)
+        m_level = np.abs(f[:, [3, 4, 5, 9, 10, 11]]).max(initial=0.0)
+        M = self.node_transforms(H)
+        if M is not None and len(self.el_transformed):
+            e = self.el_transformed
+            T = np.zeros((len(e), 12, 12))
+            T[:, :6, :6] = M[self.enodes[e, 0]]
+            T[:, 6:, 6:] = M[self.enodes[e, 1]]
+            Tt = np.swapaxes(T, 1, 2)
+            f = f.copy()
+            f[e] = np.einsum("nij,nj->ni", Tt, f[e])
+            if K is not None:
+                K[e] = Tt @ K[e] @ T
+        ndof = 6 * self.n_nodes
+        r = np.bincount(self.edofs.ravel(), weights=f.ravel(), minlength=ndof)
+        # external loads (body components at their node, then transformed)
+        blocks = np.zeros((len(self.block_nodes), 6, 6)) if tangent else None
+        fe_level = 0.0
+        if len(self.load_nodes):
+            lf = load_factors
+            R = H[self.load_nodes, :3, :3]
+            Fs, Ms = self.load_F * lf[:, None], self.load_M * lf[:, None]
+            fb = np.where(self.load_follower[:, None], Fs, np.einsum("nji,nj->ni", R, Fs))
+            mb = np.where(self.load_follower[:, None], Ms, np.einsum("nji,nj->ni", R, Ms))
+            fext = np.concatenate([fb, mb], axis=1)
+            fe_level = np.abs(Fs).max(initial=0.0), np.abs(Ms).max(initial=0.0)
+            f_level, m_level = max(f_level, fe_level[0]), max(m_level, fe_level[1])
+            if M is not None:
+                fext = np.einsum("nji,nj->ni", M[self.load_nodes], fext)
+            ldofs = (6 * self.rep[self.load_nodes])[:, None] + np.arange(6)
+            r -= np.bincount(ldofs.ravel(), weights=fext.ravel(), minlength=ndof)
+            if tangent and len(self.dead):
+                d = self.dead
+                kb = np.zeros((len(d), 6, 6))
+                kb[:, :3, 3:] = -skew(fb[d])
+                kb[:, 3:, 3:] = -skew(mb[d])
+                if M is not None:
+                    Md = M[self.load_nodes[d]]
+                    kb = np.swapaxes(Md, 1, 2) @ kb @ Md
+                where = np.searchsorted(self.block_nodes, self.load_nodes[d])
+                np.add.at(blocks, where, kb)
+        if tangent and len(self.global_nodes):
+            g = self.global_nodes
+            rg = r.reshape(-1, 6)[g]
+            where = np.searchsorted(self.block_nodes, g)
+            blocks[where, :3, 3:] -= skew(rg[:, :3])
+            blocks[where, 3:, 3:] -= skew(rg[:, 3:])
+        kvals = None
+        if tangent:
+            kvals = np.concatenate([K.ravel(), blocks.ravel()])
+        info = dict(state=state, f_level=f_level, m_level=m_level)
+        return r, kvals, info
+
+    def matrix(self, kvals):
+        """Reduced tangent (free x free) as CSC from the COO values."""
+        data = np.bincount(self.pos, weights=kvals, minlength=self.nnz + 1)[:self.nnz]
+        return sp.csc_matrix((data, self.indices, self.indptr), shape=(self.n_free, self.n_free))
+
+    def full_matrix(self, kvals):
+        """The tangent over all ``6 n`` unknowns (constrained ones included) as CSR."""
+        ndof = 6 * self.n_nodes
+        return sp.coo_matrix((kvals, (self.coo_rows, self.coo_cols)), shape=(ndof, ndof)).tocsr()
+
+    def prescribed_coupling(self, kvals, dz_full):
+        """``K_fc dz_c`` on the free rows (reduced numbering)."""
+        e = self.fc
+        return np.bincount(self.red[self.coo_rows[e]], weights=kvals[e] * dz_full[self.coo_cols[e]],
+                           minlength=self.n_free)
+
+    # ------------------------------------------------------------ poses
+    def update(self, H, dz, chains=True):
+        """Apply unknown increments ``dz`` ``(n, 6)`` to the poses (a new array).
+
+        With ``chains``, cantilever beams are updated in strain space (see
+        ``_build_chains``); the anchored node must already hold its new pose
+        when ``H_anchor`` is given through ``dz`` (prescribed targets are set by
+        the caller before re-chaining).
+        """
+        H0 = H
+        H = H.copy()
+        body = np.flatnonzero(self.is_rep & ((self.kind == FREE) | (self.kind == PRESCRIBED)))
+        nz = body[np.any(dz[body] != 0.0, axis=1)]
+        if len(nz):
+            H[nz] = se3.compose(H[nz], se3.exp(dz[nz]))
+        if chains and self.chains:
+            self._rechain(H0, H, dz)
+        g = self.global_nodes
+        if len(g):
+            H[g, :3, 3] += dz[g, :3]
+            H[g, :3, :3] = se3.exp_so3(dz[g, 3:]) @ H[g, :3, :3]
+        self.sync_members(H)
+        return H
+
+    def _rechain(self, H_old, H, dz):
+        for nodes, elements, reverse in self.chains:
+            a, b = nodes[:-1], nodes[1:]              # chain order: anchor first
+            h = se3.log(se3.relative(H_old[a], H_old[b]))
+            # strain-space increment: dh = -T(-h)^-1 dq_a + T(h)^-1 dq_b
+            dh = (np.einsum("nij,nj->ni", se3.tangent_inv(h), dz[b])
+                  - np.einsum("nij,nj->ni", se3.tangent_inv(-h), dz[a]))
+            E = se3.exp(h + dh)
+            P = E.copy()                              # prefix products by doubling
+            d = 1
+            while d < len(P):
+                P[d:] = se3.compose(P[:-d].copy(), P[d:])
+                d *= 2
+            H[b] = se3.compose(H[nodes[0]], P)
+
+    def sync_members(self, H):
+        if len(self.members):
+            H[self.members] = se3.compose(H[self.rep[self.members]], self.X)
+
+    def prescribed_poses(self, t):
+        """Target poses ``G(t) H_0`` of the prescribed representatives ``(k, 4, 4)``."""
+        out = np.zeros((len(self.prescribed_nodes), 4, 4))
+        for j, node in enumerate(self.prescribed_nodes):
+            G = np.asarray(self.motions[node](t), dtype=float)
+            if G.shape != (4, 4) or not np.all(np.isfinite(G)):
+                raise InputError(f"prescribe({node}): motion({t}) is not a finite 4x4 pose")
+            out[j] = G @ self.poses0[node]
+        return out
+
+    def reactions(self, H, r):
+        """Global force and moment ``(n, 6)`` on each node (the residual, group-summed at joints)."""
+        rn = r.reshape(-1, 6)
+        out = np.zeros((self.n_nodes, 6))
+        rr = rn[self.rep]
+        body = self.kind[self.rep] != GLOBAL
+        R = H[self.rep, :3, :3]
+        out[body, :3] = np.einsum("nij,nj->ni", R[body], rr[body, :3])
+        out[body, 3:] = np.einsum("nij,nj->ni", R[body], rr[body, 3:])
+        out[~body] = rr[~body]
+        return out

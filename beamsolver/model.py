@@ -1,0 +1,272 @@
+"""User-facing scene declaration: beams, constraints, loads, contact pairs.
+
+A ``Model`` only records and validates what the user declares; the numerics
+live in ``element``, ``assembly`` and ``solver``.  Node ids are global
+integers (``beam.nodes``); every ``add_beam`` creates new nodes, and beams are
+connected with ``join``.
+"""
+from dataclasses import dataclass, field
+from typing import Callable, Optional
+
+import numpy as np
+
+from . import se3
+from .element import reference_strain
+from .errors import InputError
+from .section import Section
+
+__all__ = ["Model", "Beam", "Load", "ContactDeclaration", "DOF_NAMES"]
+
+DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
+ORTHONORMAL_TOL = 1e-8
+MAX_ELEMENT_ROTATION = 0.75 * np.pi   # refuse reference elements turning more than this
+JOIN_TOL = 1e-9                       # coincidence tolerance relative to the model size
+
+
+@dataclass
+class Beam:
+    """A beam: its global node ids, element ids, section and index in the model."""
+    id: int
+    nodes: np.ndarray
+    elements: np.ndarray
+    section: Section
+    name: Optional[str] = None
+
+    @property
+    def first(self):
+        return int(self.nodes[0])
+
+    @property
+    def last(self):
+        return int(self.nodes[-1])
+
+    @property
+    def n_elements(self):
+        return len(self.elements)
+
+    def __repr__(self):
+        label = f" {self.name!r}" if self.name else ""
+        return f"Beam {self.id}{label} (nodes {self.first}..{self.last}, {self.n_elements} elements)"
+
+
+@dataclass
+class Load:
+    node: int
+    force: np.ndarray
+    moment: np.ndarray
+    follower: bool
+    scale: Callable[[float], float]
+
+
+@dataclass
+class ContactDeclaration:
+    slave: list
+    master: list
+    mu: float = 0.0
+    penalty: Optional[float] = None
+    options: dict = field(default_factory=dict)
+
+
+def _ramp(t):
+    return t
+
+
+class Model:
+    """A scene: ``add_beam``, ``clamp``, ``fix``, ``prescribe``, ``join``, ``add_load``, ``add_contact``."""
+
+    def __init__(self):
+        self.beams = []
+        self._poses = []          # list of (n_i + 1, 4, 4)
+        self._n_nodes = 0
+        self._n_elements = 0
+        self.constraints = {}     # node -> ("clamp",) | ("fix", frozenset) | ("prescribe", motion)
+        self.joins = []           # (node_a, node_b)
+        self.loads = []
+        self.contacts = []
+
+    # ------------------------------------------------------------ geometry
+    @property
+    def n_nodes(self):
+        return self._n_nodes
+
+    @property
+    def n_elements(self):
+        return self._n_elements
+
+    @property
+    def poses0(self):
+        """Reference node poses ``(n_nodes, 4, 4)``."""
+        if not self._poses:
+            return np.zeros((0, 4, 4))
+        return np.concatenate(self._poses)
+
+    def add_beam(self, poses, section, name=None):
+        """Add a beam through node poses ``(n + 1, 4, 4)`` with ``section``; returns the ``Beam``."""
+        bid = len(self.beams)
+        label = f"Beam {bid}" + (f" {name!r}" if name else "")
+        if not isinstance(section, Section):
+            raise InputError(f"{label}: section must be a beamsolver.Section, got {type(section).__name__}")
+        P = np.array(poses, dtype=float)
+        if P.ndim != 3 or P.shape[1:] != (4, 4) or P.shape[0] < 2:
+            raise InputError(f"{label}: poses must have shape (n + 1, 4, 4) with n >= 1, got {P.shape}")
+        bad = np.argwhere(~np.all(np.isfinite(P), axis=(1, 2)))
+        if len(bad):
+            i = int(bad[0, 0])
+            raise InputError(f"{label}: node {i} has non-finite coordinates {P[i, :3, 3].tolist()}")
+        R = P[:, :3, :3]
+        err = np.abs(np.swapaxes(R, 1, 2) @ R - np.eye(3)).max(axis=(1, 2))
+        det = np.linalg.det(R)
+        badR = np.flatnonzero((err > ORTHONORMAL_TOL) | (det <= 0.0))
+        if len(badR):
+            i = int(badR[0])
+            raise InputError(f"{label}: pose of node {i} is not a rotation (|R^T R - I| = {err[i]:.3g}, "
+                             f"det = {det[i]:.6g}); use beamsolver.geometry or orthonormalise it")
+        if np.any(np.abs(P[:, 3] - [0, 0, 0, 1]) > 0):
+            raise InputError(f"{label}: the last row of every pose must be (0, 0, 0, 1)")
+        L, eps0 = reference_strain(P[:-1], P[1:])
+        size = max(np.ptp(P[:, :3, 3], axis=0).max(), L.sum())
+        short = np.flatnonzero(L <= 1e-12 * size)
+        if len(short):
+            i = int(short[0])
+            raise InputError(f"{label}: element {i} has zero length (nodes {i} and {i + 1} coincide at "
+                             f"{P[i, :3, 3].tolist()})")
+        ang = se3.rotation_angle(eps0[:, 3:] * L[:, None])
+        big = np.flatnonzero(ang > MAX_ELEMENT_ROTATION)
+        if len(big):
+            i = int(big[0])
+            raise InputError(f"{label}: element {i} turns by {ang[i]:.3f} rad in the reference pose "
+                             f"(limit {MAX_ELEMENT_ROTATION:.3f}); use more elements")
+        nodes = np.arange(self._n_nodes, self._n_nodes + len(P))
+        elements = np.arange(self._n_elements, self._n_elements + len(P) - 1)
+        beam = Beam(bid, nodes, elements, section, name)
+        self.beams.append(beam)
+        self._poses.append(P)
+        self._n_nodes += len(P)
+        self._n_elements += len(P) - 1
+        return beam
+
+    # ------------------------------------------------------------ helpers
+    def _node(self, node, what):
+        if isinstance(node, Beam):
+            raise InputError(f"{what}: expected a node id, got {node!r}; use beam.first / beam.last / beam.nodes[i]")
+        try:
+            i = int(node)
+        except (TypeError, ValueError):
+            raise InputError(f"{what}: node id must be an integer, got {node!r}") from None
+        if i != node or not (0 <= i < self._n_nodes):
+            raise InputError(f"{what}: unknown node id {node!r} (the model has nodes 0..{self._n_nodes - 1})")
+        return i
+
+    def beam_of_node(self, node):
+        for b in self.beams:
+            if b.nodes[0] <= node <= b.nodes[-1]:
+                return b
+        raise InputError(f"unknown node id {node!r}")
+
+    def _set_constraint(self, node, value, what):
+        old = self.constraints.get(node)
+        if old is not None and old[0] != value[0]:
+            raise InputError(f"{what}: node {node} already has a '{old[0]}' constraint")
+        if old is not None and value[0] == "fix":
+            value = ("fix", old[1] | value[1])
+        self.constraints[node] = value
+
+    # ------------------------------------------------------------ constraints
+    def clamp(self, node):
+        """Fix all six increments of ``node``."""
+        i = self._node(node, "clamp")
+        self._set_constraint(i, ("clamp",), f"clamp({node})")
+
+    def fix(self, node, dofs=DOF_NAMES):
+        """Fix the named increments of ``node`` in GLOBAL directions ('ux', 'uy', 'uz', 'rx', 'ry', 'rz')."""
+        i = self._node(node, "fix")
+        if isinstance(dofs, str):
+            dofs = (dofs,)
+        bad = [d for d in dofs if d not in DOF_NAMES]
+        if bad or not dofs:
+            raise InputError(f"fix({node}): unknown dofs {bad or dofs!r}; choose from {DOF_NAMES}")
+        idx = frozenset(DOF_NAMES.index(d) for d in dofs)
+        if len(idx) == 6:
+            self._set_constraint(i, ("clamp",), f"fix({node})")
+        else:
+            self._set_constraint(i, ("fix", idx), f"fix({node})")
+
+    def prescribe(self, node, motion):
+        """Prescribe ``pose(t) = motion(t) @ pose_0`` for ``node``; ``motion(t)`` returns a 4x4 pose."""
+        i = self._node(node, "prescribe")
+        if not callable(motion):
+            raise InputError(f"prescribe({node}): motion must be callable t -> 4x4 pose, got {motion!r}")
+        G = np.asarray(motion(0.0), dtype=float)
+        if G.shape != (4, 4) or not np.all(np.isfinite(G)):
+            raise InputError(f"prescribe({node}): motion(0) must be a finite 4x4 pose, got shape {G.shape}")
+        self._set_constraint(i, ("prescribe", motion), f"prescribe({node})")
+
+    def join(self, node_a, node_b):
+        """Rigidly join two coincident nodes (their relative pose stays the reference one)."""
+        a = self._node(node_a, "join")
+        b = self._node(node_b, "join")
+        if a == b:
+            raise InputError(f"join({node_a}, {node_b}): a node cannot be joined to itself")
+        P = self.poses0
+        size = max(1.0, np.ptp(P[:, :3, 3], axis=0).max())
+        gap = np.linalg.norm(P[a, :3, 3] - P[b, :3, 3])
+        if gap > JOIN_TOL * size:
+            raise InputError(f"join({node_a}, {node_b}): nodes are {gap:.3g} apart; a joint needs coincident nodes")
+        self.joins.append((a, b))
+
+    # ------------------------------------------------------------ loads
+    def add_load(self, node, force=None, moment=None, follower=False, scale=_ramp):
+        """Nodal force/moment, ramped by ``scale(t)`` (default ``t``).
+
+        Dead loads (default) are given in global components; a ``follower``
+        load is given in the node's body frame and turns with it.
+        """
+        i = self._node(node, "add_load")
+        F = np.zeros(3) if force is None else np.array(force, dtype=float).reshape(-1)
+        M = np.zeros(3) if moment is None else np.array(moment, dtype=float).reshape(-1)
+        for name, v in (("force", F), ("moment", M)):
+            if v.shape != (3,) or not np.all(np.isfinite(v)):
+                raise InputError(f"add_load({node}): {name} must be 3 finite numbers, got {v.tolist()}")
+        if not callable(scale):
+            raise InputError(f"add_load({node}): scale must be callable t -> float, got {scale!r}")
+        self.loads.append(Load(i, F, M, bool(follower), scale))
+
+    # ------------------------------------------------------------ contact
+    def add_contact(self, slave, master, mu=0.0, penalty=None, **options):
+        """Declare contact between ``slave`` and ``master`` (a Beam or a list of Beams each)."""
+        s = [slave] if isinstance(slave, Beam) else list(slave)
+        m = [master] if isinstance(master, Beam) else list(master)
+        for b in s + m:
+            if not isinstance(b, Beam) or b.id >= len(self.beams) or self.beams[b.id] is not b:
+                raise InputError(f"add_contact: {b!r} is not a beam of this model")
+        same = {b.id for b in s} & {b.id for b in m}
+        if same:
+            raise InputError(f"add_contact: beam {sorted(same)[0]} is declared in contact with itself")
+        if not np.isfinite(mu) or mu < 0:
+            raise InputError(f"add_contact: mu must be >= 0, got {mu!r}")
+        if penalty is not None and (not np.isfinite(penalty) or penalty <= 0):
+            raise InputError(f"add_contact: penalty must be positive, got {penalty!r}")
+        decl = ContactDeclaration(s, m, float(mu), penalty, dict(options))
+        self.contacts.append(decl)
+        return decl
+
+    # ------------------------------------------------------------ summary
+    def element_table(self):
+        """Per element: node ids ``(n_el, 2)``, reference length, reference strain, C."""
+        nodes, C = [], []
+        for b in self.beams:
+            nodes.append(np.stack([b.nodes[:-1], b.nodes[1:]], axis=1))
+            C.append(np.broadcast_to(b.section.C, (b.n_elements, 6, 6)))
+        nodes = np.concatenate(nodes)
+        P = self.poses0
+        L, eps0 = reference_strain(P[nodes[:, 0]], P[nodes[:, 1]])
+        return nodes, L, eps0, np.concatenate(C)
+
+    def characteristic_length(self):
+        P = self.poses0
+        return float(max(np.ptp(P[:, :3, 3], axis=0).max(), 1e-300))
+
+    def __repr__(self):
+        return (f"Model({len(self.beams)} beams, {self.n_nodes} nodes, {self.n_elements} elements, "
+                f"{len(self.constraints)} constrained nodes, {len(self.loads)} loads, "
+                f"{len(self.contacts)} contact declarations)")

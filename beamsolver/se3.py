@@ -1,0 +1,370 @@
+"""Lie-group kernels on SO(3) and SE(3), batched over leading axes.
+
+Conventions (stated once, used everywhere in beamsolver):
+
+- A pose is ``H = [[R, x], [0, 1]]``, shape ``(..., 4, 4)``.
+- A twist / increment is ``h = (u, w)``, shape ``(..., 6)``: translation first,
+  rotation second.
+- Increments are body (right) increments: ``H <- H exp(hat(h))``.
+- ``tangent(h)`` is the right tangent operator: ``exp(h + dh) = exp(h) exp(tangent(h) dh)``
+  to first order (Sonneville, Cardona & Bruls 2014, eqs. for T_SE3).
+
+Every coefficient that is 0/0 at zero angle has its own Taylor switch point,
+chosen where the truncated series (nine terms in t^2) and the closed form
+agree to round-off; ``tests/test_se3_coefficients.py`` sweeps them against
+50-digit arithmetic.
+"""
+import numpy as np
+
+__all__ = [
+    "skew", "unskew", "hat", "vee", "exp_so3", "log_so3", "tangent_so3",
+    "tangent_inv_so3", "exp", "log", "tangent", "tangent_inv", "adjoint",
+    "inverse", "compose", "interpolate", "rotation_angle",
+]
+
+# ---------------------------------------------------------------- coefficients
+# Series coefficients in powers of t^2 (exact rationals, computed with sympy).
+_SERIES = {
+    "a": [1, -1 / 6, 1 / 120, -1 / 5040, 1 / 362880, -1 / 39916800,
+          1 / 6227020800, -1 / 1307674368000, 1 / 355687428096000],
+    "b": [1 / 2, -1 / 24, 1 / 720, -1 / 40320, 1 / 3628800, -1 / 479001600,
+          1 / 87178291200, -1 / 20922789888000, 1 / 6402373705728000],
+    "c": [1 / 6, -1 / 120, 1 / 5040, -1 / 362880, 1 / 39916800, -1 / 6227020800,
+          1 / 1307674368000, -1 / 355687428096000, 1 / 121645100408832000],
+    "d": [1 / 12, 1 / 720, 1 / 30240, 1 / 1209600, 1 / 47900160,
+          691 / 1307674368000, 1 / 74724249600, 3617 / 10670622842880000,
+          43867 / 5109094217170944000],
+    "q2": [1 / 24, -1 / 720, 1 / 40320, -1 / 3628800, 1 / 479001600,
+           -1 / 87178291200, 1 / 20922789888000, -1 / 6402373705728000,
+           1 / 2432902008176640000],
+    "q3": [1 / 120, -1 / 2520, 1 / 120960, -1 / 9979200, 1 / 1245404160,
+           -1 / 217945728000, 1 / 50812489728000, -1 / 15205637551104000,
+           1 / 5676771352412160000],
+    # derivatives divided by t: f'(t)/t
+    "cp": [-1 / 60, 1 / 1260, -1 / 60480, 1 / 4989600, -1 / 622702080,
+           1 / 108972864000, -1 / 25406244864000, 1 / 7602818775552000,
+           -1 / 2838385676206080000],
+    "dp": [1 / 360, 1 / 7560, 1 / 201600, 1 / 5987520, 691 / 130767436800,
+           1 / 6227020800, 3617 / 762187345920000, 43867 / 319318388573184000,
+           174611 / 44603203483238400000],
+    "q2p": [-1 / 360, 1 / 10080, -1 / 604800, 1 / 59875200, -1 / 8717829120,
+            1 / 1743565824000, -1 / 457312407552000, 1 / 152056375511040000,
+            -1 / 62444484876533760000],
+    "q3p": [-1 / 1260, 1 / 30240, -1 / 1663200, 1 / 155675520, -1 / 21794572800,
+            1 / 4234374144000, -1 / 1086116967936000, 1 / 354798209525760000,
+            -1 / 143622315216027648000],
+}
+
+
+def _closed_a(t):
+    return np.sin(t) / t
+
+
+def _closed_b(t):
+    s = np.sin(0.5 * t) / (0.5 * t)  # 1 - cos t = 2 sin^2(t/2): no cancellation
+    return 0.5 * s * s
+
+
+def _closed_c(t):
+    return (t - np.sin(t)) / t**3
+
+
+def _closed_d(t):
+    return (1.0 - 0.5 * t / np.tan(0.5 * t)) / t**2
+
+
+def _closed_q2(t):
+    return (t * t + 2.0 * np.cos(t) - 2.0) / (2.0 * t**4)
+
+
+def _closed_q3(t):
+    return (2.0 * t - 3.0 * np.sin(t) + t * np.cos(t)) / (2.0 * t**5)
+
+
+def _closed_cp(t):
+    return (3.0 * np.sin(t) - t * np.cos(t) - 2.0 * t) / t**5
+
+
+def _closed_dp(t):
+    s = np.sin(0.5 * t)
+    return (t * t / (s * s) + 2.0 * t / np.tan(0.5 * t) - 8.0) / (4.0 * t**4)
+
+
+def _closed_q2p(t):
+    return (-t * t - t * np.sin(t) - 4.0 * np.cos(t) + 4.0) / t**6
+
+
+def _closed_q3p(t):
+    return (-8.0 * t + 15.0 * np.sin(t) - 7.0 * t * np.cos(t) - t * t * np.sin(t)) / (2.0 * t**7)
+
+
+_CLOSED = {"a": _closed_a, "b": _closed_b, "c": _closed_c, "d": _closed_d,
+           "q2": _closed_q2, "q3": _closed_q3, "cp": _closed_cp, "dp": _closed_dp,
+           "q2p": _closed_q2p, "q3p": _closed_q3p}
+
+# Switch points, one per coefficient, from a sweep against 200-digit
+# arithmetic (tests/test_se3_coefficients.py): below them the nine-term
+# series is exact to round-off, above them the closed form has lost little to
+# cancellation.  `d` and `dp` have poles at 2 pi, so their series converge
+# more slowly and switch earlier.  Worst relative errors over t in
+# [1e-12, 5]: a, b, c, q2 < 2e-15; d 1.2e-15; q3, cp 5e-15; dp 7e-14;
+# q2p, q3p 8e-15.
+SWITCH = {"a": 0.75, "b": 1.0, "c": 1.5, "d": 0.75, "q2": 1.5, "q3": 1.5,
+          "cp": 1.5, "dp": 1.0, "q2p": 2.0, "q3p": 2.0}
+
+
+def coefficient(name, t):
+    """Evaluate the named singular coefficient at angles ``t >= 0`` (any shape)."""
+    t = np.asarray(t, dtype=float)
+    t2 = t * t
+    coeffs = _SERIES[name]
+    series = np.full_like(t2, coeffs[-1])
+    for c in coeffs[-2::-1]:
+        series = series * t2 + c
+    small = t < SWITCH[name]
+    safe = np.where(small, 1.0, t)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        closed = _CLOSED[name](safe)
+    return np.where(small, series, closed)
+
+
+# ---------------------------------------------------------------- small algebra
+def _cross(a, b):
+    """Cross product over the last axis (faster than np.cross for batches)."""
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
+
+
+def _dot(a, b):
+    return np.einsum("...i,...i->...", a, b)
+
+
+def _mv(A, v):
+    return np.einsum("...ij,...j->...i", A, v)
+
+
+def skew(w):
+    """so(3) hat: ``(..., 3) -> (..., 3, 3)`` with ``skew(w) @ v = w x v``."""
+    w = np.asarray(w, dtype=float)
+    W = np.zeros(w.shape[:-1] + (3, 3))
+    W[..., 0, 1] = -w[..., 2]
+    W[..., 0, 2] = w[..., 1]
+    W[..., 1, 0] = w[..., 2]
+    W[..., 1, 2] = -w[..., 0]
+    W[..., 2, 0] = -w[..., 1]
+    W[..., 2, 1] = w[..., 0]
+    return W
+
+
+def unskew(W):
+    """so(3) vee of the skew part: ``(..., 3, 3) -> (..., 3)``."""
+    W = np.asarray(W)
+    return 0.5 * np.stack([W[..., 2, 1] - W[..., 1, 2],
+                           W[..., 0, 2] - W[..., 2, 0],
+                           W[..., 1, 0] - W[..., 0, 1]], axis=-1)
+
+
+def hat(h):
+    """se(3) hat: ``(..., 6) -> (..., 4, 4)``, ``[[skew(w), u], [0, 0]]``."""
+    h = np.asarray(h, dtype=float)
+    X = np.zeros(h.shape[:-1] + (4, 4))
+    X[..., :3, :3] = skew(h[..., 3:])
+    X[..., :3, 3] = h[..., :3]
+    return X
+
+
+def vee(X):
+    """se(3) vee: ``(..., 4, 4) -> (..., 6)``."""
+    X = np.asarray(X)
+    return np.concatenate([X[..., :3, 3], unskew(X[..., :3, :3])], axis=-1)
+
+
+def rotation_angle(w):
+    """``|w|``, shape ``(...,)``."""
+    return np.sqrt(_dot(w, w))
+
+
+# ---------------------------------------------------------------- SO(3)
+def exp_so3(w):
+    """``exp(skew(w)) = I + a W + b W^2``; ``(..., 3) -> (..., 3, 3)``."""
+    w = np.asarray(w, dtype=float)
+    t = rotation_angle(w)
+    a, b = coefficient("a", t), coefficient("b", t)
+    W = skew(w)
+    return np.eye(3) + a[..., None, None] * W + b[..., None, None] * (W @ W)
+
+
+def _quaternion(R):
+    """Unit quaternion ``(qw, qx, qy, qz)``, ``qw >= 0``, of ``R`` (Shepperd's method)."""
+    R = np.asarray(R, dtype=float)
+    r00, r11, r22 = R[..., 0, 0], R[..., 1, 1], R[..., 2, 2]
+    tr = r00 + r11 + r22
+    d21, d02, d10 = R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0], R[..., 1, 0] - R[..., 0, 1]
+    s01, s02, s12 = R[..., 0, 1] + R[..., 1, 0], R[..., 0, 2] + R[..., 2, 0], R[..., 1, 2] + R[..., 2, 1]
+    choice = np.argmax(np.stack([tr, r00, r11, r22], axis=-1), axis=-1)
+    # each candidate: 4 * q_k * q with q_k the largest component (never small)
+    cand = np.stack([
+        np.stack([1.0 + tr, d21, d02, d10], axis=-1),
+        np.stack([d21, 1.0 + r00 - r11 - r22, s01, s02], axis=-1),
+        np.stack([d02, s01, 1.0 - r00 + r11 - r22, s12], axis=-1),
+        np.stack([d10, s02, s12, 1.0 - r00 - r11 + r22], axis=-1),
+    ], axis=-2)
+    q = np.take_along_axis(cand, choice[..., None, None], axis=-2)[..., 0, :]
+    q = q / np.sqrt(_dot(q, q))[..., None]
+    return np.where(q[..., :1] < 0.0, -q, q)
+
+
+def log_so3(R):
+    """Rotation vector of ``R``: ``(..., 3, 3) -> (..., 3)``, angle in ``[0, pi]``.
+
+    Goes through the quaternion, so nothing divides by ``sin t`` near ``pi``.
+    """
+    q = _quaternion(R)
+    qw, qv = q[..., 0], q[..., 1:]
+    s = np.sqrt(_dot(qv, qv))
+    # 2 atan2(s, qw) / s; for small x = s/qw use the series of atan(x)/x.
+    small = s < 0.1 * qw
+    x2 = np.where(small, (s / np.where(small, qw, 1.0)) ** 2, 0.0)
+    series = np.zeros_like(x2)
+    for k in range(8, -1, -1):
+        series = series * x2 + (-1) ** k / (2 * k + 1)
+    series = 2.0 * series / np.where(small, qw, 1.0)
+    closed = 2.0 * np.arctan2(s, qw) / np.where(small, 1.0, s)
+    return np.where(small, series, closed)[..., None] * qv
+
+
+def tangent_so3(w):
+    """Right tangent ``T(w) = I - b W + c W^2``: ``exp(w + dw) = exp(w) exp(T dw)``."""
+    w = np.asarray(w, dtype=float)
+    t = rotation_angle(w)
+    W = skew(w)
+    return np.eye(3) - coefficient("b", t)[..., None, None] * W + coefficient("c", t)[..., None, None] * (W @ W)
+
+
+def tangent_inv_so3(w):
+    """``T(w)^-1 = I + W/2 + d W^2`` (singular at ``|w| = 2 pi``)."""
+    w = np.asarray(w, dtype=float)
+    t = rotation_angle(w)
+    W = skew(w)
+    return np.eye(3) + 0.5 * W + coefficient("d", t)[..., None, None] * (W @ W)
+
+
+# ---------------------------------------------------------------- SE(3)
+def exp(h):
+    """``exp(hat(h))``: ``(..., 6) -> (..., 4, 4)``, translation ``T_SO3(w)^T u``."""
+    h = np.asarray(h, dtype=float)
+    u, w = h[..., :3], h[..., 3:]
+    t = rotation_angle(w)
+    a, b, c = coefficient("a", t), coefficient("b", t), coefficient("c", t)
+    W = skew(w)
+    WW = W @ W
+    H = np.zeros(h.shape[:-1] + (4, 4))
+    H[..., :3, :3] = np.eye(3) + a[..., None, None] * W + b[..., None, None] * WW
+    wxu = _cross(w, u)
+    H[..., :3, 3] = u + b[..., None] * wxu + c[..., None] * _cross(w, wxu)
+    H[..., 3, 3] = 1.0
+    return H
+
+
+def log(H):
+    """``vee(log(H))``: ``(..., 4, 4) -> (..., 6)``; rotation angle in ``[0, pi]``."""
+    H = np.asarray(H, dtype=float)
+    w = log_so3(H[..., :3, :3])
+    x = H[..., :3, 3]
+    d = coefficient("d", rotation_angle(w))
+    wxx = _cross(w, x)
+    u = x - 0.5 * wxx + d[..., None] * _cross(w, wxx)  # T_SO3(w)^-T x
+    return np.concatenate([u, w], axis=-1)
+
+
+def _q_matrix(u, w, t=None):
+    """``Q(u, w)`` of THEORY.md section 2 (the coupling block), ``(..., 3, 3)``."""
+    if t is None:
+        t = rotation_angle(w)
+    c1, c2, c3 = coefficient("c", t), coefficient("q2", t), coefficient("q3", t)
+    P, U = skew(w), skew(u)
+    PU, UP = P @ U, U @ P
+    PUP = PU @ P
+    return (0.5 * U + c1[..., None, None] * (PU + UP + PUP)
+            + c2[..., None, None] * (P @ PU + UP @ P - 3.0 * PUP)
+            + c3[..., None, None] * (PUP @ P + P @ PUP))
+
+
+def tangent(h):
+    """Right tangent of SE(3): ``[[T(w), Q(-u,-w)], [0, T(w)]]``, ``(..., 6, 6)``."""
+    h = np.asarray(h, dtype=float)
+    u, w = h[..., :3], h[..., 3:]
+    Tw = tangent_so3(w)
+    out = np.zeros(h.shape[:-1] + (6, 6))
+    out[..., :3, :3] = Tw
+    out[..., 3:, 3:] = Tw
+    out[..., :3, 3:] = _q_matrix(-u, -w)
+    return out
+
+
+def tangent_inv(h):
+    """Inverse right tangent: ``[[Ti, -Ti Q(-u,-w) Ti], [0, Ti]]``, ``(..., 6, 6)``."""
+    h = np.asarray(h, dtype=float)
+    u, w = h[..., :3], h[..., 3:]
+    Ti = tangent_inv_so3(w)
+    out = np.zeros(h.shape[:-1] + (6, 6))
+    out[..., :3, :3] = Ti
+    out[..., 3:, 3:] = Ti
+    out[..., :3, 3:] = -Ti @ _q_matrix(-u, -w) @ Ti
+    return out
+
+
+def adjoint(H):
+    """``Ad(H) = [[R, skew(x) R], [0, R]]`` in the (u, w) ordering, ``(..., 6, 6)``."""
+    H = np.asarray(H, dtype=float)
+    R, x = H[..., :3, :3], H[..., :3, 3]
+    out = np.zeros(H.shape[:-2] + (6, 6))
+    out[..., :3, :3] = R
+    out[..., 3:, 3:] = R
+    out[..., :3, 3:] = skew(x) @ R
+    return out
+
+
+def inverse(H):
+    """``H^-1 = [[R^T, -R^T x], [0, 1]]``."""
+    H = np.asarray(H, dtype=float)
+    R, x = H[..., :3, :3], H[..., :3, 3]
+    out = np.zeros(H.shape)
+    Rt = np.swapaxes(R, -1, -2)
+    out[..., :3, :3] = Rt
+    out[..., :3, 3] = -_mv(Rt, x)
+    out[..., 3, 3] = 1.0
+    return out
+
+
+def compose(A, B):
+    """``A @ B`` for poses, batched (exploits the last row)."""
+    A, B = np.asarray(A, dtype=float), np.asarray(B, dtype=float)
+    shape = np.broadcast_shapes(A.shape, B.shape)
+    out = np.zeros(shape)
+    out[..., :3, :3] = A[..., :3, :3] @ B[..., :3, :3]
+    out[..., :3, 3] = _mv(A[..., :3, :3], B[..., :3, 3]) + A[..., :3, 3]
+    out[..., 3, 3] = 1.0
+    return out
+
+
+def relative(A, B):
+    """``A^-1 B`` for poses, batched."""
+    A, B = np.asarray(A, dtype=float), np.asarray(B, dtype=float)
+    Rt = np.swapaxes(A[..., :3, :3], -1, -2)
+    shape = np.broadcast_shapes(A.shape, B.shape)
+    out = np.zeros(shape)
+    out[..., :3, :3] = Rt @ B[..., :3, :3]
+    out[..., :3, 3] = _mv(Rt, B[..., :3, 3] - A[..., :3, 3])
+    out[..., 3, 3] = 1.0
+    return out
+
+
+def interpolate(H_A, h, xi):
+    """Constant-strain interpolation ``H_A exp(xi h)`` (Sonneville 2014).
+
+    ``H_A``: ``(..., 4, 4)``, ``h``: ``(..., 6)``, ``xi``: broadcastable to the batch.
+    """
+    xi = np.asarray(xi, dtype=float)
+    return compose(H_A, exp(xi[..., None] * np.asarray(h, dtype=float)))

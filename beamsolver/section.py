@@ -1,0 +1,97 @@
+"""Beam cross-sections: a 6x6 constitutive matrix and a contact radius.
+
+Ordering of the matrix matches the strain ``(Gamma_1, Gamma_2, Gamma_3,
+kappa_1, kappa_2, kappa_3)``: axial, two shears, torsion, two bendings, so
+the diagonal is ``(EA, GA2, GA3, GJ, EI2, EI3)``.  Units are the user's
+(consistent) units.
+"""
+import numpy as np
+
+from .errors import InputError
+
+__all__ = ["Section"]
+
+
+def _positive(name, value, owner="Section"):
+    v = float(value)
+    if not np.isfinite(v) or v <= 0.0:
+        raise InputError(f"{owner}: {name} must be positive and finite, got {value!r}")
+    return v
+
+
+class Section:
+    """Cross-section: stiffness matrix ``C`` (6x6, symmetric positive definite) and ``radius``.
+
+    ``Section(EA=, GA2=, GA3=, GJ=, EI2=, EI3=, radius=)`` builds a diagonal
+    ``C``; ``Section.from_matrix(C, radius)`` takes a full one.  ``radius`` is
+    the contact (and drawing) radius.
+    """
+
+    def __init__(self, EA, GA2, GA3, GJ, EI2, EI3, radius, name=None):
+        vals = dict(EA=EA, GA2=GA2, GA3=GA3, GJ=GJ, EI2=EI2, EI3=EI3)
+        owner = f"Section {name!r}" if name else "Section"
+        diag = [_positive(k, v, owner) for k, v in vals.items()]
+        self.C = np.diag(diag)
+        self.radius = _positive("radius", radius, owner)
+        self.name = name
+
+    @classmethod
+    def from_matrix(cls, C, radius, name=None):
+        C = np.array(C, dtype=float)
+        owner = f"Section {name!r}" if name else "Section"
+        if C.shape != (6, 6) or not np.all(np.isfinite(C)):
+            raise InputError(f"{owner}: C must be a finite 6x6 matrix, got shape {C.shape}")
+        if not np.allclose(C, C.T, rtol=1e-12, atol=0.0):
+            raise InputError(f"{owner}: C must be symmetric")
+        eig = np.linalg.eigvalsh(C)
+        if eig.min() <= 0.0:
+            raise InputError(f"{owner}: C must be positive definite, smallest eigenvalue {eig.min():g}")
+        obj = cls.__new__(cls)
+        obj.C = C
+        obj.radius = _positive("radius", radius, owner)
+        obj.name = name
+        return obj
+
+    @classmethod
+    def circular(cls, radius, E, nu=0.3, shear_factor=None, name=None):
+        """Solid circular section of ``radius``; Young's modulus ``E``, Poisson's ratio ``nu``.
+
+        Shear factor defaults to Cowper's ``6 (1 + nu) / (7 + 6 nu)``.
+        """
+        r = _positive("radius", radius)
+        E = _positive("E", E)
+        if not (-1.0 < float(nu) < 0.5):
+            raise InputError(f"Section.circular: nu must lie in (-1, 0.5), got {nu!r}")
+        k = 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu) if shear_factor is None else _positive("shear_factor", shear_factor)
+        G = E / (2.0 * (1.0 + nu))
+        A = np.pi * r**2
+        I = np.pi * r**4 / 4.0
+        return cls(EA=E * A, GA2=k * G * A, GA3=k * G * A, GJ=G * 2.0 * I, EI2=E * I, EI3=E * I,
+                   radius=r, name=name)
+
+    @classmethod
+    def rectangular(cls, width, height, E, nu=0.3, shear_factor=None, radius=None, name=None):
+        """Solid rectangle, ``width`` along ``e2`` and ``height`` along ``e3``.
+
+        Torsion constant from the Saint-Venant series approximation
+        ``J = a b^3 (1/3 - 0.21 (b/a) (1 - b^4 / (12 a^4)))`` (a >= b);
+        shear factor defaults to Cowper's ``10 (1 + nu) / (12 + 11 nu)``.
+        The contact radius defaults to half the smaller side.
+        """
+        b_, h_ = _positive("width", width), _positive("height", height)
+        E = _positive("E", E)
+        if not (-1.0 < float(nu) < 0.5):
+            raise InputError(f"Section.rectangular: nu must lie in (-1, 0.5), got {nu!r}")
+        k = 10.0 * (1.0 + nu) / (12.0 + 11.0 * nu) if shear_factor is None else _positive("shear_factor", shear_factor)
+        G = E / (2.0 * (1.0 + nu))
+        A = b_ * h_
+        a, b = max(b_, h_), min(b_, h_)
+        J = a * b**3 * (1.0 / 3.0 - 0.21 * (b / a) * (1.0 - b**4 / (12.0 * a**4)))
+        radius = 0.5 * b if radius is None else radius
+        return cls(EA=E * A, GA2=k * G * A, GA3=k * G * A, GJ=G * J,
+                   EI2=E * b_ * h_**3 / 12.0, EI3=E * h_ * b_**3 / 12.0, radius=radius, name=name)
+
+    def __repr__(self):
+        d = np.diag(self.C)
+        return (f"Section(EA={d[0]:.4g}, GA2={d[1]:.4g}, GA3={d[2]:.4g}, GJ={d[3]:.4g}, "
+                f"EI2={d[4]:.4g}, EI3={d[5]:.4g}, radius={self.radius:.4g})")

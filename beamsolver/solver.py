@@ -1,0 +1,273 @@
+"""Newton's method with pseudo-time stepping, line search and automatic cut-back.
+
+Per step ``t -> t + dt``: loads are evaluated at ``t + dt``; the first
+iteration carries the prescribed motions into the free unknowns through the
+tangent (``K_ff dz_f = -r_f - K_fc dz_c``), later iterations are plain Newton
+``K dz = -r`` with a backtracking line search on the scaled residual.
+A failing step is halved; steps regrow after easy convergence, never past
+the user's step size, and always land on the user's time grid.
+"""
+import logging
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse.linalg as spla
+
+from . import se3
+from .assembly import System
+from .errors import ConvergenceError, InputError
+from .results import Solution
+
+__all__ = ["solve", "Convergence"]
+
+log = logging.getLogger("beamsolver")
+
+MAX_ELEMENT_ROTATION = 0.8 * np.pi   # an iterate turning an element further is rejected
+
+
+@dataclass
+class Convergence:
+    """Stopping rule of the Newton loop.
+
+    Converged when the scaled residual is small,
+    ``|r_u|_inf <= rtol F_ref`` and ``|r_w|_inf <= rtol M_ref``, or when the last
+    full Newton increment is at round-off level,
+    ``|dz_u|_inf <= dtol L_ref`` and ``|dz_w|_inf <= dtol``.  ``F_ref`` and
+    ``M_ref`` are the largest element nodal force/moment or applied load of
+    the iterate (``F_ref >= M_ref / L_ref`` and ``M_ref >= F_ref L_ref``), ``L_ref``
+    the model size: the same scene in any unit system converges in the
+    same iterations.
+    """
+    rtol: float = 1e-8
+    dtol: float = 1e-11
+    max_iter: int = 30
+    divergence: float = 1e12
+
+    def scales(self, info, L_ref):
+        f, m = info["f_level"], info["m_level"]
+        F = max(f, m / L_ref)
+        M = max(m, f * L_ref)
+        return F, M
+
+    def residual_ratio(self, r_free_u, r_free_w, F, M):
+        ru = np.abs(r_free_u).max(initial=0.0)
+        rw = np.abs(r_free_w).max(initial=0.0)
+        return max(ru / F if F > 0 else (0.0 if ru == 0 else np.inf),
+                   rw / M if M > 0 else (0.0 if rw == 0 else np.inf))
+
+    def increment_ratio(self, dz, L_ref):
+        return max(np.abs(dz[:, :3]).max(initial=0.0) / L_ref, np.abs(dz[:, 3:]).max(initial=0.0))
+
+
+class _StepFailed(Exception):
+    pass
+
+
+def _factorize(K):
+    try:
+        return spla.splu(K, permc_spec="MMD_AT_PLUS_A")
+    except RuntimeError as e:  # exactly singular
+        raise _StepFailed(f"singular tangent ({e}); is a rigid-body mode unconstrained?") from None
+
+
+class _Newton:
+    def __init__(self, system, conv, line_search, callback):
+        self.sys = system
+        self.conv = conv
+        self.line_search = line_search
+        self.callback = callback
+        n = system.n_nodes
+        dof_u = np.zeros((n, 6), dtype=bool)
+        dof_u[:, :3] = True
+        fu = dof_u.ravel()[system.free_dofs]
+        self.fu, self.fw = np.flatnonzero(fu), np.flatnonzero(~fu)
+        self.L_ref = system.length_scale
+
+    def _ratio(self, r, scales):
+        rf = r[self.sys.free_dofs]
+        return self.conv.residual_ratio(rf[self.fu], rf[self.fw], *scales)
+
+    def _merit(self, r, scales):
+        rf = r[self.sys.free_dofs]
+        F, M = scales
+        return float(np.sum((rf[self.fu] / F) ** 2) + np.sum((rf[self.fw] / M) ** 2))
+
+    def _check_rotation(self, state):
+        ang = se3.rotation_angle(state.h[:, 3:])
+        worst = int(np.argmax(ang)) if len(ang) else 0
+        if len(ang) and ang[worst] > MAX_ELEMENT_ROTATION:
+            raise _StepFailed(f"element {worst} turns by {ang[worst]:.3f} rad within one element "
+                              f"(limit {MAX_ELEMENT_ROTATION:.3f}): refine the mesh")
+
+    def step(self, H, t, H_target):
+        """Solve for equilibrium at ``t``; returns ``(H, r, info, stats)`` or raises ``_StepFailed``."""
+        sys, conv = self.sys, self.conv
+        lf = sys.load_factors(t) if len(sys.load_scales) else np.zeros(0)
+        n = sys.n_nodes
+        residuals = []
+        dz_c = None
+        if len(sys.prescribed_nodes):
+            p = sys.prescribed_nodes
+            dz_c = np.zeros((n, 6))
+            dz_c[p] = se3.log(se3.relative(H[p], H_target))
+            if not np.any(dz_c):
+                dz_c = None
+        last_inc = np.inf
+        for it in range(conv.max_iter + 1):
+            r, kvals, info = sys.evaluate(H, lf, tangent=True)
+            if not np.all(np.isfinite(r)):
+                raise _StepFailed("the residual is not finite")
+            self._check_rotation(info["state"])
+            scales = conv.scales(info, self.L_ref)
+            ratio = self._ratio(r, scales)
+            residuals.append(ratio)
+            if self.callback is not None:
+                self.callback(dict(t=t, iteration=it, residual=ratio, poses=H))
+            if dz_c is None and (ratio <= conv.rtol or last_inc <= conv.dtol):
+                return H, r, info, dict(iterations=it, residuals=residuals)
+            if it == conv.max_iter:
+                raise _StepFailed(f"no convergence in {conv.max_iter} iterations (scaled residual {ratio:.3g})")
+            if ratio > conv.divergence:
+                raise _StepFailed(f"diverging (scaled residual {ratio:.3g})")
+            rhs = -r[sys.free_dofs]
+            if dz_c is not None:
+                rhs -= sys.prescribed_coupling(kvals, dz_c.ravel())
+            lu = _factorize(sys.matrix(kvals))
+            dzf = lu.solve(rhs)
+            if not np.all(np.isfinite(dzf)):
+                raise _StepFailed("the linear solve returned non-finite values")
+            dz = np.zeros(6 * n)
+            dz[sys.free_dofs] = dzf
+            dz = dz.reshape(n, 6)
+            if dz_c is not None:
+                H = sys.update(H, dz)
+                H[sys.prescribed_nodes] = H_target
+                sys.sync_members(H)
+                dz_c = None
+                last_inc = np.inf
+                continue
+            last_inc = conv.increment_ratio(dz, self.L_ref)
+            H = self._line_search(H, dz, r, scales, lf) if self.line_search else sys.update(H, dz)
+        raise AssertionError("unreachable")
+
+    def _line_search(self, H, dz, r0, scales, lf):
+        sys = self.sys
+        phi0 = self._merit(r0, scales)
+        H1 = sys.update(H, dz)
+        if phi0 <= (10.0 * self.conv.rtol) ** 2 * len(sys.free_dofs):
+            return H1
+        alpha = 1.0
+        best = (np.inf, H1)
+        for _ in range(8):
+            try:
+                r1, _, info = sys.evaluate(H1, lf, tangent=False)
+                self._check_rotation(info["state"])
+                phi = self._merit(r1, scales) if np.all(np.isfinite(r1)) else np.inf
+            except _StepFailed:
+                phi = np.inf
+            if phi < best[0]:
+                best = (phi, H1)
+            if phi <= (1.0 - 1e-4 * alpha) * phi0:
+                return H1
+            # minimiser of the quadratic through phi(0), phi'(0) = -2 phi0, phi(alpha)
+            if np.isfinite(phi):
+                a_new = phi0 * alpha**2 / (phi - phi0 + 2.0 * alpha * phi0)
+            else:
+                a_new = 0.1 * alpha
+            alpha = float(np.clip(a_new, 0.1 * alpha, 0.5 * alpha))
+            H1 = sys.update(H, alpha * dz)
+        if not np.isfinite(best[0]):
+            raise _StepFailed("line search found no finite residual along the Newton direction")
+        return best[1]
+
+
+def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dtol=1e-11,
+          max_iter=30, line_search=True, min_step_ratio=2.0**-12, callback=None,
+          check_rigid_modes=True, verbose=False, initial_poses=None):
+    """Quasi-static solve of ``model`` from ``t_start`` to ``t_end`` in ``steps`` equal steps.
+
+    Every converged (sub)step is recorded in the returned ``Solution``.  A step
+    that fails is halved down to ``min_step_ratio`` times the user's step, then
+    ``ConvergenceError`` is raised with the last converged ``Solution``.
+
+    ``output``: folder for ParaView files (``None``: no output).
+    ``callback(info)`` is called at every Newton iteration with ``t``,
+    ``iteration``, ``residual`` (scaled) and ``poses``.
+    """
+    if int(steps) != steps or steps < 1:
+        raise InputError(f"solve: steps must be a positive integer, got {steps!r}")
+    if not (np.isfinite(t_end) and np.isfinite(t_start) and t_end > t_start):
+        raise InputError(f"solve: need t_end > t_start, got t_start={t_start!r}, t_end={t_end!r}")
+    system = System(model, check_rigid_modes=check_rigid_modes)
+    conv = Convergence(rtol=rtol, dtol=dtol, max_iter=max_iter)
+    newton = _Newton(system, conv, line_search, callback)
+    writer = None
+    if output is not None:
+        from .io.vtk import StepWriter
+        writer = StepWriter(output, system)
+
+    H = system.poses0.copy() if initial_poses is None else np.array(initial_poses, dtype=float)
+    if len(system.prescribed_nodes):
+        H[system.prescribed_nodes] = system.prescribed_poses(t_start)
+        system.sync_members(H)
+    sol = Solution(model, system)
+    lf0 = system.load_factors(t_start) if len(system.load_scales) else np.zeros(0)
+    r0, _, info0 = system.evaluate(H, lf0, tangent=False)
+    sol.append(t_start, H, system.reactions(H, r0), info0["state"].sigma, info0["state"].strain,
+               dict(iterations=0, residuals=[], wall_time=0.0, dt=0.0, cutbacks=0))
+    if writer is not None:
+        writer.write(sol, 0)
+
+    grid = np.linspace(t_start, t_end, int(steps) + 1)
+    dt_user = grid[1] - grid[0]
+    dt_min = dt_user * min_step_ratio
+    dt = dt_user
+    t = t_start
+    k = 1
+    easy = 0
+    while k <= steps:
+        t_next = min(t + dt, grid[k])
+        if grid[k] - t_next < 1e-9 * dt_user:
+            t_next = grid[k]
+        t0 = time.perf_counter()
+        cutbacks = 0
+        while True:
+            try:
+                H_target = system.prescribed_poses(t_next) if len(system.prescribed_nodes) else None
+                H_new, r, info, stats = newton.step(H, t_next, H_target)
+                break
+            except _StepFailed as e:
+                cutbacks += 1
+                dt_try = (t_next - t) / 2.0
+                log.info("t = %.6g: step %.3g failed (%s); cutting back to %.3g", t_next, t_next - t, e, dt_try)
+                if dt_try < dt_min:
+                    sol.converged = False
+                    sol.message = str(e)
+                    if writer is not None:
+                        writer.close()
+                    raise ConvergenceError(
+                        f"solve: could not advance from t = {t:.6g} (step fell below {dt_min:.3g}): {e}",
+                        sol) from None
+                t_next = t + dt_try
+                easy = 0
+        stats.update(wall_time=time.perf_counter() - t0, dt=t_next - t, cutbacks=cutbacks)
+        H = H_new
+        state = info["state"]
+        sol.append(t_next, H, system.reactions(H, r), state.sigma, state.strain, stats)
+        if writer is not None:
+            writer.write(sol, len(sol.times) - 1)
+        if verbose:
+            print(f"t = {t_next:.6g}  iterations {stats['iterations']}  "
+                  f"residual {stats['residuals'][-1]:.2e}  cut-backs {cutbacks}")
+        dt = t_next - t
+        t = t_next
+        if t >= grid[k] - 1e-12 * dt_user:
+            t = grid[k]
+            k += 1
+        easy = easy + 1 if stats["iterations"] <= 6 and cutbacks == 0 else 0
+        if easy >= 2:
+            dt = min(2.0 * dt, dt_user)
+    if writer is not None:
+        writer.close()
+    return sol
