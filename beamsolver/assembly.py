@@ -52,6 +52,10 @@ class System:
         self._build_loads(model)
         self._build_pattern()
         self._build_chains(model)
+        self.contact = None
+        if model.contacts:   # scenes without contact never import or run contact code
+            from .contact.system import ContactSystem
+            self.contact = ContactSystem(self)
         if check_rigid_modes:
             self._check_rigid_modes(model)
 
@@ -316,24 +320,53 @@ class System:
         kvals = None
         if tangent:
             kvals = np.concatenate([K.ravel(), blocks.ravel()])
-        info = dict(state=state, f_level=f_level, m_level=m_level)
+        info = dict(state=state, f_level=f_level, m_level=m_level, extra=None)
+        if self.contact is not None:
+            # contact residual (6 n,) in z numbering and COO tangent (rows, cols, vals)
+            rc, coo, cinfo = self.contact.evaluate(H, tangent)
+            r = r + rc
+            info["extra"] = coo
+            info["contact"] = cinfo
+            info["f_level"] = max(f_level, cinfo.get("f_level", 0.0))
+            info["m_level"] = max(m_level, cinfo.get("m_level", 0.0))
         return r, kvals, info
 
-    def matrix(self, kvals):
-        """Reduced tangent (free x free) as CSC from the COO values."""
-        data = np.bincount(self.pos, weights=kvals, minlength=self.nnz + 1)[:self.nnz]
-        return sp.csc_matrix((data, self.indices, self.indptr), shape=(self.n_free, self.n_free))
+    def matrix(self, kvals, extra=None):
+        """Reduced tangent (free x free) as CSC from the COO values.
 
-    def full_matrix(self, kvals):
+        ``extra``: optional ``(rows, cols, vals)`` COO entries in full ``z``
+        numbering (contact), whose pattern may change between iterations.
+        """
+        data = np.bincount(self.pos, weights=kvals, minlength=self.nnz + 1)[:self.nnz]
+        K = sp.csc_matrix((data, self.indices, self.indptr), shape=(self.n_free, self.n_free))
+        if extra is not None and len(extra[2]):
+            rows, cols, vals = extra
+            rr, rc = self.red[rows], self.red[cols]
+            keep = (rr >= 0) & (rc >= 0)
+            K = K + sp.csc_matrix((vals[keep], (rr[keep], rc[keep])), shape=K.shape)
+        return K
+
+    def full_matrix(self, kvals, extra=None):
         """The tangent over all ``6 n`` unknowns (constrained ones included) as CSR."""
         ndof = 6 * self.n_nodes
-        return sp.coo_matrix((kvals, (self.coo_rows, self.coo_cols)), shape=(ndof, ndof)).tocsr()
+        rows, cols = self.coo_rows, self.coo_cols
+        if extra is not None and len(extra[2]):
+            rows = np.concatenate([rows, extra[0]])
+            cols = np.concatenate([cols, extra[1]])
+            kvals = np.concatenate([kvals, extra[2]])
+        return sp.coo_matrix((kvals, (rows, cols)), shape=(ndof, ndof)).tocsr()
 
-    def prescribed_coupling(self, kvals, dz_full):
+    def prescribed_coupling(self, kvals, dz_full, extra=None):
         """``K_fc dz_c`` on the free rows (reduced numbering)."""
         e = self.fc
-        return np.bincount(self.red[self.coo_rows[e]], weights=kvals[e] * dz_full[self.coo_cols[e]],
-                           minlength=self.n_free)
+        out = np.bincount(self.red[self.coo_rows[e]], weights=kvals[e] * dz_full[self.coo_cols[e]],
+                          minlength=self.n_free)
+        if extra is not None and len(extra[2]):
+            rows, cols, vals = extra
+            rr = self.red[rows]
+            keep = (rr >= 0) & (self.red[cols] < 0)
+            out += np.bincount(rr[keep], weights=vals[keep] * dz_full[cols[keep]], minlength=self.n_free)
+        return out
 
     # ------------------------------------------------------------ poses
     def update(self, H, dz, chains=True):

@@ -132,8 +132,8 @@ class _Newton:
                 raise _StepFailed(f"diverging (scaled residual {ratio:.3g})")
             rhs = -r[sys.free_dofs]
             if dz_c is not None:
-                rhs -= sys.prescribed_coupling(kvals, dz_c.ravel())
-            lu = _factorize(sys.matrix(kvals))
+                rhs -= sys.prescribed_coupling(kvals, dz_c.ravel(), info["extra"])
+            lu = _factorize(sys.matrix(kvals, info["extra"]))
             dzf = lu.solve(rhs)
             if not np.all(np.isfinite(dzf)):
                 raise _StepFailed("the linear solve returned non-finite values")
@@ -235,7 +235,16 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
         while True:
             try:
                 H_target = system.prescribed_poses(t_next) if len(system.prescribed_nodes) else None
+                if system.contact is not None:
+                    system.contact.begin_step(H, t_next)
                 H_new, r, info, stats = newton.step(H, t_next, H_target)
+                # augmented Lagrangian: update multipliers and re-solve until satisfied
+                while system.contact is not None and system.contact.augment(H_new):
+                    more = newton.step(H_new, t_next, None)
+                    H_new, r, info = more[0], more[1], more[2]
+                    stats["iterations"] += more[3]["iterations"]
+                    stats["residuals"] += more[3]["residuals"]
+                    stats["augmentations"] = stats.get("augmentations", 0) + 1
                 break
             except _StepFailed as e:
                 cutbacks += 1
@@ -254,7 +263,11 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
         stats.update(wall_time=time.perf_counter() - t0, dt=t_next - t, cutbacks=cutbacks)
         H = H_new
         state = info["state"]
-        sol.append(t_next, H, system.reactions(H, r), state.sigma, state.strain, stats)
+        contact_data = None
+        if system.contact is not None:
+            system.contact.commit(H)
+            contact_data = system.contact.results(H)
+        sol.append(t_next, H, system.reactions(H, r), state.sigma, state.strain, stats, contact_data)
         if writer is not None:
             writer.write(sol, len(sol.times) - 1)
         if verbose:
