@@ -115,13 +115,13 @@ SWITCH = {"a": 0.75, "b": 1.0, "c": 1.5, "d": 0.75, "q2": 1.5, "q3": 1.5,
 
 def coefficient(name, t):
     """Evaluate the named singular coefficient at angles ``t >= 0`` (any shape)."""
-    t = np.asarray(t, dtype=float)
+    t = _arr(t)
     t2 = t * t
     coeffs = _SERIES[name]
     series = np.full_like(t2, coeffs[-1])
     for c in coeffs[-2::-1]:
         series = series * t2 + c
-    small = t < SWITCH[name]
+    small = t.real < SWITCH[name]
     safe = np.where(small, 1.0, t)
     with np.errstate(invalid="ignore", divide="ignore"):
         closed = _CLOSED[name](safe)
@@ -129,6 +129,16 @@ def coefficient(name, t):
 
 
 # ---------------------------------------------------------------- small algebra
+def _arr(x):
+    """Float array, or complex if the input is complex (complex-step differentiation)."""
+    x = np.asarray(x)
+    return x if np.iscomplexobj(x) else x.astype(float, copy=False)
+
+
+def _zeros(shape, *like):
+    dt = complex if any(np.iscomplexobj(a) for a in like) else float
+    return np.zeros(shape, dtype=dt)
+
 def _cross(a, b):
     """Cross product over the last axis (faster than np.cross for batches)."""
     a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
@@ -146,8 +156,8 @@ def _mv(A, v):
 
 def skew(w):
     """so(3) hat: ``(..., 3) -> (..., 3, 3)`` with ``skew(w) @ v = w x v``."""
-    w = np.asarray(w, dtype=float)
-    W = np.zeros(w.shape[:-1] + (3, 3))
+    w = _arr(w)
+    W = _zeros(w.shape[:-1] + (3, 3), w)
     W[..., 0, 1] = -w[..., 2]
     W[..., 0, 2] = w[..., 1]
     W[..., 1, 0] = w[..., 2]
@@ -167,8 +177,8 @@ def unskew(W):
 
 def hat(h):
     """se(3) hat: ``(..., 6) -> (..., 4, 4)``, ``[[skew(w), u], [0, 0]]``."""
-    h = np.asarray(h, dtype=float)
-    X = np.zeros(h.shape[:-1] + (4, 4))
+    h = _arr(h)
+    X = _zeros(h.shape[:-1] + (4, 4), h)
     X[..., :3, :3] = skew(h[..., 3:])
     X[..., :3, 3] = h[..., :3]
     return X
@@ -188,7 +198,7 @@ def rotation_angle(w):
 # ---------------------------------------------------------------- SO(3)
 def exp_so3(w):
     """``exp(skew(w)) = I + a W + b W^2``; ``(..., 3) -> (..., 3, 3)``."""
-    w = np.asarray(w, dtype=float)
+    w = _arr(w)
     t = rotation_angle(w)
     a, b = coefficient("a", t), coefficient("b", t)
     W = skew(w)
@@ -197,7 +207,7 @@ def exp_so3(w):
 
 def _quaternion(R):
     """Unit quaternion ``(qw, qx, qy, qz)``, ``qw >= 0``, of ``R`` (Shepperd's method)."""
-    R = np.asarray(R, dtype=float)
+    R = _arr(R)
     r00, r11, r22 = R[..., 0, 0], R[..., 1, 1], R[..., 2, 2]
     tr = r00 + r11 + r22
     d21, d02, d10 = R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0], R[..., 1, 0] - R[..., 0, 1]
@@ -236,7 +246,7 @@ def log_so3(R):
 
 def tangent_so3(w):
     """Right tangent ``T(w) = I - b W + c W^2``: ``exp(w + dw) = exp(w) exp(T dw)``."""
-    w = np.asarray(w, dtype=float)
+    w = _arr(w)
     t = rotation_angle(w)
     W = skew(w)
     return np.eye(3) - coefficient("b", t)[..., None, None] * W + coefficient("c", t)[..., None, None] * (W @ W)
@@ -244,7 +254,7 @@ def tangent_so3(w):
 
 def tangent_inv_so3(w):
     """``T(w)^-1 = I + W/2 + d W^2`` (singular at ``|w| = 2 pi``)."""
-    w = np.asarray(w, dtype=float)
+    w = _arr(w)
     t = rotation_angle(w)
     W = skew(w)
     return np.eye(3) + 0.5 * W + coefficient("d", t)[..., None, None] * (W @ W)
@@ -253,13 +263,13 @@ def tangent_inv_so3(w):
 # ---------------------------------------------------------------- SE(3)
 def exp(h):
     """``exp(hat(h))``: ``(..., 6) -> (..., 4, 4)``, translation ``T_SO3(w)^T u``."""
-    h = np.asarray(h, dtype=float)
+    h = _arr(h)
     u, w = h[..., :3], h[..., 3:]
     t = rotation_angle(w)
     a, b, c = coefficient("a", t), coefficient("b", t), coefficient("c", t)
     W = skew(w)
     WW = W @ W
-    H = np.zeros(h.shape[:-1] + (4, 4))
+    H = _zeros(h.shape[:-1] + (4, 4), h)
     H[..., :3, :3] = np.eye(3) + a[..., None, None] * W + b[..., None, None] * WW
     wxu = _cross(w, u)
     H[..., :3, 3] = u + b[..., None] * wxu + c[..., None] * _cross(w, wxu)
@@ -269,7 +279,7 @@ def exp(h):
 
 def log(H):
     """``vee(log(H))``: ``(..., 4, 4) -> (..., 6)``; rotation angle in ``[0, pi]``."""
-    H = np.asarray(H, dtype=float)
+    H = _arr(H)
     w = log_so3(H[..., :3, :3])
     x = H[..., :3, 3]
     d = coefficient("d", rotation_angle(w))
@@ -293,10 +303,10 @@ def _q_matrix(u, w, t=None):
 
 def tangent(h):
     """Right tangent of SE(3): ``[[T(w), Q(-u,-w)], [0, T(w)]]``, ``(..., 6, 6)``."""
-    h = np.asarray(h, dtype=float)
+    h = _arr(h)
     u, w = h[..., :3], h[..., 3:]
     Tw = tangent_so3(w)
-    out = np.zeros(h.shape[:-1] + (6, 6))
+    out = _zeros(h.shape[:-1] + (6, 6), h)
     out[..., :3, :3] = Tw
     out[..., 3:, 3:] = Tw
     out[..., :3, 3:] = _q_matrix(-u, -w)
@@ -305,10 +315,10 @@ def tangent(h):
 
 def tangent_inv(h):
     """Inverse right tangent: ``[[Ti, -Ti Q(-u,-w) Ti], [0, Ti]]``, ``(..., 6, 6)``."""
-    h = np.asarray(h, dtype=float)
+    h = _arr(h)
     u, w = h[..., :3], h[..., 3:]
     Ti = tangent_inv_so3(w)
-    out = np.zeros(h.shape[:-1] + (6, 6))
+    out = _zeros(h.shape[:-1] + (6, 6), h)
     out[..., :3, :3] = Ti
     out[..., 3:, 3:] = Ti
     out[..., :3, 3:] = -Ti @ _q_matrix(-u, -w) @ Ti
@@ -317,9 +327,9 @@ def tangent_inv(h):
 
 def adjoint(H):
     """``Ad(H) = [[R, skew(x) R], [0, R]]`` in the (u, w) ordering, ``(..., 6, 6)``."""
-    H = np.asarray(H, dtype=float)
+    H = _arr(H)
     R, x = H[..., :3, :3], H[..., :3, 3]
-    out = np.zeros(H.shape[:-2] + (6, 6))
+    out = _zeros(H.shape[:-2] + (6, 6), H)
     out[..., :3, :3] = R
     out[..., 3:, 3:] = R
     out[..., :3, 3:] = skew(x) @ R
@@ -328,9 +338,9 @@ def adjoint(H):
 
 def inverse(H):
     """``H^-1 = [[R^T, -R^T x], [0, 1]]``."""
-    H = np.asarray(H, dtype=float)
+    H = _arr(H)
     R, x = H[..., :3, :3], H[..., :3, 3]
-    out = np.zeros(H.shape)
+    out = _zeros(H.shape, H)
     Rt = np.swapaxes(R, -1, -2)
     out[..., :3, :3] = Rt
     out[..., :3, 3] = -_mv(Rt, x)
@@ -340,9 +350,9 @@ def inverse(H):
 
 def compose(A, B):
     """``A @ B`` for poses, batched (exploits the last row)."""
-    A, B = np.asarray(A, dtype=float), np.asarray(B, dtype=float)
+    A, B = _arr(A), _arr(B)
     shape = np.broadcast_shapes(A.shape, B.shape)
-    out = np.zeros(shape)
+    out = _zeros(shape, A, B)
     out[..., :3, :3] = A[..., :3, :3] @ B[..., :3, :3]
     out[..., :3, 3] = _mv(A[..., :3, :3], B[..., :3, 3]) + A[..., :3, 3]
     out[..., 3, 3] = 1.0
@@ -351,10 +361,10 @@ def compose(A, B):
 
 def relative(A, B):
     """``A^-1 B`` for poses, batched."""
-    A, B = np.asarray(A, dtype=float), np.asarray(B, dtype=float)
+    A, B = _arr(A), _arr(B)
     Rt = np.swapaxes(A[..., :3, :3], -1, -2)
     shape = np.broadcast_shapes(A.shape, B.shape)
-    out = np.zeros(shape)
+    out = _zeros(shape, A, B)
     out[..., :3, :3] = Rt @ B[..., :3, :3]
     out[..., :3, 3] = _mv(Rt, B[..., :3, 3] - A[..., :3, 3])
     out[..., 3, 3] = 1.0
@@ -366,5 +376,5 @@ def interpolate(H_A, h, xi):
 
     ``H_A``: ``(..., 4, 4)``, ``h``: ``(..., 6)``, ``xi``: broadcastable to the batch.
     """
-    xi = np.asarray(xi, dtype=float)
-    return compose(H_A, exp(xi[..., None] * np.asarray(h, dtype=float)))
+    xi = _arr(xi)
+    return compose(H_A, exp(xi[..., None] * _arr(h)))

@@ -1,0 +1,195 @@
+"""Local contact kernel: one slave section against one master element, batched over pairs.
+
+For each pair the kernel takes the poses of the four nodes (slave element
+A1, B1; master element A2, B2) and returns the body-frame nodal wrenches of
+the contact forces (seed paper; THEORY.md sections 5-6):
+
+- slave section ``{C}`` at ``xi1`` from the constant-strain interpolation
+  ``H_A1 exp(xi1 h1)``; master section ``{F}`` at ``xi2`` from the projection
+  (kind ``LINE``: ``(x_F - x_C) . e_C1 = 0``; ``ORTHOGONAL``: ``(x_C - x_F) . e_F1 = 0``;
+  ``POINT``: closest points of both centre lines, ``xi1`` solved too);
+- ``n = (x_F - x_C)/|x_F - x_C|``, ``t1 = e_C1`` (made orthogonal to ``n``),
+  ``t2 = n x t1``; ``{L}`` at ``x_C + R1 n``, ``{K}`` at ``x_F - R2 n``, gap
+  ``g = |x_F - x_C| - R1 - R2``;
+- slip ``dg_T = (dy[1], dy[2])``, ``dy = log(H_LK_prev^-1 H_LK)`` with ``{L}``,
+  ``{K}`` carried as material frames from the last converged step;
+- traction on the slave at ``L``: ``-lam_N n + lam_T1 t1 + lam_T2 t2`` (times
+  the integration weight); the opposite on the master at ``K``; lever arms
+  give the moments ``R1 n x F`` and ``-R2 n x F``.
+
+The kernel is written so that complex inputs give complex-step derivatives:
+branches are fixed on the real part, and the non-analytic SE(3) logarithm is
+linearised exactly around its real part (``_log_c``).
+"""
+import numpy as np
+
+from .. import se3
+from ..se3 import _cross
+from .law import coulomb_return_mapping, normal_force
+
+LINE, ORTHOGONAL, POINT = 0, 1, 2
+
+
+def _dot(a, b):
+    return np.sum(a * b, axis=-1)
+
+
+def _log_c(H):
+    """SE(3) log that is exact under complex-step: ``log(H_r) + i T^-1 vee(Im(H_r^-1 H))``."""
+    if not np.iscomplexobj(H):
+        return se3.log(H)
+    Hr = H.real
+    h = se3.log(Hr)
+    d = se3.vee(se3.relative(Hr, H).imag)
+    return h + 1j * np.einsum("...ij,...j->...i", se3.tangent_inv(h), d)
+
+
+def _section(HA, h, xi):
+    """Pose, position derivative ``dx/dxi`` and second derivative at ``xi``."""
+    H = se3.compose(HA, se3.exp(xi[..., None] * h))
+    R = H[..., :3, :3]
+    u, w = h[..., :3], h[..., 3:]
+    xp = np.einsum("...ij,...j->...i", R, u)
+    xpp = np.einsum("...ij,...j->...i", R, _cross(w, u))
+    return H, xp, xpp
+
+
+def _project(kind, HA1, h1, xi1, HA2, h2, xi2, iterations=3):
+    """Newton on the projection conditions, starting from the search's real solution."""
+    for _ in range(iterations):
+        H1, x1p, x1pp = _section(HA1, h1, xi1)
+        H2, x2p, x2pp = _section(HA2, h2, xi2)
+        d = H2[..., :3, 3] - H1[..., :3, 3]
+        e1 = H1[..., :3, 0]
+        # LINE: f = d . e_C1, df/dxi2 = x2' . e_C1
+        f_line = _dot(d, e1)
+        j_line = _dot(x2p, e1)
+        # ORTHOGONAL: f = d . x2', df/dxi2 = x2'.x2' + d . x2''
+        f_orth = _dot(d, x2p)
+        j_orth = _dot(x2p, x2p) + _dot(d, x2pp)
+        step2 = np.where(kind == LINE, -f_line / np.where(j_line == 0, 1.0, j_line),
+                         -f_orth / np.where(j_orth == 0, 1.0, j_orth))
+        # POINT: F = (d . x1', d . x2') = 0, 2x2 Newton
+        a11 = -_dot(x1p, x1p) + _dot(d, x1pp)
+        a12 = _dot(x2p, x1p)
+        a21 = -_dot(x1p, x2p)
+        a22 = _dot(x2p, x2p) + _dot(d, x2pp)
+        det = a11 * a22 - a12 * a21
+        det = np.where(det == 0, 1.0, det)
+        g1, g2 = _dot(d, x1p), f_orth
+        p1 = -(a22 * g1 - a12 * g2) / det
+        p2 = -(-a21 * g1 + a11 * g2) / det
+        point = kind == POINT
+        xi1 = xi1 + np.where(point, p1, 0.0)
+        xi2 = xi2 + np.where(point, p2, step2)
+    return xi1, xi2
+
+
+def _node_jacobians(h, xi):
+    """``J_A, J_B`` with ``dq_C = J_A dq_A + J_B dq_B`` for ``H_C = H_A exp(xi h)``."""
+    Txi = se3.tangent(xi[..., None] * h) * xi[..., None, None]
+    JA = se3.adjoint(se3.exp(-xi[..., None] * h)) - Txi @ se3.tangent_inv(-h)
+    JB = Txi @ se3.tangent_inv(h)
+    return JA, JB
+
+
+def _body_wrench(H, F, m):
+    R = H[..., :3, :3]
+    return np.concatenate([np.einsum("...ji,...j->...i", R, F), np.einsum("...ji,...j->...i", R, m)], axis=-1)
+
+
+def contact_kernel(X, p, friction=True):
+    """Nodal wrenches ``(..., 4, 6)`` (body frames of A1, B1, A2, B2) and point data.
+
+    ``X``: ``(..., 4, 4, 4)`` node poses.  ``p``: dict of per-pair arrays
+    (``kind``, ``xi1``, ``xi2``, ``R1``, ``R2``, ``weight``, ``penalty``,
+    ``multiplier``, ``mu``, ``penalty_t``, and for friction ``has_history``,
+    ``H_CL``, ``H_FK``, ``H_LK_prev``, ``xi1_prev``, ``xi2_prev``, ``lam_t_prev``
+    (global 3-vector per unit weight)).
+    """
+    HA1, HB1, HA2, HB2 = X[..., 0, :, :], X[..., 1, :, :], X[..., 2, :, :], X[..., 3, :, :]
+    h1 = _log_c(se3.relative(HA1, HB1))
+    h2 = _log_c(se3.relative(HA2, HB2))
+    kind = p["kind"]
+    xi1, xi2 = _project(kind, HA1, h1, p["xi1"] + 0 * h1[..., 0], HA2, h2, p["xi2"] + 0 * h2[..., 0])
+    HC, _, _ = _section(HA1, h1, xi1)
+    HF, _, _ = _section(HA2, h2, xi2)
+    xC, xF = HC[..., :3, 3], HF[..., :3, 3]
+    d = xF - xC
+    dist = np.sqrt(_dot(d, d))
+    n = d / dist[..., None]
+    e1 = HC[..., :3, 0]
+    t1 = e1 - _dot(e1, n)[..., None] * n
+    t1 = t1 / np.sqrt(_dot(t1, t1))[..., None]
+    t2 = _cross(n, t1)
+    R1, R2 = p["R1"], p["R2"]
+    gap = dist - R1 - R2
+    lam_n, active = normal_force(gap, p["penalty"], p["multiplier"])
+    w = p["weight"]
+    F_slave = -(w * lam_n)[..., None] * n
+    out = dict(gap=gap, lam_n=lam_n, active=active, n=n, t1=t1, t2=t2, xC=xC, xF=xF,
+               xi1=xi1, xi2=xi2)
+    lam_t = np.zeros(gap.shape + (2,), dtype=gap.dtype)
+    stick = np.ones(gap.shape, dtype=bool)
+    slip = np.zeros(gap.shape + (2,), dtype=gap.dtype)
+    if friction:
+        frame = np.stack([n, t1, t2], axis=-1)
+        HL = _pose(frame, xC + R1[..., None] * n)
+        HK = _pose(frame, xF - R2[..., None] * n)
+        # material frames carried from the last converged step
+        HCm, _, _ = _section(HA1, h1, p["xi1_prev"] + 0 * xi1)
+        HFm, _, _ = _section(HA2, h2, p["xi2_prev"] + 0 * xi2)
+        HLm = se3.compose(HCm, p["H_CL"])
+        HKm = se3.compose(HFm, p["H_FK"])
+        dy = _log_c(se3.relative(p["H_LK_prev"], se3.relative(HLm, HKm)))
+        has = p["has_history"]
+        slip = np.where(has[..., None], dy[..., 1:3], 0.0)
+        prev = p["lam_t_prev"]
+        lam_prev = np.stack([_dot(prev, t1), _dot(prev, t2)], axis=-1)
+        # transport: keep the magnitude of the stored traction in the new basis
+        np_ = np.sqrt(np.real(_dot(prev, prev)))
+        nl = np.sqrt(_dot(lam_prev, lam_prev))
+        scale = np.where(np.real(nl) > 1e-300 * (1 + np_), np_ / np.where(np.real(nl) > 0, nl, 1.0), 0.0)
+        lam_prev = lam_prev * scale[..., None]
+        trial = lam_prev + p["penalty_t"][..., None] * slip
+        lam_t, stick = coulomb_return_mapping(trial, p["mu"], lam_n)
+        lam_t = np.where(active[..., None], lam_t, 0.0)
+        F_slave = F_slave + (w * lam_t[..., 0])[..., None] * t1 + (w * lam_t[..., 1])[..., None] * t2
+        out.update(HL=HL, HK=HK, HC=HC, HF=HF)
+    out.update(lam_t=lam_t, stick=stick, slip=slip)
+    m_slave = _cross(R1[..., None] * n, F_slave)
+    F_master = -F_slave
+    m_master = _cross(-R2[..., None] * n, F_master)
+    wC = _body_wrench(HC, F_slave, m_slave)
+    wF = _body_wrench(HF, F_master, m_master)
+    JA1, JB1 = _node_jacobians(h1, xi1)
+    JA2, JB2 = _node_jacobians(h2, xi2)
+    f = np.stack([np.einsum("...ji,...j->...i", JA1, wC), np.einsum("...ji,...j->...i", JB1, wC),
+                  np.einsum("...ji,...j->...i", JA2, wF), np.einsum("...ji,...j->...i", JB2, wF)], axis=-2)
+    out["F_slave"] = F_slave
+    return f, out
+
+
+def _pose(R, x):
+    H = np.zeros(R.shape[:-2] + (4, 4), dtype=R.dtype)
+    H[..., :3, :3] = R
+    H[..., :3, 3] = x
+    H[..., 3, 3] = 1.0
+    return H
+
+
+def kernel_and_tangent(X, p, friction=True, h=1e-30):
+    """Wrenches ``(P, 4, 6)`` and their exact derivative ``(P, 24, 24)`` by complex step.
+
+    Column ``6 j + k`` perturbs node ``j`` by the body increment ``exp(i h e_k)``.
+    """
+    f, out = contact_kernel(X, p, friction)
+    P = X.shape[0]
+    E = se3.exp(1j * h * np.eye(6))                     # (6, 4, 4)
+    Xc = np.broadcast_to(X.astype(complex), (24,) + X.shape).copy()
+    for j in range(4):
+        Xc[6 * j:6 * j + 6, :, j] = se3.compose(X[None, :, j], E[:, None])
+    pc = {k: (np.broadcast_to(v, (24,) + np.shape(v)) if np.ndim(v) else v) for k, v in p.items()}
+    fc, _ = contact_kernel(Xc, pc, friction)
+    dF = fc.imag.reshape(24, P, 24) / h                 # (col, P, row)
+    return f, np.transpose(dF, (1, 2, 0)), out

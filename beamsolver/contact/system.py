@@ -1,0 +1,412 @@
+"""Contact as a pipeline inside the Newton loop: search -> pairs -> kernel -> scatter.
+
+``ContactSystem`` is created by ``assembly.System`` only when the model has
+contact declarations.  Per evaluation it searches, evaluates the contact
+kernel (forces and complex-step tangent) on the active pairs and returns the
+residual and COO tangent in the unknowns' numbering.  Per step it keeps the
+friction history and augmented-Lagrangian multipliers, keyed by material slave
+point and master beam, committed only when a step is accepted.
+
+Options per ``Model.add_contact`` declaration (keyword arguments):
+``gauss_points`` (5), ``penalty`` (default ``law.default_penalty``, per unit
+length), ``penalty_t`` (tangential, default = penalty), ``tolerance``
+(penetration tolerance enabling augmented-Lagrangian updates; None: pure
+penalty), ``line_angle`` (20 deg), ``point_ratio`` (0.5), ``margin``
+(search margin, default the sum of radii).
+"""
+from collections import Counter
+
+import numpy as np
+
+from .. import se3
+from ..errors import InputError
+from .law import default_penalty
+from .pairs import LINE, ORTHOGONAL, POINT, _project, contact_kernel, kernel_and_tangent
+from .search import XI_TOL, broad_phase, closest_points, element_spheres
+
+CALLS = Counter()          # instrumentation: a scene without contact leaves it empty
+MAX_AUGMENT = 30
+
+_KNOWN = {"gauss_points", "penalty_t", "tolerance", "line_angle", "point_ratio", "margin"}
+
+
+class _Decl:
+    def __init__(self, k, decl, model):
+        bad = set(decl.options) - _KNOWN
+        if bad:
+            raise InputError(f"add_contact: unknown options {sorted(bad)}; known: {sorted(_KNOWN)}")
+        o = decl.options
+        self.index = k
+        self.slave_el = np.concatenate([b.elements for b in decl.slave])
+        self.master_el = np.concatenate([b.elements for b in decl.master])
+        secs = [b.section for b in decl.slave + decl.master]
+        self.penalty = decl.penalty if decl.penalty is not None else min(
+            default_penalty(a, b) for a in secs for b in secs)
+        self.penalty_t = float(o.get("penalty_t", self.penalty))
+        self.mu = decl.mu
+        self.tolerance = o.get("tolerance")
+        self.n_gp = int(o.get("gauss_points", 5))
+        if self.n_gp < 1:
+            raise InputError(f"add_contact: gauss_points must be >= 1, got {self.n_gp}")
+        self.line_angle = float(o.get("line_angle", np.deg2rad(20.0)))
+        self.point_ratio = float(o.get("point_ratio", 0.5))
+        rmax = max(s.radius for s in secs)
+        self.margin = float(o.get("margin", 2.0 * rmax))
+        if self.tolerance is not None and not self.tolerance > 0:
+            raise InputError(f"add_contact: tolerance must be positive, got {self.tolerance!r}")
+
+
+class ContactSystem:
+    def __init__(self, system):
+        self.sys = system
+        model = system.model
+        n_el = system.n_elements
+        self.el_beam = np.empty(n_el, dtype=int)
+        self.el_radius = np.empty(n_el)
+        for b in model.beams:
+            self.el_beam[b.elements] = b.id
+            self.el_radius[b.elements] = b.section.radius
+        self.el_last = np.zeros(n_el, dtype=bool)
+        for b in model.beams:
+            self.el_last[b.elements[-1]] = True
+        self.n_beams = len(model.beams)
+        self.decls = [_Decl(k, d, model) for k, d in enumerate(model.contacts)]
+        self.max_gp = max(d.n_gp for d in self.decls)
+        self.point_offset = np.int64(n_el) * self.max_gp * self.n_beams * len(self.decls)
+        self._history = self._empty_history()
+        self._mult_committed = (np.zeros(0, dtype=np.int64), np.zeros(0))
+        self._mult = self._mult_committed
+        self._augments = 0
+        self._prev_points = np.zeros(0, dtype=np.int64)
+
+    # ------------------------------------------------------------ history
+    @staticmethod
+    def _empty_history():
+        return dict(key=np.zeros(0, dtype=np.int64), H_CL=np.zeros((0, 4, 4)), H_FK=np.zeros((0, 4, 4)),
+                    H_LK=np.zeros((0, 4, 4)), e=np.zeros(0, dtype=int), m=np.zeros(0, dtype=int),
+                    xi1=np.zeros(0), xi2=np.zeros(0), lam_t=np.zeros((0, 3)))
+
+    @staticmethod
+    def _lookup(keys_sorted, keys):
+        if len(keys_sorted) == 0:
+            return np.zeros(len(keys), dtype=int), np.zeros(len(keys), dtype=bool)
+        idx = np.clip(np.searchsorted(keys_sorted, keys), 0, len(keys_sorted) - 1)
+        return idx, keys_sorted[idx] == keys
+
+    # ------------------------------------------------------------ search
+    def pairs(self, H):
+        """All potential contact pairs at poses ``H`` as a dict of arrays."""
+        CALLS["search"] += 1
+        sysm = self.sys
+        en = sysm.enodes
+        out = []
+        chosen = []
+        for d in self.decls:
+            cs, rs, hs, ts = element_spheres(H, en[d.slave_el], self.el_radius[d.slave_el], d.margin)
+            cm, rm, hm, tm = element_spheres(H, en[d.master_el], self.el_radius[d.master_el], d.margin)
+            i, j = broad_phase(cs, rs, cm, rm)
+            e, m = d.slave_el[i], d.master_el[j]
+            # elements sharing a node (a beam joined to another) never pair
+            share = np.isin(en[e], en[m]).any(axis=1)
+            i, j, e, m = i[~share], j[~share], e[~share], m[~share]
+            cosang = np.abs(np.sum(ts[i] * tm[j], axis=1))
+            angle = np.arccos(np.clip(cosang, 0.0, 1.0))
+            big = angle >= d.line_angle
+            kinds = np.full(len(i), LINE)
+            xi1p = np.zeros(len(i))
+            xi2p = np.zeros(len(i))
+            if big.any():
+                b = np.flatnonzero(big)
+                x1, x2, ratio = closest_points(H[en[e[b], 0]], hs[i[b]], H[en[m[b], 0]], hm[j[b]])
+                pt = ratio >= d.point_ratio
+                kinds[b[pt]] = POINT
+                kinds[b[~pt]] = ORTHOGONAL
+                xi1p[b], xi2p[b] = x1, x2
+            parts = []
+            # point-to-point pairs: one per element pair, inside both elements (half-open)
+            pt = np.flatnonzero(kinds == POINT)
+            if len(pt):
+                x1, x2 = xi1p[pt], xi2p[pt]
+                ok = ((x1 >= -XI_TOL) & ((x1 < 1.0) | (self.el_last[e[pt]] & (x1 <= 1.0 + XI_TOL)))
+                      & (x2 >= -XI_TOL) & ((x2 < 1.0) | (self.el_last[m[pt]] & (x2 <= 1.0 + XI_TOL))))
+                pt = pt[ok]
+                pt = self._dedupe_points(H, e[pt], m[pt], xi1p[pt], xi2p[pt], pt)
+                chosen.append(e[pt] * len(en) + m[pt])
+                key = self.point_offset + (np.int64(d.index) * len(en) + e[pt]) * len(en) + m[pt]
+                parts.append(dict(kind=np.full(len(pt), POINT), e=e[pt], m=m[pt], xi1=xi1p[pt],
+                                  xi2=xi2p[pt], weight=sysm.L[e[pt]], key=key, gp=np.zeros(len(pt), int)))
+            # Gauss-point pairs (line and orthogonal projections)
+            gp = np.flatnonzero(kinds != POINT)
+            if len(gp):
+                xg, wg = np.polynomial.legendre.leggauss(d.n_gp)
+                xg, wg = 0.5 * (xg + 1.0), 0.5 * wg
+                rep = np.repeat(gp, d.n_gp)
+                g = np.tile(np.arange(d.n_gp), len(gp))
+                ee, mm = e[rep], m[rep]
+                kk = kinds[rep]
+                xi1 = xg[g]
+                _, xi2 = _project(kk, H[en[ee, 0]], hs[i[rep]], xi1, H[en[mm, 0]], hm[j[rep]],
+                                  np.full(len(rep), 0.5), iterations=8)
+                HC, _, _ = _section_real(H[en[ee, 0]], hs[i[rep]], xi1)
+                HF, _, _ = _section_real(H[en[mm, 0]], hm[j[rep]], xi2)
+                dist = np.linalg.norm(HF[:, :3, 3] - HC[:, :3, 3], axis=1)
+                ok = (xi2 >= -XI_TOL) & (xi2 <= 1.0 + XI_TOL) & np.isfinite(dist)
+                key = ((np.int64(d.index) * len(en) + ee) * self.max_gp + g) * self.n_beams + self.el_beam[mm]
+                sel = np.flatnonzero(ok)
+                if len(sel):
+                    order = np.lexsort((dist[sel], key[sel]))
+                    sel = sel[order]
+                    first = np.concatenate([[True], key[sel][1:] != key[sel][:-1]])
+                    sel = sel[first]
+                parts.append(dict(kind=kk[sel], e=ee[sel], m=mm[sel], xi1=xi1[sel], xi2=xi2[sel],
+                                  weight=wg[g[sel]] * sysm.L[ee[sel]], key=key[sel], gp=g[sel]))
+            for p in parts:
+                p["decl"] = np.full(len(p["e"]), d.index)
+            out.extend(parts)
+        self._prev_points = np.concatenate(chosen) if chosen else np.zeros(0, dtype=np.int64)
+        if not out:
+            return None
+        P = {k: np.concatenate([p[k] for p in out]) for k in out[0]}
+        nodes = np.stack([en[P["e"], 0], en[P["e"], 1], en[P["m"], 0], en[P["m"], 1]], axis=1)
+        P["nodes"] = nodes
+        P["R1"] = self.el_radius[P["e"]]
+        P["R2"] = self.el_radius[P["m"]]
+        return P
+
+    def _dedupe_points(self, H, e, m, xi1, xi2, idx):
+        """One point pair per crossing: at a node where two elements meet (a kink of the
+        C0 centre line) each element has its own closest point; keep the nearest
+        of pairs of the same two beams lying within ``R1 + R2`` of each other."""
+        if len(idx) < 2:
+            return idx
+        en = self.sys.enodes
+        xC = _interp_pos(H, en, e, xi1)
+        xF = _interp_pos(H, en, m, xi2)
+        dist = np.linalg.norm(xF - xC, axis=1)
+        rad = self.el_radius[e] + self.el_radius[m]
+        group = self.el_beam[e] * self.n_beams + self.el_beam[m]
+        # hysteresis: a pair chosen at the last evaluation keeps priority, so the
+        # choice cannot flip between the two elements of a kink inside Newton
+        known = np.isin(e * len(en) + m, self._prev_points)
+        order = np.lexsort((dist, ~known, group))
+        keep = []
+        for k in order:
+            close = [j for j in keep if group[j] == group[k]
+                     and np.linalg.norm(xC[j] - xC[k]) < rad[k] and np.linalg.norm(xF[j] - xF[k]) < rad[k]]
+            if not close:
+                keep.append(k)
+        return idx[np.sort(np.array(keep, dtype=int))]
+
+    def _params(self, P, sel, H):
+        """Kernel parameters for the pairs ``sel`` (history and multipliers looked up)."""
+        dec = [self.decls[k] for k in P["decl"][sel]]
+        p = dict(kind=P["kind"][sel], xi1=P["xi1"][sel], xi2=P["xi2"][sel], R1=P["R1"][sel],
+                 R2=P["R2"][sel], weight=P["weight"][sel],
+                 penalty=np.array([d.penalty for d in dec]), penalty_t=np.array([d.penalty_t for d in dec]),
+                 mu=np.array([d.mu for d in dec]))
+        key = P["key"][sel]
+        mi, mf = self._lookup(self._mult[0], key)
+        p["multiplier"] = np.where(mf, self._mult[1][mi] if len(self._mult[1]) else 0.0, 0.0)
+        hist = self._history
+        hi, hf = self._lookup(hist["key"], key)
+        n = len(key)
+        if len(hist["key"]):
+            p["H_CL"] = np.where(hf[:, None, None], hist["H_CL"][hi], np.eye(4))
+            p["H_FK"] = np.where(hf[:, None, None], hist["H_FK"][hi], np.eye(4))
+            p["H_LK_prev"] = np.where(hf[:, None, None], hist["H_LK"][hi], np.eye(4))
+            # material points, re-expressed on the current elements (same beam, consecutive ids)
+            p["xi1_prev"] = np.where(hf, hist["xi1"][hi] + hist["e"][hi] - P["e"][sel], p["xi1"])
+            p["xi2_prev"] = np.where(hf, hist["xi2"][hi] + hist["m"][hi] - P["m"][sel], p["xi2"])
+            p["lam_t_prev"] = np.where(hf[:, None], hist["lam_t"][hi], 0.0)
+        else:
+            p.update(H_CL=np.tile(np.eye(4), (n, 1, 1)), H_FK=np.tile(np.eye(4), (n, 1, 1)),
+                     H_LK_prev=np.tile(np.eye(4), (n, 1, 1)), xi1_prev=p["xi1"].copy(),
+                     xi2_prev=p["xi2"].copy(), lam_t_prev=np.zeros((n, 3)))
+        p["has_history"] = hf
+        return p
+
+    def _active(self, P, H):
+        """Pairs whose trial normal traction is positive, with their kernel parameters."""
+        xC = _interp_pos(H, self.sys.enodes, P["e"], P["xi1"])
+        xF = _interp_pos(H, self.sys.enodes, P["m"], P["xi2"])
+        gap = np.linalg.norm(xF - xC, axis=1) - P["R1"] - P["R2"]
+        pen = np.array([self.decls[k].penalty for k in P["decl"]])
+        mi, mf = self._lookup(self._mult[0], P["key"])
+        mult = np.where(mf, self._mult[1][mi] if len(self._mult[1]) else 0.0, 0.0)
+        # a small band around zero keeps the projection-updated gap consistent
+        return np.flatnonzero(mult - pen * gap > -pen * 1e-3 * (P["R1"] + P["R2"]))
+
+    # ------------------------------------------------------------ evaluation
+    def evaluate(self, H, tangent=True):
+        """Contact residual ``(6 n,)``, COO tangent ``(rows, cols, vals)`` and point data."""
+        CALLS["evaluate"] += 1
+        sysm = self.sys
+        ndof = 6 * sysm.n_nodes
+        r = np.zeros(ndof)
+        empty = (np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0))
+        P = self.pairs(H)
+        if P is None:
+            return r, empty, dict(n_active=0)
+        sel = self._active(P, H)
+        if len(sel) == 0:
+            return r, empty, dict(n_active=0)
+        p = self._params(P, sel, H)
+        X = H[P["nodes"][sel]]
+        fric = p["mu"] > 0
+        f = np.zeros((len(sel), 4, 6))
+        K = np.zeros((len(sel), 24, 24)) if tangent else None
+        out = {}
+        for mask, use_fric in ((fric, True), (~fric, False)):
+            if not mask.any():
+                continue
+            pm = {k: (v[mask] if np.ndim(v) else v) for k, v in p.items()}
+            CALLS["kernel_pairs"] += int(mask.sum())
+            if tangent:
+                fm, Km, om = kernel_and_tangent(X[mask], pm, friction=use_fric)
+                K[mask] = Km
+            else:
+                fm, om = contact_kernel(X[mask], pm, friction=use_fric)
+            f[mask] = fm
+            for k, v in om.items():
+                if k not in out:
+                    out[k] = np.zeros((len(sel),) + np.shape(v)[1:], dtype=np.asarray(v).dtype)
+                out[k][mask] = v
+        nodes = P["nodes"][sel]
+        f = f.reshape(-1, 24)
+        M = sysm.node_transforms(H)
+        if M is not None:
+            T = np.zeros((len(sel), 24, 24))
+            for j in range(4):
+                T[:, 6 * j:6 * j + 6, 6 * j:6 * j + 6] = M[nodes[:, j]]
+            Tt = np.swapaxes(T, 1, 2)
+            f = np.einsum("nij,nj->ni", Tt, f)
+            if tangent:
+                K = Tt @ K @ T
+        dofs = ((6 * sysm.rep[nodes])[:, :, None] + np.arange(6)).reshape(-1, 24)
+        r -= np.bincount(dofs.ravel(), weights=f.ravel(), minlength=ndof)
+        coo = empty
+        if tangent:
+            rows = np.repeat(dofs, 24, axis=1).ravel()
+            cols = np.tile(dofs, (1, 24)).ravel()
+            coo = (rows, cols, -K.ravel())
+        fl = np.abs(f.reshape(-1, 4, 6)[:, :, :3]).max(initial=0.0)
+        ml = np.abs(f.reshape(-1, 4, 6)[:, :, 3:]).max(initial=0.0)
+        info = dict(n_active=len(sel), f_level=fl, m_level=ml)
+        return r, coo, info
+
+    # ------------------------------------------------------------ per step
+    def begin_step(self, H, t):
+        self._mult = self._mult_committed
+        self._augments = 0
+
+    def _state(self, H):
+        P = self.pairs(H)
+        if P is None:
+            return None, None, None
+        sel = self._active(P, H)
+        p = self._params(P, sel, H)
+        out = {}
+        if len(sel):
+            fric = p["mu"] > 0
+            # the full kernel (with friction frames) for every active pair
+            _, out = contact_kernel(H[P["nodes"][sel]], p, friction=True) if fric.any() else \
+                contact_kernel(H[P["nodes"][sel]], p, friction=False)
+            if not fric.any():
+                out["slip"] = np.zeros((len(sel), 2))
+        return P, sel, (p, out)
+
+    def augment(self, H):
+        """Augmented-Lagrangian update; True when the step must be re-solved."""
+        tol = [d.tolerance for d in self.decls]
+        if all(t is None for t in tol) or self._augments >= MAX_AUGMENT:
+            return False
+        P, sel, po = self._state(H)
+        if P is None or len(sel) == 0:
+            return False
+        p, out = po
+        gap = out["gap"]
+        tols = np.array([np.inf if self.decls[k].tolerance is None else self.decls[k].tolerance
+                         for k in P["decl"][sel]])
+        if np.all(-gap <= tols):
+            return False
+        keys = P["key"][sel]
+        lam = np.where(np.isfinite(tols), out["lam_n"], 0.0)
+        order = np.argsort(keys)
+        self._mult = (keys[order], lam[order])
+        self._augments += 1
+        return True
+
+    def commit(self, H):
+        """Store friction history and multipliers of the converged state."""
+        self._mult_committed = self._mult
+        P, sel, po = self._state(H)
+        if P is None or len(sel) == 0:
+            self._history = self._empty_history()
+            self._last = None
+            return
+        p, out = po
+        keys = P["key"][sel]
+        order = np.argsort(keys)
+        HL, HK = _frames(out)
+        HC = _interp_pose(H, self.sys.enodes, P["e"][sel], out["xi1"])
+        HF = _interp_pose(H, self.sys.enodes, P["m"][sel], out["xi2"])
+        lam_t = out["lam_t"]
+        lam_vec = lam_t[:, :1] * out["t1"] + lam_t[:, 1:] * out["t2"]
+        self._history = dict(key=keys[order], H_CL=se3.relative(HC, HL)[order],
+                             H_FK=se3.relative(HF, HK)[order], H_LK=se3.relative(HL, HK)[order],
+                             e=P["e"][sel][order], m=P["m"][sel][order], xi1=out["xi1"][order],
+                             xi2=out["xi2"][order], lam_t=lam_vec[order])
+        self._last = (P, sel, p, out)
+
+    def results(self, H):
+        """Contact point table of the committed state (dict of arrays)."""
+        last = getattr(self, "_last", None)
+        if last is None:
+            return dict(position=np.zeros((0, 3)), gap=np.zeros(0), normal_force=np.zeros(0),
+                        tangential_force=np.zeros((0, 3)), stick=np.zeros(0, dtype=bool),
+                        slip_increment=np.zeros((0, 2)), kind=np.zeros(0, dtype=int),
+                        angle=np.zeros(0), slave_element=np.zeros(0, dtype=int),
+                        master_element=np.zeros(0, dtype=int), xi1=np.zeros(0), xi2=np.zeros(0),
+                        weight=np.zeros(0))
+        P, sel, p, out = last
+        w = p["weight"]
+        lam_t = out["lam_t"]
+        ft = (w * lam_t[:, 0])[:, None] * out["t1"] + (w * lam_t[:, 1])[:, None] * out["t2"]
+        e1s = _interp_pose(H, self.sys.enodes, P["e"][sel], out["xi1"])[:, :3, 0]
+        e1m = _interp_pose(H, self.sys.enodes, P["m"][sel], out["xi2"])[:, :3, 0]
+        ang = np.degrees(np.arccos(np.clip(np.abs(np.sum(e1s * e1m, axis=1)), 0.0, 1.0)))
+        active = out["lam_n"] > 0
+        return dict(position=0.5 * (out["xC"] + out["xF"]) + 0.5 * (p["R1"] - p["R2"])[:, None] * out["n"],
+                    gap=out["gap"], normal_force=w * out["lam_n"], tangential_force=ft,
+                    stick=out["stick"] & active, slip_increment=out["slip"], kind=p["kind"],
+                    angle=ang, slave_element=P["e"][sel], master_element=P["m"][sel],
+                    xi1=out["xi1"], xi2=out["xi2"], weight=w, normal=out["n"])
+
+
+def _frames(out):
+    frame = np.stack([out["n"], out["t1"], out["t2"]], axis=-1)
+    R1 = out.get("R1")
+    HL = np.zeros(frame.shape[:-2] + (4, 4))
+    HK = np.zeros_like(HL)
+    HL[:, :3, :3] = HK[:, :3, :3] = frame
+    HL[:, 3, 3] = HK[:, 3, 3] = 1.0
+    if "HL" in out:
+        return out["HL"], out["HK"]
+    HL[:, :3, 3] = out["xC"]
+    HK[:, :3, 3] = out["xF"]
+    return HL, HK
+
+
+def _interp_pose(H, enodes, e, xi):
+    HA, HB = H[enodes[e, 0]], H[enodes[e, 1]]
+    h = se3.log(se3.relative(HA, HB))
+    return se3.interpolate(HA, h, xi)
+
+
+def _interp_pos(H, enodes, e, xi):
+    return _interp_pose(H, enodes, e, xi)[:, :3, 3]
+
+
+def _section_real(HA, h, xi):
+    from .pairs import _section
+    return _section(HA, h, xi)
