@@ -24,6 +24,7 @@ __all__ = ["solve", "Convergence"]
 log = logging.getLogger("beamsolver")
 
 MAX_ELEMENT_ROTATION = 0.8 * np.pi   # an iterate turning an element further is rejected
+LS_GROWTH = 10.0                     # full Newton steps are kept unless the merit grows this much
 
 
 @dataclass
@@ -168,7 +169,9 @@ class _Newton:
                 phi = np.inf
             if phi < best[0]:
                 best = (phi, H1)
-            if phi <= (1.0 - 1e-4 * alpha) * phi0:
+            # Newton may raise the residual for a while: only a blow-up (factor
+            # LS_GROWTH) triggers backtracking, which then asks for a decrease
+            if phi <= (LS_GROWTH * phi0 if alpha == 1.0 else (1.0 - 1e-4 * alpha) * phi0):
                 return H1
             # minimiser of the quadratic through phi(0), phi'(0) = -2 phi0, phi(alpha)
             if np.isfinite(phi):
