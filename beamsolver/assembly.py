@@ -132,6 +132,11 @@ class System:
         self.X = se3.relative(P[rep[self.members]], P[self.members])   # H_i = H_rep X_i
         self.Ad_Xinv = se3.adjoint(se3.inverse(self.X))
         self.global_nodes = np.flatnonzero(kind == GLOBAL)
+        # prescribed global translations of fixed components: (node, component, f)
+        self.fix_values = []
+        for node, vals in model.fix_values.items():
+            for comp, f in vals.items():
+                self.fix_values.append((int(node), int(comp), f))
         self.prescribed_nodes = np.array(sorted(self.motions), dtype=int)
         free = np.repeat(is_rep, 6).reshape(n, 6) & ~fixed
         self.free = free.ravel()
@@ -190,8 +195,10 @@ class System:
                 rows.append(Rg[fixed])
             rank = np.linalg.matrix_rank(np.concatenate(rows), tol=1e-9 * self.length_scale) if rows else 0
             if rank < 6:
-                beams = sorted({model.beam_of_node(i).id for i in nodes})
-                raise InputError(f"beam(s) {beams}: {6 - rank} rigid-body mode(s) are not constrained; "
+                owners = {model.beam_of_node(i) for i in nodes}
+                beams = sorted(b.id for b in owners if b is not None)
+                what = f"beam(s) {beams}" if beams else f"node(s) {nodes}"
+                raise InputError(f"{what}: {6 - rank} rigid-body mode(s) are not constrained; "
                                  "clamp, fix or prescribe nodes (or pass check_rigid_modes=False "
                                  "if contact holds them)")
 
@@ -238,6 +245,8 @@ class System:
         presc = np.zeros(6 * n, dtype=bool)
         for r in self.prescribed_nodes:
             presc[6 * r:6 * r + 6] = True
+        for node, comp, _ in self.fix_values:
+            presc[6 * node + comp] = True
         self.fc = np.flatnonzero((rr >= 0) & presc[cols])
 
     # ------------------------------------------------------------ transforms
@@ -420,6 +429,10 @@ class System:
                 raise InputError(f"prescribe({node}): motion({t}) is not a finite 4x4 pose")
             out[j] = G @ self.poses0[node]
         return out
+
+    def fixed_translation_targets(self, t):
+        """``[(node, component, target coordinate)]`` for ``fix(..., values=)``."""
+        return [(n, c, self.poses0[n, c, 3] + float(f(t))) for n, c, f in self.fix_values]
 
     def reactions(self, H, r):
         """Global force and moment ``(n, 6)`` on each node (the residual, group-summed at joints)."""

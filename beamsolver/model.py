@@ -83,6 +83,8 @@ class Model:
         self.joins = []           # (node_a, node_b)
         self.loads = []
         self.contacts = []
+        self.free_nodes = []      # nodes created by add_node (no elements)
+        self.fix_values = {}      # node -> {component: callable} prescribed global translations
 
     # ------------------------------------------------------------ geometry
     @property
@@ -145,6 +147,27 @@ class Model:
         self._n_elements += len(P) - 1
         return beam
 
+    def add_node(self, pose, name=None):
+        """A node without elements (e.g. the reference of a rigid plate); returns its id.
+
+        It carries stiffness only through ``join(..., rigid=True)`` links.
+        """
+        H = np.array(pose, dtype=float)
+        if H.shape == (3,):
+            H = np.eye(4)
+            H[:3, 3] = np.array(pose, dtype=float)
+        label = f"add_node({name or ''})"
+        if H.shape != (4, 4) or not np.all(np.isfinite(H)):
+            raise InputError(f"{label}: pose must be a finite 4x4 matrix or a 3-vector, got shape {H.shape}")
+        R = H[:3, :3]
+        if np.abs(R.T @ R - np.eye(3)).max() > ORTHONORMAL_TOL or np.linalg.det(R) <= 0:
+            raise InputError(f"{label}: pose is not a rotation")
+        i = self._n_nodes
+        self._poses.append(H[None])
+        self._n_nodes += 1
+        self.free_nodes.append(i)
+        return i
+
     # ------------------------------------------------------------ helpers
     def _node(self, node, what):
         if isinstance(node, Beam):
@@ -158,9 +181,12 @@ class Model:
         return i
 
     def beam_of_node(self, node):
+        """The Beam owning ``node`` (None for nodes made by ``add_node``)."""
         for b in self.beams:
             if b.nodes[0] <= node <= b.nodes[-1]:
                 return b
+        if node in self.free_nodes:
+            return None
         raise InputError(f"unknown node id {node!r}")
 
     def _set_constraint(self, node, value, what):
@@ -177,8 +203,12 @@ class Model:
         i = self._node(node, "clamp")
         self._set_constraint(i, ("clamp",), f"clamp({node})")
 
-    def fix(self, node, dofs=DOF_NAMES):
-        """Fix the named increments of ``node`` in GLOBAL directions ('ux', 'uy', 'uz', 'rx', 'ry', 'rz')."""
+    def fix(self, node, dofs=DOF_NAMES, values=None):
+        """Fix the named increments of ``node`` in GLOBAL directions ('ux', 'uy', 'uz', 'rx', 'ry', 'rz').
+
+        ``values``: optional ``{'uz': f, ...}`` giving prescribed global
+        displacements ``f(t)`` (translations only) of fixed components.
+        """
         i = self._node(node, "fix")
         if isinstance(dofs, str):
             dofs = (dofs,)
@@ -186,6 +216,17 @@ class Model:
         if bad or not dofs:
             raise InputError(f"fix({node}): unknown dofs {bad or dofs!r}; choose from {DOF_NAMES}")
         idx = frozenset(DOF_NAMES.index(d) for d in dofs)
+        if values:
+            for k, f in values.items():
+                if k not in ("ux", "uy", "uz") or k not in dofs:
+                    raise InputError(f"fix({node}): values can prescribe fixed translations only "
+                                     f"(one of {tuple(dofs)} among ux, uy, uz), got {k!r}; use prescribe "
+                                     "for rotations")
+                if not callable(f):
+                    raise InputError(f"fix({node}): values[{k!r}] must be callable t -> float")
+            if len(idx) == 6:
+                raise InputError(f"fix({node}): with all six dofs fixed use prescribe() for motions")
+            self.fix_values.setdefault(i, {}).update({DOF_NAMES.index(k): f for k, f in values.items()})
         if len(idx) == 6:
             self._set_constraint(i, ("clamp",), f"fix({node})")
         else:
@@ -201,8 +242,12 @@ class Model:
             raise InputError(f"prescribe({node}): motion(0) must be a finite 4x4 pose, got shape {G.shape}")
         self._set_constraint(i, ("prescribe", motion), f"prescribe({node})")
 
-    def join(self, node_a, node_b):
-        """Rigidly join two coincident nodes (their relative pose stays the reference one)."""
+    def join(self, node_a, node_b, rigid=False):
+        """Rigidly join two coincident nodes (their relative pose stays the reference one).
+
+        With ``rigid=True`` the nodes may be apart: a rigid link (e.g. wire
+        ends on a plate made with ``add_node``).
+        """
         a = self._node(node_a, "join")
         b = self._node(node_b, "join")
         if a == b:
@@ -210,8 +255,9 @@ class Model:
         P = self.poses0
         size = max(1.0, np.ptp(P[:, :3, 3], axis=0).max())
         gap = np.linalg.norm(P[a, :3, 3] - P[b, :3, 3])
-        if gap > JOIN_TOL * size:
-            raise InputError(f"join({node_a}, {node_b}): nodes are {gap:.3g} apart; a joint needs coincident nodes")
+        if gap > JOIN_TOL * size and not rigid:
+            raise InputError(f"join({node_a}, {node_b}): nodes are {gap:.3g} apart; a joint needs coincident "
+                             "nodes (pass rigid=True for a rigid link)")
         self.joins.append((a, b))
 
     # ------------------------------------------------------------ loads

@@ -108,10 +108,14 @@ class _Newton:
         n = sys.n_nodes
         residuals = []
         dz_c = None
-        if len(sys.prescribed_nodes):
-            p = sys.prescribed_nodes
+        targets = sys.fixed_translation_targets(t) if sys.fix_values else []
+        if len(sys.prescribed_nodes) or targets:
             dz_c = np.zeros((n, 6))
-            dz_c[p] = se3.log(se3.relative(H[p], H_target))
+            if len(sys.prescribed_nodes):
+                p = sys.prescribed_nodes
+                dz_c[p] = se3.log(se3.relative(H[p], H_target))
+            for node, comp, x in targets:
+                dz_c[node, comp] = x - H[node, comp, 3]
             if not np.any(dz_c):
                 dz_c = None
         last_inc = np.inf
@@ -142,8 +146,11 @@ class _Newton:
             dz[sys.free_dofs] = dzf
             dz = dz.reshape(n, 6)
             if dz_c is not None:
-                H = sys.update(H, dz)
-                H[sys.prescribed_nodes] = H_target
+                H = sys.update(H, dz + dz_c)
+                if len(sys.prescribed_nodes):
+                    H[sys.prescribed_nodes] = H_target
+                for node, comp, x in targets:
+                    H[node, comp, 3] = x
                 sys.sync_members(H)
                 dz_c = None
                 last_inc = np.inf
