@@ -430,9 +430,31 @@ class System:
             out[j] = G @ self.poses0[node]
         return out
 
-    def fixed_translation_targets(self, t):
-        """``[(node, component, target coordinate)]`` for ``fix(..., values=)``."""
-        return [(n, c, self.poses0[n, c, 3] + float(f(t))) for n, c, f in self.fix_values]
+    def fixed_value_increments(self, H, t):
+        """``[(node, component, increment)]`` reaching ``fix(..., values=)`` targets at ``t``."""
+        out = []
+        for n, c, f in self.fix_values:
+            v = float(f(t))
+            if c < 3:
+                out.append((n, c, self.poses0[n, c, 3] + v - H[n, c, 3]))
+            else:
+                Rr = H[n, :3, :3] @ self.poses0[n, :3, :3].T      # rotation about e_k only
+                k = c - 3
+                a, b = (k + 1) % 3, (k + 2) % 3
+                cur = np.arctan2(Rr[b, a], Rr[a, a])
+                out.append((n, c, (v - cur + np.pi) % (2.0 * np.pi) - np.pi))
+        return out
+
+    def enforce_fixed_values(self, H, t):
+        """Set the prescribed components of ``fix(..., values=)`` exactly (in place)."""
+        for n, c, f in self.fix_values:
+            v = float(f(t))
+            if c < 3:
+                H[n, c, 3] = self.poses0[n, c, 3] + v
+            else:
+                w = np.zeros(3)
+                w[c - 3] = v
+                H[n, :3, :3] = se3.exp_so3(w) @ self.poses0[n, :3, :3]
 
     def reactions(self, H, r):
         """Global force and moment ``(n, 6)`` on each node (the residual, group-summed at joints)."""

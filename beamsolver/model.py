@@ -206,8 +206,9 @@ class Model:
     def fix(self, node, dofs=DOF_NAMES, values=None):
         """Fix the named increments of ``node`` in GLOBAL directions ('ux', 'uy', 'uz', 'rx', 'ry', 'rz').
 
-        ``values``: optional ``{'uz': f, ...}`` giving prescribed global
-        displacements ``f(t)`` (translations only) of fixed components.
+        ``values``: optional ``{'uz': f, 'rz': g, ...}`` giving prescribed global
+        displacements ``f(t)`` of fixed components, and at most one rotation
+        angle ``g(t)`` about a global axis (then rx, ry, rz must all be fixed).
         """
         i = self._node(node, "fix")
         if isinstance(dofs, str):
@@ -217,13 +218,16 @@ class Model:
             raise InputError(f"fix({node}): unknown dofs {bad or dofs!r}; choose from {DOF_NAMES}")
         idx = frozenset(DOF_NAMES.index(d) for d in dofs)
         if values:
+            rot = {"rx", "ry", "rz"}
             for k, f in values.items():
-                if k not in ("ux", "uy", "uz") or k not in dofs:
-                    raise InputError(f"fix({node}): values can prescribe fixed translations only "
-                                     f"(one of {tuple(dofs)} among ux, uy, uz), got {k!r}; use prescribe "
-                                     "for rotations")
+                if k not in dofs:
+                    raise InputError(f"fix({node}): values[{k!r}] needs {k!r} among the fixed dofs {tuple(dofs)}")
+                if k in rot and not rot <= set(dofs):
+                    raise InputError(f"fix({node}): a prescribed rotation {k!r} needs all of rx, ry, rz fixed")
                 if not callable(f):
                     raise InputError(f"fix({node}): values[{k!r}] must be callable t -> float")
+            if len([k for k in values if k in rot]) > 1:
+                raise InputError(f"fix({node}): at most one rotation can be prescribed; use prescribe()")
             if len(idx) == 6:
                 raise InputError(f"fix({node}): with all six dofs fixed use prescribe() for motions")
             self.fix_values.setdefault(i, {}).update({DOF_NAMES.index(k): f for k, f in values.items()})

@@ -108,14 +108,14 @@ class _Newton:
         n = sys.n_nodes
         residuals = []
         dz_c = None
-        targets = sys.fixed_translation_targets(t) if sys.fix_values else []
+        targets = sys.fixed_value_increments(H, t) if sys.fix_values else []
         if len(sys.prescribed_nodes) or targets:
             dz_c = np.zeros((n, 6))
             if len(sys.prescribed_nodes):
                 p = sys.prescribed_nodes
                 dz_c[p] = se3.log(se3.relative(H[p], H_target))
-            for node, comp, x in targets:
-                dz_c[node, comp] = x - H[node, comp, 3]
+            for node, comp, dx in targets:
+                dz_c[node, comp] = dx
             if not np.any(dz_c):
                 dz_c = None
         last_inc = np.inf
@@ -149,8 +149,8 @@ class _Newton:
                 H = sys.update(H, dz + dz_c)
                 if len(sys.prescribed_nodes):
                     H[sys.prescribed_nodes] = H_target
-                for node, comp, x in targets:
-                    H[node, comp, 3] = x
+                if targets:
+                    sys.enforce_fixed_values(H, t)
                 sys.sync_members(H)
                 dz_c = None
                 last_inc = np.inf

@@ -1,0 +1,194 @@
+"""Cable builders: straight multi-layer strands of helical wires along ``e_z``.
+
+A strand is a list of ``Layer`` s from the centre out.  A layer of one wire
+with pitch radius 0 is a straight core; every other layer is ``n_wires``
+helices (``geometry.helix``, exact constant-strain reference poses) at pitch
+radius ``r`` with lay angle ``beta``: ``tan(beta) = 2 pi r / lay_length``.
+By default a layer touches the layer below (``r_k = r_{k-1} + R_{k-1} + R_k``).
+
+Contact declarations are made for touching neighbours only: each layer
+(slave) against the layer below (master), and neighbouring wires of a layer
+when their centre lines come closer than ``(1 + touch_tol) 2 R``.
+
+End conditions: ``Strand.clamp(side)`` clamps every wire end of a side;
+``Strand.plate(side)`` makes a node on the axis rigidly linked to every wire
+end of that side (a rigid end plate), to be pulled / twisted with
+``model.prescribe`` or ``model.fix(..., values=...)``; ``Strand.resultant``
+gives the axial force and the torque about the axis from the plate reaction.
+"""
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+from . import geometry
+from .errors import InputError
+from .model import Model
+from .section import Section
+
+__all__ = ["Layer", "Strand", "build_strand", "fibre_stiffness"]
+
+
+@dataclass
+class Layer:
+    """One layer: ``n_wires`` wires of ``wire_radius``; lay given by ``lay_length`` or ``lay_angle``.
+
+    ``direction``: 'right' (Z lay) or 'left' (S lay); ``phase``: angle of the
+    first wire (rad); ``pitch_radius``: default, touching the layer below.
+    """
+    wire_radius: float
+    n_wires: int = 1
+    lay_length: Optional[float] = None
+    lay_angle: Optional[float] = None
+    direction: str = "right"
+    phase: float = 0.0
+    pitch_radius: Optional[float] = None
+
+
+@dataclass
+class Strand:
+    model: Model
+    layers: list
+    wires: list            # per layer, list of Beam
+    pitch_radii: list
+    lay_angles: list
+    lay_lengths: list
+    length: float
+    contacts: list
+
+    @property
+    def all_wires(self):
+        return [w for layer in self.wires for w in layer]
+
+    def ends(self, side):
+        if side not in ("bottom", "top"):
+            raise InputError(f"Strand: side must be 'bottom' or 'top', got {side!r}")
+        return [w.first if side == "bottom" else w.last for w in self.all_wires]
+
+    def clamp(self, side):
+        for n in self.ends(side):
+            self.model.clamp(n)
+
+    def plate(self, side):
+        """A node on the axis at the ``side`` end, rigidly linked to every wire end there."""
+        z = 0.0 if side == "bottom" else self.length
+        node = self.model.add_node((0.0, 0.0, z), name=f"plate {side}")
+        for n in self.ends(side):
+            self.model.join(node, n, rigid=True)
+        return node
+
+    @staticmethod
+    def resultant(solution, plate, step=-1):
+        """Axial force and torque about ``e_z`` exerted by the support on the strand at ``plate``."""
+        r = solution.reaction(plate, step)
+        return float(r[2]), float(r[5])
+
+
+def _lay(layer, r):
+    if r == 0.0:
+        return 0.0, np.inf
+    if (layer.lay_length is None) == (layer.lay_angle is None):
+        raise InputError(f"Layer {layer}: give exactly one of lay_length, lay_angle")
+    if layer.lay_angle is not None:
+        beta = float(layer.lay_angle)
+        if not 0.0 < beta < np.pi / 2:
+            raise InputError(f"Layer: lay_angle must lie in (0, pi/2) rad, got {beta!r}")
+        return beta, 2.0 * np.pi * r / np.tan(beta)
+    p = float(layer.lay_length)
+    if not p > 0:
+        raise InputError(f"Layer: lay_length must be positive, got {p!r}")
+    return float(np.arctan(2.0 * np.pi * r / p)), p
+
+
+def build_strand(layers, length, E, nu=0.3, elements_per_lay=24, min_elements=8, mu=0.0,
+                 contact=True, touch_tol=0.05, model=None, contact_options=None):
+    """Build the wires of a straight strand into ``model`` (a new one by default); returns a ``Strand``."""
+    if not layers:
+        raise InputError("build_strand: need at least one layer")
+    if not length > 0:
+        raise InputError(f"build_strand: length must be positive, got {length!r}")
+    model = Model() if model is None else model
+    wires, radii, angles, lays = [], [], [], []
+    r_prev, R_prev = None, None
+    for k, layer in enumerate(layers):
+        R = float(layer.wire_radius)
+        if not R > 0 or int(layer.n_wires) < 1:
+            raise InputError(f"build_strand: layer {k} needs wire_radius > 0 and n_wires >= 1, got {layer}")
+        if layer.pitch_radius is not None:
+            r = float(layer.pitch_radius)
+        elif k == 0 and layer.n_wires == 1:
+            r = 0.0
+        elif k == 0:
+            r = R / np.sin(np.pi / layer.n_wires)          # wires touching around an empty centre
+        else:
+            r = r_prev + R_prev + R
+        beta, p = _lay(layer, r)
+        if layer.direction not in ("right", "left"):
+            raise InputError(f"build_strand: layer {k} direction must be 'right' or 'left'")
+        sign = 1.0 if layer.direction == "right" else -1.0
+        sec = Section.circular(radius=R, E=E, nu=nu, name=f"layer {k}")
+        layer_wires = []
+        for i in range(int(layer.n_wires)):
+            if r == 0.0:
+                P = geometry.straight((0, 0, 0), (0, 0, length), max(min_elements, int(elements_per_lay)))
+            else:
+                n_el = max(min_elements, int(np.ceil(elements_per_lay * length / p)))
+                P = geometry.helix(radius=r, pitch=sign * p, length=length, n_elements=n_el,
+                                   phase=layer.phase + 2.0 * np.pi * i / layer.n_wires)
+            layer_wires.append(model.add_beam(P, sec, name=f"layer {k} wire {i}"))
+        wires.append(layer_wires)
+        radii.append(r)
+        angles.append(beta)
+        lays.append(p)
+        r_prev, R_prev = r, R
+    contacts = []
+    if contact:
+        opts = dict(contact_options or {})
+        for k in range(1, len(wires)):
+            contacts.append(model.add_contact(wires[k], wires[k - 1], mu=mu, **opts))
+        for k, lw in enumerate(wires):
+            m = len(lw)
+            if m < 2:
+                continue
+            R = layers[k].wire_radius
+            d = _neighbour_distance(model, lw[0], lw[1])
+            if d <= 2.0 * R * (1.0 + touch_tol):
+                pairs = [(i, (i + 1) % m) for i in range(m if m > 2 else 1)]
+                for i, j in pairs:
+                    contacts.append(model.add_contact(lw[i], lw[j], mu=mu, **opts))
+    return Strand(model, list(layers), wires, radii, angles, lays, float(length), contacts)
+
+
+def _neighbour_distance(model, a, b, samples=400):
+    """Minimum distance between the reference centre lines of two wires (dense sampling)."""
+    P = model.poses0
+    xa = P[a.nodes, :3, 3]
+    xb = P[b.nodes, :3, 3]
+    from scipy.spatial import cKDTree
+    sa = _densify(xa, samples)
+    sb = _densify(xb, samples)
+    d, _ = cKDTree(sb).query(sa)
+    return float(d.min())
+
+
+def _densify(x, samples):
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(x, axis=0), axis=1))])
+    t = np.linspace(0.0, s[-1], samples)
+    return np.stack([np.interp(t, s, x[:, k]) for k in range(3)], axis=-1)
+
+
+def fibre_stiffness(core_radius, wire_radius, n_wires, pitch_radius, lay_angle, E, nu=0.3):
+    """Thin-wire (fibre) limit of a 1+m strand: ``(K_ee, K_ew, K_ww)``.
+
+    ``K_ee = E A_c + m E A_h cos^3 b``, ``K_ew = m E A_h r sin b cos^2 b``,
+    ``K_ww = G J_c + m E A_h r^2 sin^2 b cos b``; fixed ends ``F = K_ee eps``,
+    ``M = K_ew eps``; free ends ``F = (K_ee - K_ew^2 / K_ww) eps``.
+    """
+    G = E / (2.0 * (1.0 + nu))
+    Ac, Ah = np.pi * core_radius**2, np.pi * wire_radius**2
+    Jc = 0.5 * np.pi * core_radius**4
+    b, r, m = lay_angle, pitch_radius, n_wires
+    Kee = E * Ac + m * E * Ah * np.cos(b) ** 3
+    Kew = m * E * Ah * r * np.sin(b) * np.cos(b) ** 2
+    Kww = G * Jc + m * E * Ah * r**2 * np.sin(b) ** 2 * np.cos(b)
+    return Kee, Kew, Kww
