@@ -195,8 +195,8 @@ class System:
                 rows.append(Rg[fixed])
             rank = np.linalg.matrix_rank(np.concatenate(rows), tol=1e-9 * self.length_scale) if rows else 0
             if rank < 6:
-                owners = {model.beam_of_node(i) for i in nodes}
-                beams = sorted(b.id for b in owners if b is not None)
+                owners = [model.beam_of_node(i) for i in nodes]   # Beam (a dataclass) is unhashable
+                beams = sorted({b.id for b in owners if b is not None})
                 what = f"beam(s) {beams}" if beams else f"node(s) {nodes}"
                 raise InputError(f"{what}: {6 - rank} rigid-body mode(s) are not constrained; "
                                  "clamp, fix or prescribe nodes (or pass check_rigid_modes=False "

@@ -77,17 +77,20 @@ def arc(radius, angle, n_elements, origin=(0.0, 0.0, 0.0)):
     """Circular arc from ``origin`` with tangent ``+x``, turning towards ``+y`` about ``+z``.
 
     Centre ``origin + (0, radius, 0)``; ``e2`` points to the centre, ``e3 = +z``.
+    A negative ``angle`` turns towards ``-y`` (centre ``origin - (0, radius, 0)``,
+    ``e3 = -z``), so ``e1`` always runs along the node order.
     """
     n = _check_n(n_elements, "arc")
     if not np.isfinite(radius) or radius <= 0:
         raise InputError(f"geometry.arc: radius must be positive, got {radius!r}")
     if not np.isfinite(angle) or angle == 0:
         raise InputError(f"geometry.arc: angle must be finite and non-zero, got {angle!r}")
-    phi = np.linspace(0.0, angle, n + 1)
+    sg = np.sign(angle)
+    phi = np.linspace(0.0, abs(angle), n + 1)
     c, s = np.cos(phi), np.sin(phi)
-    x = np.stack([radius * s, radius * (1.0 - c), np.zeros_like(phi)], axis=-1) + np.asarray(origin, float)
-    e1 = np.stack([c, s, np.zeros_like(phi)], axis=-1)
-    e2 = np.stack([-s, c, np.zeros_like(phi)], axis=-1)
+    x = np.stack([radius * s, sg * radius * (1.0 - c), np.zeros_like(phi)], axis=-1) + np.asarray(origin, float)
+    e1 = np.stack([c, sg * s, np.zeros_like(phi)], axis=-1)
+    e2 = np.stack([-s, sg * c, np.zeros_like(phi)], axis=-1)
     return _poses(x, e1, e2)
 
 

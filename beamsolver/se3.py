@@ -12,7 +12,7 @@ Conventions (stated once, used everywhere in beamsolver):
 Every coefficient that is 0/0 at zero angle has its own Taylor switch point,
 chosen where the truncated series (nine terms in t^2) and the closed form
 agree to round-off; ``tests/test_se3_coefficients.py`` sweeps them against
-50-digit arithmetic.
+200-digit arithmetic.
 """
 import numpy as np
 
@@ -107,8 +107,9 @@ _CLOSED = {"a": _closed_a, "b": _closed_b, "c": _closed_c, "d": _closed_d,
 # series is exact to round-off, above them the closed form has lost little to
 # cancellation.  `d` and `dp` have poles at 2 pi, so their series converge
 # more slowly and switch earlier.  Worst relative errors over t in
-# [1e-12, 5]: a, b, c, q2 < 2e-15; d 1.2e-15; q3, cp 5e-15; dp 7e-14;
-# q2p, q3p 8e-15.
+# [1e-12, 5]: a, b, c, q2 < 2e-15; d 3e-15; q3, cp 5e-15; q2p 8e-15;
+# q3p 1.5e-14; dp 2.5e-13 (with nine terms the series and closed-form errors
+# of dp cross near 1e-13 around t = 1, so no switch point does better).
 SWITCH = {"a": 0.75, "b": 1.0, "c": 1.5, "d": 0.75, "q2": 1.5, "q3": 1.5,
           "cp": 1.5, "dp": 1.0, "q2p": 2.0, "q3p": 2.0}
 

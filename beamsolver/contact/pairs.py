@@ -85,11 +85,15 @@ def _project(kind, HA1, h1, xi1, HA2, h2, xi2, iterations=3):
     return xi1, xi2
 
 
-def _node_jacobians(h, xi):
-    """``J_A, J_B`` with ``dq_C = J_A dq_A + J_B dq_B`` for ``H_C = H_A exp(xi h)``."""
-    Txi = se3.tangent(xi[..., None] * h) * xi[..., None, None]
-    JA = se3.adjoint(se3.exp(-xi[..., None] * h)) - Txi @ se3.tangent_inv(-h)
-    JB = Txi @ se3.tangent_inv(h)
+def _node_jacobians(h, xi, E_h, E_xi):
+    """``J_A, J_B`` with ``dq_C = J_A dq_A + J_B dq_B`` for ``H_C = H_A exp(xi h)``.
+
+    ``J_B = xi T(xi h) T(h)^-1`` and ``J_A = Ad(exp(-xi h)) - xi T(xi h) T(-h)^-1``,
+    with ``T(-h)^-1 = T(h)^-1 Ad(exp(-h))`` (from ``T(-h) = Ad(exp(h)) T(h)``), so one
+    inverse tangent serves both.  ``E_h = exp(h) = H_A^-1 H_B``, ``E_xi = exp(xi h) = H_A^-1 H_C``.
+    """
+    JB = (se3.tangent(xi[..., None] * h) * xi[..., None, None]) @ se3.tangent_inv(h)
+    JA = se3.adjoint(se3.inverse(E_xi)) - JB @ se3.adjoint(se3.inverse(E_h))
     return JA, JB
 
 
@@ -108,21 +112,14 @@ def contact_kernel(X, p, friction=True):
     (global 3-vector per unit weight)).
     """
     HA1, HB1, HA2, HB2 = X[..., 0, :, :], X[..., 1, :, :], X[..., 2, :, :], X[..., 3, :, :]
-    h1 = _log_c(se3.relative(HA1, HB1))
-    h2 = _log_c(se3.relative(HA2, HB2))
+    E1, E2 = se3.relative(HA1, HB1), se3.relative(HA2, HB2)
+    h1, h2 = _log_c(E1), _log_c(E2)
     kind = p["kind"]
     xi1, xi2 = _project(kind, HA1, h1, p["xi1"] + 0 * h1[..., 0], HA2, h2, p["xi2"] + 0 * h2[..., 0])
     HC, _, _ = _section(HA1, h1, xi1)
     HF, _, _ = _section(HA2, h2, xi2)
-    xC, xF = HC[..., :3, 3], HF[..., :3, 3]
-    d = xF - xC
-    dist = np.sqrt(_dot(d, d))
-    n = d / dist[..., None]
-    e1 = HC[..., :3, 0]
-    t1 = e1 - _dot(e1, n)[..., None] * n
-    t1 = t1 / np.sqrt(_dot(t1, t1))[..., None]
-    t2 = _cross(n, t1)
     R1, R2 = p["R1"], p["R2"]
+    xC, xF, n, t1, t2, dist = _axes(HC, HF)
     gap = dist - R1 - R2
     lam_n, active = normal_force(gap, p["penalty"], p["multiplier"])
     w = p["weight"]
@@ -133,9 +130,7 @@ def contact_kernel(X, p, friction=True):
     stick = np.ones(gap.shape, dtype=bool)
     slip = np.zeros(gap.shape + (2,), dtype=gap.dtype)
     if friction:
-        frame = np.stack([n, t1, t2], axis=-1)
-        HL = _pose(frame, xC + R1[..., None] * n)
-        HK = _pose(frame, xF - R2[..., None] * n)
+        HL, HK = _contact_frames(n, t1, t2, xC, xF, R1, R2)
         # material frames carried from the last converged step
         HCm, _, _ = _section(HA1, h1, p["xi1_prev"] + 0 * xi1)
         HFm, _, _ = _section(HA2, h2, p["xi2_prev"] + 0 * xi2)
@@ -162,12 +157,44 @@ def contact_kernel(X, p, friction=True):
     m_master = _cross(-R2[..., None] * n, F_master)
     wC = _body_wrench(HC, F_slave, m_slave)
     wF = _body_wrench(HF, F_master, m_master)
-    JA1, JB1 = _node_jacobians(h1, xi1)
-    JA2, JB2 = _node_jacobians(h2, xi2)
+    JA1, JB1 = _node_jacobians(h1, xi1, E1, se3.relative(HA1, HC))
+    JA2, JB2 = _node_jacobians(h2, xi2, E2, se3.relative(HA2, HF))
     f = np.stack([np.einsum("...ji,...j->...i", JA1, wC), np.einsum("...ji,...j->...i", JB1, wC),
                   np.einsum("...ji,...j->...i", JA2, wF), np.einsum("...ji,...j->...i", JB2, wF)], axis=-2)
     out["F_slave"] = F_slave
     return f, out
+
+
+def _axes(HC, HF):
+    """Centre points, contact axes ``n, t1, t2`` and centre distance (THEORY.md section 5)."""
+    xC, xF = HC[..., :3, 3], HF[..., :3, 3]
+    d = xF - xC
+    dist = np.sqrt(_dot(d, d))
+    n = d / dist[..., None]
+    e1 = HC[..., :3, 0]
+    t1 = e1 - _dot(e1, n)[..., None] * n
+    t1 = t1 / np.sqrt(_dot(t1, t1))[..., None]
+    return xC, xF, n, t1, _cross(n, t1), dist
+
+
+def _contact_frames(n, t1, t2, xC, xF, R1, R2):
+    """``{L}`` at ``x_C + R1 n`` and ``{K}`` at ``x_F - R2 n``, axes ``(n, t1, t2)``."""
+    frame = np.stack([n, t1, t2], axis=-1)
+    return _pose(frame, xC + R1[..., None] * n), _pose(frame, xF - R2[..., None] * n)
+
+
+def material_frames(X, kind, xi1, xi2, R1, R2):
+    """Frames of a pair at fixed ``xi1, xi2`` (no projection): ``H_CL``, ``H_FK``, ``H_LK``.
+
+    Used to start the friction history of a pair that has none: its material
+    frames are those of the pair at the last converged poses ``X``.
+    """
+    HA1, HB1, HA2, HB2 = X[..., 0, :, :], X[..., 1, :, :], X[..., 2, :, :], X[..., 3, :, :]
+    HC, _, _ = _section(HA1, se3.log(se3.relative(HA1, HB1)), xi1)
+    HF, _, _ = _section(HA2, se3.log(se3.relative(HA2, HB2)), xi2)
+    xC, xF, n, t1, t2, _ = _axes(HC, HF)
+    HL, HK = _contact_frames(n, t1, t2, xC, xF, R1, R2)
+    return se3.relative(HC, HL), se3.relative(HF, HK), se3.relative(HL, HK)
 
 
 def _pose(R, x):
@@ -178,18 +205,29 @@ def _pose(R, x):
     return H
 
 
+CHUNK = 256   # pairs per complex-step block: (24, CHUNK) arrays stay in cache
+
+
 def kernel_and_tangent(X, p, friction=True, h=1e-30):
     """Wrenches ``(P, 4, 6)`` and their exact derivative ``(P, 24, 24)`` by complex step.
 
     Column ``6 j + k`` perturbs node ``j`` by the body increment ``exp(i h e_k)``.
+    The 24 perturbed kernels run in blocks of ``CHUNK`` pairs (same results,
+    bounded memory).
     """
     f, out = contact_kernel(X, p, friction)
     P = X.shape[0]
+    K = np.empty((P, 24, 24))
     E = se3.exp(1j * h * np.eye(6))                     # (6, 4, 4)
-    Xc = np.broadcast_to(X.astype(complex), (24,) + X.shape).copy()
-    for j in range(4):
-        Xc[6 * j:6 * j + 6, :, j] = se3.compose(X[None, :, j], E[:, None])
-    pc = {k: (np.broadcast_to(v, (24,) + np.shape(v)) if np.ndim(v) else v) for k, v in p.items()}
-    fc, _ = contact_kernel(Xc, pc, friction)
-    dF = fc.imag.reshape(24, P, 24) / h                 # (col, P, row)
-    return f, np.transpose(dF, (1, 2, 0)), out
+    for a in range(0, P, CHUNK):
+        b = min(a + CHUNK, P)
+        Xb = X[a:b]
+        Xc = np.broadcast_to(Xb.astype(complex), (24,) + Xb.shape).copy()
+        for j in range(4):
+            Xc[6 * j:6 * j + 6, :, j] = se3.compose(Xb[None, :, j], E[:, None])
+        pc = {k: (np.broadcast_to(v[a:b], (24,) + np.shape(v[a:b])) if np.ndim(v) else v)
+              for k, v in p.items()}
+        fc, _ = contact_kernel(Xc, pc, friction)
+        dF = fc.imag.reshape(24, b - a, 24) / h         # (col, pair, row)
+        K[a:b] = np.transpose(dF, (1, 2, 0))
+    return f, K, out

@@ -18,7 +18,11 @@ the README, tested on both sides of each switch):
    ``sin^2 45 deg = 0.5``): one **point-to-point** pair at the closest points
    (isolated crossing);
 3. else **orthogonal projection** of each slave Gauss point onto the master
-   centre line (wrapping).
+   centre line (wrapping).  A slave element that would be a point pair but
+   shares a node with an orthogonal one against the same master beam (a
+   straight rope leaving a wrap tangentially) is projected orthogonally too:
+   its closest point sits at its end, and a point pair there would switch on
+   and off as the tangent point moves (``ContactSystem._extend_wrap``).
 
 Projections are accepted on ``[0, 1]`` of the master element (so they continue
 across element boundaries along the whole master beam); per slave Gauss point
@@ -28,7 +32,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .. import se3
-from .pairs import LINE, ORTHOGONAL, POINT, _project, _section
+from .pairs import POINT, _project, _section
 
 XI_TOL = 1e-9
 

@@ -5,7 +5,10 @@ contact declarations.  Per evaluation it searches, evaluates the contact
 kernel (forces and complex-step tangent) on the active pairs and returns the
 residual and COO tangent in the unknowns' numbering.  Per step it keeps the
 friction history and augmented-Lagrangian multipliers, keyed by material slave
-point and master beam, committed only when a step is accepted.
+point and master beam, committed only when a step is accepted.  A pair with
+no history (it just came into contact) starts one from the poses at the start
+of the step (``begin_step``): its material frames are those of the pair there,
+its tangential traction zero, so friction acts from the first step of contact.
 
 Options per ``Model.add_contact`` declaration (keyword arguments):
 ``gauss_points`` (5), ``penalty`` (default ``law.default_penalty``, per unit
@@ -17,11 +20,13 @@ penalty), ``line_angle`` (20 deg), ``point_ratio`` (0.5), ``margin``
 from collections import Counter
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from .. import se3
 from ..errors import InputError
 from .law import default_penalty
-from .pairs import LINE, ORTHOGONAL, POINT, _project, contact_kernel, kernel_and_tangent
+from .pairs import (LINE, ORTHOGONAL, POINT, _project, _section, contact_kernel, kernel_and_tangent,
+                    material_frames)
 from .search import XI_TOL, broad_phase, closest_points, element_spheres
 
 CALLS = Counter()          # instrumentation: a scene without contact leaves it empty
@@ -42,7 +47,10 @@ class _Decl:
         secs = [b.section for b in decl.slave + decl.master]
         self.penalty = decl.penalty if decl.penalty is not None else min(
             default_penalty(a, b) for a in secs for b in secs)
-        self.penalty_t = float(o.get("penalty_t", self.penalty))
+        pt = o.get("penalty_t")
+        self.penalty_t = self.penalty if pt is None else float(pt)
+        if not (np.isfinite(self.penalty_t) and self.penalty_t > 0):
+            raise InputError(f"add_contact: penalty_t must be positive, got {pt!r}")
         self.mu = decl.mu
         self.tolerance = o.get("tolerance")
         self.n_gp = int(o.get("gauss_points", 5))
@@ -78,6 +86,7 @@ class ContactSystem:
         self._mult = self._mult_committed
         self._augments = 0
         self._prev_points = np.zeros(0, dtype=np.int64)
+        self._H_prev = None        # last converged poses (start of the step)
 
     # ------------------------------------------------------------ history
     @staticmethod
@@ -122,6 +131,7 @@ class ContactSystem:
                 kinds[b[pt]] = POINT
                 kinds[b[~pt]] = ORTHOGONAL
                 xi1p[b], xi2p[b] = x1, x2
+                kinds = self._extend_wrap(e, m, kinds)
             parts = []
             # point-to-point pairs: one per element pair, inside both elements (half-open)
             pt = np.flatnonzero(kinds == POINT)
@@ -147,8 +157,8 @@ class ContactSystem:
                 xi1 = xg[g]
                 _, xi2 = _project(kk, H[en[ee, 0]], hs[i[rep]], xi1, H[en[mm, 0]], hm[j[rep]],
                                   np.full(len(rep), 0.5), iterations=8)
-                HC, _, _ = _section_real(H[en[ee, 0]], hs[i[rep]], xi1)
-                HF, _, _ = _section_real(H[en[mm, 0]], hm[j[rep]], xi2)
+                HC, _, _ = _section(H[en[ee, 0]], hs[i[rep]], xi1)
+                HF, _, _ = _section(H[en[mm, 0]], hm[j[rep]], xi2)
                 dist = np.linalg.norm(HF[:, :3, 3] - HC[:, :3, 3], axis=1)
                 ok = (xi2 >= -XI_TOL) & (xi2 <= 1.0 + XI_TOL) & np.isfinite(dist)
                 key = ((np.int64(d.index) * len(en) + ee) * self.max_gp + g) * self.n_beams + self.el_beam[mm]
@@ -173,6 +183,24 @@ class ContactSystem:
         P["R2"] = self.el_radius[P["m"]]
         return P
 
+    def _extend_wrap(self, e, m, kinds):
+        """A straight slave element leaving a wrap tangentially (it shares a node with an
+        ``ORTHOGONAL`` element against the same master beam) is projected orthogonally
+        too: its closest point to the master sits at its end, where a point pair would
+        switch on and off as the tangent point moves (search.py, rule 3)."""
+        orth = kinds == ORTHOGONAL
+        if not orth.any() or orth.all():
+            return kinds
+        en = self.sys.enodes
+        nb = self.n_beams
+        mb = self.el_beam[m]
+        wrap = np.unique((en[e[orth]] * nb + mb[orth, None]).ravel())
+        pt = np.flatnonzero(kinds == POINT)
+        near = np.isin(en[e[pt]] * nb + mb[pt, None], wrap).any(axis=1)
+        kinds = kinds.copy()
+        kinds[pt[near]] = ORTHOGONAL
+        return kinds
+
     def _dedupe_points(self, H, e, m, xi1, xi2, idx):
         """One point pair per crossing: at a node where two elements meet (a kink of the
         C0 centre line) each element has its own closest point; keep the nearest
@@ -189,13 +217,27 @@ class ContactSystem:
         # choice cannot flip between the two elements of a kink inside Newton
         known = np.isin(e * len(en) + m, self._prev_points)
         order = np.lexsort((dist, ~known, group))
-        keep = []
-        for k in order:
-            close = [j for j in keep if group[j] == group[k]
-                     and np.linalg.norm(xC[j] - xC[k]) < rad[k] and np.linalg.norm(xF[j] - xF[k]) < rad[k]]
-            if not close:
-                keep.append(k)
-        return idx[np.sort(np.array(keep, dtype=int))]
+        rank = np.empty(len(order), dtype=int)
+        rank[order] = np.arange(len(order))
+        # candidate pairs (a dominates b: higher priority, same beams, both points close)
+        ij = cKDTree(xC).query_pairs(float(rad.max()), output_type="ndarray")
+        if len(ij) == 0:
+            return idx
+        a, b = ij[:, 0], ij[:, 1]
+        swap = rank[a] > rank[b]
+        a, b = np.where(swap, b, a), np.where(swap, a, b)
+        close = ((group[a] == group[b]) & (np.linalg.norm(xC[a] - xC[b], axis=1) < rad[b])
+                 & (np.linalg.norm(xF[a] - xF[b], axis=1) < rad[b]))
+        a, b = a[close], b[close]
+        # greedy in priority order, as a fixed point: dropped iff a kept pair dominates it
+        dropped = np.zeros(len(idx), dtype=bool)
+        for _ in range(len(idx)):
+            new = np.zeros(len(idx), dtype=bool)
+            new[b[~dropped[a]]] = True
+            if np.array_equal(new, dropped):
+                break
+            dropped = new
+        return idx[~dropped]
 
     def _params(self, P, sel, H):
         """Kernel parameters for the pairs ``sel`` (history and multipliers looked up)."""
@@ -222,8 +264,59 @@ class ContactSystem:
             p.update(H_CL=np.tile(np.eye(4), (n, 1, 1)), H_FK=np.tile(np.eye(4), (n, 1, 1)),
                      H_LK_prev=np.tile(np.eye(4), (n, 1, 1)), xi1_prev=p["xi1"].copy(),
                      xi2_prev=p["xi2"].copy(), lam_t_prev=np.zeros((n, 3)))
+        # a point pair whose crossing moved to a neighbouring element pair keeps the
+        # history of the committed point pair of the same two beams next to it
+        cand = np.flatnonzero(~hf & (p["kind"] == POINT) & (p["mu"] > 0))
+        hp = np.flatnonzero(hist["key"] >= self.point_offset)
+        if len(cand) and len(hp):
+            hf = self._inherit_points(P, sel, H, p, hf, cand, hp)
+        # a pair without history starts it from the last converged poses: its
+        # material frames are those of the pair there (same xi), its traction zero
+        new = np.flatnonzero(~hf & (p["mu"] > 0))
+        if len(new) and self._H_prev is not None:
+            X = self._H_prev[P["nodes"][sel][new]]
+            H_CL, H_FK, H_LK = material_frames(X, p["kind"][new], p["xi1"][new], p["xi2"][new],
+                                               p["R1"][new], p["R2"][new])
+            ok = np.isfinite(H_LK).all(axis=(1, 2))
+            new = new[ok]
+            p["H_CL"][new], p["H_FK"][new], p["H_LK_prev"][new] = H_CL[ok], H_FK[ok], H_LK[ok]
+            p["xi1_prev"][new], p["xi2_prev"][new] = p["xi1"][new], p["xi2"][new]
+            hf = hf.copy()
+            hf[new] = True
         p["has_history"] = hf
         return p
+
+    def _inherit_points(self, P, sel, H, p, hf, cand, hp):
+        """Give the point pairs ``cand`` (no history of their own) the history of the nearest
+        committed point pair ``hp`` of the same declaration and beams within ``R1 + R2``;
+        material points are re-expressed on the new elements (same beam, consecutive ids)."""
+        hist = self._history
+        en, nb = self.sys.enodes, self.n_beams
+        e, m = P["e"][sel][cand], P["m"][sel][cand]
+        x = _interp_pos(H, en, e, p["xi1"][cand])
+        he, hm = hist["e"][hp], hist["m"][hp]
+        hx = _interp_pos(H, en, he, hist["xi1"][hp])       # the stored material points, now
+        hdecl = (hist["key"][hp] - self.point_offset) // (np.int64(len(en)) * len(en))
+        g_new = (P["decl"][sel][cand] * nb + self.el_beam[e]) * nb + self.el_beam[m]
+        g_old = (hdecl * nb + self.el_beam[he]) * nb + self.el_beam[hm]
+        k = min(4, len(hp))
+        dist, j = cKDTree(hx).query(x, k=k)
+        dist, j = dist.reshape(len(cand), k), j.reshape(len(cand), k)
+        jc = np.minimum(j, len(hp) - 1)
+        good = (j < len(hp)) & (g_old[jc] == g_new[:, None]) & \
+            (dist < (p["R1"][cand] + p["R2"][cand])[:, None])
+        ok = good.any(axis=1)
+        if not ok.any():
+            return hf
+        jh = hp[jc[ok, np.argmax(good[ok], axis=1)]]
+        ii = cand[ok]
+        for name, src in (("H_CL", "H_CL"), ("H_FK", "H_FK"), ("H_LK_prev", "H_LK"), ("lam_t_prev", "lam_t")):
+            p[name][ii] = hist[src][jh]
+        p["xi1_prev"][ii] = hist["xi1"][jh] + hist["e"][jh] - P["e"][sel][ii]
+        p["xi2_prev"][ii] = hist["xi2"][jh] + hist["m"][jh] - P["m"][sel][ii]
+        hf = hf.copy()
+        hf[ii] = True
+        return hf
 
     def _active(self, P, H):
         """Pairs whose trial normal traction is positive, with their kernel parameters."""
@@ -296,6 +389,7 @@ class ContactSystem:
 
     # ------------------------------------------------------------ per step
     def begin_step(self, H, t):
+        self._H_prev = np.array(H, dtype=float)
         self._mult = self._mult_committed
         self._augments = 0
 
@@ -359,7 +453,14 @@ class ContactSystem:
         self._last = (P, sel, p, out)
 
     def results(self, H):
-        """Contact point table of the committed state (dict of arrays)."""
+        """Contact point table of the committed state (dict of arrays).
+
+        ``position`` (k, 3) midway between the contour points, ``gap``, ``normal_force``
+        and ``tangential_force`` (k, 3) (forces on the slave, integrated over the point's
+        weight), ``stick`` (False for frictionless or open points), ``slip_increment``
+        (k, 2) of the step, ``kind`` (0 line, 1 orthogonal, 2 point), ``angle`` between
+        the tangents (degrees), element ids, ``xi1``, ``xi2``, ``weight``, ``normal``.
+        """
         last = getattr(self, "_last", None)
         if last is None:
             return dict(position=np.zeros((0, 3)), gap=np.zeros(0), normal_force=np.zeros(0),
@@ -378,14 +479,13 @@ class ContactSystem:
         active = out["lam_n"] > 0
         return dict(position=0.5 * (out["xC"] + out["xF"]) + 0.5 * (p["R1"] - p["R2"])[:, None] * out["n"],
                     gap=out["gap"], normal_force=w * out["lam_n"], tangential_force=ft,
-                    stick=out["stick"] & active, slip_increment=out["slip"], kind=p["kind"],
+                    stick=out["stick"] & active & (p["mu"] > 0), slip_increment=out["slip"], kind=p["kind"],
                     angle=ang, slave_element=P["e"][sel], master_element=P["m"][sel],
                     xi1=out["xi1"], xi2=out["xi2"], weight=w, normal=out["n"])
 
 
 def _frames(out):
     frame = np.stack([out["n"], out["t1"], out["t2"]], axis=-1)
-    R1 = out.get("R1")
     HL = np.zeros(frame.shape[:-2] + (4, 4))
     HK = np.zeros_like(HL)
     HL[:, :3, :3] = HK[:, :3, :3] = frame
@@ -405,8 +505,3 @@ def _interp_pose(H, enodes, e, xi):
 
 def _interp_pos(H, enodes, e, xi):
     return _interp_pose(H, enodes, e, xi)[:, :3, 3]
-
-
-def _section_real(HA, h, xi):
-    from .pairs import _section
-    return _section(HA, h, xi)

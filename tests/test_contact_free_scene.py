@@ -1,0 +1,52 @@
+"""A scene without contact runs none of the contact code (fresh interpreter, clean sys.modules)."""
+import json
+import subprocess
+import sys
+import textwrap
+
+SCRIPT = textwrap.dedent("""
+    import json, sys
+    import numpy as np
+    import beamsolver as bs
+    m = bs.Model()
+    b = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 4), bs.Section.circular(radius=0.01, E=1e9))
+    m.clamp(b.first)
+    m.add_load(b.last, force=(0, 0, -1.0))
+    sol = bs.solve(m, steps=2)
+    out = dict(system="beamsolver.contact.system" in sys.modules,
+               search="beamsolver.contact.search" in sys.modules,
+               pairs="beamsolver.contact.pairs" in sys.modules,
+               contact=[len(c) for c in sol.contacts])
+    print(json.dumps(out))
+""")
+
+SCRIPT_CONTACT = textwrap.dedent("""
+    import json, sys
+    import beamsolver as bs
+    sec = bs.Section.circular(radius=0.05, E=1e7)
+    m = bs.Model()
+    a = m.add_beam(bs.geometry.straight((0, -1, 0), (0, 1, 0), 3), sec)
+    b = m.add_beam(bs.geometry.straight((-1, 0, 1), (1, 0, 1), 3), sec)
+    for n in (a.first, a.last, b.first, b.last):
+        m.clamp(n)
+    m.add_contact(b, a)
+    bs.solve(m, steps=1)
+    from beamsolver.contact.system import CALLS
+    print(json.dumps(dict(CALLS)))
+""")
+
+
+def _run(script):
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def test_scene_without_contact_never_imports_the_contact_system():
+    out = _run(SCRIPT)
+    assert out == dict(system=False, search=False, pairs=False, contact=[0, 0, 0])
+
+
+def test_instrumentation_counts_contact_calls_when_there_is_contact():
+    calls = _run(SCRIPT_CONTACT)          # the probe above would see these if they ran
+    assert calls.get("search", 0) > 0 and calls.get("evaluate", 0) > 0
