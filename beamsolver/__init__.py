@@ -1,6 +1,8 @@
 """beamsolver: quasi-static geometrically exact beams on SE(3) with frictional contact."""
 from . import contact, geometry, motion, se3
 from .errors import ConvergenceError, InputError
+from .io import load
+from .linear import Linearization, linearize
 from .model import Beam, Model
 from .results import Solution
 from .section import Section
@@ -9,4 +11,5 @@ from .solver import Convergence, solve
 __version__ = "0.1.0"
 
 __all__ = ["Model", "Beam", "Section", "Solution", "solve", "Convergence", "InputError",
-           "ConvergenceError", "se3", "geometry", "motion", "contact", "__version__"]
+           "ConvergenceError", "load", "linearize", "Linearization", "se3", "geometry", "motion",
+           "contact", "__version__"]

@@ -225,9 +225,14 @@ class System:
         bn = np.unique(np.concatenate([self.load_nodes[self.dead], self.global_nodes]))
         self.block_nodes = bn.astype(int)
         ndofs = (6 * self.rep[self.block_nodes])[:, None] + k6
-        rows = np.concatenate([np.repeat(self.edofs, 12, axis=1).ravel(),
+        # element entries in the order of the kernel's tangent storage, (12, 12, n_el)
+        # (element axis last, ``element`` module docstring), then the node blocks (n_b, 6, 6)
+        et = self.edofs.T
+        n_el = len(self.edofs)
+        rows = np.concatenate([np.broadcast_to(et[:, None, :], (12, 12, n_el)).ravel(),
                                np.repeat(ndofs, 6, axis=1).ravel()])
-        cols = np.concatenate([np.tile(self.edofs, (1, 12)).ravel(), np.tile(ndofs, (1, 6)).ravel()])
+        cols = np.concatenate([np.broadcast_to(et[None, :, :], (12, 12, n_el)).ravel(),
+                               np.tile(ndofs, (1, 6)).ravel()])
         self.coo_rows, self.coo_cols = rows, cols
         rr, rc = self.red[rows], self.red[cols]
         keep = (rr >= 0) & (rc >= 0)
@@ -274,8 +279,13 @@ class System:
         and force levels for the convergence test.
         """
         HA, HB = H[self.enodes[:, 0]], H[self.enodes[:, 1]]
+        kvals = None
         if tangent:
-            f, K, state = internal_forces_and_tangent(HA, HB, self.L, self.eps0, self.C)
+            # the kernel writes its tangent straight into the COO value array (no copy)
+            n_k = 144 * self.n_elements
+            kvals = np.empty(n_k + 36 * len(self.block_nodes))
+            f, K, state = internal_forces_and_tangent(HA, HB, self.L, self.eps0, self.C,
+                                                      out=kvals[:n_k].reshape(12, 12, self.n_elements))
         else:
             f, state = internal_forces(HA, HB, self.L, self.eps0, self.C)
             K = None
@@ -326,9 +336,8 @@ class System:
             where = np.searchsorted(self.block_nodes, g)
             blocks[where, :3, 3:] -= skew(rg[:, :3])
             blocks[where, 3:, 3:] -= skew(rg[:, 3:])
-        kvals = None
         if tangent:
-            kvals = np.concatenate([K.ravel(), blocks.ravel()])
+            kvals[n_k:] = blocks.ravel()
         info = dict(state=state, f_level=f_level, m_level=m_level, extra=None)
         if self.contact is not None:
             # contact residual (6 n,) in z numbering and COO tangent (rows, cols, vals)

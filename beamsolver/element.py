@@ -9,21 +9,44 @@ For an element with nodal poses ``H_A, H_B`` and reference length ``L``
 - body-frame nodal forces ``f_A = -T(-h)^-T sigma``, ``f_B = T(h)^-T sigma``;
 - tangent ``K = B^T (C/L) B + [G(-h, sigma); G(h, sigma)] B`` with
   ``B = [-T(-h)^-1, T(h)^-1]`` and ``G(h, s) = d(T(h)^-T s)/dh`` in closed
-  form (derived below, checked against complex-step and finite differences in
+  form (derived below, checked against finite differences in
   ``tests/test_element.py``).
 
-All functions take arrays batched over elements: poses ``(n, 4, 4)``, ``L``
-``(n,)``, ``eps0`` ``(n, 6)``, ``C`` ``(n, 6, 6)``.
+All public functions take arrays batched over elements: poses ``(n, 4, 4)``,
+``L`` ``(n,)``, ``eps0`` ``(n, 6)``, ``C`` ``(n, 6, 6)``.  They return forces and
+states with the element axis first; the tangent is an ``(n, 12, 12)`` view of
+an array stored element-axis-last (``np.moveaxis(K, 0, -1)`` is contiguous),
+which is the order ``assembly.System`` scatters.
+
+Implementation.  Inside, every quantity is stored with the element axis
+*last* (vectors ``(3, m)``, 3x3 blocks ``(3, 3, m)``) and elements are processed
+in chunks of ``CHUNK``: the small-index algebra is then elementwise operations
+on long contiguous arrays (an order of magnitude faster in numpy than stacked
+``(m, 3, 3) @ (m, 3, 3)`` products).  Products of skew matrices are expanded
+with ``hat(a) hat(b) = b a^T - (a.b) I`` and ``hat(w)^2 = w w^T - |w|^2 I``, so
+``Q`` (THEORY.md section 2) and the geometric stiffness become sums of a skew
+matrix, a few outer products and a multiple of ``I`` (``_mat``).
+
+Both nodes share one code path: with ``T(h)^-1 = [[Ti, X], [0, Ti]]``,
+``Ti = T_SO3(w)^-1 = I + W/2 + d W^2`` and ``X = -Ti Q(-u, -w) Ti``, the matrix
+``T(-h)^-1`` is ``T(h)^-1`` evaluated at ``-h``, so every side quantity is
+computed once on the doubled batch ``[-h | h]`` (node A, then node B):
+``f_A = -g(h)``, ``f_B = g(-h)`` with ``g(h) = T(-h)^-T sigma = [Ti n; X n + Ti m]``,
+and the columns of ``B`` for node A (B) are ``-T(-h)^-1`` (``T(h)^-1``).
 """
 from typing import NamedTuple
 
 import numpy as np
 
 from . import se3
-from .se3 import _cross, coefficient, skew
+from .se3 import coefficient
 
 __all__ = ["ElementState", "element_state", "reference_strain", "energy",
-           "internal_forces", "internal_forces_and_tangent"]
+           "internal_forces", "internal_forces_and_tangent", "CHUNK"]
+
+# elements per chunk, measured (benchmarks/element_throughput.py): larger chunks amortise the
+# per-call overhead of numpy, beyond ~8k the temporaries fall out of the cache
+CHUNK = 6144
 
 
 class ElementState(NamedTuple):
@@ -39,11 +62,290 @@ def reference_strain(H_A, H_B):
     return L, h0 / L[..., None]
 
 
+# ---------------------------------------------------------------- batch-last algebra
+def _cross(a, b):
+    """Cross product over axis 0 (trailing axes broadcast)."""
+    return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+def _crosses(a, *vs):
+    """``a x v`` for each ``v`` in one operation."""
+    r = _cross(a, np.stack(vs, axis=1))
+    return [r[:, i] for i in range(len(vs))]
+
+
+def _dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _mm(A, B):
+    """``A @ B`` for ``A`` (r, 3, m) and ``B`` (3, 3, m)."""
+    return np.einsum("ikm,kjm->ijm", A, B)
+
+
+def _mv(A, v):
+    """``A @ v`` for ``A`` (3, 3, m) and ``v`` (3, m)."""
+    return np.einsum("ijm,jm->im", A, v)
+
+
+def _mat(skew=None, outers=(), diag=None):
+    """``hat(skew) + sum(l r^T for l, r in outers) + diag I``, a (3, 3, m) matrix."""
+    l, r = outers[0]
+    M = l[:, None] * r[None, :]
+    for l, r in outers[1:]:
+        M += l[:, None] * r[None, :]
+    if skew is not None:
+        M[0, 1] -= skew[2]
+        M[0, 2] += skew[1]
+        M[1, 0] += skew[2]
+        M[1, 2] -= skew[0]
+        M[2, 0] -= skew[1]
+        M[2, 1] += skew[0]
+    if diag is not None:
+        M[0, 0] += diag
+        M[1, 1] += diag
+        M[2, 2] += diag
+    return M
+
+
+def _ti(w, d, v, sign=1.0):
+    """``Ti v`` (sign +1) or ``Ti^T v`` (sign -1), ``Ti = I + W/2 + d W^2``."""
+    wv = _cross(w, v)
+    return v + (0.5 * sign) * wv + d * _cross(w, wv)
+
+
+def _q_mat(u, w, wu, a, t2, c1, c2, c3):
+    """``Q(u, w)`` (3, 3, m), ``wu = w.u``, ``a = w x u``, ``t2 = |w|^2``.
+
+    ``WU + UW + WUW = u w^T + w u^T - 2 (w.u) I - (w.u) W``,
+    ``WWU + UWW - 3 WUW = w a^T - a w^T - 2 t^2 U + 3 (w.u) W``,
+    ``WUWW + WWUW = -2 (w.u) (w w^T - t^2 I)``.
+    """
+    return _mat(skew=(0.5 - 2.0 * c2 * t2) * u + ((3.0 * c2 - c1) * wu) * w,
+                outers=[(c1 * u - c2 * a - (2.0 * c3 * wu) * w, w), (w, c1 * u + c2 * a)],
+                diag=(2.0 * c3 * t2 - 2.0 * c1) * wu)
+
+
+# ---------------------------------------------------------------- coefficients
+FORCE_COEFFICIENTS = ("c", "q2", "q3")
+TANGENT_COEFFICIENTS = ("c", "q2", "q3", "dp", "cp", "q2p", "q3p")
+_SERIES_TABLE = {names: np.array([se3._SERIES[k] for k in names]).T[:, :, None]
+                 for names in (FORCE_COEFFICIENTS, TANGENT_COEFFICIENTS)}
+
+
+def _coefficients(names, t):
+    """``{name: se3.coefficient(name, t)}`` for several names at once.
+
+    The series (the same as ``se3.coefficient``'s, evaluated the same way) run
+    as one stacked Horner scheme; only angles at or above a coefficient's
+    switch point (elements turning by more than ~0.75 rad) call
+    ``se3.coefficient`` for the closed form.
+    """
+    table = _SERIES_TABLE[names]
+    t2 = t * t
+    series = np.repeat(table[-1], len(t), axis=-1)
+    for row in table[-2::-1]:
+        series = series * t2 + row
+    out = dict(zip(names, series))
+    for name in names:
+        big = np.flatnonzero(t >= se3.SWITCH[name])
+        if len(big):
+            out[name] = out[name].copy()
+            out[name][big] = coefficient(name, t[big])
+    return out
+
+
+# ---------------------------------------------------------------- relative pose and log
+def _split(H):
+    """Rotation (3, 3, m) and position (3, m) of poses (m, 4, 4), element axis last."""
+    T = np.ascontiguousarray(H[:, :3, :].transpose(1, 2, 0))
+    return T[:, :3], T[:, 3]
+
+
+def _log_relative(HA, HB):
+    """``log(H_A^-1 H_B)`` as ``u, w`` (3, m), and ``t = |w|``, ``d`` (coefficient of ``Ti``).
+
+    Rotation vector through the unit quaternion (Shepperd's choice of the
+    largest component, as ``se3.log_so3``: nothing divides by ``sin t``).
+    """
+    RA, xA = _split(HA)
+    RB, xB = _split(HB)
+    R = np.einsum("kim,kjm->ijm", RA, RB)
+    x = np.einsum("kim,km->im", RA, xB - xA)
+    r00, r11, r22 = R[0, 0], R[1, 1], R[2, 2]
+    tr = r00 + r11 + r22
+    q = np.stack([1.0 + tr, R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    other = np.flatnonzero((r00 > tr) | (r11 > tr) | (r22 > tr))
+    if len(other):   # rotations beyond ~120 degrees: a diagonal element leads
+        q[:, other] = se3._quaternion(R[:, :, other].transpose(2, 0, 1)).T
+    q *= 1.0 / np.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    qw, qv = q[0], q[1:]
+    s = np.sqrt(_dot(qv, qv))
+    small = s < 0.1 * qw
+    qs = np.where(small, qw, 1.0)
+    x2 = np.where(small, s / qs, 0.0) ** 2
+    series = np.full_like(x2, 1.0 / 17.0)
+    for k in range(7, -1, -1):
+        series = series * x2 + (-1) ** k / (2 * k + 1)
+    factor = 2.0 * series / qs
+    if not small.all():
+        with np.errstate(invalid="ignore", divide="ignore"):
+            factor = np.where(small, factor, 2.0 * np.arctan2(s, qw) / np.where(small, 1.0, s))
+    w = factor * qv
+    t = np.sqrt(_dot(w, w))
+    d = coefficient("d", t)
+    u = _ti(w, d, x, -1.0)     # T_SO3(w)^-T x
+    return u, w, t, d
+
+
+# ---------------------------------------------------------------- geometric stiffness
+def _d_tinv_t(w, d, dp, v):
+    """``d(T_SO3(w)^-T v)/dw`` with ``T^-T v = v - w x v / 2 + d w x (w x v)``:
+
+    ``hat(v)/2 + dp (w x (w x v)) w^T + d ((w.v) I + w v^T - 2 v w^T)``.
+    """
+    wwv = _cross(w, _cross(w, v))
+    return _mat(skew=0.5 * v, outers=[(dp * wwv - 2.0 * d * v, w), (w, d * v)], diag=d * _dot(w, v))
+
+
+def _geometric(u, w, n, mo, k):
+    """Blocks of ``G(h, sigma) = d(T(h)^-T sigma)/dh = [[0, G12], [G21, G22]]`` (3, 3, m) each.
+
+    ``T(h)^-T sigma = [A n; A m - A Q(u, w) A n]`` with ``A = T_SO3(w)^-T`` and
+    ``Q(u, w) = Q(-u, -w)^T``, differentiated term by term with c1 = c,
+    c2 = q2, c3 = q3 of se3 and their derivatives divided by t (c1p = cp, ...);
+    with ``y = A n``, ``z = Q(u, w) y``, ``D(v) = d(A v)/dw``:
+    ``G12 = D(n)``, ``G21 = -A dQ/du``, ``G22 = D(m - z) - A (dQ/dw + Q D(n))``,
+    where ``dQ/du``, ``dQ/dw`` are the derivatives of ``Q(u, w) y`` at fixed ``y``.
+    ``k``: dict of the coefficients and ``t2 = |w|^2``.
+    """
+    d, dp, t2 = k["d"], k["dp"], k["t2"]
+    c1, c2, c3 = k["c"], k["q2"], k["q3"]
+    y = _ti(w, d, n, -1.0)                                          # A n
+    yw = _cross(w, y)
+    yww = _cross(w, yw)
+    a_, b_, e_ = _crosses(u, y, yw, yww)
+    wa_, wb_, we_ = _crosses(w, a_, b_, e_)
+    wwa_, wwb_ = _crosses(w, wa_, wb_)
+    g1 = wa_ + b_ + wb_
+    g2 = wwa_ + e_ - 3.0 * wb_
+    g3 = we_ + wwb_
+    z = 0.5 * a_ + c1 * g1 + c2 * g2 + c3 * g3                      # Q(u, w) y
+    wy, uy, wu = _dot(w, y), _dot(u, y), _dot(w, u)
+    uxw = _cross(u, w)
+    # dQ/du = -(Y/2 + c1 (P Y + S1 + P S1) + c2 (PP Y + S2 - 3 P S1) + c3 (P S2 + PP S1)),
+    # Y, S1, S2 = hat(y), hat(yw), hat(yww), P = hat(w), expanded (module docstring)
+    dQu = _mat(skew=-((0.5 - c2 * t2) * y + (c1 - c3 * t2) * yw + c2 * yww),
+               outers=[(-(c1 * y + (c1 - 3.0 * c2) * yw + c3 * yww), w), (w, -(c2 * yw + c3 * yww))],
+               diag=c1 * wy)
+    # dQ/dw = (c1p g1 + c2p g2 + c3p g3) w^T + c1 (-hat(a) - U Y - hat(b) - P U Y)
+    #       + c2 (m(w, a) + U m(w, y) + 3 hat(b) + 3 P U Y) + c3 (-hat(e) + P U m(w, y) + m(w, b) - P P U Y),
+    # m(w, v) = (w.v) I + w v^T - 2 v w^T, expanded
+    gp = k["cp"] * g1 + k["q2p"] * g2 + k["q3p"] * g3
+    dQw = _mat(skew=-c1 * a_ + (3.0 * c2 - c1) * b_ - c3 * e_ + ((c1 - 3.0 * c2) * uy) * w + (c2 * wy) * u,
+               outers=[(gp - 4.0 * c2 * a_ + c3 * (wy * u - 2.0 * wa_ - 2.0 * b_ + uy * w), w),
+                       ((c3 * t2 - c1) * y + (3.0 * c2 - c1) * yw - (c3 * wy) * w, u),
+                       (w, c2 * a_ + c3 * b_),
+                       (c2 * uxw + c3 * _cross(w, uxw), y)],
+               diag=c1 * uy + c2 * _dot(w, a_) - c3 * wy * wu + c3 * _dot(w, b_) - c3 * t2 * uy)
+    DAn = _d_tinv_t(w, d, dp, n)
+    A = _mat(skew=-0.5 * w, outers=[(d * w, w)], diag=1.0 - d * t2)
+    Q = _q_mat(u, w, wu, -uxw, t2, c1, c2, c3)
+    G21 = -_mm(A, dQu)
+    G22 = _d_tinv_t(w, d, dp, mo - z) - _mm(A, dQw + _mm(Q, DAn))
+    return DAn, G21, G22
+
+
+# ---------------------------------------------------------------- the kernel
+_OFF_DIAGONAL = ~np.eye(6, dtype=bool)
+
+
+def _diagonal(C):
+    """Diagonal ``(6, m)`` of ``C`` (m, 6, 6) if every ``C`` is diagonal, else ``None``."""
+    if np.any(C[:, _OFF_DIAGONAL]):
+        return None
+    return np.ascontiguousarray(np.einsum("nii->in", C))
+
+
+def _twice(x):
+    return np.concatenate([x, x], axis=-1)
+
+
+def _chunk(HA, HB, L, eps0, C, tangent, K_out):
+    """Forces (12, m), h, strain, sigma (6, m) of one chunk; the tangent goes to ``K_out`` (12, 12, m)."""
+    m = len(L)
+    u, w, t, d = _log_relative(HA, HB)
+    h = np.concatenate([u, w])
+    strain = h / L
+    de = strain - eps0.T
+    Cd = _diagonal(C)
+    if Cd is not None:
+        sigma = Cd * de
+    else:
+        sigma = np.einsum("ijm,jm->im", C.transpose(1, 2, 0), de)
+    k = {name: _twice(v) for name, v in
+         _coefficients(TANGENT_COEFFICIENTS if tangent else FORCE_COEFFICIENTS, t).items()}
+    c1, c2, c3 = k["c"], k["q2"], k["q3"]
+    # doubled batch [-h | h]: node A quantities first, node B second
+    u2, w2, d2 = np.concatenate([-u, u], axis=1), np.concatenate([-w, w], axis=1), _twice(d)
+    n2, m2 = _twice(sigma[:3]), _twice(sigma[3:])
+    t2 = _twice(t * t)
+    wu = _twice(_dot(w, u))
+    axu = np.concatenate([_cross(w, u)] * 2, axis=1)            # (-w) x (-u) = w x u
+    Ti = _mat(skew=0.5 * w2, outers=[(d2 * w2, w2)], diag=1.0 - d2 * t2)
+    X = -_mm(_mm(Ti, _q_mat(-u2, -w2, wu, axu, t2, c1, c2, c3)), Ti)
+    Tin = _mv(Ti, n2)
+    g = np.concatenate([Tin, _mv(X, n2) + _mv(Ti, m2)])    # g(h) = T(-h)^-T sigma = [Ti n; X n + Ti m]
+    f = np.concatenate([-g[:, m:], g[:, :m]])             # f_A = -g(h), f_B = g(-h)
+    if not tangent:
+        return f, h, strain, sigma
+    k.update(d=d2, t2=t2)
+    G12, G21, G22 = _geometric(u2, w2, n2, m2, k)
+    # rows of node s (A: sign -1, B: +1): Z_s = sign [[Ti^T, 0], [X^T, Ti^T]] (C/L) + [[0, G12], [G21, G22]]
+    sign = np.repeat([-1.0, 1.0], m)
+    TiT, XT = sign * Ti.transpose(1, 0, 2), sign * X.transpose(1, 0, 2)
+    if Cd is not None:
+        kd = _twice(Cd / L)
+        Z0 = np.concatenate([TiT * kd[:3], XT * kd[:3] + G21])            # (6, 3, 2m)
+        Z1 = np.concatenate([G12, TiT * kd[3:] + G22])
+    else:
+        CL = _twice(C.transpose(1, 2, 0) / L)
+        Bt = np.concatenate([np.concatenate([TiT, np.zeros_like(TiT)], axis=1),
+                             np.concatenate([XT, TiT], axis=1)])          # (6, 6, 2m)
+        Z = np.einsum("ikm,kjm->ijm", Bt, CL)
+        Z0 = Z[:, :3] + np.concatenate([np.zeros_like(G21), G21])
+        Z1 = Z[:, 3:] + np.concatenate([G12, G22])
+    Z0 = np.concatenate([Z0[..., :m], Z0[..., m:]])                       # (12, 3, m)
+    Z1 = np.concatenate([Z1[..., :m], Z1[..., m:]])
+    # columns of node s: sign [[Ti, X], [0, Ti]] of its side
+    for s, cols in ((0, slice(0, 6)), (1, slice(6, 12))):
+        part = slice(s * m, (s + 1) * m)
+        Tis, Xs = sign[part] * Ti[..., part], sign[part] * X[..., part]
+        K_out[:, cols.start:cols.start + 3] = _mm(Z0, Tis)
+        K_out[:, cols.start + 3:cols.stop] = _mm(Z0, Xs) + _mm(Z1, Tis)
+    return f, h, strain, sigma
+
+
+def _evaluate(H_A, H_B, L, eps0, C, tangent, out=None):
+    n = len(L)
+    f = np.empty((n, 12))
+    K = None
+    if tangent:
+        K = np.empty((12, 12, n)) if out is None else out
+        if K.shape != (12, 12, n):
+            raise ValueError(f"out must have shape (12, 12, {n}), got {K.shape}")
+    h, strain, sigma = np.empty((n, 6)), np.empty((n, 6)), np.empty((n, 6))
+    for a in range(0, n, CHUNK):
+        b = min(a + CHUNK, n)
+        out = _chunk(H_A[a:b], H_B[a:b], L[a:b], eps0[a:b], C[a:b], tangent,
+                     K[..., a:b] if tangent else None)
+        f[a:b], h[a:b], strain[a:b], sigma[a:b] = (x.T for x in out)
+    return f, (K.transpose(2, 0, 1) if tangent else None), ElementState(h, strain, sigma)
+
+
 def element_state(H_A, H_B, L, eps0, C):
-    h = se3.log(se3.relative(H_A, H_B))
-    strain = h / L[:, None]
-    sigma = np.einsum("nij,nj->ni", C, strain - eps0)
-    return ElementState(h, strain, sigma)
+    """``ElementState`` (relative twist, strain, section forces) per element."""
+    return _evaluate(H_A, H_B, L, eps0, C, tangent=False)[2]
 
 
 def energy(H_A, H_B, L, eps0, C):
@@ -53,127 +355,18 @@ def energy(H_A, H_B, L, eps0, C):
     return 0.5 * L * np.einsum("ni,ni->n", de, s.sigma)
 
 
-def _tangent_inv_blocks(h):
-    """Blocks of ``T(h)^-1 = [[Ti, X], [0, Ti]]`` and the pieces reused by ``G``."""
-    u, w = h[..., :3], h[..., 3:]
-    t = se3.rotation_angle(w)
-    W = skew(w)
-    WW = W @ W
-    d = coefficient("d", t)
-    Ti = np.eye(3) + 0.5 * W + d[..., None, None] * WW
-    Qm = se3._q_matrix(-u, -w, t)
-    X = -Ti @ Qm @ Ti
-    return Ti, X, t, d
-
-
-def _assemble_tinv(Ti, X, transpose_blocks=False):
-    n = Ti.shape[:-2]
-    out = np.zeros(n + (6, 6))
-    if transpose_blocks:  # T(-h)^-1 is T(h)^-1 with every 3x3 block transposed
-        Ti, X = np.swapaxes(Ti, -1, -2), np.swapaxes(X, -1, -2)
-    out[..., :3, :3] = Ti
-    out[..., 3:, 3:] = Ti
-    out[..., :3, 3:] = X
-    return out
-
-
 def internal_forces(H_A, H_B, L, eps0, C):
     """Body-frame nodal forces ``(n, 12)`` (A then B) and the ``ElementState``."""
-    s = element_state(H_A, H_B, L, eps0, C)
-    Ti, X, _, _ = _tangent_inv_blocks(s.h)
-    TiB = _assemble_tinv(Ti, X)
-    TiA = _assemble_tinv(Ti, X, transpose_blocks=True)
-    f = np.concatenate([-np.einsum("nji,nj->ni", TiA, s.sigma),
-                        np.einsum("nji,nj->ni", TiB, s.sigma)], axis=-1)
-    return f, s
+    f, _, state = _evaluate(H_A, H_B, L, eps0, C, tangent=False)
+    return f, state
 
 
-def _outer(a, b):
-    return a[..., :, None] * b[..., None, :]
-
-
-def _m(w, a):
-    """``d(w x (w x a))/dw = (w.a) I + w a^T - 2 a w^T``."""
-    wa = np.einsum("...i,...i->...", w, a)
-    return wa[..., None, None] * np.eye(3) + _outer(w, a) - 2.0 * _outer(a, w)
-
-
-def _d_tinv_t(w, t, d, vec):
-    """``d(T_SO3(w)^-T vec)/dw`` with ``T^-T vec = vec - w x vec / 2 + d w x (w x vec)``."""
-    dp = coefficient("dp", t)
-    wwv = _cross(w, _cross(w, vec))
-    return 0.5 * skew(vec) + dp[..., None, None] * _outer(wwv, w) + d[..., None, None] * _m(w, vec)
-
-
-def _geometric(h, sigma):
-    """``G(h, sigma) = d(T(h)^-T sigma)/dh``, ``(n, 6, 6)``.
-
-    ``T(h)^-T sigma = [A n; A m - A Q(u, w) A n]`` with ``A = T_SO3(w)^-T`` and
-    ``Q(u, w) = Q(-u, -w)^T``; differentiated term by term (c1 = c, c2 = q2,
-    c3 = q3 of se3, and their derivatives divided by t).
-    """
-    u, w = h[..., :3], h[..., 3:]
-    n, m = sigma[..., :3], sigma[..., 3:]
-    t = se3.rotation_angle(w)
-    P, U = skew(w), skew(u)
-    PP = P @ P
-    d = coefficient("d", t)
-    c1, c2, c3 = coefficient("c", t), coefficient("q2", t), coefficient("q3", t)
-    c1p, c2p, c3p = coefficient("cp", t), coefficient("q2p", t), coefficient("q3p", t)
-    A = np.eye(3) - 0.5 * P + d[..., None, None] * PP
-
-    y = np.einsum("...ij,...j->...i", A, n)
-    yw = _cross(w, y)
-    yww = _cross(w, yw)
-    a_ = _cross(u, y)
-    b_ = _cross(u, yw)
-    e_ = _cross(u, yww)
-    g1 = _cross(w, a_) + _cross(u, yw) + _cross(w, b_)
-    g2 = _cross(w, _cross(w, a_)) + e_ - 3.0 * _cross(w, b_)
-    g3 = _cross(w, e_) + _cross(w, _cross(w, b_))
-    z = 0.5 * a_ + c1[..., None] * g1 + c2[..., None] * g2 + c3[..., None] * g3  # Q(u,w) y
-
-    C1, C2, C3 = c1[..., None, None], c2[..., None, None], c3[..., None, None]
-    Y, S1, S2 = skew(y), skew(yw), skew(yww)
-    dQu = -(0.5 * Y + C1 * (P @ Y + S1 + P @ S1) + C2 * (PP @ Y + S2 - 3.0 * P @ S1)
-            + C3 * (P @ S2 + PP @ S1))
-    UY = U @ Y
-    PUY = P @ UY
-    Mwy = _m(w, y)
-    dQw = (_outer(c1p[..., None] * g1 + c2p[..., None] * g2 + c3p[..., None] * g3, w)
-           + C1 * (-skew(a_) - UY - skew(b_) - PUY)
-           + C2 * (_m(w, a_) + U @ Mwy + 3.0 * skew(b_) + 3.0 * PUY)
-           + C3 * (-skew(e_) + P @ U @ Mwy + _m(w, b_) - PP @ UY))
-    DAn = _d_tinv_t(w, t, d, n)
-
-    G = np.zeros(h.shape[:-1] + (6, 6))
-    G[..., :3, 3:] = DAn
-    G[..., 3:, :3] = -A @ dQu
-    G[..., 3:, 3:] = _d_tinv_t(w, t, d, m) - _d_tinv_t(w, t, d, z) - A @ (dQw + _q_times(u, w, t, DAn))
-    return G
-
-
-def _q_times(u, w, t, M):
-    return se3._q_matrix(u, w, t) @ M
-
-
-def internal_forces_and_tangent(H_A, H_B, L, eps0, C):
+def internal_forces_and_tangent(H_A, H_B, L, eps0, C, out=None):
     """Nodal forces ``(n, 12)``, tangent ``(n, 12, 12)`` and the ``ElementState``.
 
     The tangent is ``d f / d q`` for body increments ``q = (q_A, q_B)``
-    (``H <- H exp(hat(q))``), material and geometric parts, exact.
+    (``H <- H exp(hat(q))``), material and geometric parts, exact.  It is a
+    view of an element-axis-last array (see the module docstring): ``out``,
+    if given, an array ``(12, 12, n)`` to write it into.
     """
-    s = element_state(H_A, H_B, L, eps0, C)
-    h, sigma = s.h, s.sigma
-    Ti, X, t, d = _tangent_inv_blocks(h)
-    TiB = _assemble_tinv(Ti, X)
-    TiA = _assemble_tinv(Ti, X, transpose_blocks=True)
-    f = np.concatenate([-np.einsum("nji,nj->ni", TiA, sigma),
-                        np.einsum("nji,nj->ni", TiB, sigma)], axis=-1)
-    B = np.concatenate([-TiA, TiB], axis=-1)                     # (n, 6, 12)
-    CB = (C / L[:, None, None]) @ B
-    G = _geometric(np.concatenate([-h, h]), np.concatenate([sigma, sigma]))
-    nel = h.shape[0]
-    Gs = np.concatenate([G[:nel], G[nel:]], axis=-2)            # (n, 12, 6)
-    K = np.swapaxes(B, -1, -2) @ CB + Gs @ B
-    return f, K, s
+    return _evaluate(H_A, H_B, L, eps0, C, tangent=True, out=out)

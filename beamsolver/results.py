@@ -1,9 +1,54 @@
-"""The ``Solution`` of a solve: poses, reactions, section forces and statistics per converged step."""
+"""The ``Solution`` of a solve: poses, reactions, section forces and statistics per converged step.
+
+A ``Solution`` also carries a plain description of its model (``describe_model``:
+arrays only, enough to redraw and summarise it without the ``Model``), the
+stepping state needed to restart (``resume``) and, for scenes with contact,
+the committed contact history of the last step.  ``save`` writes it all to a
+versioned ``.npz`` file (``beamsolver.io.archive``); ``beamsolver.load`` reads it.
+"""
 import numpy as np
 
 from .errors import InputError
 
-__all__ = ["Solution"]
+__all__ = ["Solution", "describe_model"]
+
+
+def describe_model(model, system=None):
+    """Arrays describing ``model`` for drawing and summaries (no callables, no objects).
+
+    ``poses0`` (n, 4, 4); ``enodes`` (n_el, 2); ``L`` (n_el,); ``eps0`` (n_el, 6);
+    ``element_beam`` (n_el,); ``node_beam`` (n,) (-1 for nodes of ``add_node``);
+    ``beam_first_node``, ``beam_n_nodes``, ``beam_radius`` (n_beams,); ``beam_C``
+    (n_beams, 6, 6); ``beam_name`` (str); ``constrained_nodes`` and
+    ``constraint_kind`` ('clamp', 'fix' or 'prescribe'); ``load_nodes``;
+    ``joins`` (k, 2); ``n_contact_declarations``.
+    """
+    if system is not None:
+        enodes, L, eps0 = system.enodes, system.L, system.eps0
+    else:
+        enodes, L, eps0, _ = model.element_table()
+    beams = model.beams
+    n = model.n_nodes
+    node_beam = np.full(n, -1, dtype=np.int64)
+    element_beam = np.zeros(len(L), dtype=np.int64)
+    for b in beams:
+        node_beam[b.nodes] = b.id
+        element_beam[b.elements] = b.id
+    cons = sorted(model.constraints.items())
+    return dict(
+        poses0=np.array(model.poses0, dtype=float), enodes=np.array(enodes, dtype=np.int64),
+        L=np.array(L, dtype=float), eps0=np.array(eps0, dtype=float),
+        element_beam=element_beam, node_beam=node_beam,
+        beam_first_node=np.array([b.first for b in beams], dtype=np.int64),
+        beam_n_nodes=np.array([len(b.nodes) for b in beams], dtype=np.int64),
+        beam_radius=np.array([b.section.radius for b in beams], dtype=float),
+        beam_C=np.array([b.section.C for b in beams], dtype=float).reshape(-1, 6, 6),
+        beam_name=np.array([b.name or "" for b in beams], dtype=str),
+        constrained_nodes=np.array([c[0] for c in cons], dtype=np.int64),
+        constraint_kind=np.array([c[1][0] for c in cons], dtype=str),
+        load_nodes=np.array([ld.node for ld in model.loads], dtype=np.int64),
+        joins=np.array(model.joins, dtype=np.int64).reshape(-1, 2),
+        n_contact_declarations=np.int64(len(model.contacts)))
 
 
 class Solution:
@@ -15,15 +60,51 @@ class Solution:
     ``(n_steps + 1, n_elements, 6)`` in the section frame; ``stats`` a list of
     dicts per step (``iterations``, ``residuals``, ``wall_time``, ``dt``,
     ``cutbacks``); ``contacts`` a list per step of contact point tables.
+
+    ``description``: arrays describing the model (``describe_model``);
+    ``resume``: the stepping state after the last step (``t0``, ``t_end``,
+    ``steps``, ``dt``, ``easy``), used by ``solve(..., restart=)``;
+    ``contact_state``: committed contact history of the last step (dict of
+    arrays, empty without contact).  ``model`` and ``system`` are ``None`` for
+    a loaded solution.
     """
 
-    def __init__(self, model, system=None):
+    def __init__(self, model, system=None, description=None):
         self.model = model
         self.system = system
+        self._description = description
         self._times, self._poses, self._reactions = [], [], []
         self._sigma, self._strain, self.stats, self.contacts = [], [], [], []
         self.converged = True
         self.message = ""
+        self.resume = {}
+        self.contact_state = {}
+
+    @property
+    def description(self):
+        if self._description is None:
+            self._description = describe_model(self.model, self.system)
+        return self._description
+
+    def save(self, path):
+        """Write every step, the statistics, contact data and model description to ``path`` (.npz).
+
+        The file is written under a temporary name and renamed, so ``path`` is
+        always a complete file.  Read it back with ``beamsolver.load``; the
+        format is documented in ``beamsolver.io.archive``.
+        """
+        from .io.archive import save
+        return save(self, path)
+
+    def copy_steps(self, model=None, system=None):
+        """A new ``Solution`` of ``model``/``system`` holding (copies of the lists of) these steps."""
+        new = Solution(model, system, self._description if model is None else None)
+        for name in ("_times", "_poses", "_reactions", "_sigma", "_strain", "stats", "contacts"):
+            setattr(new, name, list(getattr(self, name)))
+        new.resume = dict(self.resume)
+        new.contact_state = dict(self.contact_state)
+        new.converged, new.message = self.converged, self.message
+        return new
 
     def append(self, t, H, reactions, sigma, strain, stats, contact=None):
         self._times.append(float(t))

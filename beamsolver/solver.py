@@ -17,6 +17,8 @@ import scipy.sparse.linalg as spla
 from . import se3
 from .assembly import System
 from .errors import ConvergenceError, InputError
+from .progress import Progress
+from .restart import contact_snapshot, restart_from
 from .results import Solution
 
 __all__ = ["solve", "Convergence"]
@@ -127,6 +129,7 @@ class _Newton:
             scales = conv.scales(info, self.L_ref)
             ratio = self._ratio(r, scales)
             residuals.append(ratio)
+            log.debug("t = %.6g  iteration %d  scaled residual %.3e", t, it, ratio)
             if self.callback is not None:
                 self.callback(dict(t=t, iteration=it, residual=ratio, poses=H))
             if dz_c is None and (ratio <= conv.rtol or last_inc <= conv.dtol):
@@ -194,40 +197,43 @@ class _Newton:
 
 def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dtol=1e-11,
           max_iter=30, line_search=True, min_step_ratio=2.0**-12, callback=None,
-          check_rigid_modes=True, verbose=False, initial_poses=None):
+          check_rigid_modes=True, verbose=None, initial_poses=None, restart=None, checkpoint=60.0):
     """Quasi-static solve of ``model`` from ``t_start`` to ``t_end`` in ``steps`` equal steps.
 
     Every converged (sub)step is recorded in the returned ``Solution``.  A step
     that fails is halved down to ``min_step_ratio`` times the user's step, then
     ``ConvergenceError`` is raised with the last converged ``Solution``.
 
-    ``output``: folder for ParaView files (``None``: no output).
+    ``output``: folder for ParaView files and ``solution.npz`` (``None``: no
+    output; see ``beamsolver.io.vtk``), the latter saved at the end and every
+    ``checkpoint`` seconds (0: every step); or a writer object with
+    ``write(solution, step)`` and ``close()`` such as ``io.vtk.StepWriter``.
     ``callback(info)`` is called at every Newton iteration with ``t``,
     ``iteration``, ``residual`` (scaled) and ``poses``.
+    ``verbose``: progress bar / lines (see ``progress.Progress``); ``None`` shows a bar on a terminal.
+    ``restart``: a ``Solution`` (or the path of a saved one) of this model; the
+    run continues from its last step on the grid ``linspace(restart.times[0],
+    t_end, steps + 1)`` with its stepping state and contact history, so the
+    same arguments give the same final state as a run never interrupted.
     """
+    if restart is not None and initial_poses is not None:
+        raise InputError("solve: give either restart or initial_poses, not both")
     if int(steps) != steps or steps < 1:
         raise InputError(f"solve: steps must be a positive integer, got {steps!r}")
+    system = System(model, check_rigid_modes=check_rigid_modes)
+    if restart is not None:
+        sol = restart_from(restart, model, system)
+        t_start = sol._times[0]
     if not (np.isfinite(t_end) and np.isfinite(t_start) and t_end > t_start):
         raise InputError(f"solve: need t_end > t_start, got t_start={t_start!r}, t_end={t_end!r}")
-    system = System(model, check_rigid_modes=check_rigid_modes)
     conv = Convergence(rtol=rtol, dtol=dtol, max_iter=max_iter)
     newton = _Newton(system, conv, line_search, callback)
     writer = None
-    if output is not None:
+    if output is not None and hasattr(output, "write"):
+        writer = output                   # e.g. io.vtk.StepWriter(folder, refine=4, compression=None)
+    elif output is not None:
         from .io.vtk import StepWriter
-        writer = StepWriter(output, system)
-
-    H = system.poses0.copy() if initial_poses is None else np.array(initial_poses, dtype=float)
-    if len(system.prescribed_nodes):
-        H[system.prescribed_nodes] = system.prescribed_poses(t_start)
-        system.sync_members(H)
-    sol = Solution(model, system)
-    lf0 = system.load_factors(t_start) if len(system.load_scales) else np.zeros(0)
-    r0, _, info0 = system.evaluate(H, lf0, tangent=False)
-    sol.append(t_start, H, system.reactions(H, r0), info0["state"].sigma, info0["state"].strain,
-               dict(iterations=0, residuals=[], wall_time=0.0, dt=0.0, cutbacks=0))
-    if writer is not None:
-        writer.write(sol, 0)
+        writer = StepWriter(output, system, checkpoint=checkpoint)
 
     grid = np.linspace(t_start, t_end, int(steps) + 1)
     dt_user = grid[1] - grid[0]
@@ -236,6 +242,29 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     t = t_start
     k = 1
     easy = 0
+    if restart is None:
+        H = system.poses0.copy() if initial_poses is None else np.array(initial_poses, dtype=float)
+        if len(system.prescribed_nodes):
+            H[system.prescribed_nodes] = system.prescribed_poses(t_start)
+            system.sync_members(H)
+        sol = Solution(model, system)
+        lf0 = system.load_factors(t_start) if len(system.load_scales) else np.zeros(0)
+        r0, _, info0 = system.evaluate(H, lf0, tangent=False)
+        sol.append(t_start, H, system.reactions(H, r0), info0["state"].sigma, info0["state"].strain,
+                   dict(iterations=0, residuals=[], wall_time=0.0, dt=0.0, cutbacks=0))
+        if writer is not None:
+            writer.write(sol, 0)
+    else:
+        H = sol._poses[-1].copy()
+        t = sol._times[-1]
+        k = int(np.searchsorted(grid, t + 1e-12 * dt_user, side="right"))
+        rs = sol.resume
+        if rs.get("t0") == t_start and rs.get("t_end") == t_end and rs.get("steps") == steps:
+            dt, easy = min(rs["dt"], dt_user), rs["easy"]
+        if writer is not None:
+            for j in range(len(sol._times)):
+                writer.write(sol, j)
+    progress = Progress(verbose, t_start, t_end, t)
     while k <= steps:
         t_next = min(t + dt, grid[k])
         if grid[k] - t_next < 1e-9 * dt_user:
@@ -263,6 +292,7 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
                 if dt_try < dt_min:
                     sol.converged = False
                     sol.message = str(e)
+                    progress.close()
                     if writer is not None:
                         writer.close()
                     raise ConvergenceError(
@@ -277,12 +307,11 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
         if system.contact is not None:
             system.contact.commit(H)
             contact_data = system.contact.results(H)
+            sol.contact_state = contact_snapshot(system.contact)
         sol.append(t_next, H, system.reactions(H, r), state.sigma, state.strain, stats, contact_data)
         if writer is not None:
-            writer.write(sol, len(sol.times) - 1)
-        if verbose:
-            print(f"t = {t_next:.6g}  iterations {stats['iterations']}  "
-                  f"residual {stats['residuals'][-1]:.2e}  cut-backs {cutbacks}")
+            writer.write(sol, sol.n_steps)
+        progress.step(sol.n_steps, t_next, t_next - t, stats)
         dt = t_next - t
         t = t_next
         if t >= grid[k] - 1e-12 * dt_user:
@@ -291,6 +320,8 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
         easy = easy + 1 if stats["iterations"] <= 6 and cutbacks == 0 else 0
         if easy >= 2:
             dt = min(2.0 * dt, dt_user)
+        sol.resume = dict(t0=float(grid[0]), t_end=float(t_end), steps=int(steps), dt=float(dt), easy=int(easy))
+    progress.close()
     if writer is not None:
         writer.close()
     return sol

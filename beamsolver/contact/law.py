@@ -8,11 +8,26 @@ import numpy as np
 __all__ = ["normal_force", "coulomb_return_mapping", "default_penalty"]
 
 
-def normal_force(gap, penalty, multiplier=0.0):
-    """Penalty / augmented-Lagrangian normal traction ``<multiplier - penalty g>`` (>= 0)."""
+def normal_force(gap, penalty, multiplier=0.0, smoothing=0.0):
+    """Penalty / augmented-Lagrangian normal traction, smoothed near first touch.
+
+    The trial traction ``x = multiplier - penalty g`` gives ``lam = <x>`` for a sharp
+    law (``smoothing = 0``).  With a smoothing gap ``w > 0`` the ramp is replaced on
+    ``|x| < W = penalty w`` by the C1 parabola ``(x + W)^2 / (4 W)``: the traction
+    and its derivative are continuous, contact starts at a gap ``w`` with zero force
+    and zero stiffness, and traction above ``W`` is untouched.  This keeps Newton
+    from cycling on points whose gap hovers at zero (two touching, lightly loaded
+    beams), as the quadratic regularisation of Meier, Popp & Wall (2016).
+    Returns ``(lam, active)``, ``active`` where ``lam`` (or its stiffness) is non-zero.
+    """
     trial = multiplier - penalty * gap
-    active = np.real(trial) >= 0.0   # touching (g = 0) counts: it carries stiffness
-    return np.where(active, trial, 0.0 * trial), active
+    W = penalty * smoothing
+    xr, Wr = np.real(trial), np.real(W)
+    active = xr > -Wr if np.any(Wr > 0) else xr >= 0.0   # sharp: touching counts (it carries stiffness)
+    safe = np.where(Wr > 0, W, 1.0)
+    parab = (trial + W) ** 2 / (4.0 * safe)
+    lam = np.where(xr >= Wr, trial, np.where(active, parab, 0.0 * trial))
+    return lam, active
 
 
 def coulomb_return_mapping(lam_trial, mu, lam_n):

@@ -107,7 +107,7 @@ def contact_kernel(X, p, friction=True):
 
     ``X``: ``(..., 4, 4, 4)`` node poses.  ``p``: dict of per-pair arrays
     (``kind``, ``xi1``, ``xi2``, ``R1``, ``R2``, ``weight``, ``penalty``,
-    ``multiplier``, ``mu``, ``penalty_t``, and for friction ``has_history``,
+    ``multiplier``, ``mu``, ``penalty_t``, optional ``smoothing`` (gap), and for friction ``has_history``,
     ``H_CL``, ``H_FK``, ``H_LK_prev``, ``xi1_prev``, ``xi2_prev``, ``lam_t_prev``
     (global 3-vector per unit weight)).
     """
@@ -121,7 +121,7 @@ def contact_kernel(X, p, friction=True):
     R1, R2 = p["R1"], p["R2"]
     xC, xF, n, t1, t2, dist = _axes(HC, HF)
     gap = dist - R1 - R2
-    lam_n, active = normal_force(gap, p["penalty"], p["multiplier"])
+    lam_n, active = normal_force(gap, p["penalty"], p["multiplier"], p.get("smoothing", 0.0))
     w = p["weight"]
     F_slave = -(w * lam_n)[..., None] * n
     out = dict(gap=gap, lam_n=lam_n, active=active, n=n, t1=t1, t2=t2, xC=xC, xF=xF,

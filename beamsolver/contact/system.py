@@ -11,7 +11,8 @@ of the step (``begin_step``): its material frames are those of the pair there,
 its tangential traction zero, so friction acts from the first step of contact.
 
 Options per ``Model.add_contact`` declaration (keyword arguments):
-``gauss_points`` (5), ``penalty`` (default ``law.default_penalty``, per unit
+``smoothing`` (gap over which the normal law is smoothed, default 0: the
+sharp penalty; about ``1e-3 (R1 + R2)`` helps touching, lightly loaded beams), ``gauss_points`` (5), ``penalty`` (default ``law.default_penalty``, per unit
 length), ``penalty_t`` (tangential, default = penalty), ``tolerance``
 (penetration tolerance enabling augmented-Lagrangian updates; None: pure
 penalty), ``line_angle`` (20 deg), ``point_ratio`` (0.5), ``margin``
@@ -32,7 +33,8 @@ from .search import XI_TOL, broad_phase, closest_points, element_spheres
 CALLS = Counter()          # instrumentation: a scene without contact leaves it empty
 MAX_AUGMENT = 30
 
-_KNOWN = {"gauss_points", "penalty_t", "tolerance", "line_angle", "point_ratio", "margin"}
+SMOOTHING = 0.0           # default smoothing gap of the normal law, relative to R1 + R2 (0: sharp)
+_KNOWN = {"smoothing", "gauss_points", "penalty_t", "tolerance", "line_angle", "point_ratio", "margin"}
 
 
 class _Decl:
@@ -60,6 +62,10 @@ class _Decl:
         self.point_ratio = float(o.get("point_ratio", 0.5))
         rmax = max(s.radius for s in secs)
         self.margin = float(o.get("margin", 2.0 * rmax))
+        sm = o.get("smoothing")
+        if sm is not None and not (np.isfinite(sm) and sm >= 0):
+            raise InputError(f"add_contact: smoothing must be a gap >= 0, got {sm!r}")
+        self.smoothing = sm          # None: SMOOTHING * (R1 + R2) per pair
         if self.tolerance is not None and not self.tolerance > 0:
             raise InputError(f"add_contact: tolerance must be positive, got {self.tolerance!r}")
 
@@ -246,6 +252,7 @@ class ContactSystem:
                  R2=P["R2"][sel], weight=P["weight"][sel],
                  penalty=np.array([d.penalty for d in dec]), penalty_t=np.array([d.penalty_t for d in dec]),
                  mu=np.array([d.mu for d in dec]))
+        p["smoothing"] = self._smoothing(P, sel)
         key = P["key"][sel]
         mi, mf = self._lookup(self._mult[0], key)
         p["multiplier"] = np.where(mf, self._mult[1][mi] if len(self._mult[1]) else 0.0, 0.0)
@@ -318,6 +325,12 @@ class ContactSystem:
         hf[ii] = True
         return hf
 
+    def _smoothing(self, P, sel):
+        rsum = P["R1"][sel] + P["R2"][sel]
+        given = np.array([np.nan if self.decls[k].smoothing is None else self.decls[k].smoothing
+                          for k in P["decl"][sel]])
+        return np.where(np.isnan(given), SMOOTHING * rsum, given)
+
     def _active(self, P, H):
         """Pairs whose trial normal traction is positive, with their kernel parameters."""
         xC = _interp_pos(H, self.sys.enodes, P["e"], P["xi1"])
@@ -326,8 +339,9 @@ class ContactSystem:
         pen = np.array([self.decls[k].penalty for k in P["decl"]])
         mi, mf = self._lookup(self._mult[0], P["key"])
         mult = np.where(mf, self._mult[1][mi] if len(self._mult[1]) else 0.0, 0.0)
-        # a small band around zero keeps the projection-updated gap consistent
-        return np.flatnonzero(mult - pen * gap > -pen * 1e-3 * (P["R1"] + P["R2"]))
+        # the smoothing zone plus a small band keeps the projection-updated gap consistent
+        band = self._smoothing(P, slice(None)) + 1e-3 * (P["R1"] + P["R2"])
+        return np.flatnonzero(mult - pen * gap > -pen * band)
 
     # ------------------------------------------------------------ evaluation
     def evaluate(self, H, tangent=True):

@@ -1,0 +1,197 @@
+"""The ``beamsolver`` command: run a scene script, summarise or render a saved result, export VTK.
+
+``beamsolver run SCRIPT [--output DIR] [--steps N] [--t-end T] [--quiet]``
+    Runs ``SCRIPT`` (a Python file) with ``__name__ == "__beamsolver__"`` (its
+    ``if __name__ == "__main__":`` block does not run), then takes the scene from
+    it, first match wins:
+
+    1. a global ``model`` (a ``beamsolver.Model``);
+    2. a function ``build()`` called without arguments, returning a ``Model``
+       or a tuple whose first item is one (``model, beam_a, ...``).
+
+    An optional global dict ``solve_options`` gives keyword arguments of
+    ``beamsolver.solve`` (``steps``, ``t_end``, ``rtol``, ...); ``--steps`` and
+    ``--t-end`` override it.  Output (VTU/PVD and ``solution.npz``) goes to
+    ``DIR`` (default: ``<script name>_output`` in the current directory).
+    Exit status 0 when every step converged, 2 on ``ConvergenceError`` (the
+    converged steps are written), 1 on bad input.
+``beamsolver info RESULT [--all]``
+    ``RESULT``: a ``.npz`` file or an output folder.  Prints steps, Newton
+    iterations, wall time, contact force, smallest gap / largest
+    penetration per step and the reactions of the constrained nodes.
+``beamsolver render RESULT [--step K] -o PNG [--color-by FIELD] [--size W H]``
+    Draws the beams as tubes (needs ``beamsolver[viz]``).
+``beamsolver export RESULT DIR``
+    Writes the VTU/PVD files of a saved result.
+"""
+import argparse
+import os
+import runpy
+import sys
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["main"]
+
+
+def _scene(script):
+    from .model import Model
+    ns = runpy.run_path(str(script), run_name="__beamsolver__")
+    model = ns.get("model")
+    if not isinstance(model, Model):
+        build = ns.get("build")
+        if not callable(build):
+            raise SystemExit(f"beamsolver run: {script} defines neither a Model named 'model' nor a "
+                             "function build() returning one")
+        out = build()
+        model = out[0] if isinstance(out, tuple) and out else out
+        if not isinstance(model, Model):
+            raise SystemExit(f"beamsolver run: build() in {script} returned {type(out).__name__}, "
+                             "not a Model (or a tuple starting with one)")
+    opts = dict(ns.get("solve_options") or {})
+    return model, opts
+
+
+def cmd_run(args):
+    import beamsolver as bs
+    script = Path(args.script)
+    if not script.is_file():
+        print(f"beamsolver run: no such script {script}", file=sys.stderr)
+        return 1
+    try:
+        model, opts = _scene(script)
+    except bs.InputError as e:
+        print(f"beamsolver run: {e}", file=sys.stderr)
+        return 1
+    if args.steps is not None:
+        opts["steps"] = args.steps
+    if args.t_end is not None:
+        opts["t_end"] = args.t_end
+    out = Path(args.output) if args.output else Path(f"{script.stem}_output")
+    opts["output"] = str(out)
+    opts.setdefault("verbose", False if args.quiet else None)
+    if args.restart:
+        opts["restart"] = args.restart
+    try:
+        sol = bs.solve(model, **opts)
+    except bs.ConvergenceError as e:
+        print(f"beamsolver run: {e}", file=sys.stderr)
+        if not args.quiet:
+            print(f"converged steps written to {out}/ (beams.pvd, solution.npz)")
+        return 2
+    except bs.InputError as e:
+        print(f"beamsolver run: {e}", file=sys.stderr)
+        return 1
+    if not args.quiet:
+        print(sol.summary())
+        print(f"written: {out}/beams.pvd (ParaView), {out}/solution.npz")
+    return 0
+
+
+def _row(cells, widths):
+    return "  ".join(str(c).rjust(w) for c, w in zip(cells, widths))
+
+
+def cmd_info(args):
+    import beamsolver as bs
+    sol = bs.load(args.result)
+    d = sol.description
+    n = len(sol._times)
+    print(f"{args.result}: {len(d['beam_radius'])} beams, {len(d['poses0'])} nodes, {len(d['enodes'])} elements, "
+          f"{int(d['n_contact_declarations'])} contact declarations")
+    status = "converged" if sol.converged else f"STOPPED: {sol.message}"
+    print(f"{sol.summary()}; {status}")
+    contact = int(d["n_contact_declarations"]) > 0
+    head = ["step", "t", "iterations", "residual", "cut-backs", "wall [s]"]
+    widths = [5, 10, 10, 9, 9, 9]
+    if contact:
+        head += ["contacts", "contact force", "min gap"]
+        widths += [8, 13, 11]
+    print(_row(head, widths))
+    steps = range(n) if args.all or n <= 22 else list(range(10)) + [None] + list(range(n - 10, n))
+    for k in steps:
+        if k is None:
+            print(_row(["..."] * len(head), widths))
+            continue
+        s = sol.stats[k]
+        res = s.get("residuals") or []
+        cells = [k, f"{sol._times[k]:.4g}", s.get("iterations", 0), f"{res[-1]:.1e}" if res else "-",
+                 s.get("cutbacks", 0), f"{s.get('wall_time', 0.0):.3f}"]
+        if contact:
+            c = sol.contacts[k]
+            gap = np.asarray(c.get("gap", np.zeros(0)))
+            fn = np.asarray(c.get("normal_force", np.zeros(0)))
+            cells += [int(np.sum(fn > 0)), f"{fn.sum():.4g}", f"{gap.min():.3g}" if len(gap) else "-"]
+        print(_row(cells, widths))
+    gaps = [np.min(c["gap"]) for c in sol.contacts if len(c.get("gap", ()))]
+    if gaps:
+        print(f"smallest gap over the run {min(gaps):.4g} (largest penetration {max(-min(gaps), 0.0):.4g})")
+    nodes, kinds = d["constrained_nodes"], d["constraint_kind"]
+    if len(nodes):
+        print("reactions at the last step (global force, moment about the node):")
+        print(_row(["node", "kind", "Fx", "Fy", "Fz", "Mx", "My", "Mz"], [5, 9] + [11] * 6))
+        R = sol._reactions[-1]
+        for node, kind in zip(nodes, kinds):
+            print(_row([int(node), kind] + [f"{v:.4g}" for v in R[node]], [5, 9] + [11] * 6))
+    return 0
+
+
+def cmd_render(args):
+    import beamsolver as bs
+    from . import viz
+    sol = bs.load(args.result)
+    color = None if args.color_by == "none" else args.color_by
+    viz.render(sol, step=args.step, path=args.output, color_by=color, window_size=tuple(args.size))
+    print(f"written: {args.output}")
+    return 0
+
+
+def cmd_export(args):
+    import beamsolver as bs
+    from .io import write_vtk
+    pvd = write_vtk(bs.load(args.result), args.folder)
+    print(f"written: {pvd}")
+    return 0
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(prog="beamsolver", description="Geometrically exact beams with contact.")
+    sub = p.add_subparsers(dest="command", required=True)
+    r = sub.add_parser("run", help="run a scene script (defines `model` or `build()`)")
+    r.add_argument("script")
+    r.add_argument("--output", "-o", help="output folder (default <script>_output)")
+    r.add_argument("--steps", type=int, help="number of pseudo-time steps")
+    r.add_argument("--t-end", type=float, help="end of the pseudo-time")
+    r.add_argument("--restart", help="continue from a saved result (.npz or output folder)")
+    r.add_argument("--quiet", "-q", action="store_true", help="no progress bar, no summary")
+    r.set_defaults(func=cmd_run)
+    i = sub.add_parser("info", help="summary table of a saved result")
+    i.add_argument("result")
+    i.add_argument("--all", action="store_true", help="every step (default: first and last ten)")
+    i.set_defaults(func=cmd_info)
+    d = sub.add_parser("render", help="PNG picture of a saved result (needs beamsolver[viz])")
+    d.add_argument("result")
+    d.add_argument("--step", type=int, default=-1)
+    d.add_argument("--output", "-o", required=True, help="PNG file")
+    d.add_argument("--color-by", default="displacement",
+                   help="displacement, radius, beam_id, N, Q2, Q3, T, M2, M3, strain or none")
+    d.add_argument("--size", type=int, nargs=2, default=(800, 600), metavar=("W", "H"))
+    d.set_defaults(func=cmd_render)
+    e = sub.add_parser("export", help="write VTU/PVD files of a saved result")
+    e.add_argument("result")
+    e.add_argument("folder")
+    e.set_defaults(func=cmd_export)
+    args = p.parse_args(argv)
+    try:
+        return args.func(args)
+    except (FileNotFoundError, ValueError) as exc:   # InputError is a ValueError
+        print(f"beamsolver {args.command}: {exc}", file=sys.stderr)
+        return 1
+    except BrokenPipeError:                          # `beamsolver info out | head`
+        sys.stdout = open(os.devnull, "w")
+        return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,91 @@
+"""Beams as refined poly-lines for drawing: points, segments and their data (numpy only).
+
+Every element is cut into ``refine`` segments at ``xi = k / refine``; the
+points are the constant-strain SE(3) interpolation ``H_A exp(xi h)`` with
+``h = log(H_A^-1 H_B)`` (``se3.interpolate``, the element's own kinematics),
+so a beam bent at constant curvature is drawn on its exact circle or helix
+however coarse the mesh.  Shared by ``io.vtk`` (ParaView files) and ``viz``
+(pictures); works from a ``Solution`` alone (a loaded one too).
+
+Point data: ``displacement`` (3), ``e1``, ``e2``, ``e3`` (section axes,
+the columns of ``R``), ``radius`` (contact radius of the section, for tubes),
+``beam_id``.  Segment (cell) data: the section forces of the element
+``N, Q2, Q3, T, M2, M3`` (section frame) and ``strain`` (6: ``Gamma_1..3,
+kappa_1..3`` minus the reference, so ``sigma = C strain``), ``element``.
+"""
+import numpy as np
+
+from .. import se3
+
+__all__ = ["LineLayout", "FORCE_NAMES", "STRAIN_NAMES"]
+
+FORCE_NAMES = ("N", "Q2", "Q3", "T", "M2", "M3")
+STRAIN_NAMES = ("Gamma1", "Gamma2", "Gamma3", "kappa1", "kappa2", "kappa3")
+
+
+class LineLayout:
+    """Point/segment numbering of the refined poly-lines of a model description.
+
+    ``description``: ``Solution.description`` (dict of arrays, see
+    ``results.describe_model``); ``refine``: segments per element (>= 1).
+    """
+
+    def __init__(self, description, refine=8):
+        refine = int(refine)
+        if refine < 1:
+            raise ValueError(f"refine must be >= 1, got {refine}")
+        d = description
+        self.refine = refine
+        self.enodes = np.asarray(d["enodes"])
+        n_el = len(self.enodes)
+        self.n_elements = n_el
+        el_beam = np.asarray(d["element_beam"])
+        radius = np.asarray(d["beam_radius"], dtype=float)
+        # points: per element xi = 0, 1/s, .., (s-1)/s, plus the last node of each beam
+        # (elements of a beam are consecutive and chained, model.add_beam)
+        last_of_beam = np.r_[el_beam[1:] != el_beam[:-1], True] if n_el else np.zeros(0, dtype=bool)
+        self.last_of_beam = np.flatnonzero(last_of_beam)
+        per_el = refine + last_of_beam.astype(int)
+        start = np.concatenate([[0], np.cumsum(per_el)[:-1]]).astype(np.int64)
+        self.n_points = int(per_el.sum())
+        k = np.arange(refine)
+        self.point_el = np.repeat(np.arange(n_el), refine)                 # interior/first points
+        self.point_xi = np.tile(k / refine, n_el)
+        self.point_index = (start[:, None] + k).ravel()
+        self.end_index = start[self.last_of_beam] + refine                # last node of each beam
+        self.end_node = self.enodes[self.last_of_beam, 1]
+        seg_a = (start[:, None] + k).ravel()
+        self.segments = np.stack([seg_a, seg_a + 1], axis=1)              # (n_el * s, 2)
+        self.segment_el = np.repeat(np.arange(n_el), refine)
+        pbeam = np.empty(self.n_points, dtype=np.int32)
+        pbeam[self.point_index] = el_beam[self.point_el]
+        pbeam[self.end_index] = el_beam[self.last_of_beam]
+        self.point_beam = pbeam
+        self.point_radius = radius[pbeam]
+        self.eps0 = np.asarray(d["eps0"], dtype=float)
+        self.reference = self.poses(np.asarray(d["poses0"], dtype=float))[:, :3, 3]
+
+    def poses(self, H):
+        """Poses ``(n_points, 4, 4)`` of the refined points for node poses ``H``."""
+        out = np.empty((self.n_points, 4, 4))
+        if self.n_elements == 0:
+            return out
+        HA, HB = H[self.enodes[:, 0]], H[self.enodes[:, 1]]
+        h = se3.log(se3.relative(HA, HB))
+        e = self.point_el
+        out[self.point_index] = se3.interpolate(HA[e], h[e], self.point_xi)
+        out[self.end_index] = H[self.end_node]
+        return out
+
+    def point_data(self, H):
+        P = self.poses(H)
+        return dict(displacement=P[:, :3, 3] - self.reference, e1=P[:, :3, 0].copy(),
+                    e2=P[:, :3, 1].copy(), e3=P[:, :3, 2].copy(), radius=self.point_radius,
+                    beam_id=self.point_beam), P[:, :3, 3].copy()
+
+    def cell_data(self, sigma, strain):
+        e = self.segment_el
+        out = {name: np.ascontiguousarray(sigma[e, i]) for i, name in enumerate(FORCE_NAMES)}
+        out["strain"] = np.ascontiguousarray((strain - self.eps0)[e])
+        out["element"] = e.astype(np.int32)
+        return out

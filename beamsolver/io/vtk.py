@@ -1,0 +1,199 @@
+"""ParaView output through meshio: one ``.vtu`` per converged step and ``.pvd`` collections.
+
+Files in the output folder (``solve(model, output=folder)``, or
+``write_vtk(solution, folder)`` for a saved solution):
+
+- ``beams_<k>.vtu``: the beams as ``line`` cells, each element refined into
+  ``refine`` segments with the SE(3) interpolation (``io.lines``); point
+  data ``displacement``, ``e1``, ``e2``, ``e3``, ``radius``, ``beam_id``;
+  cell data ``N, Q2, Q3, T, M2, M3``, ``strain`` (6), ``element``.
+- ``contact_<k>.vtu`` (scenes with contact only): one vertex per contact
+  point, with ``gap``, ``normal_force``, ``tangential_force`` (3),
+  ``stick`` (1 stick, 0 slip or frictionless), ``slip_increment`` (2),
+  ``normal`` (3), ``kind``; no points before contact occurs (such a file
+  is valid VTK that ParaView and pyvista read; meshio cannot read any mesh
+  without cells).
+- ``beams.pvd`` and ``contact.pvd``: the collections with the pseudo-times.
+- ``solution.npz``: the ``Solution`` (``io.archive``), saved at the end of the
+  run (also when it stops with ``ConvergenceError``) and every
+  ``checkpoint`` seconds of wall time (``0``: after every step), for
+  ``beamsolver info`` and ``solve(..., restart=folder)``.
+
+Every file is written under a temporary name in the same folder and then
+renamed (``os.replace``, atomic on POSIX), and the ``.pvd`` files are
+rewritten after every step: a run that stops at any moment leaves only
+complete files, and ``.pvd`` files that list exactly the steps written.
+meshio cannot write VTK poly-lines (type 4), hence two-point ``line`` cells;
+ParaView's Tube filter (after Extract Surface) draws them.
+"""
+import os
+import tempfile
+import time
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from .lines import LineLayout
+
+__all__ = ["StepWriter", "write_vtk", "write_pvd"]
+
+BEAMS = "beams"
+CONTACT = "contact"
+ARCHIVE = "solution.npz"
+CONTACT_FIELDS = {"gap": (), "normal_force": (), "tangential_force": (3,), "stick": (),
+                  "slip_increment": (2,), "normal": (3,), "kind": ()}
+
+
+def _atomic(path, write):
+    """Call ``write(tmp_path)`` then rename ``tmp_path`` to ``path``."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".tmp" + path.suffix, dir=path.parent)
+    os.close(fd)
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def write_pvd(path, entries):
+    """Atomically write a ParaView collection of ``(time, file name)`` entries."""
+    lines = ['<?xml version="1.0"?>',
+             '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
+             "  <Collection>"]
+    for t, name in entries:
+        lines.append(f'    <DataSet timestep="{float(t)!r}" group="" part="0" file={quoteattr(name)}/>')
+    lines += ["  </Collection>", "</VTKFile>", ""]
+    text = "\n".join(lines)
+
+    def write(tmp):
+        with open(tmp, "w") as f:
+            f.write(text)
+    _atomic(path, write)
+
+
+class StepWriter:
+    """Writes the steps of a ``Solution`` as they converge (used by ``solve(output=)``).
+
+    ``folder``: created if missing; ``system``: the ``assembly.System`` (or
+    ``None`` when writing a loaded solution); ``refine``: segments drawn per
+    element; ``compression``: ``"zlib"``, ``"lzma"`` or ``None``;
+    ``checkpoint``: seconds between saves of ``solution.npz`` (``None``: never
+    save it, as for exporting a loaded solution).
+    """
+
+    def __init__(self, folder, system=None, refine=8, compression="zlib", contact=None, checkpoint=60.0):
+        import meshio   # imported here: scenes without output never pay for it
+        self._meshio = meshio
+        self.folder = Path(folder)
+        self.folder.mkdir(parents=True, exist_ok=True)
+        self.refine = refine
+        self.compression = compression
+        if contact is None and system is not None:
+            contact = system.contact is not None
+        self.contact = contact     # None: decided from the solution's model description
+        self.layout = None
+        self.entries = {}          # step -> time
+        self.width = 4
+        self.checkpoint = checkpoint
+        self._solution = None
+        self._saved_at = time.perf_counter()
+
+    def _name(self, kind, step):
+        return f"{kind}_{step:0{self.width}d}.vtu"
+
+    def write(self, solution, step):
+        """Write step ``step`` of ``solution`` and rewrite the collections."""
+        meshio = self._meshio
+        if self.layout is None:
+            self.layout = LineLayout(solution.description, self.refine)
+            if self.contact is None:
+                self.contact = int(solution.description.get("n_contact_declarations", 0)) > 0
+        lay = self.layout
+        H = solution._poses[step]
+        t = solution._times[step]
+        pdata, points = lay.point_data(H)
+        cdata = lay.cell_data(solution._sigma[step], solution._strain[step])
+        mesh = meshio.Mesh(points, [("line", lay.segments)], point_data=pdata,
+                           cell_data={k: [v] for k, v in cdata.items()})
+        self._write_mesh(self.folder / self._name(BEAMS, step), mesh)
+        if self.contact:
+            path = self.folder / self._name(CONTACT, step)
+            table = solution.contacts[step]
+            if len(table.get("position", ())):
+                self._write_mesh(path, contact_mesh(table))
+            else:
+                _atomic(path, _write_empty_points)
+        self.entries[step] = t
+        self._write_collections()
+        self._solution = solution
+        if self.checkpoint is not None and time.perf_counter() - self._saved_at >= self.checkpoint:
+            self.save()
+
+    def save(self):
+        """Save the solution written so far to ``solution.npz`` (atomically)."""
+        if self._solution is not None and self.checkpoint is not None:
+            self._solution.save(self.folder / ARCHIVE)
+            self._saved_at = time.perf_counter()
+
+    def _write_mesh(self, path, mesh):
+        meshio = self._meshio
+        _atomic(path, lambda tmp: meshio.vtu.write(tmp, mesh, binary=True, compression=self.compression))
+
+    def _write_collections(self):
+        steps = sorted(self.entries)
+        write_pvd(self.folder / f"{BEAMS}.pvd", [(self.entries[k], self._name(BEAMS, k)) for k in steps])
+        if self.contact:
+            write_pvd(self.folder / f"{CONTACT}.pvd",
+                      [(self.entries[k], self._name(CONTACT, k)) for k in steps])
+
+    def close(self):
+        """Save ``solution.npz`` (every VTU/PVD file is already complete when ``write`` returns)."""
+        self.save()
+
+
+def contact_mesh(table):
+    """The contact points of one step as a meshio vertex mesh."""
+    import meshio
+    pos = np.asarray(table.get("position", np.zeros((0, 3))), dtype=float).reshape(-1, 3)
+    k = len(pos)
+    pdata = {}
+    for name, shape in CONTACT_FIELDS.items():
+        v = np.asarray(table.get(name, np.zeros((k,) + shape)))
+        if name in ("stick", "kind"):
+            v = v.astype(np.int32)
+        else:
+            v = v.astype(float)
+        pdata[name] = v.reshape((k,) + shape)
+    cells = [("vertex", np.arange(k, dtype=np.int64).reshape(-1, 1))]
+    return meshio.Mesh(pos, cells, point_data=pdata)
+
+
+def _write_empty_points(path):
+    """A valid VTU with no points but the contact arrays (meshio writes no Cells for it)."""
+    arrays = "".join(f'<DataArray type="{"Int32" if k in ("stick", "kind") else "Float64"}" Name="{k}" '
+                     f'NumberOfComponents="{int(np.prod(shape))}" format="ascii"></DataArray>\n'
+                     for k, shape in CONTACT_FIELDS.items())
+    text = ('<?xml version="1.0"?>\n'
+            '<VTKFile type="UnstructuredGrid" version="0.1" byte_order="LittleEndian">\n'
+            '<UnstructuredGrid>\n<Piece NumberOfPoints="0" NumberOfCells="0">\n'
+            '<Points>\n<DataArray type="Float64" NumberOfComponents="3" format="ascii"></DataArray>\n'
+            '</Points>\n<Cells>\n<DataArray type="Int64" Name="connectivity" format="ascii"></DataArray>\n'
+            '<DataArray type="Int64" Name="offsets" format="ascii"></DataArray>\n'
+            '<DataArray type="UInt8" Name="types" format="ascii"></DataArray>\n</Cells>\n'
+            f'<PointData>\n{arrays}</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n')
+    with open(path, "w") as f:
+        f.write(text)
+
+
+def write_vtk(solution, folder, steps=None, refine=8, compression="zlib"):
+    """Write the steps (default all) of a (saved or fresh) ``solution`` to ``folder``; returns the .pvd path."""
+    writer = StepWriter(folder, None, refine=refine, compression=compression, checkpoint=None)
+    n = len(solution._times)
+    for k in (range(n) if steps is None else [s % n for s in steps]):
+        writer.write(solution, k)
+    writer.close()
+    return writer.folder / f"{BEAMS}.pvd"

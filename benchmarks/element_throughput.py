@@ -1,0 +1,140 @@
+"""Element throughput: the batched SE(3) beam kernel and the assembly, in elements per second.
+
+Scene: one clamped helix (curved and twisted elements, so every coefficient of
+the kernel is non-trivial) of ``n`` elements with a dead tip load, in a
+deformed, non-equilibrium state.  Per size ``n = 1e2 .. 1e5``:
+
+- kernel: ``element.internal_forces_and_tangent`` (forces + exact tangent);
+- assembly: ``System.evaluate`` (kernel + loads + residual scatter) and
+  ``System.matrix`` (tangent values scattered into the CSC pattern built once);
+- iteration: assembly plus the sparse factorisation and solve of one Newton
+  iteration (scipy ``splu``, as ``solve`` does), to show the per-iteration cost
+  growing linearly with ``n``;
+
+plus a plain per-element Python loop of the same maths (the kernel called
+with one element at a time) on a subset, measured in the same run, and the
+ratio batched / loop.  Single core: the thread counts of the BLAS/OpenMP
+libraries are set to 1 before numpy is imported.  Table on stdout, CSV in
+``benchmarks/results/element_throughput.csv``.
+
+``python benchmarks/element_throughput.py [max_elements]``
+"""
+import os
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "VECLIB_MAXIMUM_THREADS",
+             "NUMEXPR_NUM_THREADS"):
+    os.environ[_var] = "1"
+
+import csv  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+import scipy.sparse.linalg as spla  # noqa: E402
+
+import beamsolver as bs  # noqa: E402
+from beamsolver import element  # noqa: E402
+from beamsolver.assembly import System  # noqa: E402
+
+OUT = Path(__file__).resolve().parent / "results"
+TARGET = 5e5            # elements per second for the kernel on one core (issue 2)
+LOOP_SUBSET = 300       # elements timed one at a time
+
+
+def scene(n_elements, seed=0):
+    """System and a deformed state of a clamped helix with ``n_elements`` elements."""
+    sec = bs.Section.circular(radius=0.002, E=2e11)
+    m = bs.Model()
+    pitch = 0.1
+    beam = m.add_beam(bs.geometry.helix(radius=0.02, pitch=pitch, length=pitch * n_elements / 20.0,
+                                        n_elements=n_elements), sec)
+    m.clamp(beam.first)
+    m.add_load(beam.last, force=(1.0, -2.0, 3.0))
+    system = System(m)
+    rng = np.random.default_rng(seed)
+    dz = 1e-3 * rng.standard_normal((system.n_nodes, 6))
+    dz[:, :3] *= 0.01
+    H = system.update(system.poses0, dz, chains=False)
+    return system, H
+
+
+def _best(fn, min_time=0.3, max_repeat=20):
+    """Best wall time of ``fn()`` over repeats lasting at least ``min_time`` in total."""
+    best, total, k = np.inf, 0.0, 0
+    while (total < min_time or k < 3) and k < max_repeat:
+        t0 = time.perf_counter()
+        fn()
+        dt = time.perf_counter() - t0
+        best, total, k = min(best, dt), total + dt, k + 1
+    return best
+
+
+def measure(n):
+    system, H = scene(n)
+    HA, HB = H[system.enodes[:, 0]], H[system.enodes[:, 1]]
+    args = (HA, HB, system.L, system.eps0, system.C)
+    lf = system.load_factors(1.0)
+    t_kernel = _best(lambda: element.internal_forces_and_tangent(*args))
+    t_forces = _best(lambda: element.internal_forces(*args))
+
+    def assemble():
+        r, kvals, info = system.evaluate(H, lf, tangent=True)
+        return r, system.matrix(kvals, info["extra"])
+    t_assembly = _best(assemble)
+    r, K = assemble()
+    rhs = -r[system.free_dofs]
+
+    def iteration():
+        r, K = assemble()
+        spla.splu(K, permc_spec="MMD_AT_PLUS_A").solve(rhs)
+    t_iteration = _best(iteration)
+    return dict(n_elements=n, n_dofs=system.n_free, kernel=n / t_kernel, forces_only=n / t_forces,
+                assembly=n / t_assembly, iteration_ms=1e3 * t_iteration, iteration=n / t_iteration)
+
+
+def loop_rate(n=LOOP_SUBSET):
+    """Elements per second of the same kernel called once per element (plain Python loop)."""
+    system, H = scene(n)
+    HA, HB = H[system.enodes[:, 0]], H[system.enodes[:, 1]]
+    L, eps0, C = system.L, system.eps0, system.C
+
+    def loop():
+        for e in range(n):
+            element.internal_forces_and_tangent(HA[e:e + 1], HB[e:e + 1], L[e:e + 1], eps0[e:e + 1],
+                                                C[e:e + 1])
+    return n / _best(loop, min_time=0.5, max_repeat=5)
+
+
+def main(max_elements=100_000):
+    sizes = [n for n in (100, 1_000, 10_000, 100_000) if n <= max_elements]
+    loop = loop_rate()
+    rows = []
+    for n in sizes:
+        row = measure(n)
+        row["ratio_to_loop"] = row["kernel"] / loop
+        rows.append(row)
+    header = (f"{'elements':>9} {'dofs':>8} {'kernel el/s':>12} {'forces el/s':>12} {'assembly el/s':>14} "
+              f"{'iteration ms':>13} {'iteration el/s':>15} {'kernel/loop':>12}")
+    lines = ["Element throughput (one core; kernel = forces + exact tangent; assembly = kernel + loads "
+             "+ scatter into CSC; iteration = assembly + splu factor/solve)", header]
+    for r in rows:
+        lines.append(f"{r['n_elements']:>9d} {r['n_dofs']:>8d} {r['kernel']:>12.3g} {r['forces_only']:>12.3g} "
+                     f"{r['assembly']:>14.3g} {r['iteration_ms']:>13.2f} {r['iteration']:>15.3g} "
+                     f"{r['ratio_to_loop']:>12.0f}")
+    lines.append(f"per-element Python loop over the same kernel ({LOOP_SUBSET} elements): {loop:.3g} el/s")
+    best = max(r["kernel"] for r in rows)
+    lines.append(f"target {TARGET:.0e} el/s for the kernel: {'met' if best >= TARGET else 'NOT met'} "
+                 f"(best {best:.3g} el/s)")
+    print("\n".join(lines))
+    OUT.mkdir(exist_ok=True)
+    with open(OUT / "element_throughput.csv", "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]) + ["loop"])
+        w.writeheader()
+        for r in rows:
+            w.writerow({**r, "loop": loop})
+    return rows, loop
+
+
+if __name__ == "__main__":
+    main(int(float(sys.argv[1])) if len(sys.argv) > 1 else 100_000)

@@ -1,0 +1,61 @@
+"""Pictures (optional [viz] extra): skipped cleanly when pyvista / matplotlib are missing."""
+import struct
+
+import numpy as np
+import pytest
+
+import beamsolver as bs
+
+
+def png_size(path):
+    with open(path, "rb") as f:
+        head = f.read(24)
+    assert head[:8] == b"\x89PNG\r\n\x1a\n"
+    return struct.unpack(">II", head[16:24])
+
+
+@pytest.fixture(scope="module")
+def roll_up():
+    L, EI = 10.0, 1e2
+    sec = bs.Section(EA=1e4, GA2=1e4, GA3=1e4, GJ=1e2, EI2=EI, EI3=EI, radius=0.2)
+    m = bs.Model()
+    b = m.add_beam(bs.geometry.straight((0, 0, 0), (L, 0, 0), 4), sec)
+    m.clamp(b.first)
+    m.add_load(b.last, moment=(0, 0, 2 * np.pi * EI / L), follower=True)
+    return bs.solve(m, steps=2), b
+
+
+def test_core_never_imports_pictures():
+    import subprocess
+    import sys
+    code = ("import sys, beamsolver as bs; bs.Model(); "
+            "print(any(m.split('.')[0] in ('pyvista', 'vtk', 'matplotlib', 'meshio') for m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
+
+
+def test_render_png_of_requested_size(tmp_path, roll_up):
+    pytest.importorskip("pyvista")
+    from beamsolver import viz
+    sol, _ = roll_up
+    path = tmp_path / "roll.png"
+    img = viz.render(sol, path=path, color_by="M3", window_size=(320, 240))
+    assert png_size(path) == (320, 240) and path.stat().st_size > 1000
+    assert img.shape == (240, 320, 3)
+    assert (img != img[0, 0]).any(axis=-1).mean() > 0.02        # something besides background is drawn
+    with pytest.raises(ValueError, match="color_by"):
+        viz.render(sol, color_by="nonsense", window_size=(50, 50))
+
+
+def test_plot_history_png(tmp_path, roll_up):
+    pytest.importorskip("matplotlib")
+    from beamsolver import viz
+    sol, b = roll_up
+    fig = viz.plot_history(sol, "reaction", node=b.first, component="mz", path=tmp_path / "h.png")
+    w, h = png_size(tmp_path / "h.png")                  # 6 x 4 in at 100 dpi, cropped to the drawing
+    assert 300 < w <= 600 and 200 < h <= 400
+    line = fig.axes[0].lines[0]
+    np.testing.assert_allclose(line.get_xdata(), sol.times)
+    np.testing.assert_allclose(line.get_ydata(), [sol.reaction(b.first, k)[5] for k in range(3)])
+    fig = viz.plot_history(sol, ["iterations", lambda s, k: s.position(b.last, k)[1]])
+    assert len(fig.axes[0].lines) == 2
