@@ -1,19 +1,18 @@
 """The 1+6 strand example against the fibre limit of strand theory (reduced set of angles)."""
-import importlib.util
-import pathlib
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-EXAMPLE = pathlib.Path(__file__).resolve().parents[1] / "examples" / "seven_wire_strand.py"
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+
+import seven_wire_strand  # noqa: E402
 
 
 @pytest.fixture(scope="module")
 def rows():
-    spec = importlib.util.spec_from_file_location("seven_wire_strand", EXAMPLE)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod.main(angles=(5.0, 15.0))
+    return seven_wire_strand.main(angles=(5.0, 15.0))
 
 
 def test_fixed_end_stiffness_and_torque_near_fibre_limit(rows):

@@ -1,23 +1,17 @@
 """The twisted-pair example (frictionless) at a reduced size."""
-import importlib.util
-import pathlib
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-EXAMPLE = pathlib.Path(__file__).resolve().parents[1] / "examples" / "twisted_pair.py"
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+
+import twisted_pair  # noqa: E402
 
 
 @pytest.fixture(scope="module")
-def twisted_pair():
-    spec = importlib.util.spec_from_file_location("twisted_pair", EXAMPLE)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
-@pytest.fixture(scope="module")
-def runs(twisted_pair):
+def runs():
     kw = dict(turns=0.5, steps=4, n_elements=8, mu=0.0)
     base = twisted_pair.main(**kw)
     swapped = twisted_pair.main(swap=True, **kw)
@@ -46,7 +40,7 @@ def test_slave_master_symmetry(runs):
     assert rows_s[-1][2] == pytest.approx(rows[-1][2], rel=1e-6)
 
 
-def test_halved_steps_agree(twisted_pair, runs):
+def test_halved_steps_agree(runs):
     (_, rows, _), _ = runs
     _, rows_h, _ = twisted_pair.main(turns=0.5, steps=8, n_elements=8, mu=0.0)
     assert rows_h[-1][1] == pytest.approx(rows[-1][1], rel=1e-3)

@@ -85,6 +85,12 @@ class ContactSystem:
             self.el_last[b.elements[-1]] = True
         self.n_beams = len(model.beams)
         self.decls = [_Decl(k, d, model) for k, d in enumerate(model.contacts)]
+        # per-declaration parameters as arrays, indexed by a pair's ``decl`` (no loop over pairs)
+        self._decl_penalty = np.array([d.penalty for d in self.decls])
+        self._decl_penalty_t = np.array([d.penalty_t for d in self.decls])
+        self._decl_mu = np.array([d.mu for d in self.decls])
+        self._decl_smoothing = np.array([np.nan if d.smoothing is None else d.smoothing for d in self.decls])
+        self._decl_tolerance = np.array([np.inf if d.tolerance is None else d.tolerance for d in self.decls])
         self.max_gp = max(d.n_gp for d in self.decls)
         self.point_offset = np.int64(n_el) * self.max_gp * self.n_beams * len(self.decls)
         self._history = self._empty_history()
@@ -247,11 +253,10 @@ class ContactSystem:
 
     def _params(self, P, sel, H):
         """Kernel parameters for the pairs ``sel`` (history and multipliers looked up)."""
-        dec = [self.decls[k] for k in P["decl"][sel]]
+        dec = P["decl"][sel]
         p = dict(kind=P["kind"][sel], xi1=P["xi1"][sel], xi2=P["xi2"][sel], R1=P["R1"][sel],
-                 R2=P["R2"][sel], weight=P["weight"][sel],
-                 penalty=np.array([d.penalty for d in dec]), penalty_t=np.array([d.penalty_t for d in dec]),
-                 mu=np.array([d.mu for d in dec]))
+                 R2=P["R2"][sel], weight=P["weight"][sel], penalty=self._decl_penalty[dec],
+                 penalty_t=self._decl_penalty_t[dec], mu=self._decl_mu[dec])
         p["smoothing"] = self._smoothing(P, sel)
         key = P["key"][sel]
         mi, mf = self._lookup(self._mult[0], key)
@@ -327,8 +332,7 @@ class ContactSystem:
 
     def _smoothing(self, P, sel):
         rsum = P["R1"][sel] + P["R2"][sel]
-        given = np.array([np.nan if self.decls[k].smoothing is None else self.decls[k].smoothing
-                          for k in P["decl"][sel]])
+        given = self._decl_smoothing[P["decl"][sel]]
         return np.where(np.isnan(given), SMOOTHING * rsum, given)
 
     def _active(self, P, H):
@@ -336,7 +340,7 @@ class ContactSystem:
         xC = _interp_pos(H, self.sys.enodes, P["e"], P["xi1"])
         xF = _interp_pos(H, self.sys.enodes, P["m"], P["xi2"])
         gap = np.linalg.norm(xF - xC, axis=1) - P["R1"] - P["R2"]
-        pen = np.array([self.decls[k].penalty for k in P["decl"]])
+        pen = self._decl_penalty[P["decl"]]
         mi, mf = self._lookup(self._mult[0], P["key"])
         mult = np.where(mf, self._mult[1][mi] if len(self._mult[1]) else 0.0, 0.0)
         # the smoothing zone plus a small band keeps the projection-updated gap consistent
@@ -433,8 +437,7 @@ class ContactSystem:
             return False
         p, out = po
         gap = out["gap"]
-        tols = np.array([np.inf if self.decls[k].tolerance is None else self.decls[k].tolerance
-                         for k in P["decl"][sel]])
+        tols = self._decl_tolerance[P["decl"][sel]]
         if np.all(-gap <= tols):
             return False
         keys = P["key"][sel]
