@@ -1,4 +1,4 @@
-"""The twisted-pair example (frictionless) at a reduced size."""
+"""The twisted-pair example (frictional, mu = 0.3) at a reduced size."""
 import sys
 from pathlib import Path
 
@@ -9,12 +9,14 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 
 import twisted_pair  # noqa: E402
 
+KW = dict(turns=0.5, steps=4, n_elements=8, mu=0.3)
+R = 0.5e-3
+
 
 @pytest.fixture(scope="module")
 def runs():
-    kw = dict(turns=0.5, steps=4, n_elements=8, mu=0.0)
-    base = twisted_pair.main(**kw)
-    swapped = twisted_pair.main(swap=True, **kw)
+    base = twisted_pair.main(**KW)
+    swapped = twisted_pair.main(swap=True, **KW)
     return base, swapped
 
 
@@ -25,23 +27,48 @@ def test_wires_touch_and_torque_grows(runs):
     torque = np.array([r[1] for r in rows])
     assert np.all(np.diff(torque) > 0) and torque[-1] > 0
     # torsion of both wires dominates: 2 G J phi / L within 10 %
-    G, J = 200e9 / 2.6, np.pi * 0.5e-3**4 / 2
+    G, J = 200e9 / 2.6, np.pi * R**4 / 2
     assert torque[-1] == pytest.approx(2 * G * J * 2 * np.pi * twist[-1] / 0.02, rel=0.1)
+    # the clamps carry the 5 N pull
+    assert rows[-1][2] == pytest.approx(5.0, rel=1e-6)
     c = sol.contact(-1)
     active = c["normal_force"] > 0
     assert active.sum() >= 10
-    # touching along the twisted part: gaps within the smoothing gap, no deep penetration
-    assert np.all(np.abs(c["gap"][active]) < 2e-3 * 0.5e-3 * 2)
+    # touching along the twisted part: gaps within the smoothing gap, penetration below 1e-3 R
+    assert np.all(c["gap"][active] < 2e-3 * R) and np.all(c["gap"][active] > -1e-3 * R)
+    z = c["position"][active, 2]
+    assert z.min() < 0.25 * 0.02 and z.max() > 0.75 * 0.02        # along the whole length
+
+
+def test_friction_acts_within_the_coulomb_cone(runs):
+    (sol, _, _), _ = runs
+    c = sol.contact(-1)
+    active = c["normal_force"] > 0
+    ft = np.linalg.norm(c["tangential_force"], axis=1)[active]
+    fn = c["normal_force"][active]
+    assert ft.max() > 0.05 * 0.3 * fn.max()                           # friction is on
+    assert np.all(ft <= 0.3 * fn * (1 + 1e-9))                          # Coulomb cone
+    slipping = ~c["stick"][active]
+    np.testing.assert_allclose(ft[slipping], 0.3 * fn[slipping], rtol=1e-9)
 
 
 def test_slave_master_symmetry(runs):
     (_, rows, _), (_, rows_s, _) = runs
     assert rows_s[-1][1] == pytest.approx(rows[-1][1], rel=0.02)
-    assert rows_s[-1][2] == pytest.approx(rows[-1][2], rel=1e-6)
+    assert rows_s[-1][3] == pytest.approx(rows[-1][3], rel=1e-6)
 
 
 def test_halved_steps_agree(runs):
     (_, rows, _), _ = runs
-    _, rows_h, _ = twisted_pair.main(turns=0.5, steps=8, n_elements=8, mu=0.0)
+    _, rows_h, _ = twisted_pair.main(**dict(KW, steps=8))
     assert rows_h[-1][1] == pytest.approx(rows[-1][1], rel=1e-3)
-    assert rows_h[-1][2] == pytest.approx(rows[-1][2], rel=1e-6)
+    assert rows_h[-1][3] == pytest.approx(rows[-1][3], rel=1e-6)
+
+
+def test_friction_changes_the_answer_only_slightly(runs):
+    """Torsion of the wires dominates the torque of a lightly pulled pair: the frictional
+    and frictionless runs differ by well under 1 %, but they differ."""
+    (_, rows, _), _ = runs
+    _, rows_0, _ = twisted_pair.main(**dict(KW, mu=0.0))
+    assert rows_0[-1][1] == pytest.approx(rows[-1][1], rel=1e-2)
+    assert rows_0[-1][1] != rows[-1][1]

@@ -28,6 +28,7 @@ from ..se3 import _cross
 from .law import coulomb_return_mapping, normal_force
 
 LINE, ORTHOGONAL, POINT = 0, 1, 2
+PENALTY_T_MIN = 1e-3     # floor of the slip-tolerance tangential penalty / (mu normal penalty)
 
 
 def _dot(a, b):
@@ -107,7 +108,8 @@ def contact_kernel(X, p, friction=True):
 
     ``X``: ``(..., 4, 4, 4)`` node poses.  ``p``: dict of per-pair arrays
     (``kind``, ``xi1``, ``xi2``, ``R1``, ``R2``, ``weight``, ``penalty``,
-    ``multiplier``, ``mu``, ``penalty_t``, optional ``smoothing`` (gap), and for friction ``has_history``,
+    ``multiplier``, ``mu``, ``penalty_t`` (nan: ``mu lam_N / elastic_slip``), optional ``smoothing``
+    (gap) and ``elastic_slip``, and for friction ``has_history``,
     ``H_CL``, ``H_FK``, ``H_LK_prev``, ``xi1_prev``, ``xi2_prev``, ``lam_t_prev``
     (global 3-vector per unit weight)).
     """
@@ -146,7 +148,15 @@ def contact_kernel(X, p, friction=True):
         nl = np.sqrt(_dot(lam_prev, lam_prev))
         scale = np.where(np.real(nl) > 1e-300 * (1 + np_), np_ / np.where(np.real(nl) > 0, nl, 1.0), 0.0)
         lam_prev = lam_prev * scale[..., None]
-        trial = lam_prev + p["penalty_t"][..., None] * slip
+        # tangential penalty: given, or such that sliding starts at the elastic slip
+        # ``elastic_slip`` (it then scales with lam_N, whose derivative the tangent carries;
+        # the floor PENALTY_T_MIN keeps a just-touching point, lam_N = 0, from leaving a
+        # rigid mode that only friction holds unconstrained)
+        pen_t = p["penalty_t"]
+        if "elastic_slip" in p:
+            pen_t = np.where(np.isnan(np.real(pen_t)),
+                             p["mu"] * (lam_n / p["elastic_slip"] + PENALTY_T_MIN * p["penalty"]), pen_t)
+        trial = lam_prev + pen_t[..., None] * slip
         lam_t, stick = coulomb_return_mapping(trial, p["mu"], lam_n)
         lam_t = np.where(active[..., None], lam_t, 0.0)
         F_slave = F_slave + (w * lam_t[..., 0])[..., None] * t1 + (w * lam_t[..., 1])[..., None] * t2

@@ -13,7 +13,11 @@ its tangential traction zero, so friction acts from the first step of contact.
 Options per ``Model.add_contact`` declaration (keyword arguments):
 ``smoothing`` (gap over which the normal law is smoothed, default 0: the
 sharp penalty; about ``1e-3 (R1 + R2)`` helps touching, lightly loaded beams), ``gauss_points`` (5), ``penalty`` (default ``law.default_penalty``, per unit
-length), ``penalty_t`` (tangential, default = penalty), ``tolerance``
+length), ``penalty_t`` (tangential penalty, force / length^3; default: none, see
+``slip_tolerance``), ``slip_tolerance`` (default 0.005: without ``penalty_t`` the
+tangential stiffness of a point is ``mu lam_N / (slip_tolerance L_e)``, so the elastic
+slip at the onset of sliding is ``slip_tolerance`` times the slave element length
+``L_e`` -- Abaqus' default penalty friction), ``tolerance``
 (penetration tolerance enabling augmented-Lagrangian updates; None: pure
 penalty), ``line_angle`` (20 deg), ``point_ratio`` (0.5), ``margin``
 (search margin, default the sum of radii).
@@ -34,7 +38,9 @@ CALLS = Counter()          # instrumentation: a scene without contact leaves it 
 MAX_AUGMENT = 30
 
 SMOOTHING = 0.0           # default smoothing gap of the normal law, relative to R1 + R2 (0: sharp)
-_KNOWN = {"smoothing", "gauss_points", "penalty_t", "tolerance", "line_angle", "point_ratio", "margin"}
+SLIP_TOLERANCE = 0.005    # elastic slip at the onset of sliding / slave element length (Abaqus' default)
+_KNOWN = {"smoothing", "gauss_points", "penalty_t", "slip_tolerance", "tolerance", "line_angle", "point_ratio",
+          "margin"}
 
 
 class _Decl:
@@ -50,9 +56,13 @@ class _Decl:
         self.penalty = decl.penalty if decl.penalty is not None else min(
             default_penalty(a, b) for a in secs for b in secs)
         pt = o.get("penalty_t")
-        self.penalty_t = self.penalty if pt is None else float(pt)
-        if not (np.isfinite(self.penalty_t) and self.penalty_t > 0):
+        self.penalty_t = np.nan if pt is None else float(pt)     # nan: from the slip tolerance
+        if pt is not None and not (np.isfinite(self.penalty_t) and self.penalty_t > 0):
             raise InputError(f"add_contact: penalty_t must be positive, got {pt!r}")
+        st = o.get("slip_tolerance", SLIP_TOLERANCE)
+        if not (np.isfinite(st) and st > 0):
+            raise InputError(f"add_contact: slip_tolerance must be positive, got {st!r}")
+        self.slip_tolerance = float(st)
         self.mu = decl.mu
         self.tolerance = o.get("tolerance")
         self.n_gp = int(o.get("gauss_points", 5))
@@ -89,6 +99,7 @@ class ContactSystem:
         self._decl_penalty = np.array([d.penalty for d in self.decls])
         self._decl_penalty_t = np.array([d.penalty_t for d in self.decls])
         self._decl_mu = np.array([d.mu for d in self.decls])
+        self._decl_slip_tol = np.array([d.slip_tolerance for d in self.decls])
         self._decl_smoothing = np.array([np.nan if d.smoothing is None else d.smoothing for d in self.decls])
         self._decl_tolerance = np.array([np.inf if d.tolerance is None else d.tolerance for d in self.decls])
         self.max_gp = max(d.n_gp for d in self.decls)
@@ -257,6 +268,8 @@ class ContactSystem:
         p = dict(kind=P["kind"][sel], xi1=P["xi1"][sel], xi2=P["xi2"][sel], R1=P["R1"][sel],
                  R2=P["R2"][sel], weight=P["weight"][sel], penalty=self._decl_penalty[dec],
                  penalty_t=self._decl_penalty_t[dec], mu=self._decl_mu[dec])
+        # elastic slip at the onset of sliding (used where no penalty_t is given)
+        p["elastic_slip"] = self._decl_slip_tol[dec] * self.sys.L[P["e"][sel]]
         p["smoothing"] = self._smoothing(P, sel)
         key = P["key"][sel]
         mi, mf = self._lookup(self._mult[0], key)

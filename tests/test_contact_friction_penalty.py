@@ -1,0 +1,73 @@
+"""Default tangential penalty: sliding starts at an elastic slip of ``slip_tolerance`` slave
+element lengths (Abaqus' default penalty friction), whatever the normal force."""
+import numpy as np
+import pytest
+
+import beamsolver as bs
+from beamsolver import se3
+from beamsolver.assembly import System
+from beamsolver.contact.pairs import PENALTY_T_MIN
+from beamsolver.errors import InputError
+
+R = 0.05
+SEC = bs.Section.circular(radius=R, E=1e7, nu=0.3)
+MU = 0.4
+
+
+def _crossing(depth, **options):
+    m = bs.Model()
+    master = m.add_beam(bs.geometry.straight((0, -1, 0), (0, 1, 0), 5), SEC)
+    slave = m.add_beam(bs.geometry.straight((-1, 0, 2 * R - depth), (1, 0, 2 * R - depth), 5), SEC)
+    m.clamp(master.first)
+    m.clamp(slave.first)
+    m.add_contact(slave, master, mu=MU, **options)
+    system = System(m, check_rigid_modes=False)
+    H = system.poses0.copy()
+    system.contact.commit(H)                 # friction history at the start
+    return system, H, slave
+
+
+def _slide(system, H, slave, s):
+    G = se3.exp(np.array([s, 0, 0, 0, 0, 0.0]))
+    H = H.copy()
+    H[slave.nodes] = se3.compose(np.broadcast_to(G, (len(slave.nodes), 4, 4)), H[slave.nodes])
+    system.contact.commit(H)
+    return system.contact.results(H)
+
+
+@pytest.mark.parametrize("depth,fraction", [(1e-2 * R, f) for f in (0.25, 0.5, 0.9, 1.5, 4.0)]
+                         + [(1e-4 * R, 0.25), (1e-4 * R, 4.0)])
+def test_sliding_starts_at_the_elastic_slip(depth, fraction):
+    system, H, slave = _crossing(depth)
+    es = 0.005 * 0.4                         # slip tolerance x slave element length
+    res = _slide(system, H, slave, fraction * es)
+    on = res["normal_force"] > 0
+    assert on.sum() == 1
+    ratio = np.linalg.norm(res["tangential_force"][on]) / (MU * res["normal_force"][on])
+    if fraction < 1:
+        assert res["stick"][on].all()
+        # |lam_T| = mu (lam_N / es + PENALTY_T_MIN penalty) s; the floor matters only
+        # where the penetration is below PENALTY_T_MIN es
+        lam_n = res["normal_force"][on] / res["weight"][on]
+        expected = fraction * (1.0 + PENALTY_T_MIN * 1e7 * es / lam_n)
+        assert ratio == pytest.approx(expected, rel=1e-6)
+        assert ratio == pytest.approx(fraction, rel=0.01 if depth > 1e-3 * R else 0.5)
+    else:
+        assert not res["stick"][on].any()
+        assert ratio == pytest.approx(1.0, rel=1e-12)
+
+
+def test_explicit_penalty_t_overrides_the_slip_tolerance():
+    system, H, slave = _crossing(1e-2 * R, penalty_t=1e3)
+    s = 1e-5
+    res = _slide(system, H, slave, s)
+    on = res["normal_force"] > 0
+    w = res["weight"][on]
+    assert res["stick"][on].all()
+    np.testing.assert_allclose(np.linalg.norm(res["tangential_force"][on], axis=1), 1e3 * s * w, rtol=1e-6)
+
+
+@pytest.mark.parametrize("bad", [0.0, -1.0, np.nan])
+def test_bad_slip_tolerance_is_refused(bad):
+    with pytest.raises(InputError, match="slip_tolerance"):
+        _crossing(1e-2 * R, slip_tolerance=bad)
