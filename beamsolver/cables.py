@@ -26,7 +26,7 @@ from .errors import InputError
 from .model import Model
 from .section import Section
 
-__all__ = ["Layer", "Strand", "build_strand", "fibre_stiffness"]
+__all__ = ["Layer", "Strand", "build_strand", "fibre_stiffness", "rod_stiffness"]
 
 
 @dataclass
@@ -192,3 +192,30 @@ def fibre_stiffness(core_radius, wire_radius, n_wires, pitch_radius, lay_angle, 
     Kew = m * E * Ah * r * np.sin(b) * np.cos(b) ** 2
     Kww = G * Jc + m * E * Ah * r**2 * np.sin(b) ** 2 * np.cos(b)
     return Kee, Kew, Kww
+
+
+def rod_stiffness(core_radius, wire_radius, n_wires, pitch_radius, lay_angle, E, nu=0.3):
+    """Linear strand stiffness with the wires' own bending and torsion: ``(K_ee, K_ew, K_ww)``.
+
+    Thin-rod theory of a straight 1+m strand (the kinematics of Costello's theory,
+    linearised, with the helix radius ``r`` held: no Poisson contraction, no contact
+    flattening).  A strand strain ``eps`` and twist rate ``theta`` turn each wire into
+    another helix of angle ``b + db``, ``db = cos^2 b (r theta - tan b eps)``; its axial
+    strain is ``eps cos^2 b + r theta sin b cos b`` (the fibre limit), its curvature
+    ``sin^2 b / r`` and torsion ``sin b cos b / r`` change by ``(2 sin b cos b / r) db`` and
+    ``(cos 2b / r) db``.  The strain energy per strand length (wire length ``1 / cos b``)
+    ``U = G J_c theta^2 / 2 + E A_c eps^2 / 2 + m / (2 cos b) (E A_h e_w^2 + E I_h dk^2 + G J_h dt^2)``
+    gives the stiffness; without ``I_h, J_h`` it is :func:`fibre_stiffness`.
+    """
+    G = E / (2.0 * (1.0 + nu))
+    Kee, Kew, Kww = fibre_stiffness(core_radius, wire_radius, n_wires, pitch_radius, lay_angle, E, nu)
+    b, r, m = lay_angle, pitch_radius, n_wires
+    s, c = np.sin(b), np.cos(b)
+    Ih = 0.25 * np.pi * wire_radius**4
+    # d(curvature, torsion) / d theta and / d eps
+    k_th = np.array([2.0 * s * c**3, c**2 * np.cos(2 * b)])
+    k_ep = np.array([-2.0 * s**2 * c**2 / r, -np.cos(2 * b) * s * c / r])
+    D = np.array([E * Ih, G * 2.0 * Ih])
+    w = m / c
+    return (Kee + w * np.sum(D * k_ep * k_ep), Kew + w * np.sum(D * k_ep * k_th),
+            Kww + w * np.sum(D * k_th * k_th))
