@@ -117,7 +117,10 @@ def contact_kernel(X, p, friction=True):
     E1, E2 = se3.relative(HA1, HB1), se3.relative(HA2, HB2)
     h1, h2 = _log_c(E1), _log_c(E2)
     kind = p["kind"]
-    xi1, xi2 = _project(kind, HA1, h1, p["xi1"] + 0 * h1[..., 0], HA2, h2, p["xi2"] + 0 * h2[..., 0])
+    # the search converged the projection at these poses: two Newton iterations polish it
+    # and carry its exact derivative (one would, from an exact start)
+    xi1, xi2 = _project(kind, HA1, h1, p["xi1"] + 0 * h1[..., 0], HA2, h2, p["xi2"] + 0 * h2[..., 0],
+                        iterations=2)
     HC, _, _ = _section(HA1, h1, xi1)
     HF, _, _ = _section(HA2, h2, xi2)
     R1, R2 = p["R1"], p["R2"]
@@ -223,12 +226,14 @@ def kernel_and_tangent(X, p, friction=True, h=1e-30):
 
     Column ``6 j + k`` perturbs node ``j`` by the body increment ``exp(i h e_k)``.
     The 24 perturbed kernels run in blocks of ``CHUNK`` pairs (same results,
-    bounded memory).
+    bounded memory).  The values are the real parts of the first perturbed
+    kernel: with ``h = 1e-30`` the perturbation changes them by ``O(h^2) = 0``.
     """
-    f, out = contact_kernel(X, p, friction)
     P = X.shape[0]
     K = np.empty((P, 24, 24))
+    f = np.empty((P, 4, 6))
     E = se3.exp(1j * h * np.eye(6))                     # (6, 4, 4)
+    outs = []
     for a in range(0, P, CHUNK):
         b = min(a + CHUNK, P)
         Xb = X[a:b]
@@ -237,7 +242,10 @@ def kernel_and_tangent(X, p, friction=True, h=1e-30):
             Xc[6 * j:6 * j + 6, :, j] = se3.compose(Xb[None, :, j], E[:, None])
         pc = {k: (np.broadcast_to(v[a:b], (24,) + np.shape(v[a:b])) if np.ndim(v) else v)
               for k, v in p.items()}
-        fc, _ = contact_kernel(Xc, pc, friction)
+        fc, oc = contact_kernel(Xc, pc, friction)
+        f[a:b] = fc[0].real
         dF = fc.imag.reshape(24, b - a, 24) / h         # (col, pair, row)
         K[a:b] = np.transpose(dF, (1, 2, 0))
+        outs.append({k: np.real(v[0]) for k, v in oc.items()})
+    out = {k: np.concatenate([o[k] for o in outs]) for k in outs[0]} if outs else contact_kernel(X, p, friction)[1]
     return f, K, out
