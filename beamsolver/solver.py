@@ -12,9 +12,8 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse.linalg as spla
 
-from . import se3
+from . import linsolve, se3
 from .assembly import System
 from .errors import ConvergenceError, InputError
 from .progress import Progress
@@ -67,10 +66,18 @@ class _StepFailed(Exception):
     pass
 
 
-def _factorize(K):
+def _factorize(K, solver=None):
+    """Factorise the tangent through ``linsolve`` (default back-end ``"auto"``)."""
     try:
-        return spla.splu(K, permc_spec="MMD_AT_PLUS_A")
-    except RuntimeError as e:  # exactly singular
+        return (solver if solver is not None else linsolve.Solver()).factorize(K)
+    except linsolve.SingularMatrixError as e:
+        raise _StepFailed(f"singular tangent ({e}); is a rigid-body mode unconstrained?") from None
+
+
+def _solve_linear(lu, rhs):
+    try:
+        return lu.solve(rhs)
+    except linsolve.SingularMatrixError as e:   # pardiso reports singularity at the solve
         raise _StepFailed(f"singular tangent ({e}); is a rigid-body mode unconstrained?") from None
 
 
@@ -86,6 +93,7 @@ class _Newton:
         fu = dof_u.ravel()[system.free_dofs]
         self.fu, self.fw = np.flatnonzero(fu), np.flatnonzero(~fu)
         self.L_ref = system.length_scale
+        self.linsolver = linsolve.Solver()    # solve(linear_solver=...) replaces it
 
     def _ratio(self, r, scales):
         rf = r[self.sys.free_dofs]
@@ -141,8 +149,8 @@ class _Newton:
             rhs = -r[sys.free_dofs]
             if dz_c is not None:
                 rhs -= sys.prescribed_coupling(kvals, dz_c.ravel(), info["extra"])
-            lu = _factorize(sys.matrix(kvals, info["extra"]))
-            dzf = lu.solve(rhs)
+            lu = _factorize(sys.matrix(kvals, info["extra"]), self.linsolver)
+            dzf = _solve_linear(lu, rhs)
             if not np.all(np.isfinite(dzf)):
                 raise _StepFailed("the linear solve returned non-finite values")
             dz = np.zeros(6 * n)
@@ -197,7 +205,8 @@ class _Newton:
 
 def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dtol=1e-11,
           max_iter=30, line_search=True, min_step_ratio=2.0**-12, callback=None,
-          check_rigid_modes=True, verbose=None, initial_poses=None, restart=None, checkpoint=60.0):
+          check_rigid_modes=True, verbose=None, initial_poses=None, restart=None, checkpoint=60.0,
+          linear_solver=None):
     """Quasi-static solve of ``model`` from ``t_start`` to ``t_end`` in ``steps`` equal steps.
 
     Every converged (sub)step is recorded in the returned ``Solution``.  A step
@@ -215,6 +224,11 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     run continues from its last step on the grid ``linspace(restart.times[0],
     t_end, steps + 1)`` with its stepping state and contact history, so the
     same arguments give the same final state as a run never interrupted.
+    ``linear_solver``: sparse direct solver of the Newton systems, ``"auto"``
+    (default: scipy ``"splu"`` for beams and small scenes; for large bundles
+    of wires in contact ``"pardiso"`` if pypardiso is installed, ``pip install
+    "beamsolver[fast]"``, else ``"splu-rcm"``, scipy after an RCM ordering),
+    or one of those by name (see ``beamsolver.linsolve``).
     """
     if restart is not None and initial_poses is not None:
         raise InputError("solve: give either restart or initial_poses, not both")
@@ -228,6 +242,7 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
         raise InputError(f"solve: need t_end > t_start, got t_start={t_start!r}, t_end={t_end!r}")
     conv = Convergence(rtol=rtol, dtol=dtol, max_iter=max_iter)
     newton = _Newton(system, conv, line_search, callback)
+    newton.linsolver = linsolve.Solver(linear_solver)
     writer = None
     if output is not None and hasattr(output, "write"):
         writer = output                   # e.g. io.vtk.StepWriter(folder, refine=4, compression=None)

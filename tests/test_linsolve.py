@@ -1,0 +1,122 @@
+"""Linear-solver back-ends (``beamsolver.linsolve``): same solution as a dense solve, errors."""
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+import beamsolver as bs
+from beamsolver import linsolve
+from beamsolver.errors import InputError
+
+HAVE_PARDISO = "pardiso" in linsolve.available()
+BACKENDS = ["splu", "splu-rcm", pytest.param("pardiso", marks=pytest.mark.skipif(not HAVE_PARDISO,
+                                                                                 reason="pypardiso not installed")),
+            "auto"]
+
+
+def spd_matrix(n=60, seed=0):
+    """Sparse SPD: a 1-D Laplacian plus a random sparse Gram part."""
+    rng = np.random.default_rng(seed)
+    lap = sp.diags([-np.ones(n - 1), 2.0 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1])
+    B = sp.random(n, n, density=0.05, random_state=rng)
+    return sp.csc_matrix(lap + B.T @ B + 0.1 * sp.eye(n))
+
+
+def nonsymmetric_matrix(n=80, seed=1):
+    """Sparse, non-symmetric, diagonally dominant, with a permuted pattern (pivoting needed elsewhere)."""
+    rng = np.random.default_rng(seed)
+    A = sp.random(n, n, density=0.08, random_state=rng).tolil()
+    A.setdiag(np.abs(A).sum(axis=1).A1 + 1.0)
+    A = sp.csc_matrix(A)
+    assert abs(A - A.T).max() > 0.1
+    return A
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("make", [spd_matrix, nonsymmetric_matrix])
+@pytest.mark.parametrize("fmt", ["csc", "csr"])
+def test_same_solution_as_dense(backend, make, fmt):
+    A = make().asformat(fmt)
+    b = np.random.default_rng(2).standard_normal(A.shape[0])
+    x_dense = np.linalg.solve(A.toarray(), b)
+    x = linsolve.factorize(A, backend).solve(b)
+    np.testing.assert_allclose(x, x_dense, rtol=1e-10, atol=1e-12 * np.abs(x_dense).max())
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_solver_refactorises_same_pattern(backend):
+    """A Solver kept across iterations: new values with the same pattern, and an older factor still solves."""
+    A = nonsymmetric_matrix()
+    A2 = A.copy()
+    A2.data = A2.data * np.linspace(0.5, 2.0, A2.nnz)
+    A2 = A2 + sp.diags(np.abs(A2).sum(axis=1).A1)          # same pattern (diagonal present), new values
+    b = np.ones(A.shape[0])
+    s = linsolve.Solver(backend)
+    f1 = s.factorize(A)
+    f2 = s.factorize(A2)
+    np.testing.assert_allclose(f2.solve(b), np.linalg.solve(A2.toarray(), b), rtol=1e-10)
+    np.testing.assert_allclose(f1.solve(b), np.linalg.solve(A.toarray(), b), rtol=1e-10)
+    if s.backend_for(A) == "pardiso":
+        assert s.stats["analyses"] == 1          # the symbolic analysis was reused
+    s.close()
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_singular_matrix_raises(backend):
+    A = sp.csc_matrix(np.array([[1.0, 2.0, 3.0], [2.0, 4.0, 6.0], [1.0, 1.0, 1.0]]))
+    with pytest.raises(linsolve.SingularMatrixError):
+        linsolve.factorize(A, backend).solve(np.ones(3))
+
+
+def test_bad_backend_name():
+    with pytest.raises(InputError, match="umfpack"):
+        linsolve.factorize(spd_matrix(), "umfpack")
+    with pytest.raises(InputError, match="linear_solver"):
+        linsolve.Solver("Pardiso")
+
+
+def test_missing_pardiso_is_an_input_error(monkeypatch):
+    monkeypatch.setattr(linsolve, "_pypardiso", lambda: None)
+    with pytest.raises(InputError, match="pypardiso"):
+        linsolve.Solver("pardiso")
+    assert linsolve.Solver("auto").backend_for(spd_matrix()) == "splu"
+    assert "pardiso" not in linsolve.available()
+    assert linsolve.Solver("auto").backend_for(coupled_matrix()) == "splu-rcm"
+
+
+def coupled_matrix(n=2000, half_band=20):
+    """Banded, 41 non-zeros per column: what contact couplings look like to ``auto``."""
+    offsets = list(range(-half_band, half_band + 1))
+    diags = [np.full(n - abs(k), -0.01) for k in offsets]
+    diags[half_band] = np.full(n, 1.0)
+    return sp.csc_matrix(sp.diags(diags, offsets))
+
+
+def test_auto_choice():
+    small, coupled = spd_matrix(), coupled_matrix()
+    assert linsolve.Solver("auto").backend_for(small) == "splu"
+    assert linsolve.Solver("auto").backend_for(coupled) == ("pardiso" if HAVE_PARDISO else "splu-rcm")
+    b = np.ones(coupled.shape[0])
+    np.testing.assert_allclose(linsolve.factorize(coupled, "auto").solve(b),
+                               linsolve.factorize(coupled, "splu").solve(b), rtol=1e-10)
+
+
+def _cantilever():
+    m = bs.Model()
+    beam = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 8), bs.Section.circular(radius=0.01, E=2e11))
+    m.clamp(beam.first)
+    m.add_load(beam.last, force=(0.0, 0.0, -100.0))
+    return m, beam
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_solve_keyword(backend):
+    m, beam = _cantilever()
+    ref = bs.solve(m, steps=2, verbose=False)
+    sol = bs.solve(m, steps=2, verbose=False, linear_solver=backend)
+    np.testing.assert_allclose(sol.position(beam.last), ref.position(beam.last), rtol=1e-9, atol=1e-12)
+
+
+def test_solve_keyword_bad_name():
+    m, _ = _cantilever()
+    with pytest.raises(InputError, match="linear_solver"):
+        bs.solve(m, steps=1, verbose=False, linear_solver="mumps")
