@@ -9,6 +9,12 @@ two-ply in contact, with Coulomb friction (``mu = 0.3`` by default; the slip
 increment is the SE(3) finite difference of the seed paper; sliding starts at
 an elastic slip of 0.005 element lengths, Abaqus' default penalty friction).
 
+Stability: the torque of the pair passes Greenhill's limit ``8.99 B / L``
+(``B = 2 E I``) at about 1.7 turns; beyond, the straight two-ply followed here
+(by symmetry) is an unstable equilibrium, which the script detects from the
+eigenvalues of the tangent (``bs.linearize``) and reports: a real pair writhes
+into a plectoneme there, which needs an imperfection and path following.
+
 The script prints torque and axial force against the twist angle, writes
 ParaView files (``.pvd`` + ``.vtu``, beams and contact points) to ``--output``
 and, when the ``[viz]`` extra is installed, renders a picture.
@@ -69,6 +75,23 @@ def table(sol, plate, clamps, turns):
     return rows
 
 
+def stability(model, sol, turns):
+    """Twist [turns] from which the tangent (``bs.linearize``) has a negative eigenvalue (None
+    if never), and its lowest eigenvalue at the last step.  ``model`` should be the frictionless
+    twin of the solved scene: the elastic, load and normal-contact stiffness at the solution's
+    poses is symmetric (conservative), so its eigenvalues decide stability; a slipping point's
+    tangent is not symmetric, and sticking friction is left out (the estimate is conservative).
+    Cheap here (about 200 unknowns, dense)."""
+    lowest = []
+    for k in range(1, len(sol.times)):
+        K = bs.linearize(model, sol, k).K.toarray()
+        lowest.append(np.linalg.eigvalsh(0.5 * (K + K.T))[0])
+    lowest = np.array(lowest)
+    neg = np.flatnonzero(lowest < 0)
+    first = None if len(neg) == 0 else turns * sol.times[1 + neg[0]]
+    return first, float(lowest[-1]) if len(lowest) else np.nan
+
+
 def main(output=None, turns=2.0, steps=16, n_elements=16, mu=0.3, length=0.02, verbose=False, swap=False):
     """Solve and print the summary; returns ``(solution, rows, wall time)``."""
     model, plate, (a, b) = build(length=length, n_elements=n_elements, turns=turns, mu=mu, swap=swap)
@@ -84,6 +107,16 @@ def main(output=None, turns=2.0, steps=16, n_elements=16, mu=0.3, length=0.02, v
         print(f"| {tw:.3f} | {tq:.5g} | {ax + 0.0:.4g} | {z:.6g} | {nc} | {ns} | {g:.3e} | {it} | {w:.2f} |")
     n_it = sum(s["iterations"] for s in sol.stats)
     print(f"converged steps {len(sol.times) - 1}, Newton iterations {n_it}, wall time {wall:.1f} s")
+    twin, _, _ = build(length=length, n_elements=n_elements, turns=turns, mu=0.0, swap=swap)
+    tw_c, lam = stability(twin, sol, turns)
+    if tw_c is None:
+        print(f"stability: the frictionless tangent stays positive definite (lowest eigenvalue {lam:.3g} N m "
+              f"at the end)")
+    else:
+        print(f"stability: the frictionless tangent has a negative eigenvalue from {tw_c:.3g} turns on (lowest {lam:.3g} N m "
+              f"at the end).\n  The torque has passed the Greenhill limit of the pair (about 9 B / L, B = 2 E I):"
+              f"\n  the straight two-ply followed here by symmetry is an unstable equilibrium; a real pair\n"
+              f"  writhes into a plectoneme there (more pull delays it only a little: the pair is short).")
     if output is not None:
         print(f"ParaView: open {output}/*.pvd (Extract Surface, then Tube with radius by 'radius')")
         try:

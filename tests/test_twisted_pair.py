@@ -72,3 +72,25 @@ def test_friction_changes_the_answer_only_slightly(runs):
     _, rows_0, _ = twisted_pair.main(**dict(KW, mu=0.0))
     assert rows_0[-1][1] == pytest.approx(rows[-1][1], rel=1e-2)
     assert rows_0[-1][1] != rows[-1][1]
+
+
+def test_reduced_run_is_stable(runs):
+    (sol, rows, _), _ = runs
+    model, _, _ = twisted_pair.build(turns=KW["turns"], n_elements=KW["n_elements"], mu=0.0)
+    first, lowest = twisted_pair.stability(model, sol, KW["turns"])
+    assert first is None and lowest > 0
+
+
+def test_pair_loses_stability_at_the_greenhill_torque():
+    """Frictionless pair twisted by 2 turns: the lowest eigenvalue of the tangent changes sign
+    where the torque passes Greenhill's clamped-clamped limit M_c = 8.99 B / L (B = 2 E I,
+    small pull), between two converged steps."""
+    model, plate, _ = twisted_pair.build(turns=2.0, n_elements=8, mu=0.0)
+    sol = twisted_pair.bs.solve(model, steps=8)
+    first, lowest = twisted_pair.stability(model, sol, 2.0)
+    assert first is not None and lowest < 0
+    k = int(np.argmin(np.abs(2.0 * np.asarray(sol.times) - first)))
+    torque = [sol.reaction(plate, j)[5] for j in (k - 1, k)]
+    B = 2 * 200e9 * np.pi * R**4 / 4
+    Mc = 8.99 * B / 0.02
+    assert torque[0] < Mc * 1.03 and torque[1] > Mc * 0.97, (torque, Mc)
