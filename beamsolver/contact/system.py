@@ -175,12 +175,23 @@ class ContactSystem:
                 xg, wg = 0.5 * (xg + 1.0), 0.5 * wg
                 rep = np.repeat(gp, d.n_gp)
                 g = np.tile(np.arange(d.n_gp), len(gp))
+                xi1 = xg[g]
+                HC, _, _ = _section(H[en[e[rep], 0]], hs[i[rep]], xi1)
+                # a slave Gauss point outside the master element's sphere (grown by R1) cannot
+                # touch that element: no projection for it
+                xc = HC[:, :3, 3]
+                near = (np.sum((xc - cm[j[rep], :3, 3]) ** 2, axis=1)
+                        <= (rm[j[rep]] + self.el_radius[e[rep]]) ** 2)
+                rep, g, xi1, HC, xc = rep[near], g[near], xi1[near], HC[near], xc[near]
                 ee, mm = e[rep], m[rep]
                 kk = kinds[rep]
-                xi1 = xg[g]
-                _, xi2 = _project(kk, H[en[ee, 0]], hs[i[rep]], xi1, H[en[mm, 0]], hm[j[rep]],
-                                  np.full(len(rep), 0.5), iterations=8)
-                HC, _, _ = _section(H[en[ee, 0]], hs[i[rep]], xi1)
+                # start from the projection on the master chord: a few Newton iterations converge
+                xa, xb = H[en[mm, 0], :3, 3], H[en[mm, 1], :3, 3]
+                chord = xb - xa
+                xi2 = np.clip(np.sum((xc - xa) * chord, axis=1) / np.maximum(np.sum(chord * chord, axis=1),
+                                                                               1e-300), 0.0, 1.0)
+                _, xi2 = _project(kk, H[en[ee, 0]], hs[i[rep]], xi1, H[en[mm, 0]], hm[j[rep]], xi2,
+                                  iterations=5)
                 HF, _, _ = _section(H[en[mm, 0]], hm[j[rep]], xi2)
                 dist = np.linalg.norm(HF[:, :3, 3] - HC[:, :3, 3], axis=1)
                 ok = (xi2 >= -XI_TOL) & (xi2 <= 1.0 + XI_TOL) & np.isfinite(dist)
