@@ -81,6 +81,16 @@ def _solve_linear(lu, rhs):
         raise _StepFailed(f"singular tangent ({e}); is a rigid-body mode unconstrained?") from None
 
 
+def _largest_element_rotation(system, H):
+    """Largest rotation angle between the two nodes of an element at poses ``H``."""
+    if system.n_elements == 0:
+        return 0.0
+    en = system.enodes
+    R = np.swapaxes(H[en[:, 0], :3, :3], 1, 2) @ H[en[:, 1], :3, :3]
+    c = np.clip(0.5 * (np.trace(R, axis1=1, axis2=2) - 1.0), -1.0, 1.0)
+    return float(np.arccos(c).max())
+
+
 class _Newton:
     def __init__(self, system, conv, line_search, callback):
         self.sys = system
@@ -286,6 +296,7 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
             t_next = grid[k]
         t0 = time.perf_counter()
         cutbacks = 0
+        rotation_limit = None         # an attempt of this step turned an element too far
         while True:
             try:
                 H_target = system.prescribed_poses(t_next) if len(system.prescribed_nodes) else None
@@ -294,7 +305,7 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
                 H_new, r, info, stats = newton.step(H, t_next, H_target)
                 # augmented Lagrangian: update multipliers and re-solve until satisfied
                 while system.contact is not None and system.contact.augment(H_new):
-                    more = newton.step(H_new, t_next, None)
+                    more = newton.step(H_new, t_next, H_target)
                     H_new, r, info = more[0], more[1], more[2]
                     stats["iterations"] += more[3]["iterations"]
                     stats["residuals"] += more[3]["residuals"]
@@ -302,6 +313,8 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
                 break
             except _StepFailed as e:
                 cutbacks += 1
+                if "within one element" in str(e):
+                    rotation_limit = str(e)
                 dt_try = (t_next - t) / 2.0
                 log.info("t = %.6g: step %.3g failed (%s); cutting back to %.3g", t_next, t_next - t, e, dt_try)
                 if dt_try < dt_min:
@@ -310,8 +323,14 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
                     progress.close()
                     if writer is not None:
                         writer.close()
+                    hint = "" if rotation_limit is None or rotation_limit == str(e) else \
+                        f"; a larger step had failed because {rotation_limit}"
+                    turned = _largest_element_rotation(system, H)
+                    if not hint and turned > 0.75 * MAX_ELEMENT_ROTATION:
+                        hint = (f"; elements already turn by up to {turned:.2f} rad within one element "
+                                f"(limit {MAX_ELEMENT_ROTATION:.2f}): refine the mesh")
                     raise ConvergenceError(
-                        f"solve: could not advance from t = {t:.6g} (step fell below {dt_min:.3g}): {e}",
+                        f"solve: could not advance from t = {t:.6g} (step fell below {dt_min:.3g}): {e}{hint}",
                         sol) from None
                 t_next = t + dt_try
                 easy = 0
