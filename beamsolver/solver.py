@@ -177,11 +177,21 @@ class _Newton:
                 last_inc = np.inf
                 continue
             last_inc = conv.increment_ratio(dz, self.L_ref)
-            H = self._line_search(H, dz, r, scales, lf) if self.line_search else sys.update(H, dz)
+            H = self._line_search(H, dz, r, scales, lf, lu, dzf) if self.line_search else sys.update(H, dz)
         raise AssertionError("unreachable")
 
-    def _line_search(self, H, dz, r0, scales, lf):
+    def _increment_norm(self, dzf):
+        """Norm of free increments with translations measured in units of the model size."""
+        return float(np.sqrt(np.sum((dzf[self.fu] / self.L_ref) ** 2) + np.sum(dzf[self.fw] ** 2)))
+
+    def _line_search(self, H, dz, r0, scales, lf, lu=None, dzf=None):
+        """Backtracking on the scaled residual, with Deuflhard's natural-monotonicity test: a
+        trial ``alpha`` is also accepted when the simplified Newton correction at it (the old
+        factorisation applied to the new residual) is smaller than the Newton increment,
+        ``|dz_bar| < (1 - alpha / 4) |dz|``: near strong rotation nonlinearity the residual can
+        grow along a good Newton step while the increments still contract."""
         sys = self.sys
+        nrm = self._increment_norm(dzf) if dzf is not None else 0.0
         phi0 = self._merit(r0, scales)
         H1 = sys.update(H, dz)
         if phi0 <= (10.0 * self.conv.rtol) ** 2 * len(sys.free_dofs):
@@ -201,6 +211,14 @@ class _Newton:
             # LS_GROWTH) triggers backtracking, which then asks for a decrease
             if phi <= (LS_GROWTH * phi0 if alpha == 1.0 else (1.0 - 1e-4 * alpha) * phi0):
                 return H1
+            if np.isfinite(phi) and lu is not None and nrm > 0:
+                try:
+                    bar = _solve_linear(lu, -r1[sys.free_dofs])
+                except _StepFailed:
+                    bar = None
+                if bar is not None and np.all(np.isfinite(bar)) and \
+                        self._increment_norm(bar) < (1.0 - 0.25 * alpha) * nrm:
+                    return H1
             # minimiser of the quadratic through phi(0), phi'(0) = -2 phi0, phi(alpha)
             if np.isfinite(phi):
                 a_new = phi0 * alpha**2 / (phi - phi0 + 2.0 * alpha * phi0)

@@ -130,13 +130,12 @@ def test_joined_roll_up_smaller_moment_is_quadratic():
     assert np.abs(np.linalg.norm(x - [0.0, rho, 0.0], axis=1) - rho).max() < 1e-9
 
 
-@pytest.mark.xfail(reason="solver line search: after a first iterate that raises the merit more than "
-                          "LS_GROWTH, backtracking leaves steps of ~1 % and the residual falls ~1 % per "
-                          "iteration; the plain Newton step converges in 5 iterations", strict=False)
 def test_joined_roll_up_with_line_search_converges_in_a_few_iterations():
+    """The first Newton iterate raises the residual more than LS_GROWTH; the natural-monotonicity
+    test accepts it (the increments contract), as plain Newton would (5 iterations)."""
     model, _ = _joined_roll_up(fraction=0.05)
     sol = bs.solve(model, steps=1, max_iter=15, min_step_ratio=0.5)
-    assert sol.stats[-1]["iterations"] <= 10
+    assert sol.stats[-1]["iterations"] <= 8
 
 
 def test_dead_loads_are_quadratic():
