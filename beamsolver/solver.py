@@ -189,9 +189,13 @@ class _Newton:
         trial ``alpha`` is also accepted when the simplified Newton correction at it (the old
         factorisation applied to the new residual) is smaller than the Newton increment,
         ``|dz_bar| < (1 - alpha / 4) |dz|``: near strong rotation nonlinearity the residual can
-        grow along a good Newton step while the increments still contract."""
+        grow along a good Newton step while the increments still contract.  Scenes without
+        contact only: with contact (a piecewise smooth residual) the test accepted steps that
+        later stalled (the twisted pair), so the residual merit decides alone."""
         sys = self.sys
         nrm = self._increment_norm(dzf) if dzf is not None else 0.0
+        # contact makes the residual only piecewise smooth: there the residual merit decides alone
+        smooth = sys.contact is None
         phi0 = self._merit(r0, scales)
         H1 = sys.update(H, dz)
         if phi0 <= (10.0 * self.conv.rtol) ** 2 * len(sys.free_dofs):
@@ -211,7 +215,7 @@ class _Newton:
             # LS_GROWTH) triggers backtracking, which then asks for a decrease
             if phi <= (LS_GROWTH * phi0 if alpha == 1.0 else (1.0 - 1e-4 * alpha) * phi0):
                 return H1
-            if np.isfinite(phi) and lu is not None and nrm > 0:
+            if smooth and np.isfinite(phi) and lu is not None and nrm > 0:
                 try:
                     bar = _solve_linear(lu, -r1[sys.free_dofs])
                 except _StepFailed:

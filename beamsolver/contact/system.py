@@ -185,13 +185,14 @@ class ContactSystem:
                 rep, g, xi1, HC, xc = rep[near], g[near], xi1[near], HC[near], xc[near]
                 ee, mm = e[rep], m[rep]
                 kk = kinds[rep]
-                # start from the projection on the master chord: a few Newton iterations converge
+                # start from the projection on the master chord (8 Newton iterations: the kernel
+                # polishes the point with 2 more and needs it converged for an exact tangent)
                 xa, xb = H[en[mm, 0], :3, 3], H[en[mm, 1], :3, 3]
                 chord = xb - xa
                 xi2 = np.clip(np.sum((xc - xa) * chord, axis=1) / np.maximum(np.sum(chord * chord, axis=1),
                                                                                1e-300), 0.0, 1.0)
                 _, xi2 = _project(kk, H[en[ee, 0]], hs[i[rep]], xi1, H[en[mm, 0]], hm[j[rep]], xi2,
-                                  iterations=5)
+                                  iterations=8)
                 HF, _, _ = _section(H[en[mm, 0]], hm[j[rep]], xi2)
                 dist = np.linalg.norm(HF[:, :3, 3] - HC[:, :3, 3], axis=1)
                 ok = (xi2 >= -XI_TOL) & (xi2 <= 1.0 + XI_TOL) & np.isfinite(dist)
