@@ -351,6 +351,11 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
                     if not hint and turned > 0.75 * MAX_ELEMENT_ROTATION:
                         hint = (f"; elements already turn by up to {turned:.2f} rad within one element "
                                 f"(limit {MAX_ELEMENT_ROTATION:.2f}): refine the mesh")
+                    if not hint and "no convergence" in str(e):
+                        hint = ("; if the structure may have buckled (a limit point or bifurcation: "
+                                "check the eigenvalues of bs.linearize(model, error.solution)) or "
+                                "lost the support of a contact, a force-controlled quasi-static solve "
+                                "cannot pass it: prescribe displacements, add supports, or refine")
                     raise ConvergenceError(
                         f"solve: could not advance from t = {t:.6g} (step fell below {dt_min:.3g}): {e}{hint}",
                         sol) from None
