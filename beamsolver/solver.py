@@ -2,8 +2,12 @@
 
 Per step ``t -> t + dt``: loads are evaluated at ``t + dt``; the first
 iteration carries the prescribed motions into the free unknowns through the
-tangent (``K_ff dz_f = -r_f - K_fc dz_c``), later iterations are plain Newton
-``K dz = -r`` with a backtracking line search on the scaled residual.
+tangent (``K_ff dz_f = -r_f - K_fc dz_c``), later iterations are Newton
+``K dz = -r``, damped on the size of the Newton correction without contact
+(``_Newton._damped``) and by a backtracking line search on the scaled residual
+with contact (``_Newton._line_search``).  Elements may not turn by more than
+``MAX_ELEMENT_ROTATION`` (nor pass pi within a step): such steps fail with a
+message saying how many elements the beam needs.
 A failing step is halved; steps regrow after easy convergence, never past
 the user's step size, and always land on the user's time grid.
 """
@@ -26,6 +30,7 @@ log = logging.getLogger("beamsolver")
 
 MAX_ELEMENT_ROTATION = 0.8 * np.pi   # an iterate turning an element further is rejected
 LS_GROWTH = 10.0                     # full Newton steps are kept unless the merit grows this much
+DAMPING_MIN = 1.0 / 64.0             # shortest damped Newton step (scenes without contact)
 
 
 @dataclass
@@ -63,7 +68,11 @@ class Convergence:
 
 
 class _StepFailed(Exception):
-    pass
+    """A Newton step that failed; ``rotation``: it failed on the element-rotation limit."""
+
+    def __init__(self, message, rotation=False):
+        super().__init__(message)
+        self.rotation = rotation
 
 
 def _factorize(K, solver=None):
@@ -91,6 +100,24 @@ def _largest_element_rotation(system, H):
     return float(np.arccos(c).max())
 
 
+def _refine_advice(system, H, t, t_start, t_end):
+    """How many elements the beams whose elements turn most would need (rotations taken to grow
+    in proportion to the pseudo-time), as a message tail."""
+    en = system.enodes
+    R = np.swapaxes(H[en[:, 0], :3, :3], 1, 2) @ H[en[:, 1], :3, :3]
+    ang = np.arccos(np.clip(0.5 * (np.trace(R, axis1=1, axis2=2) - 1.0), -1.0, 1.0))
+    grow = (t_end - t_start) / (t - t_start) if t > t_start else 1.0
+    parts = []
+    for b in system.model.beams:
+        a = float(ang[b.elements].max())
+        if a < 0.5 * MAX_ELEMENT_ROTATION:
+            continue
+        need = int(np.ceil(b.n_elements * max(a * grow, MAX_ELEMENT_ROTATION) / (0.5 * np.pi)))
+        parts.append(f"Beam {b.id} ({b.n_elements} elements) turns by {a:.3f} rad per element at "
+                     f"t = {t:.6g}: about {need} elements keep it below pi/2 at t = {t_end:.6g}")
+    return "".join("; " + p for p in parts)
+
+
 class _Newton:
     def __init__(self, system, conv, line_search, callback):
         self.sys = system
@@ -114,19 +141,86 @@ class _Newton:
         F, M = scales
         return float(np.sum((rf[self.fu] / F) ** 2) + np.sum((rf[self.fw] / M) ** 2))
 
+    def _element_label(self, e):
+        """``element e (element j of Beam b)`` for a global element id."""
+        for b in self.sys.model.beams:
+            if b.elements[0] <= e <= b.elements[-1]:
+                return f"element {e} (no. {e - b.elements[0]} of the {b.n_elements} of Beam {b.id})"
+        return f"element {e}"
+
     def _check_rotation(self, state):
         ang = se3.rotation_angle(state.h[:, 3:])
         worst = int(np.argmax(ang)) if len(ang) else 0
         if len(ang) and ang[worst] > MAX_ELEMENT_ROTATION:
-            raise _StepFailed(f"element {worst} turns by {ang[worst]:.3f} rad within one element "
-                              f"(limit {MAX_ELEMENT_ROTATION:.3f}): refine the mesh")
+            raise _StepFailed(f"{self._element_label(worst)} turns by {ang[worst]:.4f} rad within one element "
+                              f"(limit MAX_ELEMENT_ROTATION = {MAX_ELEMENT_ROTATION / np.pi:.2g} pi = "
+                              f"{MAX_ELEMENT_ROTATION:.4f} rad; an element cannot turn by pi): refine the mesh",
+                              rotation=True)
+
+    def _check_continuity(self, H0, H1):
+        """Refuse a step over which an element's relative rotation may have passed through pi.
+
+        The element only sees ``log(H_A^-1 H_B)``, whose angle lies in ``[0, pi]``: an element
+        turned past pi within one load step would look like one turned the short way round (a
+        silent wrong answer).  Passing pi and coming back to the angle ``t1`` from ``t0`` takes a
+        rotation of at least ``(pi - t0) + (pi - t1)``, so a step whose relative rotations change
+        by less than that (the geodesic angle between old and new) cannot have passed it.
+        """
+        if self.sys.n_elements == 0:
+            return
+        en = self.sys.enodes
+        R0 = np.swapaxes(H0[en[:, 0], :3, :3], 1, 2) @ H0[en[:, 1], :3, :3]
+        R1 = np.swapaxes(H1[en[:, 0], :3, :3], 1, 2) @ H1[en[:, 1], :3, :3]
+
+        def angle(R):
+            return np.arccos(np.clip(0.5 * (np.trace(R, axis1=1, axis2=2) - 1.0), -1.0, 1.0))
+        change = angle(np.swapaxes(R0, 1, 2) @ R1)
+        bad = np.flatnonzero(change >= (np.pi - angle(R0)) + (np.pi - angle(R1)) - 1e-9)
+        if len(bad):
+            e = int(bad[np.argmax(change[bad])])
+            raise _StepFailed(f"{self._element_label(e)} turns by {change[e]:.3f} rad within one element in "
+                              "one load step and may have passed pi, which an element cannot represent: "
+                              "use smaller steps or refine the mesh", rotation=True)
+
+    def _norm(self, dzf):
+        """Norm of free increments, translations in units of the model size (unit-independent)."""
+        return float(np.sqrt(np.sum((dzf[self.fu] / self.L_ref) ** 2) + np.sum(dzf[self.fw] ** 2)))
+
+    def _inc(self, dzf):
+        """``Convergence.increment_ratio`` of free increments."""
+        return max(np.abs(dzf[self.fu]).max(initial=0.0) / self.L_ref, np.abs(dzf[self.fw]).max(initial=0.0))
+
+    def _direction(self, r, kvals, info, dz_c=None):
+        """Newton increment on the free unknowns (with the prescribed-motion coupling ``dz_c``)."""
+        sys = self.sys
+        rhs = -r[sys.free_dofs]
+        if dz_c is not None:
+            rhs -= sys.prescribed_coupling(kvals, dz_c.ravel(), info["extra"])
+        lu = _factorize(sys.matrix(kvals, info["extra"]), self.linsolver)
+        dzf = _solve_linear(lu, rhs)
+        if not np.all(np.isfinite(dzf)):
+            raise _StepFailed("the linear solve returned non-finite values")
+        return lu, dzf
+
+    def _evaluate(self, H, lf):
+        r, kvals, info = self.sys.evaluate(H, lf, tangent=True)
+        if not np.all(np.isfinite(r)):
+            raise _StepFailed("the residual is not finite")
+        self._check_rotation(info["state"])
+        return r, kvals, info
 
     def step(self, H, t, H_target):
-        """Solve for equilibrium at ``t``; returns ``(H, r, info, stats)`` or raises ``_StepFailed``."""
+        """Solve for equilibrium at ``t``; returns ``(H, r, info, stats)`` or raises ``_StepFailed``.
+
+        Without contact, with ``line_search``, the Newton step is damped on the Newton correction
+        (``_damped``); with contact the residual line search ``_line_search`` is used.
+        """
         sys, conv = self.sys, self.conv
         lf = sys.load_factors(t) if len(sys.load_scales) else np.zeros(0)
         n = sys.n_nodes
+        H_start = H
         residuals = []
+        damped_its = 0
         dz_c = None
         targets = sys.fixed_value_increments(H, t) if sys.fix_values else []
         if len(sys.prescribed_nodes) or targets:
@@ -138,12 +232,18 @@ class _Newton:
                 dz_c[node, comp] = dx
             if not np.any(dz_c):
                 dz_c = None
+        damping = self.line_search and sys.contact is None
         last_inc = np.inf
+        ahead = None                 # (r, kvals, info, lu, dzf) of an accepted damped trial
+        lam = 1.0
+        rotation_streak = 0
         for it in range(conv.max_iter + 1):
-            r, kvals, info = sys.evaluate(H, lf, tangent=True)
-            if not np.all(np.isfinite(r)):
-                raise _StepFailed("the residual is not finite")
-            self._check_rotation(info["state"])
+            if ahead is None:
+                r, kvals, info = self._evaluate(H, lf)
+                lu = dzf = None
+            else:
+                r, kvals, info, lu, dzf = ahead
+                ahead = None
             scales = conv.scales(info, self.L_ref)
             ratio = self._ratio(r, scales)
             residuals.append(ratio)
@@ -151,18 +251,17 @@ class _Newton:
             if self.callback is not None:
                 self.callback(dict(t=t, iteration=it, residual=ratio, poses=H))
             if dz_c is None and (ratio <= conv.rtol or last_inc <= conv.dtol):
-                return H, r, info, dict(iterations=it, residuals=residuals)
+                self._check_continuity(H_start, H)
+                stats = dict(iterations=it, residuals=residuals)
+                if damped_its:
+                    stats["damped"] = damped_its
+                return H, r, info, stats
             if it == conv.max_iter:
                 raise _StepFailed(f"no convergence in {conv.max_iter} iterations (scaled residual {ratio:.3g})")
             if ratio > conv.divergence:
                 raise _StepFailed(f"diverging (scaled residual {ratio:.3g})")
-            rhs = -r[sys.free_dofs]
-            if dz_c is not None:
-                rhs -= sys.prescribed_coupling(kvals, dz_c.ravel(), info["extra"])
-            lu = _factorize(sys.matrix(kvals, info["extra"]), self.linsolver)
-            dzf = _solve_linear(lu, rhs)
-            if not np.all(np.isfinite(dzf)):
-                raise _StepFailed("the linear solve returned non-finite values")
+            if dzf is None:
+                lu, dzf = self._direction(r, kvals, info, dz_c)
             dz = np.zeros(6 * n)
             dz[sys.free_dofs] = dzf
             dz = dz.reshape(n, 6)
@@ -176,9 +275,65 @@ class _Newton:
                 dz_c = None
                 last_inc = np.inf
                 continue
-            last_inc = conv.increment_ratio(dz, self.L_ref)
-            H = self._line_search(H, dz, r, scales, lf, lu, dzf) if self.line_search else sys.update(H, dz)
+            if not damping:
+                last_inc = conv.increment_ratio(dz, self.L_ref)
+                H = self._line_search(H, dz, r, scales, lf, lu, dzf) if self.line_search else sys.update(H, dz)
+                continue
+            lam0 = min(1.0, 2.0 * lam)          # after a damped iteration, try twice its length
+            H, lam, ahead, rotation = self._damped(H, dz, dzf, lf, lam0)
+            damped_its += lam < 1.0
+            # the full step turned an element past the limit in two iterations running: the
+            # equilibrium itself needs it (refine) rather than an overshooting iterate
+            rotation_streak = rotation_streak + 1 if rotation is not None else 0
+            if rotation_streak >= 2:
+                raise rotation
+            last_inc = conv.increment_ratio(dz, self.L_ref) if lam == 1.0 else np.inf
         raise AssertionError("unreachable")
+
+    def _damped(self, H, dz, dzf, lf, lam):
+        """Damped Newton update ``H exp(lam dz)`` (scenes without contact).
+
+        A trial length is accepted when the Newton correction at the trial point is smaller than
+        the current one (``|dz(trial)| < |dz|``, translations scaled by the model size): an
+        affine-invariant test, blind to the huge but harmless axial-force residuals a slender
+        beam shows after a large rotation increment (the next iteration removes them), which
+        made the residual line search crawl.  The trial's tangent, factorisation and
+        correction are those of the next iteration, so an accepted full step costs nothing
+        extra: where plain Newton converges, this is plain Newton.  Otherwise the length is
+        halved (a trial that is not finite, is singular or turns an element past the limit is
+        rejected too) down to ``DAMPING_MIN``.
+
+        Returns ``(H, lam, ahead, rotation)``: ``ahead`` the trial's ``(r, kvals, info, lu,
+        dzf)`` (``None`` if it converged), ``rotation`` the rotation-limit failure of the full
+        first trial, if that is what rejected it.
+        """
+        sys, conv = self.sys, self.conv
+        if self._inc(dzf) <= 1e3 * conv.dtol:     # round-off level: nothing to damp
+            return sys.update(H, dz), 1.0, None, None
+        nrm = self._norm(dzf)
+        rotation = None
+        failure = None
+        first = True
+        while True:
+            H1 = sys.update(H, lam * dz)
+            try:
+                r1, k1, info1 = self._evaluate(H1, lf)
+                if self._ratio(r1, conv.scales(info1, self.L_ref)) <= conv.rtol:
+                    return H1, lam, (r1, k1, info1, None, None), None
+                lu1, d1 = self._direction(r1, k1, info1)
+                if self._norm(d1) < nrm or self._inc(d1) <= conv.dtol:
+                    return H1, lam, (r1, k1, info1, lu1, d1), rotation
+            except _StepFailed as e:
+                failure = e
+                if first and e.rotation:
+                    rotation = e
+            first = False
+            lam *= 0.5
+            if lam < DAMPING_MIN:
+                if failure is not None and failure.rotation:
+                    raise failure
+                raise _StepFailed(f"damped Newton stalled: no step length down to {DAMPING_MIN:g} of the "
+                                  "Newton increment reduces the Newton correction")
 
     def _increment_norm(self, dzf):
         """Norm of free increments with translations measured in units of the model size."""
@@ -348,9 +503,16 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
                     hint = "" if rotation_limit is None or rotation_limit == str(e) else \
                         f"; a larger step had failed because {rotation_limit}"
                     turned = _largest_element_rotation(system, H)
-                    if not hint and turned > 0.75 * MAX_ELEMENT_ROTATION:
+                    rot = getattr(e, "rotation", False)
+                    if not hint and turned > 0.75 * MAX_ELEMENT_ROTATION and not rot:
                         hint = (f"; elements already turn by up to {turned:.2f} rad within one element "
                                 f"(limit {MAX_ELEMENT_ROTATION:.2f}): refine the mesh")
+                    if rot or rotation_limit is not None or turned > 0.75 * MAX_ELEMENT_ROTATION:
+                        hint += _refine_advice(system, H, t, t_start, t_end)
+                    if not hint and "stalled" in str(e):
+                        hint = ("; large rotations of slender beams need small load steps where the "
+                                "strain-space update does not apply (joined, guided or supported beams): "
+                                "lower min_step_ratio or use more steps")
                     if not hint and "no convergence" in str(e):
                         hint = ("; if the structure may have buckled (a limit point or bifurcation: "
                                 "check the eigenvalues of bs.linearize(model, error.solution)) or "

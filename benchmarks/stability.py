@@ -28,7 +28,7 @@ sys.path.insert(0, str(HERE.parent / "examples"))
 
 import beamsolver as bs  # noqa: E402
 
-CASE_TIME = 120.0            # seconds per case before it is reported as a hang
+CASE_TIME = 60.0             # seconds per case before it is reported as a hang
 
 
 # ----------------------------------------------------------------- helpers
@@ -42,7 +42,7 @@ def _row(case, sol=None, wall=0.0, accuracy="", error=None, expect="converge"):
     if error is None:
         outcome = "converged"
     else:
-        outcome = f"{type(error).__name__}: {str(error).splitlines()[0][:400]}"
+        outcome = f"{type(error).__name__}: {str(error).splitlines()[0][:600]}"
     return dict(case=case, outcome=outcome, expected=expect, steps=len(its),
                 smallest_step=min(dts) if dts else np.nan, iterations=sum(its),
                 max_iterations=max(its) if its else 0, wall=wall, accuracy=accuracy)
@@ -68,6 +68,11 @@ def _quadratic(sol):
             if 1e-2 > a >= 100 * floor and b > 1e-10:
                 worst = max(worst, b / a**2)
     return worst
+
+
+def _last_residuals(sol, k=4):
+    """The last ``k`` scaled residuals of the last step, ``a > b > c``."""
+    return " > ".join(f"{r:.1e}" for r in sol.stats[-1]["residuals"][-k:])
 
 
 def _floor(sol):
@@ -101,7 +106,8 @@ def roll_up(turns=1.0, n=16, steps=1, L=1.0, radius=0.01, E=210e9):
 def case_slender_roll_up(ratio):
     sol, wall, err = roll_up(radius=1.0 / ratio, n=16)
     return _row(f"roll-up, L/R = {ratio:.0e} (EA L^2/EI = {4 * ratio**2:.0e})", sol, wall,
-                f"circle error {err:.1e} L; r+/r^2 {_quadratic(sol):.2g}; final residual {_floor(sol):.1e}")
+                f"circle error {err:.1e} L; r+/r^2 {_quadratic(sol):.2g}; final residual {_floor(sol):.1e}; "
+                f"residuals {_last_residuals(sol)}")
 
 
 def case_slender_bend(ratio):
@@ -121,7 +127,7 @@ def case_slender_bend(ratio):
     tip = sol.position(beam.last)
     return _row(f"45-degree bend, L/R = {ratio:.0e}", sol, wall,
                 f"tip ({tip[0]:.2f}, {tip[1]:.2f}, {tip[2]:.2f}); r+/r^2 {_quadratic(sol):.2g}; "
-                f"final residual {_floor(sol):.1e}")
+                f"final residual {_floor(sol):.1e}; residuals {_last_residuals(sol)}")
 
 
 def case_units():
@@ -132,6 +138,87 @@ def case_units():
     return _row("units: roll-up in m-N vs mm-N", b, wall,
                 f"iterations {a.iterations[1:].tolist()} vs {b.iterations[1:].tolist()} "
                 f"({'same' if same else 'DIFFERENT'}); errors {ea:.1e}, {eb:.1e}")
+
+
+def joined_roll_up(turns=0.25, n=16, ratio=100.0, L=1.0, E=210e9, steps=1, **kw):
+    """The roll-up of a cantilever made of two beams joined in the middle: the joint takes it
+    out of the strain-space (chain) update, Newton iterates with ``H exp(dq)`` (exact: a circle)."""
+    sec = bs.Section.circular(radius=L / ratio, E=E, nu=0.3)
+    m = bs.Model()
+    b1 = m.add_beam(bs.geometry.straight((0, 0, 0), (L / 2, 0, 0), n // 2), sec)
+    b2 = m.add_beam(bs.geometry.straight((L / 2, 0, 0), (L, 0, 0), n // 2), sec)
+    m.join(b1.last, b2.first)
+    m.clamp(b1.first)
+    m.add_load(b2.last, moment=(0, 0, turns * 2 * np.pi * sec.C[5, 5] / L), follower=True)
+    sol, wall = _run(m, steps=steps, **kw)
+    x = np.concatenate([sol.poses[-1][b1.nodes, :3, 3], sol.poses[-1][b2.nodes[1:], :3, 3]])
+    rho = L / (2 * np.pi * turns)
+    phi = np.linspace(0.0, L, n + 1) / rho
+    xe = np.stack([rho * np.sin(phi), rho * (1 - np.cos(phi)), 0 * phi], axis=1)
+    return sol, wall, float(np.linalg.norm(x - xe, axis=1).max() / L)
+
+
+def case_units_newton():
+    """Bend and joined roll-up (real Newton iterations) in m-N-s vs mm-N-s: the same iterations."""
+    import bend45 as b45
+    its, tips = [], []
+    for k in (1.0, 1e3):                   # lengths x k, E / k^2, forces unchanged
+        sec = b45.section()
+        sec = bs.Section(**{n: v / k**2 for n, v in zip(("EA", "GA2", "GA3", "GJ", "EI2", "EI3"),
+                                                            (sec.C[i, i] * (k**2 if i < 3 else k**4)
+                                                             for i in range(6)))}, radius=0.5 * k)
+        model = bs.Model()
+        beam = model.add_beam(bs.geometry.arc(radius=100.0 * k, angle=np.pi / 4, n_elements=8), sec)
+        model.clamp(beam.first)
+        model.add_load(beam.last, force=(0.0, 0.0, b45.P_MAX))
+        sol, wall = _run(model, steps=1)
+        its.append(sol.iterations[1:].tolist())
+        tips.append(sol.position(beam.last) / k)
+        j, _, err = joined_roll_up(turns=0.25, ratio=100.0, L=k, E=210e9 / k**2, steps=4)
+        its.append(j.iterations[1:].tolist())
+    same = its[0] == its[2] and its[1] == its[3]
+    return _row("units: bend and joined roll-up in m-N vs mm-N", sol, wall,
+                f"iterations bend {its[0]} vs {its[2]}, joined roll-up {its[1]} vs {its[3]} "
+                f"({'same' if same else 'DIFFERENT'}); tips differ by {np.linalg.norm(tips[0] - tips[1]):.1e}")
+
+
+def case_slender_joined(ratio):
+    """Quarter-turn roll-up through a joint (no strain-space update) at slenderness ``ratio``."""
+    sol, wall, err = joined_roll_up(turns=0.25, n=16, ratio=ratio)
+    cut = sum(s["cutbacks"] for s in sol.stats[1:])
+    return _row(f"joined roll-up (H exp(dq) update), L/R = {ratio:.0e}", sol, wall,
+                f"circle error {err:.1e} L; cut-backs {cut}; residuals {_last_residuals(sol)}")
+
+
+def case_slender_joined_refused(ratio=1e5):
+    t0 = time.perf_counter()
+    try:
+        sol, wall, err = joined_roll_up(turns=0.25, n=16, ratio=ratio)
+        return _row(f"joined roll-up (H exp(dq) update), L/R = {ratio:.0e}", sol, wall, f"circle error {err:.1e} L")
+    except bs.ConvergenceError as e:
+        return _row(f"joined roll-up (H exp(dq) update), L/R = {ratio:.0e}", error=e, expect="refuse",
+                    wall=time.perf_counter() - t0,
+                    accuracy="converges with min_step_ratio=1e-7: 2466 steps, 36 s, circle error 2e-15 L")
+
+
+def case_guided_roll_up(turns=1.0, n=16):
+    """Roll-up with the tip guided in its plane (uz, rx, ry fixed: no strain-space update) in
+    one user step: damped Newton, cut-backs and regrowth."""
+    L = 1.0
+    sec = bs.Section.circular(radius=0.01, E=210e9, nu=0.3)
+    m = bs.Model()
+    b = m.add_beam(bs.geometry.straight((0, 0, 0), (L, 0, 0), n), sec)
+    m.clamp(b.first)
+    m.fix(b.last, ("uz", "rx", "ry"))
+    m.add_load(b.last, moment=(0, 0, turns * 2 * np.pi * sec.C[5, 5] / L), follower=True)
+    sol, wall = _run(m, steps=1)
+    err = _circle_error(sol, b, L, turns)
+    dts = np.array([s["dt"] for s in sol.stats[1:]])
+    cut = sum(s["cutbacks"] for s in sol.stats[1:])
+    regrew = int(np.sum(dts[1:] > 1.5 * dts[:-1]))
+    return _row(f"roll-up to {turns:g} turn, tip guided in its plane, 1 user step", sol, wall,
+                f"circle error {err:.1e} L; cut-backs {cut}, step regrown {regrew} times, "
+                f"largest step {dts.max():.3g}")
 
 
 def case_roll_up_turns(turns, n, steps):
@@ -164,8 +251,45 @@ def case_near_pi():
         return _row("roll-up 1 turn, 2 elements (pi per element)", sol, wall, f"circle error {err:.1e}",
                     expect="refuse")
     except bs.ConvergenceError as e:
-        return _row("roll-up 1 turn, 2 elements (pi per element)", error=e, expect="refuse",
-                    wall=time.perf_counter() - t0)
+        wall = time.perf_counter() - t0
+        return _row("roll-up 1 turn, 2 elements (pi per element)", error=e, expect="refuse", wall=wall,
+                    accuracy=_follow_advice(e, lambda n: roll_up(turns=1.0, n=n, steps=1)[2]))
+
+
+def _follow_advice(error, rerun):
+    """Re-run with the element count the error message advises; returns a summary."""
+    import re
+    m = re.search(r"about (\d+) elements", str(error))
+    if not m:
+        return "no element count in the message"
+    n = int(m.group(1))
+    try:
+        return f"advice followed ({n} elements): circle error {rerun(n):.1e} L"
+    except bs.ConvergenceError as e2:
+        return f"advice followed ({n} elements): still fails ({str(e2)[:80]})"
+
+
+def case_near_pi_guided():
+    """The guided roll-up (no strain-space update) to one turn with 2 elements."""
+    t0 = time.perf_counter()
+
+    def run(n):
+        L = 1.0
+        sec = bs.Section.circular(radius=0.01, E=210e9, nu=0.3)
+        m = bs.Model()
+        b = m.add_beam(bs.geometry.straight((0, 0, 0), (L, 0, 0), n), sec)
+        m.clamp(b.first)
+        m.fix(b.last, ("uz", "rx", "ry"))
+        m.add_load(b.last, moment=(0, 0, 2 * np.pi * sec.C[5, 5] / L), follower=True)
+        sol, _ = _run(m, steps=1)
+        return _circle_error(sol, b, L, 1.0)
+    try:
+        err = run(2)
+        return _row("guided roll-up 1 turn, 2 elements", None, time.perf_counter() - t0, f"circle error {err:.1e}",
+                    expect="refuse")
+    except bs.ConvergenceError as e:
+        return _row("guided roll-up 1 turn, 2 elements (pi per element)", error=e, expect="refuse",
+                    wall=time.perf_counter() - t0, accuracy=_follow_advice(e, run))
 
 
 def case_steps(steps):
@@ -272,7 +396,7 @@ def case_angle(deg):
     # a shorter slave (its ends away from the master's clamps), pressed by 1/4 of the depth
     m, slave, master = crossing(angle=np.deg2rad(deg), half=0.7, depth=0.005)
     sol, wall = _run(m, steps=4)
-    return _contact_row(f"slave at {deg:g} deg to the master", sol, wall, slave, 0.05)
+    return _contact_row(f"slave at {deg:g} deg ({np.deg2rad(deg):.3g} rad) to the master", sol, wall, slave, 0.05)
 
 
 def case_initial(gap_over_R):
@@ -381,17 +505,21 @@ def cases(quick=False):
     out = [("slender", lambda r=r: case_slender_roll_up(r)) for r in ((10, 1e3, 1e5) if quick else
                                                                     (10, 1e2, 1e3, 1e4, 1e5))]
     out += [("slender", lambda r=r: case_slender_bend(r)) for r in ((10, 1e5) if quick else (10, 1e2, 1e3, 1e4, 1e5))]
-    out += [("units", case_units)]
+    out += [("slender", lambda r=r: case_slender_joined(r)) for r in ((1e2,) if quick else (10, 1e2, 1e3, 1e4))]
+    out += [("slender", case_slender_joined_refused)]
+    out += [("units", case_units), ("units", case_units_newton)]
     out += [("rotation", lambda: case_roll_up_turns(2, 32, 1)), ("rotation", lambda: case_twist(20, 100))]
     if not quick:
         out += [("rotation", lambda: case_roll_up_turns(5, 80, 1)),
                 ("rotation", lambda: case_twist(20, 100, follower=True))]
-    out += [("rotation", case_near_pi), ("steps", lambda: case_steps(1)),
+    out += [("rotation", case_guided_roll_up)]
+    out += [("rotation", case_near_pi), ("rotation", case_near_pi_guided), ("steps", lambda: case_steps(1)),
             ("steps", lambda: case_steps(100 if quick else 1000)), ("steps", case_cutback)]
     out += [("contact", lambda s=s: case_penalty(s)) for s in ((1e-3, 1e3) if quick else (1e-3, 1e-1, 1, 1e1, 1e3))]
     out += [("contact", case_augmented)]
     out += [("contact", lambda r=r: case_radius_ratio(r)) for r in ((1, 100) if quick else (1, 10, 100))]
-    out += [("contact", lambda a=a: case_angle(a)) for a in ((90, 1e-4) if quick else (90, 45, 20.5, 19.5, 1e-4))]
+    out += [("contact", lambda a=a: case_angle(a)) for a in ((90, np.rad2deg(1e-6)) if quick else
+                                                            (90, 45, 20.5, 19.5, np.rad2deg(1e-6), 0.0))]
     out += [("contact", lambda g=g: case_initial(g)) for g in ((-0.01, 0.01) if quick else (-0.05, -0.01, 0.01, 0.05))]
     out += [("contact", case_lost_regained)]
     out += [("friction", lambda mu=mu: case_friction(mu)) for mu in ((0.3,) if quick else (0.0, 0.1, 0.3, 1.0))]
@@ -454,6 +582,15 @@ asserts a fast subset).  Every case converges to the stated accuracy or stops wi
 quadratic convergence).  At extreme slenderness the scaled residual stalls on a round-off floor
 (about `1e-16 EA / F_ref`: 1e-5 at L/R = 1e5); the step is then accepted on its increment
 (`dtol`), and the answer is still exact (roll-up) or the converged one.
+Cantilevers are updated in strain space (one iteration for the roll-up, at any slenderness);
+the *joined* and *guided* roll-ups take the plain `H exp(dq)` update, where Newton meets
+spurious axial forces after large rotation increments: it is damped on the size of the Newton
+correction (`solver._Newton._damped`; the residual line search it replaced needed 5-10x more
+iterations: 4904 instead of 866 on the guided roll-up, 15262 instead of 1492 on the joined one
+at L/R = 1e4), and load steps shrink with the
+slenderness (L/R = 1e5 stops with a clear error at the default `min_step_ratio`).  Elements
+asked to turn by `MAX_ELEMENT_ROTATION` (0.8 pi) or more are refused with the number of elements
+to use; the `accuracy` column shows the advice followed.
 
 {md}
 """)

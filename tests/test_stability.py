@@ -83,3 +83,76 @@ def test_stick_slip_reversal_obeys_coulomb():
     assert r["outcome"] == "converged" and "force reverses: yes" in r["accuracy"]
     ratios = [float(x) for part in r["accuracy"].split(";")[0].split(",") for x in part.split()[-1].split("-")]
     np.testing.assert_allclose(ratios, 1.0, atol=1e-6)
+
+
+# ------------------------------------------------------------------ solver fixes of issue 7
+def test_near_pi_fails_fast_and_says_how_many_elements():
+    r = S.case_near_pi()
+    msg = r["outcome"]
+    assert "MAX_ELEMENT_ROTATION" in msg and "about 5 elements" in msg and "Beam 0" in msg
+    assert r["wall"] < 5.0                       # no 30-iteration crawl per cut-back any more
+    assert r["accuracy"].startswith("advice followed (5 elements): circle error")
+    assert float(r["accuracy"].split("circle error ")[1].split(" ")[0]) < 1e-9
+
+
+def test_near_pi_without_strain_space_update_is_refused_too():
+    r = S.case_near_pi_guided()
+    assert r["outcome"].startswith("ConvergenceError") and "MAX_ELEMENT_ROTATION" in r["outcome"]
+    assert float(r["accuracy"].split("circle error ")[1].split(" ")[0]) < 1e-9
+
+
+def test_a_step_through_pi_is_refused():
+    """An element whose relative rotation goes from 0.7 pi to 1.3 pi (which its log sees as
+    0.7 pi the other way round) within one step: refused, not accepted as a short turn."""
+    from beamsolver import solver
+    from beamsolver.assembly import System
+    model = S.bs.Model()
+    b = model.add_beam(S.bs.geometry.straight((0, 0, 0), (1, 0, 0), 1), S.bs.Section.circular(radius=0.01, E=1e9))
+    model.clamp(b.first)
+    newton = solver._Newton(System(model), solver.Convergence(), True, None)
+
+    def poses(angle):
+        H = np.array([np.eye(4), np.eye(4)])
+        H[1, :3, 3] = (1.0, 0.0, 0.0)
+        H[1, :3, :3] = S.bs.se3.exp_so3([0.0, 0.0, angle])
+        return H
+    newton._check_continuity(poses(0.7 * np.pi), poses(0.75 * np.pi))      # a real turn: fine
+    with pytest.raises(solver._StepFailed, match="may have passed pi"):
+        newton._check_continuity(poses(0.7 * np.pi), poses(1.3 * np.pi))
+
+
+def test_newton_without_strain_space_update_converges_on_slender_beams():
+    """Roll-up through a joint at L/R = 1e3 (EA L^2 / EI = 4e6): exact circle; before the damped
+    Newton (issue 7) the residual line search needed 1733 iterations, now ~320."""
+    r = S.case_slender_joined(1e3)
+    assert r["outcome"] == "converged" and r["iterations"] < 600
+    assert float(r["accuracy"].split("circle error ")[1].split(" ")[0]) < 1e-9
+
+
+def test_extreme_slenderness_without_strain_space_update_stops_clearly():
+    r = S.case_slender_joined_refused(1e5)
+    assert r["outcome"].startswith("ConvergenceError") and "min_step_ratio" in r["outcome"]
+    assert r["wall"] < 10.0
+
+
+def test_guided_roll_up_cuts_back_and_regrows():
+    r = S.case_guided_roll_up()
+    assert r["outcome"] == "converged"
+    assert float(r["accuracy"].split("circle error ")[1].split(" ")[0]) < 1e-9
+    assert int(r["accuracy"].split("step regrown ")[1].split(" ")[0]) >= 1
+
+
+def test_units_do_not_change_newton_iterations():
+    r = S.case_units_newton()
+    assert "(same)" in r["accuracy"]
+
+
+def test_thousand_steps_on_a_tiny_mesh_end_where_one_step_does():
+    import bend45
+    tips = []
+    for steps in (1, 1000):
+        model, beam = bend45.build(3)
+        sol = S.bs.solve(model, steps=steps, verbose=False)
+        assert sol.n_steps == steps and all(s["cutbacks"] == 0 for s in sol.stats[1:])
+        tips.append(sol.position(beam.last))
+    np.testing.assert_allclose(tips[0], tips[1], atol=1e-8 * 100)
