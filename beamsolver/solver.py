@@ -90,22 +90,28 @@ def _solve_linear(lu, rhs):
         raise _StepFailed(f"singular tangent ({e}); is a rigid-body mode unconstrained?") from None
 
 
+def _relative_rotations(system, H):
+    """Rotations ``R_A^T R_B`` between the two nodes of every element, ``(n_elements, 3, 3)``."""
+    en = system.enodes
+    return np.swapaxes(H[en[:, 0], :3, :3], 1, 2) @ H[en[:, 1], :3, :3]
+
+
+def _angle(R):
+    """Rotation angles in ``[0, pi]`` of ``(..., 3, 3)`` rotation matrices."""
+    return np.arccos(np.clip(0.5 * (np.trace(R, axis1=-2, axis2=-1) - 1.0), -1.0, 1.0))
+
+
 def _largest_element_rotation(system, H):
     """Largest rotation angle between the two nodes of an element at poses ``H``."""
     if system.n_elements == 0:
         return 0.0
-    en = system.enodes
-    R = np.swapaxes(H[en[:, 0], :3, :3], 1, 2) @ H[en[:, 1], :3, :3]
-    c = np.clip(0.5 * (np.trace(R, axis1=1, axis2=2) - 1.0), -1.0, 1.0)
-    return float(np.arccos(c).max())
+    return float(_angle(_relative_rotations(system, H)).max())
 
 
 def _refine_advice(system, H, t, t_start, t_end):
     """How many elements the beams whose elements turn most would need (rotations taken to grow
     in proportion to the pseudo-time), as a message tail."""
-    en = system.enodes
-    R = np.swapaxes(H[en[:, 0], :3, :3], 1, 2) @ H[en[:, 1], :3, :3]
-    ang = np.arccos(np.clip(0.5 * (np.trace(R, axis1=1, axis2=2) - 1.0), -1.0, 1.0))
+    ang = _angle(_relative_rotations(system, H))
     grow = (t_end - t_start) / (t - t_start) if t > t_start else 1.0
     parts = []
     for b in system.model.beams:
@@ -168,14 +174,9 @@ class _Newton:
         """
         if self.sys.n_elements == 0:
             return
-        en = self.sys.enodes
-        R0 = np.swapaxes(H0[en[:, 0], :3, :3], 1, 2) @ H0[en[:, 1], :3, :3]
-        R1 = np.swapaxes(H1[en[:, 0], :3, :3], 1, 2) @ H1[en[:, 1], :3, :3]
-
-        def angle(R):
-            return np.arccos(np.clip(0.5 * (np.trace(R, axis1=1, axis2=2) - 1.0), -1.0, 1.0))
-        change = angle(np.swapaxes(R0, 1, 2) @ R1)
-        bad = np.flatnonzero(change >= (np.pi - angle(R0)) + (np.pi - angle(R1)) - 1e-9)
+        R0, R1 = _relative_rotations(self.sys, H0), _relative_rotations(self.sys, H1)
+        change = _angle(np.swapaxes(R0, 1, 2) @ R1)
+        bad = np.flatnonzero(change >= (np.pi - _angle(R0)) + (np.pi - _angle(R1)) - 1e-9)
         if len(bad):
             e = int(bad[np.argmax(change[bad])])
             raise _StepFailed(f"{self._element_label(e)} turns by {change[e]:.3f} rad within one element in "
@@ -277,7 +278,7 @@ class _Newton:
                 continue
             if not damping:
                 last_inc = conv.increment_ratio(dz, self.L_ref)
-                H = self._line_search(H, dz, r, scales, lf, lu, dzf) if self.line_search else sys.update(H, dz)
+                H = self._line_search(H, dz, r, scales, lf) if self.line_search else sys.update(H, dz)
                 continue
             lam0 = min(1.0, 2.0 * lam)          # after a damped iteration, try twice its length
             H, lam, ahead, rotation = self._damped(H, dz, dzf, lf, lam0)
@@ -335,22 +336,11 @@ class _Newton:
                 raise _StepFailed(f"damped Newton stalled: no step length down to {DAMPING_MIN:g} of the "
                                   "Newton increment reduces the Newton correction")
 
-    def _increment_norm(self, dzf):
-        """Norm of free increments with translations measured in units of the model size."""
-        return float(np.sqrt(np.sum((dzf[self.fu] / self.L_ref) ** 2) + np.sum(dzf[self.fw] ** 2)))
-
-    def _line_search(self, H, dz, r0, scales, lf, lu=None, dzf=None):
-        """Backtracking on the scaled residual, with Deuflhard's natural-monotonicity test: a
-        trial ``alpha`` is also accepted when the simplified Newton correction at it (the old
-        factorisation applied to the new residual) is smaller than the Newton increment,
-        ``|dz_bar| < (1 - alpha / 4) |dz|``: near strong rotation nonlinearity the residual can
-        grow along a good Newton step while the increments still contract.  Scenes without
-        contact only: with contact (a piecewise smooth residual) the test accepted steps that
-        later stalled (the twisted pair), so the residual merit decides alone."""
+    def _line_search(self, H, dz, r0, scales, lf):
+        """Backtracking on the scaled residual (scenes with contact; the others use the damped
+        Newton of ``_damped``: a piecewise smooth contact residual made its natural-monotonicity
+        test accept steps that later stalled, e.g. in the twisted pair)."""
         sys = self.sys
-        nrm = self._increment_norm(dzf) if dzf is not None else 0.0
-        # contact makes the residual only piecewise smooth: there the residual merit decides alone
-        smooth = sys.contact is None
         phi0 = self._merit(r0, scales)
         H1 = sys.update(H, dz)
         if phi0 <= (10.0 * self.conv.rtol) ** 2 * len(sys.free_dofs):
@@ -370,14 +360,6 @@ class _Newton:
             # LS_GROWTH) triggers backtracking, which then asks for a decrease
             if phi <= (LS_GROWTH * phi0 if alpha == 1.0 else (1.0 - 1e-4 * alpha) * phi0):
                 return H1
-            if smooth and np.isfinite(phi) and lu is not None and nrm > 0:
-                try:
-                    bar = _solve_linear(lu, -r1[sys.free_dofs])
-                except _StepFailed:
-                    bar = None
-                if bar is not None and np.all(np.isfinite(bar)) and \
-                        self._increment_norm(bar) < (1.0 - 0.25 * alpha) * nrm:
-                    return H1
             # minimiser of the quadratic through phi(0), phi'(0) = -2 phi0, phi(alpha)
             if np.isfinite(phi):
                 a_new = phi0 * alpha**2 / (phi - phi0 + 2.0 * alpha * phi0)

@@ -91,12 +91,15 @@ def _circle_error(sol, beam, L, turns):
 
 
 # ----------------------------------------------------------------- beams
-def roll_up(turns=1.0, n=16, steps=1, L=1.0, radius=0.01, E=210e9):
-    """Cantilever rolled up by a follower end moment ``turns 2 pi EI / L`` (exact: a circle)."""
+def roll_up(turns=1.0, n=16, steps=1, L=1.0, radius=0.01, E=210e9, guided=False):
+    """Cantilever rolled up by a follower end moment ``turns 2 pi EI / L`` (exact: a circle);
+    ``guided``: the tip held in its plane (uz, rx, ry fixed: no strain-space update)."""
     sec = bs.Section.circular(radius=radius, E=E, nu=0.3)
     m = bs.Model()
     b = m.add_beam(bs.geometry.straight((0, 0, 0), (L, 0, 0), n), sec)
     m.clamp(b.first)
+    if guided:
+        m.fix(b.last, ("uz", "rx", "ry"))
     m.add_load(b.last, moment=(0, 0, turns * 2 * np.pi * sec.C[5, 5] / L), follower=True)
     sol, wall = _run(m, steps=steps)
     err = _circle_error(sol, b, L, turns)
@@ -204,15 +207,7 @@ def case_slender_joined_refused(ratio=1e5):
 def case_guided_roll_up(turns=1.0, n=16):
     """Roll-up with the tip guided in its plane (uz, rx, ry fixed: no strain-space update) in
     one user step: damped Newton, cut-backs and regrowth."""
-    L = 1.0
-    sec = bs.Section.circular(radius=0.01, E=210e9, nu=0.3)
-    m = bs.Model()
-    b = m.add_beam(bs.geometry.straight((0, 0, 0), (L, 0, 0), n), sec)
-    m.clamp(b.first)
-    m.fix(b.last, ("uz", "rx", "ry"))
-    m.add_load(b.last, moment=(0, 0, turns * 2 * np.pi * sec.C[5, 5] / L), follower=True)
-    sol, wall = _run(m, steps=1)
-    err = _circle_error(sol, b, L, turns)
+    sol, wall, err = roll_up(turns=turns, n=n, steps=1, guided=True)
     dts = np.array([s["dt"] for s in sol.stats[1:]])
     cut = sum(s["cutbacks"] for s in sol.stats[1:])
     regrew = int(np.sum(dts[1:] > 1.5 * dts[:-1]))
@@ -274,15 +269,7 @@ def case_near_pi_guided():
     t0 = time.perf_counter()
 
     def run(n):
-        L = 1.0
-        sec = bs.Section.circular(radius=0.01, E=210e9, nu=0.3)
-        m = bs.Model()
-        b = m.add_beam(bs.geometry.straight((0, 0, 0), (L, 0, 0), n), sec)
-        m.clamp(b.first)
-        m.fix(b.last, ("uz", "rx", "ry"))
-        m.add_load(b.last, moment=(0, 0, 2 * np.pi * sec.C[5, 5] / L), follower=True)
-        sol, _ = _run(m, steps=1)
-        return _circle_error(sol, b, L, 1.0)
+        return roll_up(turns=1.0, n=n, steps=1, guided=True)[2]
     try:
         err = run(2)
         return _row("guided roll-up 1 turn, 2 elements", None, time.perf_counter() - t0, f"circle error {err:.1e}",
