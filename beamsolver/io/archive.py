@@ -28,7 +28,11 @@ Floats are stored in binary (``poses``, ...) or as shortest-repr JSON
 """
 import json
 import os
+import struct
 import tempfile
+import zipfile
+import zlib
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -71,7 +75,7 @@ def _pack_tables(tables, prefix):
 
 def _unpack_tables(data, prefix, n_steps):
     tables = [dict() for _ in range(n_steps)]
-    for name in data.files:
+    for name in list(data):
         if not name.startswith(prefix + "/"):
             continue
         k = name[len(prefix) + 1:]
@@ -106,54 +110,193 @@ def save(solution, path):
     arrays.update(_pack_tables(s.contacts, "contact"))
     for k, v in s.contact_state.items():
         arrays[f"contact_state/{k}"] = np.asarray(v)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    tmp = None
     try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
         with os.fdopen(fd, "wb") as f:
             np.savez_compressed(f, **arrays)
         os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
+    except OSError as e:
+        raise InputError(f"save({str(path)!r}): cannot write ({e.strerror or e})") from None
+    finally:
+        if tmp is not None and os.path.exists(tmp):
             os.unlink(tmp)
-        raise
     return path
 
 
-def load(path):
-    """Read a ``Solution`` written by ``Solution.save`` (``model`` and ``system`` are ``None``)."""
-    from ..results import Solution
+def _resolve(path):
+    """The archive a user names: a file, ``<name>`` for ``<name>.npz``, or a folder's solution.npz."""
     path = Path(path)
     if path.is_dir():
-        path = path / "solution.npz"
+        if not (path / "solution.npz").is_file():
+            raise InputError(f"load({str(path)!r}): no solution.npz in the folder (not a beamsolver output "
+                             "folder, or the run saved nothing)")
+        return path / "solution.npz"
     if not path.exists() and path.suffix != ".npz" and path.with_name(path.name + ".npz").exists():
-        path = path.with_name(path.name + ".npz")
+        return path.with_name(path.name + ".npz")
+    if not path.exists():
+        raise InputError(f"load({str(path)!r}): no such file")
+    return path
+
+
+@contextmanager
+def _open(path):
+    """The opened archive (``np.load``) after checking that it is a beamsolver one (else ``InputError``)."""
+    where = f"load({str(path)!r})"
     try:
-        data = np.load(path, allow_pickle=False)
-    except (OSError, ValueError) as e:
-        raise InputError(f"load({str(path)!r}): not a readable .npz file ({e})") from None
-    with data:
-        if "format" not in data.files or str(data["format"]) != FORMAT:
-            raise InputError(f"load({str(path)!r}): not a saved beamsolver Solution")
-        version = int(data["format_version"])
-        if version > FORMAT_VERSION:
-            raise InputError(f"load({str(path)!r}): format version {version} is newer than this "
-                             f"beamsolver reads ({FORMAT_VERSION}); upgrade beamsolver")
-        desc = {k[6:]: data[k] for k in data.files if k.startswith("model/")}
-        for k in ("beam_name", "constraint_kind"):
-            if k in desc:
-                desc[k] = desc[k].astype(str)
-        desc["n_contact_declarations"] = np.int64(desc.get("n_contact_declarations", 0))
-        sol = Solution(None, None, desc)
-        times, poses = data["times"], data["poses"]
-        sol._times = [float(t) for t in times]
-        sol._poses = list(poses)
-        sol._reactions = list(data["reactions"])
-        sol._sigma = list(data["section_forces"])
-        sol._strain = list(data["strains"])
-        sol.stats = json.loads(str(data["stats"]))
-        sol.contacts = _unpack_tables(data, "contact", len(times))
-        sol.converged = bool(data["converged"])
-        sol.message = str(data["message"])
-        sol.resume = json.loads(str(data["resume"]))
-        sol.contact_state = {k[14:]: data[k] for k in data.files if k.startswith("contact_state/")}
+        f = open(path, "rb")
+    except OSError as e:
+        raise InputError(f"{where}: cannot read ({e.strerror or e})") from None
+    with f:
+        head = f.read(4)
+        if not head:
+            raise InputError(f"{where}: the file is empty: not a beamsolver result")
+        if head != b"PK\x03\x04":
+            raise InputError(f"{where}: not a beamsolver result (not a .npz archive written by Solution.save)")
+        f.seek(0)
+        with np.load(f, allow_pickle=False) as data:
+            if "format" not in data.files or str(data["format"]) != FORMAT:
+                raise InputError(f"{where}: not a beamsolver result (an .npz archive, but not a saved "
+                                 "beamsolver Solution)")
+            version = int(data["format_version"])
+            if version > FORMAT_VERSION:
+                raise InputError(f"{where}: format version {version} is newer than this beamsolver reads "
+                                 f"({FORMAT_VERSION}); upgrade beamsolver")
+            yield data
+
+
+def _guarded(path, read):
+    """``read(path)``, with any error from a damaged file turned into an ``InputError`` naming it."""
+    try:
+        return read(path)
+    except InputError:
+        raise
+    except (zipfile.BadZipFile, zlib.error, EOFError, struct.error) as e:
+        raise InputError(f"load({str(path)!r}): damaged beamsolver result: truncated or corrupted ({e})") from None
+    except (OSError, KeyError, ValueError, TypeError, IndexError) as e:
+        raise InputError(f"load({str(path)!r}): damaged beamsolver result ({type(e).__name__}: {e})") from None
+
+
+def saved_times(path):
+    """The ``times`` of a saved solution (only that array is read); ``InputError`` if damaged."""
+    path = _resolve(path)
+
+    def read(p):
+        with _open(p) as data:
+            times = _check_times(data, f"load({str(p)!r})")
+        return times
+    return _guarded(path, read)
+
+
+def load(path):
+    """Read a ``Solution`` written by ``Solution.save`` (``model`` and ``system`` are ``None``).
+
+    ``path``: the ``.npz`` file (the suffix may be left out) or an output folder.  A file that
+    is not such an archive, or is truncated, corrupted or inconsistent, raises ``InputError``
+    naming it and what is wrong (``check_archive``).
+    """
+    path = _resolve(path)
+    return _guarded(path, _read)
+
+
+def _read(path):
+    from ..results import Solution
+    with _open(path) as data:
+        arrays = check_archive(data, f"load({str(path)!r})")
+    desc = {k[6:]: v for k, v in arrays.items() if k.startswith("model/")}
+    for k in ("beam_name", "constraint_kind"):
+        if k in desc:
+            desc[k] = desc[k].astype(str)
+    desc["n_contact_declarations"] = np.int64(desc.get("n_contact_declarations", 0))
+    sol = Solution(None, None, desc)
+    times = arrays["times"]
+    sol._times = [float(t) for t in times]
+    sol._poses = list(arrays["poses"])
+    sol._reactions = list(arrays["reactions"])
+    sol._sigma = list(arrays["section_forces"])
+    sol._strain = list(arrays["strains"])
+    sol.stats = arrays["stats"]
+    sol.contacts = _unpack_tables(arrays, "contact", len(times))
+    sol.converged = bool(arrays["converged"])
+    sol.message = str(arrays["message"])
+    sol.resume = arrays["resume"]
+    sol.contact_state = {k[14:]: v for k, v in arrays.items() if k.startswith("contact_state/")}
     return sol
+
+
+
+MODEL_KEYS = ("poses0", "enodes", "L", "eps0", "element_beam", "node_beam", "beam_first_node", "beam_n_nodes",
+              "beam_radius", "beam_C", "beam_name", "constrained_nodes", "constraint_kind", "load_nodes", "joins")
+REQUIRED = ("times", "poses", "reactions", "section_forces", "strains", "stats", "converged", "message",
+            "resume") + tuple(f"model/{k}" for k in MODEL_KEYS)
+
+
+def _damaged(where, what):
+    return InputError(f"{where}: damaged beamsolver result: {what}")
+
+
+def _check_times(data, where):
+    if "times" not in data:
+        raise _damaged(where, "missing 'times'")
+    times = np.asarray(data["times"])
+    if times.ndim != 1 or times.dtype.kind not in "iuf" or not np.all(np.isfinite(times)):
+        raise _damaged(where, f"'times' must be a 1-D array of finite numbers, got shape {times.shape}")
+    return times.astype(float)
+
+
+def _json(arrays, key, kind, where):
+    try:
+        value = json.loads(str(arrays[key]))
+    except json.JSONDecodeError as e:
+        raise _damaged(where, f"'{key}' is not valid JSON ({e})") from None
+    if not isinstance(value, kind):
+        raise _damaged(where, f"'{key}' must hold a JSON {kind.__name__}, got {type(value).__name__}")
+    return value
+
+
+def _shape(arrays, key, expected, where):
+    a = np.asarray(arrays[key])
+    if a.shape != expected:
+        raise _damaged(where, f"'{key}' has shape {a.shape}, expected {expected}")
+
+
+def check_archive(data, where):
+    """All members of an opened archive as a dict, checked for presence and consistency.
+
+    ``stats`` and ``resume`` are returned parsed.  Raises ``InputError`` (``where: damaged
+    beamsolver result: ...``) on a missing key, bad JSON or lengths that disagree.
+    """
+    missing = [k for k in REQUIRED if k not in data.files]
+    if missing:
+        raise _damaged(where, "missing " + ", ".join(repr(k) for k in missing))
+    arrays = {k: data[k] for k in data.files}
+    times = _check_times(arrays, where)
+    s = len(times)
+    n, n_el = len(arrays["model/poses0"]), len(arrays["model/enodes"])
+    _shape(arrays, "model/poses0", (n, 4, 4), where)
+    _shape(arrays, "model/enodes", (n_el, 2), where)
+    if n_el and not (0 <= arrays["model/enodes"].min() and arrays["model/enodes"].max() < n):
+        raise _damaged(where, f"'model/enodes' refers to nodes outside 0..{n - 1}")
+    poses = arrays["poses"]
+    if poses.ndim >= 1 and len(poses) != s:
+        raise _damaged(where, f"inconsistent: {s} times but {len(poses)} steps of poses")
+    for key, shape in (("poses", (s, n, 4, 4)), ("reactions", (s, n, 6)), ("section_forces", (s, n_el, 6)),
+                       ("strains", (s, n_el, 6))):
+        _shape(arrays, key, shape, where)
+    bad = np.flatnonzero(~np.all(np.isfinite(poses.reshape(s, -1)), axis=1))
+    if len(bad):
+        raise _damaged(where, f"'poses' is not finite at step {int(bad[0])}")
+    arrays["stats"] = _json(arrays, "stats", list, where)
+    if len(arrays["stats"]) != s or not all(isinstance(x, dict) for x in arrays["stats"]):
+        raise _damaged(where, f"'stats' must be a list of {s} dicts (one per step for {s} steps)")
+    arrays["resume"] = _json(arrays, "resume", dict, where)
+    for key in [k for k in arrays if k.startswith("contact/")]:
+        cname = "contact_count/" + key[len("contact/"):]
+        counts = np.asarray(arrays.get(cname, np.zeros(0)))
+        if cname not in arrays or counts.shape != (s,):
+            raise _damaged(where, f"'{cname}' has {counts.size} entries for {s} steps")
+        if counts.dtype.kind not in "iu" or counts[counts >= 0].sum() != len(arrays[key]):
+            raise _damaged(where, f"'{key}' has {len(arrays[key])} rows but '{cname}' counts "
+                           f"{int(counts[counts >= 0].sum()) if counts.dtype.kind in 'iu' else counts.tolist()}")
+    return arrays

@@ -34,6 +34,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from ..errors import InputError
 from .lines import LineLayout
 
 __all__ = ["StepWriter", "write_vtk", "write_pvd"]
@@ -46,17 +47,42 @@ CONTACT_FIELDS = {"gap": (), "normal_force": (), "tangential_force": (3,), "stic
 
 
 def _atomic(path, write):
-    """Call ``write(tmp_path)`` then rename ``tmp_path`` to ``path``."""
+    """Call ``write(tmp_path)`` then rename ``tmp_path`` to ``path``; a failing file system
+    (full disk, permissions) raises ``InputError`` naming the folder and the file."""
     path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".tmp" + path.suffix, dir=path.parent)
-    os.close(fd)
+    tmp = None
     try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".tmp" + path.suffix, dir=path.parent)
+        os.close(fd)
         write(tmp)
         os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
+        tmp = None
+    except OSError as e:
+        raise InputError(f"output folder {str(path.parent)!r}: cannot write {path.name} "
+                         f"({e.strerror or e})") from None
+    finally:
+        if tmp is not None and os.path.exists(tmp):
             os.unlink(tmp)
-        raise
+
+
+def _output_folder(folder):
+    """``folder`` created if missing and checked writable (a probe file is written and removed)."""
+    folder = Path(folder)
+    for p in (folder, *folder.parents):
+        if p.exists():
+            if not p.is_dir():
+                raise InputError(f"output {str(folder)!r}: {str(p)!r} is a file, not a folder")
+            break
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise InputError(f"output folder {str(folder)!r}: cannot create it ({e.strerror or e})") from None
+    _atomic(folder / ".write-test", lambda tmp: None)
+    try:
+        os.unlink(folder / ".write-test")
+    except OSError as e:
+        raise InputError(f"output folder {str(folder)!r}: cannot write ({e.strerror or e})") from None
+    return folder
 
 
 def write_pvd(path, entries):
@@ -88,8 +114,7 @@ class StepWriter:
     def __init__(self, folder, system=None, refine=8, compression="zlib", contact=None, checkpoint=60.0):
         import meshio   # imported here: scenes without output never pay for it
         self._meshio = meshio
-        self.folder = Path(folder)
-        self.folder.mkdir(parents=True, exist_ok=True)
+        self.folder = _output_folder(folder)
         self.refine = refine
         self.compression = compression
         if contact is None and system is not None:
