@@ -22,10 +22,31 @@ from . import se3
 from .element import internal_forces, internal_forces_and_tangent
 from .errors import InputError
 from .se3 import skew
+from .validation import check_pose
 
 __all__ = ["System", "FREE", "GLOBAL", "CLAMPED", "PRESCRIBED"]
 
 FREE, GLOBAL, CLAMPED, PRESCRIBED = 0, 1, 2, 3
+
+
+def _rigid_mode_rank(x, fixed):
+    """Number of independent rigid-body modes of a group of nodes that ``fixed`` constrains.
+
+    ``x``: ``(k, 3)`` node positions, ``fixed``: ``(k, 6)`` fixed global increments.  A rigid
+    mode is ``u = a + theta x (x - c)``, ``w = theta``; positions are taken about the group's
+    centroid ``c`` and in units of its size, so the rank (tolerance ``1e-9``) is the same in any
+    unit system and anywhere in space.
+    """
+    if not fixed.any():
+        return 0
+    c = x.mean(axis=0)
+    size = float(np.ptp(x, axis=0).max()) if len(x) > 1 else 0.0
+    d = (x - c) / (size if size > 0.0 else 1.0)
+    G = np.zeros((len(x), 6, 6))
+    G[:, :3, :3] = np.eye(3)
+    G[:, :3, 3:] = -skew(d)
+    G[:, 3:, 3:] = np.eye(3)
+    return int(np.linalg.matrix_rank(G[fixed], tol=1e-9))
 
 
 def _find(parent, i):
@@ -181,19 +202,9 @@ class System:
         for i in range(n):
             groups.setdefault(_find(parent, i), []).append(i)
         P = self.poses0
+        fixed = self.fixed_dofs.reshape(n, 6) & (self.is_rep & (self.kind != FREE))[:, None]
         for root, nodes in groups.items():
-            rows = []
-            for i in nodes:
-                if not self.is_rep[i] or self.kind[i] == FREE:
-                    continue
-                x = P[i, :3, 3]
-                Rg = np.zeros((6, 6))
-                Rg[:3, :3] = np.eye(3)
-                Rg[:3, 3:] = -skew(x)
-                Rg[3:, 3:] = np.eye(3)
-                fixed = self.fixed_dofs.reshape(n, 6)[i]
-                rows.append(Rg[fixed])
-            rank = np.linalg.matrix_rank(np.concatenate(rows), tol=1e-9 * self.length_scale) if rows else 0
+            rank = _rigid_mode_rank(P[nodes, :3, 3], fixed[nodes])
             if rank < 6:
                 owners = [model.beam_of_node(i) for i in nodes]   # Beam (a dataclass) is unhashable
                 beams = sorted({b.id for b in owners if b is not None})
@@ -430,12 +441,11 @@ class System:
             H[self.members] = se3.compose(H[self.rep[self.members]], self.X)
 
     def prescribed_poses(self, t):
-        """Target poses ``G(t) H_0`` of the prescribed representatives ``(k, 4, 4)``."""
+        """Target poses ``G(t) H_0`` of the prescribed representatives ``(k, 4, 4)``; every
+        ``G(t)`` is checked to be a rigid motion (``validation.check_pose``)."""
         out = np.zeros((len(self.prescribed_nodes), 4, 4))
         for j, node in enumerate(self.prescribed_nodes):
-            G = np.asarray(self.motions[node](t), dtype=float)
-            if G.shape != (4, 4) or not np.all(np.isfinite(G)):
-                raise InputError(f"prescribe({node}): motion({t}) is not a finite 4x4 pose")
+            G = check_pose(self.motions[node](t), f"prescribe({node})", f"motion(t = {t:.6g})")
             out[j] = G @ self.poses0[node]
         return out
 

@@ -25,6 +25,7 @@ from . import geometry
 from .errors import InputError
 from .model import Model
 from .section import Section
+from .validation import count, real
 
 __all__ = ["Layer", "Strand", "build_strand", "fibre_stiffness", "rod_stiffness"]
 
@@ -90,13 +91,11 @@ def _lay(layer, r):
     if (layer.lay_length is None) == (layer.lay_angle is None):
         raise InputError(f"Layer {layer}: give exactly one of lay_length, lay_angle")
     if layer.lay_angle is not None:
-        beta = float(layer.lay_angle)
+        beta = real(layer.lay_angle, "lay_angle", "Layer")
         if not 0.0 < beta < np.pi / 2:
             raise InputError(f"Layer: lay_angle must lie in (0, pi/2) rad, got {beta!r}")
         return beta, 2.0 * np.pi * r / np.tan(beta)
-    p = float(layer.lay_length)
-    if not p > 0:
-        raise InputError(f"Layer: lay_length must be positive, got {p!r}")
+    p = real(layer.lay_length, "lay_length", "Layer", above=0.0)
     return float(np.arctan(2.0 * np.pi * r / p)), p
 
 
@@ -105,21 +104,22 @@ def build_strand(layers, length, E, nu=0.3, elements_per_lay=24, min_elements=8,
     """Build the wires of a straight strand into ``model`` (a new one by default); returns a ``Strand``."""
     if not layers:
         raise InputError("build_strand: need at least one layer")
-    if not length > 0:
-        raise InputError(f"build_strand: length must be positive, got {length!r}")
+    length = real(length, "length", "build_strand", above=0.0)
+    elements_per_lay = count(elements_per_lay, "elements_per_lay", "build_strand")
+    min_elements = count(min_elements, "min_elements", "build_strand")
+    touch_tol = real(touch_tol, "touch_tol", "build_strand")
     model = Model() if model is None else model
     wires, radii, angles, lays = [], [], [], []
     r_prev, R_prev = None, None
     for k, layer in enumerate(layers):
-        R = float(layer.wire_radius)
-        if not R > 0 or int(layer.n_wires) < 1:
-            raise InputError(f"build_strand: layer {k} needs wire_radius > 0 and n_wires >= 1, got {layer}")
+        R = real(layer.wire_radius, f"layer {k} wire_radius", "build_strand", above=0.0)
+        n_wires = count(layer.n_wires, f"layer {k} n_wires", "build_strand")
         if layer.pitch_radius is not None:
-            r = float(layer.pitch_radius)
-        elif k == 0 and layer.n_wires == 1:
+            r = real(layer.pitch_radius, f"layer {k} pitch_radius", "build_strand", minimum=0.0)
+        elif k == 0 and n_wires == 1:
             r = 0.0
         elif k == 0:
-            r = R / np.sin(np.pi / layer.n_wires)          # wires touching around an empty centre
+            r = R / np.sin(np.pi / n_wires)          # wires touching around an empty centre
         else:
             r = r_prev + R_prev + R
         beta, p = _lay(layer, r)
@@ -128,13 +128,13 @@ def build_strand(layers, length, E, nu=0.3, elements_per_lay=24, min_elements=8,
         sign = 1.0 if layer.direction == "right" else -1.0
         sec = Section.circular(radius=R, E=E, nu=nu, name=f"layer {k}")
         layer_wires = []
-        for i in range(int(layer.n_wires)):
+        for i in range(n_wires):
             if r == 0.0:
                 P = geometry.straight((0, 0, 0), (0, 0, length), max(min_elements, int(elements_per_lay)))
             else:
                 n_el = max(min_elements, int(np.ceil(elements_per_lay * length / p)))
                 P = geometry.helix(radius=r, pitch=sign * p, length=length, n_elements=n_el,
-                                   phase=layer.phase + 2.0 * np.pi * i / layer.n_wires)
+                                   phase=layer.phase + 2.0 * np.pi * i / n_wires)
             layer_wires.append(model.add_beam(P, sec, name=f"layer {k} wire {i}"))
         wires.append(layer_wires)
         radii.append(r)

@@ -5,10 +5,17 @@ is given): ``e2 = unit(e_z x e1)``, or ``e_y`` when ``e1`` is parallel to
 ``e_z``; ``e3 = e1 x e2``.  So a beam along ``+x`` has ``e2 = +y``, ``e3 = +z``.
 Arcs and helices carry their principal normal (towards the centre / axis) as
 ``e2``; polylines parallel-transport ``e2`` from the first node.
+
+No generator makes an element turning by more than ``MAX_ELEMENT_ROTATION``
+(0.75 pi, the model's limit): past it the relative rotation of the end frames
+would describe a shorter turn the other way (a helix with one element per turn
+would be straight).  Arcs and helices name the ``n_elements`` needed; a polyline
+whose centre line folds back or turns that sharply at a point is refused.
 """
 import numpy as np
 
 from .errors import InputError
+from .validation import MAX_ELEMENT_ROTATION, count, real
 
 __all__ = ["straight", "arc", "helix", "polyline", "frames_from_tangents"]
 
@@ -24,7 +31,10 @@ def _unit(v, what="vector"):
 
 
 def _finite_points(points, what):
-    p = np.asarray(points, dtype=float)
+    try:
+        p = np.asarray(points, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"geometry.{what}: points must be numbers of shape (n, 3), got {points!r}") from None
     if p.ndim != 2 or p.shape[1] != 3:
         raise InputError(f"geometry.{what}: points must have shape (n, 3), got {p.shape}")
     if not np.all(np.isfinite(p)):
@@ -34,9 +44,17 @@ def _finite_points(points, what):
 
 
 def _check_n(n_elements, what):
-    if int(n_elements) != n_elements or n_elements < 1:
-        raise InputError(f"geometry.{what}: n_elements must be a positive integer, got {n_elements!r}")
-    return int(n_elements)
+    return count(n_elements, "n_elements", f"geometry.{what}")
+
+
+def _check_turn(angle_per_element, n, what):
+    """Refuse elements turning by more than ``MAX_ELEMENT_ROTATION`` (the relative rotation of
+    their end frames would alias to a shorter rotation): name the element count needed."""
+    if angle_per_element > MAX_ELEMENT_ROTATION * (1.0 + 1e-12):
+        need = int(np.ceil(n * angle_per_element / MAX_ELEMENT_ROTATION * (1.0 - 1e-12)))
+        raise InputError(f"geometry.{what}: {n} element(s) turn by {angle_per_element:.3f} rad per element, "
+                         f"more than an element can represent (limit 0.75 pi = {MAX_ELEMENT_ROTATION:.3f} "
+                         f"rad; its end frames would describe a shorter turn); use n_elements >= {need}")
 
 
 def _default_e2(e1):
@@ -81,14 +99,16 @@ def arc(radius, angle, n_elements, origin=(0.0, 0.0, 0.0)):
     ``e3 = -z``), so ``e1`` always runs along the node order.
     """
     n = _check_n(n_elements, "arc")
-    if not np.isfinite(radius) or radius <= 0:
-        raise InputError(f"geometry.arc: radius must be positive, got {radius!r}")
-    if not np.isfinite(angle) or angle == 0:
+    radius = real(radius, "radius", "geometry.arc", above=0.0)
+    angle = real(angle, "angle", "geometry.arc")
+    if angle == 0:
         raise InputError(f"geometry.arc: angle must be finite and non-zero, got {angle!r}")
+    _check_turn(abs(angle) / n, n, "arc")
+    origin = _finite_points([origin], "arc")[0]
     sg = np.sign(angle)
     phi = np.linspace(0.0, abs(angle), n + 1)
     c, s = np.cos(phi), np.sin(phi)
-    x = np.stack([radius * s, sg * radius * (1.0 - c), np.zeros_like(phi)], axis=-1) + np.asarray(origin, float)
+    x = np.stack([radius * s, sg * radius * (1.0 - c), np.zeros_like(phi)], axis=-1) + origin
     e1 = np.stack([c, sg * s, np.zeros_like(phi)], axis=-1)
     e2 = np.stack([-s, sg * c, np.zeros_like(phi)], axis=-1)
     return _poses(x, e1, e2)
@@ -102,11 +122,15 @@ def helix(radius, pitch, length, n_elements, phase=0.0, z0=0.0):
     axis), so every element has the same constant reference strain.
     """
     n = _check_n(n_elements, "helix")
-    for name, v in (("radius", radius), ("length", length)):
-        if not np.isfinite(v) or v <= 0:
-            raise InputError(f"geometry.helix: {name} must be positive, got {v!r}")
-    if not np.isfinite(pitch) or pitch == 0:
+    radius = real(radius, "radius", "geometry.helix", above=0.0)
+    length = real(length, "length", "geometry.helix", above=0.0)
+    pitch = real(pitch, "pitch", "geometry.helix")
+    phase = real(phase, "phase", "geometry.helix")
+    z0 = real(z0, "z0", "geometry.helix")
+    if pitch == 0:
         raise InputError(f"geometry.helix: pitch must be finite and non-zero, got {pitch!r}")
+    # the frames turn about the Darboux vector by 2 pi per turn of the helix
+    _check_turn(2.0 * np.pi * length / abs(pitch) / n, n, "helix")
     z = z0 + np.linspace(0.0, length, n + 1)
     k = 2.0 * np.pi / pitch
     th = k * (z - z0) + phase
@@ -163,11 +187,35 @@ def polyline(points, n_elements=None, e2=None):
         return frames_from_tangents(p, t, e2)
     a = p[1:-1] - p[:-2]
     b = p[2:] - p[1:-1]
-    tm = a / np.sum(a * a, axis=1, keepdims=True) + b / np.sum(b * b, axis=1, keepdims=True)
-    tm = _unit(tm, "tangent")
+    ia, ib = 1.0 / np.sum(a * a, axis=1, keepdims=True), 1.0 / np.sum(b * b, axis=1, keepdims=True)
+    tm = a * ia + b * ib
+    nt = np.linalg.norm(tm, axis=1)
+    rev = np.flatnonzero(nt <= 1e-12 * np.sqrt(np.maximum(ia, ib))[:, 0])
+    if len(rev):
+        i = int(rev[0]) + 1
+        raise InputError(f"geometry.polyline: element {i - 1} (points {i - 1} to {i}) turns by {np.pi:.3f} rad "
+                         f"(limit 0.75 pi = {MAX_ELEMENT_ROTATION:.3f} rad): the centre line reverses at point {i}")
+    tm = tm / nt[:, None]
     c0 = _unit(p[1] - p[0])
     t0 = 2.0 * np.dot(tm[0], c0) * c0 - tm[0]
     c1 = _unit(p[-1] - p[-2])
     t1 = 2.0 * np.dot(tm[-1], c1) * c1 - tm[-1]
     t = np.concatenate([t0[None], tm, t1[None]])
+    _check_fold(p, t)
     return frames_from_tangents(p, t, e2)
+
+
+def _check_fold(p, t):
+    """Refuse a polyline whose node tangent leaves a chord by more than half the element limit:
+    the element between them would turn by more than ``MAX_ELEMENT_ROTATION`` (or fold back,
+    ``e1`` against the chord)."""
+    c = np.diff(p, axis=0)
+    c /= np.linalg.norm(c, axis=1, keepdims=True)
+    ang = np.arccos(np.clip(np.stack([np.sum(t[:-1] * c, axis=1), np.sum(t[1:] * c, axis=1)]), -1.0, 1.0))
+    turn = 2.0 * ang.max(axis=0)
+    bad = np.flatnonzero(turn > MAX_ELEMENT_ROTATION)
+    if len(bad):
+        i = int(bad[0])
+        raise InputError(f"geometry.polyline: element {i} (points {i} to {i + 1}) turns by {turn[i]:.3f} rad "
+                         f"(limit 0.75 pi = {MAX_ELEMENT_ROTATION:.3f} rad): the centre line folds back or "
+                         "turns too sharply there; round the corner with more points")

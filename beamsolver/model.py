@@ -5,6 +5,7 @@ live in ``element``, ``assembly`` and ``solver``.  Node ids are global
 integers (``beam.nodes``); every ``add_beam`` creates new nodes, and beams are
 connected with ``join``.
 """
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Callable, Optional
 
@@ -14,12 +15,12 @@ from . import se3
 from .element import reference_strain
 from .errors import InputError
 from .section import Section
+from .validation import (MAX_ELEMENT_ROTATION, ORTHONORMAL_TOL, check_contact_options, check_node_id, check_pose,
+                         real)
 
 __all__ = ["Model", "Beam", "Load", "ContactDeclaration", "DOF_NAMES"]
 
 DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
-ORTHONORMAL_TOL = 1e-8
-MAX_ELEMENT_ROTATION = 0.75 * np.pi   # refuse reference elements turning more than this
 JOIN_TOL = 1e-9                       # coincidence tolerance relative to the model size
 
 
@@ -152,16 +153,18 @@ class Model:
 
         It carries stiffness only through ``join(..., rigid=True)`` links.
         """
-        H = np.array(pose, dtype=float)
-        if H.shape == (3,):
-            H = np.eye(4)
-            H[:3, 3] = np.array(pose, dtype=float)
         label = f"add_node({name or ''})"
+        try:
+            H = np.array(pose, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError(f"{label}: pose must be a finite 4x4 matrix or a 3-vector, got {pose!r}") from None
+        if H.shape == (3,):
+            x = H
+            H = np.eye(4)
+            H[:3, 3] = x
         if H.shape != (4, 4) or not np.all(np.isfinite(H)):
             raise InputError(f"{label}: pose must be a finite 4x4 matrix or a 3-vector, got shape {H.shape}")
-        R = H[:3, :3]
-        if np.abs(R.T @ R - np.eye(3)).max() > ORTHONORMAL_TOL or np.linalg.det(R) <= 0:
-            raise InputError(f"{label}: pose is not a rotation")
+        H = check_pose(H, label)
         i = self._n_nodes
         self._poses.append(H[None])
         self._n_nodes += 1
@@ -172,13 +175,7 @@ class Model:
     def _node(self, node, what):
         if isinstance(node, Beam):
             raise InputError(f"{what}: expected a node id, got {node!r}; use beam.first / beam.last / beam.nodes[i]")
-        try:
-            i = int(node)
-        except (TypeError, ValueError):
-            raise InputError(f"{what}: node id must be an integer, got {node!r}") from None
-        if i != node or not (0 <= i < self._n_nodes):
-            raise InputError(f"{what}: unknown node id {node!r} (the model has nodes 0..{self._n_nodes - 1})")
-        return i
+        return check_node_id(node, self._n_nodes, what)
 
     def beam_of_node(self, node):
         """The Beam owning ``node`` (None for nodes made by ``add_node``)."""
@@ -213,10 +210,14 @@ class Model:
         i = self._node(node, "fix")
         if isinstance(dofs, str):
             dofs = (dofs,)
+        if not isinstance(dofs, (tuple, list, set, frozenset, np.ndarray)):
+            raise InputError(f"fix({node}): dofs must be names from {DOF_NAMES}, got {dofs!r}")
         bad = [d for d in dofs if d not in DOF_NAMES]
         if bad or not dofs:
             raise InputError(f"fix({node}): unknown dofs {bad or dofs!r}; choose from {DOF_NAMES}")
         idx = frozenset(DOF_NAMES.index(d) for d in dofs)
+        if values is not None and not isinstance(values, Mapping):
+            raise InputError(f"fix({node}): values must be a dict {{dof: t -> float}}, got {values!r}")
         if values:
             rot = {"rx", "ry", "rz"}
             for k, f in values.items():
@@ -241,9 +242,7 @@ class Model:
         i = self._node(node, "prescribe")
         if not callable(motion):
             raise InputError(f"prescribe({node}): motion must be callable t -> 4x4 pose, got {motion!r}")
-        G = np.asarray(motion(0.0), dtype=float)
-        if G.shape != (4, 4) or not np.all(np.isfinite(G)):
-            raise InputError(f"prescribe({node}): motion(0) must be a finite 4x4 pose, got shape {G.shape}")
+        check_pose(motion(0.0), f"prescribe({node})", "motion(t = 0)")
         self._set_constraint(i, ("prescribe", motion), f"prescribe({node})")
 
     def join(self, node_a, node_b, rigid=False):
@@ -292,11 +291,9 @@ class Model:
         same = {b.id for b in s} & {b.id for b in m}
         if same:
             raise InputError(f"add_contact: beam {sorted(same)[0]} is declared in contact with itself")
-        if not np.isfinite(mu) or mu < 0:
-            raise InputError(f"add_contact: mu must be >= 0, got {mu!r}")
-        if penalty is not None and (not np.isfinite(penalty) or penalty <= 0):
-            raise InputError(f"add_contact: penalty must be positive, got {penalty!r}")
-        decl = ContactDeclaration(s, m, float(mu), penalty, dict(options))
+        mu = real(mu, "mu", "add_contact", minimum=0.0)
+        penalty = real(penalty, "penalty", "add_contact", above=0.0, none=True)
+        decl = ContactDeclaration(s, m, mu, penalty, check_contact_options(options))
         self.contacts.append(decl)
         return decl
 

@@ -8,15 +8,13 @@ the diagonal is ``(EA, GA2, GA3, GJ, EI2, EI3)``.  Units are the user's
 import numpy as np
 
 from .errors import InputError
+from .validation import real
 
 __all__ = ["Section"]
 
 
 def _positive(name, value, owner="Section"):
-    v = float(value)
-    if not np.isfinite(v) or v <= 0.0:
-        raise InputError(f"{owner}: {name} must be positive and finite, got {value!r}")
-    return v
+    return real(value, name, owner, above=0.0)
 
 
 class Section:
@@ -37,8 +35,11 @@ class Section:
 
     @classmethod
     def from_matrix(cls, C, radius, name=None):
-        C = np.array(C, dtype=float)
         owner = f"Section {name!r}" if name else "Section"
+        try:
+            C = np.array(C, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError(f"{owner}: C must be a finite 6x6 matrix of numbers, got {C!r}") from None
         if C.shape != (6, 6) or not np.all(np.isfinite(C)):
             raise InputError(f"{owner}: C must be a finite 6x6 matrix, got shape {C.shape}")
         if not np.allclose(C, C.T, rtol=1e-12, atol=0.0):
@@ -60,7 +61,7 @@ class Section:
         """
         r = _positive("radius", radius)
         E = _positive("E", E)
-        if not (-1.0 < float(nu) < 0.5):
+        if not (-1.0 < real(nu, "nu", "Section.circular") < 0.5):
             raise InputError(f"Section.circular: nu must lie in (-1, 0.5), got {nu!r}")
         k = 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu) if shear_factor is None else _positive("shear_factor", shear_factor)
         G = E / (2.0 * (1.0 + nu))
@@ -80,7 +81,7 @@ class Section:
         """
         b_, h_ = _positive("width", width), _positive("height", height)
         E = _positive("E", E)
-        if not (-1.0 < float(nu) < 0.5):
+        if not (-1.0 < real(nu, "nu", "Section.rectangular") < 0.5):
             raise InputError(f"Section.rectangular: nu must lie in (-1, 0.5), got {nu!r}")
         k = 10.0 * (1.0 + nu) / (12.0 + 11.0 * nu) if shear_factor is None else _positive("shear_factor", shear_factor)
         G = E / (2.0 * (1.0 + nu))

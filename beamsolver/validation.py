@@ -1,0 +1,213 @@
+"""Checks of user input: numbers, counts, poses, contact options and ``solve``'s arguments.
+
+Every check raises ``InputError`` naming where the value came from (``owner``,
+e.g. ``"solve"`` or ``"Section 'wire'"``), the argument and the value; none of
+them lets a raw ``TypeError``/``ValueError``/``OverflowError`` from numpy out.
+Numbers are Python or numpy reals (not ``bool``, not strings); counts are
+integers or integral floats.
+"""
+import numbers
+
+import numpy as np
+
+from .errors import InputError
+
+__all__ = ["real", "count", "check_pose", "check_node_id", "check_contact_options",
+           "check_solve_arguments", "MAX_ELEMENT_ROTATION", "ORTHONORMAL_TOL", "MAX_COUNT"]
+
+MAX_ELEMENT_ROTATION = 0.75 * np.pi   # a reference element may turn by at most this much
+ORTHONORMAL_TOL = 1e-8                # |R^T R - I| and |last row - (0, 0, 0, 1)| of a pose
+MAX_COUNT = 10**6                     # elements per generated beam, load steps per solve
+
+
+def _is_real(value):
+    if isinstance(value, (bool, np.bool_)):
+        return False
+    if isinstance(value, numbers.Real):
+        return True
+    return isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf"
+
+
+def real(value, name, owner, *, minimum=None, above=None, maximum=None, none=False):
+    """``value`` as a finite float with ``value >= minimum``, ``> above``, ``<= maximum``.
+
+    ``none``: ``None`` is accepted (and returned).
+    """
+    if value is None and none:
+        return None
+    if minimum is not None:
+        what = "a number >= " + ("0" if minimum == 0 else f"{minimum:g}")
+    elif above is not None:
+        what = "positive" if above == 0 else f"a number > {above:g}"
+    else:
+        what = "a finite number"
+    if maximum is not None:
+        what += f" and <= {maximum:g}"
+    ok = _is_real(value) and np.isfinite(float(value))
+    if ok:
+        v = float(value)
+        ok = ((minimum is None or v >= minimum) and (above is None or v > above)
+              and (maximum is None or v <= maximum))
+    if not ok:
+        raise InputError(f"{owner}: {name} must be {what}, got {value!r}")
+    return v
+
+
+def count(value, name, owner, *, minimum=1, maximum=MAX_COUNT):
+    """``value`` as an int in ``[minimum, maximum]`` (integral floats accepted)."""
+    ok = _is_real(value) and np.isfinite(float(value)) and float(value) == int(value)
+    if not ok or int(value) < minimum:
+        kind = "a positive integer" if minimum == 1 else f"an integer >= {minimum}"
+        raise InputError(f"{owner}: {name} must be {kind}, got {value!r}")
+    if int(value) > maximum:
+        raise InputError(f"{owner}: {name} must be at most {maximum}, got {value!r}")
+    return int(value)
+
+
+def check_poses(P, where, what):
+    """Poses ``(k, 4, 4)`` as floats: finite, rotation blocks orthonormal with ``det > 0`` and last
+    rows ``(0, 0, 0, 1)`` (to ``ORTHONORMAL_TOL``; set exactly on return).
+
+    ``where`` names the source (``"solve"``), ``what(i)`` the pose (``"initial_poses[3]"``).
+    """
+    H = np.array(P, dtype=float)
+    finite = np.all(np.isfinite(H), axis=(1, 2))
+    R = np.where(finite[:, None, None], H[:, :3, :3], np.eye(3))
+    err = np.abs(np.swapaxes(R, 1, 2) @ R - np.eye(3)).max(axis=(1, 2), initial=0.0)
+    det = np.linalg.det(R) if len(H) else np.zeros(0)
+    row = np.abs(H[:, 3] - [0.0, 0.0, 0.0, 1.0]).max(axis=1, initial=0.0)
+    bad = np.flatnonzero(~finite | (err > ORTHONORMAL_TOL) | ~(det > 0.0) | (row > ORTHONORMAL_TOL))
+    if len(bad):
+        i = int(bad[0])
+        if not finite[i]:
+            raise InputError(f"{where}: {what(i)} must be finite, got {H[i].tolist()}")
+        if err[i] > ORTHONORMAL_TOL or not det[i] > 0.0:
+            raise InputError(f"{where}: {what(i)} is not a rigid motion: its rotation block has "
+                             f"|R^T R - I| = {err[i]:.3g}, det = {det[i]:.6g}")
+        raise InputError(f"{where}: {what(i)} is not a rigid motion: its last row is {H[i, 3].tolist()}, "
+                         "not (0, 0, 0, 1)")
+    H[:, 3] = (0.0, 0.0, 0.0, 1.0)
+    return H
+
+
+def check_pose(G, where, what="pose"):
+    """One pose ``G`` (a 4x4 rigid motion) as a float array; see ``check_poses``."""
+    try:
+        H = np.array(G, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{where}: {what} must be a 4x4 matrix of numbers, got {G!r}") from None
+    if H.shape != (4, 4):
+        raise InputError(f"{where}: {what} must be a 4x4 matrix, got shape {H.shape}")
+    return check_poses(H[None], where, lambda i: what)[0]
+
+
+def check_node_id(node, n_nodes, what):
+    """A node id as an int in ``[0, n_nodes)``; bools, beams and non-integers are refused."""
+    if isinstance(node, (bool, np.bool_)) or not _is_real(node) or not np.isfinite(float(node)) \
+            or float(node) != int(node):
+        raise InputError(f"{what}: node id must be an integer, got {node!r}")
+    i = int(node)
+    if not 0 <= i < n_nodes:
+        raise InputError(f"{what}: unknown node id {node!r} (the model has nodes 0..{n_nodes - 1})")
+    return i
+
+
+def scalar_of(fn, t, where):
+    """``fn(t)`` as a finite float; ``where`` names the callable (e.g. ``add_load(4): scale``)."""
+    v = fn(t)
+    if not _is_real(v) or not np.isfinite(float(v)):
+        kind = f"an array of shape {np.shape(v)}" if isinstance(v, np.ndarray) else repr(v)
+        raise InputError(f"{where}({t:.6g}) must return a finite number, got {kind}")
+    return float(v)
+
+
+
+
+# ------------------------------------------------------------ contact options
+def _gauss_points(v, owner):
+    return count(v, "gauss_points", owner, maximum=64)
+
+
+CONTACT_OPTIONS = {   # name -> check(value, owner) returning the stored value (see contact.system)
+    "smoothing": lambda v, o: real(v, "smoothing", o, minimum=0.0, none=True),
+    "gauss_points": _gauss_points,
+    "penalty_t": lambda v, o: real(v, "penalty_t", o, above=0.0, none=True),
+    "slip_tolerance": lambda v, o: real(v, "slip_tolerance", o, above=0.0),
+    "tolerance": lambda v, o: real(v, "tolerance", o, above=0.0, none=True),
+    "line_angle": lambda v, o: _line_angle(v, o),
+    "point_ratio": lambda v, o: real(v, "point_ratio", o, minimum=0.0, maximum=1.0),
+    "margin": lambda v, o: real(v, "margin", o, minimum=0.0),
+}
+
+
+def _line_angle(v, owner):
+    a = real(v, "line_angle", owner)
+    if not 0.0 <= a <= 0.5 * np.pi:
+        raise InputError(f"{owner}: line_angle must lie in [0, pi/2] rad, got {v!r}")
+    return a
+
+
+def check_contact_options(options, owner="add_contact"):
+    """Validated copy of ``Model.add_contact``'s keyword options (unknown names refused)."""
+    bad = sorted(set(options) - set(CONTACT_OPTIONS))
+    if bad:
+        raise InputError(f"{owner}: unknown options {bad}; known: {sorted(CONTACT_OPTIONS)}")
+    return {k: CONTACT_OPTIONS[k](v, owner) for k, v in options.items()}
+
+
+# ------------------------------------------------------------ solve
+def check_solve_arguments(model, *, steps, t_end, t_start, rtol, dtol, max_iter, min_step_ratio,
+                          checkpoint, initial_poses, restart, callback=None):
+    """Refuse bad ``solve`` arguments before any work (types, ranges, shapes, load scales).
+
+    The load scales and ``fix(..., values=)`` functions are evaluated at ``t_start`` and
+    ``t_end`` (they must return finite numbers); ``initial_poses`` must be ``(n_nodes, 4, 4)``
+    rigid motions; ``restart``'s last saved time must not lie after ``t_end``.
+    """
+    from .model import DOF_NAMES, Model
+    if not isinstance(model, Model):
+        raise InputError(f"solve: model must be a beamsolver.Model, got {type(model).__name__}")
+    count(steps, "steps", "solve")
+    t0 = real(t_start, "t_start", "solve")
+    t1 = real(t_end, "t_end", "solve")
+    real(rtol, "rtol", "solve", above=0.0)
+    real(dtol, "dtol", "solve", minimum=0.0)
+    count(max_iter, "max_iter", "solve")
+    real(min_step_ratio, "min_step_ratio", "solve", above=0.0, maximum=1.0)
+    real(checkpoint, "checkpoint", "solve", minimum=0.0, none=True)
+    if callback is not None and not callable(callback):
+        raise InputError(f"solve: callback must be callable or None, got {callback!r}")
+    if initial_poses is not None:
+        _check_initial_poses(initial_poses, model.n_nodes)
+    if restart is not None:
+        last = _last_saved_time(restart)
+        if t1 < last:
+            raise InputError(f"solve: t_end = {t_end!r} is before the end of the restart solution "
+                             f"(t = {last:.6g}); give t_end >= {last:.6g}")
+        t0 = last
+    for t in (t0, t1):
+        for ld in model.loads:
+            scalar_of(ld.scale, t, f"add_load({ld.node}): scale")
+        for node, fns in model.fix_values.items():
+            for comp, fn in fns.items():
+                scalar_of(fn, t, f"fix({node}): values[{DOF_NAMES[comp]!r}]")
+
+
+def _check_initial_poses(P, n_nodes):
+    try:
+        H = np.array(P, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"solve: initial_poses must be an array of numbers of shape ({n_nodes}, 4, 4)") from None
+    if H.shape != (n_nodes, 4, 4):
+        raise InputError(f"solve: initial_poses must have shape ({n_nodes}, 4, 4) (one pose per node), "
+                         f"got {H.shape}")
+    check_poses(H, "solve", lambda i: f"initial_poses[{i}]")
+
+
+def _last_saved_time(restart):
+    """Last time of a restart ``Solution`` or saved file (only ``times`` is read from a file)."""
+    if hasattr(restart, "_times"):
+        return float(restart._times[-1]) if restart._times else -np.inf
+    from .io.archive import saved_times
+    times = saved_times(restart)
+    return float(times[-1]) if len(times) else -np.inf
