@@ -15,7 +15,7 @@ whose centre line folds back or turns that sharply at a point is refused.
 import numpy as np
 
 from .errors import InputError
-from .validation import MAX_ELEMENT_ROTATION, count, real
+from .validation import MAX_ELEMENT_ROTATION, count, real, vector
 
 __all__ = ["straight", "arc", "helix", "polyline", "frames_from_tangents"]
 
@@ -85,7 +85,7 @@ def straight(start=(0.0, 0.0, 0.0), end=(1.0, 0.0, 0.0), n_elements=10, e2=None)
     if np.linalg.norm(b - a) == 0.0:
         raise InputError(f"geometry.straight: start and end coincide at {a.tolist()}")
     e1 = (b - a) / np.linalg.norm(b - a)
-    e2v = _default_e2(e1) if e2 is None else np.asarray(e2, dtype=float)
+    e2v = _default_e2(e1) if e2 is None else vector(e2, "e2", "geometry.straight")
     s = np.linspace(0.0, 1.0, n + 1)[:, None]
     x = a + s * (b - a)
     return _poses(x, np.broadcast_to(e1, x.shape), np.broadcast_to(e2v, x.shape).copy())
@@ -154,7 +154,7 @@ def _rotation_between(a, b):
 def frames_from_tangents(x, t, e2=None):
     """Poses at points ``x`` with tangents ``t``; ``e2`` parallel-transported from the first."""
     t = _unit(t, "tangent")
-    e2_0 = _default_e2(t[0]) if e2 is None else np.asarray(e2, dtype=float)
+    e2_0 = _default_e2(t[0]) if e2 is None else vector(e2, "e2", "geometry")
     e2_0 = e2_0 - np.dot(e2_0, t[0]) * t[0]
     e2s = np.zeros_like(t)
     e2s[0] = _unit(e2_0, "e2 (parallel to the first tangent?)")

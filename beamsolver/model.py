@@ -15,8 +15,8 @@ from . import se3
 from .element import reference_strain
 from .errors import InputError
 from .section import Section
-from .validation import (MAX_ELEMENT_ROTATION, ORTHONORMAL_TOL, check_contact_options, check_node_id, check_pose,
-                         real)
+from .validation import (MAX_ELEMENT_ROTATION, ORTHONORMAL_TOL, as_array, check_contact_options, check_node_id,
+                         check_pose, real)
 
 __all__ = ["Model", "Beam", "Load", "ContactDeclaration", "DOF_NAMES"]
 
@@ -109,7 +109,7 @@ class Model:
         label = f"Beam {bid}" + (f" {name!r}" if name else "")
         if not isinstance(section, Section):
             raise InputError(f"{label}: section must be a beamsolver.Section, got {type(section).__name__}")
-        P = np.array(poses, dtype=float)
+        P = as_array(poses, "poses", label)
         if P.ndim != 3 or P.shape[1:] != (4, 4) or P.shape[0] < 2:
             raise InputError(f"{label}: poses must have shape (n + 1, 4, 4) with n >= 1, got {P.shape}")
         bad = np.argwhere(~np.all(np.isfinite(P), axis=(1, 2)))
@@ -271,8 +271,8 @@ class Model:
         load is given in the node's body frame and turns with it.
         """
         i = self._node(node, "add_load")
-        F = np.zeros(3) if force is None else np.array(force, dtype=float).reshape(-1)
-        M = np.zeros(3) if moment is None else np.array(moment, dtype=float).reshape(-1)
+        F = np.zeros(3) if force is None else as_array(force, "force", f"add_load({node})").reshape(-1)
+        M = np.zeros(3) if moment is None else as_array(moment, "moment", f"add_load({node})").reshape(-1)
         for name, v in (("force", F), ("moment", M)):
             if v.shape != (3,) or not np.all(np.isfinite(v)):
                 raise InputError(f"add_load({node}): {name} must be 3 finite numbers, got {v.tolist()}")
@@ -283,6 +283,9 @@ class Model:
     # ------------------------------------------------------------ contact
     def add_contact(self, slave, master, mu=0.0, penalty=None, **options):
         """Declare contact between ``slave`` and ``master`` (a Beam or a list of Beams each)."""
+        for side, v in (("slave", slave), ("master", master)):
+            if not isinstance(v, (Beam, list, tuple)):
+                raise InputError(f"add_contact: {side} must be a Beam or a list of Beams, got {v!r}")
         s = [slave] if isinstance(slave, Beam) else list(slave)
         m = [master] if isinstance(master, Beam) else list(master)
         for b in s + m:

@@ -7,12 +7,13 @@ Numbers are Python or numpy reals (not ``bool``, not strings); counts are
 integers or integral floats.
 """
 import numbers
+import os
 
 import numpy as np
 
 from .errors import InputError
 
-__all__ = ["real", "count", "check_pose", "check_node_id", "check_contact_options",
+__all__ = ["real", "count", "as_array", "vector", "check_pose", "check_poses", "check_node_id", "check_contact_options",
            "check_solve_arguments", "MAX_ELEMENT_ROTATION", "ORTHONORMAL_TOL", "MAX_COUNT"]
 
 MAX_ELEMENT_ROTATION = 0.75 * np.pi   # a reference element may turn by at most this much
@@ -62,6 +63,22 @@ def count(value, name, owner, *, minimum=1, maximum=MAX_COUNT):
     if int(value) > maximum:
         raise InputError(f"{owner}: {name} must be at most {maximum}, got {value!r}")
     return int(value)
+
+
+def as_array(value, name, owner):
+    """``value`` as a float array (``InputError`` if it is not made of numbers)."""
+    try:
+        return np.array(value, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise InputError(f"{owner}: {name} must be an array of numbers, got {value!r}") from None
+
+
+def vector(value, name, owner, size=3):
+    """``value`` as a finite float vector of ``size`` numbers."""
+    v = as_array(value, name, owner).reshape(-1)
+    if v.shape != (size,) or not np.all(np.isfinite(v)):
+        raise InputError(f"{owner}: {name} must be {size} finite numbers, got {v.tolist()}")
+    return v
 
 
 def check_poses(P, where, what):
@@ -157,7 +174,7 @@ def check_contact_options(options, owner="add_contact"):
 
 # ------------------------------------------------------------ solve
 def check_solve_arguments(model, *, steps, t_end, t_start, rtol, dtol, max_iter, min_step_ratio,
-                          checkpoint, initial_poses, restart, callback=None):
+                          checkpoint, initial_poses, restart, callback=None, output=None):
     """Refuse bad ``solve`` arguments before any work (types, ranges, shapes, load scales).
 
     The load scales and ``fix(..., values=)`` functions are evaluated at ``t_start`` and
@@ -177,6 +194,10 @@ def check_solve_arguments(model, *, steps, t_end, t_start, rtol, dtol, max_iter,
     real(checkpoint, "checkpoint", "solve", minimum=0.0, none=True)
     if callback is not None and not callable(callback):
         raise InputError(f"solve: callback must be callable or None, got {callback!r}")
+    if output is not None and not isinstance(output, (str, os.PathLike)) and not hasattr(output, "write"):
+        raise InputError(f"solve: output must be a folder (str or Path), a writer or None, got {output!r}")
+    if restart is not None and not isinstance(restart, (str, os.PathLike)) and not hasattr(restart, "_times"):
+        raise InputError(f"solve: restart must be a Solution or the path of a saved one, got {restart!r}")
     if initial_poses is not None:
         _check_initial_poses(initial_poses, model.n_nodes)
     if restart is not None:

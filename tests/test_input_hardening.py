@@ -160,6 +160,11 @@ def _contact(**kw):
     return lambda: m.add_contact(a, b, **kw)
 
 
+def _contact_with(slave):
+    m, a, b = _crossing()
+    m.add_contact(slave, b)
+
+
 def _restart_before_saved_time():
     m, _ = _cantilever()
     sol = bs.solve(m, steps=2, t_end=1.0, verbose=False)
@@ -209,6 +214,13 @@ CASES = {
     "smoothing str": (_contact(smoothing="a"), r"add_contact: smoothing .*'a'"),
     "tolerance 0": (_contact(tolerance=0.0), r"add_contact: tolerance .*0.0"),
     "unknown option": (_contact(gausspoints=3), r"add_contact: unknown options \['gausspoints'\]"),
+    "e2 str": (lambda: geometry.straight(e2="abc"), r"geometry.straight: e2 must be an array of numbers, got 'abc'"),
+    "poses str": (lambda: bs.Model().add_beam("abc", _sec()), r"Beam 0: poses must be an array of numbers"),
+    "force str": (lambda: _cantilever()[0].add_load(4, force="up"), r"add_load\(4\): force must be an array"),
+    "contact slave None": (lambda: _contact_with(None), r"add_contact: slave must be a Beam or a list of Beams, got None"),
+    "output int": (_solve(steps=1, output=3), r"solve: output must be a folder .*got 3"),
+    "restart float": (_solve(steps=1, restart=1.5), r"solve: restart must be a Solution or the path .*got 1.5"),
+    "load None": (lambda: bs.load(None), r"load: path must be a file or folder name .*got None"),
     "n_wires 2.5": (lambda: _strand(2.5), r"build_strand: layer 1 n_wires must be a positive integer, got 2.5"),
     "wire_radius str": (lambda: cables.build_strand([cables.Layer("1e-3")], 0.05, 2e11),
                         r"build_strand: layer 0 wire_radius .*'1e-3'"),

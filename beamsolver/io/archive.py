@@ -127,6 +127,8 @@ def save(solution, path):
 
 def _resolve(path):
     """The archive a user names: a file, ``<name>`` for ``<name>.npz``, or a folder's solution.npz."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputError(f"load: path must be a file or folder name (str or Path), got {path!r}")
     path = Path(path)
     if path.is_dir():
         if not (path / "solution.npz").is_file():
