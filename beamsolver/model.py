@@ -15,7 +15,7 @@ from . import se3
 from .element import reference_strain
 from .errors import InputError
 from .section import Section
-from .validation import (MAX_ELEMENT_ROTATION, ORTHONORMAL_TOL, as_array, check_contact_options, check_node_id,
+from .validation import (MAX_ELEMENT_ROTATION, ORTHONORMAL_TOL, CheckedScalar, as_array, check_contact_options, check_node_id,
                          check_pose, real)
 
 __all__ = ["Model", "Beam", "Load", "ContactDeclaration", "DOF_NAMES"]
@@ -231,7 +231,8 @@ class Model:
                 raise InputError(f"fix({node}): at most one rotation can be prescribed; use prescribe()")
             if len(idx) == 6:
                 raise InputError(f"fix({node}): with all six dofs fixed use prescribe() for motions")
-            self.fix_values.setdefault(i, {}).update({DOF_NAMES.index(k): f for k, f in values.items()})
+            self.fix_values.setdefault(i, {}).update(
+                {DOF_NAMES.index(k): CheckedScalar(f, f"fix({node}): values[{k!r}]") for k, f in values.items()})
         if len(idx) == 6:
             self._set_constraint(i, ("clamp",), f"fix({node})")
         else:
@@ -278,7 +279,7 @@ class Model:
                 raise InputError(f"add_load({node}): {name} must be 3 finite numbers, got {v.tolist()}")
         if not callable(scale):
             raise InputError(f"add_load({node}): scale must be callable t -> float, got {scale!r}")
-        self.loads.append(Load(i, F, M, bool(follower), scale))
+        self.loads.append(Load(i, F, M, bool(follower), CheckedScalar(scale, f"add_load({node}): scale")))
 
     # ------------------------------------------------------------ contact
     def add_contact(self, slave, master, mu=0.0, penalty=None, **options):

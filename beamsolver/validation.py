@@ -129,6 +129,18 @@ def check_node_id(node, n_nodes, what):
     return i
 
 
+class CheckedScalar:
+    """``fn(t)`` checked at every call to be a finite number (``scalar_of``): a user's load
+    scale or ``fix`` value that returns a string, an array or NaN at some ``t`` is an
+    ``InputError`` naming it and ``t``, not a raw error or a NaN state.  ``fn``: the user's."""
+
+    def __init__(self, fn, where):
+        self.fn, self.where = fn, where
+
+    def __call__(self, t):
+        return scalar_of(self.fn, t, self.where)
+
+
 def scalar_of(fn, t, where):
     """``fn(t)`` as a finite float; ``where`` names the callable (e.g. ``add_load(4): scale``)."""
     v = fn(t)
@@ -181,7 +193,7 @@ def check_solve_arguments(model, *, steps, t_end, t_start, rtol, dtol, max_iter,
     ``t_end`` (they must return finite numbers); ``initial_poses`` must be ``(n_nodes, 4, 4)``
     rigid motions; ``restart``'s last saved time must not lie after ``t_end``.
     """
-    from .model import DOF_NAMES, Model
+    from .model import Model
     if not isinstance(model, Model):
         raise InputError(f"solve: model must be a beamsolver.Model, got {type(model).__name__}")
     count(steps, "steps", "solve")
@@ -206,12 +218,12 @@ def check_solve_arguments(model, *, steps, t_end, t_start, rtol, dtol, max_iter,
             raise InputError(f"solve: t_end = {t_end!r} is before the end of the restart solution "
                              f"(t = {last:.6g}); give t_end >= {last:.6g}")
         t0 = last
-    for t in (t0, t1):
+    for t in (t0, t1):                 # CheckedScalar: every later evaluation is checked too
         for ld in model.loads:
-            scalar_of(ld.scale, t, f"add_load({ld.node}): scale")
-        for node, fns in model.fix_values.items():
-            for comp, fn in fns.items():
-                scalar_of(fn, t, f"fix({node}): values[{DOF_NAMES[comp]!r}]")
+            ld.scale(t)
+        for fns in model.fix_values.values():
+            for fn in fns.values():
+                fn(t)
 
 
 def _check_initial_poses(P, n_nodes):

@@ -148,11 +148,11 @@ def _solve(**kw):
     return lambda: bs.solve(_cantilever()[0], verbose=False, **kw)
 
 
-def _with_scale(scale):
+def _with_scale(scale, steps=1):
     m, b = _cantilever()
     m.loads.clear()
     m.add_load(b.last, force=(0, 0, 1.0), scale=scale)
-    return lambda: bs.solve(m, steps=1, verbose=False)
+    return lambda: bs.solve(m, steps=steps, verbose=False)
 
 
 def _contact(**kw):
@@ -197,9 +197,15 @@ CASES = {
     "restart before": (_restart_before_saved_time, r"solve: t_end = 0.5 is before the end of the restart solution \(t = 1\)"),
     "scale str": (_with_scale(lambda t: "x"), r"add_load\(4\): scale\(0\) must return a finite number, got 'x'"),
     "scale array": (_with_scale(lambda t: np.array([t, t])), r"add_load\(4\): scale\(0\) .*array"),
+    "scale str later": (_with_scale(lambda t: "x" if 0.2 < t < 0.9 else t, steps=4),
+                        r"add_load\(4\): scale\(0.25\) must return a finite number, got 'x'"),
+    "scale nan later": (_with_scale(lambda t: np.nan if 0.2 < t < 0.9 else t, steps=4),
+                        r"add_load\(4\): scale\(0.25\) must return a finite number, got nan"),
     "scale not callable": (lambda: _cantilever()[0].add_load(4, force=(1, 0, 0), scale=2.0),
                            r"add_load\(4\): scale must be callable"),
     "fix values str": (lambda: _fix_values_str(), r"fix\(4\): values\['uz'\]\(0\) must return a finite number"),
+    "fix values array later": (lambda: _fix_values_array_later(),
+                               r"fix\(4\): values\['uz'\]\(0.25\) must return .*array of shape \(2,\)"),
     "fix None": (lambda: _cantilever()[0].fix(4, None), r"fix\(4\): dofs .*None"),
     "clamp True": (lambda: _cantilever()[0].clamp(True), r"clamp: node id must be an integer, got True"),
     "node float": (lambda: _cantilever()[0].clamp(1.5), r"clamp: .*1.5"),
@@ -227,6 +233,12 @@ CASES = {
     "strand length str": (lambda: cables.build_strand([cables.Layer(1e-3)], "0.05", 2e11),
                           r"build_strand: length .*'0.05'"),
 }
+
+
+def _fix_values_array_later():
+    m, b = _cantilever()
+    m.fix(b.last, ("uz",), values={"uz": lambda t: np.array([t, t]) if 0.2 < t < 0.9 else 0.1 * t})
+    return bs.solve(m, steps=4, verbose=False)
 
 
 def _fix_values_str():
