@@ -15,8 +15,8 @@ from . import se3
 from .element import reference_strain
 from .errors import InputError
 from .section import Section
-from .validation import (MAX_ELEMENT_ROTATION, ORTHONORMAL_TOL, CheckedScalar, as_array, check_contact_options, check_node_id,
-                         check_pose, real)
+from .validation import (MAX_ELEMENT_ROTATION, ORTHONORMAL_TOL, CheckedScalar, as_array, check_contact_options,
+                         check_node_id, check_pose, real)
 
 __all__ = ["Model", "Beam", "Load", "ContactDeclaration", "DOF_NAMES"]
 

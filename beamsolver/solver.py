@@ -400,7 +400,9 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     "beamsolver[fast]"``, else ``"splu-rcm"``, scipy after an RCM ordering),
     or one of those by name (see ``beamsolver.linsolve``).
     """
-    check_solve_arguments(model, steps=steps, t_end=t_end, t_start=t_start, rtol=rtol, dtol=dtol, max_iter=max_iter, min_step_ratio=min_step_ratio, checkpoint=checkpoint, initial_poses=initial_poses, restart=restart, callback=callback, output=output)  # noqa: E501
+    check_solve_arguments(model, steps=steps, t_end=t_end, t_start=t_start, rtol=rtol, dtol=dtol, max_iter=max_iter,
+                          min_step_ratio=min_step_ratio, checkpoint=checkpoint, initial_poses=initial_poses,
+                          restart=restart, callback=callback, output=output)
     if restart is not None and initial_poses is not None:
         raise InputError("solve: give either restart or initial_poses, not both")
     if int(steps) != steps or steps < 1:
