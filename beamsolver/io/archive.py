@@ -275,6 +275,8 @@ def check_archive(data, where):
     arrays = {k: data[k] for k in data.files}
     times = _check_times(arrays, where)
     s = len(times)
+    if s == 0:
+        raise _damaged(where, "no steps (a saved solution holds at least its step 0)")
     n, n_el = len(arrays["model/poses0"]), len(arrays["model/enodes"])
     _shape(arrays, "model/poses0", (n, 4, 4), where)
     _shape(arrays, "model/enodes", (n_el, 2), where)
