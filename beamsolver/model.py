@@ -257,7 +257,7 @@ class Model:
         if a == b:
             raise InputError(f"join({node_a}, {node_b}): a node cannot be joined to itself")
         P = self.poses0
-        size = max(1.0, np.ptp(P[:, :3, 3], axis=0).max())
+        size = self.characteristic_length()          # relative: the same decision in any unit
         gap = np.linalg.norm(P[a, :3, 3] - P[b, :3, 3])
         if gap > JOIN_TOL * size and not rigid:
             raise InputError(f"join({node_a}, {node_b}): nodes are {gap:.3g} apart; a joint needs coincident "

@@ -255,3 +255,15 @@ def test_wrongly_typed_argument_gives_input_error(name):
     call, pattern = CASES[name]
     with pytest.raises(InputError, match=pattern):
         call()
+
+
+@pytest.mark.parametrize("unit", [1.0, 1e-3, 1e3])
+def test_join_tolerance_is_relative_to_the_model_size_in_any_unit(unit):
+    """Nodes 1e-8 model sizes apart are not coincident, in metres, kilometres or millimetres."""
+    m = bs.Model()
+    a = m.add_beam(geometry.straight((0, 0, 0), (unit, 0, 0), 2), _sec(unit))
+    b = m.add_beam(geometry.straight((unit * (1 + 1e-8), 0, 0), (2 * unit, 0, 0), 2), _sec(unit))
+    with pytest.raises(InputError, match=r"join\(2, 3\): nodes are .* apart"):
+        m.join(a.last, b.first)
+    c = m.add_beam(geometry.straight((unit * (1 + 1e-11), 0, 0), (2 * unit, 0, 0), 2), _sec(unit))
+    m.join(a.last, c.first)                      # 1e-11 sizes apart: coincident
