@@ -150,11 +150,16 @@ def scalar_of(fn, t, where):
     return float(v)
 
 
-
-
 # ------------------------------------------------------------ contact options
 def _gauss_points(v, owner):
     return count(v, "gauss_points", owner, maximum=64)
+
+
+def _line_angle(v, owner):
+    a = real(v, "line_angle", owner)
+    if not 0.0 <= a <= 0.5 * np.pi:
+        raise InputError(f"{owner}: line_angle must lie in [0, pi/2] rad, got {v!r}")
+    return a
 
 
 CONTACT_OPTIONS = {   # name -> check(value, owner) returning the stored value (see contact.system)
@@ -163,17 +168,10 @@ CONTACT_OPTIONS = {   # name -> check(value, owner) returning the stored value (
     "penalty_t": lambda v, o: real(v, "penalty_t", o, above=0.0, none=True),
     "slip_tolerance": lambda v, o: real(v, "slip_tolerance", o, above=0.0),
     "tolerance": lambda v, o: real(v, "tolerance", o, above=0.0, none=True),
-    "line_angle": lambda v, o: _line_angle(v, o),
+    "line_angle": _line_angle,
     "point_ratio": lambda v, o: real(v, "point_ratio", o, minimum=0.0, maximum=1.0),
     "margin": lambda v, o: real(v, "margin", o, minimum=0.0),
 }
-
-
-def _line_angle(v, owner):
-    a = real(v, "line_angle", owner)
-    if not 0.0 <= a <= 0.5 * np.pi:
-        raise InputError(f"{owner}: line_angle must lie in [0, pi/2] rad, got {v!r}")
-    return a
 
 
 def check_contact_options(options, owner="add_contact"):
