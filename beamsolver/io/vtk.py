@@ -7,12 +7,13 @@ Files in the output folder (``solve(model, output=folder)``, or
   ``refine`` segments with the SE(3) interpolation (``io.lines``); point
   data ``displacement``, ``e1``, ``e2``, ``e3``, ``radius``, ``beam_id``;
   cell data ``N, Q2, Q3, T, M2, M3``, ``strain`` (6), ``element``.
-- ``contact_<k>.vtu`` (scenes with contact only): one vertex per contact
-  point, with ``gap``, ``normal_force``, ``tangential_force`` (3),
-  ``stick`` (1 stick, 0 slip or frictionless), ``slip_increment`` (2),
-  ``normal`` (3), ``kind``; no points before contact occurs (such a file
-  is valid VTK that ParaView and pyvista read; meshio cannot read any mesh
-  without cells).
+- ``contact_<k>.vtu`` (scenes with contact only): one vertex per active
+  contact point (``normal_force > 0``; the candidates the search found open
+  are left out, so a Glyph draws contacts only), with ``gap``,
+  ``normal_force``, ``tangential_force`` (3), ``stick`` (1 stick, 0 slip or
+  frictionless), ``slip_increment`` (2), ``normal`` (3), ``kind``.  A step
+  without contact has no points and one empty poly-vertex cell (VTK type 2):
+  meshio cannot read a file without cells, and skips that one with a warning.
 - ``beams.pvd`` and ``contact.pvd``: the collections with the pseudo-times.
 - ``solution.npz``: the ``Solution`` (``io.archive``), saved at the end of the
   run (also when it stops with ``ConvergenceError``) and every
@@ -20,11 +21,15 @@ Files in the output folder (``solve(model, output=folder)``, or
   ``beamsolver info`` and ``solve(..., restart=folder)``.
 
 Every file is written under a temporary name in the same folder and then
-renamed (``os.replace``, atomic on POSIX), and the ``.pvd`` files are
+renamed, with the mode ``open()`` would give it (``0666 & ~umask``) (``os.replace``, atomic on POSIX), and the ``.pvd`` files are
 rewritten after every step: a run that stops at any moment leaves only
 complete files, and ``.pvd`` files that list exactly the steps written.
-meshio cannot write VTK poly-lines (type 4), hence two-point ``line`` cells;
-ParaView's Tube filter (after Extract Surface) draws them.
+A writer first removes the numbered files its folder's ``beams.pvd`` and
+``contact.pvd`` list (the previous run's series; nothing else), so ParaView
+never groups two runs.
+meshio can neither write nor read VTK poly-lines (type 4), hence two-point
+``line`` cells; for smooth tubes ParaView joins them into poly-lines with
+*Triangle Strips* before the Tube filter (README, "ParaView").
 """
 import os
 import tempfile
@@ -35,6 +40,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from ..errors import InputError
+from .files import follow_umask, previous_series
 from .lines import LineLayout
 
 __all__ = ["StepWriter", "write_vtk", "write_pvd"]
@@ -42,6 +48,7 @@ __all__ = ["StepWriter", "write_vtk", "write_pvd"]
 BEAMS = "beams"
 CONTACT = "contact"
 ARCHIVE = "solution.npz"
+SERIES = rf"({BEAMS}|{CONTACT})_[0-9]+\.vtu"     # names of the numbered files of a run
 CONTACT_FIELDS = {"gap": (), "normal_force": (), "tangential_force": (3,), "stick": (),
                   "slip_increment": (2,), "normal": (3,), "kind": ()}
 
@@ -53,6 +60,7 @@ def _atomic(path, write):
     tmp = None
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".tmp" + path.suffix, dir=path.parent)
+        follow_umask(fd)
         os.close(fd)
         write(tmp)
         os.replace(tmp, path)
@@ -115,6 +123,10 @@ class StepWriter:
         import meshio   # imported here: scenes without output never pay for it
         self._meshio = meshio
         self.folder = _output_folder(folder)
+        for old in previous_series(self.folder, (f"{BEAMS}.pvd", f"{CONTACT}.pvd"), SERIES):
+            old.unlink()
+        for name in (f"{BEAMS}.pvd", f"{CONTACT}.pvd"):
+            (self.folder / name).unlink(missing_ok=True)
         self.refine = refine
         self.compression = compression
         if contact is None and system is not None:
@@ -148,7 +160,7 @@ class StepWriter:
         if self.contact:
             path = self.folder / self._name(CONTACT, step)
             table = solution.contacts[step]
-            if len(table.get("position", ())):
+            if len(active_points(table)):
                 self._write_mesh(path, contact_mesh(table))
             else:
                 _atomic(path, _write_empty_points)
@@ -180,14 +192,22 @@ class StepWriter:
         self.save()
 
 
+def active_points(table):
+    """Indices of the contact points of a step's table that carry force (``normal_force > 0``)."""
+    return np.flatnonzero(np.asarray(table.get("normal_force", np.zeros(0)), dtype=float) > 0)
+
+
 def contact_mesh(table):
-    """The contact points of one step as a meshio vertex mesh."""
+    """The active contact points of one step (``active_points``) as a meshio vertex mesh."""
     import meshio
     pos = np.asarray(table.get("position", np.zeros((0, 3))), dtype=float).reshape(-1, 3)
+    n = len(pos)
+    on = active_points(table) if "normal_force" in table else np.arange(n)
+    pos = pos[on]
     k = len(pos)
     pdata = {}
     for name, shape in CONTACT_FIELDS.items():
-        v = np.asarray(table.get(name, np.zeros((k,) + shape)))
+        v = np.asarray(table[name]).reshape((n,) + shape)[on] if name in table else np.zeros((k,) + shape)
         if name in ("stick", "kind"):
             v = v.astype(np.int32)
         else:
@@ -198,17 +218,21 @@ def contact_mesh(table):
 
 
 def _write_empty_points(path):
-    """A valid VTU with no points but the contact arrays (meshio writes no Cells for it)."""
+    """A VTU with no points, the contact arrays (empty) and one empty poly-vertex cell.
+
+    meshio (5.3) can neither write this nor read a file without cells, nor an empty
+    ``format="ascii"`` array without text (hence the blank); ParaView and pyvista read both.
+    """
     arrays = "".join(f'<DataArray type="{"Int32" if k in ("stick", "kind") else "Float64"}" Name="{k}" '
-                     f'NumberOfComponents="{int(np.prod(shape))}" format="ascii"></DataArray>\n'
+                     f'NumberOfComponents="{int(np.prod(shape))}" format="ascii"> </DataArray>\n'
                      for k, shape in CONTACT_FIELDS.items())
     text = ('<?xml version="1.0"?>\n'
             '<VTKFile type="UnstructuredGrid" version="0.1" byte_order="LittleEndian">\n'
-            '<UnstructuredGrid>\n<Piece NumberOfPoints="0" NumberOfCells="0">\n'
-            '<Points>\n<DataArray type="Float64" NumberOfComponents="3" format="ascii"></DataArray>\n'
-            '</Points>\n<Cells>\n<DataArray type="Int64" Name="connectivity" format="ascii"></DataArray>\n'
-            '<DataArray type="Int64" Name="offsets" format="ascii"></DataArray>\n'
-            '<DataArray type="UInt8" Name="types" format="ascii"></DataArray>\n</Cells>\n'
+            '<UnstructuredGrid>\n<Piece NumberOfPoints="0" NumberOfCells="1">\n'
+            '<Points>\n<DataArray type="Float64" NumberOfComponents="3" format="ascii"> </DataArray>\n'
+            '</Points>\n<Cells>\n<DataArray type="Int64" Name="connectivity" format="ascii"> </DataArray>\n'
+            '<DataArray type="Int64" Name="offsets" format="ascii">0</DataArray>\n'
+            '<DataArray type="UInt8" Name="types" format="ascii">2</DataArray>\n</Cells>\n'
             f'<PointData>\n{arrays}</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n')
     with open(path, "w") as f:
         f.write(text)
