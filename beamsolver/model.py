@@ -72,6 +72,30 @@ def _ramp(t):
     return t
 
 
+def _distinct_pairs(slave, master):
+    """Unordered pairs ``(a, b)`` of distinct beams, ``a`` (slave) in ``slave`` and ``b`` in ``master``,
+    each once, in the order of the lists: ``[a, b, c]`` twice gives ``(a, b), (a, c), (b, c)``."""
+    seen, out = set(), []
+    for a in slave:
+        for b in master:
+            key = frozenset((a.id, b.id))
+            if a.id != b.id and key not in seen:
+                seen.add(key)
+                out.append((a, b))
+    return out
+
+
+def _constant(value, what):
+    """A function of ``t`` returning the finite number ``value`` (for values given as constants)."""
+    try:
+        c = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{what} must be a number or a function t -> float, got {value!r}") from None
+    if not np.isfinite(c):
+        raise InputError(f"{what} must be finite, got {value!r}")
+    return lambda t: c
+
+
 class Model:
     """A scene: ``add_beam``, ``clamp``, ``fix``, ``prescribe``, ``join``, ``add_load``, ``add_contact``."""
 
@@ -205,7 +229,9 @@ class Model:
 
         ``values``: optional ``{'uz': f, 'rz': g, ...}`` giving prescribed global
         displacements ``f(t)`` of fixed components, and at most one rotation
-        angle ``g(t)`` about a global axis (then rx, ry, rz must all be fixed).
+        angle ``g(t)`` about a global axis (then rx, ry, rz must all be fixed);
+        a number instead of a function is held constant (``solve`` then starts
+        from the equilibrium with it at ``t_start``).
         """
         i = self._node(node, "fix")
         if isinstance(dofs, str):
@@ -226,7 +252,7 @@ class Model:
                 if k in rot and not rot <= set(dofs):
                     raise InputError(f"fix({node}): a prescribed rotation {k!r} needs all of rx, ry, rz fixed")
                 if not callable(f):
-                    raise InputError(f"fix({node}): values[{k!r}] must be callable t -> float")
+                    values = {**values, k: _constant(f, f"fix({node}): values[{k!r}]")}
             if len([k for k in values if k in rot]) > 1:
                 raise InputError(f"fix({node}): at most one rotation can be prescribed; use prescribe()")
             if len(idx) == 6:
@@ -283,7 +309,37 @@ class Model:
 
     # ------------------------------------------------------------ contact
     def add_contact(self, slave, master, mu=0.0, penalty=None, **options):
-        """Declare contact between ``slave`` and ``master`` (a Beam or a list of Beams each)."""
+        """Declare contact between ``slave`` and ``master`` (a Beam or a list of Beams each).
+
+        ``mu``: Coulomb friction coefficient (default 0: frictionless).
+        ``penalty``: normal penalty, force / length^2 (contact force per unit length
+        per unit penetration; default: the Young's modulus ``EA / (pi r^2)`` of the
+        softer section, ``contact.law.default_penalty``).  Options, lengths in the
+        model's unit:
+
+        - ``smoothing``: gap over which the normal law is made C1 (default 0, sharp;
+          about ``1e-3 (R1 + R2)`` helps touching, lightly loaded wires);
+        - ``tolerance``: penetration below which augmented-Lagrangian updates stop
+          (default None: pure penalty, no updates);
+        - ``slip_tolerance``: elastic slip at the onset of sliding, in slave element
+          lengths (default 0.005, Abaqus' default); the tangential stiffness of a point
+          is then ``mu lam_N / (slip_tolerance L_e)``;
+        - ``penalty_t``: a fixed tangential penalty instead, force / length^3
+          (default None: from ``slip_tolerance``);
+        - ``gauss_points``: integration points per slave element for line contact (5);
+        - ``line_angle``: crossing angle (rad) below which a pair is line contact
+          (default ``radians(20)``);
+        - ``point_ratio``: from this ``sin^2`` of the crossing angle up a pair is one
+          point contact, below it orthogonal projection (0.5);
+        - ``margin``: search margin around every element (default twice the largest radius).
+
+        Unknown options are refused.  A beam in both lists
+        (``add_contact(group, group)``, as for the wires of a cable) declares every
+        unordered pair of distinct beams once, as one declaration per pair (the same as
+        declaring the pairs one by one); no beam is in contact with itself, nor elements
+        sharing a node.  Lists that only partly overlap are refused.  Returns the
+        ``ContactDeclaration`` (a list of them for a group).
+        """
         for side, v in (("slave", slave), ("master", master)):
             if not isinstance(v, (Beam, list, tuple)):
                 raise InputError(f"add_contact: {side} must be a Beam or a list of Beams, got {v!r}")
@@ -292,14 +348,23 @@ class Model:
         for b in s + m:
             if not isinstance(b, Beam) or b.id >= len(self.beams) or self.beams[b.id] is not b:
                 raise InputError(f"add_contact: {b!r} is not a beam of this model")
-        same = {b.id for b in s} & {b.id for b in m}
-        if same:
-            raise InputError(f"add_contact: beam {sorted(same)[0]} is declared in contact with itself")
         mu = real(mu, "mu", "add_contact", minimum=0.0)
         penalty = real(penalty, "penalty", "add_contact", above=0.0, none=True)
-        decl = ContactDeclaration(s, m, mu, penalty, check_contact_options(options))
-        self.contacts.append(decl)
-        return decl
+        options = check_contact_options(options)
+        same = {b.id for b in s} & {b.id for b in m}
+        if not same:
+            decl = ContactDeclaration(s, m, mu, penalty, options)
+            self.contacts.append(decl)
+            return decl
+        pairs = _distinct_pairs(s, m) if {b.id for b in s} == {b.id for b in m} else []
+        if not pairs:
+            raise InputError(f"add_contact: beam {sorted(same)[0]} is declared in contact with itself"
+                             + ("" if len(same) == 1 and len(s) == len(m) == 1 else
+                                " (a group in contact within itself is declared with the same beams on "
+                                "both sides)"))
+        decls = [ContactDeclaration([a], [b], mu, penalty, dict(options)) for a, b in pairs]
+        self.contacts.extend(decls)
+        return decls
 
     # ------------------------------------------------------------ summary
     def element_table(self):

@@ -21,16 +21,17 @@ class Progress:
         self.bar = None
         if verbose is not False and tty:
             from tqdm import tqdm
+            # tqdm puts ", " before a postfix: the text after "t = " lives in ``unit`` instead
             self.bar = tqdm(total=t1 - t0, initial=t - t0, desc="beamsolver", leave=True, dynamic_ncols=True,
-                            bar_format="{desc}: {percentage:3.0f}%|{bar}| t = {postfix} [{elapsed}<{remaining}]")
-            self.bar.set_postfix_str(f"{t:.4g}", refresh=False)
+                            unit=f"{t:.4g}",
+                            bar_format="{desc}: {percentage:3.0f}%|{bar}| t = {unit} [{elapsed}<{remaining}]")
 
     def step(self, k, t, dt, stats):
         it, res, cut = stats["iterations"], stats["residuals"][-1], stats["cutbacks"]
         log.info("step %d  t = %.6g  iterations %d  residual %.2e  cut-backs %d  wall %.3f s",
                  k, t, it, res, cut, stats["wall_time"])
         if self.bar is not None:
-            self.bar.set_postfix_str(f"{t:.4g}  step {k}  iterations {it}  residual {res:.1e}", refresh=False)
+            self.bar.unit = f"{t:.4g}  step {k}  iterations {it}  residual {res:.1e}"
             self.bar.update(dt)
         elif self.lines:
             print(f"t = {t:.6g}  iterations {it}  residual {res:.2e}  cut-backs {cut}")

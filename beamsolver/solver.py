@@ -125,6 +125,53 @@ def _refine_advice(system, H, t, t_start, t_end):
     return "".join("; " + p for p in parts)
 
 
+def _acts_at(system, H, t):
+    """Whether loads, prescribed motions or ``fix`` values act at ``t`` on the state ``H``."""
+    if len(system.load_scales):
+        lf = system.load_factors(t)
+        if np.any(lf * (np.abs(system.load_F).sum(axis=1) + np.abs(system.load_M).sum(axis=1)) != 0):
+            return True
+    if len(system.prescribed_nodes) and np.any(system.prescribed_poses(t) != H[system.prescribed_nodes]):
+        return True
+    return any(dx != 0 for _, _, dx in system.fixed_value_increments(H, t)) if system.fix_values else False
+
+
+def _initial_equilibrium(system, newton, H, t_start, sol):
+    """Step 0 when loads or motions act at ``t_start``: the equilibrium there, solved from ``H``.
+
+    Returns ``(H, r, info, stats)``, or ``None`` when nothing acts (``H`` is then step 0 as
+    it is); raises ``ConvergenceError`` (with the empty ``sol``) when Newton fails there.
+    """
+    if not _acts_at(system, H, t_start):
+        return None
+    t0 = time.perf_counter()
+    H_target = system.prescribed_poses(t_start) if len(system.prescribed_nodes) else None
+    try:
+        if system.contact is not None:
+            system.contact.begin_step(H, t_start)
+        H, r, info, stats = newton.step(H, t_start, H_target)
+        while system.contact is not None and system.contact.augment(H):
+            H, r, info, more = newton.step(H, t_start, H_target)
+            stats["iterations"] += more["iterations"]
+            stats["residuals"] += more["residuals"]
+    except _StepFailed as e:
+        sol.converged, sol.message = False, str(e)
+        raise ConvergenceError(f"solve: no equilibrium at t_start = {t_start:.6g}, where loads or motions "
+                               f"already act: {e}; start the loads from zero or use more steps", sol) from None
+    stats.update(wall_time=time.perf_counter() - t0, dt=0.0, cutbacks=0)
+    return H, r, info, stats
+
+
+def _commit_contact(system, sol, H):
+    """Commit the contact history of a converged state; its contact table (None without contact)."""
+    if system.contact is None:
+        return None
+    system.contact.commit(H)
+    out = system.contact.results(H)
+    sol.contact_state = contact_snapshot(system.contact)
+    return out
+
+
 class _Newton:
     def __init__(self, system, conv, line_search, callback):
         self.sys = system
@@ -379,7 +426,10 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
           linear_solver=None):
     """Quasi-static solve of ``model`` from ``t_start`` to ``t_end`` in ``steps`` equal steps.
 
-    Every converged (sub)step is recorded in the returned ``Solution``.  A step
+    Every converged (sub)step is recorded in the returned ``Solution``.  Step 0 is
+    the state at ``t_start``: the reference (or ``initial_poses``) when no load,
+    prescribed motion or ``fix`` value acts there, else the equilibrium solved
+    there (its Newton statistics in ``stats[0]``).  A step
     that fails is halved down to ``min_step_ratio`` times the user's step, then
     ``ConvergenceError`` is raised with the last converged ``Solution``.
 
@@ -436,10 +486,17 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
             H[system.prescribed_nodes] = system.prescribed_poses(t_start)
             system.sync_members(H)
         sol = Solution(model, system)
-        lf0 = system.load_factors(t_start) if len(system.load_scales) else np.zeros(0)
-        r0, _, info0 = system.evaluate(H, lf0, tangent=False)
+        first = _initial_equilibrium(system, newton, system.poses0.copy() if initial_poses is None else
+                                     np.array(initial_poses, dtype=float), t_start, sol)
+        if first is None:
+            lf0 = system.load_factors(t_start) if len(system.load_scales) else np.zeros(0)
+            r0, _, info0 = system.evaluate(H, lf0, tangent=False)
+            stats0, contact0 = dict(iterations=0, residuals=[], wall_time=0.0, dt=0.0, cutbacks=0), None
+        else:
+            H, r0, info0, stats0 = first
+            contact0 = _commit_contact(system, sol, H)
         sol.append(t_start, H, system.reactions(H, r0), info0["state"].sigma, info0["state"].strain,
-                   dict(iterations=0, residuals=[], wall_time=0.0, dt=0.0, cutbacks=0))
+                   stats0, contact0)
         if writer is not None:
             writer.write(sol, 0)
     else:

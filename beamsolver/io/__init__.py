@@ -1,8 +1,10 @@
 """Files: saved solutions (``archive``, numpy only) and ParaView output (``vtk``, needs meshio).
 
 ``vtk`` is imported only when output is asked for (``solve(output=)``,
-``write_vtk``), so ``import beamsolver`` never imports meshio.
+``write_vtk``) or the submodule is first used (``bs.io.vtk.StepWriter``), so
+``import beamsolver`` never imports meshio.
 """
+import importlib
 from .archive import FORMAT_VERSION, load, save
 
 __all__ = ["load", "save", "write_vtk", "FORMAT_VERSION"]
@@ -12,3 +14,10 @@ def write_vtk(solution, folder, steps=None, refine=8, compression="zlib"):
     """Write ``solution`` (all steps, or ``steps``) as VTU/PVD files to ``folder``; see ``io.vtk``."""
     from .vtk import write_vtk as _write
     return _write(solution, folder, steps=steps, refine=refine, compression=compression)
+
+
+def __getattr__(name):
+    """``bs.io.vtk`` without an explicit import, loaded (with meshio) on first use."""
+    if name == "vtk":
+        return importlib.import_module(".vtk", __name__)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
