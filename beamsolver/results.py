@@ -52,12 +52,15 @@ def describe_model(model, system=None):
 
 
 class Solution:
-    """Results at every converged pseudo-time step (the initial state is step 0).
+    """Results at every converged pseudo-time step (step 0: the state at ``t_start``, see ``solve``).
 
     Attributes: ``times`` ``(n_steps + 1,)``; ``poses`` ``(n_steps + 1, n_nodes, 4, 4)``;
     ``reactions`` ``(n_steps + 1, n_nodes, 6)`` global force and moment on every
     node (non-zero on constrained nodes); ``section_forces`` and ``strains``
-    ``(n_steps + 1, n_elements, 6)`` in the section frame; ``stats`` a list of
+    ``(n_steps + 1, n_elements, 6)`` in the section frame, ``strains`` the element
+    strain ``h / L`` itself, reference included (``(1, 0, 0, 0, 0, 0)`` for a straight
+    beam at rest), so ``section_forces = C (strains - description["eps0"])``; the
+    VTU field ``strain`` is that difference (``io.lines``); ``stats`` a list of
     dicts per step (``iterations``, ``residuals``, ``wall_time``, ``dt``,
     ``cutbacks``); ``contacts`` a list per step of contact point tables.
 

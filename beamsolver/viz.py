@@ -157,32 +157,50 @@ _COMPONENTS = {"x": 0, "y": 1, "z": 2, "fx": 0, "fy": 1, "fz": 2, "mx": 3, "my":
 
 
 def _series(solution, what, node, component):
-    """Values over the steps and a label for ``what``."""
+    """Values over the steps, a label and the kind of unit (curves of one kind share an axis)."""
     n = len(solution._times)
     if callable(what):
-        return np.array([float(what(solution, k)) for k in range(n)]), getattr(what, "__name__", "value")
+        name = getattr(what, "__name__", "value")
+        return np.array([float(what(solution, k)) for k in range(n)]), name, getattr(what, "unit", name)
     c = _COMPONENTS.get(component, component)
     if what in ("reaction", "position", "displacement"):
         if node is None:
             raise ValueError(f"plot_history: {what!r} needs node=")
         if what == "reaction":
             v = np.array([solution._reactions[k][node] for k in range(n)])
+            unit = "moment" if c is not None and int(c) >= 3 else "force"
         else:
             v = np.array([solution._poses[k][node, :3, 3] for k in range(n)])
             if what == "displacement":
                 v = v - v[0]
+            unit = "length"
         label = f"{what} {component if component is not None else '|.|'} at node {node}"
-        return (np.linalg.norm(v[:, :3], axis=1) if c is None else v[:, int(c)]), label
+        return (np.linalg.norm(v[:, :3], axis=1) if c is None else v[:, int(c)]), label, unit
     if what == "iterations":
-        return np.array([s.get("iterations", 0) for s in solution.stats], dtype=float), "Newton iterations"
+        return (np.array([s.get("iterations", 0) for s in solution.stats], dtype=float), "Newton iterations",
+                "count")
     if what == "contact_force":
         force = [np.sum(t.get("normal_force", 0.0)) for t in solution.contacts]
-        return np.array(force), "total normal contact force"
+        return np.array(force), "total normal contact force", "force"
     if what == "penetration":
         return np.array([max(-np.min(t["gap"], initial=0.0), 0.0) if "gap" in t else 0.0
-                         for t in solution.contacts]), "largest penetration"
+                         for t in solution.contacts]), "largest penetration", "length"
     raise ValueError(f"plot_history: unknown quantity {what!r}; use 'reaction', 'position', 'displacement', "
                      "'iterations', 'contact_force', 'penetration' or a callable f(solution, step)")
+
+
+def _unit_axes(ax, units):
+    """One y axis per kind of unit: ``ax`` for the first, twin axes on the right for the others."""
+    axes = {}
+    for i, u in enumerate(dict.fromkeys(units)):
+        if i == 0:
+            axes[u] = ax
+            continue
+        twin = ax.twinx()
+        if i > 1:
+            twin.spines["right"].set_position(("axes", 1.0 + 0.18 * (i - 1)))
+        axes[u] = twin
+    return axes
 
 
 def plot_history(solution, what="reaction", node=None, component=None, path=None, ax=None,
@@ -192,7 +210,10 @@ def plot_history(solution, what="reaction", node=None, component=None, path=None
     ``what``: ``"reaction"`` (``component`` ``fx fy fz mx my mz`` or 0..5),
     ``"position"``/``"displacement"`` (``x y z``), ``"iterations"``,
     ``"contact_force"``, ``"penetration"``, a callable ``f(solution, step)``,
-    or a list of these (one curve each, same ``node``/``component``).
+    or a list of these (one curve each, same ``node``/``component``; curves of
+    one kind of unit -- force, moment, length, count, or each callable (its
+    ``unit`` attribute, else its name) -- share a y axis, the others get twin
+    axes on the right: ``fig.axes``).
     ``path``: image file to write.  Without ``ax`` a new ``Figure`` is made
     on matplotlib's Agg canvas (no pyplot, no display needed).
     """
@@ -207,14 +228,18 @@ def plot_history(solution, what="reaction", node=None, component=None, path=None
         fig = ax.figure
     t = np.array(solution._times)
     whats = what if isinstance(what, (list, tuple)) else [what]
-    for w in whats:
-        y, lab = _series(solution, w, node, component)
-        ax.plot(t, y, marker=marker, label=label or lab, **plot_kw)
+    curves = [_series(solution, w, node, component) for w in whats]
+    axes = _unit_axes(ax, [u for _, _, u in curves])
+    lines = []
+    for i, (y, lab, unit) in enumerate(curves):
+        kw = dict(plot_kw) if "color" in plot_kw else dict(plot_kw, color=f"C{i}")
+        lines += axes[unit].plot(t, y, marker=marker, label=label or lab, **kw)
     ax.set_xlabel("pseudo-time t")
-    if len(whats) == 1:
-        ax.set_ylabel(label or lab)
-    else:
-        ax.legend()
+    for unit, a in axes.items():
+        labs = [lab for _, lab, u in curves if u == unit]
+        a.set_ylabel(label or (labs[0] if len(labs) == 1 else f"{unit}: " + ", ".join(labs)))
+    if len(whats) > 1:
+        ax.legend(lines, [ln.get_label() for ln in lines])
     ax.grid(True, alpha=0.3)
     if path is not None:
         fig.savefig(path, dpi=100, bbox_inches="tight")

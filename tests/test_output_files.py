@@ -13,6 +13,7 @@ import beamsolver as bs
 meshio = pytest.importorskip("meshio")
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+import crossing_beams  # noqa: E402
 import twisted_pair  # noqa: E402
 
 L, EI = 10.0, 1e2
@@ -82,8 +83,9 @@ def test_export_into_a_used_folder_removes_stale_steps(tmp_path):
 
 def test_every_file_is_read_by_meshio_and_pyvista(tmp_path):
     pv = pytest.importorskip("pyvista")
-    sol = bs.solve(pair(), steps=2, t_end=0.125, output=tmp_path)
-    assert sol.contact(0) == {} or len(sol.contact(0).get("gap", ())) == 0   # step 0: no contact file points
+    model, _, _ = crossing_beams.build(load=50.0, n_elements=4)
+    sol = bs.solve(model, steps=2, output=tmp_path)
+    assert len(sol.contact(0).get("gap", ())) == 0 and len(sol.contact(2)["gap"]) > 0   # step 0: no contact
     for vtu in sorted(tmp_path.glob("*.vtu")):
         mesh = meshio.read(vtu)
         grid = pv.read(vtu)
@@ -113,3 +115,16 @@ def test_contact_files_hold_the_active_points_only(tmp_path):
     np.testing.assert_allclose(mesh.point_data["gap"], c["gap"][active])
     np.testing.assert_allclose(mesh.point_data["tangential_force"], c["tangential_force"][active])
     np.testing.assert_array_equal(mesh.point_data["stick"], c["stick"][active].astype(int))
+
+
+def test_vtu_strain_is_the_solution_strain_minus_the_reference(tmp_path):
+    m, b = roll_up()
+    sol = bs.solve(m, steps=1, output=tmp_path)
+    eps0 = sol.description["eps0"]
+    assert "reference included" in bs.Solution.__doc__ and "Solution.strains - eps0" in bs.io.vtk.__doc__
+    np.testing.assert_allclose(sol.strains[0], eps0)                    # at rest: the reference strain
+    mesh = meshio.read(tmp_path / "beams_0001.vtu")
+    el = mesh.cell_data["element"][0]
+    np.testing.assert_allclose(mesh.cell_data["strain"][0], (sol.strains[1] - eps0)[el])
+    C = b.section.C
+    np.testing.assert_allclose(sol.section_forces[1], (sol.strains[1] - eps0) @ C.T, rtol=1e-9, atol=1e-9)

@@ -11,7 +11,9 @@ Point data: ``displacement`` (3), ``e1``, ``e2``, ``e3`` (section axes,
 the columns of ``R``), ``radius`` (contact radius of the section, for tubes),
 ``beam_id``.  Segment (cell) data: the section forces of the element
 ``N, Q2, Q3, T, M2, M3`` (section frame) and ``strain`` (6: ``Gamma_1..3,
-kappa_1..3`` minus the reference, so ``sigma = C strain``), ``element``.
+kappa_1..3`` minus the reference, so ``sigma = C strain`` and a beam at rest
+shows 0; ``Solution.strains`` is the strain itself, reference included:
+``strain = Solution.strains - eps0``), ``element``.
 """
 import numpy as np
 
