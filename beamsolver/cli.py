@@ -1,13 +1,14 @@
 """The ``beamsolver`` command: run a scene script, summarise or render a saved result, export VTK.
 
-``beamsolver run SCRIPT [--output DIR] [--steps N] [--t-end T] [--quiet]``
+``beamsolver run SCRIPT [--output DIR] [--steps N] [--t-end T] [--restart RESULT] [--checkpoint S] [--quiet]``
     Runs ``SCRIPT`` (a Python file) with ``__name__ == "__beamsolver__"`` (its
     ``if __name__ == "__main__":`` block does not run), then takes the scene from
     it, first match wins:
 
     1. a global ``model`` (a ``beamsolver.Model``);
     2. a function ``build()`` called without arguments, returning a ``Model``
-       or a tuple whose first item is one (``model, beam_a, ...``).
+       or a tuple whose first item is one (``model, beam_a, ...``); a ``build``
+       with required arguments is refused with a one-line message.
 
     An optional global dict ``solve_options`` gives keyword arguments of
     ``beamsolver.solve`` (``steps``, ``t_end``, ``rtol``, ...); ``--steps`` and
@@ -18,13 +19,16 @@
 ``beamsolver info RESULT [--all]``
     ``RESULT``: a ``.npz`` file or an output folder.  Prints steps, Newton
     iterations, wall time, contact force, smallest gap / largest
-    penetration per step and the reactions of the constrained nodes.
+    penetration per step and the reactions of the constrained nodes; the
+    status line says ``converged``, ``STOPPED`` (a ``ConvergenceError``) or
+    ``stopped at t = ... of ...`` (a checkpoint of a run interrupted).
 ``beamsolver render RESULT [--step K] -o PNG [--color-by FIELD] [--size W H]``
     Draws the beams as tubes (needs ``beamsolver[viz]``).
 ``beamsolver export RESULT DIR``
     Writes the VTU/PVD files of a saved result.
 """
 import argparse
+import inspect
 import os
 import runpy
 import sys
@@ -33,6 +37,19 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["main"]
+
+
+def _check_no_arguments(build, script):
+    """Refuse, in one line, a ``build()`` that cannot be called without arguments."""
+    try:
+        inspect.signature(build).bind()
+    except TypeError:
+        need = [n for n, p in inspect.signature(build).parameters.items()
+                if p.default is p.empty and p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
+        raise SystemExit(f"beamsolver run: build() in {script} needs arguments ({', '.join(need)}); give them "
+                         "defaults, or define a Model named 'model'") from None
+    except ValueError:          # no signature (a builtin): let the call decide
+        pass
 
 
 def _scene(script):
@@ -44,6 +61,7 @@ def _scene(script):
         if not callable(build):
             raise SystemExit(f"beamsolver run: {script} defines neither a Model named 'model' nor a "
                              "function build() returning one")
+        _check_no_arguments(build, script)
         out = build()
         model = out[0] if isinstance(out, tuple) and out else out
         if not isinstance(model, Model):
@@ -73,6 +91,8 @@ def cmd_run(args):
     opts.setdefault("verbose", False if args.quiet else None)
     if args.restart:
         opts["restart"] = args.restart
+    if args.checkpoint is not None:
+        opts["checkpoint"] = args.checkpoint
     try:
         sol = bs.solve(model, **opts)
     except bs.ConvergenceError as e:
@@ -85,12 +105,25 @@ def cmd_run(args):
         return 1
     if not args.quiet:
         print(sol.summary())
-        print(f"written: {out}/beams.pvd (ParaView), {out}/solution.npz")
+        pvd = f"{out}/beams.pvd" + (f", {out}/contact.pvd" if model.contacts else "")
+        print(f"written: {pvd} (ParaView), {out}/solution.npz")
     return 0
 
 
 def _row(cells, widths):
     return "  ".join(str(c).rjust(w) for c, w in zip(cells, widths))
+
+
+def _status(sol):
+    """``converged``, ``STOPPED: <why>`` or, for a run interrupted (Ctrl-C, a kill) after a
+    checkpoint, ``stopped at t = ... of ...``."""
+    if not sol.converged:
+        return f"STOPPED: {sol.message}"
+    t, t0, t_end = sol._times[-1], sol._times[0], sol.resume.get("t_end")
+    if t_end is not None and t < t_end - 1e-9 * abs(t_end - t0):
+        return (f"stopped at t = {t:.6g} of {t_end:.6g} (interrupted; `beamsolver run SCRIPT --restart "
+                "RESULT` continues it)")
+    return "converged"
 
 
 def cmd_info(args):
@@ -100,8 +133,7 @@ def cmd_info(args):
     n = len(sol._times)
     print(f"{args.result}: {len(d['beam_radius'])} beams, {len(d['poses0'])} nodes, {len(d['enodes'])} elements, "
           f"{int(d['n_contact_declarations'])} contact declarations")
-    status = "converged" if sol.converged else f"STOPPED: {sol.message}"
-    print(f"{sol.summary()}; {status}")
+    print(f"{sol.summary()}; {_status(sol)}")
     contact = int(d["n_contact_declarations"]) > 0
     head = ["step", "t", "iterations", "residual", "cut-backs", "wall [s]"]
     widths = [5, 10, 10, 9, 9, 9]
@@ -164,6 +196,8 @@ def main(argv=None):
     r.add_argument("--steps", type=int, help="number of pseudo-time steps")
     r.add_argument("--t-end", type=float, help="end of the pseudo-time")
     r.add_argument("--restart", help="continue from a saved result (.npz or output folder)")
+    r.add_argument("--checkpoint", type=float, metavar="SECONDS",
+                   help="save solution.npz every SECONDS of wall time (0: every step; default 60)")
     r.add_argument("--quiet", "-q", action="store_true", help="no progress bar, no summary")
     r.set_defaults(func=cmd_run)
     i = sub.add_parser("info", help="summary table of a saved result")

@@ -333,8 +333,8 @@ class Model:
           point contact, below it orthogonal projection (0.5);
         - ``margin``: search margin around every element (default twice the largest radius).
 
-        Unknown options are refused.  A beam in both lists
-        (``add_contact(group, group)``, as for the wires of a cable) declares every
+        Unknown options are refused.  The same beams on both
+        sides (``add_contact(group, group)``, as for the wires of a cable) declare every
         unordered pair of distinct beams once, as one declaration per pair (the same as
         declaring the pairs one by one); no beam is in contact with itself, nor elements
         sharing a node.  Lists that only partly overlap are refused.  Returns the

@@ -509,6 +509,7 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
         if writer is not None:
             for j in range(len(sol._times)):
                 writer.write(sol, j)
+    sol.resume = dict(t0=float(grid[0]), t_end=float(t_end), steps=int(steps), dt=float(dt), easy=int(easy))
     progress = Progress(verbose, t_start, t_end, t)
     while k <= steps:
         t_next = min(t + dt, grid[k])

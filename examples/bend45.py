@@ -50,7 +50,10 @@ def section():
     return bs.Section(EA=E, GA2=G, GA3=G, GJ=E / 12.0, EI2=E / 12.0, EI3=E / 12.0, radius=0.5)
 
 
-def build(n_elements, load=P_MAX):
+solve_options = dict(steps=4, rtol=1e-10)     # for `beamsolver run examples/bend45.py`
+
+
+def build(n_elements=8, load=P_MAX):
     """Model and beam: the bend clamped at the origin, dead tip force ``load`` along ``+z`` at ``t = 1``."""
     model = bs.Model()
     beam = model.add_beam(bs.geometry.arc(radius=RADIUS, angle=np.pi / 4.0, n_elements=n_elements), section())

@@ -29,6 +29,9 @@ def rope_path(radius, theta, straight, n_arc, n_straight):
     return x, t
 
 
+solve_options = dict(steps=8)       # for `beamsolver run examples/capstan.py`
+
+
 def build(mu=0.3, theta=np.pi, T_hold=10.0, pull=0.005, n_arc=24, n_straight=None, straight=0.03,
           post_radius=0.05, rope_radius=5e-4, EA=1e5, EI=1e-5, penalty=3e8, penalty_t=1e6,
           t_hold=0.25, **contact_options):

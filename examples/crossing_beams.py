@@ -10,6 +10,9 @@ Run ``python examples/crossing_beams.py`` to print both beside the load.
 import beamsolver as bs
 
 
+solve_options = dict(steps=2)       # for `beamsolver run examples/crossing_beams.py`
+
+
 def build(load=50.0, n_elements=8, tolerance=None, radius=0.05, E=1e7, mu=0.0):
     model = bs.Model()
     sec = bs.Section.circular(radius=radius, E=E, nu=0.3)

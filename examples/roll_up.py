@@ -33,7 +33,10 @@ def exact_poses(n_elements, fraction=1.0, length=LENGTH):
     return x, phi
 
 
-def build(n_elements, fraction=1.0, follower=True):
+solve_options = dict(steps=1)       # for `beamsolver run examples/roll_up.py`
+
+
+def build(n_elements=8, fraction=1.0, follower=True):
     """Model, beam and the applied moment vector (body components)."""
     section = bs.Section.circular(radius=RADIUS, E=E, nu=NU)
     EI = section.C[5, 5]

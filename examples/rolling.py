@@ -16,6 +16,9 @@ import numpy as np
 import beamsolver as bs
 
 
+solve_options = dict(steps=11)      # for `beamsolver run examples/rolling.py`
+
+
 def build(mu=0.5, theta=1.0, radius=0.05, force=10.0, n_elements=5, E=1e9, t_load=0.1,
           **contact_options):
     """The pressing forces ramp up over ``0 <= t <= t_load``, then the ends turn until ``t = 1``."""

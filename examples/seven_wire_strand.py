@@ -29,9 +29,12 @@ from beamsolver import cables
 E, NU = 200e9, 0.3
 
 
-def solve_strand(beta_deg, free_rotation=False, eps=1e-4, Rc=1.03e-3, Rw=1.0e-3, contact=True,
-                 elements_per_lay=24, lays=0.5):
-    """Strand ``lays`` lay lengths long; returns ``(F/eps, M/eps, plate rotation [rad], solution)``."""
+solve_options = dict(steps=1)       # for `beamsolver run examples/seven_wire_strand.py`
+
+
+def build(beta_deg=10.0, free_rotation=False, eps=1e-4, Rc=1.03e-3, Rw=1.0e-3, contact=True,
+          elements_per_lay=24, lays=0.5):
+    """Strand ``lays`` lay lengths long, stretched by ``eps`` at ``t = 1``; returns ``(model, strand, plate)``."""
     beta = np.deg2rad(beta_deg)
     r = Rc + Rw
     L = lays * 2 * np.pi * r / np.tan(beta)
@@ -43,7 +46,14 @@ def solve_strand(beta_deg, free_rotation=False, eps=1e-4, Rc=1.03e-3, Rw=1.0e-3,
         st.model.fix(plate, ("ux", "uy", "uz", "rx", "ry"), values={"uz": lambda t: eps * L * t})
     else:
         st.model.prescribe(plate, bs.motion.translation((0.0, 0.0, eps * L)))
-    sol = bs.solve(st.model, steps=1)
+    return st.model, st, plate
+
+
+def solve_strand(beta_deg, free_rotation=False, eps=1e-4, Rc=1.03e-3, Rw=1.0e-3, contact=True,
+                 elements_per_lay=24, lays=0.5):
+    """Strand ``lays`` lay lengths long; returns ``(F/eps, M/eps, plate rotation [rad], solution)``."""
+    model, st, plate = build(beta_deg, free_rotation, eps, Rc, Rw, contact, elements_per_lay, lays)
+    sol = bs.solve(model, steps=1)
     F, M = st.resultant(sol, plate)
     R = sol.rotation(plate)
     phi = np.arctan2(R[1, 0], R[0, 0])

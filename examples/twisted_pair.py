@@ -33,6 +33,9 @@ import numpy as np
 import beamsolver as bs
 
 
+solve_options = dict(steps=16)      # for `beamsolver run examples/twisted_pair.py`
+
+
 def build(radius=0.5e-3, length=0.02, n_elements=16, turns=2.0, pull=5.0, mu=0.3, E=200e9, nu=0.3,
           swap=False, smoothing=None):
     """Returns ``(model, plate node, (beam_a, beam_b))``; ``swap`` exchanges slave and master."""

@@ -77,9 +77,10 @@ def test_group_contact_declaration_equals_the_pairwise_one():
     a, b, c = st_g.wires[0]
     with pytest.raises(bs.InputError, match="with itself"):
         st_g.model.add_contact(a, [a])
-    # overlapping lists: every unordered pair of distinct beams once
-    more = st_g.model.add_contact([a, b], [b, c])
-    assert sorted((d.slave[0].id, d.master[0].id) for d in more) == [(0, 1), (0, 2), (1, 2)]
+    with pytest.raises(bs.InputError, match="same beams on both sides"):
+        st_g.model.add_contact([a, b], [b, c])                      # only partly overlapping: a mistake
+    more = st_g.model.add_contact([c, a, b], [a, b, c])             # the same group in another order
+    assert [(d.slave[0].id, d.master[0].id) for d in more] == [(2, 0), (2, 1), (0, 1)]
 
 
 def test_fix_values_accept_a_constant():
