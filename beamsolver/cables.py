@@ -194,7 +194,7 @@ def fibre_stiffness(core_radius, wire_radius, n_wires, pitch_radius, lay_angle, 
     return Kee, Kew, Kww
 
 
-def rod_stiffness(core_radius, wire_radius, n_wires, pitch_radius, lay_angle, E, nu=0.3):
+def rod_stiffness(core_radius, wire_radius, n_wires, pitch_radius, lay_angle, E, nu=0.3, measure="geometric"):
     """Linear strand stiffness with the wires' own bending and torsion: ``(K_ee, K_ew, K_ww)``.
 
     Thin-rod theory of a straight 1+m strand (the kinematics of Costello's theory,
@@ -206,7 +206,15 @@ def rod_stiffness(core_radius, wire_radius, n_wires, pitch_radius, lay_angle, E,
     ``(cos 2b / r) db``.  The strain energy per strand length (wire length ``1 / cos b``)
     ``U = G J_c theta^2 / 2 + E A_c eps^2 / 2 + m / (2 cos b) (E A_h e_w^2 + E I_h dk^2 + G J_h dt^2)``
     gives the stiffness; without ``I_h, J_h`` it is :func:`fibre_stiffness`.
+
+    ``measure``: ``"geometric"`` (default) takes ``dk, dt`` as the changes of the helix's
+    curvature and torsion (per deformed length, as Costello); ``"material"`` per unit
+    reference length, as the SE(3) beam's strains ``h / L``: a wire stretched by ``e_w``
+    adds ``e_w (k0, t0)`` with ``k0 = sin^2 b / r``, ``t0 = sin b cos b / r``.  The beam
+    model's fixed-end torque follows the latter (``examples/seven_wire_strand.py``).
     """
+    if measure not in ("geometric", "material"):
+        raise InputError(f"rod_stiffness: measure must be 'geometric' or 'material', got {measure!r}")
     G = E / (2.0 * (1.0 + nu))
     Kee, Kew, Kww = fibre_stiffness(core_radius, wire_radius, n_wires, pitch_radius, lay_angle, E, nu)
     b, r, m = lay_angle, pitch_radius, n_wires
@@ -215,6 +223,10 @@ def rod_stiffness(core_radius, wire_radius, n_wires, pitch_radius, lay_angle, E,
     # d(curvature, torsion) / d theta and / d eps
     k_th = np.array([2.0 * s * c**3, c**2 * np.cos(2 * b)])
     k_ep = np.array([-2.0 * s**2 * c**2 / r, -np.cos(2 * b) * s * c / r])
+    if measure == "material":       # + e_w (k0, t0), e_w = eps cos^2 b + r theta sin b cos b
+        k0 = np.array([s**2 / r, s * c / r])
+        k_th = k_th + r * s * c * k0
+        k_ep = k_ep + c**2 * k0
     D = np.array([E * Ih, G * 2.0 * Ih])
     w = m / c
     return (Kee + w * np.sum(D * k_ep * k_ep), Kew + w * np.sum(D * k_ep * k_th),

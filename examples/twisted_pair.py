@@ -9,11 +9,17 @@ two-ply in contact, with Coulomb friction (``mu = 0.3`` by default; the slip
 increment is the SE(3) finite difference of the seed paper; sliding starts at
 an elastic slip of 0.005 element lengths, Abaqus' default penalty friction).
 
-Stability: the torque of the pair passes Greenhill's limit ``8.99 B / L``
-(``B = 2 E I``) at about 1.7 turns; beyond, the straight two-ply followed here
-(by symmetry) is an unstable equilibrium, which the script detects from the
-eigenvalues of the tangent (``bs.linearize``) and reports: a real pair writhes
-into a plectoneme there, which needs an imperfection and path following.
+Stability: the lowest eigenvalue of the (frictionless) tangent (``bs.linearize``)
+turns negative at 1.61 turns, where the torque is 8.21 N m (16 elements, 16
+steps, interpolated between steps): beyond, the straight two-ply followed here
+(by symmetry) is an unstable equilibrium, which the script reports; a real
+pair writhes into a plectoneme there, which needs an imperfection and path
+following.  The unstable mode is the pair bending as one rod with ``B = 2 E I``
+(the wires slide along each other), Greenhill's mode of a twisted rod, but it
+sets in at ``M L / B = 8.36``, 7 % below Greenhill's clamped-clamped 8.99
+(8.83 N m), which the same eigenvalue test reproduces to 0.2 % for one wire
+alone (``benchmarks/twisted_pair_stability.py``); the 5 N pull raises a
+single rod's limit by only 0.3 %.
 
 The script prints torque and axial force against the twist angle, writes
 ParaView files (``.pvd`` + ``.vtu``, beams and contact points) to ``--output``
@@ -78,6 +84,15 @@ def table(sol, plate, clamps, turns):
     return rows
 
 
+def lowest_eigenvalues(model, sol):
+    """Lowest eigenvalue of the symmetric part of the tangent (``bs.linearize``) at steps 1..n."""
+    lowest = []
+    for k in range(1, len(sol.times)):
+        K = bs.linearize(model, sol, k).K.toarray()
+        lowest.append(np.linalg.eigvalsh(0.5 * (K + K.T))[0])
+    return np.array(lowest)
+
+
 def stability(model, sol, turns):
     """Twist [turns] from which the tangent (``bs.linearize``) has a negative eigenvalue (None
     if never), and its lowest eigenvalue at the last step.  ``model`` should be the frictionless
@@ -85,14 +100,25 @@ def stability(model, sol, turns):
     poses is symmetric (conservative), so its eigenvalues decide stability; a slipping point's
     tangent is not symmetric, and sticking friction is left out (the estimate is conservative).
     Cheap here (about 200 unknowns, dense)."""
-    lowest = []
-    for k in range(1, len(sol.times)):
-        K = bs.linearize(model, sol, k).K.toarray()
-        lowest.append(np.linalg.eigvalsh(0.5 * (K + K.T))[0])
-    lowest = np.array(lowest)
+    lowest = lowest_eigenvalues(model, sol)
     neg = np.flatnonzero(lowest < 0)
     first = None if len(neg) == 0 else turns * sol.times[1 + neg[0]]
     return first, float(lowest[-1]) if len(lowest) else np.nan
+
+
+def crossing(model, sol, plate, turns):
+    """Twist [turns] and torque [N m] where the lowest eigenvalue of the frictionless twin
+    ``model`` first turns negative, interpolated linearly between the two steps around it
+    (``None`` if it never does, or already at step 1)."""
+    lam = np.r_[np.inf, lowest_eigenvalues(model, sol)]
+    neg = np.flatnonzero(lam < 0)
+    if len(neg) == 0 or neg[0] < 2:
+        return None
+    k = neg[0]
+    s = lam[k - 1] / (lam[k - 1] - lam[k])
+    tw = turns * (sol.times[k - 1] + s * (sol.times[k] - sol.times[k - 1]))
+    m0, m1 = sol.reaction(plate, k - 1)[5], sol.reaction(plate, k)[5]
+    return float(tw), float(m0 + s * (m1 - m0))
 
 
 def main(output=None, turns=2.0, steps=16, n_elements=16, mu=0.3, length=0.02, verbose=False, swap=False):
@@ -116,12 +142,18 @@ def main(output=None, turns=2.0, steps=16, n_elements=16, mu=0.3, length=0.02, v
         print(f"stability: the frictionless tangent stays positive definite (lowest eigenvalue {lam:.3g} N m "
               f"at the end)")
     else:
-        print(f"stability: the frictionless tangent has a negative eigenvalue from {tw_c:.3g} turns on (lowest {lam:.3g} N m "
-              f"at the end).\n  The torque has passed the Greenhill limit of the pair (about 9 B / L, B = 2 E I):"
-              f"\n  the straight two-ply followed here by symmetry is an unstable equilibrium; a real pair\n"
-              f"  writhes into a plectoneme there (more pull delays it only a little: the pair is short).")
+        B = 2.0 * model.beams[0].section.C[4, 4]
+        cross = crossing(twin, sol, plate, turns)
+        where = (f"at about {cross[0]:.3g} turns (torque {cross[1]:.3g} N m, M L / B = {cross[1] * length / B:.2f} "
+                 f"with B = 2 E I; interpolated between steps)" if cross else f"from {tw_c:.3g} turns on")
+        print(f"stability: the frictionless tangent has a negative eigenvalue {where}; lowest {lam:.3g} N m at "
+              f"the end.\n  The straight two-ply followed here by symmetry is then an unstable equilibrium; a real "
+              f"pair writhes into a plectoneme.\n  The mode is the pair bending as one rod (its wires sliding along "
+              f"each other), as in Greenhill's twisted rod,\n  but a little below Greenhill's M L / B = 8.99 "
+              f"({8.99 * B / length:.3g} N m; benchmarks/twisted_pair_stability.py).")
     if output is not None:
-        print(f"ParaView: open {output}/*.pvd (Extract Surface, then Tube with radius by 'radius')")
+        print(f"ParaView: open {output}/*.pvd; tubes: Cell Data to Point Data, Extract Surface, Triangle Strips, "
+              "Tube with radius by 'radius' (README)")
         try:
             from beamsolver import viz
             png = f"{output}/twisted_pair.png"
