@@ -118,3 +118,15 @@ def test_no_equilibrium_at_t_start_raises_convergence_error():
     m.add_load(b.last, moment=(0, 0, 2 * np.pi * 1e2 / 10 * 2.0), follower=True, scale=lambda t: 1.0)
     with pytest.raises(bs.ConvergenceError, match="t_start"):
         bs.solve(m, steps=2)
+
+
+def test_one_twisted_wire_buckles_at_greenhill_torque():
+    """The eigenvalue test behind the twisted pair's stability message, on one clamped wire:
+    Greenhill's M L / B = 8.99 (8 elements, 8 steps per turn: within 2 %)."""
+    import sys
+    from pathlib import Path
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    import twisted_pair_stability as ts
+    (turns, M), _ = ts.run_wire(8, 8, pull=0.0)
+    B = bs.Section.circular(radius=ts.R, E=ts.E, nu=ts.NU).C[4, 4]
+    assert M * ts.L / B == pytest.approx(8.99, rel=0.02)

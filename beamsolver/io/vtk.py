@@ -21,8 +21,9 @@ Files in the output folder (``solve(model, output=folder)``, or
   ``checkpoint`` seconds of wall time (``0``: after every step), for
   ``beamsolver info`` and ``solve(..., restart=folder)``.
 
-Every file is written under a temporary name in the same folder and then
-renamed, with the mode ``open()`` would give it (``0666 & ~umask``) (``os.replace``, atomic on POSIX), and the ``.pvd`` files are
+Every file is written under a temporary name in the same folder, given the
+mode ``open()`` would give it (``0666 & ~umask``), and then renamed
+(``os.replace``, atomic on POSIX), and the ``.pvd`` files are
 rewritten after every step: a run that stops at any moment leaves only
 complete files, and ``.pvd`` files that list exactly the steps written.
 A writer first removes the numbered files its folder's ``beams.pvd`` and
