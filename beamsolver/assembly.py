@@ -15,6 +15,8 @@ global-type nodes the term ``[[0, -hat(r_u)], [0, -hat(r_w)]]`` from the
 dependence of ``M`` on ``R`` (``r`` in global components), which keeps Newton
 quadratic.
 """
+import time
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -352,7 +354,9 @@ class System:
         info = dict(state=state, f_level=f_level, m_level=m_level, extra=None)
         if self.contact is not None:
             # contact residual (6 n,) in z numbering and COO tangent (rows, cols, vals)
+            t0 = time.perf_counter()
             rc, coo, cinfo = self.contact.evaluate(H, tangent)
+            info["contact_time"] = time.perf_counter() - t0
             r = r + rc
             info["extra"] = coo
             info["contact"] = cinfo
@@ -449,8 +453,12 @@ class System:
             out[j] = G @ self.poses0[node]
         return out
 
-    def fixed_value_increments(self, H, t):
-        """``[(node, component, increment)]`` reaching ``fix(..., values=)`` targets at ``t``."""
+    def fixed_value_increments(self, H, t, t_prev=None):
+        """``[(node, component, increment)]`` reaching ``fix(..., values=)`` targets at ``t``.
+
+        A rotation is an angle, not wrapped: from the poses ``H`` at ``t_prev`` (angle
+        ``g(t_prev)`` up to round-off) the increment is ``g(t) - g(t_prev)`` plus that round-off.
+        """
         out = []
         for n, c, f in self.fix_values:
             v = float(f(t))
@@ -461,7 +469,8 @@ class System:
                 k = c - 3
                 a, b = (k + 1) % 3, (k + 2) % 3
                 cur = np.arctan2(Rr[b, a], Rr[a, a])
-                out.append((n, c, (v - cur + np.pi) % (2.0 * np.pi) - np.pi))
+                ref = cur if t_prev is None else float(f(t_prev))
+                out.append((n, c, v - ref - ((cur - ref + np.pi) % (2.0 * np.pi) - np.pi)))
         return out
 
     def enforce_fixed_values(self, H, t):

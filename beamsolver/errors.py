@@ -1,6 +1,6 @@
 """Exceptions raised by beamsolver."""
 
-__all__ = ["InputError", "ConvergenceError"]
+__all__ = ["InputError", "ConvergenceError", "StabilityWarning"]
 
 
 class InputError(ValueError):
@@ -8,8 +8,14 @@ class InputError(ValueError):
 
 
 class ConvergenceError(RuntimeError):
-    """A solve that could not continue; ``.solution`` holds every converged step."""
+    """A solve that could not continue; ``.solution`` holds every converged step, ``.failure``
+    the typed reason (a ``beamsolver.failures.StepFailed``) when a step failed."""
 
     def __init__(self, message, solution=None):
         super().__init__(message)
         self.solution = solution
+        self.failure = None
+
+
+class StabilityWarning(RuntimeWarning):
+    """A converged equilibrium is unstable (its tangent is indefinite): see ``solve(check_stability=)``."""

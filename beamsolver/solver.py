@@ -8,8 +8,9 @@ tangent (``K_ff dz_f = -r_f - K_fc dz_c``), later iterations are Newton
 with contact (``_Newton._line_search``).  Elements may not turn by more than
 ``MAX_ELEMENT_ROTATION`` (nor pass pi within a step): such steps fail with a
 message saying how many elements the beam needs.
-A failing step is halved; steps regrow after easy convergence, never past
-the user's step size, and always land on the user's time grid.
+Failures are typed (``beamsolver.failures``); ``Convergence.decide`` gives
+the verdict on every iterate.  The stepping (cut-back, regrowth, landing on
+the user's grid, keeping what converged when a run stops) is ``stepping.Run``.
 """
 import logging
 import time
@@ -17,13 +18,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import linsolve, se3
+from . import diagnosis, linsolve, se3
 from .assembly import System
-from .errors import ConvergenceError, InputError
-from .progress import Progress
-from .restart import contact_snapshot, restart_from
-from .results import Solution
-from .validation import check_solve_arguments
+from .errors import InputError
+from .failures import DampingStalled, Diverged, NonFinite, NotConverged, RotationLimit, SingularTangent, StepFailed
+from .restart import restart_from
+from .stepping import Run
+
+_StepFailed = StepFailed      # the base of the typed failures (``beamsolver.failures``)
 
 __all__ = ["solve", "Convergence"]
 
@@ -32,6 +34,10 @@ log = logging.getLogger("beamsolver")
 MAX_ELEMENT_ROTATION = 0.8 * np.pi   # an iterate turning an element further is rejected
 LS_GROWTH = 10.0                     # full Newton steps are kept unless the merit grows this much
 DAMPING_MIN = 1.0 / 64.0             # shortest damped Newton step (scenes without contact)
+MIN_STEP_RATIO = 1e-15               # smallest min_step_ratio: below, t + dt rounds to t
+ROUNDOFF = 64.0 * np.finfo(float).eps   # position round-off, relative to the distance from the origin
+
+CONVERGED, CONTINUE, MAX_ITER, DIVERGED = "converged", "continue", "max_iter", "diverged"
 
 
 @dataclass
@@ -45,7 +51,9 @@ class Convergence:
     ``M_ref`` are the largest element nodal force/moment or applied load of
     the iterate (``F_ref >= M_ref / L_ref`` and ``M_ref >= F_ref L_ref``), ``L_ref``
     the model size: the same scene in any unit system converges in the
-    same iterations.
+    same iterations.  Far from the origin positions carry a round-off of
+    ``ROUNDOFF |x|``: ``decide`` takes it as a floor of the increment test, so a
+    scene converges alike wherever it is placed.
     """
     rtol: float = 1e-8
     dtol: float = 1e-11
@@ -67,13 +75,24 @@ class Convergence:
     def increment_ratio(self, dz, L_ref):
         return max(np.abs(dz[:, :3]).max(initial=0.0) / L_ref, np.abs(dz[:, 3:]).max(initial=0.0))
 
+    @staticmethod
+    def floor(H, L_ref):
+        """Round-off floor of ``increment_ratio`` at poses ``H``: ``ROUNDOFF max|x| / L_ref``."""
+        return ROUNDOFF * float(np.abs(H[:, :3, 3]).max(initial=0.0)) / L_ref
 
-class _StepFailed(Exception):
-    """A Newton step that failed; ``rotation``: it failed on the element-rotation limit."""
-
-    def __init__(self, message, rotation=False):
-        super().__init__(message)
-        self.rotation = rotation
+    def decide(self, ratio, increment, iteration, floor=0.0, final=True):
+        """Verdict on an iterate with scaled residual ``ratio`` reached by a full Newton increment
+        of ``increment_ratio`` ``increment`` (``inf`` if damped or none) at ``iteration``:
+        ``CONVERGED`` (``ratio <= rtol`` or ``increment <= max(dtol, floor)``; only if ``final``,
+        i.e. the prescribed motions have been applied), else ``MAX_ITER`` (``iteration >=
+        max_iter``), ``DIVERGED`` (``ratio > divergence``) or ``CONTINUE``."""
+        if final and (ratio <= self.rtol or increment <= max(self.dtol, floor)):
+            return CONVERGED
+        if iteration >= self.max_iter:
+            return MAX_ITER
+        if ratio > self.divergence:
+            return DIVERGED
+        return CONTINUE
 
 
 def _factorize(K, solver=None):
@@ -81,14 +100,14 @@ def _factorize(K, solver=None):
     try:
         return (solver if solver is not None else linsolve.Solver()).factorize(K)
     except linsolve.SingularMatrixError as e:
-        raise _StepFailed(f"singular tangent ({e}); is a rigid-body mode unconstrained?") from None
+        raise SingularTangent(f"singular tangent ({e})") from None
 
 
 def _solve_linear(lu, rhs):
     try:
         return lu.solve(rhs)
     except linsolve.SingularMatrixError as e:   # pardiso reports singularity at the solve
-        raise _StepFailed(f"singular tangent ({e}); is a rigid-body mode unconstrained?") from None
+        raise SingularTangent(f"singular tangent ({e})") from None
 
 
 def _relative_rotations(system, H):
@@ -173,6 +192,10 @@ def _commit_contact(system, sol, H):
 
 
 class _Newton:
+    """Newton iterations of one step (``step``); ``timings`` accumulates the wall time of
+    ``assembly`` (residual, tangent, sparse matrix), ``contact`` (part of it) and
+    ``linear_solve`` (factorisation and solves) until ``reset_timings``."""
+
     def __init__(self, system, conv, line_search, callback):
         self.sys = system
         self.conv = conv
@@ -185,6 +208,10 @@ class _Newton:
         self.fu, self.fw = np.flatnonzero(fu), np.flatnonzero(~fu)
         self.L_ref = system.length_scale
         self.linsolver = linsolve.Solver()    # solve(linear_solver=...) replaces it
+        self.reset_timings()
+
+    def reset_timings(self):
+        self.timings = dict(assembly=0.0, contact=0.0, linear_solve=0.0)
 
     def _ratio(self, r, scales):
         rf = r[self.sys.free_dofs]
@@ -206,10 +233,9 @@ class _Newton:
         ang = se3.rotation_angle(state.h[:, 3:])
         worst = int(np.argmax(ang)) if len(ang) else 0
         if len(ang) and ang[worst] > MAX_ELEMENT_ROTATION:
-            raise _StepFailed(f"{self._element_label(worst)} turns by {ang[worst]:.4f} rad within one element "
-                              f"(limit MAX_ELEMENT_ROTATION = {MAX_ELEMENT_ROTATION / np.pi:.2g} pi = "
-                              f"{MAX_ELEMENT_ROTATION:.4f} rad; an element cannot turn by pi): refine the mesh",
-                              rotation=True)
+            raise RotationLimit(f"{self._element_label(worst)} turns by {ang[worst]:.4f} rad within one element "
+                                f"(limit MAX_ELEMENT_ROTATION = {MAX_ELEMENT_ROTATION / np.pi:.2g} pi = "
+                                f"{MAX_ELEMENT_ROTATION:.4f} rad; an element cannot turn by pi): refine the mesh")
 
     def _check_continuity(self, H0, H1):
         """Refuse a step over which an element's relative rotation may have passed through pi.
@@ -227,9 +253,9 @@ class _Newton:
         bad = np.flatnonzero(change >= (np.pi - _angle(R0)) + (np.pi - _angle(R1)) - 1e-9)
         if len(bad):
             e = int(bad[np.argmax(change[bad])])
-            raise _StepFailed(f"{self._element_label(e)} turns by {change[e]:.3f} rad within one element in "
-                              "one load step and may have passed pi, which an element cannot represent: "
-                              "use smaller steps or refine the mesh", rotation=True)
+            raise RotationLimit(f"{self._element_label(e)} turns by {change[e]:.3f} rad within one element in "
+                                "one load step and may have passed pi, which an element cannot represent: "
+                                "use smaller steps or refine the mesh")
 
     def _norm(self, dzf):
         """Norm of free increments, translations in units of the model size (unit-independent)."""
@@ -242,24 +268,51 @@ class _Newton:
     def _direction(self, r, kvals, info, dz_c=None):
         """Newton increment on the free unknowns (with the prescribed-motion coupling ``dz_c``)."""
         sys = self.sys
+        t0 = time.perf_counter()
         rhs = -r[sys.free_dofs]
         if dz_c is not None:
             rhs -= sys.prescribed_coupling(kvals, dz_c.ravel(), info["extra"])
-        lu = _factorize(sys.matrix(kvals, info["extra"]), self.linsolver)
-        dzf = _solve_linear(lu, rhs)
+        K = sys.matrix(kvals, info["extra"])
+        t1 = time.perf_counter()
+        try:
+            lu = _factorize(K, self.linsolver)
+            dzf = _solve_linear(lu, rhs)
+        finally:
+            t2 = time.perf_counter()
+            self.timings["assembly"] += t1 - t0
+            self.timings["linear_solve"] += t2 - t1
         if not np.all(np.isfinite(dzf)):
-            raise _StepFailed("the linear solve returned non-finite values")
+            raise SingularTangent("the linear solve returned non-finite values")
         return lu, dzf
 
-    def _evaluate(self, H, lf):
-        r, kvals, info = self.sys.evaluate(H, lf, tangent=True)
+    def _evaluate(self, H, lf, tangent=True):
+        t0 = time.perf_counter()
+        r, kvals, info = self.sys.evaluate(H, lf, tangent=tangent)
+        self.timings["assembly"] += time.perf_counter() - t0
+        self.timings["contact"] += info.get("contact_time", 0.0)
         if not np.all(np.isfinite(r)):
-            raise _StepFailed("the residual is not finite")
+            raise NonFinite("the residual is not finite")
         self._check_rotation(info["state"])
         return r, kvals, info
 
-    def step(self, H, t, H_target):
-        """Solve for equilibrium at ``t``; returns ``(H, r, info, stats)`` or raises ``_StepFailed``.
+    def _predictor(self, H, t, t_prev, H_target):
+        """Increments ``dz_c`` ``(n, 6)`` carrying the constrained nodes to their targets at ``t``
+        (``None`` if there is nothing to move) and the ``fix(values=)`` targets."""
+        sys = self.sys
+        targets = sys.fixed_value_increments(H, t, t_prev) if sys.fix_values else []
+        if not (len(sys.prescribed_nodes) or targets):
+            return None, targets
+        dz_c = np.zeros((sys.n_nodes, 6))
+        if len(sys.prescribed_nodes):
+            p = sys.prescribed_nodes
+            dz_c[p] = se3.log(se3.relative(H[p], H_target))
+        for node, comp, dx in targets:
+            dz_c[node, comp] = dx
+        return (dz_c if np.any(dz_c) else None), targets
+
+    def step(self, H, t, H_target, t_prev=None):
+        """Solve for equilibrium at ``t`` (from the equilibrium ``H`` at ``t_prev``); returns
+        ``(H, r, info, stats)`` or raises a ``failures.StepFailed``.
 
         Without contact, with ``line_search``, the Newton step is damped on the Newton correction
         (``_damped``); with contact the residual line search ``_line_search`` is used.
@@ -270,17 +323,8 @@ class _Newton:
         H_start = H
         residuals = []
         damped_its = 0
-        dz_c = None
-        targets = sys.fixed_value_increments(H, t) if sys.fix_values else []
-        if len(sys.prescribed_nodes) or targets:
-            dz_c = np.zeros((n, 6))
-            if len(sys.prescribed_nodes):
-                p = sys.prescribed_nodes
-                dz_c[p] = se3.log(se3.relative(H[p], H_target))
-            for node, comp, dx in targets:
-                dz_c[node, comp] = dx
-            if not np.any(dz_c):
-                dz_c = None
+        dz_c, targets = self._predictor(H, t, t_prev, H_target)
+        floor = conv.floor(H, self.L_ref)
         damping = self.line_search and sys.contact is None
         last_inc = np.inf
         ahead = None                 # (r, kvals, info, lu, dzf) of an accepted damped trial
@@ -299,16 +343,18 @@ class _Newton:
             log.debug("t = %.6g  iteration %d  scaled residual %.3e", t, it, ratio)
             if self.callback is not None:
                 self.callback(dict(t=t, iteration=it, residual=ratio, poses=H))
-            if dz_c is None and (ratio <= conv.rtol or last_inc <= conv.dtol):
+            verdict = conv.decide(ratio, last_inc, it, floor, final=dz_c is None)
+            if verdict == CONVERGED:
                 self._check_continuity(H_start, H)
                 stats = dict(iterations=it, residuals=residuals)
                 if damped_its:
                     stats["damped"] = damped_its
                 return H, r, info, stats
-            if it == conv.max_iter:
-                raise _StepFailed(f"no convergence in {conv.max_iter} iterations (scaled residual {ratio:.3g})")
-            if ratio > conv.divergence:
-                raise _StepFailed(f"diverging (scaled residual {ratio:.3g})")
+            if verdict == MAX_ITER:
+                raise NotConverged(f"no convergence in {conv.max_iter} iterations (scaled residual {ratio:.3g})",
+                                   ratio)
+            if verdict == DIVERGED:
+                raise Diverged(f"diverging (scaled residual {ratio:.3g})")
             if dzf is None:
                 lu, dzf = self._direction(r, kvals, info, dz_c)
             dz = np.zeros(6 * n)
@@ -337,7 +383,7 @@ class _Newton:
             if rotation_streak >= 2:
                 raise rotation
             last_inc = conv.increment_ratio(dz, self.L_ref) if lam == 1.0 else np.inf
-        raise AssertionError("unreachable")
+        raise AssertionError("unreachable: decide() returns MAX_ITER at iteration max_iter")
 
     def _damped(self, H, dz, dzf, lf, lam):
         """Damped Newton update ``H exp(lam dz)`` (scenes without contact).
@@ -372,7 +418,7 @@ class _Newton:
                 lu1, d1 = self._direction(r1, k1, info1)
                 if self._norm(d1) < nrm or self._inc(d1) <= conv.dtol:
                     return H1, lam, (r1, k1, info1, lu1, d1), rotation
-            except _StepFailed as e:
+            except StepFailed as e:
                 failure = e
                 if first and e.rotation:
                     rotation = e
@@ -381,8 +427,8 @@ class _Newton:
             if lam < DAMPING_MIN:
                 if failure is not None and failure.rotation:
                     raise failure
-                raise _StepFailed(f"damped Newton stalled: no step length down to {DAMPING_MIN:g} of the "
-                                  "Newton increment reduces the Newton correction")
+                raise DampingStalled(f"damped Newton stalled: no step length down to {DAMPING_MIN:g} of the "
+                                     "Newton increment reduces the Newton correction")
 
     def _line_search(self, H, dz, r0, scales, lf):
         """Backtracking on the scaled residual (scenes with contact; the others use the damped
@@ -397,10 +443,9 @@ class _Newton:
         best = (np.inf, H1)
         for _ in range(8):
             try:
-                r1, _, info = sys.evaluate(H1, lf, tangent=False)
-                self._check_rotation(info["state"])
-                phi = self._merit(r1, scales) if np.all(np.isfinite(r1)) else np.inf
-            except _StepFailed:
+                r1, _, _ = self._evaluate(H1, lf, tangent=False)
+                phi = self._merit(r1, scales)
+            except StepFailed:
                 phi = np.inf
             if phi < best[0]:
                 best = (phi, H1)
@@ -416,14 +461,14 @@ class _Newton:
             alpha = float(np.clip(a_new, 0.1 * alpha, 0.5 * alpha))
             H1 = sys.update(H, alpha * dz)
         if not np.isfinite(best[0]):
-            raise _StepFailed("line search found no finite residual along the Newton direction")
+            raise NonFinite("line search found no finite residual along the Newton direction")
         return best[1]
 
 
 def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dtol=1e-11,
           max_iter=30, line_search=True, min_step_ratio=2.0**-12, callback=None,
           check_rigid_modes=True, verbose=None, initial_poses=None, restart=None, checkpoint=60.0,
-          linear_solver=None):
+          linear_solver=None, allow_unmet_tolerance=False, check_stability=False):
     """Quasi-static solve of ``model`` from ``t_start`` to ``t_end`` in ``steps`` equal steps.
 
     Every converged (sub)step is recorded in the returned ``Solution``.  Step 0 is
@@ -431,12 +476,17 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     prescribed motion or ``fix`` value acts there, else the equilibrium solved
     there (its Newton statistics in ``stats[0]``).  A step
     that fails is halved down to ``min_step_ratio`` times the user's step, then
-    ``ConvergenceError`` is raised with the last converged ``Solution``.
+    ``ConvergenceError`` is raised with the last converged ``Solution``
+    (``.solution``) and the typed reason (``.failure``).  A step over which a
+    prescribed rotation turns by more than ``motion_path.MAX_MOTION_ROTATION``
+    is shortened first, so motions are followed as continuous paths.
 
     ``output``: folder for ParaView files and ``solution.npz`` (``None``: no
-    output; see ``beamsolver.io.vtk``), the latter saved at the end and every
-    ``checkpoint`` seconds (0: every step); or a writer object with
-    ``write(solution, step)`` and ``close()`` such as ``io.vtk.StepWriter``.
+    output; see ``beamsolver.io.vtk``), the latter saved at the end, whenever
+    the run stops (also by Ctrl-C or an exception) and every ``checkpoint``
+    seconds (0: every step; ``None``: only at the end or stop); or a writer
+    object with ``write(solution, step)`` and ``close()`` such as ``io.vtk.StepWriter``.
+    Any exception leaving ``solve`` carries the converged steps as ``.solution``.
     ``callback(info)`` is called at every Newton iteration with ``t``,
     ``iteration``, ``residual`` (scaled) and ``poses``.
     ``verbose``: progress bar / lines (see ``progress.Progress``); ``None`` shows a bar on a terminal.
@@ -449,6 +499,19 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     of wires in contact ``"pardiso"`` if pypardiso is installed, ``pip install
     "beamsolver[fast]"``, else ``"splu-rcm"``, scipy after an RCM ordering),
     or one of those by name (see ``beamsolver.linsolve``).
+    ``allow_unmet_tolerance``: accept a step whose contact penetration still
+    exceeds ``add_contact(tolerance=)`` after the augmented-Lagrangian updates,
+    with a warning in ``stats[k]["warnings"]`` and ``Solution.message``
+    (default: a ``ConvergenceError``).
+    ``check_stability``: after every converged step count the negative
+    eigenvalues of the tangent (``definiteness.negative_eigenvalues``) where the
+    problem is conservative (no follower loads, no friction), record
+    ``stable``, ``negative_eigenvalues`` and ``lowest_eigenvalue`` in
+    ``stats`` and warn once (``StabilityWarning``) on an unstable equilibrium.
+
+    ``Solution.stats[k]["timings"]``: wall time of the step's ``assembly``
+    (residuals, tangents, sparse matrices), ``contact`` (part of assembly) and
+    ``linear_solve`` (factorisations and solves), in seconds.
     """
     check_solve_arguments(model, steps=steps, t_end=t_end, t_start=t_start, rtol=rtol, dtol=dtol, max_iter=max_iter,
                           min_step_ratio=min_step_ratio, checkpoint=checkpoint, initial_poses=initial_poses,
@@ -458,137 +521,76 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     if int(steps) != steps or steps < 1:
         raise InputError(f"solve: steps must be a positive integer, got {steps!r}")
     system = System(model, check_rigid_modes=check_rigid_modes)
+    sol = None
     if restart is not None:
         sol = restart_from(restart, model, system)
         t_start = sol._times[0]
     if not (np.isfinite(t_end) and np.isfinite(t_start) and t_end > t_start):
         raise InputError(f"solve: need t_end > t_start, got t_start={t_start!r}, t_end={t_end!r}")
+    grid = np.linspace(t_start, t_end, int(steps) + 1)
+    dt_min = _step_floor(min_step_ratio, grid)
     conv = Convergence(rtol=rtol, dtol=dtol, max_iter=max_iter)
     newton = _Newton(system, conv, line_search, callback)
     newton.linsolver = linsolve.Solver(linear_solver)
-    writer = None
-    if output is not None and hasattr(output, "write"):
-        writer = output                   # e.g. io.vtk.StepWriter(folder, refine=4, compression=None)
-    elif output is not None:
-        from .io.vtk import StepWriter
-        writer = StepWriter(output, system, checkpoint=checkpoint)
+    options = dict(allow_unmet_tolerance=allow_unmet_tolerance, check_stability=check_stability,
+                   advice=_advice(system, t_start, t_end))
+    run = None
+    try:
+        run = Run(system, newton, _writer(output, system, checkpoint), grid, dt_min, verbose, options)
+        run.start(sol, initial_poses)
+        run.loop()
+    except BaseException as e:
+        if run is not None:
+            run.abort(e)
+        raise
+    return run.finish()
 
-    grid = np.linspace(t_start, t_end, int(steps) + 1)
+
+def _step_floor(min_step_ratio, grid):
+    """Smallest step ``min_step_ratio`` times the user's, which must be representable at ``t``."""
     dt_user = grid[1] - grid[0]
-    dt_min = dt_user * min_step_ratio
-    dt = dt_user
-    t = t_start
-    k = 1
-    easy = 0
-    if restart is None:
-        H = system.poses0.copy() if initial_poses is None else np.array(initial_poses, dtype=float)
-        if len(system.prescribed_nodes):
-            H[system.prescribed_nodes] = system.prescribed_poses(t_start)
-            system.sync_members(H)
-        sol = Solution(model, system)
-        first = _initial_equilibrium(system, newton, system.poses0.copy() if initial_poses is None else
-                                     np.array(initial_poses, dtype=float), t_start, sol)
-        if first is None:
-            lf0 = system.load_factors(t_start) if len(system.load_scales) else np.zeros(0)
-            r0, _, info0 = system.evaluate(H, lf0, tangent=False)
-            stats0, contact0 = dict(iterations=0, residuals=[], wall_time=0.0, dt=0.0, cutbacks=0), None
-        else:
-            H, r0, info0, stats0 = first
-            contact0 = _commit_contact(system, sol, H)
-        sol.append(t_start, H, system.reactions(H, r0), info0["state"].sigma, info0["state"].strain,
-                   stats0, contact0)
-        if writer is not None:
-            writer.write(sol, 0)
-    else:
-        H = sol._poses[-1].copy()
-        t = sol._times[-1]
-        k = int(np.searchsorted(grid, t + 1e-12 * dt_user, side="right"))
-        rs = sol.resume
-        if rs.get("t0") == t_start and rs.get("t_end") == t_end and rs.get("steps") == steps:
-            dt, easy = min(rs["dt"], dt_user), rs["easy"]
-        if writer is not None:
-            for j in range(len(sol._times)):
-                writer.write(sol, j)
-    sol.resume = dict(t0=float(grid[0]), t_end=float(t_end), steps=int(steps), dt=float(dt), easy=int(easy))
-    progress = Progress(verbose, t_start, t_end, t)
-    while k <= steps:
-        t_next = min(t + dt, grid[k])
-        if grid[k] - t_next < 1e-9 * dt_user:
-            t_next = grid[k]
-        t0 = time.perf_counter()
-        cutbacks = 0
-        rotation_limit = None         # an attempt of this step turned an element too far
-        while True:
-            try:
-                H_target = system.prescribed_poses(t_next) if len(system.prescribed_nodes) else None
-                if system.contact is not None:
-                    system.contact.begin_step(H, t_next)
-                H_new, r, info, stats = newton.step(H, t_next, H_target)
-                # augmented Lagrangian: update multipliers and re-solve until satisfied
-                while system.contact is not None and system.contact.augment(H_new):
-                    more = newton.step(H_new, t_next, H_target)
-                    H_new, r, info = more[0], more[1], more[2]
-                    stats["iterations"] += more[3]["iterations"]
-                    stats["residuals"] += more[3]["residuals"]
-                    stats["augmentations"] = stats.get("augmentations", 0) + 1
-                break
-            except _StepFailed as e:
-                cutbacks += 1
-                if "within one element" in str(e):
-                    rotation_limit = str(e)
-                dt_try = (t_next - t) / 2.0
-                log.info("t = %.6g: step %.3g failed (%s); cutting back to %.3g", t_next, t_next - t, e, dt_try)
-                if dt_try < dt_min:
-                    sol.converged = False
-                    sol.message = str(e)
-                    progress.close()
-                    if writer is not None:
-                        writer.close()
-                    hint = "" if rotation_limit is None or rotation_limit == str(e) else \
-                        f"; a larger step had failed because {rotation_limit}"
-                    turned = _largest_element_rotation(system, H)
-                    rot = getattr(e, "rotation", False)
-                    if not hint and turned > 0.75 * MAX_ELEMENT_ROTATION and not rot:
-                        hint = (f"; elements already turn by up to {turned:.2f} rad within one element "
-                                f"(limit {MAX_ELEMENT_ROTATION:.2f}): refine the mesh")
-                    if rot or rotation_limit is not None or turned > 0.75 * MAX_ELEMENT_ROTATION:
-                        hint += _refine_advice(system, H, t, t_start, t_end)
-                    if not hint and "stalled" in str(e):
-                        hint = ("; large rotations of slender beams need small load steps where the "
-                                "strain-space update does not apply (joined, guided or supported beams): "
-                                "lower min_step_ratio or use more steps")
-                    if not hint and "no convergence" in str(e):
-                        hint = ("; if the structure may have buckled (a limit point or bifurcation: "
-                                "check the eigenvalues of bs.linearize(model, error.solution)) or "
-                                "lost the support of a contact, a force-controlled quasi-static solve "
-                                "cannot pass it: prescribe displacements, add supports, or refine")
-                    raise ConvergenceError(
-                        f"solve: could not advance from t = {t:.6g} (step fell below {dt_min:.3g}): {e}{hint}",
-                        sol) from None
-                t_next = t + dt_try
-                easy = 0
-        stats.update(wall_time=time.perf_counter() - t0, dt=t_next - t, cutbacks=cutbacks)
-        H = H_new
-        state = info["state"]
-        contact_data = None
-        if system.contact is not None:
-            system.contact.commit(H)
-            contact_data = system.contact.results(H)
-            sol.contact_state = contact_snapshot(system.contact)
-        sol.append(t_next, H, system.reactions(H, r), state.sigma, state.strain, stats, contact_data)
-        if writer is not None:
-            writer.write(sol, sol.n_steps)
-        progress.step(sol.n_steps, t_next, t_next - t, stats)
-        dt = t_next - t
-        t = t_next
-        if t >= grid[k] - 1e-12 * dt_user:
-            t = grid[k]
-            k += 1
-        easy = easy + 1 if stats["iterations"] <= 6 and cutbacks == 0 else 0
-        if easy >= 2:
-            dt = min(2.0 * dt, dt_user)
-        sol.resume = dict(t0=float(grid[0]), t_end=float(t_end), steps=int(steps), dt=float(dt), easy=int(easy))
-    progress.close()
-    if writer is not None:
-        writer.close()
-    return sol
+    try:
+        ratio = float(min_step_ratio)
+    except (TypeError, ValueError):
+        raise InputError(f"solve: min_step_ratio must be a number in [{MIN_STEP_RATIO:g}, 1], "
+                         f"got {min_step_ratio!r}") from None
+    if not MIN_STEP_RATIO <= ratio <= 1.0:
+        raise InputError(f"solve: min_step_ratio must lie in [{MIN_STEP_RATIO:g}, 1] (smaller steps vanish "
+                         f"in round-off), got {min_step_ratio!r}")
+    dt_min = dt_user * ratio
+    t_max = float(np.abs(grid).max())
+    if dt_min <= 1e3 * np.finfo(float).eps * t_max:
+        raise InputError(f"solve: the smallest step {dt_min:.3g} (min_step_ratio {min_step_ratio!r} of the step "
+                         f"{dt_user:.3g}) vanishes in round-off at t = {t_max:.6g}: raise min_step_ratio")
+    return dt_min
+
+
+def _writer(output, system, checkpoint):
+    if output is None:
+        return None
+    if hasattr(output, "write"):
+        return output                     # e.g. io.vtk.StepWriter(folder, refine=4, compression=None)
+    if checkpoint is None:
+        checkpoint = np.inf               # saved at the end and when the run stops, not periodically
+    elif not (isinstance(checkpoint, (int, float)) and checkpoint >= 0):
+        raise InputError(f"solve: checkpoint must be a number of seconds >= 0 or None, got {checkpoint!r}")
+    from .io.vtk import StepWriter
+    return StepWriter(output, system, checkpoint=checkpoint)
+
+
+def _advice(system, t_start, t_end):
+    """``advice(failure, rotation_limit, H, t)``: the tail of a ``ConvergenceError`` message."""
+    def advice(failure, rotation_limit, H, t):
+        msg = str(failure)
+        hint = "" if rotation_limit is None or rotation_limit == msg else \
+            f"; a larger step had failed because {rotation_limit}"
+        turned = _largest_element_rotation(system, H)
+        if not hint and turned > 0.75 * MAX_ELEMENT_ROTATION and not failure.rotation:
+            hint = (f"; elements already turn by up to {turned:.2f} rad within one element "
+                    f"(limit {MAX_ELEMENT_ROTATION:.2f}): refine the mesh")
+        if failure.rotation or rotation_limit is not None or turned > 0.75 * MAX_ELEMENT_ROTATION:
+            hint += _refine_advice(system, H, t, t_start, t_end)
+        if not hint:
+            hint = diagnosis.advice(failure, system, H, t)
+        return hint
+    return advice

@@ -461,9 +461,13 @@ class ContactSystem:
         return P, sel, (p, out)
 
     def augment(self, H):
-        """Augmented-Lagrangian update; True when the step must be re-solved."""
+        """Augmented-Lagrangian update; True when the step must be re-solved.
+
+        After ``MAX_AUGMENT`` updates without meeting the tolerance it returns False with
+        ``unmet_tolerance`` set to the largest ratio penetration / tolerance (else ``None``)."""
+        self.unmet_tolerance = None
         tol = [d.tolerance for d in self.decls]
-        if all(t is None for t in tol) or self._augments >= MAX_AUGMENT:
+        if all(t is None for t in tol):
             return False
         P, sel, po = self._state(H)
         if P is None or len(sel) == 0:
@@ -472,6 +476,9 @@ class ContactSystem:
         gap = out["gap"]
         tols = self._decl_tolerance[P["decl"][sel]]
         if np.all(-gap <= tols):
+            return False
+        if self._augments >= MAX_AUGMENT:      # not met: the caller decides (error or warning)
+            self.unmet_tolerance = float(np.max(-gap / tols))
             return False
         keys = P["key"][sel]
         lam = np.where(np.isfinite(tols), out["lam_n"], 0.0)

@@ -1,0 +1,94 @@
+"""What went wrong, from what the solver knows: the source of a non-finite value, the state of
+the tangent (indefinite, ill-conditioned) and the mesh (elements turning too far).
+
+Used by ``solve`` to name the input behind a NaN (``nonfinite_source``) and to
+add advice to a ``ConvergenceError`` (``advice``).
+"""
+import numpy as np
+
+from .definiteness import negative_eigenvalues
+from .element import internal_forces
+from .failures import DampingStalled, NotConverged, SingularTangent
+
+__all__ = ["nonfinite_source", "advice", "ILL_CONDITIONED"]
+
+ILL_CONDITIONED = 1e10     # ratio of scaled diagonal stiffnesses called ill-conditioned
+
+
+def nonfinite_source(system, H, t):
+    """``(input, message)`` naming what makes the residual at poses ``H`` and time ``t``
+    non-finite (``input``: True when it is the user's input), or ``None`` if all is finite."""
+    bad = np.flatnonzero(~np.all(np.isfinite(H.reshape(len(H), -1)), axis=1))
+    if len(bad):
+        return True, f"the poses of nodes {bad[:10].tolist()} are not finite (initial_poses or a prescribed motion)"
+    model = system.model
+    if len(system.load_scales):
+        lf = system.load_factors(t)
+        j = np.flatnonzero(~np.isfinite(lf))
+        if len(j):
+            ld = model.loads[int(j[0])]
+            return True, f"add_load(node {ld.node}): scale({t:.6g}) = {lf[j[0]]!r} is not finite"
+    for node, comp, f in system.fix_values:
+        v = f(t)
+        if not np.isfinite(v):
+            return True, f"fix(node {node}): values[{comp}]({t:.6g}) = {v!r} is not finite"
+    en = system.enodes
+    if len(en):
+        f, _ = internal_forces(H[en[:, 0]], H[en[:, 1]], system.L, system.eps0, system.C)
+        e = np.flatnonzero(~np.all(np.isfinite(f), axis=1))
+        if len(e):
+            return False, f"the internal forces of element {int(e[0])} are not finite"
+    if system.contact is not None:
+        rc, _, _ = system.contact.evaluate(H, False)
+        nodes = np.flatnonzero(~np.all(np.isfinite(rc.reshape(-1, 6)), axis=1))
+        if len(nodes):
+            decl = _contact_declaration(model, nodes)
+            return True, (f"the contact forces of {decl} are not finite at nodes {nodes[:10].tolist()}: "
+                          "do two beams share a centre line (no contact normal)?")
+    return None
+
+
+def _contact_declaration(model, nodes):
+    beam_of = {int(n): b.id for b in model.beams for n in b.nodes}
+    ids = {beam_of.get(int(n)) for n in nodes}
+    for i, d in enumerate(model.contacts):
+        if ids & {b.id for b in d.slave + d.master}:
+            return (f"add_contact no. {i} (slave beams {[b.id for b in d.slave]}, "
+                    f"master beams {[b.id for b in d.master]})")
+    return "a contact declaration"
+
+
+def _tangent_state(system, H, t):
+    """``(negative eigenvalues, condition estimate)`` of the tangent at ``H`` (``None`` if unknown)."""
+    try:
+        lf = system.load_factors(t) if len(system.load_scales) else np.zeros(0)
+        _, kvals, info = system.evaluate(H, lf, tangent=True)
+        K = system.matrix(kvals, info["extra"])
+        d = np.abs(K.diagonal())
+        cond = float(d.max() / d.min()) if len(d) and d.min() > 0 else np.inf
+        return negative_eigenvalues(K)[0], cond
+    except Exception:           # advice only: never hide the failure being reported
+        return None, None
+
+
+def advice(failure, system, H, t):
+    """Advice for a ``ConvergenceError`` after ``failure`` from the converged state ``H`` at ``t``."""
+    if not isinstance(failure, (NotConverged, DampingStalled, SingularTangent)):
+        return ""
+    neg, cond = _tangent_state(system, H, t)
+    if isinstance(failure, SingularTangent):
+        if cond is not None and cond > ILL_CONDITIONED:
+            return (f"; the tangent is ill-conditioned (its diagonal stiffnesses span a ratio of {cond:.1e}): "
+                    "stiffnesses many orders of magnitude apart (sections, penalties, supports) leave "
+                    "the linear solve without significant digits")
+        return "; is a rigid-body mode unconstrained?"
+    if neg:
+        return (f"; the tangent at t = {t:.6g} is already indefinite ({neg} negative eigenvalue"
+                f"{'s' if neg > 1 else ''}): the path has passed a limit point or bifurcation, which a "
+                "force-controlled quasi-static solve cannot follow: prescribe displacements, add supports "
+                "or an imperfection")
+    if isinstance(failure, DampingStalled):
+        return ("; large rotations of slender beams need small load steps where the strain-space update "
+                "does not apply (joined, guided or supported beams): lower min_step_ratio or use more steps")
+    return ("; the tangent is positive definite at the last converged state: if a contact lost its "
+            "support or the structure snaps between steps, prescribe displacements, add supports, or refine")

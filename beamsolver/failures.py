@@ -1,0 +1,61 @@
+"""Typed failures of a Newton step (solver-private), so the solver decides on the kind, not on text.
+
+A step raises one of these; ``solve`` cuts the step back when ``retry`` is
+true, otherwise it stops at once with ``ConvergenceError`` whose ``failure``
+attribute is the instance (``isinstance(error.failure, RotationLimit)``).
+"""
+
+__all__ = ["StepFailed", "RotationLimit", "NotConverged", "Diverged", "DampingStalled",
+           "SingularTangent", "NonFinite", "AugmentationFailed", "MotionTooFast"]
+
+
+class StepFailed(Exception):
+    """A Newton step that failed; ``retry``: a smaller step may succeed."""
+    retry = True
+    rotation = False          # failed on the element-rotation limit
+
+
+class RotationLimit(StepFailed):
+    """An element turned past ``MAX_ELEMENT_ROTATION`` or may have passed pi within a step."""
+    rotation = True
+
+
+class NotConverged(StepFailed):
+    """``max_iter`` iterations without meeting the tolerance; ``ratio``: last scaled residual."""
+
+    def __init__(self, message, ratio=float("nan")):
+        super().__init__(message)
+        self.ratio = ratio
+
+
+class Diverged(StepFailed):
+    """The scaled residual grew past ``Convergence.divergence``."""
+
+
+class DampingStalled(StepFailed):
+    """Neither a damped nor the full Newton step reduces the Newton correction."""
+
+
+class SingularTangent(StepFailed):
+    """The tangent could not be factorised or solved; ``condition``: estimate if known."""
+
+    def __init__(self, message, condition=None):
+        super().__init__(message)
+        self.condition = condition
+
+
+class NonFinite(StepFailed):
+    """A non-finite residual or increment; ``source`` names the input that produced it, if known."""
+
+    def __init__(self, message, source=None):
+        super().__init__(message)
+        self.source = source
+
+
+class AugmentationFailed(StepFailed):
+    """Augmented-Lagrangian updates did not meet the requested penetration tolerance."""
+    retry = False
+
+
+class MotionTooFast(StepFailed):
+    """A prescribed motion turns too far within the step to be followed unambiguously."""

@@ -1,0 +1,267 @@
+"""Pseudo-time stepping of ``solve``: step sizes, cut-back, recording, and stopping without loss.
+
+``Run`` walks the user's grid ``t_0 < t_1 < ... < t_steps``.  A step is first
+shortened where a prescribed rotation would be ambiguous
+(``motion_path.limit_step``); a step whose Newton iterations fail with a
+retryable ``failures.StepFailed`` is halved down to ``dt_min`` (compared with a
+relative tolerance ``STEP_TOLERANCE``, so the smallest cut-back is tried);
+after a converged step the next one grows from the iteration count
+(``growth``), never past the user's step, and lands on the grid.  Every loop is
+bounded: each pass of the main loop advances by at least ``dt_min`` or stops.
+
+Whatever ends a run (``ConvergenceError``, Ctrl-C, an exception from a callback
+or a motion), ``abort`` records the converged steps in the output folder
+(``solution.npz``, atomically) and attaches the ``Solution`` to the exception.
+"""
+import logging
+import time
+import warnings
+
+import numpy as np
+
+from . import diagnosis, motion_path
+from .definiteness import negative_eigenvalues
+from .errors import ConvergenceError, InputError, StabilityWarning
+from .failures import AugmentationFailed, NonFinite, StepFailed
+from .progress import Progress
+from .restart import contact_snapshot
+from .results import Solution
+
+__all__ = ["Run", "growth", "STEP_TOLERANCE", "EASY_ITERATIONS"]
+
+log = logging.getLogger("beamsolver")
+
+STEP_TOLERANCE = 1e-9      # relative rounding allowed when comparing step sizes
+EASY_ITERATIONS = 6        # a step converging within these iterations may be followed by a longer one
+
+
+def growth(iterations, easy):
+    """Factor for the next step after a converged one: 2 from the second easy step running on
+    (``easy`` counts them, this one included), 1 otherwise."""
+    return 2.0 if easy >= 2 else 1.0
+
+
+class Run:
+    """One call of ``solve``: ``start``, then ``loop``; ``abort(exc)`` on any exception."""
+
+    def __init__(self, system, newton, writer, grid, dt_min, verbose, options):
+        self.sys, self.newton, self.writer, self.grid = system, newton, writer, grid
+        self.dt_user = grid[1] - grid[0]
+        self.dt_min = dt_min
+        self.verbose = verbose
+        self.opt = options            # allow_unmet_tolerance, check_stability
+        self.sol = None
+        self.progress = None
+        self.warned_unstable = False
+
+    # ------------------------------------------------------------------ start
+    def start(self, restart_solution, initial_poses):
+        sys, grid = self.sys, self.grid
+        t_start, steps = grid[0], len(grid) - 1
+        self.dt, self.t, self.k, self.easy = self.dt_user, t_start, 1, 0
+        if restart_solution is None:
+            H = sys.poses0.copy() if initial_poses is None else np.array(initial_poses, dtype=float)
+            if len(sys.prescribed_nodes):
+                H[sys.prescribed_nodes] = sys.prescribed_poses(t_start)
+                sys.sync_members(H)
+            self.sol = Solution(sys.model, sys)
+            lf0 = sys.load_factors(t_start) if len(sys.load_scales) else np.zeros(0)
+            r0, _, info0 = sys.evaluate(H, lf0, tangent=False)
+            self._check_finite(H, r0, info0["state"], t_start)
+            self.sol.append(t_start, H, sys.reactions(H, r0), info0["state"].sigma, info0["state"].strain,
+                            dict(iterations=0, residuals=[], wall_time=0.0, dt=0.0, cutbacks=0))
+            if self.writer is not None:
+                self.writer.write(self.sol, 0)
+        else:
+            self.sol = sol = restart_solution
+            H = sol._poses[-1].copy()
+            self.t = sol._times[-1]
+            self.k = int(np.searchsorted(grid, self.t + 1e-12 * self.dt_user, side="right"))
+            rs = sol.resume
+            if rs.get("t0") == t_start and rs.get("t_end") == grid[-1] and rs.get("steps") == steps:
+                self.dt, self.easy = min(rs["dt"], self.dt_user), rs["easy"]
+            if self.writer is not None:
+                for j in range(len(sol._times)):
+                    self.writer.write(sol, j)
+        self.H = H
+        self.progress = Progress(self.verbose, t_start, grid[-1], self.t)
+
+    def _check_finite(self, H, r, state, t):
+        """Never record a non-finite state: name the input behind it (``InputError``) or fail."""
+        if np.all(np.isfinite(r)) and np.all(np.isfinite(H)) and np.all(np.isfinite(state.sigma)):
+            return
+        found = diagnosis.nonfinite_source(self.sys, H, t)
+        if found is not None and found[0]:
+            raise InputError(f"solve: at t = {t:.6g} {found[1]}")
+        raise NonFinite(f"non-finite state at t = {t:.6g}" + (f": {found[1]}" if found else ""))
+
+    # ------------------------------------------------------------------ steps
+    def loop(self):
+        grid = self.grid
+        steps = len(grid) - 1
+        while self.k <= steps:
+            t_next = min(self.t + self.dt, grid[self.k])
+            if grid[self.k] - t_next < 1e-9 * self.dt_user:
+                t_next = grid[self.k]
+            t0 = time.perf_counter()
+            t_next, H, r, info, stats = self._attempt(t_next)
+            stats.update(wall_time=time.perf_counter() - t0, dt=t_next - self.t)
+            self._record(t_next, H, r, info, stats)
+
+    def _attempt(self, t_next):
+        """Converge the step ``t -> t_next``, halving it on failure; returns the step reached."""
+        t, cutbacks, rotation_limit = self.t, 0, None
+        while True:
+            t_try, rot = motion_path.limit_step(self.sys, t, t_next)
+            if t_try - t < self.dt_min * (1.0 - STEP_TOLERANCE):
+                self._stop(StepFailed(f"a prescribed rotation turns by {rot:.3g} rad over a step of "
+                                      f"{t_try - t:.3g}, more than MAX_MOTION_ROTATION = "
+                                      f"{motion_path.MAX_MOTION_ROTATION:.3g} rad, even at the smallest step"),
+                           rotation_limit)
+            self.newton.reset_timings()
+            try:
+                H, r, info, stats = self._newton_step(t_try)
+                self._check_finite(H, r, info["state"], t_try)
+                stats.update(cutbacks=cutbacks, timings=dict(self.newton.timings))
+                if t_try < t_next:
+                    stats["motion_rotation"] = rot
+                return t_try, H, r, info, stats
+            except StepFailed as e:
+                cutbacks += 1
+                if e.rotation:
+                    rotation_limit = str(e)
+                h = 0.5 * (t_try - t)
+                log.info("t = %.6g: step %.3g failed (%s); cutting back to %.3g", t_try, t_try - t, e, h)
+                if not e.retry or h < self.dt_min * (1.0 - STEP_TOLERANCE):
+                    self._stop(e, rotation_limit)
+                t_next = t + h
+                self.easy = 0
+
+    def _newton_step(self, t_next):
+        """Newton at ``t_next``, then augmented-Lagrangian updates until the contact tolerance holds."""
+        sys, newton = self.sys, self.newton
+        H_target = sys.prescribed_poses(t_next) if len(sys.prescribed_nodes) else None
+        if sys.contact is not None:
+            sys.contact.begin_step(self.H, t_next)
+        H, r, info, stats = newton.step(self.H, t_next, H_target, self.t)
+        while sys.contact is not None and sys.contact.augment(H):
+            H, r, info, more = newton.step(H, t_next, H_target, self.t)
+            stats["iterations"] += more["iterations"]
+            stats["residuals"] += more["residuals"]
+            stats["augmentations"] = stats.get("augmentations", 0) + 1
+        unmet = getattr(sys.contact, "unmet_tolerance", None) if sys.contact is not None else None
+        if unmet:
+            text = (f"augmented Lagrangian: after {stats.get('augmentations', 0)} updates the penetration "
+                    f"is {unmet:.3g} times the requested tolerance at t = {t_next:.6g}")
+            if not self.opt.get("allow_unmet_tolerance"):
+                raise AugmentationFailed(text + " (solve(..., allow_unmet_tolerance=True) accepts it "
+                                         "with a warning)")
+            stats.setdefault("warnings", []).append(text)
+            log.warning(text)
+            warnings.warn(text, RuntimeWarning, stacklevel=4)
+        return H, r, info, stats
+
+    def _record(self, t_next, H, r, info, stats):
+        sys, sol = self.sys, self.sol
+        contact_data = None
+        if sys.contact is not None:
+            sys.contact.commit(H)
+            contact_data = sys.contact.results(H)
+        if self.opt.get("check_stability"):
+            self._stability(H, info, stats, t_next)
+        for w in stats.get("warnings", ()):
+            sol.message = w if not sol.message else sol.message + "; " + w
+        # the stepping state after this step, set together with the step (restart reads both)
+        dt = t_next - self.t
+        t, k = t_next, self.k
+        if t >= self.grid[k] - 1e-12 * self.dt_user:
+            t, k = self.grid[k], k + 1
+        easy = self.easy + 1 if stats["iterations"] <= EASY_ITERATIONS and stats["cutbacks"] == 0 else 0
+        dt = min(growth(stats["iterations"], easy) * dt, self.dt_user)
+        if sys.contact is not None:
+            sol.contact_state = contact_snapshot(sys.contact)
+        sol.append(t_next, H, sys.reactions(H, r), info["state"].sigma, info["state"].strain, stats, contact_data)
+        sol.resume = dict(t0=float(self.grid[0]), t_end=float(self.grid[-1]), steps=len(self.grid) - 1,
+                          dt=float(dt), easy=int(easy))
+        self.H, self.t, self.k, self.dt, self.easy = H, t, k, dt, easy
+        if self.writer is not None:
+            self.writer.write(sol, sol.n_steps)
+        self.progress.step(sol.n_steps, t_next, stats["dt"], stats)
+
+    def _stability(self, H, info, stats, t):
+        """Record whether the tangent at the converged state is positive definite; warn once."""
+        sys = self.sys
+        if not sys_conservative(sys):
+            stats.update(stable=None)
+            return
+        _, kvals, info_k = sys.evaluate(H, sys.load_factors(t) if len(sys.load_scales) else np.zeros(0))
+        neg, lowest = negative_eigenvalues(sys.matrix(kvals, info_k["extra"]))
+        stats.update(stable=neg == 0, negative_eigenvalues=neg, lowest_eigenvalue=lowest)
+        if neg and not self.warned_unstable:
+            self.warned_unstable = True
+            text = (f"t = {t:.6g}: the equilibrium is unstable (the tangent has {neg} negative "
+                    "eigenvalue(s)): the path has passed a limit point or bifurcation")
+            log.warning(text)
+            warnings.warn(text, StabilityWarning, stacklevel=5)
+            self.sol.message = text if not self.sol.message else self.sol.message + "; " + text
+
+    # ------------------------------------------------------------------ end
+    def _stop(self, failure, rotation_limit):
+        """Raise ``ConvergenceError`` for ``failure`` at the current step."""
+        sol = self.sol
+        hint = self.opt["advice"](failure, rotation_limit, self.H, self.t)
+        sol.converged = False
+        sol.message = str(failure)
+        err = ConvergenceError(f"solve: could not advance from t = {self.t:.6g} (step fell below "
+                               f"{self.dt_min:.3g}): {failure}{hint}", sol)
+        err.failure = failure
+        raise err from None
+
+    def abort(self, exc):
+        """Keep what converged: save it, close the output, attach ``.solution`` to ``exc``."""
+        if self.progress is not None:
+            self.progress.close()
+        sol = self.sol
+        if sol is not None:
+            _truncate(sol)
+            if not isinstance(exc, ConvergenceError):
+                sol.converged = False
+                sol.message = f"stopped by {type(exc).__name__}: {exc}" if str(exc) else \
+                    f"stopped by {type(exc).__name__}"
+            if getattr(exc, "solution", None) is None:
+                try:
+                    exc.solution = sol
+                except AttributeError:
+                    pass
+        if self.writer is not None:
+            try:
+                entries = getattr(self.writer, "entries", None)
+                if sol is not None and entries is not None and sol.n_steps not in entries:
+                    self.writer.write(sol, sol.n_steps)
+                self.writer.close()
+            except Exception as e:      # never hide the exception that ended the run
+                log.error("could not save the solution after %s: %s", type(exc).__name__, e)
+
+    def finish(self):
+        self.progress.close()
+        if self.writer is not None:
+            self.writer.close()
+        return self.sol
+
+
+def sys_conservative(system):
+    """True when the tangent of ``system`` is symmetric at equilibrium: no follower loads and
+    no friction (conservative loads, frictionless contact)."""
+    if np.any(system.load_follower) if len(system.load_nodes) else False:
+        return False
+    if system.contact is not None and any(d.mu > 0 for d in system.model.contacts):
+        return False
+    return True
+
+
+def _truncate(sol):
+    """Cut a ``Solution`` interrupted inside ``append`` back to its complete steps."""
+    names = ("_times", "_poses", "_reactions", "_sigma", "_strain", "stats", "contacts")
+    n = min(len(getattr(sol, a)) for a in names)
+    for a in names:
+        del getattr(sol, a)[n:]
