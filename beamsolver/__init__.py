@@ -1,6 +1,6 @@
 """beamsolver: quasi-static geometrically exact beams on SE(3) with frictional contact."""
 from . import contact, geometry, motion, se3
-from .errors import ConvergenceError, InputError
+from .errors import ConvergenceError, InputError, StabilityWarning
 from .io import load
 from .linear import Linearization, linearize
 from .model import Beam, Model
@@ -11,5 +11,5 @@ from .solver import Convergence, solve
 __version__ = "0.1.0"
 
 __all__ = ["Model", "Beam", "Section", "Solution", "solve", "Convergence", "InputError",
-           "ConvergenceError", "load", "linearize", "Linearization", "se3", "geometry", "motion",
+           "ConvergenceError", "StabilityWarning", "load", "linearize", "Linearization", "se3", "geometry", "motion",
            "contact", "__version__"]

@@ -27,9 +27,9 @@ def nonfinite_source(system, H, t):
         j = np.flatnonzero(~np.isfinite(lf))
         if len(j):
             ld = model.loads[int(j[0])]
-            return True, f"add_load(node {ld.node}): scale({t:.6g}) = {lf[j[0]]!r} is not finite"
+            return True, f"add_load(node {ld.node}): scale({t:.6g}) = {float(lf[j[0]])!r} is not finite"
     for node, comp, f in system.fix_values:
-        v = f(t)
+        v = float(f(t))
         if not np.isfinite(v):
             return True, f"fix(node {node}): values[{comp}]({t:.6g}) = {v!r} is not finite"
     en = system.enodes

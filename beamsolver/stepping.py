@@ -86,6 +86,12 @@ class Run:
         self.H = H
         self.progress = Progress(self.verbose, t_start, grid[-1], self.t)
 
+    def _name_nonfinite(self, t):
+        """A non-finite residual from the user's input (a load scale or motion at ``t``): InputError."""
+        found = diagnosis.nonfinite_source(self.sys, self.H, t)
+        if found is not None and found[0]:
+            raise InputError(f"solve: at t = {t:.6g} {found[1]}")
+
     def _check_finite(self, H, r, state, t):
         """Never record a non-finite state: name the input behind it (``InputError``) or fail."""
         if np.all(np.isfinite(r)) and np.all(np.isfinite(H)) and np.all(np.isfinite(state.sigma)):
@@ -127,6 +133,8 @@ class Run:
                     stats["motion_rotation"] = rot
                 return t_try, H, r, info, stats
             except StepFailed as e:
+                if isinstance(e, NonFinite):
+                    self._name_nonfinite(t_try)
                 cutbacks += 1
                 if e.rotation:
                     rotation_limit = str(e)
