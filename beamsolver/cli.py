@@ -15,7 +15,8 @@
     ``--t-end`` override it.  Output (VTU/PVD and ``solution.npz``) goes to
     ``DIR`` (default: ``<script name>_output`` in the current directory).
     Exit status 0 when every step converged, 2 on ``ConvergenceError`` (the
-    converged steps are written), 1 on bad input.
+    converged steps are written), 1 on bad input, 130 on Ctrl-C (one line; the
+    converged steps are saved, ``--restart DIR`` continues).
 ``beamsolver info RESULT [--all]``
     ``RESULT``: a ``.npz`` file or an output folder.  Prints steps, Newton
     iterations, wall time, contact force, smallest gap / largest
@@ -103,6 +104,12 @@ def cmd_run(args):
     except bs.InputError as e:
         print(f"beamsolver run: {e}", file=sys.stderr)
         return 1
+    except KeyboardInterrupt as e:
+        done = getattr(e, "solution", None)
+        at = f" at t = {done.times[-1]:.6g} ({done.n_steps} steps saved)" if done is not None else ""
+        print(f"beamsolver run: interrupted{at}; continue with: beamsolver run {script} --output {out} "
+              f"--restart {out}", file=sys.stderr)
+        return 130
     if not args.quiet:
         print(sol.summary())
         pvd = f"{out}/beams.pvd" + (f", {out}/contact.pvd" if model.contacts else "")
