@@ -10,7 +10,7 @@ from .definiteness import negative_eigenvalues
 from .element import internal_forces
 from .failures import DampingStalled, NotConverged, SingularTangent
 
-__all__ = ["nonfinite_source", "advice", "ILL_CONDITIONED"]
+__all__ = ["nonfinite_source", "advice", "stiffness_spread", "ILL_CONDITIONED"]
 
 ILL_CONDITIONED = 1e10     # ratio of scaled diagonal stiffnesses called ill-conditioned
 
@@ -58,15 +58,24 @@ def _contact_declaration(model, nodes):
     return "a contact declaration"
 
 
+def stiffness_spread(system, K):
+    """Ratio of the largest to the smallest diagonal stiffness of the free unknowns, translations
+    scaled by the model size (``K_uu L^2`` against ``K_ww``): a unit-invariant, cheap lower bound
+    of the condition number of ``K``."""
+    d = np.abs(K.diagonal())
+    is_u = (system.free_dofs % 6) < 3
+    d = np.where(is_u, d * system.length_scale**2, d)
+    return float(d.max() / d.min()) if len(d) and d.min() > 0 else np.inf
+
+
 def _tangent_state(system, H, t):
-    """``(negative eigenvalues, condition estimate)`` of the tangent at ``H`` (``None`` if unknown)."""
+    """``(negative eigenvalues, stiffness spread)`` of the tangent at ``H`` (``None`` if unknown)."""
     try:
         lf = system.load_factors(t) if len(system.load_scales) else np.zeros(0)
         _, kvals, info = system.evaluate(H, lf, tangent=True)
         K = system.matrix(kvals, info["extra"])
-        d = np.abs(K.diagonal())
-        cond = float(d.max() / d.min()) if len(d) and d.min() > 0 else np.inf
-        return negative_eigenvalues(K)[0], cond
+        spread = stiffness_spread(system, K)
+        return (negative_eigenvalues(K)[0] if np.isfinite(spread) else None), spread
     except Exception:           # advice only: never hide the failure being reported
         return None, None
 
@@ -78,7 +87,8 @@ def advice(failure, system, H, t):
     neg, cond = _tangent_state(system, H, t)
     if isinstance(failure, SingularTangent):
         if cond is not None and cond > ILL_CONDITIONED:
-            return (f"; the tangent is ill-conditioned (its diagonal stiffnesses span a ratio of {cond:.1e}): "
+            return (f"; the tangent is ill-conditioned (its diagonal stiffnesses, translations scaled by the "
+                    f"model size, span a ratio of {cond:.1e}): "
                     "stiffnesses many orders of magnitude apart (sections, penalties, supports) leave "
                     "the linear solve without significant digits")
         return "; is a rigid-body mode unconstrained?"
@@ -87,8 +97,7 @@ def advice(failure, system, H, t):
                 f"{'s' if neg > 1 else ''}): the path has passed a limit point or bifurcation, which a "
                 "force-controlled quasi-static solve cannot follow: prescribe displacements, add supports "
                 "or an imperfection")
-    if isinstance(failure, DampingStalled):
-        return ("; large rotations of slender beams need small load steps where the strain-space update "
-                "does not apply (joined, guided or supported beams): lower min_step_ratio or use more steps")
-    return ("; the tangent is positive definite at the last converged state: if a contact lost its "
-            "support or the structure snaps between steps, prescribe displacements, add supports, or refine")
+    return ("; the tangent is positive definite at the last converged state (no limit point there): large "
+            "rotations of slender beams need small load steps where the strain-space update does not apply "
+            "(joined, guided or supported beams): lower min_step_ratio or use more steps; if a contact lost "
+            "its support, add supports or prescribe displacements")

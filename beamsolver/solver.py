@@ -34,6 +34,7 @@ log = logging.getLogger("beamsolver")
 MAX_ELEMENT_ROTATION = 0.8 * np.pi   # an iterate turning an element further is rejected
 LS_GROWTH = 10.0                     # full Newton steps are kept unless the merit grows this much
 DAMPING_MIN = 1.0 / 64.0             # shortest damped Newton step (scenes without contact)
+STALL_RATIO = 1.5                    # undamped fallback if the shortest damped step grows the correction less
 MIN_STEP_RATIO = 1e-15               # smallest min_step_ratio: below, t + dt rounds to t
 ROUNDOFF = 64.0 * np.finfo(float).eps   # position round-off, relative to the distance from the origin
 
@@ -208,6 +209,7 @@ class _Newton:
         self.fu, self.fw = np.flatnonzero(fu), np.flatnonzero(~fu)
         self.L_ref = system.length_scale
         self.linsolver = linsolve.Solver()    # solve(linear_solver=...) replaces it
+        self.stall_ratio = np.inf             # correction growth of the shortest damped trial
         self.reset_timings()
 
     def reset_timings(self):
@@ -310,6 +312,17 @@ class _Newton:
             dz_c[node, comp] = dx
         return (dz_c if np.any(dz_c) else None), targets
 
+    def _reach_targets(self, H, dz, H_target, fix_values, t):
+        """The predictor update: free nodes by ``dz``, constrained ones exactly onto their targets."""
+        sys = self.sys
+        H = sys.update(H, dz)
+        if len(sys.prescribed_nodes):
+            H[sys.prescribed_nodes] = H_target
+        if fix_values:
+            sys.enforce_fixed_values(H, t)
+        sys.sync_members(H)
+        return H
+
     def step(self, H, t, H_target, t_prev=None):
         """Solve for equilibrium at ``t`` (from the equilibrium ``H`` at ``t_prev``); returns
         ``(H, r, info, stats)`` or raises a ``failures.StepFailed``.
@@ -330,6 +343,7 @@ class _Newton:
         ahead = None                 # (r, kvals, info, lu, dzf) of an accepted damped trial
         lam = 1.0
         rotation_streak = 0
+        stats_extra = {}
         for it in range(conv.max_iter + 1):
             if ahead is None:
                 r, kvals, info = self._evaluate(H, lf)
@@ -346,27 +360,21 @@ class _Newton:
             verdict = conv.decide(ratio, last_inc, it, floor, final=dz_c is None)
             if verdict == CONVERGED:
                 self._check_continuity(H_start, H)
-                stats = dict(iterations=it, residuals=residuals)
                 if damped_its:
-                    stats["damped"] = damped_its
-                return H, r, info, stats
-            if verdict == MAX_ITER:
-                raise NotConverged(f"no convergence in {conv.max_iter} iterations (scaled residual {ratio:.3g})",
-                                   ratio)
-            if verdict == DIVERGED:
-                raise Diverged(f"diverging (scaled residual {ratio:.3g})")
+                    stats_extra["damped"] = damped_its
+                self.last_tangent = (kvals, info["extra"])     # of the converged state
+                return H, r, info, dict(iterations=it, residuals=residuals, **stats_extra)
+            if verdict != CONTINUE:
+                raise (NotConverged(f"no convergence in {conv.max_iter} iterations (scaled residual {ratio:.3g})",
+                                    ratio) if verdict == MAX_ITER else
+                       Diverged(f"diverging (scaled residual {ratio:.3g})"))
             if dzf is None:
                 lu, dzf = self._direction(r, kvals, info, dz_c)
             dz = np.zeros(6 * n)
             dz[sys.free_dofs] = dzf
             dz = dz.reshape(n, 6)
             if dz_c is not None:
-                H = sys.update(H, dz + dz_c)
-                if len(sys.prescribed_nodes):
-                    H[sys.prescribed_nodes] = H_target
-                if targets:
-                    sys.enforce_fixed_values(H, t)
-                sys.sync_members(H)
+                H = self._reach_targets(H, dz + dz_c, H_target, bool(targets), t)
                 dz_c = None
                 last_inc = np.inf
                 continue
@@ -375,7 +383,21 @@ class _Newton:
                 H = self._line_search(H, dz, r, scales, lf) if self.line_search else sys.update(H, dz)
                 continue
             lam0 = min(1.0, 2.0 * lam)          # after a damped iteration, try twice its length
-            H, lam, ahead, rotation = self._damped(H, dz, dzf, lf, lam0)
+            try:
+                H, lam, ahead, rotation = self._damped(H, dz, dzf, lf, lam0)
+            except DampingStalled:
+                if not self.stall_ratio <= STALL_RATIO:
+                    raise
+                # the shortest damped step leaves the Newton correction about as it is (a flat
+                # direction, not a poor linearisation): plain Newton from here on, as on smooth
+                # stable paths past which the damping test stalls; max_iter bounds it
+                log.debug("t = %.6g: damped Newton stalled (correction ratio %.3g); undamped Newton steps", t,
+                          self.stall_ratio)
+                damping = False
+                stats_extra["undamped"] = it
+                last_inc = conv.increment_ratio(dz, self.L_ref)
+                H = sys.update(H, dz)
+                continue
             damped_its += lam < 1.0
             # the full step turned an element past the limit in two iterations running: the
             # equilibrium itself needs it (refine) rather than an overshooting iterate
@@ -410,12 +432,14 @@ class _Newton:
         failure = None
         first = True
         while True:
+            self.stall_ratio = np.inf
             H1 = sys.update(H, lam * dz)
             try:
                 r1, k1, info1 = self._evaluate(H1, lf)
                 if self._ratio(r1, conv.scales(info1, self.L_ref)) <= conv.rtol:
                     return H1, lam, (r1, k1, info1, None, None), None
                 lu1, d1 = self._direction(r1, k1, info1)
+                self.stall_ratio = self._norm(d1) / nrm
                 if self._norm(d1) < nrm or self._inc(d1) <= conv.dtol:
                     return H1, lam, (r1, k1, info1, lu1, d1), rotation
             except StepFailed as e:

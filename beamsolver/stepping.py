@@ -4,9 +4,10 @@
 shortened where a prescribed rotation would be ambiguous
 (``motion_path.limit_step``); a step whose Newton iterations fail with a
 retryable ``failures.StepFailed`` is halved down to ``dt_min`` (compared with a
-relative tolerance ``STEP_TOLERANCE``, so the smallest cut-back is tried);
-after a converged step the next one grows from the iteration count
-(``growth``), never past the user's step, and lands on the grid.  Every loop is
+relative tolerance ``STEP_TOLERANCE``, and a grown step cut back below
+``dt_min`` tries ``dt_min`` itself); after a converged step the next one grows
+from its Newton iteration count (``growth``), never past the user's step, and
+lands on the grid (no sliver shorter than ``LANDING`` steps before a grid point).  Every loop is
 bounded: each pass of the main loop advances by at least ``dt_min`` or stops.
 
 Whatever ends a run (``ConvergenceError``, Ctrl-C, an exception from a callback
@@ -32,13 +33,18 @@ __all__ = ["Run", "growth", "STEP_TOLERANCE", "EASY_ITERATIONS"]
 log = logging.getLogger("beamsolver")
 
 STEP_TOLERANCE = 1e-9      # relative rounding allowed when comparing step sizes
-EASY_ITERATIONS = 6        # a step converging within these iterations may be followed by a longer one
+LANDING = 0.1              # a step ending within this fraction of a step before a grid point lands on it
+EASY_ITERATIONS = 6        # target Newton iterations per step: fewer grow the next step (growth)
 
 
 def growth(iterations, easy):
-    """Factor for the next step after a converged one: 2 from the second easy step running on
-    (``easy`` counts them, this one included), 1 otherwise."""
-    return 2.0 if easy >= 2 else 1.0
+    """Factor for the next step after a converged one without cut-back, from its Newton
+    ``iterations``: ``EASY_ITERATIONS / iterations`` within ``[1, 2]`` (a step that took
+    ``EASY_ITERATIONS`` or more is not grown; half as many or fewer double it); ``easy`` counts
+    the steps running without cut-back (0: this one was cut back, no growth)."""
+    if easy == 0:
+        return 1.0
+    return float(np.clip(EASY_ITERATIONS / max(iterations, 1), 1.0, 2.0))
 
 
 class Run:
@@ -79,7 +85,9 @@ class Run:
             self.k = int(np.searchsorted(grid, self.t + 1e-12 * self.dt_user, side="right"))
             rs = sol.resume
             if rs.get("t0") == t_start and rs.get("t_end") == grid[-1] and rs.get("steps") == steps:
-                self.dt, self.easy = min(rs["dt"], self.dt_user), rs["easy"]
+                dt = float(rs["dt"])
+                if np.isfinite(dt) and dt >= self.dt_min * (1.0 - STEP_TOLERANCE):   # else: a bad file
+                    self.dt, self.easy = min(dt, self.dt_user), int(rs["easy"])
             if self.writer is not None:
                 for j in range(len(sol._times)):
                     self.writer.write(sol, j)
@@ -107,8 +115,8 @@ class Run:
         steps = len(grid) - 1
         while self.k <= steps:
             t_next = min(self.t + self.dt, grid[self.k])
-            if grid[self.k] - t_next < 1e-9 * self.dt_user:
-                t_next = grid[self.k]
+            if grid[self.k] - t_next < max(1e-9 * self.dt_user, LANDING * self.dt):
+                t_next = grid[self.k]           # no sliver before the grid point
             t0 = time.perf_counter()
             t_next, H, r, info, stats = self._attempt(t_next)
             stats.update(wall_time=time.perf_counter() - t0, dt=t_next - self.t)
@@ -119,7 +127,7 @@ class Run:
         t, cutbacks, rotation_limit = self.t, 0, None
         while True:
             t_try, rot = motion_path.limit_step(self.sys, t, t_next)
-            if t_try - t < self.dt_min * (1.0 - STEP_TOLERANCE):
+            if t_try < t_next and t_try - t < self.dt_min * (1.0 - STEP_TOLERANCE):
                 self._stop(StepFailed(f"a prescribed rotation turns by {rot:.3g} rad over a step of "
                                       f"{t_try - t:.3g}, more than MAX_MOTION_ROTATION = "
                                       f"{motion_path.MAX_MOTION_ROTATION:.3g} rad, even at the smallest step"),
@@ -139,6 +147,8 @@ class Run:
                 if e.rotation:
                     rotation_limit = str(e)
                 h = 0.5 * (t_try - t)
+                if self.dt_min * (1.0 + STEP_TOLERANCE) < t_try - t and h < self.dt_min:
+                    h = self.dt_min             # a grown step cut back: the smallest step is still tried
                 log.info("t = %.6g: step %.3g failed (%s); cutting back to %.3g", t_try, t_try - t, e, h)
                 if not e.retry or h < self.dt_min * (1.0 - STEP_TOLERANCE):
                     self._stop(e, rotation_limit)
@@ -176,7 +186,7 @@ class Run:
             sys.contact.commit(H)
             contact_data = sys.contact.results(H)
         if self.opt.get("check_stability"):
-            self._stability(H, info, stats, t_next)
+            self._stability(stats, t_next)
         for w in stats.get("warnings", ()):
             sol.message = w if not sol.message else sol.message + "; " + w
         # the stepping state after this step, set together with the step (restart reads both)
@@ -184,7 +194,7 @@ class Run:
         t, k = t_next, self.k
         if t >= self.grid[k] - 1e-12 * self.dt_user:
             t, k = self.grid[k], k + 1
-        easy = self.easy + 1 if stats["iterations"] <= EASY_ITERATIONS and stats["cutbacks"] == 0 else 0
+        easy = self.easy + 1 if stats["cutbacks"] == 0 else 0
         dt = min(growth(stats["iterations"], easy) * dt, self.dt_user)
         if sys.contact is not None:
             sol.contact_state = contact_snapshot(sys.contact)
@@ -196,14 +206,14 @@ class Run:
             self.writer.write(sol, sol.n_steps)
         self.progress.step(sol.n_steps, t_next, stats["dt"], stats)
 
-    def _stability(self, H, info, stats, t):
+    def _stability(self, stats, t):
         """Record whether the tangent at the converged state is positive definite; warn once."""
         sys = self.sys
         if not sys_conservative(sys):
             stats.update(stable=None)
             return
-        _, kvals, info_k = sys.evaluate(H, sys.load_factors(t) if len(sys.load_scales) else np.zeros(0))
-        neg, lowest = negative_eigenvalues(sys.matrix(kvals, info_k["extra"]))
+        kvals, extra = self.newton.last_tangent
+        neg, lowest = negative_eigenvalues(sys.matrix(kvals, extra))
         stats.update(stable=neg == 0, negative_eigenvalues=neg, lowest_eigenvalue=lowest)
         if neg and not self.warned_unstable:
             self.warned_unstable = True

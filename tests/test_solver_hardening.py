@@ -210,3 +210,100 @@ def test_failures_are_typed_and_timings_recorded():
     sol = bs.solve(m, steps=2, verbose=False)
     t = sol.stats[-1]["timings"]
     assert set(t) == {"assembly", "contact", "linear_solve"} and t["assembly"] > 0 and t["linear_solve"] > 0
+
+
+# ------------------------------------------------------------------ item 8: damped Newton stall
+def _argyris_frame(F, imperfection=1e-4, n=4):
+    """Argyris' right-angle frame (legs 240 mm, section 30 x 0.6 mm, E = 71240 N/mm^2), clamped at
+    one end, in-plane tip force ``F`` (N) with an out-of-plane ``imperfection * F``; lateral
+    buckling near F = 1.09 N."""
+    m = bs.Model()
+    sec = bs.Section.rectangular(width=0.6, height=30.0, E=71240.0, nu=0.31)
+    a = m.add_beam(bs.geometry.straight((0, 0, 0), (0, 240, 0), n, e2=(0, 0, 1)), sec)
+    b = m.add_beam(bs.geometry.straight((0, 240, 0), (240, 240, 0), n, e2=(0, 0, 1)), sec)
+    m.join(a.last, b.first)
+    m.clamp(a.first)
+    m.add_load(b.last, force=(0, F, imperfection * F))
+    return m, b
+
+
+def test_argyris_frame_on_the_unstable_side_is_flagged():
+    """Undamped Newton in one step to 1.5 N lands on the flat, unstable branch of the imperfect
+    frame (tip barely out of plane): a converged but unstable equilibrium, now flagged."""
+    m, b = _argyris_frame(1.5)
+    with pytest.warns(bs.StabilityWarning):
+        sol = bs.solve(m, steps=1, verbose=False, line_search=False, check_stability=True)
+    assert abs(sol.position(b.last)[2]) < 0.1 and sol.stats[-1]["stable"] is False
+
+
+def test_damped_newton_falls_back_to_newton_past_the_argyris_buckling_load():
+    """Before: "damped Newton stalled" at F = 1.093 N with a positive definite tangent.  Now the
+    stable imperfect path is followed past the buckling load, every step stable."""
+    m, b = _argyris_frame(1.1)
+    sol = bs.solve(m, steps=11, verbose=False, check_stability=True)
+    assert sol.times[-1] == 1.0 and all(s["stable"] for s in sol.stats[1:])
+    assert sol.position(b.last)[2] > 10.0                      # buckled sideways
+    assert any("undamped" in s for s in sol.stats)
+
+
+# ------------------------------------------------------------------ item 14: messages
+def test_failure_advice_reads_the_tangent():
+    """A failure after an unstable equilibrium says the tangent is indefinite (a limit point or
+    bifurcation), not "lower min_step_ratio"; after a stable one it says it is positive definite."""
+    from beamsolver import diagnosis
+    for factor, expect in ((2.0, "already indefinite"), (0.5, "positive definite")):
+        model = _column(factor)
+        sol = bs.solve(model, steps=1, verbose=False)
+        advice = diagnosis.advice(failures.NotConverged("no convergence"), sol.system, sol.poses[-1], 1.0)
+        assert expect in advice and ("min_step_ratio" in advice) == (factor < 1)
+
+
+def _two_stiffnesses(ratio, unit=1.0):
+    """Two joined steel beams, the second ``ratio`` times softer; lengths in metres / ``unit``."""
+    m = bs.Model()
+    sec = bs.Section.circular(radius=0.01 * unit, E=2e11 / unit**2)
+    soft = bs.Section.circular(radius=0.01 * unit, E=2e11 / unit**2 / ratio)
+    a = m.add_beam(bs.geometry.straight((0, 0, 0), (0.5 * unit, 0, 0), 4), sec)
+    b = m.add_beam(bs.geometry.straight((0.5 * unit, 0, 0), (unit, 0, 0), 4), soft)
+    m.join(a.last, b.first)
+    m.clamp(a.first)
+    return m
+
+
+def test_singular_tangent_advice_tells_ill_conditioning_from_a_free_mode():
+    from beamsolver import diagnosis
+    from beamsolver.assembly import System
+    for ratio, expect in ((1.0, "rigid-body mode"), (1e12, "ill-conditioned")):
+        system = System(_two_stiffnesses(ratio))
+        assert expect in diagnosis.advice(failures.SingularTangent("singular"), system, system.poses0, 0.0)
+    # units do not change the estimate: the same scene in millimetres
+    spread = []
+    for unit in (1.0, 1e3):
+        s = System(_two_stiffnesses(1.0, unit))
+        spread.append(diagnosis.stiffness_spread(s, s.matrix(s.evaluate(s.poses0, np.zeros(0))[1])))
+    assert spread[0] == pytest.approx(spread[1], rel=1e-9) and spread[0] < diagnosis.ILL_CONDITIONED
+
+
+def test_an_unconstrained_beam_is_reported_as_such():
+    m = bs.Model()
+    b = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 4), bs.Section.circular(radius=0.01, E=2e11))
+    m.add_load(b.last, force=(0, 0, 1.0))
+    with pytest.raises(bs.ConvergenceError, match="rigid-body mode") as err:
+        bs.solve(m, steps=1, check_rigid_modes=False, verbose=False)
+    assert isinstance(err.value.failure, failures.SingularTangent)
+
+
+def test_a_restart_state_with_a_zero_step_does_not_hang():
+    """``resume["dt"] = 0`` (a hand-edited or corrupt file) made the stepping loop spin for ever."""
+    m, b, _ = _rod(4)
+    m.add_load(b.last, force=(0, 0, 1e3))
+
+    def stop(info):
+        if info["t"] > 0.55:
+            raise KeyboardInterrupt
+    with pytest.raises(KeyboardInterrupt) as err:
+        bs.solve(m, steps=4, callback=stop, verbose=False)
+    part = err.value.solution
+    part.resume["dt"] = 0.0
+    sol = bs.solve(m, steps=4, restart=part, verbose=False)
+    assert sol.n_steps == 4 and sol.times[-1] == 1.0

@@ -1,0 +1,77 @@
+"""Overhead of ``solve(..., check_stability=True)``: the negative eigenvalues of the tangent per step.
+
+Each scene is solved with and without the check, alternately, ``REPEATS`` times;
+the table gives the median wall time of each and their ratio, and the largest
+number of unknowns (dense LAPACK up to ``definiteness.DENSE_MAX``, shifted
+Lanczos above).  Prints a Markdown table; nothing is written.
+
+    python benchmarks/stability_check.py [--quick]
+"""
+import sys
+import time
+
+import numpy as np
+
+import beamsolver as bs
+
+REPEATS = 3
+
+
+def cantilever(n, force=2e3):
+    """Clamped steel cantilever of ``n`` elements, dead tip force (strain-space update)."""
+    m = bs.Model()
+    b = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), n), bs.Section.circular(radius=0.01, E=2e11))
+    m.clamp(b.first)
+    m.add_load(b.last, force=(0, 0, force))
+    return m
+
+
+def joined(n, force=2e3):
+    """The same cantilever made of two joined beams (plain Newton updates, damped)."""
+    m = bs.Model()
+    sec = bs.Section.circular(radius=0.01, E=2e11)
+    a = m.add_beam(bs.geometry.straight((0, 0, 0), (0.5, 0, 0), n // 2), sec)
+    b = m.add_beam(bs.geometry.straight((0.5, 0, 0), (1, 0, 0), n // 2), sec)
+    m.join(a.last, b.first)
+    m.clamp(a.first)
+    m.add_load(b.last, force=(0, 0, force))
+    return m
+
+
+def column(n):
+    """Clamped column under 0.9 times its Euler load (stable, lowest eigenvalue near zero)."""
+    m = bs.Model()
+    sec = bs.Section.circular(radius=0.01, E=2e11)
+    b = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), n), sec)
+    m.clamp(b.first)
+    m.add_load(b.last, force=(-0.9 * np.pi**2 * sec.C[4, 4] / 4, 0, 1.0))
+    return m
+
+
+def timed(build, steps, check):
+    model = build()
+    t0 = time.perf_counter()
+    sol = bs.solve(model, steps=steps, verbose=False, check_stability=check)
+    return time.perf_counter() - t0, sol
+
+
+def main(quick=False):
+    sizes = (16, 256) if quick else (16, 128, 1024)
+    rows = []
+    for name, fn in (("cantilever", cantilever), ("joined cantilever", joined), ("column 0.9 P_E", column)):
+        for n in sizes:
+            plain, checked = [], []
+            for _ in range(1 if quick else REPEATS):
+                plain.append(timed(lambda: fn(n), 8, False)[0])
+                t, sol = timed(lambda: fn(n), 8, True)
+                checked.append(t)
+            stable = all(s["stable"] for s in sol.stats[1:])
+            rows.append((name, n, 6 * n, np.median(plain), np.median(checked), stable))
+    print("| scene | elements | unknowns | solve [s] | with check [s] | ratio | all stable |")
+    print("|---|---:|---:|---:|---:|---:|---|")
+    for name, n, dofs, a, b, stable in rows:
+        print(f"| {name} | {n} | {dofs} | {a:.3f} | {b:.3f} | {b / a:.2f} | {stable} |")
+
+
+if __name__ == "__main__":
+    main(quick="--quick" in sys.argv)
