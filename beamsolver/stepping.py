@@ -38,12 +38,14 @@ EASY_ITERATIONS = 6        # target Newton iterations per step: fewer grow the n
 
 
 def growth(iterations, easy):
-    """Factor for the next step after a converged one without cut-back, from its Newton
-    ``iterations``: ``EASY_ITERATIONS / iterations`` within ``[1, 2]`` (a step that took
-    ``EASY_ITERATIONS`` or more is not grown; half as many or fewer double it); ``easy`` counts
-    the steps running without cut-back (0: this one was cut back, no growth)."""
+    """Factor for the next step after a converged one, from its Newton ``iterations``:
+    ``EASY_ITERATIONS / iterations`` within ``[1, 2]``, and 2 from the second step running that
+    took at most ``EASY_ITERATIONS``; ``easy`` counts the steps running without cut-back, this
+    one included (0: it was cut back, no growth)."""
     if easy == 0:
         return 1.0
+    if easy >= 2 and iterations <= EASY_ITERATIONS:
+        return 2.0
     return float(np.clip(EASY_ITERATIONS / max(iterations, 1), 1.0, 2.0))
 
 

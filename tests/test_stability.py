@@ -129,10 +129,14 @@ def test_newton_without_strain_space_update_converges_on_slender_beams():
     assert float(r["accuracy"].split("circle error ")[1].split(" ")[0]) < 1e-9
 
 
-def test_extreme_slenderness_without_strain_space_update_stops_clearly():
+@pytest.mark.slow
+def test_extreme_slenderness_without_strain_space_update_reaches_the_circle():
+    """L/R = 1e5 through a joint.  Until issue 12 item 8 the damped Newton stalled on a flat
+    direction and the solve stopped (this test asserted that clear stop); with the undamped
+    fallback the default min_step_ratio reaches the exact circle (about 1800 steps)."""
     r = S.case_slender_joined_refused(1e5)
-    assert r["outcome"].startswith("ConvergenceError") and "min_step_ratio" in r["outcome"]
-    assert r["wall"] < 10.0
+    assert r["outcome"] == "converged"
+    assert float(r["accuracy"].split("circle error ")[1].split(" ")[0]) < 1e-9
 
 
 def test_guided_roll_up_cuts_back_and_regrows():
