@@ -5,8 +5,8 @@ shortened where a prescribed rotation would be ambiguous
 (``motion_path.limit_step``); a step whose Newton iterations fail with a
 retryable ``failures.StepFailed`` is halved down to ``dt_min`` (compared with a
 relative tolerance ``STEP_TOLERANCE``, and a grown step cut back below
-``dt_min`` tries ``dt_min`` itself); after a converged step the next one grows
-from its Newton iteration count (``growth``), never past the user's step, and
+``dt_min`` tries ``dt_min`` itself); after two easy steps running the next one
+grows (``growth``), never past the user's step, and
 lands on the grid (no sliver shorter than ``LANDING`` steps before a grid point).  Every loop is
 bounded: each pass of the main loop advances by at least ``dt_min`` or stops.
 
@@ -34,19 +34,14 @@ log = logging.getLogger("beamsolver")
 
 STEP_TOLERANCE = 1e-9      # relative rounding allowed when comparing step sizes
 LANDING = 0.1              # a step ending within this fraction of a step before a grid point lands on it
-EASY_ITERATIONS = 6        # target Newton iterations per step: fewer grow the next step (growth)
+EASY_ITERATIONS = 6        # a step converging within these iterations is easy (growth)
 
 
 def growth(iterations, easy):
-    """Factor for the next step after a converged one, from its Newton ``iterations``:
-    ``EASY_ITERATIONS / iterations`` within ``[1, 2]``, and 2 from the second step running that
-    took at most ``EASY_ITERATIONS``; ``easy`` counts the steps running without cut-back, this
-    one included (0: it was cut back, no growth)."""
-    if easy == 0:
-        return 1.0
-    if easy >= 2 and iterations <= EASY_ITERATIONS:
-        return 2.0
-    return float(np.clip(EASY_ITERATIONS / max(iterations, 1), 1.0, 2.0))
+    """Factor for the next step after a converged one: 2 from the second step running that took
+    at most ``EASY_ITERATIONS`` Newton iterations without cut-back (``easy`` counts them, this
+    one included), else 1."""
+    return 2.0 if easy >= 2 else 1.0
 
 
 class Run:
@@ -196,7 +191,7 @@ class Run:
         t, k = t_next, self.k
         if t >= self.grid[k] - 1e-12 * self.dt_user:
             t, k = self.grid[k], k + 1
-        easy = self.easy + 1 if stats["cutbacks"] == 0 else 0
+        easy = self.easy + 1 if stats["iterations"] <= EASY_ITERATIONS and stats["cutbacks"] == 0 else 0
         dt = min(growth(stats["iterations"], easy) * dt, self.dt_user)
         if sys.contact is not None:
             sol.contact_state = contact_snapshot(sys.contact)
