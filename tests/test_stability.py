@@ -129,14 +129,38 @@ def test_newton_without_strain_space_update_converges_on_slender_beams():
     assert float(r["accuracy"].split("circle error ")[1].split(" ")[0]) < 1e-9
 
 
-@pytest.mark.slow
-def test_extreme_slenderness_without_strain_space_update_reaches_the_circle():
+class _Far(Exception):
+    pass
+
+
+def test_extreme_slenderness_without_strain_space_update_passes_where_it_stopped():
     """L/R = 1e5 through a joint.  Until issue 12 item 8 the damped Newton stalled on a flat
-    direction and the solve stopped (this test asserted that clear stop); with the undamped
-    fallback the default min_step_ratio reaches the exact circle (about 1800 steps)."""
-    r = S.case_slender_joined_refused(1e5)
-    assert r["outcome"] == "converged"
-    assert float(r["accuracy"].split("circle error ")[1].split(" ")[0]) < 1e-9
+    direction and the solve stopped at t = 0.021 (this test asserted that clear stop); with the
+    undamped fallback it goes on (the whole run reaches the exact circle in ~1800 steps,
+    ``benchmarks/stability.py``).  Checked here up to t = 0.05: the shape is the exact circle of
+    the moment reached (a follower end moment: a circle at every t)."""
+    L, ratio, n, turns = 1.0, 1e5, 16, 0.25
+    sec = S.bs.Section.circular(radius=L / ratio, E=210e9, nu=0.3)
+    m = S.bs.Model()
+    b1 = m.add_beam(S.bs.geometry.straight((0, 0, 0), (L / 2, 0, 0), n // 2), sec)
+    b2 = m.add_beam(S.bs.geometry.straight((L / 2, 0, 0), (L, 0, 0), n // 2), sec)
+    m.join(b1.last, b2.first)
+    m.clamp(b1.first)
+    m.add_load(b2.last, moment=(0, 0, turns * 2 * np.pi * sec.C[5, 5] / L), follower=True)
+
+    def stop(info):                    # first attempts go to t = 1, 0.5, ..., 0.0625: stop once past 0.05
+        if 0.05 < info["t"] < 0.06:
+            raise _Far
+    with pytest.raises(_Far) as err:
+        S.bs.solve(m, steps=1, verbose=False, callback=stop)
+    sol = err.value.solution
+    t = sol.times[-1]
+    assert 0.04 < t <= 0.05
+    x = np.concatenate([sol.poses[-1][b1.nodes, :3, 3], sol.poses[-1][b2.nodes[1:], :3, 3]])
+    rho = L / (2 * np.pi * turns * t)
+    phi = np.linspace(0.0, L, n + 1) / rho
+    exact = np.stack([rho * np.sin(phi), rho * (1 - np.cos(phi)), 0 * phi], axis=1)
+    assert np.linalg.norm(x - exact, axis=1).max() < 1e-9 * L
 
 
 def test_guided_roll_up_cuts_back_and_regrows():
