@@ -1,20 +1,22 @@
 """Is a tangent positive definite?  Negative eigenvalues of the symmetric part, counted cheaply.
 
 The tangent ``K`` (free x free, sparse) mixes forces and moments, so it is
-first scaled symmetrically, ``D K D`` with ``D = |diag K|^-1/2`` (a congruence:
-the signs of the eigenvalues -- Sylvester's inertia -- are unchanged, and the
-spectrum becomes dimensionless).  Up to ``DENSE_MAX`` unknowns all eigenvalues
-are computed (LAPACK); above, the ``k`` eigenvalues nearest zero by a shifted
-Lanczos (``scipy.sparse.linalg.eigsh``, shift-invert about ``-SHIFT``): a lower
-bound of the count, exact while fewer than ``k`` eigenvalues have crossed zero,
-which is what a path following test needs.
+first scaled symmetrically, ``A = D K D`` with ``D = |diag K|^-1/2`` (a
+congruence: the signs of the eigenvalues -- Sylvester's inertia -- are
+unchanged, and the spectrum becomes dimensionless).  Up to ``DENSE_MAX``
+unknowns a Cholesky factorisation of ``A`` decides (it exists exactly when
+``A`` is positive definite); only when it fails are the eigenvalues computed
+(LAPACK).  Above, the inertia is read from a sparse LDL^T: SuperLU with
+diagonal pivots only (``SymmetricMode``), whose pivots are ``D``; should it
+pivot off the diagonal, the ``k`` eigenvalues nearest zero by a shifted
+Lanczos (``eigsh``) give a lower bound of the count instead.
 """
 import numpy as np
 import scipy.sparse as sp
 
 __all__ = ["negative_eigenvalues", "DENSE_MAX", "SHIFT"]
 
-DENSE_MAX = 600          # unknowns up to which all eigenvalues are computed
+DENSE_MAX = 600          # unknowns up to which the dense factorisations are used
 SHIFT = 1e-6             # Lanczos shift (scaled units) below zero: K itself may be singular
 ZERO = 1e-10             # scaled eigenvalues above -ZERO count as non-negative (round-off)
 
@@ -29,16 +31,27 @@ def _scaled_symmetric(K):
 
 
 def negative_eigenvalues(K, k=6):
-    """``(count, lowest)``: number of negative eigenvalues of the symmetric part of ``K`` (all of
-    them up to ``DENSE_MAX`` unknowns, else among the ``k`` nearest zero) and the lowest one
-    found, both of the Jacobi-scaled matrix ``D K D``."""
+    """``(count, lowest)``: the number of negative eigenvalues of the symmetric part of ``K`` and
+    the lowest eigenvalue of the scaled ``D K D`` (``None`` where it was not needed: positive
+    definite, or read from a factorisation)."""
     n = K.shape[0]
     if n == 0:
-        return 0, np.inf
+        return 0, None
     A = _scaled_symmetric(K)
     if n <= DENSE_MAX:
-        lam = np.linalg.eigvalsh(A.toarray())
-    else:
-        from scipy.sparse.linalg import eigsh
-        lam = eigsh(A, k=min(k, n - 2), sigma=-SHIFT, which="LM", return_eigenvectors=False)
+        Ad = A.toarray()
+        try:
+            np.linalg.cholesky(Ad)
+            return 0, None
+        except np.linalg.LinAlgError:
+            lam = np.linalg.eigvalsh(Ad)
+            return int(np.sum(lam < -ZERO)), float(lam.min())
+    from scipy.sparse.linalg import eigsh, splu
+    try:
+        lu = splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
+        if np.array_equal(lu.perm_r, lu.perm_c):
+            return int(np.sum(lu.U.diagonal() < -ZERO)), None
+    except RuntimeError:        # an exactly zero pivot: decide by the eigenvalues
+        pass
+    lam = eigsh(A, k=min(k, n - 2), sigma=-SHIFT, which="LM", return_eigenvectors=False)
     return int(np.sum(lam < -ZERO)), float(lam.min())
