@@ -58,4 +58,5 @@ class AugmentationFailed(StepFailed):
 
 
 class MotionTooFast(StepFailed):
-    """A prescribed motion turns too far within the step to be followed unambiguously."""
+    """A prescribed motion turns by more than ``MAX_MOTION_ROTATION`` even over the smallest step."""
+    retry = False

@@ -23,7 +23,7 @@ import numpy as np
 from . import diagnosis, motion_path
 from .definiteness import negative_eigenvalues
 from .errors import ConvergenceError, InputError, StabilityWarning
-from .failures import AugmentationFailed, NonFinite, StepFailed
+from .failures import AugmentationFailed, MotionTooFast, NonFinite, StepFailed
 from .progress import Progress
 from .restart import contact_snapshot
 from .results import Solution
@@ -154,7 +154,7 @@ class Run:
         while True:
             t_try, rot = motion_path.limit_step(self.sys, t, t_next)
             if t_try < t_next and t_try - t < self.dt_min * (1.0 - STEP_TOLERANCE):
-                self._stop(StepFailed(f"a prescribed rotation turns by {rot:.3g} rad over a step of "
+                self._stop(MotionTooFast(f"a prescribed rotation turns by {rot:.3g} rad over a step of "
                                       f"{t_try - t:.3g}, more than MAX_MOTION_ROTATION = "
                                       f"{motion_path.MAX_MOTION_ROTATION:.3g} rad, even at the smallest step"),
                            rotation_limit)

@@ -307,3 +307,11 @@ def test_a_restart_state_with_a_zero_step_does_not_hang():
     part.resume["dt"] = 0.0
     sol = bs.solve(m, steps=4, restart=part, verbose=False)
     assert sol.n_steps == 4 and sol.times[-1] == 1.0
+
+
+def test_a_motion_too_fast_for_the_smallest_step_is_refused_at_once():
+    m, b, _ = _rod(8)
+    m.prescribe(b.last, bs.motion.rotation((1, 0, 0), 1e6))     # 1e6 rad in one step
+    with pytest.raises(bs.ConvergenceError, match="MAX_MOTION_ROTATION") as err:
+        bs.solve(m, steps=1, verbose=False)
+    assert isinstance(err.value.failure, failures.MotionTooFast) and err.value.solution.n_steps == 0
