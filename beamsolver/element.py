@@ -34,6 +34,7 @@ computed once on the doubled batch ``[-h | h]`` (node A, then node B):
 ``f_A = -g(h)``, ``f_B = g(-h)`` with ``g(h) = T(-h)^-T sigma = [Ti n; X n + Ti m]``,
 and the columns of ``B`` for node A (B) are ``-T(-h)^-1`` (``T(h)^-1``).
 """
+from functools import partial
 from typing import NamedTuple
 
 import numpy as np
@@ -42,7 +43,8 @@ from . import se3
 from .se3 import coefficient
 
 __all__ = ["ElementState", "element_state", "reference_strain", "energy",
-           "internal_forces", "internal_forces_and_tangent", "CHUNK"]
+           "internal_forces", "internal_forces_and_tangent", "internal_forces_numpy",
+           "internal_forces_and_tangent_numpy", "CHUNK"]
 
 # elements per chunk, measured (benchmarks/element_throughput.py): larger chunks amortise the
 # per-call overhead of numpy, beyond ~8k the temporaries fall out of the cache
@@ -63,19 +65,14 @@ def reference_strain(H_A, H_B):
 
 
 # ---------------------------------------------------------------- batch-last algebra
-def _cross(a, b):
-    """Cross product over axis 0 (trailing axes broadcast)."""
-    return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+_cross = partial(se3.cross, axis=0)   # vectors (3, m), element axis last
+_dot = partial(se3.dot, axis=0)
 
 
 def _crosses(a, *vs):
     """``a x v`` for each ``v`` in one operation."""
     r = _cross(a, np.stack(vs, axis=1))
     return [r[:, i] for i in range(len(vs))]
-
-
-def _dot(a, b):
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
 def _mm(A, B):
@@ -129,73 +126,15 @@ def _q_mat(u, w, wu, a, t2, c1, c2, c3):
 # ---------------------------------------------------------------- coefficients
 FORCE_COEFFICIENTS = ("c", "q2", "q3")
 TANGENT_COEFFICIENTS = ("c", "q2", "q3", "dp", "cp", "q2p", "q3p")
-_SERIES_TABLE = {names: np.array([se3._SERIES[k] for k in names]).T[:, :, None]
-                 for names in (FORCE_COEFFICIENTS, TANGENT_COEFFICIENTS)}
-
-
-def _coefficients(names, t):
-    """``{name: se3.coefficient(name, t)}`` for several names at once.
-
-    The series (the same as ``se3.coefficient``'s, evaluated the same way) run
-    as one stacked Horner scheme; only angles at or above a coefficient's
-    switch point (elements turning by more than ~0.75 rad) call
-    ``se3.coefficient`` for the closed form.
-    """
-    table = _SERIES_TABLE[names]
-    t2 = t * t
-    series = np.repeat(table[-1], len(t), axis=-1)
-    for row in table[-2::-1]:
-        series = series * t2 + row
-    out = dict(zip(names, series))
-    for name in names:
-        big = np.flatnonzero(t >= se3.SWITCH[name])
-        if len(big):
-            out[name] = out[name].copy()
-            out[name][big] = coefficient(name, t[big])
-    return out
 
 
 # ---------------------------------------------------------------- relative pose and log
-def _split(H):
-    """Rotation (3, 3, m) and position (3, m) of poses (m, 4, 4), element axis last."""
-    T = np.ascontiguousarray(H[:, :3, :].transpose(1, 2, 0))
-    return T[:, :3], T[:, 3]
-
-
 def _log_relative(HA, HB):
-    """``log(H_A^-1 H_B)`` as ``u, w`` (3, m), and ``t = |w|``, ``d`` (coefficient of ``Ti``).
-
-    Rotation vector through the unit quaternion (Shepperd's choice of the
-    largest component, as ``se3.log_so3``: nothing divides by ``sin t``).
-    """
-    RA, xA = _split(HA)
-    RB, xB = _split(HB)
-    R = np.einsum("kim,kjm->ijm", RA, RB)
-    x = np.einsum("kim,km->im", RA, xB - xA)
-    r00, r11, r22 = R[0, 0], R[1, 1], R[2, 2]
-    tr = r00 + r11 + r22
-    q = np.stack([1.0 + tr, R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
-    other = np.flatnonzero((r00 > tr) | (r11 > tr) | (r22 > tr))
-    if len(other):   # rotations beyond ~120 degrees: a diagonal element leads
-        q[:, other] = se3._quaternion(R[:, :, other].transpose(2, 0, 1)).T
-    q *= 1.0 / np.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
-    qw, qv = q[0], q[1:]
-    s = np.sqrt(_dot(qv, qv))
-    small = s < 0.1 * qw
-    qs = np.where(small, qw, 1.0)
-    x2 = np.where(small, s / qs, 0.0) ** 2
-    series = np.full_like(x2, 1.0 / 17.0)
-    for k in range(7, -1, -1):
-        series = series * x2 + (-1) ** k / (2 * k + 1)
-    factor = 2.0 * series / qs
-    if not small.all():
-        with np.errstate(invalid="ignore", divide="ignore"):
-            factor = np.where(small, factor, 2.0 * np.arctan2(s, qw) / np.where(small, 1.0, s))
-    w = factor * qv
+    """``log(H_A^-1 H_B)`` as ``u, w`` (3, m), and ``t = |w|``, ``d`` (coefficient of ``Ti``)."""
+    h = se3.log_relative(HA, HB).T
+    u, w = h[:3], h[3:]
     t = np.sqrt(_dot(w, w))
-    d = coefficient("d", t)
-    u = _ti(w, d, x, -1.0)     # T_SO3(w)^-T x
-    return u, w, t, d
+    return u, w, t, coefficient("d", t)
 
 
 # ---------------------------------------------------------------- geometric stiffness
@@ -284,7 +223,7 @@ def _chunk(HA, HB, L, eps0, C, tangent, K_out):
     else:
         sigma = np.einsum("ijm,jm->im", C.transpose(1, 2, 0), de)
     k = {name: _twice(v) for name, v in
-         _coefficients(TANGENT_COEFFICIENTS if tangent else FORCE_COEFFICIENTS, t).items()}
+         se3.coefficients(TANGENT_COEFFICIENTS if tangent else FORCE_COEFFICIENTS, t).items()}
     c1, c2, c3 = k["c"], k["q2"], k["q3"]
     # doubled batch [-h | h]: node A quantities first, node B second
     u2, w2, d2 = np.concatenate([-u, u], axis=1), np.concatenate([-w, w], axis=1), _twice(d)
@@ -343,9 +282,25 @@ def _evaluate(H_A, H_B, L, eps0, C, tangent, out=None):
     return f, (K.transpose(2, 0, 1) if tangent else None), ElementState(h, strain, sigma)
 
 
+def _evaluate_compiled(H_A, H_B, L, eps0, C, tangent, out=None):
+    """The compiled path (``element_jit``): same outputs as ``_evaluate``."""
+    from . import element_jit   # numba compiles (or loads its cache) on first use
+    n = len(L)
+    H_A, H_B, L, eps0, C = (np.ascontiguousarray(x, dtype=float) for x in (H_A, H_B, L, eps0, C))
+    f = np.empty((n, 12))
+    h, strain, sigma = np.empty((n, 6)), np.empty((n, 6)), np.empty((n, 6))
+    K = np.empty((12, 12, 0))
+    if tangent:
+        K = np.empty((12, 12, n)) if out is None else out
+        if K.shape != (12, 12, n):
+            raise ValueError(f"out must have shape (12, 12, {n}), got {K.shape}")
+    element_jit.evaluate(H_A, H_B, L, eps0, C, element_jit.is_diagonal(C), tangent, f, h, strain, sigma, K)
+    return f, (K.transpose(2, 0, 1) if tangent else None), ElementState(h, strain, sigma)
+
+
 def element_state(H_A, H_B, L, eps0, C):
     """``ElementState`` (relative twist, strain, section forces) per element."""
-    return _evaluate(H_A, H_B, L, eps0, C, tangent=False)[2]
+    return _evaluate_compiled(H_A, H_B, L, eps0, C, tangent=False)[2]
 
 
 def energy(H_A, H_B, L, eps0, C):
@@ -357,7 +312,7 @@ def energy(H_A, H_B, L, eps0, C):
 
 def internal_forces(H_A, H_B, L, eps0, C):
     """Body-frame nodal forces ``(n, 12)`` (A then B) and the ``ElementState``."""
-    f, _, state = _evaluate(H_A, H_B, L, eps0, C, tangent=False)
+    f, _, state = _evaluate_compiled(H_A, H_B, L, eps0, C, tangent=False)
     return f, state
 
 
@@ -367,6 +322,19 @@ def internal_forces_and_tangent(H_A, H_B, L, eps0, C, out=None):
     The tangent is ``d f / d q`` for body increments ``q = (q_A, q_B)``
     (``H <- H exp(hat(q))``), material and geometric parts, exact.  It is a
     view of an element-axis-last array (see the module docstring): ``out``,
-    if given, an array ``(12, 12, n)`` to write it into.
+    if given, an array ``(12, 12, n)`` to write it into.  Compiled
+    (``element_jit``); ``internal_forces_and_tangent_numpy`` is the numpy
+    version, kept as the test oracle.
     """
+    return _evaluate_compiled(H_A, H_B, L, eps0, C, tangent=True, out=out)
+
+
+def internal_forces_numpy(H_A, H_B, L, eps0, C):
+    """``internal_forces`` by the batched numpy kernel (the oracle of the compiled one)."""
+    f, _, state = _evaluate(H_A, H_B, L, eps0, C, tangent=False)
+    return f, state
+
+
+def internal_forces_and_tangent_numpy(H_A, H_B, L, eps0, C, out=None):
+    """``internal_forces_and_tangent`` by the batched numpy kernel (the oracle of the compiled one)."""
     return _evaluate(H_A, H_B, L, eps0, C, tangent=True, out=out)

@@ -17,14 +17,16 @@ agree to round-off; ``tests/test_se3_coefficients.py`` sweeps them against
 import numpy as np
 
 __all__ = [
+    "SERIES", "SWITCH", "COEFFICIENT_NAMES", "coefficient", "coefficients", "cross", "dot",
     "skew", "unskew", "hat", "vee", "exp_so3", "log_so3", "tangent_so3",
     "tangent_inv_so3", "exp", "log", "tangent", "tangent_inv", "adjoint",
-    "inverse", "compose", "interpolate", "rotation_angle",
+    "inverse", "compose", "relative", "interpolate", "rotation_angle", "log_relative",
+    "log_and_tangent_inv", "quaternion",
 ]
 
 # ---------------------------------------------------------------- coefficients
 # Series coefficients in powers of t^2 (exact rationals, computed with sympy).
-_SERIES = {
+SERIES = {
     "a": [1, -1 / 6, 1 / 120, -1 / 5040, 1 / 362880, -1 / 39916800,
           1 / 6227020800, -1 / 1307674368000, 1 / 355687428096000],
     "b": [1 / 2, -1 / 24, 1 / 720, -1 / 40320, 1 / 3628800, -1 / 479001600,
@@ -118,7 +120,7 @@ def coefficient(name, t):
     """Evaluate the named singular coefficient at angles ``t >= 0`` (any shape)."""
     t = _arr(t)
     t2 = t * t
-    coeffs = _SERIES[name]
+    coeffs = SERIES[name]
     series = np.full_like(t2, coeffs[-1])
     for c in coeffs[-2::-1]:
         series = series * t2 + c
@@ -127,6 +129,31 @@ def coefficient(name, t):
     with np.errstate(invalid="ignore", divide="ignore"):
         closed = _CLOSED[name](safe)
     return np.where(small, series, closed)
+
+
+COEFFICIENT_NAMES = tuple(SERIES)
+
+
+def coefficients(names, t):
+    """``{name: coefficient(name, t)}`` for several names at once, ``t`` of shape ``(m,)``.
+
+    The series run as one stacked Horner scheme (the same values as
+    ``coefficient``); only angles at or above a coefficient's switch point call
+    ``coefficient`` for the closed form.
+    """
+    t = _arr(t)
+    table = np.array([SERIES[k] for k in names]).T[:, :, None]
+    t2 = t * t
+    series = np.repeat(table[-1], len(t), axis=-1)
+    for row in table[-2::-1]:
+        series = series * t2 + row
+    out = dict(zip(names, series))
+    for name in names:
+        big = np.flatnonzero(t.real >= SWITCH[name])
+        if len(big):
+            out[name] = out[name].copy()
+            out[name][big] = coefficient(name, t[big])
+    return out
 
 
 # ---------------------------------------------------------------- small algebra
@@ -140,15 +167,18 @@ def _zeros(shape, *like):
     dt = complex if any(np.iscomplexobj(a) for a in like) else float
     return np.zeros(shape, dtype=dt)
 
-def _cross(a, b):
-    """Cross product over the last axis (faster than np.cross for batches)."""
-    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
-    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
+
+def cross(a, b, axis=-1):
+    """Cross product of 3-vectors along ``axis`` (other axes broadcast; faster than np.cross for batches)."""
+    a, b = np.moveaxis(a, axis, 0), np.moveaxis(b, axis, 0)
+    return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]],
+                    axis=axis)
 
 
-def _dot(a, b):
-    return np.einsum("...i,...i->...", a, b)
+def dot(a, b, axis=-1):
+    """Dot product of 3-vectors along ``axis``."""
+    a, b = np.moveaxis(a, axis, 0), np.moveaxis(b, axis, 0)
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
 def _mv(A, v):
@@ -193,7 +223,7 @@ def vee(X):
 
 def rotation_angle(w):
     """``|w|``, shape ``(...,)``."""
-    return np.sqrt(_dot(w, w))
+    return np.sqrt(dot(w, w))
 
 
 # ---------------------------------------------------------------- SO(3)
@@ -206,7 +236,7 @@ def exp_so3(w):
     return np.eye(3) + a[..., None, None] * W + b[..., None, None] * (W @ W)
 
 
-def _quaternion(R):
+def quaternion(R):
     """Unit quaternion ``(qw, qx, qy, qz)``, ``qw >= 0``, of ``R`` (Shepperd's method)."""
     R = _arr(R)
     r00, r11, r22 = R[..., 0, 0], R[..., 1, 1], R[..., 2, 2]
@@ -222,7 +252,7 @@ def _quaternion(R):
         np.stack([d10, s02, s12, 1.0 - r00 - r11 + r22], axis=-1),
     ], axis=-2)
     q = np.take_along_axis(cand, choice[..., None, None], axis=-2)[..., 0, :]
-    q = q / np.sqrt(_dot(q, q))[..., None]
+    q = q / np.sqrt(np.sum(q * q, axis=-1))[..., None]
     return np.where(q[..., :1] < 0.0, -q, q)
 
 
@@ -231,9 +261,9 @@ def log_so3(R):
 
     Goes through the quaternion, so nothing divides by ``sin t`` near ``pi``.
     """
-    q = _quaternion(R)
+    q = quaternion(R)
     qw, qv = q[..., 0], q[..., 1:]
-    s = np.sqrt(_dot(qv, qv))
+    s = np.sqrt(dot(qv, qv))
     # 2 atan2(s, qw) / s; for small x = s/qw use the series of atan(x)/x.
     small = s < 0.1 * qw
     x2 = np.where(small, (s / np.where(small, qw, 1.0)) ** 2, 0.0)
@@ -272,8 +302,8 @@ def exp(h):
     WW = W @ W
     H = _zeros(h.shape[:-1] + (4, 4), h)
     H[..., :3, :3] = np.eye(3) + a[..., None, None] * W + b[..., None, None] * WW
-    wxu = _cross(w, u)
-    H[..., :3, 3] = u + b[..., None] * wxu + c[..., None] * _cross(w, wxu)
+    wxu = cross(w, u)
+    H[..., :3, 3] = u + b[..., None] * wxu + c[..., None] * cross(w, wxu)
     H[..., 3, 3] = 1.0
     return H
 
@@ -284,13 +314,13 @@ def log(H):
     w = log_so3(H[..., :3, :3])
     x = H[..., :3, 3]
     d = coefficient("d", rotation_angle(w))
-    wxx = _cross(w, x)
-    u = x - 0.5 * wxx + d[..., None] * _cross(w, wxx)  # T_SO3(w)^-T x
+    wxx = cross(w, x)
+    u = x - 0.5 * wxx + d[..., None] * cross(w, wxx)  # T_SO3(w)^-T x
     return np.concatenate([u, w], axis=-1)
 
 
 def _q_matrix(u, w, t=None):
-    """``Q(u, w)`` of THEORY.md section 2 (the coupling block), ``(..., 3, 3)``."""
+    """``Q(u, w)`` of docs/theory.md eq. (2.6) (the coupling block), ``(..., 3, 3)``."""
     if t is None:
         t = rotation_angle(w)
     c1, c2, c3 = coefficient("c", t), coefficient("q2", t), coefficient("q3", t)
@@ -379,3 +409,27 @@ def interpolate(H_A, h, xi):
     """
     xi = _arr(xi)
     return compose(H_A, exp(xi[..., None] * _arr(h)))
+
+
+def log_relative(A, B):
+    """``log(A^-1 B)``: relative twist of poses ``(..., 4, 4) -> (..., 6)``."""
+    return log(relative(A, B))
+
+
+def log_and_tangent_inv(H):
+    """``h = log(H)`` and ``T(h)^-1``, ``T(-h)^-1`` (``(..., 6)``, ``(..., 6, 6)`` twice), trig shared.
+
+    ``T(-h)^-1`` is ``T(h)^-1`` with the signs of its skew-odd parts flipped:
+    ``Ti(-w) = Ti(w)^T`` and ``X(-h) = -Ti(w)^T Q(u, w) Ti(w)^T``.
+    """
+    h = log(H)
+    u, w = h[..., :3], h[..., 3:]
+    Ti = tangent_inv_so3(w)
+    TiT = np.swapaxes(Ti, -1, -2)
+    plus = _zeros(h.shape[:-1] + (6, 6), h)
+    minus = _zeros(h.shape[:-1] + (6, 6), h)
+    plus[..., :3, :3] = plus[..., 3:, 3:] = Ti
+    minus[..., :3, :3] = minus[..., 3:, 3:] = TiT
+    plus[..., :3, 3:] = -Ti @ _q_matrix(-u, -w) @ Ti
+    minus[..., :3, 3:] = -TiT @ _q_matrix(u, w) @ TiT
+    return h, plus, minus

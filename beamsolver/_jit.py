@@ -1,0 +1,13 @@
+"""The one numba decorator of the compiled kernels (``se3_jit``, ``element_jit``, ``assembly_jit``).
+
+``cache=True``: compiled once per machine, later runs load the cache.
+``error_model="numpy"``: a division by zero gives inf/nan as in numpy (no
+per-division check); no ``fastmath``, so results stay those of the numpy
+oracle to round-off.
+"""
+from numba import njit
+
+jit = njit(cache=True, error_model="numpy")
+# functions taking arrays are inlined into their caller: a call passing arrays costs a reference
+# count increment and decrement per array (measured: ~20 % of the element kernel)
+jit_inline = njit(cache=True, error_model="numpy", inline="always")
