@@ -20,8 +20,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from . import se3
-from .element import internal_forces, internal_forces_and_tangent
+from . import assembly_jit, element, se3
 from .errors import InputError
 from .se3 import skew
 from .validation import check_pose
@@ -68,6 +67,8 @@ class System:
         n = model.n_nodes
         self.n_nodes = n
         self.enodes, self.L, self.eps0, self.C = model.element_table()
+        self.C = np.ascontiguousarray(self.C, dtype=float)
+        self.C_diagonal = bool(not np.any(self.C[:, ~np.eye(6, dtype=bool)]))
         self.n_elements = len(self.L)
         self.poses0 = model.poses0
         self.length_scale = model.characteristic_length()
@@ -108,6 +109,10 @@ class System:
         self.chains = chains
         self.chain_nodes = (np.concatenate([c[0][1:] for c in chains]) if chains
                             else np.zeros(0, dtype=int))
+        # flat chain table for assembly_jit.rechain: nodes in chain order, chain k in ptr[k]:ptr[k+1]
+        self.chain_index = np.concatenate([c[0] for c in chains]).astype(np.int64) if chains \
+            else np.zeros(0, dtype=np.int64)
+        self.chain_ptr = np.cumsum([0] + [len(c[0]) for c in chains]).astype(np.int64)
 
     # ------------------------------------------------------------ dof map
     def _build_reps(self, model):
@@ -175,6 +180,7 @@ class System:
         transformed |= np.isin(rep, self.global_nodes)
         self.transformed = transformed
         self.el_transformed = np.flatnonzero(transformed[self.enodes].any(axis=1))
+        self.body_nodes = np.flatnonzero(is_rep & ((kind == FREE) | (kind == PRESCRIBED)))
 
     @staticmethod
     def _group_constraint(parent, root, cons):
@@ -297,13 +303,12 @@ class System:
             # the kernel writes its tangent straight into the COO value array (no copy)
             n_k = 144 * self.n_elements
             kvals = np.empty(n_k + 36 * len(self.block_nodes))
-            f, K, state = internal_forces_and_tangent(HA, HB, self.L, self.eps0, self.C,
-                                                      out=kvals[:n_k].reshape(12, 12, self.n_elements))
+            f, K, state = element.evaluate(HA, HB, self.L, self.eps0, self.C, True,
+                                           kvals[:n_k].reshape(12, 12, self.n_elements), self.C_diagonal)
         else:
-            f, state = internal_forces(HA, HB, self.L, self.eps0, self.C)
-            K = None
-        f_level = np.abs(f[:, [0, 1, 2, 6, 7, 8]]).max(initial=0.0)
-        m_level = np.abs(f[:, [3, 4, 5, 9, 10, 11]]).max(initial=0.0)
+            f, K, state = element.evaluate(HA, HB, self.L, self.eps0, self.C, False, diagonal=self.C_diagonal)
+        levels = np.abs(f).reshape(-1, 2, 2, 3).max(axis=(0, 1, 3), initial=0.0)   # (force, moment)
+        f_level, m_level = float(levels[0]), float(levels[1])
         M = self.node_transforms(H)
         if M is not None and len(self.el_transformed):
             e = self.el_transformed
@@ -370,8 +375,9 @@ class System:
         ``extra``: optional ``(rows, cols, vals)`` COO entries in full ``z``
         numbering (contact), whose pattern may change between iterations.
         """
-        data = np.bincount(self.pos, weights=kvals, minlength=self.nnz + 1)[:self.nnz]
-        K = sp.csc_matrix((data, self.indices, self.indptr), shape=(self.n_free, self.n_free))
+        data = np.empty(self.nnz + 1)
+        assembly_jit.scatter(self.pos, kvals, data)
+        K = sp.csc_matrix((data[:self.nnz], self.indices, self.indptr), shape=(self.n_free, self.n_free))
         if extra is not None and len(extra[2]):
             rows, cols, vals = extra
             rr, rc = self.red[rows], self.red[cols]
@@ -412,12 +418,12 @@ class System:
         """
         H0 = H
         H = H.copy()
-        body = np.flatnonzero(self.is_rep & ((self.kind == FREE) | (self.kind == PRESCRIBED)))
-        nz = body[np.any(dz[body] != 0.0, axis=1)]
+        dz = np.ascontiguousarray(dz, dtype=float)
+        nz = self.body_nodes[np.any(dz[self.body_nodes] != 0.0, axis=1)]
         if len(nz):
-            H[nz] = se3.compose(H[nz], se3.exp(dz[nz]))
+            assembly_jit.compose_exp(H, dz, nz)
         if chains and self.chains:
-            self._rechain(H0, H, dz)
+            assembly_jit.rechain(H0, H, dz, self.chain_index, self.chain_ptr)
         g = self.global_nodes
         if len(g):
             H[g, :3, 3] += dz[g, :3]
@@ -425,7 +431,8 @@ class System:
         self.sync_members(H)
         return H
 
-    def _rechain(self, H_old, H, dz):
+    def rechain_numpy(self, H_old, H, dz):
+        """The numpy form of ``assembly_jit.rechain`` (its test oracle)."""
         for nodes, elements, reverse in self.chains:
             a, b = nodes[:-1], nodes[1:]              # chain order: anchor first
             h = se3.log(se3.relative(H_old[a], H_old[b]))

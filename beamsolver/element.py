@@ -43,7 +43,7 @@ from . import se3
 from .se3 import coefficient
 
 __all__ = ["ElementState", "element_state", "reference_strain", "energy",
-           "internal_forces", "internal_forces_and_tangent", "internal_forces_numpy",
+           "internal_forces", "internal_forces_and_tangent", "evaluate", "internal_forces_numpy",
            "internal_forces_and_tangent_numpy", "CHUNK"]
 
 # elements per chunk, measured (benchmarks/element_throughput.py): larger chunks amortise the
@@ -58,8 +58,10 @@ class ElementState(NamedTuple):
 
 
 def reference_strain(H_A, H_B):
-    """Reference length ``L = |u0|`` and strain ``eps0 = h0 / L`` of reference poses."""
-    h0 = se3.log(se3.relative(H_A, H_B))
+    """Reference length ``L = |u0|`` and strain ``eps0 = h0 / L`` of reference poses ``(n, 4, 4)``."""
+    from . import element_jit
+    h0 = np.empty((len(H_A), 6))
+    element_jit.relative_twists(np.ascontiguousarray(H_A, dtype=float), np.ascontiguousarray(H_B, dtype=float), h0)
     L = np.sqrt(np.einsum("...i,...i->...", h0[..., :3], h0[..., :3]))
     return L, h0 / L[..., None]
 
@@ -282,11 +284,16 @@ def _evaluate(H_A, H_B, L, eps0, C, tangent, out=None):
     return f, (K.transpose(2, 0, 1) if tangent else None), ElementState(h, strain, sigma)
 
 
-def _evaluate_compiled(H_A, H_B, L, eps0, C, tangent, out=None):
-    """The compiled path (``element_jit``): same outputs as ``_evaluate``."""
+def evaluate(H_A, H_B, L, eps0, C, tangent, out=None, diagonal=None):
+    """Forces, tangent (``tangent``: else ``None``) and state by the compiled kernels (``element_jit``).
+
+    ``diagonal``: whether every ``C`` is diagonal, if known (else checked).
+    """
     from . import element_jit   # numba compiles (or loads its cache) on first use
     n = len(L)
     H_A, H_B, L, eps0, C = (np.ascontiguousarray(x, dtype=float) for x in (H_A, H_B, L, eps0, C))
+    if diagonal is None:
+        diagonal = element_jit.is_diagonal(C)
     f = np.empty((n, 12))
     h, strain, sigma = np.empty((n, 6)), np.empty((n, 6)), np.empty((n, 6))
     K = np.empty((12, 12, 0))
@@ -294,13 +301,13 @@ def _evaluate_compiled(H_A, H_B, L, eps0, C, tangent, out=None):
         K = np.empty((12, 12, n)) if out is None else out
         if K.shape != (12, 12, n):
             raise ValueError(f"out must have shape (12, 12, {n}), got {K.shape}")
-    element_jit.evaluate(H_A, H_B, L, eps0, C, element_jit.is_diagonal(C), tangent, f, h, strain, sigma, K)
+    element_jit.evaluate(H_A, H_B, L, eps0, C, diagonal, tangent, f, h, strain, sigma, K)
     return f, (K.transpose(2, 0, 1) if tangent else None), ElementState(h, strain, sigma)
 
 
 def element_state(H_A, H_B, L, eps0, C):
     """``ElementState`` (relative twist, strain, section forces) per element."""
-    return _evaluate_compiled(H_A, H_B, L, eps0, C, tangent=False)[2]
+    return evaluate(H_A, H_B, L, eps0, C, tangent=False)[2]
 
 
 def energy(H_A, H_B, L, eps0, C):
@@ -312,7 +319,7 @@ def energy(H_A, H_B, L, eps0, C):
 
 def internal_forces(H_A, H_B, L, eps0, C):
     """Body-frame nodal forces ``(n, 12)`` (A then B) and the ``ElementState``."""
-    f, _, state = _evaluate_compiled(H_A, H_B, L, eps0, C, tangent=False)
+    f, _, state = evaluate(H_A, H_B, L, eps0, C, tangent=False)
     return f, state
 
 
@@ -326,7 +333,7 @@ def internal_forces_and_tangent(H_A, H_B, L, eps0, C, out=None):
     (``element_jit``); ``internal_forces_and_tangent_numpy`` is the numpy
     version, kept as the test oracle.
     """
-    return _evaluate_compiled(H_A, H_B, L, eps0, C, tangent=True, out=out)
+    return evaluate(H_A, H_B, L, eps0, C, tangent=True, out=out)
 
 
 def internal_forces_numpy(H_A, H_B, L, eps0, C):

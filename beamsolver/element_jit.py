@@ -180,3 +180,14 @@ def is_diagonal(C):
     """True if every ``C`` (n, 6, 6) is diagonal."""
     return not np.any(C[:, ~np.eye(6, dtype=bool)])
 
+
+
+@jit
+def relative_twists(HA, HB, h):
+    """``h[e] = log(HA[e]^-1 HB[e])`` for poses ``(n, 4, 4)``, into ``h`` ``(n, 6)``."""
+    for e in range(len(h)):
+        RA, xA = pose(HA, e)
+        RB, xB = pose(HB, e)
+        u, w, t, d = log_relative(RA, xA, RB, xB)
+        for i in range(3):
+            h[e, i], h[e, 3 + i] = u[i], w[i]

@@ -6,7 +6,7 @@ is given): ``e2 = unit(e_z x e1)``, or ``e_y`` when ``e1`` is parallel to
 Arcs and helices carry their principal normal (towards the centre / axis) as
 ``e2``; polylines parallel-transport ``e2`` from the first node.
 
-No generator makes an element turning by more than ``MAX_ELEMENT_ROTATION``
+No generator makes an element turning by more than ``MAX_REFERENCE_ELEMENT_ROTATION``
 (0.75 pi, the model's limit): past it the relative rotation of the end frames
 would describe a shorter turn the other way (a helix with one element per turn
 would be straight).  Arcs and helices name the ``n_elements`` needed; a polyline
@@ -15,7 +15,7 @@ whose centre line folds back or turns that sharply at a point is refused.
 import numpy as np
 
 from .errors import InputError
-from .validation import MAX_ELEMENT_ROTATION, count, real, vector
+from .validation import MAX_REFERENCE_ELEMENT_ROTATION, count, real, vector
 
 __all__ = ["straight", "arc", "helix", "polyline", "frames_from_tangents"]
 
@@ -48,12 +48,12 @@ def _check_n(n_elements, what):
 
 
 def _check_turn(angle_per_element, n, what):
-    """Refuse elements turning by more than ``MAX_ELEMENT_ROTATION`` (the relative rotation of
+    """Refuse elements turning by more than ``MAX_REFERENCE_ELEMENT_ROTATION`` (the relative rotation of
     their end frames would alias to a shorter rotation): name the element count needed."""
-    if angle_per_element > MAX_ELEMENT_ROTATION * (1.0 + 1e-12):
-        need = int(np.ceil(n * angle_per_element / MAX_ELEMENT_ROTATION * (1.0 - 1e-12)))
+    if angle_per_element > MAX_REFERENCE_ELEMENT_ROTATION * (1.0 + 1e-12):
+        need = int(np.ceil(n * angle_per_element / MAX_REFERENCE_ELEMENT_ROTATION * (1.0 - 1e-12)))
         raise InputError(f"geometry.{what}: {n} element(s) turn by {angle_per_element:.3f} rad per element, "
-                         f"more than an element can represent (limit 0.75 pi = {MAX_ELEMENT_ROTATION:.3f} "
+                         f"more than an element can represent (limit 0.75 pi = {MAX_REFERENCE_ELEMENT_ROTATION:.3f} "
                          f"rad; its end frames would describe a shorter turn); use n_elements >= {need}")
 
 
@@ -194,7 +194,7 @@ def polyline(points, n_elements=None, e2=None):
     if len(rev):
         i = int(rev[0]) + 1
         raise InputError(f"geometry.polyline: element {i - 1} (points {i - 1} to {i}) turns by {np.pi:.3f} rad "
-                         f"(limit 0.75 pi = {MAX_ELEMENT_ROTATION:.3f} rad): the centre line reverses at point {i}")
+                         f"(limit 0.75 pi = {MAX_REFERENCE_ELEMENT_ROTATION:.3f} rad): the centre line reverses at point {i}")
     tm = tm / nt[:, None]
     c0 = _unit(p[1] - p[0])
     t0 = 2.0 * np.dot(tm[0], c0) * c0 - tm[0]
@@ -207,15 +207,15 @@ def polyline(points, n_elements=None, e2=None):
 
 def _check_fold(p, t):
     """Refuse a polyline whose node tangent leaves a chord by more than half the element limit:
-    the element between them would turn by more than ``MAX_ELEMENT_ROTATION`` (or fold back,
+    the element between them would turn by more than ``MAX_REFERENCE_ELEMENT_ROTATION`` (or fold back,
     ``e1`` against the chord)."""
     c = np.diff(p, axis=0)
     c /= np.linalg.norm(c, axis=1, keepdims=True)
     ang = np.arccos(np.clip(np.stack([np.sum(t[:-1] * c, axis=1), np.sum(t[1:] * c, axis=1)]), -1.0, 1.0))
     turn = 2.0 * ang.max(axis=0)
-    bad = np.flatnonzero(turn > MAX_ELEMENT_ROTATION)
+    bad = np.flatnonzero(turn > MAX_REFERENCE_ELEMENT_ROTATION)
     if len(bad):
         i = int(bad[0])
         raise InputError(f"geometry.polyline: element {i} (points {i} to {i + 1}) turns by {turn[i]:.3f} rad "
-                         f"(limit 0.75 pi = {MAX_ELEMENT_ROTATION:.3f} rad): the centre line folds back or "
+                         f"(limit 0.75 pi = {MAX_REFERENCE_ELEMENT_ROTATION:.3f} rad): the centre line folds back or "
                          "turns too sharply there; round the corner with more points")

@@ -139,7 +139,8 @@ class _SpluFactor:
     backend = "splu"
 
     def __init__(self, K):
-        K = sp.csc_matrix(K)
+        if not (sp.issparse(K) and K.format == "csc"):
+            K = sp.csc_matrix(K)
         try:
             self._lu = spla.splu(K, permc_spec="MMD_AT_PLUS_A")
         except RuntimeError as e:          # "Factor is exactly singular"

@@ -15,7 +15,7 @@ from . import se3
 from .element import reference_strain
 from .errors import InputError
 from .section import Section
-from .validation import (MAX_ELEMENT_ROTATION, ORTHONORMAL_TOL, CheckedScalar, as_array, check_contact_options,
+from .validation import (MAX_REFERENCE_ELEMENT_ROTATION, ORTHONORMAL_TOL, CheckedScalar, as_array, check_contact_options,
                          check_node_id, check_pose, real)
 
 __all__ = ["Model", "Beam", "Load", "ContactDeclaration", "DOF_NAMES"]
@@ -158,11 +158,12 @@ class Model:
             raise InputError(f"{label}: element {i} has zero length (nodes {i} and {i + 1} coincide at "
                              f"{P[i, :3, 3].tolist()})")
         ang = se3.rotation_angle(eps0[:, 3:] * L[:, None])
-        big = np.flatnonzero(ang > MAX_ELEMENT_ROTATION)
+        big = np.flatnonzero(ang > MAX_REFERENCE_ELEMENT_ROTATION)
         if len(big):
             i = int(big[0])
             raise InputError(f"{label}: element {i} turns by {ang[i]:.3f} rad in the reference pose "
-                             f"(limit {MAX_ELEMENT_ROTATION:.3f}); use more elements")
+                             f"(limit {MAX_REFERENCE_ELEMENT_ROTATION:.3f} rad, MAX_REFERENCE_ELEMENT_ROTATION); "
+                             "use more elements")
         nodes = np.arange(self._n_nodes, self._n_nodes + len(P))
         elements = np.arange(self._n_elements, self._n_elements + len(P) - 1)
         beam = Beam(bid, nodes, elements, section, name)

@@ -169,16 +169,21 @@ def _zeros(shape, *like):
 
 
 def cross(a, b, axis=-1):
-    """Cross product of 3-vectors along ``axis`` (other axes broadcast; faster than np.cross for batches)."""
-    a, b = np.moveaxis(a, axis, 0), np.moveaxis(b, axis, 0)
-    return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]],
-                    axis=axis)
+    """Cross product of 3-vectors along ``axis`` (-1 or 0; other axes broadcast; faster than np.cross)."""
+    if axis == 0:
+        return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
 def dot(a, b, axis=-1):
-    """Dot product of 3-vectors along ``axis``."""
-    a, b = np.moveaxis(a, axis, 0), np.moveaxis(b, axis, 0)
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+    """Dot product along ``axis`` (-1 or 0), other axes broadcast; unrolled for 3-vectors."""
+    if np.shape(a)[axis] != 3:
+        return np.sum(a * b, axis=axis)
+    if axis == 0:
+        return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
 
 
 def _mv(A, v):

@@ -140,7 +140,9 @@ def _refine_advice(system, H, t, t_start, t_end):
         a = float(ang[b.elements].max())
         if a < 0.5 * MAX_ELEMENT_ROTATION:
             continue
-        need = int(np.ceil(b.n_elements * max(a * grow, MAX_ELEMENT_ROTATION) / (0.5 * np.pi)))
+        # strictly below pi/2 (floor + 1, with a margin for round-off: a turn of exactly pi/2 per element
+        # is not below it)
+        need = int(np.floor(b.n_elements * max(a * grow, MAX_ELEMENT_ROTATION) / (0.5 * np.pi) + 1e-6)) + 1
         parts.append(f"Beam {b.id} ({b.n_elements} elements) turns by {a:.3f} rad per element at "
                      f"t = {t:.6g}: about {need} elements keep it below pi/2 at t = {t_end:.6g}")
     return "".join("; " + p for p in parts)

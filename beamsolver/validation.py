@@ -14,9 +14,11 @@ import numpy as np
 from .errors import InputError
 
 __all__ = ["real", "count", "as_array", "vector", "check_pose", "check_poses", "check_node_id", "check_contact_options",
-           "check_solve_arguments", "MAX_ELEMENT_ROTATION", "ORTHONORMAL_TOL", "MAX_COUNT"]
+           "check_solve_arguments", "MAX_REFERENCE_ELEMENT_ROTATION", "ORTHONORMAL_TOL", "MAX_COUNT"]
 
-MAX_ELEMENT_ROTATION = 0.75 * np.pi   # a reference element may turn by at most this much
+# a reference element may turn by at most this much; the solver refuses iterates beyond
+# solver.MAX_ELEMENT_ROTATION (0.8 pi), so a reference shape keeps some room below it
+MAX_REFERENCE_ELEMENT_ROTATION = 0.75 * np.pi
 ORTHONORMAL_TOL = 1e-8                # |R^T R - I| and |last row - (0, 0, 0, 1)| of a pose
 MAX_COUNT = 10**6                     # elements per generated beam, load steps per solve
 

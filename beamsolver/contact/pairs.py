@@ -24,15 +24,11 @@ linearised exactly around its real part (``_log_c``).
 import numpy as np
 
 from .. import se3
-from ..se3 import _cross
+from ..se3 import cross as _cross, dot as _dot
 from .law import coulomb_return_mapping, normal_force
 
 LINE, ORTHOGONAL, POINT = 0, 1, 2
 PENALTY_T_MIN = 1e-3     # floor of the slip-tolerance tangential penalty / (mu normal penalty)
-
-
-def _dot(a, b):
-    return np.sum(a * b, axis=-1)
 
 
 def _log_c(H):

@@ -1,0 +1,63 @@
+"""Compiled (numba) scatter and pose updates of ``assembly.System``.
+
+- ``scatter``: COO values summed into the CSC data array of the pattern built
+  once (``data[pos[i]] += kvals[i]``; what ``np.bincount(pos, kvals)`` does).
+- ``compose_exp``: body increments ``H_i <- H_i exp(hat(dz_i))`` of listed nodes.
+- ``rechain``: the strain-space update of cantilever chains
+  (docs/theory.md eq. 4.6): ``h_e <- h_e + T(h_e)^-1 dq_b - T(-h_e)^-1 dq_a``,
+  poses re-chained from the anchored node, ``H_b = H_a exp(h_e)``.
+
+The numpy versions (``np.bincount``, ``se3.compose``/``se3.exp``,
+``System.rechain_numpy``) are the test oracles (``tests/test_kernels_jit.py``).
+"""
+import numpy as np
+
+from ._jit import jit
+from .element_jit import _side
+from .se3_jit import C_, Q2_, Q3_, add, coefficient, compose_into, cross, dot, exp_pose, log_relative, mv, pose, scale
+
+
+@jit
+def scatter(pos, kvals, data):
+    """``data[:] = 0; data[pos[i]] += kvals[i]`` (``pos`` may point at a dummy last slot)."""
+    data[:] = 0.0
+    for i in range(len(pos)):
+        data[pos[i]] += kvals[i]
+
+
+@jit
+def compose_exp(H, dz, nodes):
+    """``H[i] <- H[i] exp(hat(dz[i]))`` for ``i`` in ``nodes`` (in place)."""
+    E = np.empty((4, 4))
+    for i in nodes:
+        exp_pose((dz[i, 0], dz[i, 1], dz[i, 2]), (dz[i, 3], dz[i, 4], dz[i, 5]), E)
+        compose_into(H[i], E, H[i])
+
+
+@jit
+def _tinv_apply(u, w, t, d, vu, vw):
+    """``T(h)^-1 (vu, vw)`` at ``h = (u, w)``: ``(Ti vu + X vw, Ti vw)``."""
+    c1, c2, c3 = coefficient(C_, t), coefficient(Q2_, t), coefficient(Q3_, t)
+    Ti, X = _side(u, w, d, t * t, dot(w, u), cross(w, u), c1, c2, c3)
+    return add(mv(Ti, vu), mv(X, vw)), mv(Ti, vw)
+
+
+@jit
+def rechain(H_old, H, dz, nodes, ptr):
+    """Strain-space update of the chains ``nodes[ptr[k]:ptr[k + 1]]`` (anchor first).
+
+    ``H[anchor]`` must already hold the anchor's new pose; the other nodes' poses are overwritten.
+    """
+    E = np.empty((4, 4))
+    for k in range(len(ptr) - 1):
+        for j in range(ptr[k], ptr[k + 1] - 1):
+            a, b = nodes[j], nodes[j + 1]
+            RA, xA = pose(H_old, a)
+            RB, xB = pose(H_old, b)
+            u, w, t, d = log_relative(RA, xA, RB, xB)
+            qa = ((dz[a, 0], dz[a, 1], dz[a, 2]), (dz[a, 3], dz[a, 4], dz[a, 5]))
+            qb = ((dz[b, 0], dz[b, 1], dz[b, 2]), (dz[b, 3], dz[b, 4], dz[b, 5]))
+            pu, pw = _tinv_apply(u, w, t, d, qb[0], qb[1])
+            mu_, mw_ = _tinv_apply(scale(-1.0, u), scale(-1.0, w), t, d, qa[0], qa[1])
+            exp_pose(add(u, add(pu, scale(-1.0, mu_))), add(w, add(pw, scale(-1.0, mw_))), E)
+            compose_into(H[a], E, H[b])
