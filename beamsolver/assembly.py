@@ -212,6 +212,8 @@ class System:
         P = self.poses0
         fixed = self.fixed_dofs.reshape(n, 6) & (self.is_rep & (self.kind != FREE))[:, None]
         for root, nodes in groups.items():
+            if np.any(np.isin(self.kind[nodes], (CLAMPED, PRESCRIBED)) & self.is_rep[nodes]):
+                continue       # a clamped or prescribed node alone fixes all six rigid-body modes
             rank = _rigid_mode_rank(P[nodes, :3, 3], fixed[nodes])
             if rank < 6:
                 owners = [model.beam_of_node(i) for i in nodes]   # Beam (a dataclass) is unhashable
@@ -243,6 +245,9 @@ class System:
         # node blocks: dead-loaded nodes and global-type representatives
         bn = np.unique(np.concatenate([self.load_nodes[self.dead], self.global_nodes]))
         self.block_nodes = bn.astype(int)
+        self.load_dofs = ((6 * self.rep[self.load_nodes])[:, None] + k6).ravel()
+        self.dead_where = np.searchsorted(self.block_nodes, self.load_nodes[self.dead])
+        self.dead_unique = len(np.unique(self.dead_where)) == len(self.dead_where)
         ndofs = (6 * self.rep[self.block_nodes])[:, None] + k6
         # element entries in the order of the kernel's tangent storage, (12, 12, n_el)
         # (element axis last, ``element`` module docstring), then the node blocks (n_b, 6, 6)
@@ -307,8 +312,8 @@ class System:
                                            kvals[:n_k].reshape(12, 12, self.n_elements), self.C_diagonal)
         else:
             f, K, state = element.evaluate(HA, HB, self.L, self.eps0, self.C, False, diagonal=self.C_diagonal)
-        levels = np.abs(f).reshape(-1, 2, 2, 3).max(axis=(0, 1, 3), initial=0.0)   # (force, moment)
-        f_level, m_level = float(levels[0]), float(levels[1])
+        levels = np.abs(f).max(axis=0, initial=0.0).reshape(4, 3).max(axis=1)     # f_A, m_A, f_B, m_B
+        f_level, m_level = max(levels[0], levels[2]), max(levels[1], levels[3])
         M = self.node_transforms(H)
         if M is not None and len(self.el_transformed):
             e = self.el_transformed
@@ -324,30 +329,8 @@ class System:
         r = np.bincount(self.edofs.ravel(), weights=f.ravel(), minlength=ndof)
         # external loads (body components at their node, then transformed)
         blocks = np.zeros((len(self.block_nodes), 6, 6)) if tangent else None
-        fe_level = 0.0
         if len(self.load_nodes):
-            lf = load_factors
-            R = H[self.load_nodes, :3, :3]
-            Fs, Ms = self.load_F * lf[:, None], self.load_M * lf[:, None]
-            fb = np.where(self.load_follower[:, None], Fs, np.einsum("nji,nj->ni", R, Fs))
-            mb = np.where(self.load_follower[:, None], Ms, np.einsum("nji,nj->ni", R, Ms))
-            fext = np.concatenate([fb, mb], axis=1)
-            fe_level = np.abs(Fs).max(initial=0.0), np.abs(Ms).max(initial=0.0)
-            f_level, m_level = max(f_level, fe_level[0]), max(m_level, fe_level[1])
-            if M is not None:
-                fext = np.einsum("nji,nj->ni", M[self.load_nodes], fext)
-            ldofs = (6 * self.rep[self.load_nodes])[:, None] + np.arange(6)
-            r -= np.bincount(ldofs.ravel(), weights=fext.ravel(), minlength=ndof)
-            if tangent and len(self.dead):
-                d = self.dead
-                kb = np.zeros((len(d), 6, 6))
-                kb[:, :3, 3:] = -skew(fb[d])
-                kb[:, 3:, 3:] = -skew(mb[d])
-                if M is not None:
-                    Md = M[self.load_nodes[d]]
-                    kb = np.swapaxes(Md, 1, 2) @ kb @ Md
-                where = np.searchsorted(self.block_nodes, self.load_nodes[d])
-                np.add.at(blocks, where, kb)
+            r, f_level, m_level = self._add_loads(H, load_factors, M, r, blocks, f_level, m_level)
         if tangent and len(self.global_nodes):
             g = self.global_nodes
             rg = r.reshape(-1, 6)[g]
@@ -368,6 +351,35 @@ class System:
             info["f_level"] = max(f_level, cinfo.get("f_level", 0.0))
             info["m_level"] = max(m_level, cinfo.get("m_level", 0.0))
         return r, kvals, info
+
+    def _add_loads(self, H, lf, M, r, blocks, f_level, m_level):
+        """``r - f_ext`` and the dead-load stiffness added to ``blocks`` (if given); updated force levels.
+
+        Dead loads: body components ``R^T F`` with the stiffness ``-[[0, hat(R^T F)], [0, hat(R^T M)]]``
+        (docs/theory.md eq. 4.2); follower loads are constant in the body frame.
+        """
+        Fs, Ms = self.load_F * lf[:, None], self.load_M * lf[:, None]
+        f_level = max(f_level, np.abs(Fs).max(initial=0.0))
+        m_level = max(m_level, np.abs(Ms).max(initial=0.0))
+        fext = np.concatenate([Fs, Ms], axis=1)
+        d = self.dead
+        kb = np.empty((len(d) if blocks is not None else 0, 6, 6))
+        if len(d):
+            fd = np.empty((len(d), 6))
+            assembly_jit.dead_loads(H, self.load_nodes[d], Fs[d], Ms[d], fd, kb)
+            fext[d] = fd
+        if M is not None:
+            fext = np.einsum("nji,nj->ni", M[self.load_nodes], fext)
+        r = r - np.bincount(self.load_dofs, weights=fext.ravel(), minlength=len(r))
+        if blocks is not None and len(d):
+            if M is not None:
+                Md = M[self.load_nodes[d]]
+                kb = np.swapaxes(Md, 1, 2) @ kb @ Md
+            if self.dead_unique:
+                blocks[self.dead_where] += kb
+            else:
+                np.add.at(blocks, self.dead_where, kb)
+        return r, f_level, m_level
 
     def matrix(self, kvals, extra=None):
         """Reduced tangent (free x free) as CSC from the COO values.

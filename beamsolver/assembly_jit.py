@@ -61,3 +61,21 @@ def rechain(H_old, H, dz, nodes, ptr):
             mu_, mw_ = _tinv_apply(scale(-1.0, u), scale(-1.0, w), t, d, qa[0], qa[1])
             exp_pose(add(u, add(pu, scale(-1.0, mu_))), add(w, add(pw, scale(-1.0, mw_))), E)
             compose_into(H[a], E, H[b])
+
+
+@jit
+def dead_loads(H, nodes, F, M, fb, kb):
+    """Dead loads (docs/theory.md eq. 4.2): body components ``fb[k] = (R^T F_k, R^T M_k)`` at ``nodes[k]``
+    and the load stiffness ``kb[k] = -[[0, hat(R^T F_k)], [0, hat(R^T M_k)]]`` (``kb`` may have length 0)."""
+    for k in range(len(nodes)):
+        i = nodes[k]
+        for a in range(3):
+            fb[k, a] = H[i, 0, a] * F[k, 0] + H[i, 1, a] * F[k, 1] + H[i, 2, a] * F[k, 2]
+            fb[k, 3 + a] = H[i, 0, a] * M[k, 0] + H[i, 1, a] * M[k, 1] + H[i, 2, a] * M[k, 2]
+        if len(kb):
+            kb[k] = 0.0
+            for r0, v0 in ((0, 0), (3, 3)):
+                x, y, z = fb[k, v0], fb[k, v0 + 1], fb[k, v0 + 2]
+                kb[k, r0, 4], kb[k, r0, 5] = z, -y
+                kb[k, r0 + 1, 3], kb[k, r0 + 1, 5] = -z, x
+                kb[k, r0 + 2, 3], kb[k, r0 + 2, 4] = y, -x

@@ -169,3 +169,18 @@ print(json.dumps(misses))
     _run(code)                                   # compiles whatever is not cached yet
     misses = json.loads(_run(code).strip().splitlines()[-1])
     assert all(v == 0 for v in misses.values()), misses
+
+
+def test_dead_loads_equal_numpy():
+    rng = np.random.default_rng(5)
+    H = random_pose(rng, angle=3.0, shape=(5,))
+    nodes = np.array([4, 1, 1])
+    F, M = rng.standard_normal((3, 3)), rng.standard_normal((3, 3))
+    fb, kb = np.empty((3, 6)), np.full((3, 6, 6), np.nan)
+    assembly_jit.dead_loads(H, nodes, F, M, fb, kb)
+    Rt = np.swapaxes(H[nodes, :3, :3], 1, 2)
+    fu, fw = np.einsum("nij,nj->ni", Rt, F), np.einsum("nij,nj->ni", Rt, M)
+    np.testing.assert_allclose(fb, np.concatenate([fu, fw], axis=1), atol=1e-14)
+    expected = np.zeros((3, 6, 6))
+    expected[:, :3, 3:], expected[:, 3:, 3:] = -se3.skew(fu), -se3.skew(fw)
+    np.testing.assert_allclose(kb, expected, atol=1e-14)
