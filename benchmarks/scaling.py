@@ -453,7 +453,6 @@ def measure_pays_nothing(n=10_000):
                 parts=dict(element=t_eval, assembly=t_mat, solve=t_sol, update=t_upd, residual=t_res,
                            bookkeeping=t_book),
                 contact_system_imported=cs is not None,
-                contact_calls=dict(cs.CALLS) if cs is not None else {},
                 system_contact_is_none=system.contact is None, modules_loaded=mods)
 
 

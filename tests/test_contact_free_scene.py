@@ -22,7 +22,18 @@ SCRIPT = textwrap.dedent("""
 
 SCRIPT_CONTACT = textwrap.dedent("""
     import json, sys
+    from collections import Counter
     import beamsolver as bs
+    from beamsolver.contact import system as cs
+    calls = Counter()
+
+    def counted(name, f):
+        def g(*a, **k):
+            calls[name] += 1
+            return f(*a, **k)
+        return g
+    cs.ContactSystem.pairs = counted("search", cs.ContactSystem.pairs)
+    cs.ContactSystem.evaluate = counted("evaluate", cs.ContactSystem.evaluate)
     sec = bs.Section.circular(radius=0.05, E=1e7)
     m = bs.Model()
     a = m.add_beam(bs.geometry.straight((0, -1, 0), (0, 1, 0), 3), sec)
@@ -31,8 +42,7 @@ SCRIPT_CONTACT = textwrap.dedent("""
         m.clamp(n)
     m.add_contact(b, a)
     bs.solve(m, steps=1)
-    from beamsolver.contact.system import CALLS
-    print(json.dumps(dict(CALLS)))
+    print(json.dumps(dict(calls)))
 """)
 
 
@@ -47,6 +57,6 @@ def test_scene_without_contact_never_imports_the_contact_system():
     assert out == dict(system=False, search=False, pairs=False, contact=[0, 0, 0])
 
 
-def test_instrumentation_counts_contact_calls_when_there_is_contact():
-    calls = _run(SCRIPT_CONTACT)          # the probe above would see these if they ran
+def test_contact_code_runs_when_there_is_contact():
+    calls = _run(SCRIPT_CONTACT)          # the sys.modules probe above would see this code if it ran
     assert calls.get("search", 0) > 0 and calls.get("evaluate", 0) > 0

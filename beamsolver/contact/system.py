@@ -22,7 +22,6 @@ slip at the onset of sliding is ``slip_tolerance`` times the slave element lengt
 penalty), ``line_angle`` (20 deg), ``point_ratio`` (0.5), ``margin``
 (search margin, default the sum of radii).
 """
-from collections import Counter
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -34,7 +33,6 @@ from .pairs import (LINE, ORTHOGONAL, POINT, _project, _section, contact_kernel,
                     material_frames)
 from .search import XI_TOL, broad_phase, closest_points, element_spheres
 
-CALLS = Counter()          # instrumentation: a scene without contact leaves it empty
 MAX_AUGMENT = 30
 
 SMOOTHING = 0.0           # default smoothing gap of the normal law, relative to R1 + R2 (0: sharp)
@@ -128,7 +126,6 @@ class ContactSystem:
     # ------------------------------------------------------------ search
     def pairs(self, H):
         """All potential contact pairs at poses ``H`` as a dict of arrays."""
-        CALLS["search"] += 1
         sysm = self.sys
         en = sysm.enodes
         out = []
@@ -375,7 +372,6 @@ class ContactSystem:
     # ------------------------------------------------------------ evaluation
     def evaluate(self, H, tangent=True):
         """Contact residual ``(6 n,)``, COO tangent ``(rows, cols, vals)`` and point data."""
-        CALLS["evaluate"] += 1
         sysm = self.sys
         ndof = 6 * sysm.n_nodes
         r = np.zeros(ndof)
@@ -396,7 +392,6 @@ class ContactSystem:
             if not mask.any():
                 continue
             pm = {k: (v[mask] if np.ndim(v) else v) for k, v in p.items()}
-            CALLS["kernel_pairs"] += int(mask.sum())
             if tangent:
                 fm, Km, om = kernel_and_tangent(X[mask], pm, friction=use_fric)
                 K[mask] = Km
