@@ -7,8 +7,8 @@ from .model import Beam, Model
 from .results import Solution
 from .section import Section
 from .solver import Convergence, solve
+from .version import __version__
 
-__version__ = "0.1.0"
 
 __all__ = ["Model", "Beam", "Section", "Solution", "solve", "Convergence", "InputError",
            "ConvergenceError", "StabilityWarning", "load", "linearize", "Linearization", "se3", "geometry", "motion",

@@ -50,7 +50,7 @@ def contact_restore(contact, state):
 def restart_from(restart, model, system):
     """The ``Solution`` to continue (a copy bound to ``model``) from a Solution or a saved file."""
     if not hasattr(restart, "_poses"):
-        from .io.archive import load
+        from .results import load
         restart = load(restart)
     if not restart._times:
         raise InputError("solve: the restart solution has no steps")

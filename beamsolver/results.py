@@ -10,7 +10,22 @@ import numpy as np
 
 from .errors import InputError
 
-__all__ = ["Solution", "describe_model"]
+__all__ = ["Solution", "describe_model", "load"]
+
+
+def load(path):
+    """Read a ``Solution`` written by ``Solution.save`` (``model`` and ``system`` are ``None``).
+
+    ``path``: the ``.npz`` file (the suffix may be left out) or an output folder holding
+    ``solution.npz``; a file that is not such an archive, or is damaged, raises ``InputError``
+    naming it (``io.archive.read``).
+    """
+    from .io.archive import read
+    fields = read(path)
+    sol = Solution(None, None, fields.pop("description"))
+    for name, value in fields.items():
+        setattr(sol, name, value)
+    return sol
 
 
 def describe_model(model, system=None):

@@ -5,7 +5,9 @@
 ``import beamsolver`` never imports meshio.
 """
 import importlib
-from .archive import FORMAT_VERSION, load, save
+
+from ..results import load
+from .archive import FORMAT_VERSION, save
 
 __all__ = ["load", "save", "write_vtk", "FORMAT_VERSION"]
 

@@ -92,7 +92,7 @@ def _unpack_tables(data, prefix, n_steps):
 
 def save(solution, path):
     """Write ``solution`` to ``path`` (``.npz`` is appended if missing); returns the ``Path``."""
-    from .. import __version__
+    from ..version import __version__
     path = Path(path)
     if path.suffix != ".npz":
         path = path.with_name(path.name + ".npz")
@@ -193,19 +193,21 @@ def saved_times(path):
     return _guarded(path, read)
 
 
-def load(path):
-    """Read a ``Solution`` written by ``Solution.save`` (``model`` and ``system`` are ``None``).
+def read(path):
+    """The fields of a ``Solution`` written by ``Solution.save``, as a dict (``beamsolver.load`` builds it).
 
     ``path``: the ``.npz`` file (the suffix may be left out) or an output folder.  A file that
     is not such an archive, or is truncated, corrupted or inconsistent, raises ``InputError``
-    naming it and what is wrong (``check_archive``).
+    naming it and what is wrong (``check_archive``).  Keys: ``description`` and the
+    ``Solution`` attributes ``_times, _poses, _reactions, _sigma, _strain, stats, contacts,
+    converged, message, resume, contact_state``.  This module does not import ``results``
+    (imports run one way: ``results`` -> ``io.archive``).
     """
     path = _resolve(path)
     return _guarded(path, _read)
 
 
 def _read(path):
-    from ..results import Solution
     with _open(path) as data:
         arrays = check_archive(data, f"load({str(path)!r})")
     desc = {k[6:]: v for k, v in arrays.items() if k.startswith("model/")}
@@ -213,21 +215,13 @@ def _read(path):
         if k in desc:
             desc[k] = desc[k].astype(str)
     desc["n_contact_declarations"] = np.int64(desc.get("n_contact_declarations", 0))
-    sol = Solution(None, None, desc)
     times = arrays["times"]
-    sol._times = [float(t) for t in times]
-    sol._poses = list(arrays["poses"])
-    sol._reactions = list(arrays["reactions"])
-    sol._sigma = list(arrays["section_forces"])
-    sol._strain = list(arrays["strains"])
-    sol.stats = arrays["stats"]
-    sol.contacts = _unpack_tables(arrays, "contact", len(times))
-    sol.converged = bool(arrays["converged"])
-    sol.message = str(arrays["message"])
-    sol.resume = arrays["resume"]
-    sol.contact_state = {k[14:]: v for k, v in arrays.items() if k.startswith("contact_state/")}
-    return sol
-
+    return dict(description=desc, _times=[float(t) for t in times], _poses=list(arrays["poses"]),
+                _reactions=list(arrays["reactions"]), _sigma=list(arrays["section_forces"]),
+                _strain=list(arrays["strains"]), stats=arrays["stats"],
+                contacts=_unpack_tables(arrays, "contact", len(times)), converged=bool(arrays["converged"]),
+                message=str(arrays["message"]), resume=arrays["resume"],
+                contact_state={k[14:]: v for k, v in arrays.items() if k.startswith("contact_state/")})
 
 
 MODEL_KEYS = ("poses0", "enodes", "L", "eps0", "element_beam", "node_beam", "beam_first_node", "beam_n_nodes",
