@@ -447,10 +447,9 @@ class System:
         """The numpy form of ``assembly_jit.rechain`` (its test oracle)."""
         for nodes, elements, reverse in self.chains:
             a, b = nodes[:-1], nodes[1:]              # chain order: anchor first
-            h = se3.log(se3.relative(H_old[a], H_old[b]))
+            h, Tp, Tm = se3.log_and_tangent_inv(se3.relative(H_old[a], H_old[b]))
             # strain-space increment: dh = -T(-h)^-1 dq_a + T(h)^-1 dq_b
-            dh = (np.einsum("nij,nj->ni", se3.tangent_inv(h), dz[b])
-                  - np.einsum("nij,nj->ni", se3.tangent_inv(-h), dz[a]))
+            dh = np.einsum("nij,nj->ni", Tp, dz[b]) - np.einsum("nij,nj->ni", Tm, dz[a])
             E = se3.exp(h + dh)
             P = E.copy()                              # prefix products by doubling
             d = 1
