@@ -1,7 +1,7 @@
 """The two-node SE(3) beam element (Sonneville, Cardona & Bruls 2014), batched.
 
 For an element with nodal poses ``H_A, H_B`` and reference length ``L``
-(THEORY.md section 3):
+(docs/theory.md eqs. 3.1-3.7):
 
 - ``h = log(H_A^-1 H_B)``, strain ``eps = h / L`` (``Gamma`` then ``kappa``,
   section frame), section forces ``sigma = C (eps - eps0)``;
@@ -24,7 +24,7 @@ in chunks of ``CHUNK``: the small-index algebra is then elementwise operations
 on long contiguous arrays (an order of magnitude faster in numpy than stacked
 ``(m, 3, 3) @ (m, 3, 3)`` products).  Products of skew matrices are expanded
 with ``hat(a) hat(b) = b a^T - (a.b) I`` and ``hat(w)^2 = w w^T - |w|^2 I``, so
-``Q`` (THEORY.md section 2) and the geometric stiffness become sums of a skew
+``Q`` (docs/theory.md eq. 2.6) and the geometric stiffness become sums of a skew
 matrix, a few outer products and a multiple of ``I`` (``_mat``).
 
 Both nodes share one code path: with ``T(h)^-1 = [[Ti, X], [0, Ti]]``,

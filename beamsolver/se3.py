@@ -7,7 +7,7 @@ Conventions (stated once, used everywhere in beamsolver):
   rotation second.
 - Increments are body (right) increments: ``H <- H exp(hat(h))``.
 - ``tangent(h)`` is the right tangent operator: ``exp(h + dh) = exp(h) exp(tangent(h) dh)``
-  to first order (Sonneville, Cardona & Bruls 2014, eqs. for T_SE3).
+  to first order (Sonneville, Cardona & Bruls 2014; docs/theory.md section 2).
 
 Every coefficient that is 0/0 at zero angle has its own Taylor switch point,
 chosen where the truncated series (nine terms in t^2) and the closed form
@@ -117,7 +117,7 @@ SWITCH = {"a": 0.75, "b": 1.0, "c": 1.5, "d": 0.75, "q2": 1.5, "q3": 1.5,
 
 
 def coefficient(name, t):
-    """Evaluate the named singular coefficient at angles ``t >= 0`` (any shape)."""
+    """Evaluate the named singular coefficient at angles ``t >= 0`` (any shape; docs/theory.md eq. 2.9)."""
     t = _arr(t)
     t2 = t * t
     coeffs = SERIES[name]
@@ -233,7 +233,7 @@ def rotation_angle(w):
 
 # ---------------------------------------------------------------- SO(3)
 def exp_so3(w):
-    """``exp(skew(w)) = I + a W + b W^2``; ``(..., 3) -> (..., 3, 3)``."""
+    """``exp(skew(w)) = I + a W + b W^2`` (docs/theory.md eq. 2.1); ``(..., 3) -> (..., 3, 3)``."""
     w = _arr(w)
     t = rotation_angle(w)
     a, b = coefficient("a", t), coefficient("b", t)
@@ -281,7 +281,7 @@ def log_so3(R):
 
 
 def tangent_so3(w):
-    """Right tangent ``T(w) = I - b W + c W^2``: ``exp(w + dw) = exp(w) exp(T dw)``."""
+    """Right tangent ``T(w) = I - b W + c W^2``: ``exp(w + dw) = exp(w) exp(T dw)`` (eq. 2.2)."""
     w = _arr(w)
     t = rotation_angle(w)
     W = skew(w)
@@ -289,7 +289,7 @@ def tangent_so3(w):
 
 
 def tangent_inv_so3(w):
-    """``T(w)^-1 = I + W/2 + d W^2`` (singular at ``|w| = 2 pi``)."""
+    """``T(w)^-1 = I + W/2 + d W^2`` (eq. 2.3; singular at ``|w| = 2 pi``)."""
     w = _arr(w)
     t = rotation_angle(w)
     W = skew(w)
@@ -298,7 +298,7 @@ def tangent_inv_so3(w):
 
 # ---------------------------------------------------------------- SE(3)
 def exp(h):
-    """``exp(hat(h))``: ``(..., 6) -> (..., 4, 4)``, translation ``T_SO3(w)^T u``."""
+    """``exp(hat(h))`` (docs/theory.md eq. 2.4): ``(..., 6) -> (..., 4, 4)``, translation ``T_SO3(w)^T u``."""
     h = _arr(h)
     u, w = h[..., :3], h[..., 3:]
     t = rotation_angle(w)
@@ -314,7 +314,7 @@ def exp(h):
 
 
 def log(H):
-    """``vee(log(H))``: ``(..., 4, 4) -> (..., 6)``; rotation angle in ``[0, pi]``."""
+    """``vee(log(H))`` (docs/theory.md eqs. 2.5, 2.10): ``(..., 4, 4) -> (..., 6)``; rotation angle in ``[0, pi]``."""
     H = _arr(H)
     w = log_so3(H[..., :3, :3])
     x = H[..., :3, 3]
@@ -338,7 +338,7 @@ def _q_matrix(u, w, t=None):
 
 
 def tangent(h):
-    """Right tangent of SE(3): ``[[T(w), Q(-u,-w)], [0, T(w)]]``, ``(..., 6, 6)``."""
+    """Right tangent of SE(3) (docs/theory.md eq. 2.7): ``[[T(w), Q(-u,-w)], [0, T(w)]]``, ``(..., 6, 6)``."""
     h = _arr(h)
     u, w = h[..., :3], h[..., 3:]
     Tw = tangent_so3(w)
@@ -350,7 +350,7 @@ def tangent(h):
 
 
 def tangent_inv(h):
-    """Inverse right tangent: ``[[Ti, -Ti Q(-u,-w) Ti], [0, Ti]]``, ``(..., 6, 6)``."""
+    """Inverse right tangent (eq. 2.7): ``[[Ti, -Ti Q(-u,-w) Ti], [0, Ti]]``, ``(..., 6, 6)``."""
     h = _arr(h)
     u, w = h[..., :3], h[..., 3:]
     Ti = tangent_inv_so3(w)

@@ -1,4 +1,4 @@
-"""Error versus run time of the reference problems (THEORY.md section 7).
+"""Error versus run time of the reference problems (docs/theory.md section 9).
 
     python benchmarks/error_vs_runtime.py [--quick]
 

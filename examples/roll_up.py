@@ -5,7 +5,7 @@ to the beam axis there; node ``i`` (arc length ``s_i``) sits at
 ``(rho sin(s_i / rho), rho (1 - cos(s_i / rho)), 0)`` with ``rho = L / (2 pi fraction)``
 and its section frame turned by ``s_i / rho`` about ``e_z``.  The SE(3) element
 has constant strain, so it reproduces this state exactly on any mesh
-(THEORY.md sections 3 and 7).  The moment is a follower load (it turns with
+(docs/theory.md eqs. 3.8 and 9.1).  The moment is a follower load (it turns with
 the tip section), which is what keeps the bending moment uniform.
 
 Run ``python examples/roll_up.py`` to print, for 4, 8 and 16 elements, the

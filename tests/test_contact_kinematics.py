@@ -1,4 +1,4 @@
-"""SE(3) slip increment (seed eqs. 4, 7, 8; THEORY.md section 5, properties a-c)."""
+"""SE(3) slip increment (seed eqs. 4, 7, 8; docs/theory.md eqs. 6.4-6.5)."""
 import numpy as np
 import pytest
 

@@ -1,4 +1,4 @@
-"""The SE(3) beam element (THEORY.md section 3): forces, tangent, invariances, patch tests."""
+"""The SE(3) beam element (docs/theory.md section 3): forces, tangent, invariances, patch tests."""
 import zlib
 
 import numpy as np

@@ -21,7 +21,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 import bend45  # noqa: E402
 
 ASYMPTOTIC = 1e-2     # r_k below this: near the solution
-FLOOR_FACTOR = 10.0   # round-off floor: this times the smallest residual reached (THEORY.md section 4)
+FLOOR_FACTOR = 10.0   # round-off floor: this times the smallest residual reached (docs/theory.md eq. 5.2)
 C_QUAD = 50.0         # r_{k+1} <= C r_k^2 (scaled, dimensionless residuals)
 
 

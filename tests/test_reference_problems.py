@@ -1,4 +1,4 @@
-"""Reference problems with known answers (THEORY.md section 7): roll-up, patch tests, 45-degree bend.
+"""Reference problems with known answers (docs/theory.md section 9): roll-up, patch tests, 45-degree bend.
 
 The examples ``examples/roll_up.py`` and ``examples/bend45.py`` build the
 scenes; the tests import them and assert their numbers.

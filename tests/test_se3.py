@@ -1,4 +1,4 @@
-"""Property tests of the Lie-group kernels (THEORY.md sections 1-2)."""
+"""Property tests of the Lie-group kernels (docs/theory.md sections 1-2)."""
 import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
@@ -185,7 +185,7 @@ def test_adjoint_identity(seed, shape, angle):
 @given(seed=SEEDS, shape=SHAPE,
        angle=st.one_of(st.sampled_from([0.0, 1e-12, 1e-8, 1e-4, 1e-2]), st.floats(1e-3, 3.0)))
 def test_tangent_inverse_adjoint_identity(seed, shape, angle):
-    """``T(h)^-1 Ad(exp(-h)) = T(-h)^-1`` (THEORY.md section 2)."""
+    """``T(h)^-1 Ad(exp(-h)) = T(-h)^-1`` (docs/theory.md eq. 2.8)."""
     rng = np.random.default_rng(seed)
     h = _twist(rng, shape, angle)
     lhs = se3.tangent_inv(h) @ se3.adjoint(se3.exp(-h))

@@ -88,7 +88,7 @@ def test_coefficient_continuous_across_switch():
 
 
 def test_naive_t_minus_sin_trap():
-    """THEORY.md: ``(t - sin t)/t^3`` evaluated directly at 1e-5 is wrong in the 6th digit."""
+    """docs/theory.md eq. 2.9: ``(t - sin t)/t^3`` evaluated directly at 1e-5 is wrong in the 6th digit."""
     t = 1e-5
     exact = float(_reference("c", t))
     naive = (t - np.sin(t)) / t**3

@@ -1,4 +1,4 @@
-"""Contact laws, batched over contact points (THEORY.md section 6).
+"""Contact laws, batched over contact points (docs/theory.md section 7).
 
 Complex inputs are allowed (complex-step tangents): every branch is decided on
 the real part, arithmetic stays analytic.

@@ -2,7 +2,7 @@
 
 For each pair the kernel takes the poses of the four nodes (slave element
 A1, B1; master element A2, B2) and returns the body-frame nodal wrenches of
-the contact forces (seed paper; THEORY.md sections 5-6):
+the contact forces (seed paper; docs/theory.md sections 6-7):
 
 - slave section ``{C}`` at ``xi1`` from the constant-strain interpolation
   ``H_A1 exp(xi1 h1)``; master section ``{F}`` at ``xi2`` from the projection
@@ -175,7 +175,7 @@ def contact_kernel(X, p, friction=True):
 
 
 def _axes(HC, HF):
-    """Centre points, contact axes ``n, t1, t2`` and centre distance (THEORY.md section 5)."""
+    """Centre points, contact axes ``n, t1, t2`` and centre distance (docs/theory.md eqs. 6.2-6.3)."""
     xC, xF = HC[..., :3, 3], HF[..., :3, 3]
     d = xF - xC
     dist = np.sqrt(_dot(d, d))
