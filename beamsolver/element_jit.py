@@ -142,8 +142,8 @@ def element_kernel(HA, HB, L, eps0, C, e, diagonal, tangent, f, h, strain, sigma
     c1, c2, c3 = coefficient(C_, t), coefficient(Q2_, t), coefficient(Q3_, t)
     t2, wu, axu = t * t, dot(w, u), cross(w, u)
     mu, mw = scale(-1.0, u), scale(-1.0, w)
-    TiA, XA = _side(mu, mw, d, t2, wu, axu, c1, c2, c3)     # node A: argument -h
     TiB, XB = _side(u, w, d, t2, wu, axu, c1, c2, c3)       # node B: argument h
+    TiA, XA = transpose(TiB), transpose(XB)                 # node A: argument -h (eq. 2.7: T(-h)^-1 blocks)
     gA0, gA1 = mv(TiA, n), add(mv(XA, n), mv(TiA, m))
     gB0, gB1 = mv(TiB, n), add(mv(XB, n), mv(TiB, m))
     for i in range(3):                                      # f_A = -g(h), f_B = g(-h)
