@@ -249,13 +249,13 @@ class System:
         self.dead_where = np.searchsorted(self.block_nodes, self.load_nodes[self.dead])
         self.dead_unique = len(np.unique(self.dead_where)) == len(self.dead_where)
         ndofs = (6 * self.rep[self.block_nodes])[:, None] + k6
-        # element entries in the order of the kernel's tangent storage, (12, 12, n_el)
-        # (element axis last, ``element`` module docstring), then the node blocks (n_b, 6, 6)
-        et = self.edofs.T
-        n_el = len(self.edofs)
-        rows = np.concatenate([np.broadcast_to(et[:, None, :], (12, 12, n_el)).ravel(),
+        # element entries in the order of the compiled kernel's tangent storage, (n_el, 12, 12),
+        # then the node blocks (n_b, 6, 6)
+        ed = self.edofs
+        n_el = len(ed)
+        rows = np.concatenate([np.broadcast_to(ed[:, :, None], (n_el, 12, 12)).ravel(),
                                np.repeat(ndofs, 6, axis=1).ravel()])
-        cols = np.concatenate([np.broadcast_to(et[None, :, :], (12, 12, n_el)).ravel(),
+        cols = np.concatenate([np.broadcast_to(ed[:, None, :], (n_el, 12, 12)).ravel(),
                                np.tile(ndofs, (1, 6)).ravel()])
         self.coo_rows, self.coo_cols = rows, cols
         rr, rc = self.red[rows], self.red[cols]
@@ -309,7 +309,7 @@ class System:
             n_k = 144 * self.n_elements
             kvals = np.empty(n_k + 36 * len(self.block_nodes))
             f, K, state = element.evaluate(HA, HB, self.L, self.eps0, self.C, True,
-                                           kvals[:n_k].reshape(12, 12, self.n_elements), self.C_diagonal)
+                                           kvals[:n_k].reshape(self.n_elements, 12, 12), self.C_diagonal)
         else:
             f, K, state = element.evaluate(HA, HB, self.L, self.eps0, self.C, False, diagonal=self.C_diagonal)
         levels = np.abs(f).max(axis=0, initial=0.0).reshape(4, 3).max(axis=1)     # f_A, m_A, f_B, m_B

@@ -14,11 +14,14 @@ For an element with nodal poses ``H_A, H_B`` and reference length ``L``
 
 All public functions take arrays batched over elements: poses ``(n, 4, 4)``,
 ``L`` ``(n,)``, ``eps0`` ``(n, 6)``, ``C`` ``(n, 6, 6)``.  They return forces and
-states with the element axis first; the tangent is an ``(n, 12, 12)`` view of
-an array stored element-axis-last (``np.moveaxis(K, 0, -1)`` is contiguous),
-which is the order ``assembly.System`` scatters.
+states with the element axis first and the tangent ``(n, 12, 12)``.  They run
+the compiled kernels of ``element_jit`` (numba; one element per call, a batch
+loop, tangent stored element-major, the order ``assembly.System`` scatters).
+The ``*_numpy`` functions run the batched numpy kernel below, kept as the
+test oracle (its tangent is an ``(n, 12, 12)`` view of an element-axis-last
+array).
 
-Implementation.  Inside, every quantity is stored with the element axis
+Numpy implementation.  Inside, every quantity is stored with the element axis
 *last* (vectors ``(3, m)``, 3x3 blocks ``(3, 3, m)``) and elements are processed
 in chunks of ``CHUNK``: the small-index algebra is then elementwise operations
 on long contiguous arrays (an order of magnitude faster in numpy than stacked
@@ -287,6 +290,7 @@ def _evaluate(H_A, H_B, L, eps0, C, tangent, out=None):
 def evaluate(H_A, H_B, L, eps0, C, tangent, out=None, diagonal=None):
     """Forces, tangent (``tangent``: else ``None``) and state by the compiled kernels (``element_jit``).
 
+    The tangent is a C-contiguous ``(n, 12, 12)`` array (``out`` if given, of that shape).
     ``diagonal``: whether every ``C`` is diagonal, if known (else checked).
     """
     from . import element_jit   # numba compiles (or loads its cache) on first use
@@ -296,13 +300,13 @@ def evaluate(H_A, H_B, L, eps0, C, tangent, out=None, diagonal=None):
         diagonal = element_jit.is_diagonal(C)
     f = np.empty((n, 12))
     h, strain, sigma = np.empty((n, 6)), np.empty((n, 6)), np.empty((n, 6))
-    K = np.empty((12, 12, 0))
+    K = np.empty((0, 12, 12))
     if tangent:
-        K = np.empty((12, 12, n)) if out is None else out
-        if K.shape != (12, 12, n):
-            raise ValueError(f"out must have shape (12, 12, {n}), got {K.shape}")
+        K = np.empty((n, 12, 12)) if out is None else out
+        if K.shape != (n, 12, 12):
+            raise ValueError(f"out must have shape ({n}, 12, 12), got {K.shape}")
     element_jit.evaluate(H_A, H_B, L, eps0, C, diagonal, tangent, f, h, strain, sigma, K)
-    return f, (K.transpose(2, 0, 1) if tangent else None), ElementState(h, strain, sigma)
+    return f, (K if tangent else None), ElementState(h, strain, sigma)
 
 
 def element_state(H_A, H_B, L, eps0, C):
@@ -327,11 +331,11 @@ def internal_forces_and_tangent(H_A, H_B, L, eps0, C, out=None):
     """Nodal forces ``(n, 12)``, tangent ``(n, 12, 12)`` and the ``ElementState``.
 
     The tangent is ``d f / d q`` for body increments ``q = (q_A, q_B)``
-    (``H <- H exp(hat(q))``), material and geometric parts, exact.  It is a
-    view of an element-axis-last array (see the module docstring): ``out``,
-    if given, an array ``(12, 12, n)`` to write it into.  Compiled
+    (``H <- H exp(hat(q))``), material and geometric parts, exact; ``out``,
+    if given, a C-contiguous array ``(n, 12, 12)`` to write it into.  Compiled
     (``element_jit``); ``internal_forces_and_tangent_numpy`` is the numpy
-    version, kept as the test oracle.
+    version, kept as the test oracle (its ``out`` is element-axis-last,
+    ``(12, 12, n)``, see the module docstring).
     """
     return evaluate(H_A, H_B, L, eps0, C, tangent=True, out=out)
 

@@ -75,11 +75,11 @@ def test_element_kernel_writes_into_out_and_checks_its_shape():
     rng = np.random.default_rng(3)
     args = _batch(rng, False, n=1)
     n = len(args[2])
-    out = np.full((12, 12, n), np.nan)
+    out = np.full((n, 12, 12), np.nan)
     _, K, _ = element.internal_forces_and_tangent(*args, out=out)
     assert np.shares_memory(K, out) and np.isfinite(out).all()
     with pytest.raises(ValueError, match="out must have shape"):
-        element.internal_forces_and_tangent(*args, out=np.empty((12, 12, n + 1)))
+        element.internal_forces_and_tangent(*args, out=np.empty((n + 1, 12, 12)))
 
 
 def test_reference_strain_equals_se3_log():
