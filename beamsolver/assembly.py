@@ -28,6 +28,9 @@ from .validation import check_pose
 __all__ = ["System", "FREE", "GLOBAL", "CLAMPED", "PRESCRIBED"]
 
 FREE, GLOBAL, CLAMPED, PRESCRIBED = 0, 1, 2, 3
+# rank tolerance of the rigid-mode check: the constraint rows mix unit rotations with lever arms
+# in units of the group's size (``_rigid_mode_rank``), so entries are O(1)
+RIGID_MODE_TOL = 1e-9
 
 
 def _rigid_mode_rank(x, fixed):
@@ -35,8 +38,8 @@ def _rigid_mode_rank(x, fixed):
 
     ``x``: ``(k, 3)`` node positions, ``fixed``: ``(k, 6)`` fixed global increments.  A rigid
     mode is ``u = a + theta x (x - c)``, ``w = theta``; positions are taken about the group's
-    centroid ``c`` and in units of its size, so the rank (tolerance ``1e-9``) is the same in any
-    unit system and anywhere in space.
+    centroid ``c`` and in units of its size, so the rank is the same in any
+    unit system and anywhere in space (tolerance ``RIGID_MODE_TOL``).
     """
     if not fixed.any():
         return 0
@@ -47,7 +50,7 @@ def _rigid_mode_rank(x, fixed):
     G[:, :3, :3] = np.eye(3)
     G[:, :3, 3:] = -skew(d)
     G[:, 3:, 3:] = np.eye(3)
-    return int(np.linalg.matrix_rank(G[fixed], tol=1e-9))
+    return int(np.linalg.matrix_rank(G[fixed], tol=RIGID_MODE_TOL))
 
 
 def _find(parent, i):

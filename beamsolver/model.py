@@ -22,6 +22,7 @@ __all__ = ["Model", "Beam", "Load", "ContactDeclaration", "DOF_NAMES"]
 
 DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
 JOIN_TOL = 1e-9                       # coincidence tolerance relative to the model size
+ZERO_LENGTH_TOL = 1e-12               # an element shorter than this times the model size has zero length
 
 
 @dataclass
@@ -152,7 +153,7 @@ class Model:
             raise InputError(f"{label}: the last row of every pose must be (0, 0, 0, 1)")
         L, eps0 = reference_strain(P[:-1], P[1:])
         size = max(np.ptp(P[:, :3, 3], axis=0).max(), L.sum())
-        short = np.flatnonzero(L <= 1e-12 * size)
+        short = np.flatnonzero(L <= ZERO_LENGTH_TOL * size)
         if len(short):
             i = int(short[0])
             raise InputError(f"{label}: element {i} has zero length (nodes {i} and {i + 1} coincide at "

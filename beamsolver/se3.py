@@ -112,6 +112,11 @@ _CLOSED = {"a": _closed_a, "b": _closed_b, "c": _closed_c, "d": _closed_d,
 # [1e-12, 5]: a, b, c, q2 < 2e-15; d 3e-15; q3, cp 5e-15; q2p 8e-15;
 # q3p 1.5e-14; dp 2.5e-13 (with nine terms the series and closed-form errors
 # of dp cross near 1e-13 around t = 1, so no switch point does better).
+# log_so3: below this ratio |q_v| / q_w (rotation angle < 2 atan(0.1) = 0.2 rad) the factor
+# 2 atan(x) / x is summed as its series (nine terms: error < x^18 / 19 ~ 1e-19); above it, atan2 has
+# no cancellation
+ATAN_SERIES_RATIO = 0.1
+
 SWITCH = {"a": 0.75, "b": 1.0, "c": 1.5, "d": 0.75, "q2": 1.5, "q3": 1.5,
           "cp": 1.5, "dp": 1.0, "q2p": 2.0, "q3p": 2.0}
 
@@ -270,7 +275,7 @@ def log_so3(R):
     qw, qv = q[..., 0], q[..., 1:]
     s = np.sqrt(dot(qv, qv))
     # 2 atan2(s, qw) / s; for small x = s/qw use the series of atan(x)/x.
-    small = s < 0.1 * qw
+    small = s < ATAN_SERIES_RATIO * qw
     x2 = np.where(small, (s / np.where(small, qw, 1.0)) ** 2, 0.0)
     series = np.zeros_like(x2)
     for k in range(8, -1, -1):

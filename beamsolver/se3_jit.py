@@ -12,7 +12,7 @@ version, so both agree to round-off (``tests/test_kernels_jit.py``).
 import numpy as np
 from ._jit import jit, jit_inline
 
-from .se3 import COEFFICIENT_NAMES, SERIES, SWITCH
+from .se3 import ATAN_SERIES_RATIO, COEFFICIENT_NAMES, SERIES, SWITCH
 
 # coefficient indices (rows of _SERIES_TABLE)
 A_, B_, C_, D_, Q2_, Q3_, CP_, DP_, Q2P_, Q3P_ = (COEFFICIENT_NAMES.index(k) for k in
@@ -193,7 +193,7 @@ def log_relative(RA, xA, RB, xB):
         inv = -inv
     qw, qv = q[0] * inv, (q[1] * inv, q[2] * inv, q[3] * inv)
     s = np.sqrt(dot(qv, qv))
-    if s < 0.1 * qw:        # 2 atan(x)/x / qw, x = s / qw: series
+    if s < ATAN_SERIES_RATIO * qw:        # 2 atan(x)/x / qw, x = s / qw: series
         x2 = (s / qw) ** 2
         series = 1.0 / 17.0
         for k in range(7, -1, -1):
