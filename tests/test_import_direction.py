@@ -14,8 +14,8 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[1] / "beamsolver"
 
 LAYER = {
-    # 0: no physics
-    "errors": 0, "version": 0, "_jit": 0, "progress": 0,
+    # 0: no physics (errors, argument checks, the numpy file format of saved solutions)
+    "errors": 0, "version": 0, "_jit": 0, "progress": 0, "validation": 0, "io.archive": 0,
     # 1: maths and geometry (Lie groups, sections, node poses, motions)
     "se3": 1, "se3_jit": 1, "section": 1, "geometry": 1, "motion": 1,
     # 2: element and contact kernels
@@ -23,8 +23,6 @@ LAYER = {
     "contact.pairs": 2, "contact.search": 2,
     # 3: model declarations and their assembly
     "model": 3, "cables": 3, "assembly": 3, "assembly_jit": 3, "contact.system": 3, "linsolve": 3,
-    # 4: the solution file format (numpy only)
-    "io.archive": 4,
     # 5: results
     "results": 5, "restart": 5,
     # 6: solver and linearisation
