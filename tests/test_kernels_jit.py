@@ -30,7 +30,7 @@ ROUND_OFF = 1e-12        # relative to the largest entry of the element's force 
 def _batch(rng, full_C, n=4):
     """Elements (straight, arc, helix references) deformed to every angle of ``ANGLES``."""
     refs = [geometry.straight((0, 0, 0), (0.7, 0.2, -0.1), 1), geometry.arc(1.3, 0.9, 1),
-            geometry.helix(0.4, 1.5, 0.8, 1)]
+            geometry.helix(0.4, 1.5, 0.8, 2)[:2]]          # one element turning by 1.7 rad
     HA, HB, L, eps0, C = [], [], [], [], []
     for P in refs:
         l, e0 = element.reference_strain(P[:1], P[1:])
@@ -151,7 +151,7 @@ def test_second_process_loads_the_cache():
     code = """
 import json, numpy as np
 from beamsolver import assembly_jit, element, element_jit, geometry
-P = geometry.helix(0.4, 1.5, 3.0, 4)
+P = geometry.helix(0.4, 1.5, 3.0, 4 * 2)[:5]
 L, e0 = element.reference_strain(P[:-1], P[1:])
 C = np.broadcast_to(np.diag([1e3, 4e2, 5e2, 20.0, 30.0, 40.0]), (4, 6, 6))
 element.internal_forces_and_tangent(P[:-1], P[1:], L, e0, C)
