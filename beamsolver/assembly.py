@@ -434,9 +434,7 @@ class System:
         H0 = H
         H = H.copy()
         dz = np.ascontiguousarray(dz, dtype=float)
-        nz = self.body_nodes[np.any(dz[self.body_nodes] != 0.0, axis=1)]
-        if len(nz):
-            assembly_jit.compose_exp(H, dz, nz)
+        assembly_jit.compose_exp(H, dz, self.body_nodes)       # nodes with a zero increment are skipped
         if chains and self.chains:
             assembly_jit.rechain(H0, H, dz, self.chain_index, self.chain_ptr)
         g = self.global_nodes

@@ -27,9 +27,12 @@ def scatter(pos, kvals, data):
 
 @jit
 def compose_exp(H, dz, nodes):
-    """``H[i] <- H[i] exp(hat(dz[i]))`` for ``i`` in ``nodes`` (in place)."""
+    """``H[i] <- H[i] exp(hat(dz[i]))`` for ``i`` in ``nodes`` with a non-zero ``dz[i]`` (in place)."""
     E = np.empty((4, 4))
     for i in nodes:
+        if dz[i, 0] == 0.0 and dz[i, 1] == 0.0 and dz[i, 2] == 0.0 and dz[i, 3] == 0.0 and dz[i, 4] == 0.0 \
+                and dz[i, 5] == 0.0:
+            continue
         exp_pose((dz[i, 0], dz[i, 1], dz[i, 2]), (dz[i, 3], dz[i, 4], dz[i, 5]), E)
         compose_into(H[i], E, H[i])
 

@@ -103,11 +103,12 @@ def test_compose_exp_equals_se3():
     H = random_pose(rng, angle=3.0, shape=(6,))
     dz = np.concatenate([rng.standard_normal((6, 3)), random_rotation_vector(rng, [0, 1e-9, 0.3, 1.0, 3.0, 3.1])],
                         axis=1)
+    dz[3] = 0.0                                    # skipped: the pose stays bit for bit
     nodes = np.array([0, 2, 3, 4, 5])
     H1 = H.copy()
     assembly_jit.compose_exp(H1, dz, nodes)
     np.testing.assert_allclose(H1[nodes], se3.compose(H[nodes], se3.exp(dz[nodes])), atol=1e-14 * 4)
-    assert np.array_equal(H1[1], H[1])
+    assert np.array_equal(H1[1], H[1]) and np.array_equal(H1[3], H[3])
 
 
 @pytest.mark.parametrize("reverse", [False, True])
