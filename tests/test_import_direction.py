@@ -16,8 +16,9 @@ PACKAGE = Path(__file__).resolve().parents[1] / "beamsolver"
 LAYER = {
     # 0: no physics (errors, argument checks, the numpy file format of saved solutions)
     "errors": 0, "version": 0, "_jit": 0, "progress": 0, "validation": 0, "io.archive": 0, "io.files": 0,
+    "failures": 0,
     # 1: maths and geometry (Lie groups, sections, node poses, motions)
-    "se3": 1, "se3_jit": 1, "section": 1, "geometry": 1, "motion": 1,
+    "se3": 1, "se3_jit": 1, "section": 1, "geometry": 1, "motion": 1, "motion_path": 1, "definiteness": 1,
     # 2: element and contact kernels
     "element": 2, "element_jit": 2, "contact": 2, "contact.law": 2, "contact.kinematics": 2,
     "contact.pairs": 2, "contact.search": 2,
@@ -25,8 +26,8 @@ LAYER = {
     "model": 3, "cables": 3, "assembly": 3, "assembly_jit": 3, "contact.system": 3, "linsolve": 3,
     # 5: results
     "results": 5, "restart": 5,
-    # 6: solver and linearisation
-    "solver": 6, "linear": 6,
+    # 6: solver, its stepping and failure diagnosis, linearisation
+    "solver": 6, "stepping": 6, "diagnosis": 6, "linear": 6,
     # 7: output, pictures, command line, the package's public face
     "io": 7, "io.lines": 7, "io.vtk": 7, "viz": 7, "cli": 7, "": 7,
 }
