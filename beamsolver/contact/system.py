@@ -29,8 +29,9 @@ from scipy.spatial import cKDTree
 from .. import se3
 from ..errors import InputError
 from .law import default_penalty
-from .pairs import (LINE, ORTHOGONAL, POINT, _project, _section, contact_kernel, kernel_and_tangent,
-                    material_frames)
+from . import kernel_jit, pairs
+from .kernel_jit import contact_kernel, kernel_and_tangent      # compiled; pairs.py's are the oracle
+from .pairs import LINE, ORTHOGONAL, POINT, _project, _section, material_frames
 from .search import XI_TOL, broad_phase, closest_points, element_spheres
 
 MAX_AUGMENT = 30
@@ -39,6 +40,16 @@ SMOOTHING = 0.0           # default smoothing gap of the normal law, relative to
 SLIP_TOLERANCE = 0.005    # elastic slip at the onset of sliding / slave element length (Abaqus' default)
 _KNOWN = {"smoothing", "gauss_points", "penalty_t", "slip_tolerance", "tolerance", "line_angle", "point_ratio",
           "margin"}
+
+
+def use_numpy_kernel(flag=True):
+    """Evaluate contact with the complex-step numpy kernel of ``pairs`` (the test oracle, slow)
+    instead of the compiled ``kernel_jit`` (default); returns the previous setting."""
+    global contact_kernel, kernel_and_tangent
+    previous = kernel_and_tangent is pairs.kernel_and_tangent
+    mod = pairs if flag else kernel_jit
+    contact_kernel, kernel_and_tangent = mod.contact_kernel, mod.kernel_and_tangent
+    return previous
 
 
 class _Decl:
