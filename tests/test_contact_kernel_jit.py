@@ -150,3 +150,19 @@ def test_solves_take_the_same_newton_iterations_as_with_the_oracle(name):
     (it_jit, H_jit), (it_np, H_np) = _solve_both(build, steps=3)
     assert it_jit == it_np
     assert np.abs(H_jit - H_np).max() <= 1e-8
+
+
+def test_runs_as_plain_python_without_jit():
+    """``NUMBA_DISABLE_JIT=1`` (debugging, coverage): the same kernel as plain Python, equal to the oracle."""
+    import subprocess
+    script = ("import sys; sys.path.insert(0, {tests!r}); import numpy as np, numba; assert numba.config.DISABLE_JIT; "
+              "from test_contact_kernel_jit import _scene; from beamsolver.contact import kernel_jit, pairs; "
+              "X, p = _scene(5, True, 0.02, 3.0, True, 0.005, angles=np.array([0.1, 0.6, 1.2])); "
+              "f0, K0, _ = pairs.kernel_and_tangent(X, p); f1, K1, _ = kernel_jit.kernel_and_tangent(X, p); "
+              "print(np.abs(K1 - K0).max() / np.abs(K0).max(), np.abs(f1 - f0).max() / np.abs(f0).max())")
+    env = dict(__import__("os").environ, NUMBA_DISABLE_JIT="1")
+    out = subprocess.run([sys.executable, "-c", script.format(tests=str(Path(__file__).parent))], env=env,
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    eK, ef = map(float, out.stdout.split())
+    assert eK <= 1e-8 and ef <= 1e-8
