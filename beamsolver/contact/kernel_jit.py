@@ -84,9 +84,21 @@ def _mm6(A, B):
     for i in range(n):
         for l in range(k):
             a = A[i, l]
-            if a != 0.0:
-                for j in range(m):
-                    out[i, j] += a * B[l, j]
+            for j in range(m):
+                out[i, j] += a * B[l, j]
+    return out
+
+
+@jit
+def _mtm(A, B):
+    """``A^T @ B`` for small 2-D arrays."""
+    n, k, m = A.shape[1], A.shape[0], B.shape[1]
+    out = np.zeros((n, m))
+    for l in range(k):
+        for i in range(n):
+            a = A[l, i]
+            for j in range(m):
+                out[i, j] += a * B[l, j]
     return out
 
 
@@ -197,7 +209,7 @@ def _jacobian_derivatives(u, w, xi, wr, Ti):
     Ts = _tangent(su, sw)
     y = _mtv(Ts, wr)
     v = xi * y
-    P = _mm6(_mm6(Ti.T.copy(), Ts.T.copy()), _geo(su, sw, y))
+    P = _mtm(Ti, _mtm(Ts, _geo(su, sw, y)))
     P *= -xi
     DB = _geo(u, w, v) + xi * P
     dB = _mtv(Ti, y) + _mm6(P, h.reshape(6, 1))[:, 0]
@@ -206,8 +218,7 @@ def _jacobian_derivatives(u, w, xi, wr, Ti):
     Rh, xh = _exp(u, w)
     As, Ah = _adjoint_inv(Rs, xs), _adjoint_inv(Rh, xh)
     MsT = _m_times(_mtv(As, wr), _tangent(scale(-xi, u), scale(-xi, w)))
-    AhT = Ah.T.copy()
-    DA = -xi * MsT + _m_times(_mtv(Ah, b), _tangent(scale(-1.0, u), scale(-1.0, w))) - _mm6(AhT, DB)
+    DA = -xi * MsT + _m_times(_mtv(Ah, b), _tangent(scale(-1.0, u), scale(-1.0, w))) - _mtm(Ah, DB)
     dA = -_mm6(MsT, h.reshape(6, 1))[:, 0] - _mtv(Ah, dB)
     return DA, DB, dA, dB
 
@@ -465,13 +476,26 @@ def _wrench(R, F, DF, m, Dm, V):
 
 @jit
 def _nodal(u, w, xi, Ti, JA, JB, wr, Dw, Dh, dxi, c0, f, K, j0):
-    """``f_j = J_j^T wr`` for the two nodes of one side and their rows of the tangent."""
-    fa, fb = _mtv(JA, wr), _mtv(JB, wr)
+    """``f_j = J_j^T wr`` for the two nodes of one side and their rows of the tangent:
+    ``J^T dwr + d(J^T wr)/dh dh + d(J^T wr)/dxi dxi`` (``dh`` lives in columns ``c0:c0+12``)."""
     DA, DB, dA, dB = _jacobian_derivatives(u, w, xi, wr, Ti)
-    f[j0, :] = fa
-    f[j0 + 1, :] = fb
-    K[6 * j0:6 * j0 + 6] = _mm6(JA.T.copy(), Dw) + _mm6(DA, Dh) + np.outer(dA, dxi)
-    K[6 * j0 + 6:6 * j0 + 12] = _mm6(JB.T.copy(), Dw) + _mm6(DB, Dh) + np.outer(dB, dxi)
+    for s in range(2):
+        J, D, dd = (JA, DA, dA) if s == 0 else (JB, DB, dB)
+        r0 = 6 * (j0 + s)
+        for i in range(6):
+            acc = 0.0
+            for l in range(6):
+                acc += J[l, i] * wr[l]
+            f[j0 + s, i] = acc
+            for c in range(24):
+                K[r0 + i, c] = dd[i] * dxi[c]
+            for l in range(6):
+                a = J[l, i]
+                for c in range(24):
+                    K[r0 + i, c] += a * Dw[l, c]
+                b = D[i, l]
+                for c in range(c0, c0 + 12):
+                    K[r0 + i, c] += b * Dh[l, c]
 
 
 @jit
