@@ -20,8 +20,13 @@ projection, and the node Jacobians themselves through
 - ``d(Ad(exp(-s))^T w)/ds = -M(z) T(-s)``, ``z = Ad(exp(-s))^T w``,
   ``M(z) = [[0, hat(z_f)], [hat(z_f), hat(z_m)]]``.
 
-Two points differ from the numpy kernel only where it decides on a whole
-batch: the ``active`` flag of the smoothed law is decided per point.
+One difference from the numpy kernel, where that one decides on a whole batch:
+the ``active`` flag of the normal law is decided per point (the numpy kernel uses
+the smoothed rule for every point of a batch in which any point has a smoothing
+gap; the two differ only at a trial traction of exactly zero).
+The law formulas (``law.normal_force``, ``law.coulomb_return_mapping``, the
+``PENALTY_T_MIN`` floor of ``pairs``) are repeated here in scalar form: a change
+to them must be made in both places, and the oracle test catches a mismatch.
 ``NUMBA_DISABLE_JIT=1`` runs this module as plain Python (slowly).
 """
 import numpy as np
