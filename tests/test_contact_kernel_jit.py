@@ -166,3 +166,15 @@ def test_runs_as_plain_python_without_jit():
     assert out.returncode == 0, out.stderr
     eK, ef = map(float, out.stdout.split())
     assert eK <= 1e-8 and ef <= 1e-8
+
+
+def test_compiled_projection_equals_the_numpy_projection():
+    """``kernel_jit.project`` (a drop-in for the search's ``pairs._project``) on all kinds, 8 iterations."""
+    rng = np.random.default_rng(11)
+    X, kinds, _, _ = _pairs(rng, 12, np.tile([1e-3, 0.1, 0.5, 0.7, 1.2, np.pi / 2], 2))
+    h1 = se3.log(se3.relative(X[:, 0], X[:, 1]))
+    h2 = se3.log(se3.relative(X[:, 2], X[:, 3]))
+    xi1, xi2 = rng.uniform(0.2, 0.8, 12), rng.uniform(0.2, 0.8, 12)
+    a0, b0 = pairs._project(kinds, X[:, 0], h1, xi1, X[:, 2], h2, xi2, iterations=8)
+    a1, b1 = kernel_jit.project(kinds, X[:, 0], h1, xi1, X[:, 2], h2, xi2, iterations=8)
+    assert np.abs(a1 - a0).max() <= 1e-12 and np.abs(b1 - b0).max() <= 1e-12

@@ -230,9 +230,9 @@ def _jacobian_derivatives(u, w, xi, wr, Ti):
 
 # ---------------------------------------------------------------- projection and its derivative
 @jit
-def _project(kind, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2):
-    """The two Newton iterations of ``pairs._project`` (from the search's converged point)."""
-    for _ in range(2):
+def _project(kind, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations=2):
+    """Newton iterations of ``pairs._project`` (two in the kernel, from the search's converged point)."""
+    for _ in range(iterations):
         R1, x1, x1p, x1pp = _section(RA1, xA1, u1, w1, xi1)
         R2, x2, x2p, x2pp = _section(RA2, xA2, u2, w2, xi2)
         d = add(x2, scale(-1.0, x1))
@@ -577,6 +577,28 @@ def evaluate(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, t
     for p in range(X.shape[0]):
         _point(X[p], kind[p], par[p], has[p], HCL[p], HFK[p], HLKp[p], lamp[p], friction, f[p], K[p], sc[p],
                vec[p], two[p], flags[p], frames[p])
+
+
+@jit
+def _project_all(kind, HA1, h1, xi1, HA2, h2, xi2, iterations, out1, out2):
+    for p in range(len(kind)):
+        RA1, xA1 = _pose_of(HA1, p)
+        RA2, xA2 = _pose_of(HA2, p)
+        out1[p], out2[p] = _project(kind[p], RA1, xA1, (h1[p, 0], h1[p, 1], h1[p, 2]), (h1[p, 3], h1[p, 4], h1[p, 5]),
+                                    xi1[p], RA2, xA2, (h2[p, 0], h2[p, 1], h2[p, 2]),
+                                    (h2[p, 3], h2[p, 4], h2[p, 5]), xi2[p], iterations)
+
+
+def project(kind, HA1, h1, xi1, HA2, h2, xi2, iterations=3):
+    """Compiled ``pairs._project`` (same arguments, batches ``(P, ...)``): ``xi1, xi2`` after
+    ``iterations`` Newton iterations on the projection conditions of each pair's ``kind``."""
+    P = len(h1)
+    args = [np.ascontiguousarray(np.broadcast_to(a, (P,) + np.shape(a)[-s:] if s else (P,)), dtype=float)
+            for a, s in ((HA1, 2), (h1, 1), (xi1, 0), (HA2, 2), (h2, 1), (xi2, 0))]
+    kind = np.ascontiguousarray(np.broadcast_to(kind, (P,)), dtype=np.int64)
+    out1, out2 = np.empty(P), np.empty(P)
+    _project_all(kind, *args, int(iterations), out1, out2)
+    return out1, out2
 
 
 # ---------------------------------------------------------------- the signatures of pairs.py
