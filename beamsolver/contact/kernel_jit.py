@@ -343,28 +343,34 @@ def _cross_rows(a, D):
 
 
 @jit
-def _unit(v, Dv):
-    """``v / |v|``, its gradient and ``|v|``."""
-    nv = np.sqrt(dot(v, v))
-    e = scale(1.0 / nv, v)
-    return e, (Dv - np.outer(np.array(e), _row_dot(e, Dv, 0))) / nv, nv
-
-
-@jit
 def _axes(RC, xC, RF, xF, VC, VF):
-    """``n, t1, t2`` (``pairs._axes``), centre distance, and the gradients of ``n, t1, t2, dist``."""
+    """``n, t1, t2`` (``pairs._axes``), centre distance, and the gradients of ``n, t1, t2, dist``
+    (one pass over the 24 columns)."""
     d = add(xF, scale(-1.0, xC))
-    Dd = _rot_rows(RF, VF, 0) - _rot_rows(RC, VC, 0)
-    n, Dn, dist = _unit(d, Dd)
-    e1 = _col(RC, 0)
-    De1 = np.outer(np.array(_col(RC, 1)), VC[5]) - np.outer(np.array(_col(RC, 2)), VC[4])
+    dist = np.sqrt(dot(d, d))
+    n = scale(1.0 / dist, d)
+    e1, e2, e3 = _col(RC, 0), _col(RC, 1), _col(RC, 2)
     c = dot(e1, n)
-    Dc = _row_dot(n, De1, 0) + _row_dot(e1, Dn, 0)
     t1r = add(e1, scale(-c, n))
-    t1, Dt1, _ = _unit(t1r, De1 - np.outer(np.array(n), Dc) - c * Dn)
+    lt = np.sqrt(dot(t1r, t1r))
+    t1 = scale(1.0 / lt, t1r)
     t2 = cross(n, t1)
-    Dt2 = _cross_rows(n, Dt1) - _cross_rows(t1, Dn)
-    return n, t1, t2, dist, Dn, Dt1, Dt2, _row_dot(n, Dd, 0)
+    Dn, Dt1, Dt2, Ddist = np.empty((3, 24)), np.empty((3, 24)), np.empty((3, 24)), np.empty(24)
+    for k in range(24):
+        dF = mv(RF, (VF[0, k], VF[1, k], VF[2, k]))
+        dC = mv(RC, (VC[0, k], VC[1, k], VC[2, k]))
+        dd = add(dF, scale(-1.0, dC))
+        nd = dot(n, dd)
+        dn = scale(1.0 / dist, add(dd, scale(-nd, n)))
+        de1 = add(scale(VC[5, k], e2), scale(-VC[4, k], e3))
+        dc = dot(n, de1) + dot(e1, dn)
+        dt1r = add(add(de1, scale(-dc, n)), scale(-c, dn))
+        dt1 = scale(1.0 / lt, add(dt1r, scale(-dot(t1, dt1r), t1)))
+        dt2 = add(cross(n, dt1), scale(-1.0, cross(t1, dn)))
+        for i in range(3):
+            Dn[i, k], Dt1[i, k], Dt2[i, k] = dn[i], dt1[i], dt2[i]
+        Ddist[k] = nd
+    return n, t1, t2, dist, Dn, Dt1, Dt2, Ddist
 
 
 @jit
@@ -469,13 +475,18 @@ def _friction(slip, Dslip, lamp, t1, t2, Dt1, Dt2, lam, Dlam, par):
 # ---------------------------------------------------------------- one contact point
 @jit
 def _wrench(R, F, DF, m, Dm, V):
-    """Body wrench ``(R^T F, R^T m)`` and its gradient; ``V``: the frame's variation ``(6, 24)``."""
+    """Body wrench ``(R^T F, R^T m)`` and its gradient; ``V``: the frame's variation ``(6, 24)``;
+    ``d(R^T F)/dtheta = hat(R^T F)``."""
     Rt = transpose(R)
     bF, bm = mv(Rt, F), mv(Rt, m)
     w = np.array([bF[0], bF[1], bF[2], bm[0], bm[1], bm[2]])
     D = np.empty((6, 24))
-    D[0:3] = _rot_rows(Rt, DF, 0) + _cross_rows(bF, V[3:6])      # d(R^T F)/dtheta = hat(R^T F)
-    D[3:6] = _rot_rows(Rt, Dm, 0) + _cross_rows(bm, V[3:6])
+    for k in range(24):
+        th = (V[3, k], V[4, k], V[5, k])
+        a = add(mv(Rt, (DF[0, k], DF[1, k], DF[2, k])), cross(bF, th))
+        b = add(mv(Rt, (Dm[0, k], Dm[1, k], Dm[2, k])), cross(bm, th))
+        for i in range(3):
+            D[i, k], D[3 + i, k] = a[i], b[i]
     return w, D
 
 
