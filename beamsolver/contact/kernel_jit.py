@@ -185,13 +185,15 @@ def _geo(u, w, v):
 
 @jit
 def _m_times(z, A):
-    """``M(z) A`` with ``M(z) = [[0, hat(z_f)], [hat(z_f), hat(z_m)]]``."""
-    M = np.zeros((6, 6))
+    """``M(z) A`` with ``M(z) = [[0, hat(z_f)], [hat(z_f), hat(z_m)]]``, column by column."""
     zf, zm = (z[0], z[1], z[2]), (z[3], z[4], z[5])
-    _put3(M, 0, 3, mat(zf, 0.0))
-    _put3(M, 3, 0, mat(zf, 0.0))
-    _put3(M, 3, 3, mat(zm, 0.0))
-    return _mm6(M, A)
+    out = np.empty((6, A.shape[1]))
+    for k in range(A.shape[1]):
+        au, aw = (A[0, k], A[1, k], A[2, k]), (A[3, k], A[4, k], A[5, k])
+        top, bot = cross(zf, aw), add(cross(zf, au), cross(zm, aw))
+        for i in range(3):
+            out[i, k], out[3 + i, k] = top[i], bot[i]
+    return out
 
 
 # ---------------------------------------------------------------- node Jacobians and their derivative
@@ -208,23 +210,40 @@ def _jacobians(u, w, xi, Ti):
 
 @jit
 def _jacobian_derivatives(u, w, xi, wr, Ti):
-    """``d(J_A^T wr)/dh, d(J_B^T wr)/dh`` ``(6, 6)`` and ``d/dxi`` ``(6,)`` at fixed ``wr``."""
-    h = np.array([u[0], u[1], u[2], w[0], w[1], w[2]])
+    """``d(J_A^T wr)/dh, d(J_B^T wr)/dh`` ``(6, 6)`` and ``d/dxi`` ``(6,)`` at fixed ``wr``.
+
+    With ``s = xi h``, ``y = T(s)^T wr``, ``b = J_B^T wr = xi T(h)^-T y`` and ``T(-s) h = h``:
+    ``dB/dh = G(h, xi y) - xi^2 T(h)^-T T(s)^T G(s, y)``, ``dB/dxi = T(h)^-T y - xi T(h)^-T T(s)^T G(s, y) h``,
+    ``dA/dh = -xi M(z_s) T(-s) + M(z_h) T(-h) - Ad(exp(-h))^T dB/dh``, ``dA/dxi = -M(z_s) h - Ad(exp(-h))^T dB/dxi``.
+    """
     su, sw = scale(xi, u), scale(xi, w)
     Ts = _tangent(su, sw)
     y = _mtv(Ts, wr)
-    v = xi * y
-    P = _mtm(Ti, _mtm(Ts, _geo(su, sw, y)))
-    P *= -xi
-    DB = _geo(u, w, v) + xi * P
-    dB = _mtv(Ti, y) + _mm6(P, h.reshape(6, 1))[:, 0]
-    b = _mtv(Ti, v)
+    P = _mtm(Ti, _mtm(Ts, _geo(su, sw, y)))            # T(h)^-T T(s)^T G(s, y)
+    DB = _geo(u, w, xi * y)
+    dB = _mtv(Ti, y)
+    h = (u[0], u[1], u[2], w[0], w[1], w[2])
+    for i in range(6):
+        acc = 0.0
+        for j in range(6):
+            DB[i, j] -= xi * xi * P[i, j]
+            acc += P[i, j] * h[j]
+        dB[i] -= xi * acc
+    b = _mtv(Ti, xi * y)
     Rs, xs = _exp(su, sw)
     Rh, xh = _exp(u, w)
     As, Ah = _adjoint_inv(Rs, xs), _adjoint_inv(Rh, xh)
-    MsT = _m_times(_mtv(As, wr), _tangent(scale(-xi, u), scale(-xi, w)))
-    DA = -xi * MsT + _m_times(_mtv(Ah, b), _tangent(scale(-1.0, u), scale(-1.0, w))) - _mtm(Ah, DB)
-    dA = -_mm6(MsT, h.reshape(6, 1))[:, 0] - _mtv(Ah, dB)
+    zs = _mtv(As, wr)
+    DA = _m_times(_mtv(Ah, b), _tangent(scale(-1.0, u), scale(-1.0, w)))
+    Ms = _m_times(zs, _tangent(scale(-xi, u), scale(-xi, w)))
+    AhDB = _mtm(Ah, DB)
+    hh = np.array(h).reshape(6, 1)
+    dA = _m_times(zs, hh)[:, 0]
+    AhdB = _mtv(Ah, dB)
+    for i in range(6):
+        dA[i] = -dA[i] - AhdB[i]
+        for j in range(6):
+            DA[i, j] -= xi * Ms[i, j] + AhDB[i, j]
     return DA, DB, dA, dB
 
 
