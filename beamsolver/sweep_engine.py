@@ -13,9 +13,12 @@ a shared file system on a cluster).
 Failures do not stop a study: ``run_point`` records ``ConvergenceError``,
 ``InputError`` and unexpected exceptions in the point's row; a point whose
 worker dies (``KilledWorker``) is submitted once more, then recorded.
-The local cluster's scheduler gives up on a task at the first death
+The local cluster's scheduler sends a worker one task at a time
+(``worker-saturation`` 1) and gives up on a task at the first death
 (``allowed-failures`` 0), so such a point runs twice in all; a remote
-scheduler applies its own ``distributed.scheduler.allowed-failures`` first.
+scheduler applies its own ``distributed.scheduler.allowed-failures`` first
+(default 3; tasks queued on the dead worker count too unless its
+``worker-saturation`` is 1).
 """
 import contextlib
 import os
@@ -114,7 +117,10 @@ def local_client(n_workers=None, **cluster_options):
     opts = dict(n_workers=n_workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
                 host="127.0.0.1", dashboard_address="127.0.0.1:0", env={v: "1" for v in BLAS_VARS})
     opts.update(cluster_options)
-    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+    # a worker holds only the task it runs (saturation 1), so a death marks that task alone: KilledWorker at
+    # the first death (allowed-failures 0), and _run submits the point once more
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0,
+                          "distributed.scheduler.worker-saturation": 1.0}):
         try:
             cluster = distributed.LocalCluster(**opts)
         except RuntimeError as e:
@@ -292,10 +298,15 @@ class _Progress:
 
 
 def _dashboard(client):
-    """The dashboard address of ``client``'s scheduler, or ``None`` when it serves none."""
+    """The dashboard address of ``client``'s scheduler (``None`` when it serves none), with a note when
+    the scheduler runs here without bokeh (it then serves only an "install bokeh" page)."""
+    import importlib.util
     try:
         if "dashboard" not in client.scheduler_info().get("services", {}):
             return None
-        return client.dashboard_link
+        link = client.dashboard_link
     except Exception:       # a scheduler that does not report its services
         return None
+    if getattr(client, "_beamsolver_cluster", None) is not None and importlib.util.find_spec("bokeh") is None:
+        link += " (install bokeh>=3.1 to see it)"
+    return link

@@ -1,0 +1,109 @@
+"""Sweep studies without Dask: grid expansion, point ids, input errors, records, the study report,
+and the core import path staying free of dask."""
+import json
+import subprocess
+import sys
+
+import pytest
+
+import beamsolver as bs
+from beamsolver import study
+from beamsolver.sweep_cli import SceneScript, parse_param
+
+
+def test_grid_product_order_and_ids():
+    pts = study.points({"mu": [0.1, 0.3], "lay_angle": [8, 12], "ends": ["fixed"]})
+    assert pts == [dict(mu=0.1, lay_angle=8, ends="fixed"), dict(mu=0.1, lay_angle=12, ends="fixed"),
+                   dict(mu=0.3, lay_angle=8, ends="fixed"), dict(mu=0.3, lay_angle=12, ends="fixed")]
+    assert study.point_id(pts[1]) == "mu=0.1_lay_angle=12_ends=fixed"
+    assert study.point_id({"eps": 1e-05}) == "eps=1e-05"
+    # values that do not make a file name: a stable hash of the parameters
+    odd = study.point_id({"path": "/tmp/x y"})
+    assert odd.startswith("point-") and odd == study.point_id({"path": "/tmp/x y"})
+    assert odd != study.point_id({"path": "/tmp/x z"})
+    assert study.points([{"a": 1}, {"a": 2, "b": "x"}]) == [{"a": 1}, {"a": 2, "b": "x"}]
+    assert study.param_names([{"a": 1}, {"a": 2, "b": "x"}]) == ["a", "b"]
+
+
+@pytest.mark.parametrize("grid, words", [
+    ({}, "grid is empty"),
+    ({"mu": 0.3}, "grid['mu']"),
+    ({"mu": []}, "grid['mu']"),
+    ({"status": [1]}, "reserved"),
+    ({"not a name": [1]}, "identifier"),
+    ([{"a": 1}, {"a": 1}], "repeats point 0"),
+    ([{"a": object()}], "grid point 0"),
+    ("mu", "grid must be"),
+])
+def test_bad_grids_raise_input_error(grid, words):
+    with pytest.raises(bs.InputError, match=words.replace("[", r"\[").replace("]", r"\]")):
+        study.points(grid)
+
+
+def test_bad_arguments_raise_before_any_engine_starts(tmp_path):
+    def scene(a):
+        return bs.Model()
+    with pytest.raises(bs.InputError, match="scene must be callable"):
+        bs.sweep(42, {"a": [1]})
+    with pytest.raises(bs.InputError, match="summary must be callable"):
+        bs.sweep(scene, {"a": [1]}, summary="x")
+    with pytest.raises(bs.InputError, match="'output'"):
+        bs.sweep(scene, {"a": [1]}, solve_options={"output": "x"})
+    with pytest.raises(bs.InputError, match="client must be"):
+        bs.sweep(scene, {"a": [1]}, client=42, output=tmp_path / "s")
+
+
+def test_complete_records_and_report(tmp_path):
+    opts = {"steps": 4}
+    params = [{"mu": 0.1}, {"mu": 0.2}, {"mu": 0.3}]
+    ids = [study.point_id(p) for p in params]
+    study.write_json(tmp_path / study.STUDY, dict(names=["mu"], options=study.canonical(opts),
+                                                  points=[dict(id=i, params=p) for i, p in zip(ids, params)]))
+    rows = [dict(id=ids[0], mu=0.1, status="converged", iterations=3, steps=4, wall=0.5, K=1.25, message=""),
+            dict(id=ids[1], mu=0.2, status="ConvergenceError", iterations=9, steps=2, wall=0.7,
+                 message="solve: could not advance")]
+    for p, r in zip(params, rows):
+        (tmp_path / r["id"]).mkdir()
+        study.write_json(tmp_path / r["id"] / study.POINT, dict(params=p, options=study.canonical(opts), row=r))
+    rec = study.read_point(tmp_path, ids[0])
+    assert study.is_complete(rec, params[0], opts)
+    assert not study.is_complete(rec, params[0], {"steps": 8})          # other solve options: stale
+    assert not study.is_complete(rec, params[1], opts)
+    assert not study.is_complete(None, params[2], opts)
+    lost = dict(rows[1], status="KilledWorker")
+    assert not study.is_complete(dict(params=params[1], options=study.canonical(opts), row=lost), params[1], opts)
+    meta, loaded = study.load_study(tmp_path)
+    assert loaded == rows + [None]
+    text = study.report(tmp_path)
+    assert "3 points over mu" in text and "1 converged" in text and "1 not run" in text
+    assert "1 ConvergenceError" in text and "solve: could not advance" in text and "1.25" in text
+    path = study.write_summary(tmp_path, loaded, meta["names"])
+    lines = path.read_text().splitlines()
+    assert lines[0] == "id,mu,status,iterations,steps,wall,K,message"
+    assert lines[1] == "mu=0.1,0.1,converged,3,4,0.5,1.25," and len(lines) == 3
+
+
+def test_cli_params_and_scene_script_pickle(tmp_path):
+    import pickle
+    assert parse_param("mu=0.1,0.2") == ("mu", [0.1, 0.2])
+    assert parse_param("n=8, 12") == ("n", [8, 12])
+    assert parse_param("ends=fixed,'free'") == ("ends", ["fixed", "free"])
+    with pytest.raises(bs.InputError, match="NAME=VALUE"):
+        parse_param("mu")
+    path = tmp_path / "s.py"
+    path.write_text("solve_options = dict(steps=3)\ncalls = []\n"
+                    "def build(a):\n    calls.append(a)\n    return a\n")
+    s = SceneScript(path)
+    assert s.solve_options == {"steps": 3} and not s.has_summary and s.build(a=5) == 5
+    t = pickle.loads(pickle.dumps(s))                     # the source travels, not the namespace
+    assert t.source == s.source and t._ns is None and t.build(a=7) == 7
+    assert t.namespace()["calls"] == [7] and s.namespace()["calls"] == [5]
+
+
+def test_core_import_path_is_free_of_dask():
+    code = ("import sys, beamsolver as bs, beamsolver.cli, beamsolver.study, beamsolver.sweep_cli, "
+            "beamsolver.sweep_engine; assert callable(bs.sweep); "
+            "print(sorted({m.split('.')[0] for m in sys.modules} & {'dask', 'distributed', 'cloudpickle'}))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert json.loads(out.stdout.replace("'", '"')) == []
