@@ -35,6 +35,7 @@ __all__ = ["sweep", "local_client", "run_point"]
 BLAS_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "VECLIB_MAXIMUM_THREADS",
              "NUMEXPR_NUM_THREADS")
 BARRED_OPTIONS = ("output", "restart")
+NO_WORKERS_TIMEOUT = "120s"
 
 
 def _model_of(built, where):
@@ -58,15 +59,34 @@ def _scalars(values):
     return out
 
 
-def run_point(scene, summary, params, pid, folder, options, paraview=False):
-    """Build, solve and record one point (runs in a worker); returns its row (see ``beamsolver.study``)."""
+class SceneLoadError(RuntimeError):
+    """The worker could not unpickle the scene or summary (typically: it cannot import their module)."""
+
+
+def _load(code):
+    import pickle
+    try:
+        return pickle.loads(code)
+    except Exception as e:
+        raise SceneLoadError(f"the worker cannot load the scene ({type(e).__name__}: {e}): it must import the "
+                             "scene's module (install it, put it on the workers' PYTHONPATH, or use "
+                             "client.upload_file)") from e
+
+
+def run_point(code, params, pid, folder, options, paraview=False):
+    """Build, solve and record one point (runs in a worker); returns its row (see ``beamsolver.study``).
+
+    ``code``: the pickled pair ``(scene, summary)`` (``pack``), loaded here so that a scene the worker
+    cannot import is recorded as the point's failure instead of breaking the worker.
+    """
     from .solver import solve
     t0 = time.perf_counter()
     row = dict(id=pid, **params, status="converged", iterations=0, steps=0, wall=0.0)
     point = Path(folder) / pid if folder is not None else None
     record = dict(params=params, options=study.canonical(options))
-    sol = built = None
+    sol = built = summary = None
     try:
+        scene, summary = _load(code)
         model, built = _model_of(scene(**params), "scene(**params)")
         kw = {"verbose": False, **options}
         sol = solve(model, output=str(point) if paraview and point is not None else None, **kw)
@@ -119,8 +139,10 @@ def local_client(n_workers=None, **cluster_options):
     opts.update(cluster_options)
     # a worker holds only the task it runs (saturation 1), so a death marks that task alone: KilledWorker at
     # the first death (allowed-failures 0), and _run submits the point once more
+    # and tasks fail (recorded) rather than wait forever should every worker be gone for NO_WORKERS_TIMEOUT
     with dask.config.set({"distributed.scheduler.allowed-failures": 0,
-                          "distributed.scheduler.worker-saturation": 1.0}):
+                          "distributed.scheduler.worker-saturation": 1.0,
+                          "distributed.scheduler.no-workers-timeout": NO_WORKERS_TIMEOUT}):
         try:
             cluster = distributed.LocalCluster(**opts)
         except RuntimeError as e:
@@ -151,6 +173,16 @@ def _engine(client):
         c.close()
         if cluster is not None:
             cluster.close()
+
+
+def pack(scene, summary):
+    """``(scene, summary)`` pickled by cloudpickle (functions of ``__main__``, closures, lambdas by value)."""
+    import cloudpickle
+    try:
+        return cloudpickle.dumps((scene, summary))
+    except Exception as e:
+        raise InputError(f"sweep: scene or summary cannot be sent to the workers: {type(e).__name__}: {e}") \
+            from None
 
 
 def _check(scene, summary, solve_options):
@@ -205,7 +237,8 @@ def sweep(scene, grid, *, summary=None, client=None, output=None, solve_options=
                 rows[i] = rec["row"]
     todo = [i for i, r in enumerate(rows) if r is None]
     if todo:
-        task = dict(scene=scene, summary=summary, folder=None if folder is None else str(folder.resolve()),
+        _import_distributed()
+        task = dict(code=pack(scene, summary), folder=None if folder is None else str(folder.resolve()),
                     options=opts, paraview=bool(paraview))
         with _engine(client) as c:
             _run(c, task, pts, ids, todo, rows, names, folder, verbose)
@@ -221,7 +254,7 @@ def _run(client, task, pts, ids, todo, rows, names, folder, verbose):
     tag = uuid.uuid4().hex[:8]
 
     def submit(i, attempt):
-        f = client.submit(run_point, task["scene"], task["summary"], pts[i], ids[i], task["folder"],
+        f = client.submit(run_point, task["code"], pts[i], ids[i], task["folder"],
                           task["options"], task["paraview"], key=f"beamsolver-{ids[i]}-{tag}-{attempt}",
                           pure=False)
         meta[f.key] = (i, attempt, f)
@@ -239,12 +272,10 @@ def _run(client, task, pts, ids, todo, rows, names, folder, verbose):
                 if attempt == 0:
                     futures.add(submit(i, 1))
                     continue
-                row = dict(id=ids[i], **pts[i], status="KilledWorker", iterations=0, steps=0, wall=0.0,
-                           message=f"the worker died twice running this point ({e})")
-                if folder is not None:
-                    (folder / ids[i]).mkdir(exist_ok=True)
-                    study.write_json(folder / ids[i] / study.POINT, dict(
-                        params=pts[i], options=study.canonical(task["options"]), row=row))
+                row = _engine_failure(folder, ids[i], pts[i], task["options"], "KilledWorker",
+                                      f"the worker died twice running this point ({e})")
+            except Exception as e:  # the engine's own failures (e.g. no workers left): recorded
+                row = _engine_failure(folder, ids[i], pts[i], task["options"], type(e).__name__, str(e))
             rows[i] = row
             if folder is not None:
                 study.write_summary(folder, rows, names)
@@ -253,6 +284,15 @@ def _run(client, task, pts, ids, todo, rows, names, folder, verbose):
         progress.close()
         if meta:                   # interrupted: the points not finished stay to be resumed
             client.cancel([m[2] for m in meta.values()], force=True)
+
+
+def _engine_failure(folder, pid, params, options, status, message):
+    """Row (and point record) of a point that Dask could not run; such points run again on a rerun."""
+    row = dict(id=pid, **params, status=status, iterations=0, steps=0, wall=0.0, message=message)
+    if folder is not None:
+        (folder / pid).mkdir(exist_ok=True)
+        study.write_json(folder / pid / study.POINT, dict(params=params, options=study.canonical(options), row=row))
+    return row
 
 
 class _Progress:

@@ -113,6 +113,19 @@ def test_a_dying_worker_is_retried_once_then_recorded(client, tmp_path):
     assert not study.is_complete(rec, grid[0], OPTIONS)
 
 
+def test_a_scene_the_workers_cannot_import_is_recorded(client, tmp_path, monkeypatch):
+    (tmp_path / "only_here.py").write_text("from test_sweep import cantilever\n\n\n"
+                                           "def scene(turns):\n    return cantilever(turns)\n")
+    monkeypatch.syspath_prepend(str(tmp_path))               # importable here, not in the workers
+    import only_here
+    rows = bs.sweep(only_here.scene, {"turns": [0.25, 0.5]}, client=client, output=tmp_path / "s",
+                    solve_options=OPTIONS, verbose=False)
+    assert [r["status"] for r in rows] == ["SceneLoadError"] * 2
+    assert "No module named 'only_here'" in rows[0]["message"] and "upload_file" in rows[0]["message"]
+    assert bs.sweep(cantilever, {"turns": [0.25]}, client=client, solve_options=OPTIONS,
+                    verbose=False)[0]["status"] == "converged"           # the workers survived
+
+
 def test_an_interrupted_study_resumes(client, tmp_path, monkeypatch):
     log = tmp_path / "log"
     grid = [dict(turns=t, log=str(log), delay=0.0 if t == 0.25 else 0.3) for t in (0.25, 0.5, 0.75, 1.0)]
@@ -218,3 +231,24 @@ def test_cli_sweep_on_a_scheduler_and_worker_started_here(tmp_path):
             except subprocess.TimeoutExpired:
                 p.kill()
                 p.wait()
+
+
+def test_strand_sweep_example_against_strand_theory(client, tmp_path):
+    sys.path.insert(0, str(ROOT / "examples"))
+    try:
+        import strand_sweep
+    finally:
+        sys.path.remove(str(ROOT / "examples"))
+    client.upload_file(str(ROOT / "examples" / "strand_sweep.py"))     # the workers import the scene's module
+    table = strand_sweep.main(angles=(5.0, 20.0), client=client, output=tmp_path / "s", verbose=False)
+    for t in table:
+        assert t["K_fixed"] == pytest.approx(t["rod_K_fixed"], rel=0.015), t
+        assert t["K_fixed"] <= t["fibre_K_fixed"] * 1.0001, t         # the fibre limit bounds it here
+        assert t["C"] == pytest.approx(t["fibre_C"], rel=0.04), t
+        assert t["K_free"] == pytest.approx(t["rod_K_free"], rel=0.05), t
+        assert t["K_free"] > 1.4 * t["fibre_K_free"]                 # the fibre K_ww omits wire torsion
+        assert t["twist"] == pytest.approx(t["rod_twist"], rel=0.1), t   # a right-hand lay untwists
+        assert t["twist"] < 0 and t["K_free"] < t["K_fixed"]
+    assert table[1]["K_fixed"] < table[0]["K_fixed"] and table[1]["C"] > table[0]["C"]
+    pytest.importorskip("matplotlib")
+    assert strand_sweep.plot(table, tmp_path / "p.png").stat().st_size > 0
