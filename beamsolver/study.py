@@ -15,8 +15,8 @@ Study folder (``beamsolver.sweep(..., output=folder)``):
   with ``sweep(..., paraview=True)``;
 - ``<point id>/point.json``: the point's row, its solve options and, for an
   unexpected error, the traceback; written last and atomically.  A point is
-  *complete* when it has one with a final status (``FINAL``) and the same
-  parameters and solve options: reruns skip it.
+  *complete* when it has one with a final status (``FINAL``), the same
+  parameters and solve options (and ParaView files if asked for): reruns skip it.
 
 Row fields: ``id``, the parameters, ``status`` (``"converged"``,
 ``"ConvergenceError"``, ``"InputError"``, ``"KilledWorker"`` for a worker that
@@ -180,12 +180,13 @@ def read_point(folder, pid):
         return None
 
 
-def is_complete(record, params, options):
-    """Whether a point record has a final status for the same parameters and solve options."""
+def is_complete(record, params, options, paraview=False):
+    """Whether a point record has a final status for the same parameters and solve options (and
+    ParaView files when ``paraview``)."""
     if not record or "row" not in record:
         return False
     return (record["row"].get("status") in FINAL and canonical(record.get("params")) == canonical(params)
-            and record.get("options") == canonical(options))
+            and record.get("options") == canonical(options) and (record.get("paraview", False) or not paraview))
 
 
 def is_study(path):

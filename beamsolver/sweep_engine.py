@@ -83,7 +83,7 @@ def run_point(code, params, pid, folder, options, paraview=False):
     t0 = time.perf_counter()
     row = dict(id=pid, **params, status="converged", iterations=0, steps=0, wall=0.0)
     point = Path(folder) / pid if folder is not None else None
-    record = dict(params=params, options=study.canonical(options))
+    record = dict(params=params, options=study.canonical(options), paraview=bool(paraview))
     sol = built = summary = None
     try:
         scene, summary = _load(code)
@@ -233,7 +233,7 @@ def sweep(scene, grid, *, summary=None, client=None, output=None, solve_options=
             points=[dict(id=i, params=p) for i, p in zip(ids, pts)]))
         for i, (pid, p) in enumerate(zip(ids, pts)):
             rec = study.read_point(folder, pid)
-            if study.is_complete(rec, p, opts):
+            if study.is_complete(rec, p, opts, paraview):
                 rows[i] = rec["row"]
     todo = [i for i, r in enumerate(rows) if r is None]
     if todo:

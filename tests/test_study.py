@@ -70,6 +70,8 @@ def test_complete_records_and_report(tmp_path):
     assert not study.is_complete(rec, params[0], {"steps": 8})          # other solve options: stale
     assert not study.is_complete(rec, params[1], opts)
     assert not study.is_complete(None, params[2], opts)
+    assert not study.is_complete(rec, params[0], opts, paraview=True)      # no ParaView files yet
+    assert study.is_complete(dict(rec, paraview=True), params[0], opts, paraview=True)
     lost = dict(rows[1], status="KilledWorker")
     assert not study.is_complete(dict(params=params[1], options=study.canonical(opts), row=lost), params[1], opts)
     meta, loaded = study.load_study(tmp_path)
