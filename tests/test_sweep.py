@@ -252,3 +252,21 @@ def test_strand_sweep_example_against_strand_theory(client, tmp_path):
     assert table[1]["K_fixed"] < table[0]["K_fixed"] and table[1]["C"] > table[0]["C"]
     pytest.importorskip("matplotlib")
     assert strand_sweep.plot(table, tmp_path / "p.png").stat().st_size > 0
+
+
+def test_sweep_overhead_benchmark_pieces(client, tmp_path):
+    import cloudpickle
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    try:
+        import sweep_overhead as so
+    finally:
+        sys.path.remove(str(ROOT / "benchmarks"))
+    pts = [dict(load=x, n_elements=so.SIZES["small"]) for x in so.LOADS[:2]]
+    (tmp_path / "serial").mkdir()
+    assert so.serial(pts, tmp_path / "serial") > 0 and len(list((tmp_path / "serial").iterdir())) == 2
+    cloudpickle.register_pickle_by_value(so)                  # as when the script runs as __main__
+    try:
+        wall, inside = so.swept(client, pts, tmp_path / "s")
+    finally:
+        cloudpickle.unregister_pickle_by_value(so)
+    assert wall > 0 and inside > 0
