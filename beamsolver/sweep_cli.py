@@ -100,6 +100,9 @@ def cmd_sweep(args):
         print(f"beamsolver sweep: no such script {script}", file=sys.stderr)
         return 1
     scene = SceneScript(script)
+    if not callable(scene.namespace().get("build")):
+        print(f"beamsolver sweep: {script} defines no function build(**params)", file=sys.stderr)
+        return 1
     grid = dict(parse_param(p) for p in args.param)
     opts = scene.solve_options
     if args.steps is not None:
@@ -107,9 +110,13 @@ def cmd_sweep(args):
     if args.t_end is not None:
         opts["t_end"] = args.t_end
     out = Path(args.output) if args.output else Path(f"{script.stem}_study")
-    rows = sweep(scene.build, grid, summary=scene.summary if scene.has_summary else None,
-                 client=args.scheduler, output=out, solve_options=opts, paraview=args.paraview,
-                 verbose=False if args.quiet else None)
+    try:
+        rows = sweep(scene.build, grid, summary=scene.summary if scene.has_summary else None,
+                     client=args.scheduler, output=out, solve_options=opts, paraview=args.paraview,
+                     verbose=False if args.quiet else None)
+    except ImportError as e:
+        print(f"beamsolver sweep: {e}", file=sys.stderr)
+        return 1
     if not args.quiet:
         print(study.report(out))
     return 0 if all(r["status"] == "converged" for r in rows) else 2

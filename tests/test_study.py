@@ -109,3 +109,36 @@ def test_core_import_path_is_free_of_dask():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert json.loads(out.stdout.replace("'", '"')) == []
+
+
+def test_progress_bar_over_points(monkeypatch, capsys):
+    from beamsolver.sweep_engine import _Progress
+
+    class Client:
+        def nthreads(self):
+            return {"a": 1, "b": 1}
+
+        def scheduler_info(self):
+            return {"services": {"dashboard": 8787}}
+        dashboard_link = "http://127.0.0.1:8787/status"
+    monkeypatch.setattr("sys.stderr.isatty", lambda: True)
+    rows = [dict(status="converged"), dict(status="InputError"), None, None, None]
+    p = _Progress(None, rows, Client())                    # two points finished in an earlier run
+    assert p.bar.n == 2 and "done 1, failed 1, running 2" in p.bar.postfix
+    p.update(True, 2)
+    assert p.bar.n == 3 and "done 2, failed 1, running 2" in p.bar.postfix
+    p.update(False, 0)
+    assert "done 2, failed 2, running 0" in p.bar.postfix
+    p.close()
+    assert "Dask dashboard at http://127.0.0.1:8787/status" in capsys.readouterr().err
+
+
+def test_cli_sweep_refuses_a_script_without_build(tmp_path):
+    (tmp_path / "s.py").write_text("model = None\n")
+    out = subprocess.run([sys.executable, "-m", "beamsolver.cli", "sweep", "s.py", "--param", "a=1,2"],
+                         cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert out.returncode == 1 and "defines no function build(**params)" in out.stderr
+    (tmp_path / "s.py").write_text("def build(a):\n    return None\n")
+    out = subprocess.run([sys.executable, "-m", "beamsolver.cli", "sweep", "s.py", "--param", "a"],
+                         cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert out.returncode == 1 and "NAME=VALUE" in out.stderr
