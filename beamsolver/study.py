@@ -38,7 +38,7 @@ import numpy as np
 
 from .errors import InputError
 
-__all__ = ["points", "point_id", "FINAL", "RESERVED", "param_names", "table_columns", "write_json", "write_summary",
+__all__ = ["points", "point_id", "point_ids", "FINAL", "RESERVED", "param_names", "table_columns", "write_json", "write_summary",
            "read_point", "is_complete", "is_study", "load_study", "report"]
 
 FINAL = ("converged", "ConvergenceError", "InputError")
@@ -116,6 +116,16 @@ def point_id(params):
     if len(slug) <= MAX_ID and all(_SAFE.match(t) for _, t in parts):
         return slug
     return "point-" + hashlib.sha1(canonical(params).encode()).hexdigest()[:12]
+
+
+def point_ids(pts):
+    """``point_id`` of every point; points whose ids would coincide (``1`` and ``"1"``) get their hash."""
+    ids = [point_id(p) for p in pts]
+    count = {}
+    for i in ids:
+        count[i] = count.get(i, 0) + 1
+    return [i if count[i] == 1 else "point-" + hashlib.sha1(canonical(p).encode()).hexdigest()[:12]
+            for i, p in zip(ids, pts)]
 
 
 def _atomic_text(path, text):

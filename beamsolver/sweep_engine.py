@@ -220,7 +220,7 @@ def sweep(scene, grid, *, summary=None, client=None, output=None, solve_options=
     """
     pts = study.points(grid)
     opts = _check(scene, summary, solve_options)
-    ids = [study.point_id(p) for p in pts]
+    ids = study.point_ids(pts)
     names = study.param_names(pts)
     rows = [None] * len(pts)
     folder = None

@@ -21,6 +21,8 @@ def test_grid_product_order_and_ids():
     odd = study.point_id({"path": "/tmp/x y"})
     assert odd.startswith("point-") and odd == study.point_id({"path": "/tmp/x y"})
     assert odd != study.point_id({"path": "/tmp/x z"})
+    ids = study.point_ids([{"a": 1}, {"a": "1"}, {"a": 2}])         # 1 and "1" would share a folder
+    assert ids[2] == "a=2" and ids[0].startswith("point-") and ids[1].startswith("point-") and ids[0] != ids[1]
     assert study.points([{"a": 1}, {"a": 2, "b": "x"}]) == [{"a": 1}, {"a": 2, "b": "x"}]
     assert study.param_names([{"a": 1}, {"a": 2, "b": "x"}]) == ["a", "b"]
 
