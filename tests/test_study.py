@@ -144,3 +144,47 @@ def test_cli_sweep_refuses_a_script_without_build(tmp_path):
     out = subprocess.run([sys.executable, "-m", "beamsolver.cli", "sweep", "s.py", "--param", "a"],
                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert out.returncode == 1 and "NAME=VALUE" in out.stderr
+
+
+def small_scene(load=1.0, kind="beam"):
+    if kind == "nothing":
+        return "not a model"
+    if kind == "crash":
+        return 1 / 0
+    sec = bs.Section(EA=1e4, GA2=1e4, GA3=1e4, GJ=1e2, EI2=1e2, EI3=1e2, radius=0.1)
+    m = bs.Model()
+    b = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 2), sec)
+    m.clamp(b.first)
+    m.add_load(b.last, force=(0, load, 0))
+    return m, b
+
+
+def bad_summary(sol, model, beam):
+    return {"tip": sol.position(beam.last)[1], "status": "mine"}
+
+
+def tip_summary(sol, model, beam):
+    return {"tip": sol.position(beam.last)[1]}
+
+
+def test_run_point_records_every_kind_of_failure(tmp_path):
+    """``run_point`` (what a worker runs) without Dask: pickled scene and summary in, row and record out."""
+    import pickle
+    from beamsolver.sweep_engine import run_point
+    code = pickle.dumps((small_scene, tip_summary))
+    row = run_point(code, {"load": 1.0}, "p", str(tmp_path), {"steps": 2})
+    model, beam = small_scene()
+    assert row["status"] == "converged" and row["steps"] == 2 and row["message"] == ""
+    assert row["tip"] == bs.solve(model, steps=2, verbose=False).position(beam.last)[1]
+    assert bs.load(tmp_path / "p").n_steps == 2
+    assert study.read_point(tmp_path, "p")["row"] == row
+    cases = [(pickle.dumps((small_scene, bad_summary)), {}, "TypeError", "summary: entry 'status'"),
+             (code, {"kind": "nothing"}, "InputError", "returned str, not a Model"),
+             (code, {"kind": "crash"}, "ZeroDivisionError", "division by zero"),
+             (b"not a pickle", {}, "SceneLoadError", "cannot load the scene")]
+    for k, (c, params, status, words) in enumerate(cases):
+        row = run_point(c, params, f"q{k}", str(tmp_path), {"steps": 2})
+        rec = study.read_point(tmp_path, f"q{k}")
+        assert row["status"] == status and words in row["message"], row
+        assert ("traceback" in rec) == (status != "InputError") and "tip" not in row
+    assert run_point(code, {"load": 1.0}, "p", None, {"steps": 2})["status"] == "converged"   # no output
