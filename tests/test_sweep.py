@@ -242,10 +242,11 @@ def test_strand_sweep_example_against_strand_theory(client, tmp_path):
     client.upload_file(str(ROOT / "examples" / "strand_sweep.py"))     # the workers import the scene's module
     table = strand_sweep.main(angles=(5.0, 20.0), client=client, output=tmp_path / "s", verbose=False)
     for t in table:
-        assert t["K_fixed"] == pytest.approx(t["rod_K_fixed"], rel=0.015), t
+        assert t["K_fixed"] == pytest.approx(t["rod_K_fixed"], rel=0.01), t
         assert t["K_fixed"] <= t["fibre_K_fixed"] * 1.0001, t         # the fibre limit bounds it here
+        assert t["C"] == pytest.approx(t["rod_C"], rel=0.03), t
         assert t["C"] == pytest.approx(t["fibre_C"], rel=0.04), t
-        assert t["K_free"] == pytest.approx(t["rod_K_free"], rel=0.05), t
+        assert t["rod_K_free"] < t["K_free"] < 1.1 * t["rod_K_free"], t   # the plates stiffen the twist
         assert t["K_free"] > 1.4 * t["fibre_K_free"]                 # the fibre K_ww omits wire torsion
         assert t["twist"] == pytest.approx(t["rod_twist"], rel=0.1), t   # a right-hand lay untwists
         assert t["twist"] < 0 and t["K_free"] < t["K_fixed"]
