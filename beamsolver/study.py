@@ -38,8 +38,8 @@ import numpy as np
 
 from .errors import InputError
 
-__all__ = ["points", "point_id", "point_ids", "FINAL", "RESERVED", "param_names", "table_columns", "write_json", "write_summary",
-           "read_point", "is_complete", "is_study", "load_study", "report"]
+__all__ = ["points", "point_id", "point_ids", "FINAL", "RESERVED", "param_names", "table_columns", "write_json",
+           "write_summary", "read_point", "is_complete", "is_study", "load_study", "report"]
 
 FINAL = ("converged", "ConvergenceError", "InputError")
 RESERVED = ("id", "status", "iterations", "steps", "wall", "message")
