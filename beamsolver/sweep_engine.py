@@ -194,6 +194,12 @@ def _check(scene, summary, solve_options):
     for k in BARRED_OPTIONS:
         if k in opts:
             raise InputError(f"sweep: solve_options may not contain {k!r} (results go to output/<point id>/)")
+    import inspect
+    from .solver import solve
+    known = inspect.signature(solve).parameters
+    for k in opts:
+        if k not in known or k == "model":
+            raise InputError(f"sweep: solve_options has {k!r}, not an argument of beamsolver.solve")
     return opts
 
 

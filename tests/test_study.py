@@ -51,6 +51,8 @@ def test_bad_arguments_raise_before_any_engine_starts(tmp_path):
         bs.sweep(scene, {"a": [1]}, summary="x")
     with pytest.raises(bs.InputError, match="'output'"):
         bs.sweep(scene, {"a": [1]}, solve_options={"output": "x"})
+    with pytest.raises(bs.InputError, match="'stepz', not an argument of beamsolver.solve"):
+        bs.sweep(scene, {"a": [1]}, solve_options={"stepz": 4})
     with pytest.raises(bs.InputError, match="client must be"):
         bs.sweep(scene, {"a": [1]}, client=42, output=tmp_path / "s")
 
