@@ -102,12 +102,13 @@ def main(quick=False):
     rows = []
     for name, pts in sets.items():
         n, ts, (t1, in1), (t2, in2) = len(pts), t_serial[name], t_sweep[name, 1], t_sweep[name, 2]
-        rows.append([name, sizes[name], ts / n, t1, t2, t1 / t2, (t1 - ts) / n, (t1 - in1) / n, in1 / n, in2 / n])
+        rows.append([name, sizes[name], ts / n, t1, t2, t1 / t2, (t1 - ts) / n, (t1 - in1) / n, in1 / n, in2 / n,
+                     in2 / t2])
     load = os.getloadavg()
     text = table(["points", "elements", "serial loop, s per point", "sweep, 1 worker [s]", "sweep, 2 workers [s]",
                   "speed-up 2 vs 1", "overhead vs serial, s per point", "engine overhead, s per point",
-                  "in-worker s per point, 1 worker", "in-worker s per point, 2 workers"],
-                 rows, fmt={2: ".3f", 3: ".2f", 4: ".2f", 5: ".2f", 6: ".3f", 7: ".3f", 8: ".3f", 9: ".3f"})
+                  "in-worker s per point, 1 worker", "in-worker s per point, 2 workers", "points in flight, 2 workers"],
+                 rows, fmt={2: ".3f", 3: ".2f", 4: ".2f", 5: ".2f", 6: ".3f", 7: ".3f", 8: ".3f", 9: ".3f", 10: ".2f"})
     cores = os.cpu_count() or 1
     busy = "" if load[1] < 0.5 * cores else (
         f" This run shared the machine with other jobs (5-min load average {load[1]:.1f} on {cores} cores; "
@@ -124,7 +125,8 @@ imports, not in the table: {start[1]:.1f} s (1 worker), {start[2]:.1f} s (2 work
 Speed-up = sweep on 1 worker / sweep on 2 workers; overhead vs serial = (sweep on 1 worker - serial loop) / 8;
 engine overhead = (sweep on 1 worker - the sum of the points' own times in the worker) / 8, both measured in the
 same run, so other jobs slowing the machine cancel out (they do not in the comparison with the serial loop, timed
-earlier). In-worker time per point next to the serial loop's shows how loaded the machine was during the sweeps.
+earlier). In-worker time per point next to the serial loop's shows how loaded the machine was during the sweeps;
+points in flight = sum of the in-worker times / sweep wall time on 2 workers (2: both workers busy all along).
 
 {text}
 
