@@ -8,8 +8,9 @@ from .results import Solution
 from .section import Section
 from .solver import Convergence, solve
 from .version import __version__
+from .sweep_engine import sweep   # dask is imported when a sweep runs, not here
 
 
 __all__ = ["Model", "Beam", "Section", "Solution", "solve", "Convergence", "InputError",
-           "ConvergenceError", "StabilityWarning", "load", "linearize", "Linearization", "se3", "geometry", "motion",
-           "contact", "__version__"]
+           "ConvergenceError", "StabilityWarning", "load", "linearize", "sweep", "Linearization", "se3", "geometry",
+           "motion", "contact", "__version__"]

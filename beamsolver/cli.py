@@ -27,6 +27,9 @@
     Draws the beams as tubes (needs ``beamsolver[viz]``).
 ``beamsolver export RESULT DIR``
     Writes the VTU/PVD files of a saved result.
+``beamsolver sweep SCRIPT --param NAME=V1,V2 ... [-o DIR] [--scheduler ADDRESS]``
+    Solves ``build(**params)`` of ``SCRIPT`` over the grid on Dask
+    (``beamsolver.sweep_cli``); ``beamsolver info DIR`` summarises the study.
 """
 import argparse
 import inspect
@@ -135,6 +138,10 @@ def _status(sol):
 
 def cmd_info(args):
     import beamsolver as bs
+    from . import study
+    if study.is_study(args.result):              # a folder written by `beamsolver sweep` / bs.sweep
+        print(study.report(args.result, all_rows=args.all))
+        return 0
     sol = bs.load(args.result)
     d = sol.description
     n = len(sol._times)
@@ -223,6 +230,8 @@ def main(argv=None):
     e.add_argument("result")
     e.add_argument("folder")
     e.set_defaults(func=cmd_export)
+    from .sweep_cli import add_parser as add_sweep
+    add_sweep(sub)
     args = p.parse_args(argv)
     try:
         return args.func(args)

@@ -25,11 +25,11 @@ LAYER = {
     # 3: model declarations and their assembly
     "model": 3, "cables": 3, "assembly": 3, "assembly_jit": 3, "contact.system": 3, "linsolve": 3,
     # 5: results
-    "results": 5, "restart": 5,
+    "results": 5, "restart": 5, "study": 5,
     # 6: solver, its stepping and failure diagnosis, linearisation
     "solver": 6, "stepping": 6, "diagnosis": 6, "linear": 6,
     # 7: output, pictures, command line, the package's public face
-    "io": 7, "io.lines": 7, "io.vtk": 7, "viz": 7, "cli": 7, "": 7,
+    "io": 7, "io.lines": 7, "io.vtk": 7, "viz": 7, "cli": 7, "sweep_engine": 7, "sweep_cli": 7, "": 7,
 }
 
 # lazy imports against the direction, each with its reason
