@@ -48,16 +48,50 @@ def _failed_sizes(sol):
     return [x for s in sol.stats[1:] for x in s.get("failed_dt", [])]
 
 
-def test_frame_past_buckling_does_not_keep_regrowing_to_a_failed_size():
-    """Argyris' frame (4 elements per leg) from F = 1.0725 N to 1.0945 N in one user step:
-    the fixed rule failed 9 times on a size at least the previous failed one (17 cut-backs)."""
+def _window(**kw):
+    """Argyris' frame (4 elements per leg) from F = 1.0725 N to 1.0945 N in one user step."""
     m, b = frame(1.1, imperfection=1e-4, n=4)
     pre = bs.solve(m, steps=3, t_end=0.975, verbose=False)
-    sol = bs.solve(m, steps=1, t_start=0.975, t_end=0.995, initial_poses=pre.poses[-1], max_iter=12,
-                   verbose=False)
+    return m, bs.solve(m, steps=1, t_start=0.975, t_end=0.995, initial_poses=pre.poses[-1], max_iter=12,
+                       verbose=False, **kw)
+
+
+@pytest.fixture(scope="module")
+def window():
+    calls = []
+    m, sol = _window(callback=lambda info: calls.append((info["t"], info["iteration"])))
+    return m, sol, calls
+
+
+def test_frame_past_buckling_does_not_keep_regrowing_to_a_failed_size(window):
+    """The fixed rule (``WAIT_MAX = 2``) failed 9 times there on a size at least the previous
+    failed one (17 cut-backs)."""
+    m, sol, _ = window
     failed = _failed_sizes(sol)
     assert sum(s["cutbacks"] for s in sol.stats[1:]) == len(failed)
     repeats = sum(later >= earlier * (1 - 1e-9) for earlier, later in zip(failed, failed[1:]))
     assert repeats <= 4, failed
     assert sol.times[-1] == pytest.approx(0.995, abs=1e-12)
     assert sol.resume["wait"] >= EASY_RUN and (sol.resume["failed"] is None or sol.resume["failed"] > 0)
+
+
+def test_a_restart_keeps_the_failed_size_memory(window):
+    """Stopped right after a size failed again (wait 4 or more), the restart steps as the whole run."""
+    m, full, calls = window
+    steps = [j for j, s in enumerate(full.stats[1:], 1) for _ in s.get("failed_dt", [])]
+    failed = _failed_sizes(full)
+    j = next(steps[i] for i in range(1, len(failed)) if failed[i] >= failed[i - 1] * (1 - 1e-9))
+    last = max(i for i, c in enumerate(calls) if c == (full.times[j], full.stats[j]["iterations"]))
+    count = [0]
+
+    def stop(info):
+        count[0] += 1
+        if count[0] > last + 1:
+            raise KeyboardInterrupt
+    with pytest.raises(KeyboardInterrupt) as err:
+        _window(callback=stop)
+    part = err.value.solution
+    assert part.n_steps == j and part.resume["wait"] >= 2 * EASY_RUN and part.resume["failed"] > 0
+    sol = bs.solve(m, steps=1, t_start=0.975, t_end=0.995, max_iter=12, restart=part, verbose=False)
+    np.testing.assert_array_equal(sol.times, full.times)
+    np.testing.assert_allclose(sol.poses[-1], full.poses[-1], rtol=0, atol=1e-12)
