@@ -77,11 +77,13 @@ class Solution:
     beam at rest), so ``section_forces = C (strains - description["eps0"])``; the
     VTU field ``strain`` is that difference (``io.lines``); ``stats`` a list of
     dicts per step (``iterations``, ``residuals``, ``wall_time``, ``dt``,
-    ``cutbacks``); ``contacts`` a list per step of contact point tables.
+    ``cutbacks``; ``failed_dt``, the sizes of the failed attempts, after a cut-back);
+    ``contacts`` a list per step of contact point tables.
 
     ``description``: arrays describing the model (``describe_model``);
     ``resume``: the stepping state after the last step (``t0``, ``t_end``,
-    ``steps``, ``dt``, ``easy``), used by ``solve(..., restart=)``;
+    ``steps``, ``dt``, ``easy``, ``failed``, ``wait``: ``stepping.next_step``), used by
+    ``solve(..., restart=)``;
     ``contact_state``: committed contact history of the last step (dict of
     arrays, empty without contact).  ``model`` and ``system`` are ``None`` for
     a loaded solution.

@@ -6,7 +6,9 @@ shortened where a prescribed rotation would be ambiguous
 retryable ``failures.StepFailed`` is halved down to ``dt_min`` (compared with a
 relative tolerance ``STEP_TOLERANCE``, and a grown step cut back below
 ``dt_min`` tries ``dt_min`` itself); after two easy steps running the next one
-grows (``growth``), never past the user's step, and
+grows (``growth``), never past the user's step, and not back to the size of the
+last failed step before ``wait`` easy steps running (``next_step``: the wait doubles
+each time that size fails again, up to ``WAIT_MAX``; 2, the fixed rule, until then), and
 lands on the grid (no sliver shorter than ``LANDING`` steps before a grid point).  Every loop is
 bounded: each pass of the main loop advances by at least ``dt_min`` or stops.
 
@@ -28,20 +30,44 @@ from .progress import Progress
 from .restart import contact_snapshot
 from .results import Solution
 
-__all__ = ["Run", "growth", "STEP_TOLERANCE", "EASY_ITERATIONS"]
+__all__ = ["Run", "growth", "next_step", "after_failure", "STEP_TOLERANCE", "EASY_ITERATIONS", "WAIT_MAX"]
 
 log = logging.getLogger("beamsolver")
 
 STEP_TOLERANCE = 1e-9      # relative rounding allowed when comparing step sizes
 LANDING = 0.1              # a step ending within this fraction of a step before a grid point lands on it
 EASY_ITERATIONS = 6        # a step converging within these iterations is easy (growth)
+EASY_RUN = 2               # easy steps running before the step grows (growth)
+WAIT_MAX = 32              # most easy steps running before a step regrows to a size that failed again
 
 
 def growth(iterations, easy):
     """Factor for the next step after a converged one: 2 from the second step running that took
     at most ``EASY_ITERATIONS`` Newton iterations without cut-back (``easy`` counts them, this
     one included), else 1."""
-    return 2.0 if easy >= 2 else 1.0
+    return 2.0 if easy >= EASY_RUN else 1.0
+
+
+def next_step(dt, iterations, easy, failed=np.inf, wait=EASY_RUN):
+    """Size of the next step after one of size ``dt`` converged in ``iterations`` (``easy`` as in
+    ``growth``), and the memory ``(failed, wait)``: ``failed`` the size of the last failed step
+    (``inf``: none), ``wait`` the easy steps running needed before growing back to it.  A step of
+    at least ``failed`` converged: forgotten.  Returns ``(size, failed, wait)``, size before the
+    cap at the user's step."""
+    if dt >= failed * (1.0 - STEP_TOLERANCE):
+        failed, wait = np.inf, EASY_RUN
+    size = growth(iterations, easy) * dt
+    if size >= failed * (1.0 - STEP_TOLERANCE) and easy < wait:
+        size = dt
+    return size, failed, wait
+
+
+def after_failure(size, failed=np.inf, wait=EASY_RUN):
+    """Memory ``(failed, wait)`` after a step of ``size`` failed: a size at least the last one that
+    failed doubles the wait (at most ``WAIT_MAX``), as the fixed rule would retry it every third step."""
+    if size >= failed * (1.0 - STEP_TOLERANCE):
+        wait = max(min(2 * wait, WAIT_MAX), EASY_RUN)
+    return size, wait
 
 
 class Run:
@@ -62,6 +88,7 @@ class Run:
         sys, grid = self.sys, self.grid
         t_start, steps = grid[0], len(grid) - 1
         self.dt, self.t, self.k, self.easy = self.dt_user, t_start, 1, 0
+        self.failed, self.wait = np.inf, EASY_RUN
         if restart_solution is None:
             self.sol = Solution(sys.model, sys)
             H0 = sys.poses0.copy() if initial_poses is None else np.array(initial_poses, dtype=float)
@@ -76,12 +103,13 @@ class Run:
                 dt = float(rs["dt"])
                 if np.isfinite(dt) and dt >= self.dt_min * (1.0 - STEP_TOLERANCE):   # else: a bad file
                     self.dt, self.easy = min(dt, self.dt_user), int(rs["easy"])
+                    self.failed, self.wait = _memory(rs)
             if self.writer is not None:
                 for j in range(len(sol._times)):
                     self.writer.write(sol, j)
         # the stepping state before the first step: a checkpoint of a run stopped at once says how far it went
         self.sol.resume = dict(t0=float(grid[0]), t_end=float(grid[-1]), steps=int(steps), dt=float(self.dt),
-                               easy=int(self.easy))
+                               easy=int(self.easy), **self._memory_state())
         self.progress = Progress(self.verbose, t_start, grid[-1], self.t)
 
     def _step_zero(self, H0, t_start):
@@ -150,7 +178,7 @@ class Run:
 
     def _attempt(self, t_next):
         """Converge the step ``t -> t_next``, halving it on failure; returns the step reached."""
-        t, cutbacks, rotation_limit = self.t, 0, None
+        t, cutbacks, rotation_limit, failed_sizes = self.t, 0, None, []
         while True:
             t_try, rot = motion_path.limit_step(self.sys, t, t_next)
             if t_try < t_next and t_try - t < self.dt_min * (1.0 - STEP_TOLERANCE):
@@ -163,6 +191,8 @@ class Run:
                 H, r, info, stats = self._newton_step(t_try)
                 self._check_finite(H, r, info["state"], t_try)
                 stats.update(cutbacks=cutbacks, timings=dict(self.newton.timings))
+                if failed_sizes:
+                    stats["failed_dt"] = failed_sizes
                 if t_try < t_next:
                     stats["motion_rotation"] = rot
                 return t_try, H, r, info, stats
@@ -170,6 +200,8 @@ class Run:
                 if isinstance(e, NonFinite):
                     self._name_nonfinite(t_try)
                 cutbacks += 1
+                failed_sizes.append(t_try - t)
+                self.failed, self.wait = after_failure(t_try - t, self.failed, self.wait)
                 if e.rotation:
                     rotation_limit = str(e)
                 h = 0.5 * (t_try - t)
@@ -221,16 +253,21 @@ class Run:
         if t >= self.grid[k] - 1e-12 * self.dt_user:
             t, k = self.grid[k], k + 1
         easy = self.easy + 1 if stats["iterations"] <= EASY_ITERATIONS and stats["cutbacks"] == 0 else 0
-        dt = min(growth(stats["iterations"], easy) * dt, self.dt_user)
+        dt, self.failed, self.wait = next_step(dt, stats["iterations"], easy, self.failed, self.wait)
+        dt = min(dt, self.dt_user)
         if sys.contact is not None:
             sol.contact_state = contact_snapshot(sys.contact)
         sol.append(t_next, H, sys.reactions(H, r), info["state"].sigma, info["state"].strain, stats, contact_data)
         sol.resume = dict(t0=float(self.grid[0]), t_end=float(self.grid[-1]), steps=len(self.grid) - 1,
-                          dt=float(dt), easy=int(easy))
+                          dt=float(dt), easy=int(easy), **self._memory_state())
         self.H, self.t, self.k, self.dt, self.easy = H, t, k, dt, easy
         if self.writer is not None:
             self.writer.write(sol, sol.n_steps)
         self.progress.step(sol.n_steps, t_next, stats["dt"], stats)
+
+    def _memory_state(self):
+        """The failed-size memory of ``next_step`` for ``resume`` (JSON: no inf)."""
+        return dict(failed=None if not np.isfinite(self.failed) else float(self.failed), wait=int(self.wait))
 
     def _stability(self, stats, t):
         """Record whether the tangent at the converged state is positive definite; warn once."""
@@ -290,6 +327,18 @@ class Run:
         if self.writer is not None:
             self.writer.close()
         return self.sol
+
+
+def _memory(resume):
+    """``(failed, wait)`` from a ``resume`` dict; a missing or damaged entry: no memory."""
+    try:
+        failed = float(resume.get("failed"))
+        wait = int(resume.get("wait"))
+    except (TypeError, ValueError, OverflowError):
+        return np.inf, EASY_RUN
+    if not (np.isfinite(failed) and failed > 0):
+        return np.inf, EASY_RUN
+    return failed, min(max(wait, EASY_RUN), WAIT_MAX)
 
 
 def _acts_at(system, H, t):

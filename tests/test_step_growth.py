@@ -1,0 +1,97 @@
+"""Step growth after a cut-back (issue 12 item 8): the step does not regrow every third step to a
+size that has just failed (``stepping.next_step``, ``stepping.after_failure``)."""
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import beamsolver as bs
+from beamsolver.stepping import EASY_RUN, WAIT_MAX, after_failure, growth, next_step
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+from argyris_frame import frame  # noqa: E402
+
+
+@pytest.mark.parametrize("dt", [1e-3, 0.25, 1.0])
+@pytest.mark.parametrize("iterations", [1, 6, 7, 30])
+@pytest.mark.parametrize("easy", [0, 1, 2, 5])
+def test_without_a_failed_size_the_rule_is_the_fixed_one(dt, iterations, easy):
+    assert next_step(dt, iterations, easy) == (growth(iterations, easy) * dt, np.inf, EASY_RUN)
+
+
+def test_growth_back_to_a_failed_size_waits_for_wait_easy_steps():
+    assert next_step(0.5, 4, 2, failed=1.0, wait=4) == (0.5, 1.0, 4)       # would reach the failed size
+    assert next_step(0.5, 4, 3, failed=1.0, wait=4) == (0.5, 1.0, 4)
+    assert next_step(0.5, 4, 4, failed=1.0, wait=4) == (1.0, 1.0, 4)       # waited: tries it again
+    assert next_step(0.25, 4, 2, failed=1.0, wait=8) == (0.5, 1.0, 8)      # below it: grows as before
+    assert next_step(0.5, 4, 2, failed=1.0, wait=EASY_RUN) == (1.0, 1.0, EASY_RUN)   # first retry: fixed rule
+
+
+def test_a_converged_step_of_the_failed_size_forgets_it():
+    assert next_step(1.0, 3, 5, failed=1.0, wait=16) == (2.0, np.inf, EASY_RUN)
+    assert next_step(1.0 - 1e-12, 3, 5, failed=1.0, wait=16) == (2.0 * (1.0 - 1e-12), np.inf, EASY_RUN)
+
+
+def test_a_size_failing_again_doubles_the_wait_up_to_wait_max():
+    assert after_failure(1.0) == (1.0, EASY_RUN)                 # a first failure: the fixed rule
+    failed, wait, waits = 1.0, EASY_RUN, []
+    for _ in range(8):
+        failed, wait = after_failure(1.0, failed, wait)
+        waits.append(wait)
+    assert waits[:4] == [4, 8, 16, 32] and max(waits) == WAIT_MAX
+    assert after_failure(2.0, 1.0, 8) == (2.0, 16)                # larger than a size that failed
+    assert after_failure(0.5, 1.0, 8) == (0.5, 8)                 # smaller: a new size, the wait stays
+
+
+def _failed_sizes(sol):
+    return [x for s in sol.stats[1:] for x in s.get("failed_dt", [])]
+
+
+def _window(**kw):
+    """Argyris' frame (4 elements per leg) from F = 1.0725 N to 1.0945 N in one user step."""
+    m, b = frame(1.1, imperfection=1e-4, n=4)
+    pre = bs.solve(m, steps=3, t_end=0.975, verbose=False)
+    return m, bs.solve(m, steps=1, t_start=0.975, t_end=0.995, initial_poses=pre.poses[-1], max_iter=12,
+                       verbose=False, **kw)
+
+
+@pytest.fixture(scope="module")
+def window():
+    calls = []
+    m, sol = _window(callback=lambda info: calls.append((info["t"], info["iteration"])))
+    return m, sol, calls
+
+
+def test_frame_past_buckling_does_not_keep_regrowing_to_a_failed_size(window):
+    """The fixed rule (``WAIT_MAX = 2``) failed 9 times there on a size at least the previous
+    failed one (17 cut-backs)."""
+    m, sol, _ = window
+    failed = _failed_sizes(sol)
+    assert sum(s["cutbacks"] for s in sol.stats[1:]) == len(failed)
+    repeats = sum(later >= earlier * (1 - 1e-9) for earlier, later in zip(failed, failed[1:]))
+    assert repeats <= 4, failed
+    assert sol.times[-1] == pytest.approx(0.995, abs=1e-12)
+    assert sol.resume["wait"] >= EASY_RUN and (sol.resume["failed"] is None or sol.resume["failed"] > 0)
+
+
+def test_a_restart_keeps_the_failed_size_memory(window):
+    """Stopped right after a size failed again (wait 4 or more), the restart steps as the whole run."""
+    m, full, calls = window
+    steps = [j for j, s in enumerate(full.stats[1:], 1) for _ in s.get("failed_dt", [])]
+    failed = _failed_sizes(full)
+    j = next(steps[i] for i in range(1, len(failed)) if failed[i] >= failed[i - 1] * (1 - 1e-9))
+    last = max(i for i, c in enumerate(calls) if c == (full.times[j], full.stats[j]["iterations"]))
+    count = [0]
+
+    def stop(info):
+        count[0] += 1
+        if count[0] > last + 1:
+            raise KeyboardInterrupt
+    with pytest.raises(KeyboardInterrupt) as err:
+        _window(callback=stop)
+    part = err.value.solution
+    assert part.n_steps == j and part.resume["wait"] >= 2 * EASY_RUN and part.resume["failed"] > 0
+    sol = bs.solve(m, steps=1, t_start=0.975, t_end=0.995, max_iter=12, restart=part, verbose=False)
+    np.testing.assert_array_equal(sol.times, full.times)
+    np.testing.assert_allclose(sol.poses[-1], full.poses[-1], rtol=0, atol=1e-12)
