@@ -414,7 +414,7 @@ class System:
         """``K_fc dz_c`` on the free rows (reduced numbering)."""
         e = self.fc
         out = np.bincount(self.red[self.coo_rows[e]], weights=kvals[e] * dz_full[self.coo_cols[e]],
-                          minlength=self.n_free)
+                          minlength=self.n_free).astype(float)   # int when no element couples (empty)
         if extra is not None and len(extra[2]):
             rows, cols, vals = extra
             rr = self.red[rows]

@@ -14,37 +14,13 @@ __all__ = ["restart_from", "contact_snapshot", "contact_restore"]
 
 
 def contact_snapshot(contact):
-    """Committed contact history (flat dict of arrays) for saving and restart.
-
-    Uses ``contact.get_state()`` when the contact system offers it, else its
-    committed history, multipliers and last point set (whatever of them exists).
-    """
-    if hasattr(contact, "get_state"):
-        return dict(contact.get_state())
-    out = {}
-    hist = getattr(contact, "_history", None)
-    if isinstance(hist, dict):
-        out.update({f"history.{k}": v for k, v in hist.items()})
-    mult = getattr(contact, "_mult_committed", None)
-    if isinstance(mult, tuple) and len(mult) == 2:
-        out["mult_keys"], out["mult_values"] = mult
-    if getattr(contact, "_prev_points", None) is not None:
-        out["prev_points"] = contact._prev_points
-    return out
+    """Committed contact history (flat dict of arrays) for saving and restart: ``contact.get_state()``."""
+    return dict(contact.get_state())
 
 
 def contact_restore(contact, state):
-    if hasattr(contact, "set_state"):
-        contact.set_state(dict(state))
-        return
-    hist = {k[8:]: np.asarray(v) for k, v in state.items() if k.startswith("history.")}
-    if hist:
-        contact._history = hist
-    if "mult_keys" in state:
-        contact._mult_committed = (np.asarray(state["mult_keys"]), np.asarray(state["mult_values"]))
-        contact._mult = contact._mult_committed
-    if "prev_points" in state:
-        contact._prev_points = np.asarray(state["prev_points"])
+    """Give ``contact`` the state ``contact_snapshot`` took: ``contact.set_state(state)``."""
+    contact.set_state(dict(state))
 
 
 def restart_from(restart, model, system):

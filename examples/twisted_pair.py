@@ -43,8 +43,9 @@ solve_options = dict(steps=16)      # for `beamsolver run examples/twisted_pair.
 
 
 def build(radius=0.5e-3, length=0.02, n_elements=16, turns=2.0, pull=5.0, mu=0.3, E=200e9, nu=0.3,
-          swap=False, smoothing=None):
-    """Returns ``(model, plate node, (beam_a, beam_b))``; ``swap`` exchanges slave and master."""
+          swap=False, smoothing=None, **contact_options):
+    """Returns ``(model, plate node, (beam_a, beam_b))``; ``swap`` exchanges slave and master;
+    ``contact_options`` go to ``add_contact``."""
     sec = bs.Section.circular(radius=radius, E=E, nu=nu)
     model = bs.Model()
     a = model.add_beam(bs.geometry.straight((radius, 0, 0), (radius, 0, length), n_elements), sec, name="wire a")
@@ -57,7 +58,8 @@ def build(radius=0.5e-3, length=0.02, n_elements=16, turns=2.0, pull=5.0, mu=0.3
     model.fix(plate, ("ux", "uy", "rx", "ry", "rz"), values={"rz": lambda t: 2.0 * np.pi * turns * t})
     model.add_load(plate, force=(0.0, 0.0, pull), scale=lambda t: 1.0)
     slave, master = (b, a) if swap else (a, b)
-    model.add_contact(slave, master, mu=mu, smoothing=2e-3 * radius if smoothing is None else smoothing)
+    model.add_contact(slave, master, mu=mu, smoothing=2e-3 * radius if smoothing is None else smoothing,
+                      **contact_options)
     return model, plate, (a, b)
 
 

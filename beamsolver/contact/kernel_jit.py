@@ -486,8 +486,12 @@ def _friction(slip, Dslip, lamp, t1, t2, Dt1, Dt2, lam, Dlam, par):
     pen_t, mu = par[PEN_T], par[MU]
     Dpt = np.zeros(24)
     if np.isnan(pen_t) and not np.isnan(par[ESLIP]):
-        pen_t = mu * (lam / par[ESLIP] + PENALTY_T_MIN * par[PENALTY])
-        Dpt = (mu / par[ESLIP]) * Dlam
+        lam_min = PENALTY_T_MIN * par[PENALTY] * par[ESLIP]      # pairs.stick_penalty
+        if lam >= lam_min:
+            pen_t = mu * lam / par[ESLIP]
+            Dpt = (mu / par[ESLIP]) * Dlam
+        else:
+            pen_t = mu * lam_min / par[ESLIP]
     return _coulomb(lam_prev, Dprev, slip, Dslip, pen_t, Dpt, mu, lam, Dlam)
 
 

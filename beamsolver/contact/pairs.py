@@ -28,7 +28,23 @@ from ..se3 import cross as _cross, dot as _dot
 from .law import coulomb_return_mapping, normal_force
 
 LINE, ORTHOGONAL, POINT = 0, 1, 2
-PENALTY_T_MIN = 1e-3     # floor of the slip-tolerance tangential penalty / (mu normal penalty)
+NORMAL_TOL = 1e-9        # centre distance / (R1 + R2) below which a pair has no contact normal
+PENALTY_T_MIN = 1e-3     # floor of lam_N in the slip-tolerance stick stiffness, / (normal penalty x elastic slip)
+
+
+def stick_penalty(lam_n, mu, penalty, elastic_slip):
+    """Tangential penalty ``mu max(lam_N, lam_min) / s_e`` of the slip-tolerance friction law.
+
+    Sliding starts at the elastic slip ``s_e`` exactly (``|lam_T| = mu lam_N`` at
+    ``|slip| = s_e``) wherever ``lam_N >= lam_min = PENALTY_T_MIN penalty s_e``, the
+    normal traction of a penetration of ``PENALTY_T_MIN s_e``.  Below it (a just-touching
+    point) the stiffness stays at ``mu lam_min / s_e``, so a point with ``lam_N = 0`` does not
+    leave a rigid mode that only friction holds unconstrained; sliding starts there at the
+    smaller slip ``s_e lam_N / lam_min``.  The derivative with respect to ``lam_N`` is
+    carried (complex step: the branch is taken on the real part).
+    """
+    lam_min = PENALTY_T_MIN * penalty * elastic_slip
+    return mu * np.where(np.real(lam_n) >= np.real(lam_min), lam_n, lam_min + 0 * lam_n) / elastic_slip
 
 
 def _log_c(H):
@@ -120,7 +136,7 @@ def contact_kernel(X, p, friction=True):
     HC, _, _ = _section(HA1, h1, xi1)
     HF, _, _ = _section(HA2, h2, xi2)
     R1, R2 = p["R1"], p["R2"]
-    xC, xF, n, t1, t2, dist = _axes(HC, HF)
+    xC, xF, n, t1, t2, dist = _axes(HC, HF, R1, R2)
     gap = dist - R1 - R2
     lam_n, active = normal_force(gap, p["penalty"], p["multiplier"], p.get("smoothing", 0.0))
     w = p["weight"]
@@ -147,14 +163,10 @@ def contact_kernel(X, p, friction=True):
         nl = np.sqrt(_dot(lam_prev, lam_prev))
         scale = np.where(np.real(nl) > 1e-300 * (1 + np_), np_ / np.where(np.real(nl) > 0, nl, 1.0), 0.0)
         lam_prev = lam_prev * scale[..., None]
-        # tangential penalty: given, or such that sliding starts at the elastic slip
-        # ``elastic_slip`` (it then scales with lam_N, whose derivative the tangent carries;
-        # the floor PENALTY_T_MIN keeps a just-touching point, lam_N = 0, from leaving a
-        # rigid mode that only friction holds unconstrained)
         pen_t = p["penalty_t"]
         if "elastic_slip" in p:
-            pen_t = np.where(np.isnan(np.real(pen_t)),
-                             p["mu"] * (lam_n / p["elastic_slip"] + PENALTY_T_MIN * p["penalty"]), pen_t)
+            pen_t = np.where(np.isnan(np.real(pen_t)), stick_penalty(lam_n, p["mu"], p["penalty"], p["elastic_slip"]),
+                             pen_t)
         trial = lam_prev + pen_t[..., None] * slip
         lam_t, stick = coulomb_return_mapping(trial, p["mu"], lam_n)
         lam_t = np.where(active[..., None], lam_t, 0.0)
@@ -174,12 +186,22 @@ def contact_kernel(X, p, friction=True):
     return f, out
 
 
-def _axes(HC, HF):
-    """Centre points, contact axes ``n, t1, t2`` and centre distance (docs/theory.md eqs. 6.2-6.3)."""
+def no_normal(dist, R1, R2):
+    """Pairs whose centre lines (nearly) intersect: ``dist < NORMAL_TOL (R1 + R2)``, no normal."""
+    return np.real(dist) < NORMAL_TOL * np.real(R1 + R2)
+
+
+def _axes(HC, HF, R1, R2):
+    """Centre points, contact axes ``n, t1, t2`` and centre distance (docs/theory.md eqs. 6.2-6.3).
+
+    Where the centre lines intersect (``no_normal``) there is no normal: ``n`` is then
+    ``(nan, nan, nan)`` without a division by zero, and the caller must refuse the pair.
+    """
     xC, xF = HC[..., :3, 3], HF[..., :3, 3]
     d = xF - xC
     dist = np.sqrt(_dot(d, d))
-    n = d / dist[..., None]
+    bad = no_normal(dist, R1, R2) | (np.real(dist) == 0.0)
+    n = np.where(bad[..., None], np.nan, d) / np.where(bad, 1.0, dist)[..., None]
     e1 = HC[..., :3, 0]
     t1 = e1 - _dot(e1, n)[..., None] * n
     t1 = t1 / np.sqrt(_dot(t1, t1))[..., None]
@@ -201,7 +223,7 @@ def material_frames(X, kind, xi1, xi2, R1, R2):
     HA1, HB1, HA2, HB2 = X[..., 0, :, :], X[..., 1, :, :], X[..., 2, :, :], X[..., 3, :, :]
     HC, _, _ = _section(HA1, se3.log(se3.relative(HA1, HB1)), xi1)
     HF, _, _ = _section(HA2, se3.log(se3.relative(HA2, HB2)), xi2)
-    xC, xF, n, t1, t2, _ = _axes(HC, HF)
+    xC, xF, n, t1, t2, _ = _axes(HC, HF, R1, R2)
     HL, HK = _contact_frames(n, t1, t2, xC, xF, R1, R2)
     return se3.relative(HC, HL), se3.relative(HF, HK), se3.relative(HL, HK)
 

@@ -17,7 +17,8 @@ length), ``penalty_t`` (tangential penalty, force / length^3; default: none, see
 ``slip_tolerance``), ``slip_tolerance`` (default 0.005: without ``penalty_t`` the
 tangential stiffness of a point is ``mu lam_N / (slip_tolerance L_e)``, so the elastic
 slip at the onset of sliding is ``slip_tolerance`` times the slave element length
-``L_e`` -- Abaqus' default penalty friction), ``tolerance``
+``L_e`` -- Abaqus' default penalty friction; below a floor traction, see
+``pairs.stick_penalty``), ``tolerance``
 (penetration tolerance enabling augmented-Lagrangian updates; None: pure
 penalty), ``line_angle`` (20 deg), ``point_ratio`` (0.5), ``margin``
 (search margin, default the sum of radii).
@@ -31,15 +32,13 @@ from ..errors import InputError
 from .law import default_penalty
 from . import kernel_jit, pairs
 from .kernel_jit import contact_kernel, kernel_and_tangent      # compiled; pairs.py's are the oracle
-from .pairs import LINE, ORTHOGONAL, POINT, _project, _section, material_frames
+from .options import SMOOTHING, ContactOptions
+from .pairs import LINE, NORMAL_TOL, ORTHOGONAL, POINT, _project, _section, material_frames, no_normal
 from .search import XI_TOL, broad_phase, closest_points, element_spheres
 
 MAX_AUGMENT = 30
-
-SMOOTHING = 0.0           # default smoothing gap of the normal law, relative to R1 + R2 (0: sharp)
-SLIP_TOLERANCE = 0.005    # elastic slip at the onset of sliding / slave element length (Abaqus' default)
-_KNOWN = {"smoothing", "gauss_points", "penalty_t", "slip_tolerance", "tolerance", "line_angle", "point_ratio",
-          "margin"}
+XI_OVERHANG = 0.05        # accepted projection past an inner node, in element lengths (kinks of the C0 line)
+OWNER_TIE = 1e-9          # distances equal within this fraction of R1 + R2 tie (a point on a shared node)
 
 
 def use_numpy_kernel(flag=True):
@@ -53,40 +52,26 @@ def use_numpy_kernel(flag=True):
 
 
 class _Decl:
+    """One declaration's element sets and parameters (options from ``ContactOptions``)."""
+
     def __init__(self, k, decl, model):
-        bad = set(decl.options) - _KNOWN
-        if bad:
-            raise InputError(f"add_contact: unknown options {sorted(bad)}; known: {sorted(_KNOWN)}")
-        o = decl.options
+        o = ContactOptions.from_dict(decl.options)
         self.index = k
+        self.options = o
         self.slave_el = np.concatenate([b.elements for b in decl.slave])
         self.master_el = np.concatenate([b.elements for b in decl.master])
         secs = [b.section for b in decl.slave + decl.master]
         self.penalty = decl.penalty if decl.penalty is not None else min(
             default_penalty(a, b) for a in secs for b in secs)
-        pt = o.get("penalty_t")
-        self.penalty_t = np.nan if pt is None else float(pt)     # nan: from the slip tolerance
-        if pt is not None and not (np.isfinite(self.penalty_t) and self.penalty_t > 0):
-            raise InputError(f"add_contact: penalty_t must be positive, got {pt!r}")
-        st = o.get("slip_tolerance", SLIP_TOLERANCE)
-        if not (np.isfinite(st) and st > 0):
-            raise InputError(f"add_contact: slip_tolerance must be positive, got {st!r}")
-        self.slip_tolerance = float(st)
+        self.penalty_t = np.nan if o.penalty_t is None else o.penalty_t     # nan: from the slip tolerance
+        self.slip_tolerance = o.slip_tolerance
         self.mu = decl.mu
-        self.tolerance = o.get("tolerance")
-        self.n_gp = int(o.get("gauss_points", 5))
-        if self.n_gp < 1:
-            raise InputError(f"add_contact: gauss_points must be >= 1, got {self.n_gp}")
-        self.line_angle = float(o.get("line_angle", np.deg2rad(20.0)))
-        self.point_ratio = float(o.get("point_ratio", 0.5))
-        rmax = max(s.radius for s in secs)
-        self.margin = float(o.get("margin", 2.0 * rmax))
-        sm = o.get("smoothing")
-        if sm is not None and not (np.isfinite(sm) and sm >= 0):
-            raise InputError(f"add_contact: smoothing must be a gap >= 0, got {sm!r}")
-        self.smoothing = sm          # None: SMOOTHING * (R1 + R2) per pair
-        if self.tolerance is not None and not self.tolerance > 0:
-            raise InputError(f"add_contact: tolerance must be positive, got {self.tolerance!r}")
+        self.tolerance = o.tolerance
+        self.n_gp = o.gauss_points
+        self.line_angle = o.line_angle
+        self.point_ratio = o.point_ratio
+        self.margin = 2.0 * max(s.radius for s in secs) if o.margin is None else o.margin
+        self.smoothing = o.smoothing          # None: SMOOTHING * (R1 + R2) per pair
 
 
 class ContactSystem:
@@ -100,8 +85,10 @@ class ContactSystem:
             self.el_beam[b.elements] = b.id
             self.el_radius[b.elements] = b.section.radius
         self.el_last = np.zeros(n_el, dtype=bool)
+        self.el_first = np.zeros(n_el, dtype=bool)
         for b in model.beams:
             self.el_last[b.elements[-1]] = True
+            self.el_first[b.elements[0]] = True
         self.n_beams = len(model.beams)
         self.decls = [_Decl(k, d, model) for k, d in enumerate(model.contacts)]
         # per-declaration parameters as arrays, indexed by a pair's ``decl`` (no loop over pairs)
@@ -118,9 +105,39 @@ class ContactSystem:
         self._mult = self._mult_committed
         self._augments = 0
         self._prev_points = np.zeros(0, dtype=np.int64)
+        self._prev_owners = np.zeros(0, dtype=np.int64)   # Gauss-point key * n_elements + master element
         self._H_prev = None        # last converged poses (start of the step)
 
     # ------------------------------------------------------------ history
+    def get_state(self):
+        """Committed contact state as a flat dict of arrays (saved with a ``Solution``, restart).
+
+        ``history.<field>``: friction history per point key (material frames, ``xi``,
+        traction); ``mult_keys``/``mult_values``: augmented-Lagrangian multipliers;
+        ``prev_points``/``prev_owners``: the point pairs and Gauss-point owners of the last
+        evaluation (the hysteresis of the ownership rules).  ``set_state`` restores it.
+        """
+        out = {f"history.{k}": np.array(v) for k, v in self._history.items()}
+        out["mult_keys"], out["mult_values"] = (np.array(a) for a in self._mult_committed)
+        out["prev_points"] = np.array(self._prev_points)
+        out["prev_owners"] = np.array(self._prev_owners)
+        return out
+
+    def set_state(self, state):
+        """Restore a state from ``get_state`` (missing parts: empty; older archives lack some)."""
+        hist = self._empty_history()
+        for k in hist:
+            if f"history.{k}" in state:
+                hist[k] = np.asarray(state[f"history.{k}"])
+        self._history = hist
+        if "mult_keys" in state:
+            self._mult_committed = (np.asarray(state["mult_keys"], dtype=np.int64),
+                                    np.asarray(state["mult_values"], dtype=float))
+        self._mult = self._mult_committed
+        for name in ("prev_points", "prev_owners"):
+            if name in state:
+                setattr(self, f"_{name}", np.asarray(state[name], dtype=np.int64))
+
     @staticmethod
     def _empty_history():
         return dict(key=np.zeros(0, dtype=np.int64), H_CL=np.zeros((0, 4, 4)), H_FK=np.zeros((0, 4, 4)),
@@ -141,6 +158,7 @@ class ContactSystem:
         en = sysm.enodes
         out = []
         chosen = []
+        owners = []
         for d in self.decls:
             cs, rs, hs, ts = element_spheres(H, en[d.slave_el], self.el_radius[d.slave_el], d.margin)
             cm, rm, hm, tm = element_spheres(H, en[d.master_el], self.el_radius[d.master_el], d.margin)
@@ -168,9 +186,9 @@ class ContactSystem:
             pt = np.flatnonzero(kinds == POINT)
             if len(pt):
                 x1, x2 = xi1p[pt], xi2p[pt]
-                ok = ((x1 >= -XI_TOL) & ((x1 < 1.0) | (self.el_last[e[pt]] & (x1 <= 1.0 + XI_TOL)))
-                      & (x2 >= -XI_TOL) & ((x2 < 1.0) | (self.el_last[m[pt]] & (x2 <= 1.0 + XI_TOL))))
-                pt = pt[ok]
+                lo1, hi1 = self._xi_range(e[pt])
+                lo2, hi2 = self._xi_range(m[pt])
+                pt = pt[(x1 >= lo1) & (x1 <= hi1) & (x2 >= lo2) & (x2 <= hi2)]
                 pt = self._dedupe_points(H, e[pt], m[pt], xi1p[pt], xi2p[pt], pt)
                 chosen.append(e[pt] * len(en) + m[pt])
                 key = self.point_offset + (np.int64(d.index) * len(en) + e[pt]) * len(en) + m[pt]
@@ -203,20 +221,18 @@ class ContactSystem:
                                   iterations=8)
                 HF, _, _ = _section(H[en[mm, 0]], hm[j[rep]], xi2)
                 dist = np.linalg.norm(HF[:, :3, 3] - HC[:, :3, 3], axis=1)
-                ok = (xi2 >= -XI_TOL) & (xi2 <= 1.0 + XI_TOL) & np.isfinite(dist)
+                lo, hi = self._xi_range(mm)
+                ok = (xi2 >= lo) & (xi2 <= hi) & np.isfinite(dist)
                 key = ((np.int64(d.index) * len(en) + ee) * self.max_gp + g) * self.n_beams + self.el_beam[mm]
-                sel = np.flatnonzero(ok)
-                if len(sel):
-                    order = np.lexsort((dist[sel], key[sel]))
-                    sel = sel[order]
-                    first = np.concatenate([[True], key[sel][1:] != key[sel][:-1]])
-                    sel = sel[first]
+                sel = self._owners(np.flatnonzero(ok), key, mm, xi2, dist, self.el_radius[ee] + self.el_radius[mm])
+                owners.append(key[sel] * len(en) + mm[sel])
                 parts.append(dict(kind=kk[sel], e=ee[sel], m=mm[sel], xi1=xi1[sel], xi2=xi2[sel],
                                   weight=wg[g[sel]] * sysm.L[ee[sel]], key=key[sel], gp=g[sel]))
             for p in parts:
                 p["decl"] = np.full(len(p["e"]), d.index)
             out.extend(parts)
         self._prev_points = np.concatenate(chosen) if chosen else np.zeros(0, dtype=np.int64)
+        self._prev_owners = np.concatenate(owners) if owners else np.zeros(0, dtype=np.int64)
         if not out:
             return None
         P = {k: np.concatenate([p[k] for p in out]) for k in out[0]}
@@ -225,6 +241,39 @@ class ContactSystem:
         P["R1"] = self.el_radius[P["e"]]
         P["R2"] = self.el_radius[P["m"]]
         return P
+
+    def _xi_range(self, el):
+        """Accepted projections ``[lo, hi]`` on elements ``el``: ``XI_OVERHANG`` past an inner
+        node (at a kink of the C0 centre line the closest point of either element's extension
+        lies just past the shared node: without it the point would be lost), ``XI_TOL`` at a
+        beam end."""
+        lo = np.where(self.el_first[el], -XI_TOL, -XI_OVERHANG)
+        hi = np.where(self.el_last[el], 1.0 + XI_TOL, 1.0 + XI_OVERHANG)
+        return lo, hi
+
+    def _owners(self, cand, key, m, xi2, dist, rsum):
+        """One master element per slave Gauss point and master beam (``key``), among ``cand``.
+
+        Priority: a projection inside its element over one on an extension (overhang);
+        then the nearest, where distances within ``OWNER_TIE`` (R1 + R2) count as equal
+        (a point projecting on a node shared by two elements, to round-off); among equals
+        the owner of the last evaluation (no flip-flop inside Newton), then the element
+        on which the point lies at its start (smaller ``xi2``).
+        """
+        if len(cand) == 0:
+            return cand
+        k, x = key[cand], xi2[cand]
+        outside = (x < -XI_TOL) | (x > 1.0 + XI_TOL)
+        order = np.lexsort((dist[cand], outside, k))
+        c = cand[order]
+        head = np.concatenate([[True], (k[order][1:] != k[order][:-1]) | (outside[order][1:] != outside[order][:-1])])
+        best = np.maximum.accumulate(np.where(head, np.arange(len(c)), 0))
+        tie = dist[c] <= dist[c[best]] + OWNER_TIE * rsum[c]
+        known = np.isin(key[c] * len(self.sys.enodes) + m[c], self._prev_owners)
+        order = np.lexsort((xi2[c], ~known, ~tie, outside[order], key[c]))
+        c = c[order]
+        first = np.concatenate([[True], key[c][1:] != key[c][:-1]])
+        return c[first]
 
     def _extend_wrap(self, e, m, kinds):
         """A straight slave element leaving a wrap tangentially (it shares a node with an
@@ -259,7 +308,8 @@ class ContactSystem:
         # hysteresis: a pair chosen at the last evaluation keeps priority, so the
         # choice cannot flip between the two elements of a kink inside Newton
         known = np.isin(e * len(en) + m, self._prev_points)
-        order = np.lexsort((dist, ~known, group))
+        outside = (xi1 < -XI_TOL) | (xi1 > 1.0 + XI_TOL) | (xi2 < -XI_TOL) | (xi2 > 1.0 + XI_TOL)
+        order = np.lexsort((dist, ~known, outside, group))
         rank = np.empty(len(order), dtype=int)
         rank[order] = np.arange(len(order))
         # candidate pairs (a dominates b: higher priority, same beams, both points close)
@@ -380,6 +430,48 @@ class ContactSystem:
         band = self._smoothing(P, slice(None)) + 1e-3 * (P["R1"] + P["R2"])
         return np.flatnonzero(mult - pen * gap > -pen * band)
 
+    # ------------------------------------------------------------ refusals
+    def _pair_label(self, e, m):
+        beams = self.sys.model.beams
+        be, bm = beams[self.el_beam[e]], beams[self.el_beam[m]]
+        name = lambda b: f"Beam {b.id}" + (f" {b.name!r}" if b.name else "")   # noqa: E731
+        return (f"{name(be)} element {e - be.elements[0]} (global {e}) against "
+                f"{name(bm)} element {m - bm.elements[0]} (global {m})")
+
+    def _check_normals(self, P, sel, H):
+        """Refuse (a step failure: cut back) pairs whose centre lines intersect: no normal."""
+        xC = _interp_pos(H, self.sys.enodes, P["e"][sel], P["xi1"][sel])
+        xF = _interp_pos(H, self.sys.enodes, P["m"][sel], P["xi2"][sel])
+        bad = np.flatnonzero(no_normal(np.linalg.norm(xF - xC, axis=1), P["R1"][sel], P["R2"][sel]))
+        if len(bad):
+            k = sel[bad[0]]
+            msg = (f"contact: the centre lines of {self._pair_label(P['e'][k], P['m'][k])} intersect (distance "
+                   f"below {NORMAL_TOL:g} (R1 + R2)): no contact normal ({len(bad)} such pairs)")
+            if self._H_prev is None:          # the given (reference or initial) poses: bad input
+                raise InputError(msg + " in the given poses; separate the beams")
+            raise _step_failure(msg)
+
+    def _check_sides(self, P, H):
+        """Tunnelling: refuse (cut back) a step over which a pair changed sides.
+
+        The centre-line distance vector ``d = x_F - x_C`` of each candidate pair (same
+        elements and ``xi``) at the last converged poses and now: ``d_prev . d < 0`` means
+        one beam passed through the other within the step, where the penalty, seeing
+        the other side, would push them further apart and report a converged state.
+        """
+        if self._H_prev is None or self._H_prev.shape != H.shape:
+            return
+        en = self.sys.enodes
+        d = _interp_pos(H, en, P["m"], P["xi2"]) - _interp_pos(H, en, P["e"], P["xi1"])
+        d0 = _interp_pos(self._H_prev, en, P["m"], P["xi2"]) - _interp_pos(self._H_prev, en, P["e"], P["xi1"])
+        rsum = P["R1"] + P["R2"]
+        seen = ~no_normal(np.linalg.norm(d0, axis=1), P["R1"], P["R2"])
+        flip = np.flatnonzero(seen & (np.sum(d * d0, axis=1) < -(NORMAL_TOL * rsum) ** 2))
+        if len(flip):
+            k = flip[0]
+            raise _step_failure(f"contact: {self._pair_label(P['e'][k], P['m'][k])} changed sides within the "
+                                f"step (one beam passed through the other; {len(flip)} such pairs)")
+
     # ------------------------------------------------------------ evaluation
     def evaluate(self, H, tangent=True):
         """Contact residual ``(6 n,)``, COO tangent ``(rows, cols, vals)`` and point data."""
@@ -390,9 +482,11 @@ class ContactSystem:
         P = self.pairs(H)
         if P is None:
             return r, empty, dict(n_active=0)
+        self._check_sides(P, H)
         sel = self._active(P, H)
         if len(sel) == 0:
             return r, empty, dict(n_active=0)
+        self._check_normals(P, sel, H)
         p = self._params(P, sel, H)
         X = H[P["nodes"][sel]]
         fric = p["mu"] > 0
@@ -545,6 +639,12 @@ class ContactSystem:
                     stick=out["stick"] & active & (p["mu"] > 0), slip_increment=out["slip"], kind=p["kind"],
                     angle=ang, slave_element=P["e"][sel], master_element=P["m"][sel],
                     xi1=out["xi1"], xi2=out["xi2"], weight=w, normal=out["n"])
+
+
+def _step_failure(message):
+    """The solver's step failure (the step is cut back; the message ends a run that cannot)."""
+    from ..solver import _StepFailed
+    return _StepFailed(message)
 
 
 def _frames(out):

@@ -1,0 +1,46 @@
+"""Contact options of one ``Model.add_contact`` declaration as one validated, typed object.
+
+``ContactOptions.from_dict`` takes the keyword options (checked by
+``validation.check_contact_options``, which refuses unknown names and bad values
+with an ``InputError`` naming them) and fills the defaults, which live here
+only.  Lengths are in model units; ``None`` means "derived per pair" where
+stated.
+"""
+from dataclasses import asdict, dataclass
+from typing import Optional
+
+import numpy as np
+
+from ..validation import check_contact_options
+
+__all__ = ["ContactOptions", "SMOOTHING", "SLIP_TOLERANCE", "LINE_ANGLE"]
+
+SMOOTHING = 0.0           # default smoothing gap of the normal law / (R1 + R2) (0: sharp)
+SLIP_TOLERANCE = 0.005    # elastic slip at the onset of sliding / slave element length (Abaqus' default)
+LINE_ANGLE = float(np.deg2rad(20.0))   # below this crossing angle: line contact (search.py, rule 1)
+
+
+@dataclass(frozen=True)
+class ContactOptions:
+    """``smoothing``: gap over which the normal law is made C1 (None: ``SMOOTHING (R1 + R2)``);
+    ``gauss_points`` per slave element; ``penalty_t``: tangential penalty, force / length^3
+    (None: from ``slip_tolerance``); ``slip_tolerance``: elastic slip at the onset of sliding /
+    slave element length; ``tolerance``: penetration enabling augmented-Lagrangian updates
+    (None: pure penalty); ``line_angle`` [rad], ``point_ratio``: the search's kind rules;
+    ``margin``: search margin (None: twice the largest radius)."""
+    smoothing: Optional[float] = None
+    gauss_points: int = 5
+    penalty_t: Optional[float] = None
+    slip_tolerance: float = SLIP_TOLERANCE
+    tolerance: Optional[float] = None
+    line_angle: float = LINE_ANGLE
+    point_ratio: float = 0.5
+    margin: Optional[float] = None
+
+    @classmethod
+    def from_dict(cls, options, owner="add_contact"):
+        """Validated options from ``add_contact``'s keyword arguments (defaults filled)."""
+        return cls(**check_contact_options(dict(options), owner))
+
+    def as_dict(self):
+        return asdict(self)

@@ -1,0 +1,44 @@
+"""Contact options as one validated, typed object (``contact.options.ContactOptions``)."""
+import dataclasses
+
+import numpy as np
+import pytest
+
+import beamsolver as bs
+from beamsolver.assembly import System
+from beamsolver.contact.options import SLIP_TOLERANCE, SMOOTHING, ContactOptions
+
+
+def test_defaults_live_in_one_place():
+    o = ContactOptions.from_dict({})
+    assert o == ContactOptions()
+    assert o.slip_tolerance == SLIP_TOLERANCE and o.smoothing is None and o.gauss_points == 5
+    assert o.line_angle == pytest.approx(np.deg2rad(20.0)) and o.margin is None
+    assert SMOOTHING >= 0.0
+
+
+def test_given_values_are_kept_and_typed():
+    o = ContactOptions.from_dict(dict(gauss_points=3, smoothing=1e-6, line_angle=0.0))
+    assert (o.gauss_points, o.smoothing, o.line_angle) == (3, 1e-6, 0.0)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        o.gauss_points = 4
+
+
+@pytest.mark.parametrize("options,name", [(dict(gauss_points=0), "gauss_points"), (dict(smoothing=-1.0), "smoothing"),
+                                          (dict(colour="red"), "colour"), (dict(line_angle=2.0), "line_angle")])
+def test_bad_options_name_themselves(options, name):
+    with pytest.raises(bs.InputError, match=name):
+        ContactOptions.from_dict(options)
+
+
+def test_the_contact_system_reads_the_object():
+    sec = bs.Section.circular(radius=0.05, E=1e7, nu=0.3)
+    m = bs.Model()
+    a = m.add_beam(bs.geometry.straight((0, -1, 0), (0, 1, 0), 2), sec)
+    b = m.add_beam(bs.geometry.straight((-1, 0, 0.1), (1, 0, 0.1), 2), sec)
+    m.clamp(a.first)
+    m.clamp(b.first)
+    m.add_contact(b, a, gauss_points=3, margin=0.2)
+    d = System(m, check_rigid_modes=False).contact.decls[0]
+    assert d.options == ContactOptions(gauss_points=3, margin=0.2)
+    assert (d.n_gp, d.margin) == (3, 0.2)

@@ -1,0 +1,47 @@
+"""The contact history's public state (``ContactSystem.get_state`` / ``set_state``), which
+``restart`` and ``linearize`` use instead of private attributes."""
+import inspect
+import sys
+from pathlib import Path
+
+import numpy as np
+
+import beamsolver as bs
+from beamsolver import restart
+from beamsolver.assembly import System
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+
+import rolling  # noqa: E402
+
+
+def test_state_round_trip_gives_the_same_contact_forces():
+    model, slave, _ = rolling.build(mu=0.5, n_elements=3)
+    sol = bs.solve(model, steps=2)
+    state = sol.contact_state
+    assert len(state["history.key"]) > 0 and "prev_owners" in state
+    fresh = System(model).contact
+    fresh.set_state(state)
+    back = fresh.get_state()
+    assert back.keys() == state.keys()
+    for k in state:
+        np.testing.assert_array_equal(back[k], state[k])
+    # the restored history acts: forces at a moved pose equal those of the original system
+    H = sol.poses[-1].copy()
+    H[slave.nodes, 0, 3] += 1e-4
+    original = System(model).contact
+    original.set_state(state)
+    original.begin_step(sol.poses[-1], 1.0)
+    fresh.begin_step(sol.poses[-1], 1.0)
+    r1, _, _ = original.evaluate(H, tangent=False)
+    r2, _, _ = fresh.evaluate(H, tangent=False)
+    np.testing.assert_array_equal(r1, r2)
+    empty = System(model).contact                # no history: other tangential forces
+    empty.begin_step(sol.poses[-1], 1.0)
+    r0, _, _ = empty.evaluate(H, tangent=False)
+    assert np.abs(r1 - r0).max() > 1e-6 * np.abs(r1).max()
+
+
+def test_restart_uses_only_the_public_state():
+    src = inspect.getsource(restart.contact_snapshot) + inspect.getsource(restart.contact_restore)
+    assert "._" not in src
