@@ -319,8 +319,9 @@ class Model:
         softer section, ``contact.law.default_penalty``).  Options, lengths in the
         model's unit:
 
-        - ``smoothing``: gap over which the normal law is made C1 (default 0, sharp;
-          about ``1e-3 (R1 + R2)`` helps touching, lightly loaded wires);
+        - ``smoothing``: gap over which the normal law is made C1 (default None:
+          ``1e-6 (R1 + R2)`` for line contact, so touching, lightly loaded wires converge,
+          and sharp for point and orthogonal pairs; 0: sharp everywhere);
         - ``tolerance``: penetration below which augmented-Lagrangian updates stop
           (default None: pure penalty, no updates);
         - ``slip_tolerance``: elastic slip at the onset of sliding, in slave element

@@ -70,7 +70,7 @@ def measure(n_points, oracle_max=10_000):
     P = c.pairs(H)
     sel = c._active(P, H)
     p = c._params(P, sel, H)
-    X = H[P["nodes"][sel]]
+    X = H[P.nodes[sel]]
     kernel_jit.kernel_and_tangent(X[:2], {k: (v[:2] if np.ndim(v) else v) for k, v in p.items()})   # compiled
     t_jit = _best(lambda: kernel_jit.kernel_and_tangent(X, p, friction=True), repeat)
     t_np = _best(lambda: pairs.kernel_and_tangent(X, p, friction=True), 1) if n_points <= oracle_max else np.nan

@@ -209,7 +209,7 @@ def contact_parts(c, H, tangent=True):
         times["contact_other"] = max(total - acc["contact_search"] - acc["contact_kernels"], 0.0)
     times["contact_total"] = total
     P = seen.get("pairs")
-    info = dict(info, candidates=len(P["e"]) if isinstance(P, dict) else -1)
+    info = dict(info, candidates=len(P) if P is not None else -1)
     return rc, coo, info, times
 
 

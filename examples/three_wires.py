@@ -17,6 +17,8 @@ import numpy as np
 
 import beamsolver as bs
 
+solve_options = dict(steps=8)       # for `beamsolver run examples/three_wires.py`
+
 
 def build(radius=0.5e-3, length=0.03, n_elements=24, turns=1.0, pull=5.0, mu=0.3, E=200e9, nu=0.3,
           **contact_options):

@@ -62,9 +62,9 @@ def test_gauss_point_on_a_shared_master_node_has_one_stable_owner():
     for dx in (2e-11, -2e-11, 2e-11, -2e-11):
         H = _shift(system, slave.nodes, dx)
         P = cs.pairs(H)
-        mid = P["gp"] == 2                                   # the middle of 5 Gauss points
+        mid = P.gp == 2                                   # the middle of 5 Gauss points
         assert mid.sum() == 1                                # exactly one master element owns it
-        owners.append(int(P["m"][mid][0]))
+        owners.append(int(P.m[mid][0]))
         r, _, info = cs.evaluate(H, tangent=False)
         forces.append(r)
     assert len(set(owners)) == 1, owners                     # the same at every evaluation

@@ -30,9 +30,9 @@ def _pushed_crossing(drop, height=2 * R):
 
 
 def test_a_step_that_tunnels_is_cut_back():
-    """One step moves the slave (0.5 R above the master) down by 6.5 R: its first iterate lies below the master, where the
-    pair's gap is positive and its force zero -- "converged" with the master untouched unless
-    the change of side is detected and the step cut back."""
+    """One step moves the slave (0.5 R above the master) down by 6.5 R: its first iterate lies
+    below the master, where the pair's gap is positive and its force zero -- "converged" with the
+    master untouched unless the change of side is detected and the step cut back."""
     m, slave, master = _pushed_crossing(6.5 * R, height=2.5 * R)
     sol = bs.solve(m, steps=1)
     assert sol.position(master.nodes[3])[2] < -5 * R              # pushed down (was: untouched, 0)

@@ -115,7 +115,7 @@ def _pair_kinds(angle_deg, wrap=False, **options):
     m.add_contact(slave, master, **options)
     s = System(m, check_rigid_modes=False)
     P = s.contact.pairs(s.poses0)
-    return set(P["kind"].tolist())
+    return set(P.kind.tolist())
 
 
 def test_choice_rule_line_angle():

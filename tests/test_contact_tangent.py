@@ -69,8 +69,8 @@ def _towards_master(system, H, slave, master, depth):
     """Translate the slave so that its closest contact point penetrates by ``depth``."""
     P = system.contact.pairs(H)
     from beamsolver.contact.system import _interp_pos
-    xC = _interp_pos(H, system.enodes, P["e"], P["xi1"])
-    xF = _interp_pos(H, system.enodes, P["m"], P["xi2"])
+    xC = _interp_pos(H, system.enodes, P.e, P.xi1)
+    xF = _interp_pos(H, system.enodes, P.m, P.xi2)
     d = xF - xC
     dist = np.linalg.norm(d, axis=1)
     k = int(np.argmin(dist))
@@ -128,7 +128,7 @@ def _state(scene, regime):
 def test_contact_tangent_matches_finite_differences(scene, regime):
     system, H, kind = _state(scene, regime)
     P = system.contact.pairs(H)
-    assert set(P["kind"].tolist()) == {kind}
+    assert set(P.kind.tolist()) == {kind}
     err, cinfo = _fd_error(system, H)
     # the regime is the one asked for
     system.contact.commit(H)

@@ -1,7 +1,7 @@
 """Three touching wires twisted by a plate with default contact options (issue 14 defect 1),
-at a reduced size (8 elements, 10 mm, a quarter turn in 2 steps).  Before the ownership rules
-at shared nodes (tests/test_contact_at_nodes.py) it needed a cut-back and 39 iterations; the full
-scene (24 elements, 30 mm, one turn) did not converge."""
+at a reduced size (8 elements, 10 mm, a quarter turn in 2 steps).  With the sharp law and
+before the ownership rules at shared nodes (tests/test_contact_at_nodes.py) it needed 4 cut-backs;
+the full scene (24 elements, 30 mm, one turn) did not converge."""
 import sys
 from pathlib import Path
 
@@ -24,14 +24,14 @@ def test_converges_with_defaults_without_cut_backs(run):
     sol, _ = run
     assert sol.converged and sol.times[-1] == pytest.approx(1.0)
     assert sum(s.get("cutbacks", 0) for s in sol.stats) == 0
-    assert sum(s["iterations"] for s in sol.stats) <= 24
+    assert sum(s["iterations"] for s in sol.stats) <= 30        # 21 measured (8 of them for step 0)
 
 
 def test_wires_stay_in_touch_and_carry_the_torsion(run):
     sol, _ = run
-    model, plate, wires = three_wires.build(n_elements=8, length=L, turns=TURNS)
+    _, plate, _ = three_wires.build(n_elements=8, length=L, turns=TURNS)
     G, J = 200e9 / 2.6, np.pi * R**4 / 2
-    torque = sol.reaction(plate.id if hasattr(plate, "id") else plate)[5]
+    torque = sol.reaction(plate)[5]
     # torsion of the three wires dominates: 3 G J phi / L within 10 %
     assert torque == pytest.approx(3 * G * J * 2 * np.pi * TURNS / L, rel=0.1)
     c = sol.contact()

@@ -15,14 +15,15 @@ from ..validation import check_contact_options
 
 __all__ = ["ContactOptions", "SMOOTHING", "SLIP_TOLERANCE", "LINE_ANGLE"]
 
-SMOOTHING = 0.0           # default smoothing gap of the normal law / (R1 + R2) (0: sharp)
+SMOOTHING = 1e-6          # default smoothing gap of the normal law / (R1 + R2) (benchmarks/touching_defaults.py)
 SLIP_TOLERANCE = 0.005    # elastic slip at the onset of sliding / slave element length (Abaqus' default)
 LINE_ANGLE = float(np.deg2rad(20.0))   # below this crossing angle: line contact (search.py, rule 1)
 
 
 @dataclass(frozen=True)
 class ContactOptions:
-    """``smoothing``: gap over which the normal law is made C1 (None: ``SMOOTHING (R1 + R2)``);
+    """``smoothing``: gap over which the normal law is made C1 (None: ``SMOOTHING (R1 + R2)`` for
+    line contact, 0 for point and orthogonal pairs);
     ``gauss_points`` per slave element; ``penalty_t``: tangential penalty, force / length^3
     (None: from ``slip_tolerance``); ``slip_tolerance``: elastic slip at the onset of sliding /
     slave element length; ``tolerance``: penetration enabling augmented-Lagrangian updates

@@ -1,27 +1,30 @@
 """Contact as a pipeline inside the Newton loop: search -> pairs -> kernel -> scatter.
 
 ``ContactSystem`` is created by ``assembly.System`` only when the model has
-contact declarations.  Per evaluation it searches, evaluates the contact
-kernel (forces and complex-step tangent) on the active pairs and returns the
-residual and COO tangent in the unknowns' numbering.  Per step it keeps the
-friction history and augmented-Lagrangian multipliers, keyed by material slave
-point and master beam, committed only when a step is accepted.  A pair with
-no history (it just came into contact) starts one from the poses at the start
-of the step (``begin_step``): its material frames are those of the pair there,
-its tangential traction zero, so friction acts from the first step of contact.
+contact declarations.  Per evaluation it runs the stages
 
-Options per ``Model.add_contact`` declaration (keyword arguments):
-``smoothing`` (gap over which the normal law is smoothed, default 0: the
-sharp penalty; about ``1e-3 (R1 + R2)`` helps touching, lightly loaded beams), ``gauss_points`` (5), ``penalty`` (default ``law.default_penalty``, per unit
-length), ``penalty_t`` (tangential penalty, force / length^3; default: none, see
-``slip_tolerance``), ``slip_tolerance`` (default 0.005: without ``penalty_t`` the
-tangential stiffness of a point is ``mu lam_N / (slip_tolerance L_e)``, so the elastic
-slip at the onset of sliding is ``slip_tolerance`` times the slave element length
-``L_e`` -- Abaqus' default penalty friction; below a floor traction, see
-``pairs.stick_penalty``), ``tolerance``
-(penetration tolerance enabling augmented-Lagrangian updates; None: pure
-penalty), ``line_angle`` (20 deg), ``point_ratio`` (0.5), ``margin``
-(search margin, default the sum of radii).
+1. broad phase and pair rules (``_candidates``: element spheres, no pair between
+   elements sharing a node, the kind of each element pair);
+2. projection and ownership (``_point_pairs``, ``_gauss_pairs``: one owner per
+   slave point, stable at shared nodes), giving one typed ``record.PairSet``;
+3. refusals (``_check_sides``: tunnelling; ``_check_normals``: no normal);
+4. kernel parameters and history look-up (``_params``), the kernel (forces and
+   complex-step tangent, ``pairs.py``) on the active pairs;
+5. scatter into the residual and COO tangent in the unknowns' numbering.
+
+Per step it keeps the friction history and augmented-Lagrangian multipliers,
+keyed by material slave point and master beam, committed only when a step is
+accepted (``get_state``/``set_state`` for saving and restart).  A pair with no
+history (it just came into contact) starts one from the poses at the start of
+the step (``begin_step``): its material frames are those of the pair there, its
+tangential traction zero, so friction acts from the first step of contact.
+
+Options per ``Model.add_contact`` declaration: ``options.ContactOptions`` (the
+defaults and their meaning live there).  Without ``penalty_t`` the tangential
+stiffness of a point is ``mu lam_N / (slip_tolerance L_e)``, so the elastic slip
+at the onset of sliding is ``slip_tolerance`` times the slave element length
+``L_e`` (Abaqus' default penalty friction; below a floor traction, see
+``pairs.stick_penalty``).
 """
 
 import numpy as np
@@ -34,6 +37,7 @@ from . import kernel_jit, pairs
 from .kernel_jit import contact_kernel, kernel_and_tangent      # compiled; pairs.py's are the oracle
 from .options import SMOOTHING, ContactOptions
 from .pairs import LINE, NORMAL_TOL, ORTHOGONAL, POINT, _project, _section, material_frames, no_normal
+from .record import Candidates, PairSet
 from .search import XI_TOL, broad_phase, closest_points, element_spheres
 
 MAX_AUGMENT = 30
@@ -153,94 +157,108 @@ class ContactSystem:
 
     # ------------------------------------------------------------ search
     def pairs(self, H):
-        """All potential contact pairs at poses ``H`` as a dict of arrays."""
-        sysm = self.sys
-        en = sysm.enodes
-        out = []
-        chosen = []
-        owners = []
+        """All potential contact pairs at poses ``H`` (a ``PairSet``, None if there are none).
+
+        Per declaration: broad phase and pair rules (``_candidates``), then point pairs
+        (``_point_pairs``) and Gauss-point projections (``_gauss_pairs``), each keeping one
+        owner per slave point; the owners are remembered for the next evaluation.
+        """
+        out, chosen, owners = [], [], []
         for d in self.decls:
-            cs, rs, hs, ts = element_spheres(H, en[d.slave_el], self.el_radius[d.slave_el], d.margin)
-            cm, rm, hm, tm = element_spheres(H, en[d.master_el], self.el_radius[d.master_el], d.margin)
-            i, j = broad_phase(cs, rs, cm, rm)
-            e, m = d.slave_el[i], d.master_el[j]
-            # elements sharing a node (a beam joined to another) never pair
-            share = np.isin(en[e], en[m]).any(axis=1)
-            i, j, e, m = i[~share], j[~share], e[~share], m[~share]
-            cosang = np.abs(np.sum(ts[i] * tm[j], axis=1))
-            angle = np.arccos(np.clip(cosang, 0.0, 1.0))
-            big = angle >= d.line_angle
-            kinds = np.full(len(i), LINE)
-            xi1p = np.zeros(len(i))
-            xi2p = np.zeros(len(i))
-            if big.any():
-                b = np.flatnonzero(big)
-                x1, x2, ratio = closest_points(H[en[e[b], 0]], hs[i[b]], H[en[m[b], 0]], hm[j[b]])
-                pt = ratio >= d.point_ratio
-                kinds[b[pt]] = POINT
-                kinds[b[~pt]] = ORTHOGONAL
-                xi1p[b], xi2p[b] = x1, x2
-                kinds = self._extend_wrap(e, m, kinds)
-            parts = []
-            # point-to-point pairs: one per element pair, inside both elements (half-open)
-            pt = np.flatnonzero(kinds == POINT)
-            if len(pt):
-                x1, x2 = xi1p[pt], xi2p[pt]
-                lo1, hi1 = self._xi_range(e[pt])
-                lo2, hi2 = self._xi_range(m[pt])
-                pt = pt[(x1 >= lo1) & (x1 <= hi1) & (x2 >= lo2) & (x2 <= hi2)]
-                pt = self._dedupe_points(H, e[pt], m[pt], xi1p[pt], xi2p[pt], pt)
-                chosen.append(e[pt] * len(en) + m[pt])
-                key = self.point_offset + (np.int64(d.index) * len(en) + e[pt]) * len(en) + m[pt]
-                parts.append(dict(kind=np.full(len(pt), POINT), e=e[pt], m=m[pt], xi1=xi1p[pt],
-                                  xi2=xi2p[pt], weight=sysm.L[e[pt]], key=key, gp=np.zeros(len(pt), int)))
-            # Gauss-point pairs (line and orthogonal projections)
-            gp = np.flatnonzero(kinds != POINT)
-            if len(gp):
-                xg, wg = np.polynomial.legendre.leggauss(d.n_gp)
-                xg, wg = 0.5 * (xg + 1.0), 0.5 * wg
-                rep = np.repeat(gp, d.n_gp)
-                g = np.tile(np.arange(d.n_gp), len(gp))
-                xi1 = xg[g]
-                HC, _, _ = _section(H[en[e[rep], 0]], hs[i[rep]], xi1)
-                # a slave Gauss point outside the master element's sphere (grown by R1) cannot
-                # touch that element: no projection for it
-                xc = HC[:, :3, 3]
-                near = (np.sum((xc - cm[j[rep], :3, 3]) ** 2, axis=1)
-                        <= (rm[j[rep]] + self.el_radius[e[rep]]) ** 2)
-                rep, g, xi1, HC, xc = rep[near], g[near], xi1[near], HC[near], xc[near]
-                ee, mm = e[rep], m[rep]
-                kk = kinds[rep]
-                # start from the projection on the master chord (8 Newton iterations: the kernel
-                # polishes the point with 2 more and needs it converged for an exact tangent)
-                xa, xb = H[en[mm, 0], :3, 3], H[en[mm, 1], :3, 3]
-                chord = xb - xa
-                xi2 = np.clip(np.sum((xc - xa) * chord, axis=1) / np.maximum(np.sum(chord * chord, axis=1),
-                                                                               1e-300), 0.0, 1.0)
-                _, xi2 = _project(kk, H[en[ee, 0]], hs[i[rep]], xi1, H[en[mm, 0]], hm[j[rep]], xi2,
-                                  iterations=8)
-                HF, _, _ = _section(H[en[mm, 0]], hm[j[rep]], xi2)
-                dist = np.linalg.norm(HF[:, :3, 3] - HC[:, :3, 3], axis=1)
-                lo, hi = self._xi_range(mm)
-                ok = (xi2 >= lo) & (xi2 <= hi) & np.isfinite(dist)
-                key = ((np.int64(d.index) * len(en) + ee) * self.max_gp + g) * self.n_beams + self.el_beam[mm]
-                sel = self._owners(np.flatnonzero(ok), key, mm, xi2, dist, self.el_radius[ee] + self.el_radius[mm])
-                owners.append(key[sel] * len(en) + mm[sel])
-                parts.append(dict(kind=kk[sel], e=ee[sel], m=mm[sel], xi1=xi1[sel], xi2=xi2[sel],
-                                  weight=wg[g[sel]] * sysm.L[ee[sel]], key=key[sel], gp=g[sel]))
-            for p in parts:
-                p["decl"] = np.full(len(p["e"]), d.index)
-            out.extend(parts)
+            c = self._candidates(d, H)
+            part, ids = self._point_pairs(d, H, c)
+            out.append(part)
+            chosen.append(ids)
+            part, ids = self._gauss_pairs(d, H, c)
+            out.append(part)
+            owners.append(ids)
         self._prev_points = np.concatenate(chosen) if chosen else np.zeros(0, dtype=np.int64)
         self._prev_owners = np.concatenate(owners) if owners else np.zeros(0, dtype=np.int64)
-        if not out:
-            return None
-        P = {k: np.concatenate([p[k] for p in out]) for k in out[0]}
-        nodes = np.stack([en[P["e"], 0], en[P["e"], 1], en[P["m"], 0], en[P["m"], 1]], axis=1)
-        P["nodes"] = nodes
-        P["R1"] = self.el_radius[P["e"]]
-        P["R2"] = self.el_radius[P["m"]]
-        return P
+        out = [p for p in out if len(p)]
+        return PairSet.concatenate(out) if out else None
+
+    def _candidates(self, d, H):
+        """Broad phase and pair rules of declaration ``d``: element pairs not sharing a node,
+        their kind (line below ``line_angle``, else point or orthogonal by the reduced-Hessian
+        ratio; search.py) and the closest points of non-line pairs."""
+        en = self.sys.enodes
+        cs, rs, hs, ts = element_spheres(H, en[d.slave_el], self.el_radius[d.slave_el], d.margin)
+        cm, rm, hm, tm = element_spheres(H, en[d.master_el], self.el_radius[d.master_el], d.margin)
+        i, j = broad_phase(cs, rs, cm, rm)
+        e, m = d.slave_el[i], d.master_el[j]
+        # elements sharing a node (a beam joined to another) never pair
+        share = np.isin(en[e], en[m]).any(axis=1)
+        i, j, e, m = i[~share], j[~share], e[~share], m[~share]
+        angle = np.arccos(np.clip(np.abs(np.sum(ts[i] * tm[j], axis=1)), 0.0, 1.0))
+        big = angle >= d.line_angle
+        kinds = np.full(len(i), LINE)
+        xi1, xi2 = np.zeros(len(i)), np.zeros(len(i))
+        if big.any():
+            b = np.flatnonzero(big)
+            x1, x2, ratio = closest_points(H[en[e[b], 0]], hs[i[b]], H[en[m[b], 0]], hm[j[b]])
+            pt = ratio >= d.point_ratio
+            kinds[b[pt]] = POINT
+            kinds[b[~pt]] = ORTHOGONAL
+            xi1[b], xi2[b] = x1, x2
+            kinds = self._extend_wrap(e, m, kinds)
+        return Candidates(e=e, m=m, kind=kinds, xi1=xi1, xi2=xi2, h1=hs[i], h2=hm[j], c2=cm[j], r2=rm[j])
+
+    def _record(self, d, kind, e, m, xi1, xi2, weight, key, gp):
+        en = self.sys.enodes
+        nodes = np.stack([en[e, 0], en[e, 1], en[m, 0], en[m, 1]], axis=1)
+        return PairSet(kind=kind, e=e, m=m, xi1=xi1, xi2=xi2, weight=weight, key=key, gp=gp,
+                       decl=np.full(len(e), d.index), nodes=nodes, R1=self.el_radius[e], R2=self.el_radius[m])
+
+    def _point_pairs(self, d, H, c):
+        """Point-to-point pairs: one per crossing (``_dedupe_points``), on both elements up to
+        ``XI_OVERHANG`` past an inner node.  Returns the record and the chosen element pairs."""
+        n_el = len(self.sys.enodes)
+        pt = np.flatnonzero(c.kind == POINT)
+        e, m, x1, x2 = c.e[pt], c.m[pt], c.xi1[pt], c.xi2[pt]
+        lo1, hi1 = self._xi_range(e)
+        lo2, hi2 = self._xi_range(m)
+        pt = pt[(x1 >= lo1) & (x1 <= hi1) & (x2 >= lo2) & (x2 <= hi2)]
+        e, m = c.e[pt], c.m[pt]
+        keep = self._dedupe_points(H, e, m, c.xi1[pt], c.xi2[pt], np.arange(len(pt)))
+        pt, e, m = pt[keep], e[keep], m[keep]
+        key = self.point_offset + (np.int64(d.index) * n_el + e) * n_el + m
+        rec = self._record(d, np.full(len(pt), POINT), e, m, c.xi1[pt], c.xi2[pt], self.sys.L[e], key,
+                           np.zeros(len(pt), int))
+        return rec, e * n_el + m
+
+    def _gauss_pairs(self, d, H, c):
+        """Line and orthogonal projections of the slave Gauss points; one owner per slave
+        point and master beam (``_owners``).  Returns the record and the owner ids."""
+        en = self.sys.enodes
+        gp = np.flatnonzero(c.kind != POINT)
+        xg, wg = np.polynomial.legendre.leggauss(d.n_gp)
+        xg, wg = 0.5 * (xg + 1.0), 0.5 * wg
+        rep = np.repeat(gp, d.n_gp)
+        g = np.tile(np.arange(d.n_gp), len(gp))
+        e, m, h1, h2 = c.e[rep], c.m[rep], c.h1[rep], c.h2[rep]
+        xi1 = xg[g]
+        HC, _, _ = _section(H[en[e, 0]], h1, xi1)
+        # a slave Gauss point outside the master element's sphere (grown by R1) cannot
+        # touch that element: no projection for it
+        xc = HC[:, :3, 3]
+        near = np.sum((xc - c.c2[rep, :3, 3]) ** 2, axis=1) <= (c.r2[rep] + self.el_radius[e]) ** 2
+        rep, g, e, m, h1, h2, xi1, xc = rep[near], g[near], e[near], m[near], h1[near], h2[near], xi1[near], xc[near]
+        kind = c.kind[rep]
+        # start from the projection on the master chord (8 Newton iterations: the kernel
+        # polishes the point with 2 more and needs it converged for an exact tangent)
+        xa, xb = H[en[m, 0], :3, 3], H[en[m, 1], :3, 3]
+        chord = xb - xa
+        xi2 = np.clip(np.sum((xc - xa) * chord, axis=1) / np.maximum(np.sum(chord * chord, axis=1), 1e-300),
+                      0.0, 1.0)
+        _, xi2 = _project(kind, H[en[e, 0]], h1, xi1, H[en[m, 0]], h2, xi2, iterations=8)
+        HF, _, _ = _section(H[en[m, 0]], h2, xi2)
+        dist = np.linalg.norm(HF[:, :3, 3] - xc, axis=1)
+        lo, hi = self._xi_range(m)
+        ok = (xi2 >= lo) & (xi2 <= hi) & np.isfinite(dist)
+        key = ((np.int64(d.index) * len(en) + e) * self.max_gp + g) * self.n_beams + self.el_beam[m]
+        s = self._owners(np.flatnonzero(ok), key, m, xi2, dist, self.el_radius[e] + self.el_radius[m])
+        rec = self._record(d, kind[s], e[s], m[s], xi1[s], xi2[s], wg[g[s]] * self.sys.L[e[s]], key[s], g[s])
+        return rec, key[s] * len(en) + m[s]
 
     def _xi_range(self, el):
         """Accepted projections ``[lo, hi]`` on elements ``el``: ``XI_OVERHANG`` past an inner
@@ -334,14 +352,14 @@ class ContactSystem:
 
     def _params(self, P, sel, H):
         """Kernel parameters for the pairs ``sel`` (history and multipliers looked up)."""
-        dec = P["decl"][sel]
-        p = dict(kind=P["kind"][sel], xi1=P["xi1"][sel], xi2=P["xi2"][sel], R1=P["R1"][sel],
-                 R2=P["R2"][sel], weight=P["weight"][sel], penalty=self._decl_penalty[dec],
+        dec = P.decl[sel]
+        p = dict(kind=P.kind[sel], xi1=P.xi1[sel], xi2=P.xi2[sel], R1=P.R1[sel],
+                 R2=P.R2[sel], weight=P.weight[sel], penalty=self._decl_penalty[dec],
                  penalty_t=self._decl_penalty_t[dec], mu=self._decl_mu[dec])
         # elastic slip at the onset of sliding (used where no penalty_t is given)
-        p["elastic_slip"] = self._decl_slip_tol[dec] * self.sys.L[P["e"][sel]]
+        p["elastic_slip"] = self._decl_slip_tol[dec] * self.sys.L[P.e[sel]]
         p["smoothing"] = self._smoothing(P, sel)
-        key = P["key"][sel]
+        key = P.key[sel]
         mi, mf = self._lookup(self._mult[0], key)
         p["multiplier"] = np.where(mf, self._mult[1][mi] if len(self._mult[1]) else 0.0, 0.0)
         hist = self._history
@@ -352,8 +370,8 @@ class ContactSystem:
             p["H_FK"] = np.where(hf[:, None, None], hist["H_FK"][hi], np.eye(4))
             p["H_LK_prev"] = np.where(hf[:, None, None], hist["H_LK"][hi], np.eye(4))
             # material points, re-expressed on the current elements (same beam, consecutive ids)
-            p["xi1_prev"] = np.where(hf, hist["xi1"][hi] + hist["e"][hi] - P["e"][sel], p["xi1"])
-            p["xi2_prev"] = np.where(hf, hist["xi2"][hi] + hist["m"][hi] - P["m"][sel], p["xi2"])
+            p["xi1_prev"] = np.where(hf, hist["xi1"][hi] + hist["e"][hi] - P.e[sel], p["xi1"])
+            p["xi2_prev"] = np.where(hf, hist["xi2"][hi] + hist["m"][hi] - P.m[sel], p["xi2"])
             p["lam_t_prev"] = np.where(hf[:, None], hist["lam_t"][hi], 0.0)
         else:
             p.update(H_CL=np.tile(np.eye(4), (n, 1, 1)), H_FK=np.tile(np.eye(4), (n, 1, 1)),
@@ -369,7 +387,7 @@ class ContactSystem:
         # material frames are those of the pair there (same xi), its traction zero
         new = np.flatnonzero(~hf & (p["mu"] > 0))
         if len(new) and self._H_prev is not None:
-            X = self._H_prev[P["nodes"][sel][new]]
+            X = self._H_prev[P.nodes[sel][new]]
             H_CL, H_FK, H_LK = material_frames(X, p["kind"][new], p["xi1"][new], p["xi2"][new],
                                                p["R1"][new], p["R2"][new])
             ok = np.isfinite(H_LK).all(axis=(1, 2))
@@ -387,12 +405,12 @@ class ContactSystem:
         material points are re-expressed on the new elements (same beam, consecutive ids)."""
         hist = self._history
         en, nb = self.sys.enodes, self.n_beams
-        e, m = P["e"][sel][cand], P["m"][sel][cand]
+        e, m = P.e[sel][cand], P.m[sel][cand]
         x = _interp_pos(H, en, e, p["xi1"][cand])
         he, hm = hist["e"][hp], hist["m"][hp]
         hx = _interp_pos(H, en, he, hist["xi1"][hp])       # the stored material points, now
         hdecl = (hist["key"][hp] - self.point_offset) // (np.int64(len(en)) * len(en))
-        g_new = (P["decl"][sel][cand] * nb + self.el_beam[e]) * nb + self.el_beam[m]
+        g_new = (P.decl[sel][cand] * nb + self.el_beam[e]) * nb + self.el_beam[m]
         g_old = (hdecl * nb + self.el_beam[he]) * nb + self.el_beam[hm]
         k = min(4, len(hp))
         dist, j = cKDTree(hx).query(x, k=k)
@@ -407,27 +425,31 @@ class ContactSystem:
         ii = cand[ok]
         for name, src in (("H_CL", "H_CL"), ("H_FK", "H_FK"), ("H_LK_prev", "H_LK"), ("lam_t_prev", "lam_t")):
             p[name][ii] = hist[src][jh]
-        p["xi1_prev"][ii] = hist["xi1"][jh] + hist["e"][jh] - P["e"][sel][ii]
-        p["xi2_prev"][ii] = hist["xi2"][jh] + hist["m"][jh] - P["m"][sel][ii]
+        p["xi1_prev"][ii] = hist["xi1"][jh] + hist["e"][jh] - P.e[sel][ii]
+        p["xi2_prev"][ii] = hist["xi2"][jh] + hist["m"][jh] - P.m[sel][ii]
         hf = hf.copy()
         hf[ii] = True
         return hf
 
     def _smoothing(self, P, sel):
-        rsum = P["R1"][sel] + P["R2"][sel]
-        given = self._decl_smoothing[P["decl"][sel]]
-        return np.where(np.isnan(given), SMOOTHING * rsum, given)
+        """Smoothing gap per pair: the declaration's, else ``SMOOTHING (R1 + R2)`` for line
+        contact (touching, nearly parallel wires, whose many Gauss points hover at gap zero)
+        and 0 (sharp) for point and orthogonal pairs (crossings and wraps keep the exact
+        penalty law)."""
+        rsum = P.R1[sel] + P.R2[sel]
+        given = self._decl_smoothing[P.decl[sel]]
+        return np.where(np.isnan(given), np.where(P.kind[sel] == LINE, SMOOTHING * rsum, 0.0), given)
 
     def _active(self, P, H):
         """Pairs whose trial normal traction is positive, with their kernel parameters."""
-        xC = _interp_pos(H, self.sys.enodes, P["e"], P["xi1"])
-        xF = _interp_pos(H, self.sys.enodes, P["m"], P["xi2"])
-        gap = np.linalg.norm(xF - xC, axis=1) - P["R1"] - P["R2"]
-        pen = self._decl_penalty[P["decl"]]
-        mi, mf = self._lookup(self._mult[0], P["key"])
+        xC = _interp_pos(H, self.sys.enodes, P.e, P.xi1)
+        xF = _interp_pos(H, self.sys.enodes, P.m, P.xi2)
+        gap = np.linalg.norm(xF - xC, axis=1) - P.R1 - P.R2
+        pen = self._decl_penalty[P.decl]
+        mi, mf = self._lookup(self._mult[0], P.key)
         mult = np.where(mf, self._mult[1][mi] if len(self._mult[1]) else 0.0, 0.0)
         # the smoothing zone plus a small band keeps the projection-updated gap consistent
-        band = self._smoothing(P, slice(None)) + 1e-3 * (P["R1"] + P["R2"])
+        band = self._smoothing(P, slice(None)) + 1e-3 * (P.R1 + P.R2)
         return np.flatnonzero(mult - pen * gap > -pen * band)
 
     # ------------------------------------------------------------ refusals
@@ -440,12 +462,12 @@ class ContactSystem:
 
     def _check_normals(self, P, sel, H):
         """Refuse (a step failure: cut back) pairs whose centre lines intersect: no normal."""
-        xC = _interp_pos(H, self.sys.enodes, P["e"][sel], P["xi1"][sel])
-        xF = _interp_pos(H, self.sys.enodes, P["m"][sel], P["xi2"][sel])
-        bad = np.flatnonzero(no_normal(np.linalg.norm(xF - xC, axis=1), P["R1"][sel], P["R2"][sel]))
+        xC = _interp_pos(H, self.sys.enodes, P.e[sel], P.xi1[sel])
+        xF = _interp_pos(H, self.sys.enodes, P.m[sel], P.xi2[sel])
+        bad = np.flatnonzero(no_normal(np.linalg.norm(xF - xC, axis=1), P.R1[sel], P.R2[sel]))
         if len(bad):
             k = sel[bad[0]]
-            msg = (f"contact: the centre lines of {self._pair_label(P['e'][k], P['m'][k])} intersect (distance "
+            msg = (f"contact: the centre lines of {self._pair_label(P.e[k], P.m[k])} intersect (distance "
                    f"below {NORMAL_TOL:g} (R1 + R2)): no contact normal ({len(bad)} such pairs)")
             if self._H_prev is None:          # the given (reference or initial) poses: bad input
                 raise InputError(msg + " in the given poses; separate the beams")
@@ -462,14 +484,14 @@ class ContactSystem:
         if self._H_prev is None or self._H_prev.shape != H.shape:
             return
         en = self.sys.enodes
-        d = _interp_pos(H, en, P["m"], P["xi2"]) - _interp_pos(H, en, P["e"], P["xi1"])
-        d0 = _interp_pos(self._H_prev, en, P["m"], P["xi2"]) - _interp_pos(self._H_prev, en, P["e"], P["xi1"])
-        rsum = P["R1"] + P["R2"]
-        seen = ~no_normal(np.linalg.norm(d0, axis=1), P["R1"], P["R2"])
+        d = _interp_pos(H, en, P.m, P.xi2) - _interp_pos(H, en, P.e, P.xi1)
+        d0 = _interp_pos(self._H_prev, en, P.m, P.xi2) - _interp_pos(self._H_prev, en, P.e, P.xi1)
+        rsum = P.R1 + P.R2
+        seen = ~no_normal(np.linalg.norm(d0, axis=1), P.R1, P.R2)
         flip = np.flatnonzero(seen & (np.sum(d * d0, axis=1) < -(NORMAL_TOL * rsum) ** 2))
         if len(flip):
             k = flip[0]
-            raise _step_failure(f"contact: {self._pair_label(P['e'][k], P['m'][k])} changed sides within the "
+            raise _step_failure(f"contact: {self._pair_label(P.e[k], P.m[k])} changed sides within the "
                                 f"step (one beam passed through the other; {len(flip)} such pairs)")
 
     # ------------------------------------------------------------ evaluation
@@ -488,7 +510,7 @@ class ContactSystem:
             return r, empty, dict(n_active=0)
         self._check_normals(P, sel, H)
         p = self._params(P, sel, H)
-        X = H[P["nodes"][sel]]
+        X = H[P.nodes[sel]]
         fric = p["mu"] > 0
         f = np.zeros((len(sel), 4, 6))
         K = np.zeros((len(sel), 24, 24)) if tangent else None
@@ -510,7 +532,7 @@ class ContactSystem:
         # kept for commit/augment at the same poses (the converged iterate): no second pass
         if fric.all() or not fric.any():
             self._cache = (H.copy(), P, sel, p, out)
-        nodes = P["nodes"][sel]
+        nodes = P.nodes[sel]
         f = f.reshape(-1, 24)
         M = sysm.node_transforms(H)
         if M is not None:
@@ -554,8 +576,8 @@ class ContactSystem:
         if len(sel):
             fric = p["mu"] > 0
             # the full kernel (with friction frames) for every active pair
-            _, out = contact_kernel(H[P["nodes"][sel]], p, friction=True) if fric.any() else \
-                contact_kernel(H[P["nodes"][sel]], p, friction=False)
+            _, out = contact_kernel(H[P.nodes[sel]], p, friction=True) if fric.any() else \
+                contact_kernel(H[P.nodes[sel]], p, friction=False)
             if not fric.any():
                 out["slip"] = np.zeros((len(sel), 2))
         return P, sel, (p, out)
@@ -574,13 +596,13 @@ class ContactSystem:
             return False
         p, out = po
         gap = out["gap"]
-        tols = self._decl_tolerance[P["decl"][sel]]
+        tols = self._decl_tolerance[P.decl[sel]]
         if np.all(-gap <= tols):
             return False
         if self._augments >= MAX_AUGMENT:      # not met: the caller decides (error or warning)
             self.unmet_tolerance = float(np.max(-gap / tols))
             return False
-        keys = P["key"][sel]
+        keys = P.key[sel]
         lam = np.where(np.isfinite(tols), out["lam_n"], 0.0)
         order = np.argsort(keys)
         self._mult = (keys[order], lam[order])
@@ -596,16 +618,16 @@ class ContactSystem:
             self._last = None
             return
         p, out = po
-        keys = P["key"][sel]
+        keys = P.key[sel]
         order = np.argsort(keys)
         HL, HK = _frames(out)
-        HC = _interp_pose(H, self.sys.enodes, P["e"][sel], out["xi1"])
-        HF = _interp_pose(H, self.sys.enodes, P["m"][sel], out["xi2"])
+        HC = _interp_pose(H, self.sys.enodes, P.e[sel], out["xi1"])
+        HF = _interp_pose(H, self.sys.enodes, P.m[sel], out["xi2"])
         lam_t = out["lam_t"]
         lam_vec = lam_t[:, :1] * out["t1"] + lam_t[:, 1:] * out["t2"]
         self._history = dict(key=keys[order], H_CL=se3.relative(HC, HL)[order],
                              H_FK=se3.relative(HF, HK)[order], H_LK=se3.relative(HL, HK)[order],
-                             e=P["e"][sel][order], m=P["m"][sel][order], xi1=out["xi1"][order],
+                             e=P.e[sel][order], m=P.m[sel][order], xi1=out["xi1"][order],
                              xi2=out["xi2"][order], lam_t=lam_vec[order])
         self._last = (P, sel, p, out)
 
@@ -630,14 +652,14 @@ class ContactSystem:
         w = p["weight"]
         lam_t = out["lam_t"]
         ft = (w * lam_t[:, 0])[:, None] * out["t1"] + (w * lam_t[:, 1])[:, None] * out["t2"]
-        e1s = _interp_pose(H, self.sys.enodes, P["e"][sel], out["xi1"])[:, :3, 0]
-        e1m = _interp_pose(H, self.sys.enodes, P["m"][sel], out["xi2"])[:, :3, 0]
+        e1s = _interp_pose(H, self.sys.enodes, P.e[sel], out["xi1"])[:, :3, 0]
+        e1m = _interp_pose(H, self.sys.enodes, P.m[sel], out["xi2"])[:, :3, 0]
         ang = np.degrees(np.arccos(np.clip(np.abs(np.sum(e1s * e1m, axis=1)), 0.0, 1.0)))
         active = out["lam_n"] > 0
         return dict(position=0.5 * (out["xC"] + out["xF"]) + 0.5 * (p["R1"] - p["R2"])[:, None] * out["n"],
                     gap=out["gap"], normal_force=w * out["lam_n"], tangential_force=ft,
                     stick=out["stick"] & active & (p["mu"] > 0), slip_increment=out["slip"], kind=p["kind"],
-                    angle=ang, slave_element=P["e"][sel], master_element=P["m"][sel],
+                    angle=ang, slave_element=P.e[sel], master_element=P.m[sel],
                     xi1=out["xi1"], xi2=out["xi2"], weight=w, normal=out["n"])
 
 
