@@ -6,7 +6,8 @@ attribute is the instance (``isinstance(error.failure, RotationLimit)``).
 """
 
 __all__ = ["StepFailed", "RotationLimit", "NotConverged", "Diverged", "DampingStalled",
-           "SingularTangent", "NonFinite", "AugmentationFailed", "MotionTooFast"]
+           "SingularTangent", "NonFinite", "AugmentationFailed", "MotionTooFast",
+           "ContactTunnelling", "NoContactNormal"]
 
 
 class StepFailed(Exception):
@@ -60,3 +61,11 @@ class AugmentationFailed(StepFailed):
 class MotionTooFast(StepFailed):
     """A prescribed motion turns by more than ``MAX_MOTION_ROTATION`` even over the smallest step."""
     retry = False
+
+
+class ContactTunnelling(StepFailed):
+    """A contact pair changed sides within the step (one beam passed through the other)."""
+
+
+class NoContactNormal(StepFailed):
+    """The centre lines of a contact pair intersect: the pair has no normal."""

@@ -52,3 +52,17 @@ def test_intersecting_centre_lines_name_the_pair():
             bs.solve(m, steps=1)
     msg = str(err.value)
     assert "'slave'" in msg and "'master'" in msg and "element" in msg and "normal" in msg
+
+
+def test_tunnelling_is_a_typed_step_failure_naming_the_pair():
+    from beamsolver.assembly import System
+    from beamsolver.failures import ContactTunnelling
+    m, slave, master = _pushed_crossing(6.5 * R, height=2.5 * R)
+    system = System(m)
+    cs = system.contact
+    H = system.poses0.copy()
+    cs.begin_step(H, 1.0)
+    H[slave.nodes, 2, 3] -= 6.5 * R                     # the slave's centre line now under the master's
+    with pytest.raises(ContactTunnelling, match="'slave' element .* 'master' element .* changed sides"):
+        cs.evaluate(H)
+    assert ContactTunnelling.retry                     # the step is cut back

@@ -32,6 +32,7 @@ from scipy.spatial import cKDTree
 
 from .. import se3
 from ..errors import InputError
+from ..failures import ContactTunnelling, NoContactNormal
 from .law import default_penalty
 from . import kernel_jit, pairs
 from .kernel_jit import contact_kernel, kernel_and_tangent      # compiled; pairs.py's are the oracle
@@ -471,7 +472,7 @@ class ContactSystem:
                    f"below {NORMAL_TOL:g} (R1 + R2)): no contact normal ({len(bad)} such pairs)")
             if self._H_prev is None:          # the given (reference or initial) poses: bad input
                 raise InputError(msg + " in the given poses; separate the beams")
-            raise _step_failure(msg)
+            raise NoContactNormal(msg)
 
     def _check_sides(self, P, H):
         """Tunnelling: refuse (cut back) a step over which a pair changed sides.
@@ -491,7 +492,7 @@ class ContactSystem:
         flip = np.flatnonzero(seen & (np.sum(d * d0, axis=1) < -(NORMAL_TOL * rsum) ** 2))
         if len(flip):
             k = flip[0]
-            raise _step_failure(f"contact: {self._pair_label(P.e[k], P.m[k])} changed sides within the "
+            raise ContactTunnelling(f"contact: {self._pair_label(P.e[k], P.m[k])} changed sides within the "
                                 f"step (one beam passed through the other; {len(flip)} such pairs)")
 
     # ------------------------------------------------------------ evaluation
@@ -661,12 +662,6 @@ class ContactSystem:
                     stick=out["stick"] & active & (p["mu"] > 0), slip_increment=out["slip"], kind=p["kind"],
                     angle=ang, slave_element=P.e[sel], master_element=P.m[sel],
                     xi1=out["xi1"], xi2=out["xi2"], weight=w, normal=out["n"])
-
-
-def _step_failure(message):
-    """The solver's step failure (the step is cut back; the message ends a run that cannot)."""
-    from ..solver import _StepFailed
-    return _StepFailed(message)
 
 
 def _frames(out):
