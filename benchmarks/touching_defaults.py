@@ -64,8 +64,8 @@ def main(elements=24, turns=1.0, steps=8, length=0.03, write=True):
 `python benchmarks/touching_defaults.py --elements {elements} --turns {turns:g} --steps {steps} --length {length:g}`
 ({machine()}).  Three touching steel wires (R = 0.5 mm, `examples/three_wires.py`), `mu = 0.3`,
 the normal law smoothed over `smoothing` (line contact; point and orthogonal pairs stay sharp);
-the default is `1e-6 (R1 + R2)` (`contact.options.SMOOTHING`): the smallest that converges here,
-so that it leaves the answers of lightly loaded strands unchanged (the seven-wire strand's radial
+the default is `1e-6 (R1 + R2)` (`contact.options.SMOOTHING`): every smoothing tried converges,
+and the smallest leaves the answers of lightly loaded strands unchanged (the seven-wire strand's radial
 deformation at a strain of 1e-4 is about 3e-8 m, and a smoothing gap of 1e-3 (R1 + R2) changed its
 stiffness by 7 %).  The sharp law (`0`) stalls in the first step: touching points cycle between
 open and closed.
