@@ -468,10 +468,10 @@ class ContactSystem:
         bad = np.flatnonzero(no_normal(np.linalg.norm(xF - xC, axis=1), P.R1[sel], P.R2[sel]))
         if len(bad):
             k = sel[bad[0]]
-            msg = (f"contact: the centre lines of {self._pair_label(P.e[k], P.m[k])} intersect (distance "
-                   f"below {NORMAL_TOL:g} (R1 + R2)): no contact normal ({len(bad)} such pairs)")
+            msg = (f"add_contact no. {int(P.decl[k])}: the centre lines of {self._pair_label(P.e[k], P.m[k])} "
+                   f"intersect (distance below {NORMAL_TOL:g} (R1 + R2)): no contact normal ({len(bad)} such pairs)")
             if self._H_prev is None:          # the given (reference or initial) poses: bad input
-                raise InputError(msg + " in the given poses; separate the beams")
+                raise InputError(msg + " in the given poses: do two beams share a centre line? Separate them")
             raise NoContactNormal(msg)
 
     def _check_sides(self, P, H):
