@@ -166,11 +166,13 @@ class StepWriter:
                 self._write_mesh(path, contact_mesh(table))
             else:
                 _atomic(path, _write_empty_points)
-        self.entries[step] = t
-        self._write_collections()
+        # the archive first, then the collections: a run killed in between never has a .pvd that
+        # lists a step its solution.npz lacks (with checkpoint=0 both list the same steps)
         self._solution = solution
         if self.checkpoint is not None and time.perf_counter() - self._saved_at >= self.checkpoint:
             self.save()
+        self.entries[step] = t
+        self._write_collections()
 
     def save(self):
         """Save the solution written so far to ``solution.npz`` (atomically)."""
