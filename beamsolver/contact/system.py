@@ -37,7 +37,7 @@ from .law import default_penalty
 from . import kernel_jit, pairs
 from .kernel_jit import contact_kernel, kernel_and_tangent      # compiled; pairs.py's are the oracle
 from .options import SMOOTHING, ContactOptions
-from .pairs import LINE, NORMAL_TOL, ORTHOGONAL, POINT, _project, _section, material_frames, no_normal
+from .pairs import LINE, NORMAL_TOL, ORTHOGONAL, POINT, _section, material_frames, no_normal
 from .record import Candidates, PairSet
 from .search import XI_TOL, broad_phase, closest_points, element_spheres
 
@@ -245,13 +245,14 @@ class ContactSystem:
         near = np.sum((xc - c.c2[rep, :3, 3]) ** 2, axis=1) <= (c.r2[rep] + self.el_radius[e]) ** 2
         rep, g, e, m, h1, h2, xi1, xc = rep[near], g[near], e[near], m[near], h1[near], h2[near], xi1[near], xc[near]
         kind = c.kind[rep]
-        # start from the projection on the master chord (8 Newton iterations: the kernel
-        # polishes the point with 2 more and needs it converged for an exact tangent)
+        # start from the projection on the master chord (8 Newton iterations, compiled: kernel_jit.project
+        # equals pairs._project; the kernel polishes the point with 2 more and needs it converged for an
+        # exact tangent)
         xa, xb = H[en[m, 0], :3, 3], H[en[m, 1], :3, 3]
         chord = xb - xa
         xi2 = np.clip(np.sum((xc - xa) * chord, axis=1) / np.maximum(np.sum(chord * chord, axis=1), 1e-300),
                       0.0, 1.0)
-        _, xi2 = _project(kind, H[en[e, 0]], h1, xi1, H[en[m, 0]], h2, xi2, iterations=8)
+        _, xi2 = kernel_jit.project(kind, H[en[e, 0]], h1, xi1, H[en[m, 0]], h2, xi2, iterations=8)
         HF, _, _ = _section(H[en[m, 0]], h2, xi2)
         dist = np.linalg.norm(HF[:, :3, 3] - xc, axis=1)
         lo, hi = self._xi_range(m)
