@@ -288,7 +288,6 @@ class _Newton:
         """
         sys, conv = self.sys, self.conv
         lf = sys.load_factors(t) if len(sys.load_scales) else np.zeros(0)
-        n = sys.n_nodes
         H_start = H
         residuals = []
         damped_its = 0
@@ -321,14 +320,10 @@ class _Newton:
                 self.last_tangent = (kvals, info["extra"])     # of the converged state
                 return H, r, info, dict(iterations=it, residuals=residuals, **stats_extra)
             if verdict != CONTINUE:
-                raise (NotConverged(f"no convergence in {conv.max_iter} iterations (scaled residual {ratio:.3g})",
-                                    ratio) if verdict == MAX_ITER else
-                       Diverged(f"diverging (scaled residual {ratio:.3g})"))
+                raise self._failure(verdict, ratio)
             if dzf is None:
                 lu, dzf = self._direction(r, kvals, info, dz_c)
-            dz = np.zeros(6 * n)
-            dz[sys.free_dofs] = dzf
-            dz = dz.reshape(n, 6)
+            dz = self._full(dzf)
             if dz_c is not None:
                 H = self._reach_targets(H, dz + dz_c, H_target, bool(targets), t)
                 dz_c = None
@@ -362,6 +357,19 @@ class _Newton:
                 raise rotation
             last_inc = conv.increment_ratio(dz, self.L_ref) if lam == 1.0 else np.inf
         raise AssertionError("unreachable: decide() returns MAX_ITER at iteration max_iter")
+
+    def _failure(self, verdict, ratio):
+        """The typed failure of a ``Convergence.decide`` verdict other than converged / continue."""
+        if verdict == MAX_ITER:
+            return NotConverged(f"no convergence in {self.conv.max_iter} iterations (scaled residual {ratio:.3g})",
+                                ratio)
+        return Diverged(f"diverging (scaled residual {ratio:.3g})")
+
+    def _full(self, dzf):
+        """Increments ``(n, 6)`` of all nodes from those of the free unknowns (zero elsewhere)."""
+        dz = np.zeros(6 * self.sys.n_nodes)
+        dz[self.sys.free_dofs] = dzf
+        return dz.reshape(-1, 6)
 
     def _damped(self, H, dz, dzf, lf, lam):
         """Damped Newton update ``H exp(lam dz)`` (scenes without contact).
@@ -445,6 +453,17 @@ class _Newton:
         return best[1]
 
 
+def _starting_point(restart, model, system, t_start, t_end):
+    """``(solution to continue or None, t_start)``: a restart starts at its first saved time."""
+    sol = None
+    if restart is not None:
+        sol = restart_from(restart, model, system)
+        t_start = sol._times[0]
+    if not (np.isfinite(t_end) and np.isfinite(t_start) and t_end > t_start):
+        raise InputError(f"solve: need t_end > t_start, got t_start={t_start!r}, t_end={t_end!r}")
+    return sol, t_start
+
+
 def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dtol=1e-11,
           max_iter=30, line_search=True, min_step_ratio=2.0**-12, callback=None,
           check_rigid_modes=True, verbose=None, initial_poses=None, restart=None, checkpoint=60.0,
@@ -503,12 +522,7 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     if int(steps) != steps or steps < 1:
         raise InputError(f"solve: steps must be a positive integer, got {steps!r}")
     system = System(model, check_rigid_modes=check_rigid_modes)
-    sol = None
-    if restart is not None:
-        sol = restart_from(restart, model, system)
-        t_start = sol._times[0]
-    if not (np.isfinite(t_end) and np.isfinite(t_start) and t_end > t_start):
-        raise InputError(f"solve: need t_end > t_start, got t_start={t_start!r}, t_end={t_end!r}")
+    sol, t_start = _starting_point(restart, model, system, t_start, t_end)
     grid = np.linspace(t_start, t_end, int(steps) + 1)
     dt_min = _step_floor(min_step_ratio, grid)
     conv = Convergence(rtol=rtol, dtol=dtol, max_iter=max_iter)
