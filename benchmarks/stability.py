@@ -572,7 +572,7 @@ quadratic convergence).  At extreme slenderness the scaled residual stalls on a 
 Cantilevers are updated in strain space (one iteration for the roll-up, at any slenderness);
 the *joined* and *guided* roll-ups take the plain `H exp(dq)` update, where Newton meets
 spurious axial forces after large rotation increments: it is damped on the size of the Newton
-correction (`solver._Newton._damped`; the residual line search it replaced needed 5-10x more
+correction (the solver's damped Newton; the residual line search it replaced needed 5-10x more
 iterations: 4904 instead of 866 on the guided roll-up, 15262 instead of 1492 on the joined one
 at L/R = 1e4), and load steps shrink with the
 slenderness (L/R = 1e5 takes about 1800 steps at the default `min_step_ratio`; where the damping
