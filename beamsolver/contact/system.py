@@ -37,9 +37,10 @@ from .law import default_penalty
 from . import kernel_jit, pairs
 from .kernel_jit import contact_kernel, kernel_and_tangent      # compiled; pairs.py's are the oracle
 from .options import SMOOTHING, ContactOptions
-from .pairs import LINE, NORMAL_TOL, ORTHOGONAL, POINT, _section, material_frames, no_normal
+from .pairs import LINE, NORMAL_TOL, ORTHOGONAL, POINT, material_frames, no_normal
 from .record import Candidates, PairSet
-from .search import XI_TOL, broad_phase, closest_points, element_spheres
+from .projection import closest_points, element_twists, project_points, section_points
+from .search import XI_TOL, broad_phase, element_spheres
 
 MAX_AUGMENT = 30
 XI_OVERHANG = 0.05        # accepted projection past an inner node, in element lengths (kinks of the C0 line)
@@ -112,6 +113,8 @@ class ContactSystem:
         self._prev_points = np.zeros(0, dtype=np.int64)
         self._prev_owners = np.zeros(0, dtype=np.int64)   # Gauss-point key * n_elements + master element
         self._H_prev = None        # last converged poses (start of the step)
+        self._geo = self._geo_prev = None    # (poses, element twists) of the last evaluation / of H_prev
+        self._blocks = None        # (poses, local blocks) of the last evaluation, for the same state
 
     # ------------------------------------------------------------ history
     def get_state(self):
@@ -130,6 +133,7 @@ class ContactSystem:
 
     def set_state(self, state):
         """Restore a state from ``get_state`` (missing parts: empty; older archives lack some)."""
+        self._blocks = None
         hist = self._empty_history()
         for k in hist:
             if f"history.{k}" in state:
@@ -155,6 +159,25 @@ class ContactSystem:
             return np.zeros(len(keys), dtype=int), np.zeros(len(keys), dtype=bool)
         idx = np.clip(np.searchsorted(keys_sorted, keys), 0, len(keys_sorted) - 1)
         return idx, keys_sorted[idx] == keys
+
+    # ------------------------------------------------------------ geometry
+    def _twists(self, H):
+        """Twists ``(n_elements, 6)`` of all elements at ``H`` (compiled; kept for the same poses)."""
+        g = self._geo
+        if g is None or g[0].shape != H.shape or not np.array_equal(g[0], H):
+            g = self._geo = (np.array(H, dtype=float), element_twists(H, self.sys.enodes))
+        return g
+
+    def _points(self, H, e, xi, prev=False):
+        """Centre points ``(k, 3)`` of the sections ``xi`` of elements ``e`` at ``H`` (``prev``: at the
+        last converged poses, whose twists are kept for the step)."""
+        if prev:
+            if self._geo_prev is None:
+                self._geo_prev = (self._H_prev, element_twists(self._H_prev, self.sys.enodes))
+            Hc, h = self._geo_prev
+        else:
+            Hc, h = self._twists(H)
+        return section_points(Hc, self.sys.enodes[e, 0], h[e], xi)[0]
 
     # ------------------------------------------------------------ search
     def pairs(self, H):
@@ -183,8 +206,9 @@ class ContactSystem:
         their kind (line below ``line_angle``, else point or orthogonal by the reduced-Hessian
         ratio; search.py) and the closest points of non-line pairs."""
         en = self.sys.enodes
-        cs, rs, hs, ts = element_spheres(H, en[d.slave_el], self.el_radius[d.slave_el], d.margin)
-        cm, rm, hm, tm = element_spheres(H, en[d.master_el], self.el_radius[d.master_el], d.margin)
+        H, h = self._twists(H)
+        cs, rs, hs, ts = element_spheres(H, en[d.slave_el], h[d.slave_el], self.el_radius[d.slave_el], d.margin)
+        cm, rm, hm, tm = element_spheres(H, en[d.master_el], h[d.master_el], self.el_radius[d.master_el], d.margin)
         i, j = broad_phase(cs, rs, cm, rm)
         e, m = d.slave_el[i], d.master_el[j]
         # elements sharing a node (a beam joined to another) never pair
@@ -196,7 +220,7 @@ class ContactSystem:
         xi1, xi2 = np.zeros(len(i)), np.zeros(len(i))
         if big.any():
             b = np.flatnonzero(big)
-            x1, x2, ratio = closest_points(H[en[e[b], 0]], hs[i[b]], H[en[m[b], 0]], hm[j[b]])
+            x1, x2, ratio = closest_points(H, en[e[b], 0], hs[i[b]], en[m[b], 0], hm[j[b]])
             pt = ratio >= d.point_ratio
             kinds[b[pt]] = POINT
             kinds[b[~pt]] = ORTHOGONAL
@@ -238,23 +262,16 @@ class ContactSystem:
         g = np.tile(np.arange(d.n_gp), len(gp))
         e, m, h1, h2 = c.e[rep], c.m[rep], c.h1[rep], c.h2[rep]
         xi1 = xg[g]
-        HC, _, _ = _section(H[en[e, 0]], h1, xi1)
+        H, _ = self._twists(H)
+        xc, _ = section_points(H, en[e, 0], h1, xi1)
         # a slave Gauss point outside the master element's sphere (grown by R1) cannot
         # touch that element: no projection for it
-        xc = HC[:, :3, 3]
-        near = np.sum((xc - c.c2[rep, :3, 3]) ** 2, axis=1) <= (c.r2[rep] + self.el_radius[e]) ** 2
-        rep, g, e, m, h1, h2, xi1, xc = rep[near], g[near], e[near], m[near], h1[near], h2[near], xi1[near], xc[near]
+        near = np.sum((xc - c.c2[rep]) ** 2, axis=1) <= (c.r2[rep] + self.el_radius[e]) ** 2
+        rep, g, e, m, h1, h2, xi1 = rep[near], g[near], e[near], m[near], h1[near], h2[near], xi1[near]
         kind = c.kind[rep]
-        # start from the projection on the master chord (8 Newton iterations, compiled: kernel_jit.project
-        # equals pairs._project; the kernel polishes the point with 2 more and needs it converged for an
-        # exact tangent)
-        xa, xb = H[en[m, 0], :3, 3], H[en[m, 1], :3, 3]
-        chord = xb - xa
-        xi2 = np.clip(np.sum((xc - xa) * chord, axis=1) / np.maximum(np.sum(chord * chord, axis=1), 1e-300),
-                      0.0, 1.0)
-        _, xi2 = kernel_jit.project(kind, H[en[e, 0]], h1, xi1, H[en[m, 0]], h2, xi2, iterations=8)
-        HF, _, _ = _section(H[en[m, 0]], h2, xi2)
-        dist = np.linalg.norm(HF[:, :3, 3] - xc, axis=1)
+        # from the projection on the master chord, 8 Newton iterations (compiled, projection.py; the
+        # kernel polishes the point with 2 more and needs it converged for an exact tangent)
+        xi2, dist = project_points(H, kind, en[e, 0], h1, xi1, en[m, 0], en[m, 1], h2, iterations=8)
         lo, hi = self._xi_range(m)
         ok = (xi2 >= lo) & (xi2 <= hi) & np.isfinite(dist)
         key = ((np.int64(d.index) * len(en) + e) * self.max_gp + g) * self.n_beams + self.el_beam[m]
@@ -320,8 +337,8 @@ class ContactSystem:
         if len(idx) < 2:
             return idx
         en = self.sys.enodes
-        xC = _interp_pos(H, en, e, xi1)
-        xF = _interp_pos(H, en, m, xi2)
+        xC = self._points(H, e, xi1)
+        xF = self._points(H, m, xi2)
         dist = np.linalg.norm(xF - xC, axis=1)
         rad = self.el_radius[e] + self.el_radius[m]
         group = self.el_beam[e] * self.n_beams + self.el_beam[m]
@@ -408,9 +425,9 @@ class ContactSystem:
         hist = self._history
         en, nb = self.sys.enodes, self.n_beams
         e, m = P.e[sel][cand], P.m[sel][cand]
-        x = _interp_pos(H, en, e, p["xi1"][cand])
+        x = self._points(H, e, p["xi1"][cand])
         he, hm = hist["e"][hp], hist["m"][hp]
-        hx = _interp_pos(H, en, he, hist["xi1"][hp])       # the stored material points, now
+        hx = self._points(H, he, hist["xi1"][hp])       # the stored material points, now
         hdecl = (hist["key"][hp] - self.point_offset) // (np.int64(len(en)) * len(en))
         g_new = (P.decl[sel][cand] * nb + self.el_beam[e]) * nb + self.el_beam[m]
         g_old = (hdecl * nb + self.el_beam[he]) * nb + self.el_beam[hm]
@@ -444,8 +461,7 @@ class ContactSystem:
 
     def _active(self, P, H):
         """Pairs whose trial normal traction is positive, with their kernel parameters."""
-        xC = _interp_pos(H, self.sys.enodes, P.e, P.xi1)
-        xF = _interp_pos(H, self.sys.enodes, P.m, P.xi2)
+        xC, xF = self._points(H, P.e, P.xi1), self._points(H, P.m, P.xi2)
         gap = np.linalg.norm(xF - xC, axis=1) - P.R1 - P.R2
         pen = self._decl_penalty[P.decl]
         mi, mf = self._lookup(self._mult[0], P.key)
@@ -464,8 +480,7 @@ class ContactSystem:
 
     def _check_normals(self, P, sel, H):
         """Refuse (a step failure: cut back) pairs whose centre lines intersect: no normal."""
-        xC = _interp_pos(H, self.sys.enodes, P.e[sel], P.xi1[sel])
-        xF = _interp_pos(H, self.sys.enodes, P.m[sel], P.xi2[sel])
+        xC, xF = self._points(H, P.e[sel], P.xi1[sel]), self._points(H, P.m[sel], P.xi2[sel])
         bad = np.flatnonzero(no_normal(np.linalg.norm(xF - xC, axis=1), P.R1[sel], P.R2[sel]))
         if len(bad):
             k = sel[bad[0]]
@@ -485,9 +500,8 @@ class ContactSystem:
         """
         if self._H_prev is None or self._H_prev.shape != H.shape:
             return
-        en = self.sys.enodes
-        d = _interp_pos(H, en, P.m, P.xi2) - _interp_pos(H, en, P.e, P.xi1)
-        d0 = _interp_pos(self._H_prev, en, P.m, P.xi2) - _interp_pos(self._H_prev, en, P.e, P.xi1)
+        d = self._points(H, P.m, P.xi2) - self._points(H, P.e, P.xi1)
+        d0 = self._points(H, P.m, P.xi2, prev=True) - self._points(H, P.e, P.xi1, prev=True)
         rsum = P.R1 + P.R2
         seen = ~no_normal(np.linalg.norm(d0, axis=1), P.R1, P.R2)
         flip = np.flatnonzero(seen & (np.sum(d * d0, axis=1) < -(NORMAL_TOL * rsum) ** 2))
@@ -497,25 +511,41 @@ class ContactSystem:
                                 f"step (one beam passed through the other; {len(flip)} such pairs)")
 
     # ------------------------------------------------------------ evaluation
-    def evaluate(self, H, tangent=True):
-        """Contact residual ``(6 n,)``, COO tangent ``(rows, cols, vals)`` and point data."""
-        sysm = self.sys
-        ndof = 6 * sysm.n_nodes
-        r = np.zeros(ndof)
-        empty = (np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0))
+    def _local_blocks(self, H, tangent):
+        """``(P, sel, p, f, K, out)`` at poses ``H``: pairs, active ones, kernel parameters, local
+        wrenches ``(m, 4, 6)``, tangent blocks ``(m, 24, 24)`` and point data; None without active pairs.
+
+        Kept for the same poses and contact state (``_blocks``, cleared when the state changes):
+        the tangent evaluation at an accepted line-search trial reuses the trial's (the compiled
+        kernel computes the tangent with the forces; the numpy oracle only when asked).
+        """
+        c = self._blocks
+        if c is not None and np.array_equal(c[0], H) and (c[1] is None or c[1][4] is not None or not tangent):
+            return c[1]
+        tangent = tangent or kernel_and_tangent is not pairs.kernel_and_tangent
         P = self.pairs(H)
-        if P is None:
-            return r, empty, dict(n_active=0)
-        self._check_sides(P, H)
-        sel = self._active(P, H)
+        sel = np.zeros(0, dtype=int)
+        if P is not None:
+            self._check_sides(P, H)
+            sel = self._active(P, H)
         if len(sel) == 0:
-            return r, empty, dict(n_active=0)
+            self._blocks = (np.array(H), None)
+            return None
         self._check_normals(P, sel, H)
         p = self._params(P, sel, H)
-        X = H[P.nodes[sel]]
+        f, K, out = self._kernel(H[P.nodes[sel]], p, tangent)
+        # kept for commit/augment at the same poses (the converged iterate): no second pass
+        if (p["mu"] > 0).all() or not (p["mu"] > 0).any():
+            self._cache = (H.copy(), P, sel, p, out)
+        self._blocks = (np.array(H), (P, sel, p, f, K, out))
+        return self._blocks[1]
+
+    @staticmethod
+    def _kernel(X, p, tangent):
+        """The kernel on the pairs with friction and on those without: ``f``, ``K`` (or None), ``out``."""
         fric = p["mu"] > 0
-        f = np.zeros((len(sel), 4, 6))
-        K = np.zeros((len(sel), 24, 24)) if tangent else None
+        f = np.zeros((len(X), 4, 6))
+        K = np.zeros((len(X), 24, 24)) if tangent else None
         out = {}
         for mask, use_fric in ((fric, True), (~fric, False)):
             if not mask.any():
@@ -529,11 +559,20 @@ class ContactSystem:
             f[mask] = fm
             for k, v in om.items():
                 if k not in out:
-                    out[k] = np.zeros((len(sel),) + np.shape(v)[1:], dtype=np.asarray(v).dtype)
+                    out[k] = np.zeros((len(X),) + np.shape(v)[1:], dtype=np.asarray(v).dtype)
                 out[k][mask] = v
-        # kept for commit/augment at the same poses (the converged iterate): no second pass
-        if fric.all() or not fric.any():
-            self._cache = (H.copy(), P, sel, p, out)
+        return f, K, out
+
+    def evaluate(self, H, tangent=True):
+        """Contact residual ``(6 n,)``, COO tangent ``(rows, cols, vals)`` and point data."""
+        sysm = self.sys
+        ndof = 6 * sysm.n_nodes
+        r = np.zeros(ndof)
+        empty = (np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0))
+        blocks = self._local_blocks(H, tangent)
+        if blocks is None:
+            return r, empty, dict(n_active=0)
+        P, sel, p, f, K, out = blocks
         nodes = P.nodes[sel]
         f = f.reshape(-1, 24)
         M = sysm.node_transforms(H)
@@ -559,7 +598,9 @@ class ContactSystem:
 
     # ------------------------------------------------------------ per step
     def begin_step(self, H, t):
+        self._blocks = None
         self._H_prev = np.array(H, dtype=float)
+        self._geo_prev = None
         self._mult = self._mult_committed
         self._augments = 0
 
@@ -609,10 +650,12 @@ class ContactSystem:
         order = np.argsort(keys)
         self._mult = (keys[order], lam[order])
         self._augments += 1
+        self._blocks = None
         return True
 
     def commit(self, H):
         """Store friction history and multipliers of the converged state."""
+        self._blocks = None
         self._mult_committed = self._mult
         P, sel, po = self._state(H)
         if P is None or len(sel) == 0:
