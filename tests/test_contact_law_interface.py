@@ -49,16 +49,17 @@ def test_compiled_normal_law_equals_the_numpy_law(smoothing, multiplier):
 
 def test_compiled_coulomb_law_equals_the_numpy_return_mapping():
     rng = np.random.default_rng(3)
+    seed = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]), np.array([0.0, 0.0, 1.0])   # d/d(trial0, trial1, lam)
     for trial, lam in zip(rng.normal(size=(50, 2)), rng.uniform(0.0, 5.0, 50)):
-        out = coulomb(trial[0], trial[1], 0.3, lam)
-        lt, stick = coulomb_return_mapping(trial, 0.3, lam)
-        np.testing.assert_allclose(out[:2], lt, rtol=1e-14)
-        assert out[8] == stick
+        lt0, lt1, D, stick = coulomb(trial[0], trial[1], seed[0], 0.3, lam, seed[1])
+        lt, stick0 = coulomb_return_mapping(trial, 0.3, lam)
+        np.testing.assert_allclose([lt0, lt1], lt, rtol=1e-14)
+        assert stick == stick0
         for j in range(2):        # d lt / d trial_j and d lt / d lam by complex step
             d = np.imag(coulomb_return_mapping(trial + 1e-30j * np.eye(2)[j], 0.3, lam)[0]) / 1e-30
-            np.testing.assert_allclose([out[2 + j], out[4 + j]], d, rtol=1e-12, atol=1e-14)
+            np.testing.assert_allclose(D[:, j], d, rtol=1e-12, atol=1e-14)
         d = np.imag(coulomb_return_mapping(trial + 0j, 0.3, lam + 1e-30j)[0]) / 1e-30
-        np.testing.assert_allclose(out[6:8], d, rtol=1e-12, atol=1e-14)
+        np.testing.assert_allclose(D[:, 2], d, rtol=1e-12, atol=1e-14)
 
 
 def _fd_tangent(X, p, friction, law, eps=1e-6):

@@ -47,6 +47,10 @@ XI1, XI2, R1_, R2_, WEIGHT, PENALTY, MULT, MU, PEN_T, SMOOTH, ESLIP, XI1P, XI2P 
 N_PAR = 13
 
 
+# the law, bound per kernel by ``make_kernel`` (the templates below call these names)
+_normal_law = _tangential_law = None
+
+
 # ---------------------------------------------------------------- small algebra (tuples, 6x6 arrays)
 @jit
 def _exp(u, w):
@@ -468,10 +472,7 @@ def _friction(slip, Dslip, lamp, t1, t2, Dt1, Dt2, lam, Dlam, par):
             pen_t = mu * lam_min / par[ESLIP]
     tr0, tr1 = lam_prev[0] + pen_t * slip[0], lam_prev[1] + pen_t * slip[1]
     Dtr = Dprev + np.outer(np.array(slip), Dpt) + pen_t * Dslip
-    lt0, lt1, d00, d01, d10, d11, dl0, dl1, stick = _tangential_law(tr0, tr1, mu, lam)
-    D = np.empty((2, 24))
-    D[0] = d00 * Dtr[0] + d01 * Dtr[1] + dl0 * Dlam
-    D[1] = d10 * Dtr[0] + d11 * Dtr[1] + dl1 * Dlam
+    lt0, lt1, D, stick = _tangential_law(tr0, tr1, Dtr, mu, lam, Dlam)
     return (lt0, lt1), D, stick
 
 
@@ -584,7 +585,7 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
     flags[0], flags[1] = active, stick
 
 
-def evaluate(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames):
+def _evaluate(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames):
     """Batch driver: ``_point`` over all pairs (a plain loop; one core).  A template: ``make_kernel``
     compiles it per contact law; the module's ``evaluate`` is the default law's."""
     for p in range(X.shape[0]):
@@ -593,7 +594,7 @@ def evaluate(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, t
 
 
 # ---------------------------------------------------------------- the kernel of a contact law
-_LAW_PATH = ("_friction", "_point", "evaluate")      # the templates on the call path to the law, callee first
+_LAW_PATH = ("_friction", "_point", "_evaluate")      # the templates on the call path to the law, callee first
 _TEMPLATES = {name: globals()[name] for name in _LAW_PATH}
 _KERNELS = {}
 
@@ -611,9 +612,9 @@ def _digest(law):
 
 
 def make_kernel(law):
-    """The compiled batch driver ``evaluate`` for ``law`` (a ``law.ContactLaw``), built once per process.
+    """The compiled batch driver ``_evaluate`` for ``law`` (a ``law.ContactLaw``), built once per process.
 
-    The templates on the law's call path (``_friction``, ``_point``, ``evaluate``) are copied
+    The templates on the law's call path (``_friction``, ``_point``, ``_evaluate``) are copied
     with ``_normal_law`` and ``_tangential_law`` bound to the law's functions as globals, under
     the name ``<template>__<law name>_<code digest>``: numba's disk cache (``cache=True``) keys
     on that name and the template's source file, so each law's kernel compiles once per machine
@@ -628,7 +629,7 @@ def make_kernel(law):
             f = types.FunctionType(t.__code__, glb, f"{name}__{key}", t.__defaults__)
             f.__qualname__, f.__doc__ = f.__name__, t.__doc__
             glb[name] = jit(f)
-        _KERNELS[key] = glb["evaluate"]
+        _KERNELS[key] = glb["_evaluate"]
     return _KERNELS[key]
 
 

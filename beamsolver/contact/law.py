@@ -72,10 +72,10 @@ class ContactLaw:
 
     ``normal(gap, penalty, multiplier, smoothing) -> (lam, dlam_dgap, active)``: normal traction per
     unit weight, its derivative with respect to the gap and whether the point carries force or
-    stiffness; ``tangential(trial0, trial1, mu, lam) -> (lt0, lt1, d00, d01, d10, d11, dl0, dl1, stick)``:
-    tangential traction from the trial ``(trial0, trial1)`` (in ``t1, t2``), its derivatives
-    ``d_ij = d lt_i / d trial_j`` and ``dl_i = d lt_i / d lam``.  Both are numba-jitted functions of
-    floats (``_jit.jit``).  ``name`` names the compiled kernel (and its numba cache entry).
+    stiffness; ``tangential(trial0, trial1, Dtrial, mu, lam, Dlam) -> (lt0, lt1, D, stick)``:
+    tangential traction from the trial ``(trial0, trial1)`` (in ``t1, t2``) in forward mode, ``D``
+    ``(2, k)`` its gradient from the gradients ``Dtrial`` ``(2, k)`` of the trial and ``Dlam`` ``(k,)``
+    of the normal traction.  Both are numba-jitted (``_jit.jit``).  ``name`` names the compiled kernel (and its numba cache entry).
     """
     name: str
     normal: Callable
@@ -100,17 +100,19 @@ def penalty_normal(gap, penalty, multiplier, smoothing):
 
 
 @jit
-def coulomb(trial0, trial1, mu, lam):
-    """``coulomb_return_mapping`` for one point with its derivatives (``ContactLaw.tangential``):
-    stick inside the disk ``|trial| <= mu lam``, else ``mu lam trial / |trial|``."""
+def coulomb(trial0, trial1, Dtrial, mu, lam, Dlam):
+    """``coulomb_return_mapping`` for one point in forward mode (``ContactLaw.tangential``): stick
+    inside the disk ``|trial| <= mu lam``, else ``mu lam trial / |trial|``.  ``Dtrial`` ``(2, k)``,
+    ``Dlam`` ``(k,)``: gradients of the trial traction and of ``lam``; returns ``(lt0, lt1, D, stick)``
+    with ``D`` ``(2, k)`` the gradient of the traction."""
     norm = np.sqrt(trial0 * trial0 + trial1 * trial1)
     limit = mu * lam
     if norm <= limit:
-        return trial0, trial1, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, True
-    t0, t1 = trial0 / norm, trial1 / norm
-    s = limit / norm
-    return (limit * t0, limit * t1, s * (1.0 - t0 * t0), -s * t0 * t1, -s * t0 * t1, s * (1.0 - t1 * t1),
-            mu * t0, mu * t1, False)
+        return trial0, trial1, Dtrial, True
+    tt = np.array([trial0 / norm, trial1 / norm])
+    proj = tt[0] * Dtrial[0] + tt[1] * Dtrial[1]
+    D = np.outer(tt, mu * Dlam) + (limit / norm) * (Dtrial - np.outer(tt, proj))
+    return limit * tt[0], limit * tt[1], D, False
 
 
 PENALTY_COULOMB = ContactLaw("penalty_coulomb", penalty_normal, coulomb)

@@ -22,7 +22,7 @@ the README, tested on both sides of each switch):
    shares a node with an orthogonal one against the same master beam (a
    straight rope leaving a wrap tangentially) is projected orthogonally too:
    its closest point sits at its end, and a point pair there would switch on
-   and off as the tangent point moves (``ContactSystem._extend_wrap``).
+   and off as the tangent point moves (``rules.extend_wrap``).
 
 Projections are accepted on ``[0, 1]`` of the master element (so they continue
 across element boundaries along the whole master beam); per slave Gauss point

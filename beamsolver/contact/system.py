@@ -1,16 +1,20 @@
-"""Contact as a pipeline inside the Newton loop: search -> pairs -> kernel -> scatter.
+"""Contact as a pipeline inside the Newton loop: search -> pair rules -> projection -> kernel.
 
 ``ContactSystem`` is created by ``assembly.System`` only when the model has
-contact declarations.  Per evaluation it runs the stages
+contact declarations.  It orchestrates pure stages kept in their own modules:
 
-1. broad phase and pair rules (``_candidates``: element spheres, no pair between
-   elements sharing a node, the kind of each element pair);
-2. projection and ownership (``_point_pairs``, ``_gauss_pairs``: one owner per
-   slave point, stable at shared nodes), giving one typed ``record.PairSet``;
-3. refusals (``_check_sides``: tunnelling; ``_check_normals``: no normal);
-4. kernel parameters and history look-up (``_params``), the kernel (forces and
-   complex-step tangent, ``pairs.py``) on the active pairs;
-5. scatter into the residual and COO tangent in the unknowns' numbering.
+1. broad phase (``search.py``: element spheres, ``scipy.spatial.cKDTree``) on the element
+   twists computed once per evaluation (``projection.element_twists``);
+2. pair rules (``rules.py``: no pair between elements sharing a node, the kind of each
+   element pair, closest points of crossings from ``projection.closest_points``);
+3. projection of the slave Gauss points (``projection.project_points``, compiled) and
+   ownership (``rules.owners``, ``rules.dedupe_points``: one owner per slave point, stable
+   at shared nodes), giving one typed ``record.PairSet``;
+4. refusals (``_check_sides``: tunnelling; ``_check_normals``: no normal);
+5. kernel parameters and history look-up (``_params``), then the compiled kernel of the
+   contact law (``kernel_jit``, ``law.ContactLaw``) on the active pairs: local wrenches
+   ``(m, 4, 6)`` and tangent blocks ``(m, 24, 24)`` (``_local_blocks``, kept for the same
+   poses and state), scattered in the unknowns' numbering.
 
 Per step it keeps the friction history and augmented-Lagrangian multipliers,
 keyed by material slave point and master beam, committed only when a step is
@@ -37,14 +41,13 @@ from .law import default_penalty
 from . import kernel_jit, pairs
 from .kernel_jit import contact_kernel, kernel_and_tangent      # compiled; pairs.py's are the oracle
 from .options import SMOOTHING, ContactOptions
-from .pairs import LINE, NORMAL_TOL, ORTHOGONAL, POINT, material_frames, no_normal
+from .pairs import LINE, NORMAL_TOL, POINT, material_frames, no_normal
 from .record import Candidates, PairSet
 from .projection import closest_points, element_twists, project_points, section_points
-from .search import XI_TOL, broad_phase, element_spheres
+from .search import broad_phase, element_spheres
+from . import rules
 
 MAX_AUGMENT = 30
-XI_OVERHANG = 0.05        # accepted projection past an inner node, in element lengths (kinks of the C0 line)
-OWNER_TIE = 1e-9          # distances equal within this fraction of R1 + R2 tie (a point on a shared node)
 
 
 def use_numpy_kernel(flag=True):
@@ -211,21 +214,16 @@ class ContactSystem:
         cm, rm, hm, tm = element_spheres(H, en[d.master_el], h[d.master_el], self.el_radius[d.master_el], d.margin)
         i, j = broad_phase(cs, rs, cm, rm)
         e, m = d.slave_el[i], d.master_el[j]
-        # elements sharing a node (a beam joined to another) never pair
-        share = np.isin(en[e], en[m]).any(axis=1)
-        i, j, e, m = i[~share], j[~share], e[~share], m[~share]
-        angle = np.arccos(np.clip(np.abs(np.sum(ts[i] * tm[j], axis=1)), 0.0, 1.0))
-        big = angle >= d.line_angle
+        keep = rules.apart(en, e, m)
+        i, j, e, m = i[keep], j[keep], e[keep], m[keep]
         kinds = np.full(len(i), LINE)
         xi1, xi2 = np.zeros(len(i)), np.zeros(len(i))
-        if big.any():
-            b = np.flatnonzero(big)
+        b = np.flatnonzero(rules.crossing(ts[i], tm[j], d.line_angle))
+        if len(b):
             x1, x2, ratio = closest_points(H, en[e[b], 0], hs[i[b]], en[m[b], 0], hm[j[b]])
-            pt = ratio >= d.point_ratio
-            kinds[b[pt]] = POINT
-            kinds[b[~pt]] = ORTHOGONAL
+            kinds[b] = rules.point_or_orthogonal(ratio, d.point_ratio)
             xi1[b], xi2[b] = x1, x2
-            kinds = self._extend_wrap(e, m, kinds)
+            kinds = rules.extend_wrap(en, self.el_beam[m], self.n_beams, e, m, kinds)
         return Candidates(e=e, m=m, kind=kinds, xi1=xi1, xi2=xi2, h1=hs[i], h2=hm[j], c2=cm[j], r2=rm[j])
 
     def _record(self, d, kind, e, m, xi1, xi2, weight, key, gp):
@@ -235,16 +233,18 @@ class ContactSystem:
                        decl=np.full(len(e), d.index), nodes=nodes, R1=self.el_radius[e], R2=self.el_radius[m])
 
     def _point_pairs(self, d, H, c):
-        """Point-to-point pairs: one per crossing (``_dedupe_points``), on both elements up to
-        ``XI_OVERHANG`` past an inner node.  Returns the record and the chosen element pairs."""
+        """Point-to-point pairs: one per crossing (``rules.dedupe_points``), on both elements up to
+        ``rules.XI_OVERHANG`` past an inner node.  Returns the record and the chosen element pairs."""
         n_el = len(self.sys.enodes)
         pt = np.flatnonzero(c.kind == POINT)
         e, m, x1, x2 = c.e[pt], c.m[pt], c.xi1[pt], c.xi2[pt]
         lo1, hi1 = self._xi_range(e)
         lo2, hi2 = self._xi_range(m)
         pt = pt[(x1 >= lo1) & (x1 <= hi1) & (x2 >= lo2) & (x2 <= hi2)]
-        e, m = c.e[pt], c.m[pt]
-        keep = self._dedupe_points(H, e, m, c.xi1[pt], c.xi2[pt], np.arange(len(pt)))
+        e, m, x1, x2 = c.e[pt], c.m[pt], c.xi1[pt], c.xi2[pt]
+        keep = rules.dedupe_points(self._points(H, e, x1), self._points(H, m, x2), x1, x2,
+                                   self.el_radius[e] + self.el_radius[m], self.el_beam[e] * self.n_beams + self.el_beam[m],
+                                   np.isin(e * n_el + m, self._prev_points))
         pt, e, m = pt[keep], e[keep], m[keep]
         key = self.point_offset + (np.int64(d.index) * n_el + e) * n_el + m
         rec = self._record(d, np.full(len(pt), POINT), e, m, c.xi1[pt], c.xi2[pt], self.sys.L[e], key,
@@ -253,7 +253,7 @@ class ContactSystem:
 
     def _gauss_pairs(self, d, H, c):
         """Line and orthogonal projections of the slave Gauss points; one owner per slave
-        point and master beam (``_owners``).  Returns the record and the owner ids."""
+        point and master beam (``rules.owners``).  Returns the record and the owner ids."""
         en = self.sys.enodes
         gp = np.flatnonzero(c.kind != POINT)
         xg, wg = np.polynomial.legendre.leggauss(d.n_gp)
@@ -275,99 +275,14 @@ class ContactSystem:
         lo, hi = self._xi_range(m)
         ok = (xi2 >= lo) & (xi2 <= hi) & np.isfinite(dist)
         key = ((np.int64(d.index) * len(en) + e) * self.max_gp + g) * self.n_beams + self.el_beam[m]
-        s = self._owners(np.flatnonzero(ok), key, m, xi2, dist, self.el_radius[e] + self.el_radius[m])
+        known = np.isin(key * len(en) + m, self._prev_owners)
+        s = rules.owners(np.flatnonzero(ok), key, xi2, dist, self.el_radius[e] + self.el_radius[m], known)
         rec = self._record(d, kind[s], e[s], m[s], xi1[s], xi2[s], wg[g[s]] * self.sys.L[e[s]], key[s], g[s])
         return rec, key[s] * len(en) + m[s]
 
     def _xi_range(self, el):
-        """Accepted projections ``[lo, hi]`` on elements ``el``: ``XI_OVERHANG`` past an inner
-        node (at a kink of the C0 centre line the closest point of either element's extension
-        lies just past the shared node: without it the point would be lost), ``XI_TOL`` at a
-        beam end."""
-        lo = np.where(self.el_first[el], -XI_TOL, -XI_OVERHANG)
-        hi = np.where(self.el_last[el], 1.0 + XI_TOL, 1.0 + XI_OVERHANG)
-        return lo, hi
-
-    def _owners(self, cand, key, m, xi2, dist, rsum):
-        """One master element per slave Gauss point and master beam (``key``), among ``cand``.
-
-        Priority: a projection inside its element over one on an extension (overhang);
-        then the nearest, where distances within ``OWNER_TIE`` (R1 + R2) count as equal
-        (a point projecting on a node shared by two elements, to round-off); among equals
-        the owner of the last evaluation (no flip-flop inside Newton), then the element
-        on which the point lies at its start (smaller ``xi2``).
-        """
-        if len(cand) == 0:
-            return cand
-        k, x = key[cand], xi2[cand]
-        outside = (x < -XI_TOL) | (x > 1.0 + XI_TOL)
-        order = np.lexsort((dist[cand], outside, k))
-        c = cand[order]
-        head = np.concatenate([[True], (k[order][1:] != k[order][:-1]) | (outside[order][1:] != outside[order][:-1])])
-        best = np.maximum.accumulate(np.where(head, np.arange(len(c)), 0))
-        tie = dist[c] <= dist[c[best]] + OWNER_TIE * rsum[c]
-        known = np.isin(key[c] * len(self.sys.enodes) + m[c], self._prev_owners)
-        order = np.lexsort((xi2[c], ~known, ~tie, outside[order], key[c]))
-        c = c[order]
-        first = np.concatenate([[True], key[c][1:] != key[c][:-1]])
-        return c[first]
-
-    def _extend_wrap(self, e, m, kinds):
-        """A straight slave element leaving a wrap tangentially (it shares a node with an
-        ``ORTHOGONAL`` element against the same master beam) is projected orthogonally
-        too: its closest point to the master sits at its end, where a point pair would
-        switch on and off as the tangent point moves (search.py, rule 3)."""
-        orth = kinds == ORTHOGONAL
-        if not orth.any() or orth.all():
-            return kinds
-        en = self.sys.enodes
-        nb = self.n_beams
-        mb = self.el_beam[m]
-        wrap = np.unique((en[e[orth]] * nb + mb[orth, None]).ravel())
-        pt = np.flatnonzero(kinds == POINT)
-        near = np.isin(en[e[pt]] * nb + mb[pt, None], wrap).any(axis=1)
-        kinds = kinds.copy()
-        kinds[pt[near]] = ORTHOGONAL
-        return kinds
-
-    def _dedupe_points(self, H, e, m, xi1, xi2, idx):
-        """One point pair per crossing: at a node where two elements meet (a kink of the
-        C0 centre line) each element has its own closest point; keep the nearest
-        of pairs of the same two beams lying within ``R1 + R2`` of each other."""
-        if len(idx) < 2:
-            return idx
-        en = self.sys.enodes
-        xC = self._points(H, e, xi1)
-        xF = self._points(H, m, xi2)
-        dist = np.linalg.norm(xF - xC, axis=1)
-        rad = self.el_radius[e] + self.el_radius[m]
-        group = self.el_beam[e] * self.n_beams + self.el_beam[m]
-        # hysteresis: a pair chosen at the last evaluation keeps priority, so the
-        # choice cannot flip between the two elements of a kink inside Newton
-        known = np.isin(e * len(en) + m, self._prev_points)
-        outside = (xi1 < -XI_TOL) | (xi1 > 1.0 + XI_TOL) | (xi2 < -XI_TOL) | (xi2 > 1.0 + XI_TOL)
-        order = np.lexsort((dist, ~known, outside, group))
-        rank = np.empty(len(order), dtype=int)
-        rank[order] = np.arange(len(order))
-        # candidate pairs (a dominates b: higher priority, same beams, both points close)
-        ij = cKDTree(xC).query_pairs(float(rad.max()), output_type="ndarray")
-        if len(ij) == 0:
-            return idx
-        a, b = ij[:, 0], ij[:, 1]
-        swap = rank[a] > rank[b]
-        a, b = np.where(swap, b, a), np.where(swap, a, b)
-        close = ((group[a] == group[b]) & (np.linalg.norm(xC[a] - xC[b], axis=1) < rad[b])
-                 & (np.linalg.norm(xF[a] - xF[b], axis=1) < rad[b]))
-        a, b = a[close], b[close]
-        # greedy in priority order, as a fixed point: dropped iff a kept pair dominates it
-        dropped = np.zeros(len(idx), dtype=bool)
-        for _ in range(len(idx)):
-            new = np.zeros(len(idx), dtype=bool)
-            new[b[~dropped[a]]] = True
-            if np.array_equal(new, dropped):
-                break
-            dropped = new
-        return idx[~dropped]
+        """Accepted projections ``[lo, hi]`` on elements ``el`` (``rules.xi_range``)."""
+        return rules.xi_range(self.el_first[el], self.el_last[el])
 
     def _params(self, P, sel, H):
         """Kernel parameters for the pairs ``sel`` (history and multipliers looked up)."""
