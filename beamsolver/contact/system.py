@@ -16,6 +16,10 @@ contact declarations.  It orchestrates pure stages kept in their own modules:
    ``(m, 4, 6)`` and tangent blocks ``(m, 24, 24)`` (``_local_blocks``, kept for the same
    poses and state), scattered in the unknowns' numbering.
 
+``ContactSystem.timings`` accumulates the CPU time (``time.process_time``) of these parts (``TIMED``: search =
+twists, spheres and broad phase; rules; projection; params = refusals, active set and
+history look-up; kernel; scatter) for benchmarks and profiles.
+
 Per step it keeps the friction history and augmented-Lagrangian multipliers,
 keyed by material slave point and master beam, committed only when a step is
 accepted (``get_state``/``set_state`` for saving and restart).  A pair with no
@@ -30,6 +34,8 @@ at the onset of sliding is ``slip_tolerance`` times the slave element length
 ``L_e`` (Abaqus' default penalty friction; below a floor traction, see
 ``pairs.stick_penalty``).
 """
+
+import time
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -48,6 +54,7 @@ from .search import broad_phase, element_spheres
 from . import rules
 
 MAX_AUGMENT = 30
+TIMED = ("search", "rules", "projection", "params", "kernel", "scatter")   # parts of ``ContactSystem.timings``
 
 
 def use_numpy_kernel(flag=True):
@@ -118,6 +125,8 @@ class ContactSystem:
         self._H_prev = None        # last converged poses (start of the step)
         self._geo = self._geo_prev = None    # (poses, element twists) of the last evaluation / of H_prev
         self._blocks = None        # (poses, local blocks) of the last evaluation, for the same state
+        self.timings = dict.fromkeys(TIMED, 0.0)
+        self._clock = time.process_time()
 
     # ------------------------------------------------------------ history
     def get_state(self):
@@ -148,7 +157,7 @@ class ContactSystem:
         self._mult = self._mult_committed
         for name in ("prev_points", "prev_owners"):
             if name in state:
-                setattr(self, f"_{name}", np.asarray(state[name], dtype=np.int64))
+                setattr(self, f"_{name}", np.sort(np.asarray(state[name], dtype=np.int64)))
 
     @staticmethod
     def _empty_history():
@@ -162,6 +171,13 @@ class ContactSystem:
             return np.zeros(len(keys), dtype=int), np.zeros(len(keys), dtype=bool)
         idx = np.clip(np.searchsorted(keys_sorted, keys), 0, len(keys_sorted) - 1)
         return idx, keys_sorted[idx] == keys
+
+    def _lap(self, part=None):
+        """Add the CPU time since the last lap to ``timings[part]`` (``None``: start a lap)."""
+        t = time.process_time()
+        if part is not None:
+            self.timings[part] += t - self._clock
+        self._clock = t
 
     # ------------------------------------------------------------ geometry
     def _twists(self, H):
@@ -191,6 +207,7 @@ class ContactSystem:
         owner per slave point; the owners are remembered for the next evaluation.
         """
         out, chosen, owners = [], [], []
+        self._lap()
         for d in self.decls:
             c = self._candidates(d, H)
             part, ids = self._point_pairs(d, H, c)
@@ -199,8 +216,8 @@ class ContactSystem:
             part, ids = self._gauss_pairs(d, H, c)
             out.append(part)
             owners.append(ids)
-        self._prev_points = np.concatenate(chosen) if chosen else np.zeros(0, dtype=np.int64)
-        self._prev_owners = np.concatenate(owners) if owners else np.zeros(0, dtype=np.int64)
+        self._prev_points = np.sort(np.concatenate(chosen)) if chosen else np.zeros(0, dtype=np.int64)
+        self._prev_owners = np.sort(np.concatenate(owners)) if owners else np.zeros(0, dtype=np.int64)
         out = [p for p in out if len(p)]
         return PairSet.concatenate(out) if out else None
 
@@ -213,6 +230,7 @@ class ContactSystem:
         cs, rs, hs, ts = element_spheres(H, en[d.slave_el], h[d.slave_el], self.el_radius[d.slave_el], d.margin)
         cm, rm, hm, tm = element_spheres(H, en[d.master_el], h[d.master_el], self.el_radius[d.master_el], d.margin)
         i, j = broad_phase(cs, rs, cm, rm)
+        self._lap("search")
         e, m = d.slave_el[i], d.master_el[j]
         keep = rules.apart(en, e, m)
         i, j, e, m = i[keep], j[keep], e[keep], m[keep]
@@ -220,10 +238,13 @@ class ContactSystem:
         xi1, xi2 = np.zeros(len(i)), np.zeros(len(i))
         b = np.flatnonzero(rules.crossing(ts[i], tm[j], d.line_angle))
         if len(b):
+            self._lap("rules")
             x1, x2, ratio = closest_points(H, en[e[b], 0], hs[i[b]], en[m[b], 0], hm[j[b]])
+            self._lap("projection")
             kinds[b] = rules.point_or_orthogonal(ratio, d.point_ratio)
             xi1[b], xi2[b] = x1, x2
             kinds = rules.extend_wrap(en, self.el_beam[m], self.n_beams, e, m, kinds)
+        self._lap("rules")
         return Candidates(e=e, m=m, kind=kinds, xi1=xi1, xi2=xi2, h1=hs[i], h2=hm[j], c2=cm[j], r2=rm[j])
 
     def _record(self, d, kind, e, m, xi1, xi2, weight, key, gp):
@@ -244,11 +265,12 @@ class ContactSystem:
         e, m, x1, x2 = c.e[pt], c.m[pt], c.xi1[pt], c.xi2[pt]
         keep = rules.dedupe_points(self._points(H, e, x1), self._points(H, m, x2), x1, x2,
                                    self.el_radius[e] + self.el_radius[m], self.el_beam[e] * self.n_beams + self.el_beam[m],
-                                   np.isin(e * n_el + m, self._prev_points))
+                                   _member(e * n_el + m, self._prev_points))
         pt, e, m = pt[keep], e[keep], m[keep]
         key = self.point_offset + (np.int64(d.index) * n_el + e) * n_el + m
         rec = self._record(d, np.full(len(pt), POINT), e, m, c.xi1[pt], c.xi2[pt], self.sys.L[e], key,
                            np.zeros(len(pt), int))
+        self._lap("rules")
         return rec, e * n_el + m
 
     def _gauss_pairs(self, d, H, c):
@@ -272,12 +294,14 @@ class ContactSystem:
         # from the projection on the master chord, 8 Newton iterations (compiled, projection.py; the
         # kernel polishes the point with 2 more and needs it converged for an exact tangent)
         xi2, dist = project_points(H, kind, en[e, 0], h1, xi1, en[m, 0], en[m, 1], h2, iterations=8)
+        self._lap("projection")
         lo, hi = self._xi_range(m)
         ok = (xi2 >= lo) & (xi2 <= hi) & np.isfinite(dist)
         key = ((np.int64(d.index) * len(en) + e) * self.max_gp + g) * self.n_beams + self.el_beam[m]
-        known = np.isin(key * len(en) + m, self._prev_owners)
+        known = _member(key * len(en) + m, self._prev_owners)
         s = rules.owners(np.flatnonzero(ok), key, xi2, dist, self.el_radius[e] + self.el_radius[m], known)
         rec = self._record(d, kind[s], e[s], m[s], xi1[s], xi2[s], wg[g[s]] * self.sys.L[e[s]], key[s], g[s])
+        self._lap("rules")
         return rec, key[s] * len(en) + m[s]
 
     def _xi_range(self, el):
@@ -439,6 +463,7 @@ class ContactSystem:
             return c[1]
         tangent = tangent or kernel_and_tangent is not pairs.kernel_and_tangent
         P = self.pairs(H)
+        self._lap()
         sel = np.zeros(0, dtype=int)
         if P is not None:
             self._check_sides(P, H)
@@ -448,7 +473,9 @@ class ContactSystem:
             return None
         self._check_normals(P, sel, H)
         p = self._params(P, sel, H)
+        self._lap("params")
         f, K, out = self._kernel(H[P.nodes[sel]], p, tangent)
+        self._lap("kernel")
         # kept for commit/augment at the same poses (the converged iterate): no second pass
         if (p["mu"] > 0).all() or not (p["mu"] > 0).any():
             self._cache = (H.copy(), P, sel, p, out)
@@ -459,6 +486,11 @@ class ContactSystem:
     def _kernel(X, p, tangent):
         """The kernel on the pairs with friction and on those without: ``f``, ``K`` (or None), ``out``."""
         fric = p["mu"] > 0
+        if fric.all() or not fric.any():        # one kind: no masked copies of the (m, 24, 24) blocks
+            if tangent:
+                return kernel_and_tangent(X, p, friction=bool(fric.any()))
+            f, out = contact_kernel(X, p, friction=bool(fric.any()))
+            return f, None, out
         f = np.zeros((len(X), 4, 6))
         K = np.zeros((len(X), 24, 24)) if tangent else None
         out = {}
@@ -485,6 +517,7 @@ class ContactSystem:
         r = np.zeros(ndof)
         empty = (np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0))
         blocks = self._local_blocks(H, tangent)
+        self._lap()
         if blocks is None:
             return r, empty, dict(n_active=0)
         P, sel, p, f, K, out = blocks
@@ -509,6 +542,7 @@ class ContactSystem:
         fl = np.abs(f.reshape(-1, 4, 6)[:, :, :3]).max(initial=0.0)
         ml = np.abs(f.reshape(-1, 4, 6)[:, :, 3:]).max(initial=0.0)
         info = dict(n_active=len(sel), f_level=fl, m_level=ml)
+        self._lap("scatter")
         return r, coo, info
 
     # ------------------------------------------------------------ per step
@@ -634,6 +668,14 @@ def _frames(out):
     HL[:, :3, 3] = out["xC"]
     HK[:, :3, 3] = out["xF"]
     return HL, HK
+
+
+def _member(a, b_sorted):
+    """``np.isin(a, b_sorted)`` for a sorted ``b_sorted`` (binary search)."""
+    if len(b_sorted) == 0:
+        return np.zeros(len(a), dtype=bool)
+    i = np.minimum(np.searchsorted(b_sorted, a), len(b_sorted) - 1)
+    return b_sorted[i] == a
 
 
 def _interp_pose(H, enodes, e, xi):
