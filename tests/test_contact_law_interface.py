@@ -99,3 +99,38 @@ def test_the_default_law_kernel_is_the_module_kernel():
     assert kernel_jit.make_kernel(PENALTY_COULOMB) is kernel_jit.evaluate
     assert kernel_jit.make_kernel(STIFF) is kernel_jit.make_kernel(ContactLaw("stiffening_test", stiffening_normal,
                                                                               coulomb))
+
+
+def _crossing(law):
+    import beamsolver as bs
+    r, n = 0.05, 8
+    sec = bs.Section.circular(radius=r, E=1e7, nu=0.3)
+    m = bs.Model()
+    lower = m.add_beam(bs.geometry.straight((0, -1, 0), (0, 1, 0), n), sec)
+    upper = m.add_beam(bs.geometry.straight((-1, 0, 2 * r), (1, 0, 2 * r), n), sec)
+    for node in (lower.first, lower.last, upper.first, upper.last):
+        m.clamp(node)
+    m.add_load(upper.nodes[n // 2], force=(0.0, 0.0, -50.0))
+    m.add_contact(upper, lower, **({} if law is None else dict(law=law)))
+    return m, sec
+
+
+@pytest.mark.parametrize("law", [None, STIFF])
+def test_a_declared_law_is_the_one_the_solve_obeys(law):
+    import beamsolver as bs
+    from beamsolver.contact.law import default_penalty
+    m, sec = _crossing(law)
+    sol = bs.solve(m, steps=2, verbose=False)
+    c = sol.contact()
+    on = c["normal_force"] > 0
+    assert on.sum() == 1
+    lam, x, pen = c["normal_force"][on] / c["weight"][on], -c["gap"][on], default_penalty(sec, sec)
+    expected = pen * x if law is None else pen * x * (1.0 + x / STIFFENING)
+    np.testing.assert_allclose(lam, expected, rtol=1e-9)
+    np.testing.assert_allclose(c["normal_force"].sum(), 25.0, rtol=0.02)     # half the load, as with any law
+
+
+def test_a_law_that_is_not_a_contact_law_is_refused_naming_it():
+    import beamsolver as bs
+    with pytest.raises(bs.InputError, match="law must be .*ContactLaw.*'hertz'"):
+        _crossing("hertz")

@@ -88,6 +88,7 @@ class _Decl:
         self.point_ratio = o.point_ratio
         self.margin = 2.0 * max(s.radius for s in secs) if o.margin is None else o.margin
         self.smoothing = o.smoothing          # None: SMOOTHING * (R1 + R2) per pair
+        self.law = o.law                      # None: the kernel's default law
 
 
 class ContactSystem:
@@ -474,7 +475,7 @@ class ContactSystem:
         self._check_normals(P, sel, H)
         p = self._params(P, sel, H)
         self._lap("params")
-        f, K, out = self._kernel(H[P.nodes[sel]], p, tangent)
+        f, K, out = self._kernels(H[P.nodes[sel]], p, P.decl[sel], tangent)
         self._lap("kernel")
         # kept for commit/augment at the same poses (the converged iterate): no second pass
         if (p["mu"] > 0).all() or not (p["mu"] > 0).any():
@@ -482,27 +483,38 @@ class ContactSystem:
         self._blocks = (np.array(H), (P, sel, p, f, K, out))
         return self._blocks[1]
 
-    @staticmethod
-    def _kernel(X, p, tangent):
-        """The kernel on the pairs with friction and on those without: ``f``, ``K`` (or None), ``out``."""
-        fric = p["mu"] > 0
-        if fric.all() or not fric.any():        # one kind: no masked copies of the (m, 24, 24) blocks
-            if tangent:
-                return kernel_and_tangent(X, p, friction=bool(fric.any()))
-            f, out = contact_kernel(X, p, friction=bool(fric.any()))
-            return f, None, out
+    def kernel_inputs(self, H):
+        """Node poses ``(m, 4, 4, 4)`` and kernel parameters (dict of arrays) of the pairs active at
+        ``H``, as the kernel receives them (benchmarks, tests); ``None`` without active pairs."""
+        P = self.pairs(H)
+        if P is None:
+            return None
+        sel = self._active(P, H)
+        if len(sel) == 0:
+            return None
+        return H[P.nodes[sel]], self._params(P, sel, H)
+
+    def _kernels(self, X, p, decl, tangent, friction=None):
+        """The kernel of each declaration's law on the pairs with friction and on those without
+        (``friction``: the friction branch for all): ``f``, ``K`` (or None), ``out``."""
+        laws = [d.law for d in self.decls]
+        if any(law is not None for law in laws) and kernel_and_tangent is pairs.kernel_and_tangent:
+            raise InputError("contact: the numpy oracle kernel (use_numpy_kernel) has only the default law; "
+                             f"add_contact declared law={next(law for law in laws if law is not None)!r}")
+        fric = p["mu"] > 0 if friction is None else np.full(len(X), friction)
+        group = np.unique([id(law) for law in laws], return_inverse=True)[1][decl] * 2 + fric
+        kinds = np.unique(group)
+        if len(kinds) == 1:                     # one kind: no masked copies of the (m, 24, 24) blocks
+            return _kernel(X, p, bool(kinds[0] % 2), laws[decl[0]], tangent)
         f = np.zeros((len(X), 4, 6))
         K = np.zeros((len(X), 24, 24)) if tangent else None
         out = {}
-        for mask, use_fric in ((fric, True), (~fric, False)):
-            if not mask.any():
-                continue
+        for g in kinds:
+            mask = group == g
             pm = {k: (v[mask] if np.ndim(v) else v) for k, v in p.items()}
+            fm, Km, om = _kernel(X[mask], pm, bool(g % 2), laws[decl[np.argmax(mask)]], tangent)
             if tangent:
-                fm, Km, om = kernel_and_tangent(X[mask], pm, friction=use_fric)
                 K[mask] = Km
-            else:
-                fm, om = contact_kernel(X[mask], pm, friction=use_fric)
             f[mask] = fm
             for k, v in om.items():
                 if k not in out:
@@ -568,8 +580,7 @@ class ContactSystem:
         if len(sel):
             fric = p["mu"] > 0
             # the full kernel (with friction frames) for every active pair
-            _, out = contact_kernel(H[P.nodes[sel]], p, friction=True) if fric.any() else \
-                contact_kernel(H[P.nodes[sel]], p, friction=False)
+            _, _, out = self._kernels(H[P.nodes[sel]], p, P.decl[sel], False, friction=bool(fric.any()))
             if not fric.any():
                 out["slip"] = np.zeros((len(sel), 2))
         return P, sel, (p, out)
@@ -668,6 +679,14 @@ def _frames(out):
     HL[:, :3, 3] = out["xC"]
     HK[:, :3, 3] = out["xF"]
     return HL, HK
+
+
+def _kernel(X, p, friction, law, tangent):
+    """``f``, ``K`` (None without ``tangent`` on the numpy path) and point data of one kernel call."""
+    if tangent:
+        return kernel_and_tangent(X, p, friction=friction, **({} if law is None else dict(law=law)))
+    f, out = contact_kernel(X, p, friction=friction, **({} if law is None else dict(law=law)))
+    return f, None, out
 
 
 def _member(a, b_sorted):
