@@ -314,7 +314,20 @@ class System:
         if K is not None and len(nodes):
             n = d.shape[1]
             coo = (np.repeat(d, n, axis=1).ravel(), np.tile(d, (1, n)).ravel(), K.ravel())
+            g = np.intersect1d(self.global_nodes, self.rep[nodes])
+            if len(g):
+                coo = _concat(coo, self._global_node_terms(r, g))
         return (r, coo) + _blocks.levels(f)
+
+    @staticmethod
+    def _global_node_terms(r, g):
+        """COO of ``[[0, -hat(r_u)], [0, -hat(r_w)]]`` at global-type nodes ``g`` (the dependence of
+        ``M`` on ``R``, see the module docstring) for the residual ``r`` of one contribution."""
+        rg = r.reshape(-1, 6)[g]
+        vals = -np.concatenate([skew(rg[:, :3]), skew(rg[:, 3:])], axis=1)          # (k, 6, 3)
+        rows = np.broadcast_to((6 * g)[:, None, None] + np.arange(6)[:, None], vals.shape)
+        cols = np.broadcast_to((6 * g)[:, None, None] + 3 + np.arange(3), vals.shape)
+        return rows.ravel(), cols.ravel(), vals.ravel()
 
     # ------------------------------------------------------------ evaluation
     def evaluate(self, H, load_factors, tangent=True):
@@ -523,3 +536,8 @@ class System:
         out[body, 3:] = np.einsum("nij,nj->ni", R[body], rr[body, 3:])
         out[~body] = rr[~body]
         return out
+
+
+def _concat(a, b):
+    """Two COO triplets ``(rows, cols, vals)`` as one."""
+    return tuple(np.concatenate([x, y]) for x, y in zip(a, b))
