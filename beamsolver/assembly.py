@@ -297,7 +297,8 @@ class System:
         return M
 
     def assemble_blocks(self, H, blocks):
-        """Generic assembly of local blocks (``blocks.Blocks``, any ``k`` nodes per block).
+        """Generic assembly of local blocks (``blocks.Blocks``, any ``k`` nodes per block;
+        docs/theory.md eqs. 10.2-10.3).
 
         Node transforms (joins, global-type nodes) are applied to the blocks touching a
         transformed node.  Returns ``(r, coo, f_level, m_level)``: the residual ``(6 n,)``,

@@ -24,7 +24,8 @@ solver uses, and nothing else of the physics:
   ``conservative``: no follower loads and every contribution derives from a potential.
 
 ``system`` is the DOF map and constraints the solver reads (free unknowns,
-prescribed nodes and their targets, reactions).
+prescribed nodes and their targets, reactions).  docs/theory.md section 10
+gives the equations and the data flow of one Newton iteration.
 """
 import time
 from dataclasses import dataclass, field
