@@ -36,6 +36,8 @@ from .assembly import System
 
 __all__ = ["Problem", "Evaluation"]
 
+ALWAYS_TIMED = ("contact",)      # parts reported in the timings of every step, 0 when absent
+
 
 @dataclass
 class Evaluation:
@@ -82,8 +84,10 @@ class Problem:
 
     @property
     def timing_names(self):
-        """Names of the contributions timed in ``Evaluation.timings``."""
-        return tuple(c.name for c in self.contributions)
+        """Names of the parts timed in ``Evaluation.timings``: ``contact`` always (0 without
+        contact: ``Solution.stats[k]["timings"]`` has the same keys in every scene), then those of
+        the other contributions."""
+        return ALWAYS_TIMED + tuple(c.name for c in self.contributions if c.name not in ALWAYS_TIMED)
 
     # ------------------------------------------------------------ evaluation
     def load_factors(self, t):

@@ -162,7 +162,7 @@ def test_life_cycle_outer_iteration_commit_and_globalisation():
     (one re-solve), commit with the step's record; a smooth contribution keeps the damped Newton."""
     problem, spring = _problem(k=50.0)
     assert problem.smooth and problem.conservative
-    assert Problem(problem.system, []).get_state() == {} and problem.timing_names == ("spring",)
+    assert Problem(problem.system, []).get_state() == {} and problem.timing_names == ("contact", "spring")
     from beamsolver.solver import Convergence, _Newton
     from beamsolver.stepping import Run
     newton = _Newton(problem, Convergence(), True, None)
