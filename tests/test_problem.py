@@ -192,3 +192,53 @@ def test_solver_knows_nothing_of_contact(module):
     assert not [n for n in names if "contact" in n.lower()]
     src = (PACKAGE / module).read_text()
     assert "from .contact" not in src and "beamsolver.contact" not in src
+
+
+def _pair_on_a_plate(n=3, R=0.5e-3, L=4e-3, depth=0.1):
+    """Two touching wires, ``a`` joined at its top to a plate node with a partial fix (global-type),
+    ``b`` clamped at both ends: the contact pairs of the top elements load the plate; the wires
+    pressed together by ``depth R`` at their interior nodes."""
+    sec = bs.Section.circular(radius=R, E=200e9)
+    m = bs.Model()
+    a = m.add_beam(geometry.straight((R, 0, 0), (R, 0, L), n), sec)
+    b = m.add_beam(geometry.straight((-R, 0, 0), (-R, 0, L), n), sec)
+    m.clamp(a.first)
+    m.clamp(b.first)
+    plate = m.add_node((0.0, 0.0, L))
+    m.join(plate, a.last, rigid=True)
+    m.clamp(b.last)
+    m.fix(plate, ("ux", "uy", "rx"))
+    m.add_contact(a, b)
+    problem = Problem.from_model(m)
+    system = problem.system
+    dz = np.zeros((system.n_nodes, 6))
+    dz[a.nodes[1:-1], 0], dz[b.nodes[1:-1], 0] = -depth * R, depth * R
+    dz[plate, 5] = 0.05                                      # and the plate turned a little
+    H = system.update(system.poses0, dz)
+    problem.begin_step(H, 0.0)
+    return problem, H, plate
+
+
+def test_contact_tangent_at_a_global_type_node_matches_finite_differences(monkeypatch):
+    """The contact blocks' global-node term (docs/theory.md eq. 10.3): without it the columns of the
+    plate's rotation miss the contact forces carried by the plate (the path before the Problem)."""
+    problem, H, plate = _pair_on_a_plate()
+    system = problem.system
+    ev = problem.evaluate(H, 0.0)
+    assert ev.details["contact"]["n_active"] > 0
+    free = system.free_dofs
+    cols = np.flatnonzero(free // 6 == plate)                 # the plate's free unknowns
+    eps = 1e-7
+    fd = np.zeros((len(free), len(cols)))
+    for j, c in enumerate(cols):
+        dz = np.zeros(6 * system.n_nodes)
+        dz[free[c]] = eps * (1e-3 if free[c] % 6 < 3 else 1.0)
+        rp = problem.evaluate(problem.update(H, dz.reshape(-1, 6)), 0.0, tangent=False).r
+        rm = problem.evaluate(problem.update(H, -dz.reshape(-1, 6)), 0.0, tangent=False).r
+        fd[:, j] = (rp[free] - rm[free]) / (2 * dz[free[c]])
+    K = problem.tangent(ev).toarray()[:, cols]
+    assert rel_err(K, fd) < 1e-5, rel_err(K, fd)
+    monkeypatch.setattr(System, "_global_node_terms", staticmethod(lambda r, g: (np.zeros(0, int),) * 2
+                                                                   + (np.zeros(0),)))
+    K_without = problem.tangent(problem.evaluate(H, 0.0)).toarray()[:, cols]
+    assert rel_err(K_without, fd) > 10 * rel_err(K, fd), (rel_err(K_without, fd), rel_err(K, fd))
