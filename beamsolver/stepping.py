@@ -38,6 +38,7 @@ LANDING = 0.1              # a step ending within this fraction of a step before
 EASY_ITERATIONS = 6        # a step converging within these iterations is easy (growth)
 EASY_RUN = 2               # easy steps running before the step grows (growth)
 WAIT_MAX = 32              # most easy steps running before a step regrows to a size that failed again
+MAX_OUTER = 100            # outer iterations of a step (Problem.repeat_step) before it fails
 
 
 def growth(iterations, easy):
@@ -219,6 +220,9 @@ class Run:
         problem.begin_step(self.H, t_next)
         H, ev, stats = newton.step(self.H, t_next, H_target, self.t)
         while problem.repeat_step(H):
+            if stats.get("augmentations", 0) >= MAX_OUTER:
+                raise AugmentationFailed(f"the outer iterations (augmented-Lagrangian updates) still ask to re-solve "
+                                         f"the step at t = {t_next:.6g} after MAX_OUTER = {MAX_OUTER}")
             H, ev, more = newton.step(H, t_next, H_target, self.t)
             stats["iterations"] += more["iterations"]
             stats["residuals"] += more["residuals"]

@@ -179,6 +179,21 @@ def test_life_cycle_outer_iteration_commit_and_globalisation():
     assert np.abs(ev.r[problem.system.free_dofs]).max() <= 1e-8 * max(ev.f_level, ev.m_level)
 
 
+def test_outer_iterations_are_bounded():
+    """A contribution that always asks to re-solve the step: a typed failure after MAX_OUTER."""
+    from beamsolver import failures, stepping
+    from beamsolver.errors import ConvergenceError
+    from beamsolver.solver import Convergence, _Newton
+    problem, spring = _problem(k=50.0)
+    spring.repeat_step = lambda H: True
+    run = stepping.Run(problem, _Newton(problem, Convergence(), True, None), None, np.linspace(0.0, 1.0, 2),
+                       1e-3, False, dict(advice=lambda *a: ""))
+    run.start(None, None)
+    with pytest.raises(ConvergenceError) as err:
+        run.loop()
+    assert isinstance(err.value.failure, failures.AugmentationFailed) and "MAX_OUTER" in str(err.value)
+
+
 def _names(path):
     toks = tokenize.generate_tokens(io.StringIO(path.read_text()).readline)
     return {t.string for t in toks if t.type == tokenize.NAME}
