@@ -64,8 +64,9 @@ class Convergence:
     divergence: float = 1e12
 
     def scales(self, ev, L_ref):
-        """``(F_ref, M_ref)`` from the force levels of an evaluation (``problem.Evaluation``)."""
-        f, m = ev.f_level, ev.m_level
+        """``(F_ref, M_ref)`` from the force levels of an evaluation (``problem.Evaluation``, or a
+        dict with ``f_level`` and ``m_level``)."""
+        f, m = (ev["f_level"], ev["m_level"]) if isinstance(ev, dict) else (ev.f_level, ev.m_level)
         F = max(f, m / L_ref)
         M = max(m, f * L_ref)
         return F, M
