@@ -6,9 +6,10 @@ tangent (``K_ff dz_f = -r_f - K_fc dz_c``), later iterations are Newton
 ``K dz = -r``, damped on the size of the Newton correction for a smooth problem
 (``_Newton._damped``) and by a backtracking line search on the scaled residual
 otherwise (``_Newton._line_search``).  The physics is reached only through the
-``problem.Problem`` interface (residual, tangent, update, step life cycle).  Elements may not turn by more than
-``MAX_ELEMENT_ROTATION`` (nor pass pi within a step): such steps fail with a
-message saying how many elements the beam needs.
+``problem.Problem`` interface (residual, tangent, update, step life cycle).
+Elements may not turn by more than ``MAX_ELEMENT_ROTATION`` (nor pass pi
+within a step): such steps fail with a message saying how many elements the
+beam needs.
 Failures are typed (``beamsolver.failures``); ``Convergence.decide`` gives
 the verdict on every iterate.  The stepping (cut-back, regrowth, landing on
 the user's grid, keeping what converged when a run stops) is ``stepping.Run``.
@@ -21,8 +22,8 @@ import numpy as np
 
 from . import diagnosis, linsolve, se3
 from .errors import InputError
-from .problem import Problem
 from .failures import DampingStalled, Diverged, NonFinite, NotConverged, RotationLimit, SingularTangent, StepFailed
+from .problem import Problem
 from .restart import restart_from
 from .stepping import Run
 from .validation import check_solve_arguments

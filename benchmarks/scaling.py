@@ -518,7 +518,8 @@ def report(rows, base, nothing, max_elements, cap, wall):
     out = lines.append
     out(f"`python benchmarks/scaling.py {max_elements}` ({machine()}; one thread; whole run {wall:.0f} s). "
         "Cost of one Newton iteration split into its parts, in ms of CPU time (one thread), each part timed "
-        "by calling what one Newton iteration calls through `problem.Problem` (best of up to 5 calls); `output` (one VTU step, refine 8, zlib) and "
+        "by calling what one Newton iteration calls through `problem.Problem` (best of up to 5 calls); "
+        "`output` (one VTU step, refine 8, zlib) and "
         "`commit` (contact history + point table) are per converged step, not per iteration. "
         "`residual` is the line search's residual-only evaluation (contact included). "
         "`iteration` = element + contact + assembly + solve + update + residual. "
