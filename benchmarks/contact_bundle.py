@@ -5,14 +5,15 @@ Scene: the 1+6+12 strand of ``benchmarks/scaling.py`` (19 twisted wires, lay 0.1
 force, 5 Gauss points, mu = 0.3) at about ``n`` elements (default 3000: 158 per wire).
 One Newton iteration at the reference poses, by the public pieces a solver calls:
 
-- ``element``: ``System.evaluate`` minus its contact part;
-- the contact parts from ``ContactSystem.timings`` (CPU time of each stage, one
+- ``element``: ``System.evaluate`` (elements, loads; contact is a contribution of the
+  ``problem.Problem``);
+- the contact stages from ``ContactSystem.timings`` (CPU time of each stage, one
   ``evaluate``): search (twists, spheres, broad phase), rules (pair rules, ownership),
   projection (closest points, Gauss-point projections), params (refusals, active set,
-  history look-up), kernel (compiled forces and exact tangent), scatter (residual and
-  COO triplets);
-- ``assembly``: ``System.matrix``; ``linear solve``: each ``linsolve`` back-end available
-  (factorisation + solve); ``update``: ``System.update``.
+  history look-up), kernel (compiled forces and exact tangent), blocks (the local blocks
+  handed over); contact assembly: ``System.assemble_blocks`` (transforms, residual, COO);
+- ``tangent assembly``: ``Problem.tangent`` (CSC); ``linear solve``: each ``linsolve``
+  back-end available (factorisation + solve); ``update``: ``Problem.update``.
 
 Times are CPU times of the process (``time.process_time``, least of ``REPEAT`` runs;
 the machine is shared), one thread.
@@ -30,48 +31,49 @@ single_thread()
 import numpy as np  # noqa: E402
 
 from beamsolver import linsolve  # noqa: E402
-from beamsolver.assembly import System  # noqa: E402
+from beamsolver.problem import Problem  # noqa: E402
 from beamsolver.contact.system import TIMED  # noqa: E402
 from scaling import bundle_model, bundle_per_wire  # noqa: E402
 
 REPEAT = 3
 
 
-def one_iteration(system, H, lf):
-    """CPU seconds of each part of one Newton iteration (contact evaluated afresh)."""
-    c = system.contact
-    c.begin_step(H, 0.0)                     # a new step: nothing cached
+def _cpu(fn):
+    t0 = time.process_time()
+    out = fn()
+    return time.process_time() - t0, out
+
+
+def one_iteration(problem, H):
+    """CPU seconds of each part of one Newton iteration (contact evaluated afresh) and the
+    number of active contact points."""
+    system, c = problem.system, problem.system.contact
+    problem.begin_step(H, 0.0)                     # a new step: nothing kept from the last evaluation
     for k in c.timings:
         c.timings[k] = 0.0
     t = {}
-    t0 = time.process_time()
-    r, kvals, info = system.evaluate(H, lf, tangent=True)
-    total = time.process_time() - t0
+    t["element"], _ = _cpu(lambda: system.evaluate(H, problem.load_factors(1.0), tangent=True))
+    _, (blocks, info) = _cpu(lambda: c.evaluate(H, tangent=True))
     t.update({f"contact {k}": c.timings[k] for k in TIMED})
-    t["element"] = max(total - sum(c.timings.values()), 0.0)
-    t0 = time.process_time()
-    K = system.matrix(kvals, info["extra"])
-    t["assembly"] = time.process_time() - t0
-    rhs = -r[system.free_dofs]
+    t["contact assembly (transforms, COO)"], _ = _cpu(lambda: system.assemble_blocks(H, blocks))
+    ev = problem.evaluate(H, 1.0, tangent=True)    # the same evaluation, as the solver gets it (kept)
+    t["tangent assembly (CSC)"], K = _cpu(lambda: problem.tangent(ev))
+    rhs = -ev.r[system.free_dofs]
     for b in linsolve.available():
-        t0 = time.process_time()
-        dz = linsolve.factorize(K, b).solve(rhs)
-        t[f"linear solve ({b})"] = time.process_time() - t0
+        t[f"linear solve ({b})"], dz = _cpu(lambda: linsolve.factorize(K, b).solve(rhs))
     full = np.zeros(6 * system.n_nodes)
     full[system.free_dofs] = dz
-    t0 = time.process_time()
-    system.update(H, full.reshape(-1, 6))
-    t["update"] = time.process_time() - t0
-    return t, info.get("contact", {}).get("n_active", -1)
+    t["update"], _ = _cpu(lambda: problem.update(H, full.reshape(-1, 6)))
+    return t, info.get("n_active", -1)
 
 
 def main(n=3000):
     m, _ = bundle_model(bundle_per_wire(n))
-    system = System(m)
+    problem = Problem.from_model(m)
+    system = problem.system
     H = system.poses0.copy()
-    lf = system.load_factors(1.0)
-    _, points = one_iteration(system, H, lf)             # compiled kernels loaded, caches warm
-    runs = [one_iteration(system, H, lf)[0] for _ in range(REPEAT)]
+    _, points = one_iteration(problem, H)             # compiled kernels loaded, caches warm
+    runs = [one_iteration(problem, H)[0] for _ in range(REPEAT)]
     best = {k: min(r[k] for r in runs) for k in runs[0]}
     solvers = [k for k in best if k.startswith("linear solve")]
     fastest = min(solvers, key=best.get)

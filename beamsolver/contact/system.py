@@ -12,13 +12,14 @@ contact declarations.  It orchestrates pure stages kept in their own modules:
    at shared nodes), giving one typed ``record.PairSet``;
 4. refusals (``_check_sides``: tunnelling; ``_check_normals``: no normal);
 5. kernel parameters and history look-up (``_params``), then the compiled kernel of the
-   contact law (``kernel_jit``, ``law.ContactLaw``) on the active pairs: local wrenches
-   ``(m, 4, 6)`` and tangent blocks ``(m, 24, 24)`` (``_local_blocks``, kept for the same
-   poses and state), scattered in the unknowns' numbering.
+   contact law (``kernel_jit``, ``law.ContactLaw``) on the active pairs (``_local_blocks``,
+   kept for the same poses and state);
+6. local force and tangent blocks over the pairs' 4 nodes, which the generic assembler
+   (``assembly.System.assemble_blocks``) transforms and scatters like any contribution.
 
-``ContactSystem.timings`` accumulates the CPU time (``time.process_time``) of these parts (``TIMED``: search =
-twists, spheres and broad phase; rules; projection; params = refusals, active set and
-history look-up; kernel; scatter) for benchmarks and profiles.
+``ContactSystem.timings`` accumulates the CPU time (``time.process_time``) of these parts
+(``TIMED``: search = twists, spheres and broad phase; rules; projection; params = refusals,
+active set and history look-up; kernel; blocks) for benchmarks and profiles.
 
 Per step it keeps the friction history and augmented-Lagrangian multipliers,
 keyed by material slave point and master beam, committed only when a step is
@@ -41,6 +42,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .. import se3
+from ..blocks import Blocks, Contribution
 from ..errors import InputError
 from ..failures import ContactTunnelling, NoContactNormal
 from .law import default_penalty
@@ -54,7 +56,7 @@ from .search import broad_phase, element_spheres
 from . import rules
 
 MAX_AUGMENT = 30
-TIMED = ("search", "rules", "projection", "params", "kernel", "scatter")   # parts of ``ContactSystem.timings``
+TIMED = ("search", "rules", "projection", "params", "kernel", "blocks")   # parts of ``ContactSystem.timings``
 
 
 def use_numpy_kernel(flag=True):
@@ -91,7 +93,7 @@ class _Decl:
         self.law = o.law                      # None: the kernel's default law
 
 
-class ContactSystem:
+class ContactSystem(Contribution):
     def __init__(self, system):
         self.sys = system
         model = system.model
@@ -451,6 +453,14 @@ class ContactSystem:
                                 f"step (one beam passed through the other; {len(flip)} such pairs)")
 
     # ------------------------------------------------------------ evaluation
+    name = "contact"         # of the contribution, in timings and evaluation details (problem.Problem)
+    smooth = False           # a piecewise smooth residual: the solver backtracks on the residual
+
+    @property
+    def conservative(self):
+        """Frictionless contact has a potential (symmetric tangent at equilibrium)."""
+        return not any(d.mu > 0 for d in self.decls)
+
     def _local_blocks(self, H, tangent):
         """``(P, sel, p, f, K, out)`` at poses ``H``: pairs, active ones, kernel parameters, local
         wrenches ``(m, 4, 6)``, tangent blocks ``(m, 24, 24)`` and point data; None without active pairs.
@@ -523,39 +533,22 @@ class ContactSystem:
         return f, K, out
 
     def evaluate(self, H, tangent=True):
-        """Contact residual ``(6 n,)``, COO tangent ``(rows, cols, vals)`` and point data."""
-        sysm = self.sys
-        ndof = 6 * sysm.n_nodes
-        r = np.zeros(ndof)
-        empty = (np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0))
+        """Local blocks of the active pairs and point data: ``(blocks.Blocks, info)``.
+
+        Blocks over the pair's 4 nodes (slave A, B, master A, B): ``f`` ``(m, 24)`` is the
+        contact's part of the residual (minus the contact forces on the nodes) and ``K``
+        ``(m, 24, 24)`` its derivative in the nodes' body increments; the generic assembler
+        (``assembly.System.assemble_blocks``) transforms and scatters them.  The kernel's results
+        are kept for the same poses and state (``_local_blocks``).
+        """
         blocks = self._local_blocks(H, tangent)
         self._lap()
         if blocks is None:
-            return r, empty, dict(n_active=0)
+            return Blocks.empty(4, tangent), dict(n_active=0)
         P, sel, p, f, K, out = blocks
-        nodes = P.nodes[sel]
-        f = f.reshape(-1, 24)
-        M = sysm.node_transforms(H)
-        if M is not None:
-            T = np.zeros((len(sel), 24, 24))
-            for j in range(4):
-                T[:, 6 * j:6 * j + 6, 6 * j:6 * j + 6] = M[nodes[:, j]]
-            Tt = np.swapaxes(T, 1, 2)
-            f = np.einsum("nij,nj->ni", Tt, f)
-            if tangent:
-                K = Tt @ K @ T
-        dofs = ((6 * sysm.rep[nodes])[:, :, None] + np.arange(6)).reshape(-1, 24)
-        r -= np.bincount(dofs.ravel(), weights=f.ravel(), minlength=ndof)
-        coo = empty
-        if tangent:
-            rows = np.repeat(dofs, 24, axis=1).ravel()
-            cols = np.tile(dofs, (1, 24)).ravel()
-            coo = (rows, cols, -K.ravel())
-        fl = np.abs(f.reshape(-1, 4, 6)[:, :, :3]).max(initial=0.0)
-        ml = np.abs(f.reshape(-1, 4, 6)[:, :, 3:]).max(initial=0.0)
-        info = dict(n_active=len(sel), f_level=fl, m_level=ml)
-        self._lap("scatter")
-        return r, coo, info
+        b = Blocks(P.nodes[sel], -f.reshape(-1, 24), -K if tangent else None)
+        self._lap("blocks")
+        return b, dict(n_active=len(sel))
 
     # ------------------------------------------------------------ per step
     def begin_step(self, H, t):
@@ -584,6 +577,18 @@ class ContactSystem:
             if not fric.any():
                 out["slip"] = np.zeros((len(sel), 2))
         return P, sel, (p, out)
+
+    def repeat_step(self, H):
+        """The outer iteration of ``problem.Problem``: an augmented-Lagrangian update (``augment``)."""
+        return self.augment(H)
+
+    def unmet(self, t):
+        """Why the last step may not be accepted (penetration above the tolerance after
+        ``MAX_AUGMENT`` updates), or ``None``."""
+        if not getattr(self, "unmet_tolerance", None):
+            return None
+        return (f"augmented Lagrangian: after {self._augments} updates the penetration "
+                f"is {self.unmet_tolerance:.3g} times the requested tolerance at t = {t:.6g}")
 
     def augment(self, H):
         """Augmented-Lagrangian update; True when the step must be re-solved.
