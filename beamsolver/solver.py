@@ -23,6 +23,7 @@ from .assembly import System
 from .errors import InputError
 from .failures import DampingStalled, Diverged, NonFinite, NotConverged, RotationLimit, SingularTangent, StepFailed
 from .restart import restart_from
+from .stabilize import from_option as stabilize_option
 from .stepping import Run
 from .validation import check_solve_arguments
 
@@ -165,6 +166,7 @@ class _Newton:
         self.fu, self.fw = np.flatnonzero(fu), np.flatnonzero(~fu)
         self.L_ref = system.length_scale
         self.linsolver = linsolve.Solver()    # solve(linear_solver=...) replaces it
+        self.stabilizer = None                # solve(stabilize=...) sets a stabilize.Stabilization
         self.stall_ratio = np.inf             # correction growth of the shortest damped trial
         self.reset_timings()
 
@@ -246,6 +248,8 @@ class _Newton:
     def _evaluate(self, H, lf, tangent=True):
         t0 = time.perf_counter()
         r, kvals, info = self.sys.evaluate(H, lf, tangent=tangent)
+        if self.stabilizer is not None:
+            r, info = self.stabilizer.add(H, r, info, tangent)
         self.timings["assembly"] += time.perf_counter() - t0
         self.timings["contact"] += info.get("contact_time", 0.0)
         if not np.all(np.isfinite(r)):
@@ -467,7 +471,7 @@ def _starting_point(restart, model, system, t_start, t_end):
 def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dtol=1e-11,
           max_iter=30, line_search=True, min_step_ratio=2.0**-12, callback=None,
           check_rigid_modes=True, verbose=None, initial_poses=None, restart=None, checkpoint=60.0,
-          linear_solver=None, allow_unmet_tolerance=False, check_stability=False):
+          linear_solver=None, allow_unmet_tolerance=False, check_stability=False, stabilize=None):
     """Quasi-static solve of ``model`` from ``t_start`` to ``t_end`` in ``steps`` equal steps.
 
     Every converged (sub)step is recorded in the returned ``Solution``.  Step 0 is
@@ -510,6 +514,11 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     (``StabilityWarning``) on an unstable equilibrium; opt-in: 5-16 % of the
     solve time (``benchmarks/stability_check.py``).
 
+    ``stabilize``: artificial viscous damping in pseudo-time (Abaqus ``*STATIC, STABILIZE``) to pass
+    instabilities under load control: ``True`` (dissipated-energy fraction 2e-4), a fraction, or
+    ``dict(fraction=, factor=, warn=)``; the energy it dissipates is recorded per step in
+    ``stats[k]["stabilization"]`` and warned about above ``warn`` (``beamsolver.stabilize``).
+
     ``Solution.stats[k]["timings"]``: wall time of the step's ``assembly``
     (residuals, tangents, sparse matrices), ``contact`` (part of assembly) and
     ``linear_solve`` (factorisations and solves), in seconds.
@@ -528,6 +537,7 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     conv = Convergence(rtol=rtol, dtol=dtol, max_iter=max_iter)
     newton = _Newton(system, conv, line_search, callback)
     newton.linsolver = linsolve.Solver(linear_solver)
+    newton.stabilizer = stabilize_option(system, stabilize)
     options = dict(allow_unmet_tolerance=allow_unmet_tolerance, check_stability=check_stability,
                    advice=_advice(system, t_start, t_end))
     run = None

@@ -219,7 +219,11 @@ class Run:
         H_target = sys.prescribed_poses(t_next) if len(sys.prescribed_nodes) else None
         if sys.contact is not None:
             sys.contact.begin_step(self.H, t_next)
+        if newton.stabilizer is not None:
+            newton.stabilizer.begin_step(self.H, None if self.t is None else t_next - self.t)
         H, r, info, stats = newton.step(self.H, t_next, H_target, self.t)
+        if newton.stabilizer is not None:
+            newton.stabilizer.check(sys.matrix(*newton.last_tangent), t_next)
         while sys.contact is not None and sys.contact.augment(H):
             H, r, info, more = newton.step(H, t_next, H_target, self.t)
             stats["iterations"] += more["iterations"]
@@ -245,6 +249,8 @@ class Run:
             contact_data = sys.contact.results(H)
         if self.opt.get("check_stability"):
             self._stability(stats, t_next)
+        if self.newton.stabilizer is not None:
+            stats["stabilization"] = self.newton.stabilizer.commit(H, t_next)
         for w in stats.get("warnings", ()):
             sol.message = w if not sol.message else sol.message + "; " + w
         # the stepping state after this step, set together with the step (restart reads both)
