@@ -24,7 +24,7 @@ from .errors import InputError
 from .failures import DampingStalled, Diverged, NonFinite, NotConverged, RotationLimit, SingularTangent, StepFailed
 from .restart import restart_from
 from .stabilize import from_option as stabilize_option
-from .stepping import Run
+from .stepping import Run, sys_conservative
 from .validation import check_solve_arguments
 
 _StepFailed = StepFailed      # the base of the typed failures (``beamsolver.failures``)
@@ -537,7 +537,7 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     conv = Convergence(rtol=rtol, dtol=dtol, max_iter=max_iter)
     newton = _Newton(system, conv, line_search, callback)
     newton.linsolver = linsolve.Solver(linear_solver)
-    newton.stabilizer = stabilize_option(system, stabilize)
+    newton.stabilizer = stabilize_option(system, stabilize, check=sys_conservative(system))
     options = dict(allow_unmet_tolerance=allow_unmet_tolerance, check_stability=check_stability,
                    advice=_advice(system, t_start, t_end))
     run = None

@@ -22,7 +22,9 @@ implicit Euler on the viscous flow ``c M* v = -r``, i.e. a minimiser of the pote
 ``(c / 2 dt) h^T M* h``: a converged step whose stabilised tangent ``K + (c / dt) M*`` is not
 positive definite overshot an unstable mode (it lands on the far side of the unstable
 equilibrium) and is refused (``StabilizedSaddle``, retried with a shorter step, which
-raises ``c / dt``).  ``factor=`` sets ``c`` directly
+raises ``c / dt``).  The check needs a symmetric tangent: ``solve`` makes it only for
+conservative problems (no friction, no follower loads), where the symmetric part of a
+frictional tangent may be indefinite at a stable state.  ``factor=`` sets ``c`` directly
 (active from the first step).  After every step the dissipated energy, its running total and its
 ratio to the beams' strain energy are recorded; a ratio above ``warn`` (default 0.05) warns
 (``StabilizationWarning``): the answer is then polluted by the damping.
@@ -93,8 +95,9 @@ class Stabilization:
     """The damping of one solve: ``begin_step``, ``evaluate`` (residual and COO tangent) and
     ``commit`` (calibration, energies, warning) of the step life cycle."""
 
-    def __init__(self, system, fraction=DEFAULT_FRACTION, factor=None, warn=WARN_FRACTION):
+    def __init__(self, system, fraction=DEFAULT_FRACTION, factor=None, warn=WARN_FRACTION, check=True):
         self.sys = system
+        self.check_saddle = check
         self.nodes = np.flatnonzero(system.is_rep & (system.kind == FREE))
         m = mass_scales(system.rep[system.enodes], system.L, system.C, system.length_scale, system.n_nodes)
         self.m = m[self.nodes]
@@ -142,7 +145,7 @@ class Stabilization:
     def check(self, K, t):
         """Refuse (``StabilizedSaddle``) a converged step whose stabilised tangent ``K`` (free x free,
         its symmetric part) has a negative eigenvalue: the step then minimises nothing."""
-        if not self.active:
+        if not (self.active and self.check_saddle):
             return
         neg, _ = negative_eigenvalues(K)
         if neg:
@@ -182,13 +185,14 @@ class Stabilization:
                     fraction=frac)
 
 
-def from_option(system, stabilize):
+def from_option(system, stabilize, check=True):
     """The ``Stabilization`` of ``solve(stabilize=...)``: ``None``/``False`` (off), ``True`` (fraction
-    ``DEFAULT_FRACTION``), a fraction ``> 0``, or ``dict(fraction=, factor=, warn=)``."""
+    ``DEFAULT_FRACTION``), a fraction ``> 0``, or ``dict(fraction=, factor=, warn=)``; ``check``:
+    refuse saddle steps (``Stabilization.check``)."""
     if stabilize is None or stabilize is False:
         return None
     if stabilize is True:
-        return Stabilization(system)
+        return Stabilization(system, check=check)
     if isinstance(stabilize, dict):
         unknown = set(stabilize) - {"fraction", "factor", "warn"}
         if unknown:
@@ -203,4 +207,4 @@ def from_option(system, stabilize):
         if v is not None and not (isinstance(v, (int, float)) and np.isfinite(v) and v > 0):
             raise InputError(f"solve: stabilize {key} must be a positive number, got {v!r}")
     return Stabilization(system, fraction=opts.get("fraction") or DEFAULT_FRACTION, factor=opts.get("factor"),
-                         warn=opts.get("warn") or WARN_FRACTION)
+                         warn=opts.get("warn") or WARN_FRACTION, check=check)

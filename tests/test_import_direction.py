@@ -23,7 +23,7 @@ LAYER = {
     "element": 2, "element_jit": 2, "contact": 2, "contact.law": 2, "contact.kinematics": 2,
     "contact.pairs": 2, "contact.search": 2, "contact.kernel_jit": 2, "contact.options": 2, "contact.record": 2,
     # 3: model declarations and their assembly
-    "model": 3, "cables": 3, "assembly": 3, "stabilize": 3, "assembly_jit": 3, "contact.system": 3, "linsolve": 3,
+    "model": 3, "cables": 3, "assembly": 3, "stabilize": 3, "topology": 1, "assembly_jit": 3, "contact.system": 3, "linsolve": 3,
     # 5: results
     "results": 5, "restart": 5, "study": 5,
     # 6: solver, its stepping and failure diagnosis, linearisation
