@@ -36,12 +36,13 @@ import numpy as np
 
 from . import element, se3
 from .assembly import FREE
+from .blocks import Blocks, Contribution
 from .definiteness import negative_eigenvalues
 from .errors import InputError, StabilizationWarning
 from .failures import StepFailed
 
-__all__ = ["StabilizedSaddle", "DEFAULT_FRACTION", "WARN_FRACTION", "mass_scales", "increments", "forces", "tangent",
-           "dissipated", "Stabilization", "from_option"]
+__all__ = ["StabilizedSaddle", "DEFAULT_FRACTION", "WARN_FRACTION", "mass_scales", "increments", "forces",
+           "stabilized_tangent", "dissipated", "Stabilization", "from_option"]
 
 log = logging.getLogger("beamsolver")
 
@@ -81,7 +82,7 @@ def forces(h, m, c, dt):
     return (c / dt) * _diagonal(m) * h
 
 
-def tangent(Ti, m, c, dt):
+def stabilized_tangent(Ti, m, c, dt):
     """Their derivative ``(c / dt) M* T(h)^-1`` ``(n, 6, 6)`` with respect to body increments."""
     return (c / dt) * _diagonal(m)[:, :, None] * Ti
 
@@ -91,9 +92,14 @@ def dissipated(h, m, c, dt):
     return float((c / dt) * np.sum(_diagonal(m) * h * h))
 
 
-class Stabilization:
-    """The damping of one solve: ``begin_step``, ``evaluate`` (residual and COO tangent) and
-    ``commit`` (calibration, energies, warning) of the step life cycle."""
+class Stabilization(Contribution):
+    """The damping of one solve as a ``blocks.Contribution`` (one 6x6 block per damped node):
+    ``begin_step`` / ``evaluate`` / ``commit`` of the step life cycle, plus ``check`` (the saddle
+    test of a converged step) and ``record`` (calibration, energies, warning) that ``solve``
+    calls.  ``t_last``: the time of the last converged state (``None``: no step yet)."""
+    name = "stabilization"
+    smooth = True
+    conservative = False          # viscous: no potential
 
     def __init__(self, system, fraction=DEFAULT_FRACTION, factor=None, warn=WARN_FRACTION, check=True):
         self.sys = system
@@ -103,10 +109,7 @@ class Stabilization:
         self.m = m[self.nodes]
         self.fraction, self.warn = fraction, warn
         self.c = 0.0 if factor is None else float(factor)
-        dofs = 6 * self.nodes[:, None] + np.arange(6)
-        self.rows = np.repeat(dofs, 6, axis=1).ravel()
-        self.cols = np.tile(dofs, (1, 6)).ravel()
-        self.H_prev, self.dt = None, None
+        self.H_prev, self.dt, self.t_last, self.t_next = None, None, None, None
         self.total = 0.0
         self.warned = False
 
@@ -114,33 +117,22 @@ class Stabilization:
     def active(self):
         return self.c > 0.0 and self.H_prev is not None and len(self.nodes) > 0
 
-    def begin_step(self, H_prev, dt):
-        """Start a step of size ``dt`` from the converged poses ``H_prev`` (``dt=None``: no step)."""
-        self.H_prev = None if dt is None else H_prev[self.nodes].copy()
-        self.dt = dt
+    def begin_step(self, H, t):
+        """Start the step to ``t`` from the converged poses ``H`` (at ``t_last``)."""
+        self.t_next = t
+        self.dt = None if self.t_last is None else t - self.t_last
+        self.H_prev = None if self.dt is None or self.dt <= 0 else H[self.nodes].copy()
 
-    def evaluate(self, H, tangent_wanted=True):
-        """Viscous residual ``(6 n,)`` and tangent ``(rows, cols, vals)`` (``None`` without tangent)."""
-        r = np.zeros(6 * self.sys.n_nodes)
+    def commit(self, H):
+        self.t_last = self.t_next
+
+    def evaluate(self, H, tangent=True):
+        """``(Blocks, {})``: the viscous forces ``(m, 6)`` and their tangent ``(m, 6, 6)`` per node."""
         if not self.active:
-            return r, None
+            return Blocks.empty(1, tangent), {}
         h, Ti = increments(self.H_prev, H[self.nodes])
-        r[6 * self.nodes[:, None] + np.arange(6)] = forces(h, self.m, self.c, self.dt)
-        if not tangent_wanted:
-            return r, None
-        return r, (self.rows, self.cols, tangent(Ti, self.m, self.c, self.dt).ravel())
-
-    def add(self, H, r, info, tangent_wanted=True):
-        """``r + f_v`` and ``info`` with the tangent appended to ``info["extra"]`` (COO)."""
-        if not self.active:
-            return r, info
-        rv, coo = self.evaluate(H, tangent_wanted)
-        if coo is not None:
-            extra = info.get("extra")
-            if extra is not None and len(extra[2]):
-                coo = tuple(np.concatenate([a, b]) for a, b in zip(extra, coo))
-            info["extra"] = coo
-        return r + rv, info
+        K = stabilized_tangent(Ti, self.m, self.c, self.dt) if tangent else None
+        return Blocks(self.nodes[:, None], forces(h, self.m, self.c, self.dt), K), {}
 
     def check(self, K, t):
         """Refuse (``StabilizedSaddle``) a converged step whose stabilised tangent ``K`` (free x free,
@@ -157,7 +149,7 @@ class Stabilization:
         s = self.sys
         return float(element.energy(H[s.enodes[:, 0]], H[s.enodes[:, 1]], s.L, s.eps0, s.C).sum())
 
-    def commit(self, H, t):
+    def record(self, H, t):
         """After a converged step: calibrate ``c`` if not yet set, account the dissipated energy;
         returns the step's record ``dict(factor, dissipated, dissipated_total, strain_energy,
         fraction)`` (energies in J)."""

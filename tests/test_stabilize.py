@@ -11,6 +11,7 @@ from scipy.special import ellipk
 import beamsolver as bs
 from beamsolver import se3, stabilize
 from beamsolver.assembly import System
+from beamsolver.problem import Problem
 
 
 def _cantilever(n=6):
@@ -21,6 +22,15 @@ def _cantilever(n=6):
     return m, b, sec
 
 
+def _assembled(system, stab, H, tangent=True):
+    """Residual ``(6 n,)`` and dense tangent of the stabilisation through the generic assembler."""
+    blocks, _ = stab.evaluate(H, tangent)
+    r, (rows, cols, vals), _, _ = system.assemble_blocks(H, blocks)
+    K = np.zeros((len(r), len(r)))
+    np.add.at(K, (rows, cols), vals)
+    return r, K
+
+
 def test_viscous_tangent_matches_finite_differences():
     m, b, _ = _cantilever()
     system = System(m)
@@ -28,10 +38,10 @@ def test_viscous_tangent_matches_finite_differences():
     stab = stabilize.Stabilization(system, factor=0.7)
     H_prev = system.update(system.poses0, 0.2 * rng.standard_normal((system.n_nodes, 6)))
     H = system.update(H_prev, 0.3 * rng.standard_normal((system.n_nodes, 6)))
-    stab.begin_step(H_prev, 0.05)
-    r, (rows, cols, vals) = stab.evaluate(H)
-    K = np.zeros((6 * system.n_nodes, 6 * system.n_nodes))
-    np.add.at(K, (rows, cols), vals)
+    stab.t_last = 0.3
+    stab.begin_step(H_prev, 0.35)
+    assert stab.dt == pytest.approx(0.05)
+    r, K = _assembled(system, stab, H)
     eps = 1e-6
     for node in stab.nodes:
         for k in range(6):
@@ -40,7 +50,7 @@ def test_viscous_tangent_matches_finite_differences():
             Hp, Hm = H.copy(), H.copy()
             Hp[node] = H[node] @ se3.exp(e)
             Hm[node] = H[node] @ se3.exp(-e)
-            fd = (stab.evaluate(Hp, False)[0] - stab.evaluate(Hm, False)[0]) / (2 * eps)
+            fd = (_assembled(system, stab, Hp, False)[0] - _assembled(system, stab, Hm, False)[0]) / (2 * eps)
             col = K[:, 6 * node + k]
             assert np.abs(fd - col).max() <= 1e-7 * np.abs(K).max()
     # the force is c M* log(H_prev^-1 H) / dt, zero at nodes without damping (the clamp)
@@ -101,12 +111,14 @@ def test_column_past_buckling_reaches_the_elastica_with_stabilisation():
 
 def test_saddle_step_is_refused():
     m, b = _column(2.0)
-    system = System(m)
-    stab = stabilize.Stabilization(system, factor=1e-12)
-    stab.begin_step(system.poses0, 1.0)
-    r, kvals, info = system.evaluate(system.poses0, np.array([1.0]))
+    problem = Problem.from_model(m)
+    stab = stabilize.Stabilization(problem.system, factor=1e-12)
+    problem.contributions.append(stab)
+    stab.t_last = 0.0
+    problem.begin_step(problem.system.poses0, 1.0)
+    ev = problem.evaluate(problem.system.poses0, 1.0)
     with pytest.raises(stabilize.StabilizedSaddle, match="too weak"):
-        stab.check(system.matrix(kvals, info["extra"]), 1.0)
+        stab.check(problem.tangent(ev), 1.0)
 
 
 @pytest.mark.parametrize("bad", ["yes", -1e-3, 0.0, dict(fraction=-1), dict(fractoin=1e-3), dict(factor=np.nan)])
