@@ -34,6 +34,7 @@ from beamsolver import topology
 
 R, LENGTH, PULL = 0.5e-3, 0.02, 5.0
 GREENHILL = 8.99             # M L / B of a clamped-clamped rod at the onset of buckling
+LK_MIN = 0.1                 # Lk = Tw + Wr is checked (relative error) from this many turns on
 solve_options = dict(steps=80, stabilize=2e-3)   # for `beamsolver run examples/plectoneme.py`
 
 
@@ -125,9 +126,10 @@ def main(output=None, turns=5.0, steps=80, n_elements=16, mu=0.0, stabilize=2e-3
     print("| " + " | ".join(COLUMNS) + " |")
     print("|" + "---:|" * len(COLUMNS))
     for lk, tq, z, tw, wr, err, fw, fd, nc, it in rows:
-        print(f"| {lk:.4f} | {tq:.4g} | {z:.3f} | {tw:.4f} | {wr:.4f} | {err:.2e} | {fw:.3f} | {fd:.2e} | {nc} | {it} |")
+        print(f"| {lk:.4f} | {tq:.4g} | {z:.3f} | {tw:.4f} | {wr:.4f} | {err:.2e} | {fw:.3f} | {fd:.2e} | {nc} "
+              f"| {it} |")
     B = 2.0 * model.beams[0].section.C[4, 4]
-    worst = max(r[5] for r in rows if r[0] >= 0.1 * turns) if any(r[0] >= 0.1 * turns for r in rows) else np.nan
+    worst = max((r[5] for r in rows if r[0] >= LK_MIN), default=np.nan)     # relative error: Lk not near 0
     tw_c, m_c = onset(rows)
     checks = dict(reached=turns * sol.times[-1], lk_error=worst, onset_turns=tw_c, onset_torque=m_c,
                   onset_ratio=m_c * LENGTH / B, wall=wall, writhe=rows[-1][6])
