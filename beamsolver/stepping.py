@@ -22,7 +22,7 @@ import warnings
 
 import numpy as np
 
-from . import diagnosis, motion_path
+from . import branching, diagnosis, motion_path
 from .definiteness import negative_eigenvalues
 from .errors import ConvergenceError, InputError, StabilityWarning
 from .failures import AugmentationFailed, MotionTooFast, NonFinite, StepFailed
@@ -213,13 +213,15 @@ class Run:
                 t_next = t + h
                 self.easy = 0
 
-    def _newton_step(self, t_next):
-        """Newton at ``t_next``, then augmented-Lagrangian updates until the contact tolerance holds."""
+    def _newton_step(self, t_next, start=None):
+        """Newton at ``t_next`` (from the last converged state, or from ``start`` at ``t_next``), then
+        augmented-Lagrangian updates until the contact tolerance holds."""
         sys, newton = self.sys, self.newton
         H_target = sys.prescribed_poses(t_next) if len(sys.prescribed_nodes) else None
         if sys.contact is not None:
             sys.contact.begin_step(self.H, t_next)
-        H, r, info, stats = newton.step(self.H, t_next, H_target, self.t)
+        H0, t_prev = (self.H, self.t) if start is None else (start, t_next)
+        H, r, info, stats = newton.step(H0, t_next, H_target, t_prev)
         while sys.contact is not None and sys.contact.augment(H):
             H, r, info, more = newton.step(H, t_next, H_target, self.t)
             stats["iterations"] += more["iterations"]
@@ -240,11 +242,11 @@ class Run:
     def _record(self, t_next, H, r, info, stats):
         sys, sol = self.sys, self.sol
         contact_data = None
+        if self.opt.get("check_stability"):
+            H, r, info = self._stability(stats, t_next, H, r, info)
         if sys.contact is not None:
             sys.contact.commit(H)
             contact_data = sys.contact.results(H)
-        if self.opt.get("check_stability"):
-            self._stability(stats, t_next)
         for w in stats.get("warnings", ()):
             sol.message = w if not sol.message else sol.message + "; " + w
         # the stepping state after this step, set together with the step (restart reads both)
@@ -269,15 +271,22 @@ class Run:
         """The failed-size memory of ``next_step`` for ``resume`` (JSON: no inf)."""
         return dict(failed=None if not np.isfinite(self.failed) else float(self.failed), wait=int(self.wait))
 
-    def _stability(self, stats, t):
-        """Record whether the tangent at the converged state is positive definite; warn once."""
+    def _stability(self, stats, t, H, r, info):
+        """Record whether the tangent at the converged state ``H`` is positive definite, its lowest
+        modes (``modes``) and, with ``branch_switching``, move onto a stable branch
+        (``branching.switch``); warn once.  Returns the state to record ``(H, r, info)``."""
         sys = self.sys
         if not sys_conservative(sys):
             stats.update(stable=None)
-            return
-        kvals, extra = self.newton.last_tangent
-        neg, lowest = negative_eigenvalues(sys.matrix(kvals, extra))
+            return H, r, info
+        K = sys.matrix(*self.newton.last_tangent)
+        neg, lowest = negative_eigenvalues(K)
         stats.update(stable=neg == 0, negative_eigenvalues=neg, lowest_eigenvalue=lowest)
+        if branching.wanted(self.opt.get("branch_switching"), self.sol.stats, neg):
+            H, r, info, K = branching.switch(self, stats, t, H, r, info, K)
+        if self.opt.get("modes"):
+            branching.record_modes(sys, stats, H, K, self.opt["modes"])
+        neg = stats["negative_eigenvalues"]
         if neg and not self.warned_unstable:
             self.warned_unstable = True
             text = (f"t = {t:.6g}: the equilibrium is unstable (the tangent has {neg} negative "
@@ -285,6 +294,7 @@ class Run:
             log.warning(text)
             warnings.warn(text, StabilityWarning, stacklevel=5)
             self.sol.message = text if not self.sol.message else self.sol.message + "; " + text
+        return H, r, info
 
     # ------------------------------------------------------------------ end
     def _stop(self, failure, rotation_limit):

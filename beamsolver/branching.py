@@ -1,0 +1,110 @@
+"""The stepping's hook for critical modes and branch switching (``solve(modes=, branch_switching=)``).
+
+``wanted`` decides from the counts of negative eigenvalues whether to switch
+at a converged step; ``switch`` moves the state onto a stable branch at the
+same load (``bifurcation.descend``, then the solver's Newton) and records
+what it did in the step's ``stats["branch_switch"]``; ``record_modes`` stores
+the lowest modes of the recorded state (``stats["mode_eigenvalues"]``,
+``stats["modes"]``).
+"""
+import logging
+import warnings
+
+import numpy as np
+
+from . import bifurcation, linsolve
+from .errors import StabilityWarning
+from .failures import StepFailed, SingularTangent
+from .modes import lowest_modes
+from .definiteness import negative_eigenvalues
+
+__all__ = ["wanted", "switch", "record_modes", "OPTIONS"]
+
+log = logging.getLogger("beamsolver")
+
+OPTIONS = (False, True, "auto")
+
+
+def wanted(option, recorded, negative):
+    """Switch at a step with ``negative`` negative eigenvalues?  ``True``: whenever there are some;
+    ``"auto"``: when the count went up since the last recorded step (``recorded``: its stats)."""
+    if not option or not negative:
+        return False
+    if option == "auto":
+        return bifurcation.crossing(recorded[-1].get("negative_eigenvalues") if recorded else None, negative)
+    return True
+
+
+def record_modes(system, stats, H, K, k):
+    """``stats["mode_eigenvalues"]`` ``(k,)`` and ``stats["modes"]`` ``(k, n, 6)``: the lowest eigenpairs
+    of ``K`` at ``H`` as global node displacements and rotations, each of unit size."""
+    lam, phi = lowest_modes(K, k)
+    twists = [bifurcation.normalise(system, bifurcation.node_twists(system, H, bifurcation.full_increments(system, p)))
+              for p in phi.T]
+    stats.update(mode_eigenvalues=[float(x) for x in lam], modes=[t for t in twists])
+
+
+def _factorize(K):
+    try:
+        return linsolve.Solver().factorize(K)
+    except linsolve.SingularMatrixError as e:
+        raise SingularTangent(f"branch switching: singular shifted tangent ({e})") from None
+
+
+def _descend(run, t, H, K):
+    """``bifurcation.descend`` from ``H`` along the lowest mode of ``K``; ``(H, steps, lam)``."""
+    sys, newton = run.sys, run.newton
+    lf = sys.load_factors(t) if len(sys.load_scales) else np.zeros(0)
+    lam, phi = lowest_modes(K, 1)
+    direction = bifurcation.normalise(sys, bifurcation.full_increments(sys, phi[:, 0])).ravel()[sys.free_dofs]
+
+    def evaluate(H):
+        r, kvals, info = newton._evaluate(H, lf)
+        return r[sys.free_dofs], sys.matrix(kvals, info["extra"])
+
+    def update(H, dzf):
+        return sys.update(H, bifurcation.full_increments(sys, dzf))
+
+    H1, steps = bifurcation.descend(evaluate, _factorize, update,
+                                    lambda dzf: bifurcation.size(sys, bifurcation.full_increments(sys, dzf)),
+                                    H, direction)
+    return H1, steps, float(lam[0])
+
+
+def switch(run, stats, t, H, r, info, K):
+    """Move the unstable state ``H`` at ``t`` onto a stable branch; returns ``(H, r, info, K)`` of the
+    state to record (the old one if switching failed, with a warning)."""
+    sys = run.sys
+    record = dict(mode=1, amplitude=bifurcation.AMPLITUDE, negative_before=stats["negative_eigenvalues"])
+    try:
+        H1, steps, lam = _descend(run, t, H, K)
+        H1, r1, info1, more = run._newton_step(t, start=H1)
+        K1 = sys.matrix(*run.newton.last_tangent)
+        neg, lowest = negative_eigenvalues(K1)
+    except StepFailed as e:
+        record.update(failed=str(e))
+        _warn(run, f"t = {t:.6g}: branch switching failed ({e}); the state stays on the unstable branch")
+        stats["branch_switch"] = record
+        return H, r, info, K
+    record.update(eigenvalue=lam, descent_steps=steps, iterations=more["iterations"], negative_after=neg,
+                  distance=float(bifurcation.size(sys, _distance(sys, H, H1))))
+    stats.update(branch_switch=record, stable=neg == 0, negative_eigenvalues=neg, lowest_eigenvalue=lowest)
+    log.info("t = %.6g: switched branch along mode 1 (eigenvalue %.3g) in %d descent steps; %d negative "
+             "eigenvalue(s) left", t, lam, steps, neg)
+    if neg:
+        _warn(run, f"t = {t:.6g}: after branch switching the tangent still has {neg} negative eigenvalue(s): "
+                   "the state is not stable")
+    return H1, r1, info1, K1
+
+
+def _distance(system, H0, H1):
+    """Translations ``(n, 6)`` (rotation part 0) between two states, for the unit-free size of the move."""
+    d = np.zeros((system.n_nodes, 6))
+    d[:, :3] = H1[:, :3, 3] - H0[:, :3, 3]
+    return d
+
+
+def _warn(run, text):
+    log.warning(text)
+    warnings.warn(text, StabilityWarning, stacklevel=6)
+    run.sol.message = text if not run.sol.message else run.sol.message + "; " + text
