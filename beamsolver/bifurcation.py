@@ -13,34 +13,30 @@ gives the first-order motion of *every* node (joined and constrained ones
 included) along ``dz`` in global axes: displacement ``(3)`` and rotation
 vector ``(3)`` per node, ``(n, 6)``.
 
-Branch switching (``descend``): the state ``H`` on the unstable branch is
-perturbed to ``H exp(AMPLITUDE phi)`` (``phi`` normalised: the largest
-translation is ``AMPLITUDE`` times the model size, or the largest rotation
-``AMPLITUDE`` rad) and iterated at the same load with a shifted tangent,
-``(K + sigma diag|K|) dz = -r`` with ``sigma = SHIFT_FACTOR max(-lam_min, 0)``
-(``lam_min`` the lowest eigenvalue of the scaled pencil).  With a
-conservative problem ``r`` is the gradient of the potential energy and the
-shifted matrix is positive definite, so ``dz`` descends the energy: along the
-unstable mode the perturbation doubles per iteration instead of being
-undone, as plain Newton does (it is attracted back to the saddle).  Steps are
-capped at size ``TRUST``; once the tangent is positive definite and a full
-step is below ``HANDOVER``, the state is handed back to the solver's Newton.
+Branch switching (``descend``): from the state ``H`` on the unstable branch
+the amplitude ``a`` along the normalised critical mode ``phi`` is raised,
+starting at ``AMPLITUDE`` (the largest translation ``AMPLITUDE`` times the
+model size, or the largest rotation ``AMPLITUDE`` rad), at the same load; at
+each amplitude the other unknowns are relaxed, and the energy along the way,
+``Pi(a)``, is minimised: its slope and curvature come from the relaxed state's
+residual and the tangent bordered with the amplitude constraint.  Plain Newton
+from ``H exp(AMPLITUDE phi)`` would be attracted back to the saddle, in
+particular for a beam held at both ends, whose perturbation stretches it.
 """
 import numpy as np
 import scipy.sparse as sp
 
-from .definiteness import ZERO
 from .failures import StepFailed
-from .modes import lowest_modes
 
-__all__ = ["crossing", "full_increments", "size", "normalise", "node_twists", "descend",
-           "AMPLITUDE", "TRUST", "SHIFT_FACTOR", "HANDOVER", "DESCENT_MAX"]
+__all__ = ["crossing", "full_increments", "size", "normalise", "node_twists", "descend", "AMPLITUDE", "TRUST",
+           "HANDOVER", "DESCENT_MAX"]
 
 AMPLITUDE = 0.01     # first perturbation along the normalised critical mode (unit-free size)
-TRUST = 0.1          # largest size of one descent step
-SHIFT_FACTOR = 2.0   # sigma = SHIFT_FACTOR |lam_min|: the unstable component doubles per step
-HANDOVER = 0.01      # positive definite and a full step below this size: the solver's Newton takes over
-DESCENT_MAX = 200    # most descent steps
+TRUST = 0.1          # largest change of the amplitude per descent step
+HANDOVER = 1e-3      # a Newton step in the amplitude below this: the solver's Newton takes over
+DESCENT_MAX = 100    # most amplitudes tried
+RELAX_TOL = 1e-8     # size of the last relaxation step at a fixed amplitude
+RELAX_MAX = 30       # most relaxation iterations per amplitude
 
 
 def crossing(previous, current):
@@ -86,33 +82,63 @@ def node_twists(system, H, dz):
     return np.concatenate([np.einsum("nij,nj->ni", R, xi[:, :3]), np.einsum("nij,nj->ni", R, xi[:, 3:])], axis=1)
 
 
-def _shifted(K, sigma):
-    """``K + sigma |diag K_s|`` (``K_s`` the symmetric part; zero diagonal entries count as 1)."""
-    K = sp.csc_matrix(K)
-    d = np.abs(K.diagonal())
-    d[d == 0.0] = 1.0
-    return K + sigma * sp.diags(d, format="csc")
+def _bordered(K, w):
+    """``[[K, w], [w^T, 0]]``: the tangent with the amplitude constraint ``w . dz = 0`` (CSC)."""
+    w = sp.csc_matrix(np.asarray(w, dtype=float)[:, None])
+    return sp.bmat([[sp.csc_matrix(K), w], [w.T, None]], format="csc")
 
 
-def descend(evaluate, factorize, update, scaled_size, H, direction):
-    """Leave an unstable equilibrium ``H`` along ``direction`` (free unknowns, normalised).
-
-    ``evaluate(H) -> (r, K)``: free residual and tangent; ``factorize(K)`` an object with
-    ``solve(rhs)``; ``update(H, dz_free) -> H``; ``scaled_size(dz_free)`` the unit-free size.
-    Returns ``(H, steps)`` once the tangent is positive definite and a full step is below
-    ``HANDOVER``; raises ``StepFailed`` after ``DESCENT_MAX`` steps or on a non-finite state.
-    """
-    H = update(H, AMPLITUDE * direction)
-    for step in range(1, DESCENT_MAX + 1):
+def _relax(evaluate, factorize, update, scaled_size, H, w):
+    """Newton iterations at a fixed amplitude (``w . dz = 0``), each at most ``TRUST`` long, to
+    ``RELAX_TOL``; ``(H, r, K)``."""
+    for _ in range(RELAX_MAX):
         r, K = evaluate(H)
-        lam = lowest_modes(K, 1)[0]
-        lam = float(lam[0]) if len(lam) else 0.0
-        sigma = SHIFT_FACTOR * -lam if lam < -ZERO else 0.0
-        dz = factorize(_shifted(K, sigma) if sigma > 0 else K).solve(-r)
+        lu = factorize(_bordered(K, w))
+        dz = lu.solve(np.append(-r, 0.0))[:-1]
         if not np.all(np.isfinite(dz)):
-            raise StepFailed("branch switching: the shifted tangent gave a non-finite step")
+            raise StepFailed("branch switching: non-finite step at a fixed amplitude")
         s = scaled_size(dz)
-        if sigma == 0.0 and s <= HANDOVER:
-            return update(H, dz), step
-        H = update(H, dz * min(1.0, TRUST / s) if s > 0 else dz)
-    raise StepFailed(f"branch switching: no stable state within {DESCENT_MAX} descent steps")
+        if s > TRUST:
+            dz = dz * (TRUST / s)
+        H = update(H, dz)
+        if s <= RELAX_TOL:
+            r, K = evaluate(H)
+            return H, r, K
+    raise StepFailed(f"branch switching: no equilibrium at a fixed amplitude within {RELAX_MAX} iterations")
+
+
+def descend(evaluate, factorize, update, scaled_size, H, direction, weights):
+    """Leave an unstable equilibrium ``H`` along ``direction`` ``phi`` (free unknowns, size 1).
+
+    The amplitude ``a`` along ``phi`` is the control: each step moves by ``da phi`` and relaxes
+    the other unknowns with ``w . dz = 0``, ``w = weights * phi`` (``_relax``: Newton with the
+    constraint bordered to the tangent; a perturbation alone would stretch a beam held at both
+    ends, and its tension would pull Newton back to the saddle).  At the relaxed state
+    ``r = -mu w``: the energy's slope is ``dPi/da = phi . r`` and its curvature
+    ``c^2 / (w . K^-1 w)``, ``c = w . phi`` (the bordered solve of ``(0, c)``), which give a
+    Newton step in ``a``; where the curvature is not positive the amplitude doubles instead
+    (downhill, away from the saddle).  Steps are capped at ``TRUST``.  Returns ``(H, steps)``
+    once a Newton step in ``a`` is below ``HANDOVER`` (the state then is the equilibrium
+    within Newton's reach); raises ``StepFailed`` after ``DESCENT_MAX`` steps.
+    ``evaluate(H) -> (r, K)`` free residual and tangent; ``factorize(A)`` an object with
+    ``solve(rhs)``; ``update(H, dz_free) -> H``; ``scaled_size(dz_free)`` the unit-free size.
+    """
+    phi = np.asarray(direction, dtype=float)
+    weights = np.asarray(weights, dtype=float)
+    a, da = 0.0, AMPLITUDE
+    for step in range(1, DESCENT_MAX + 1):
+        H = update(H, da * phi)
+        a += abs(da)
+        w = weights * phi
+        H, r, K = _relax(evaluate, factorize, update, scaled_size, H, w)
+        c = float(w @ phi)
+        slope = float(phi @ r)
+        curvature = -c * float(factorize(_bordered(K, w)).solve(np.append(np.zeros(len(phi)), c))[-1])
+        if curvature > 0.0:
+            da = -slope / curvature
+            if abs(da) <= HANDOVER:
+                return H, step
+        else:
+            da = -np.sign(slope) * max(a, AMPLITUDE)
+        da = float(np.clip(da, -TRUST, TRUST))
+    raise StepFailed(f"branch switching: no stable state within {DESCENT_MAX} amplitudes")

@@ -18,11 +18,13 @@ from .failures import StepFailed, SingularTangent
 from .modes import lowest_modes
 from .definiteness import negative_eigenvalues
 
-__all__ = ["wanted", "switch", "record_modes", "OPTIONS"]
+__all__ = ["wanted", "switch", "locate", "record_modes", "OPTIONS", "BISECTION"]
 
 log = logging.getLogger("beamsolver")
 
 OPTIONS = (False, True, "auto")
+BISECTION = 1e-3     # the crossing is located to this fraction of the step from the last stable state
+BISECTION_MAX = 40   # most bisections
 
 
 def wanted(option, recorded, negative):
@@ -51,11 +53,18 @@ def _factorize(K):
         raise SingularTangent(f"branch switching: singular shifted tangent ({e})") from None
 
 
-def _descend(run, t, H, K):
-    """``bifurcation.descend`` from ``H`` along the lowest mode of ``K``; ``(H, steps, lam)``."""
+def _weights(system):
+    """The metric of ``bifurcation.size`` on the free unknowns: ``1 / L_ref^2`` for translations, 1 for rotations."""
+    w = np.ones((system.n_nodes, 6))
+    w[:, :3] = 1.0 / system.length_scale**2
+    return w.ravel()[system.free_dofs]
+
+
+def _descend(run, t, H, K, K_mode):
+    """``bifurcation.descend`` from ``H`` along the lowest mode of ``K_mode``; ``(H, steps, lam)``."""
     sys, newton = run.sys, run.newton
     lf = sys.load_factors(t) if len(sys.load_scales) else np.zeros(0)
-    lam, phi = lowest_modes(K, 1)
+    lam, phi = lowest_modes(K_mode, 1)
     direction = bifurcation.normalise(sys, bifurcation.full_increments(sys, phi[:, 0])).ravel()[sys.free_dofs]
 
     def evaluate(H):
@@ -67,17 +76,44 @@ def _descend(run, t, H, K):
 
     H1, steps = bifurcation.descend(evaluate, _factorize, update,
                                     lambda dzf: bifurcation.size(sys, bifurcation.full_increments(sys, dzf)),
-                                    H, direction)
+                                    H, direction, _weights(sys))
     return H1, steps, float(lam[0])
+
+
+def locate(run, t, K, before):
+    """Bisect the step ``run.t -> t`` for the first load where the count of negative eigenvalues
+    exceeds ``before`` (to ``BISECTION`` of the step); returns ``(t_c, K_c)`` there (the step's
+    end and ``K`` if no bisection converged).  The solver's state is left as it was."""
+    t_a, found = run.t, (t, K)
+    for _ in range(BISECTION_MAX):
+        t_b = found[0]
+        if t_b - t_a <= BISECTION * (t_b - run.t):
+            break
+        t_m = 0.5 * (t_a + t_b)
+        try:
+            run._newton_step(t_m)
+        except StepFailed:
+            break
+        K_m = run.sys.matrix(*run.newton.last_tangent)
+        if negative_eigenvalues(K_m)[0] > before:
+            found = (t_m, K_m)
+        else:
+            t_a = t_m
+    return found
 
 
 def switch(run, stats, t, H, r, info, K):
     """Move the unstable state ``H`` at ``t`` onto a stable branch; returns ``(H, r, info, K)`` of the
-    state to record (the old one if switching failed, with a warning)."""
+    state to record (the old one if switching failed, with a warning).  Where the count of
+    negative eigenvalues went up over the step, the direction is the lowest mode at the first
+    load past the crossing (``locate``): the mode that went unstable first, not the lowest at
+    ``t`` when the step passed several critical loads."""
     sys = run.sys
+    before = (run.sol.stats[-1].get("negative_eigenvalues") or 0) if run.sol.stats else 0
     record = dict(mode=1, amplitude=bifurcation.AMPLITUDE, negative_before=stats["negative_eigenvalues"])
     try:
-        H1, steps, lam = _descend(run, t, H, K)
+        t_c, K_c = locate(run, t, K, before) if stats["negative_eigenvalues"] > before else (t, K)
+        H1, steps, lam = _descend(run, t, H, K, K_c)
         H1, r1, info1, more = run._newton_step(t, start=H1)
         K1 = sys.matrix(*run.newton.last_tangent)
         neg, lowest = negative_eigenvalues(K1)
@@ -86,11 +122,11 @@ def switch(run, stats, t, H, r, info, K):
         _warn(run, f"t = {t:.6g}: branch switching failed ({e}); the state stays on the unstable branch")
         stats["branch_switch"] = record
         return H, r, info, K
-    record.update(eigenvalue=lam, descent_steps=steps, iterations=more["iterations"], negative_after=neg,
-                  distance=float(bifurcation.size(sys, _distance(sys, H, H1))))
+    record.update(critical_t=t_c, eigenvalue=lam, descent_steps=steps, iterations=more["iterations"],
+                  negative_after=neg, distance=float(bifurcation.size(sys, _distance(sys, H, H1))))
     stats.update(branch_switch=record, stable=neg == 0, negative_eigenvalues=neg, lowest_eigenvalue=lowest)
-    log.info("t = %.6g: switched branch along mode 1 (eigenvalue %.3g) in %d descent steps; %d negative "
-             "eigenvalue(s) left", t, lam, steps, neg)
+    log.info("t = %.6g: switched branch along mode 1 (eigenvalue %.3g at t = %.6g) in %d descent steps; %d "
+             "negative eigenvalue(s) left", t, lam, t_c, steps, neg)
     if neg:
         _warn(run, f"t = {t:.6g}: after branch switching the tangent still has {neg} negative eigenvalue(s): "
                    "the state is not stable")

@@ -66,3 +66,166 @@ def test_slender_straight_column_beyond_euler_is_unstable_whatever_the_mesh():
     with pytest.warns(bs.StabilityWarning, match="unstable"):
         sol = bs.solve(m, steps=2, verbose=False, check_stability=True)
     assert sol.stats[2]["stable"] is False and sol.stats[2]["negative_eigenvalues"] == 2
+
+
+# ------------------------------------------------------------------ modes: the eigenpairs and their node fields
+@pytest.mark.parametrize("n", [40, DENSE_MAX + 100])
+def test_lowest_modes_are_the_scaled_pencil_eigenpairs(n):
+    """Dense (LAPACK) and sparse (shifted Lanczos) paths against ``eigh(K, diag|K|)``, with two small
+    negative eigenvalues and diagonal scales spread over six decades."""
+    rng = np.random.default_rng(7)
+    lap = sp.diags([-np.ones(n - 1), 2.0 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1])
+    lam_min = 2.0 - 2.0 * np.cos(np.pi / (n + 1))
+    B = lap - sp.identity(n) * (2.0 - 2.0 * np.cos(2.5 * np.pi / (n + 1)))   # two eigenvalues < 0
+    assert lam_min < 2.0 - 2.0 * np.cos(2.5 * np.pi / (n + 1))
+    S = sp.diags(10.0 ** rng.uniform(0, 6, n))
+    K = (S @ B @ S).tocsc()
+    lam, phi = lowest_modes(K, 4)
+    Kd = K.toarray()
+    M = np.diag(np.abs(np.diag(Kd)))
+    from scipy.linalg import eigh
+    ref = eigh(Kd, M, eigvals_only=True)[:4]
+    np.testing.assert_allclose(lam, ref, rtol=1e-8, atol=1e-12)
+    assert np.sum(lam < 0) == 2
+    np.testing.assert_allclose(Kd @ phi, M @ phi * lam, atol=1e-8 * np.abs(Kd).max())
+    np.testing.assert_allclose(phi.T @ M @ phi, np.eye(4), atol=1e-8)
+
+
+def _joined_model():
+    """A clamped beam (a chain), a beam joined to it and a partially fixed node (global increments)."""
+    m = bs.Model()
+    sec = _section()
+    a = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 4), sec)
+    b = m.add_beam(bs.geometry.arc(2.0, 0.5, 4), sec)
+    c = m.add_beam(bs.geometry.straight((1, 0, 0), (1, 1, 0), 3), sec)
+    m.clamp(a.first)
+    m.join(a.last, c.first)
+    m.clamp(b.first)
+    m.fix(c.last, dofs=("uz",))
+    return m
+
+
+def test_node_twists_are_the_first_order_motion_of_every_node(rng):
+    system = System(_joined_model())
+    assert system.chains and len(system.members) and len(system.global_nodes)
+    H = system.update(system.poses0, bifurcation.full_increments(system, 0.1 * rng.standard_normal(system.n_free)))
+    dz = bifurcation.full_increments(system, rng.standard_normal(system.n_free))
+    tw = bifurcation.node_twists(system, H, dz)
+    eps = 1e-6
+    Hp, Hm = system.update(H, eps * dz), system.update(H, -eps * dz)
+    du = (Hp[:, :3, 3] - Hm[:, :3, 3]) / (2 * eps)
+    dR = (Hp[:, :3, :3] - Hm[:, :3, :3]) / (2 * eps) @ np.swapaxes(H[:, :3, :3], 1, 2)   # skew(omega)
+    dw = np.stack([dR[:, 2, 1], dR[:, 0, 2], dR[:, 1, 0]], axis=1)
+    np.testing.assert_allclose(tw[:, :3], du, atol=1e-7)
+    np.testing.assert_allclose(tw[:, 3:], dw, atol=1e-7)
+    assert np.abs(tw[system.members]).max() > 0.1            # joined nodes move with their representative
+
+
+def test_normalise_gives_unit_size_and_a_reproducible_sign(rng):
+    system = System(_joined_model())
+    dz = bifurcation.full_increments(system, rng.standard_normal(system.n_free))
+    a, b = bifurcation.normalise(system, dz), bifurcation.normalise(system, -3.0 * dz)
+    assert bifurcation.size(system, a) == pytest.approx(1.0)
+    np.testing.assert_allclose(a, b)
+
+
+def test_euler_mode_and_the_eigenvalue_crossing():
+    """Straight clamped-free column just below / above P_cr: the lowest recorded eigenvalue changes
+    sign, and mode 1 is the Euler mode ``1 - cos(pi x / 2L)`` (lateral)."""
+    rows = []
+    for ratio in (0.97, 1.03):
+        m, b = _cantilever_column(ratio, 16, EI3=1.3)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", bs.StabilityWarning)
+            sol = bs.solve(m, steps=1, verbose=False, modes=2)
+        lam, modes = sol.modes(-1)
+        assert modes.shape == (2, m.n_nodes, 6)
+        rows.append((lam, modes[0], sol.stats[-1]["negative_eigenvalues"]))
+    (lo, mode, neg_lo), (hi, _, neg_hi) = rows
+    assert lo[0] > 0 > hi[0] and neg_lo == 0 and neg_hi == 1 and lo[1] > 0 and hi[1] > 0
+    x = np.linspace(0, 1, 17)
+    w = np.hypot(mode[:, 1], mode[:, 2])
+    np.testing.assert_allclose(w / w[-1], 1.0 - np.cos(np.pi * x / 2.0), atol=2e-3)
+    assert np.abs(mode[:, 0]).max() < 1e-6                        # no axial part
+    assert bifurcation.size(System(m), mode) == pytest.approx(1.0)
+
+
+# ------------------------------------------------------------------ branch switching vs the elastica
+@pytest.mark.parametrize("ratio", [1.5, 2.5, 4.0])
+def test_clamped_free_elastica_after_branch_switching(ratio):
+    """From the straight column, no imperfection, load in steps: 'auto' switches once, where the
+    negative count goes up, and the path ends on the elastica (tip x, deflection, rotation)."""
+    m, b = _cantilever_column(ratio, 16)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", bs.StabilityWarning)
+        sol = bs.solve(m, steps=8, verbose=False, branch_switching="auto")
+    switched = [k for k, s in enumerate(sol.stats) if "branch_switch" in s]
+    assert len(switched) == 1
+    rec = sol.stats[switched[0]]["branch_switch"]
+    assert rec["negative_before"] >= 1 and rec["negative_after"] == 0 and rec["mode"] == 1
+    assert sol.times[switched[0]] * ratio > 1.0 >= sol.times[switched[0] - 1] * ratio   # the first step past P_cr
+    assert all(s["stable"] for s in sol.stats[1:])
+    np.testing.assert_allclose(_tip(sol, b.last), elastica_tip(ratio), atol=3e-3)
+
+
+def test_elastica_error_falls_at_second_order():
+    ratio, errors, ns = 2.0, [], (4, 8, 16)
+    exact = elastica_tip(ratio)
+    for n in ns:
+        m, b = _cantilever_column(ratio, n)
+        sol = bs.solve(m, steps=2, verbose=False, branch_switching="auto")
+        errors.append(np.abs(_tip(sol, b.last) - exact))
+    errors = np.array(errors)
+    for j, name in enumerate(("x", "alpha")):
+        rate = -np.polyfit(np.log(ns), np.log(errors[:, 2 * j]), 1)[0]
+        assert 1.8 < rate < 2.3, (name, rate, errors[:, 2 * j])
+
+
+def _pinned_column(n=16):
+    m = bs.Model()
+    b = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), n), _section(EI3=3.0))
+    m.fix(b.first, dofs=("ux", "uy", "uz", "rx"))
+    return m, b
+
+
+def _pinned_reference(k):
+    """Pinned-pinned elastica (L = 1): ``(P / P_cr, midspan deflection, shortening, end rotation)``."""
+    K, E = ellipk(k * k), ellipe(k * k)
+    return (2.0 * K / np.pi) ** 2, k / K, 2.0 - 2.0 * E / K, 2.0 * np.arcsin(k)
+
+
+def _pinned_measures(sol, b):
+    mid = b.nodes[len(b.nodes) // 2]
+    x, R = sol.position(mid), sol.rotation(b.last)
+    return np.hypot(x[1], x[2]), 1.0 - sol.position(b.last)[0], np.arccos(np.clip(R[0, 0], -1.0, 1.0))
+
+
+def test_pinned_column_under_load_after_branch_switching():
+    ratio = 1.8
+    m, b = _pinned_column()
+    m.fix(b.last, dofs=("uy", "uz"))
+    m.add_load(b.last, force=(-ratio * np.pi**2 * EI, 0.0, 0.0))
+    sol = bs.solve(m, steps=4, verbose=False, branch_switching="auto")
+    _, mid, short, alpha = _pinned_reference(elastica_k(ratio))
+    # each half is a clamped-free column on 8 elements, whose discretisation error is about 4e-3
+    np.testing.assert_allclose(_pinned_measures(sol, b), (mid, short, alpha), atol=5e-3)
+    assert sol.stats[-1]["stable"] is True
+
+
+def test_pinned_column_under_prescribed_shortening():
+    """End shortening delta = 0.1 L: today's straight state gives P = EA delta / L (10^4 times
+    P_cr); with branch switching the reaction follows the elastica P(delta)."""
+    delta = 0.1
+    m, b = _pinned_column()
+    m.fix(b.last, dofs=("ux", "uy", "uz"), values={"ux": lambda t: -delta * t})
+    with pytest.warns(bs.StabilityWarning):
+        straight = bs.solve(m, steps=4, verbose=False, check_stability=True)
+    assert straight.stats[-1]["stable"] is False
+    assert -straight.reaction(b.last)[0] == pytest.approx(1e6 * delta, rel=1e-3)
+    sol = bs.solve(m, steps=4, verbose=False, branch_switching="auto")
+    k = brentq(lambda k: _pinned_reference(k)[2] - delta, 1e-6, 0.99)
+    ratio, mid, _, alpha = _pinned_reference(k)
+    assert -sol.reaction(b.last)[0] / (np.pi**2 * EI) == pytest.approx(ratio, rel=5e-3)   # 8 elements per half
+    measured = _pinned_measures(sol, b)
+    assert measured[0] == pytest.approx(mid, abs=5e-3) and measured[2] == pytest.approx(alpha, abs=5e-3)
+    assert all(s["stable"] for s in sol.stats[1:])
