@@ -229,3 +229,102 @@ def test_pinned_column_under_prescribed_shortening():
     measured = _pinned_measures(sol, b)
     assert measured[0] == pytest.approx(mid, abs=5e-3) and measured[2] == pytest.approx(alpha, abs=5e-3)
     assert all(s["stable"] for s in sol.stats[1:])
+
+
+# ------------------------------------------------------------------ modes of operation, bookkeeping, refusals
+def _lateral_cantilever():
+    m = bs.Model()
+    b = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 8), _section())
+    m.clamp(b.first)
+    m.add_load(b.last, force=(0.0, 3.0, 1.0))
+    return m
+
+
+def test_stable_path_is_unchanged_by_the_stability_options():
+    plain = bs.solve(_lateral_cantilever(), steps=4, verbose=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        checked = bs.solve(_lateral_cantilever(), steps=4, verbose=False, branch_switching="auto", modes=2)
+    np.testing.assert_array_equal(checked.poses, plain.poses)
+    assert all(s["stable"] and "branch_switch" not in s for s in checked.stats[1:])
+    assert all(len(s["mode_eigenvalues"]) == 2 and min(s["mode_eigenvalues"]) > 0 for s in checked.stats[1:])
+    assert all("stable" not in s and "modes" not in s for s in plain.stats)
+
+
+def test_true_switches_an_unstable_state_auto_waits_for_a_crossing():
+    """Restarted from a straight column already past P_cr: no crossing in the next step, so
+    'auto' leaves it (and says it is unstable); True switches it onto the elastica."""
+    m, b = _cantilever_column(2.0, 8)
+    with pytest.warns(bs.StabilityWarning):
+        first = bs.solve(m, steps=2, verbose=False, check_stability=True)
+    assert first.stats[-1]["negative_eigenvalues"] == 2
+    with pytest.warns(bs.StabilityWarning, match="unstable"):
+        auto = bs.solve(m, steps=3, t_end=1.5, verbose=False, restart=first, branch_switching="auto")
+    assert auto.stats[-1]["stable"] is False and "branch_switch" not in auto.stats[-1]
+    forced = bs.solve(m, steps=3, t_end=1.5, verbose=False, restart=first, branch_switching=True)
+    assert forced.stats[-1]["branch_switch"]["negative_after"] == 0 and forced.stats[-1]["stable"] is True
+    np.testing.assert_allclose(_tip(forced, b.last), elastica_tip(3.0), atol=1e-2)   # 8 elements
+
+
+def test_a_switch_that_leaves_negative_eigenvalues_is_not_called_stable(monkeypatch):
+    """A descent that does not move (here: replaced) leaves the saddle: warned, recorded unstable."""
+    monkeypatch.setattr(bifurcation, "descend", lambda evaluate, factorize, update, size, H, *a: (H, 0))
+    m, _ = _cantilever_column(2.0, 8)
+    with pytest.warns(bs.StabilityWarning, match="still has 2 negative"):
+        sol = bs.solve(m, steps=2, verbose=False, branch_switching="auto")
+    s = sol.stats[-1]
+    assert s["stable"] is False and s["negative_eigenvalues"] == 2 and s["branch_switch"]["negative_after"] == 2
+    assert "still has" in sol.message
+
+
+def test_a_failed_switch_is_recorded_and_keeps_the_state(monkeypatch):
+    monkeypatch.setattr(bifurcation, "DESCENT_MAX", 1)
+    m, b = _cantilever_column(2.0, 8)
+    with pytest.warns(bs.StabilityWarning, match="branch switching failed"):
+        sol = bs.solve(m, steps=2, verbose=False, branch_switching="auto")
+    s = sol.stats[-1]
+    assert "no stable state within 1" in s["branch_switch"]["failed"] and s["stable"] is False
+    assert np.hypot(*sol.position(b.last)[1:]) < 1e-9                  # still straight
+
+
+def test_non_conservative_problem_is_neither_judged_nor_switched():
+    """A follower load: no potential, the symmetric part's definiteness proves nothing."""
+    m = bs.Model()
+    b = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 8), _section())
+    m.clamp(b.first)
+    m.add_load(b.last, force=(-2.0 * np.pi**2 / 4.0, 0.0, 0.0), follower=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sol = bs.solve(m, steps=2, verbose=False, branch_switching=True, modes=1)
+    assert all(s["stable"] is None and "branch_switch" not in s and "modes" not in s for s in sol.stats[1:])
+
+
+@pytest.mark.parametrize("kw", [dict(modes=-1), dict(modes=1.5), dict(modes=True), dict(modes="2"),
+                                dict(branch_switching="always"), dict(branch_switching=1),
+                                dict(branch_switching=None)])
+def test_bad_stability_options_are_refused(kw):
+    name, value = next(iter(kw.items()))
+    with pytest.raises(bs.InputError, match=name) as e:
+        bs.solve(_lateral_cantilever(), steps=1, verbose=False, **kw)
+    assert repr(value) in str(e.value)
+
+
+def test_modes_reach_the_saved_result_the_vtu_and_info(tmp_path, capsys):
+    meshio = pytest.importorskip("meshio")
+    from beamsolver import cli
+    m, b = _cantilever_column(2.0, 8)
+    sol = bs.solve(m, steps=4, verbose=False, branch_switching="auto", modes=2, output=tmp_path / "out")
+    lam, modes = sol.modes(-1)
+    back = bs.load(tmp_path / "out")
+    np.testing.assert_array_equal(back.modes(-1)[1], modes)
+    np.testing.assert_array_equal(back.modes(-1)[0], lam)
+    assert back.modes(0)[1].shape == (0, m.n_nodes, 6)
+    mesh = meshio.read(tmp_path / "out" / "beams_0004.vtu")
+    tip = np.flatnonzero(np.all(np.isclose(mesh.points, sol.position(b.last)), axis=1))
+    assert len(tip) == 1
+    for j in (1, 2):
+        np.testing.assert_allclose(mesh.point_data[f"mode_{j}_u"][tip[0]], modes[j - 1, b.last, :3])
+        np.testing.assert_allclose(mesh.point_data[f"mode_{j}_rotation"][tip[0]], modes[j - 1, b.last, 3:])
+    assert cli.main(["info", str(tmp_path / "out")]) == 0
+    out = capsys.readouterr().out
+    assert "switched" in out and "mode 1" in out and "neg. eig." in out
