@@ -60,11 +60,11 @@ def _weights(system):
     return w.ravel()[system.free_dofs]
 
 
-def _descend(run, t, H, K, K_mode):
-    """``bifurcation.descend`` from ``H`` along the lowest mode of ``K_mode``; ``(H, steps, lam)``."""
+def _descend(run, t, H, K):
+    """``bifurcation.descend`` from ``H`` along the lowest mode of ``K``; ``(H, steps, lam)``."""
     sys, newton = run.sys, run.newton
     lf = sys.load_factors(t) if len(sys.load_scales) else np.zeros(0)
-    lam, phi = lowest_modes(K_mode, 1)
+    lam, phi = lowest_modes(K, 1)
     direction = bifurcation.normalise(sys, bifurcation.full_increments(sys, phi[:, 0])).ravel()[sys.free_dofs]
 
     def evaluate(H):
@@ -80,40 +80,61 @@ def _descend(run, t, H, K, K_mode):
     return H1, steps, float(lam[0])
 
 
-def locate(run, t, K, before):
-    """Bisect the step ``run.t -> t`` for the first load where the count of negative eigenvalues
-    exceeds ``before`` (to ``BISECTION`` of the step); returns ``(t_c, K_c)`` there (the step's
-    end and ``K`` if no bisection converged).  The solver's state is left as it was."""
-    t_a, found = run.t, (t, K)
+def _bisect(run, t_a, t_b, at_b, above):
+    """The first load in ``(t_a, t_b]`` (to ``BISECTION`` of the step from ``run.t``) whose count of
+    negative eigenvalues exceeds ``above``, and its state ``(H, r, info, K, count, lowest)``
+    (``at_b``: that of ``t_b``).  Each trial is a Newton step from the last recorded state."""
     for _ in range(BISECTION_MAX):
-        t_b = found[0]
         if t_b - t_a <= BISECTION * (t_b - run.t):
             break
         t_m = 0.5 * (t_a + t_b)
         try:
-            run._newton_step(t_m)
+            at_m = _state(run, t_m)
         except StepFailed:
             break
-        K_m = run.sys.matrix(*run.newton.last_tangent)
-        if negative_eigenvalues(K_m)[0] > before:
-            found = (t_m, K_m)
+        if at_m[4] > above:
+            t_b, at_b = t_m, at_m
         else:
             t_a = t_m
-    return found
+    return t_b, at_b
+
+
+def _state(run, t):
+    """The equilibrium at ``t`` reached from the last recorded state: ``(H, r, info, K, count, lowest)``."""
+    H, r, info, _ = run._newton_step(t)
+    K = run.sys.matrix(*run.newton.last_tangent)
+    return (H, r, info, K) + tuple(negative_eigenvalues(K))
+
+
+def locate(run, t, at_t, before):
+    """Where to switch over the step ``run.t -> t`` whose count of negative eigenvalues went up
+    from ``before``: ``(t_s, state, t_c)``.  ``t_c`` is the first load past the crossing; if the
+    step also passed the next critical load ``t_2`` (the count grew again), ``t_s`` is halfway
+    between them, where only the first mode is unstable (the other unknowns can then be relaxed
+    about it), else the step's end."""
+    t_c, at_c = _bisect(run, run.t, t, at_t, before)
+    if at_t[4] <= at_c[4]:
+        return t, at_t, t_c
+    t_2, _ = _bisect(run, t_c, t, at_t, at_c[4])
+    t_s = 0.5 * (t_c + t_2)
+    return t_s, _state(run, t_s), t_c
 
 
 def switch(run, stats, t, H, r, info, K):
-    """Move the unstable state ``H`` at ``t`` onto a stable branch; returns ``(H, r, info, K)`` of the
-    state to record (the old one if switching failed, with a warning).  Where the count of
-    negative eigenvalues went up over the step, the direction is the lowest mode at the first
-    load past the crossing (``locate``): the mode that went unstable first, not the lowest at
-    ``t`` when the step passed several critical loads."""
+    """Move the unstable state ``H`` at ``t`` onto a stable branch along the lowest mode; returns
+    ``(t, H, r, info, K)`` of the step to record: the old one if switching failed (with a
+    warning), or, where the count of negative eigenvalues went up over the step, the switched
+    state at the load ``locate`` chose, which may lie before ``t`` (the stepping goes on from it)."""
     sys = run.sys
     before = (run.sol.stats[-1].get("negative_eigenvalues") or 0) if run.sol.stats else 0
-    record = dict(mode=1, amplitude=bifurcation.AMPLITUDE, negative_before=stats["negative_eigenvalues"])
+    record = dict(mode=1, amplitude=bifurcation.AMPLITUDE)
+    at, t_c = (H, r, info, K, stats["negative_eigenvalues"], stats["lowest_eigenvalue"]), t
     try:
-        t_c, K_c = locate(run, t, K, before) if stats["negative_eigenvalues"] > before else (t, K)
-        H1, steps, lam = _descend(run, t, H, K, K_c)
+        if stats["negative_eigenvalues"] > before:
+            t, at, t_c = locate(run, t, at, before)
+        record.update(critical_t=t_c, negative_before=at[4])
+        stats.update(negative_eigenvalues=at[4], lowest_eigenvalue=at[5], stable=at[4] == 0, dt=t - run.t)
+        H1, steps, lam = _descend(run, t, at[0], at[3])
         H1, r1, info1, more = run._newton_step(t, start=H1)
         K1 = sys.matrix(*run.newton.last_tangent)
         neg, lowest = negative_eigenvalues(K1)
@@ -121,16 +142,16 @@ def switch(run, stats, t, H, r, info, K):
         record.update(failed=str(e))
         _warn(run, f"t = {t:.6g}: branch switching failed ({e}); the state stays on the unstable branch")
         stats["branch_switch"] = record
-        return H, r, info, K
-    record.update(critical_t=t_c, eigenvalue=lam, descent_steps=steps, iterations=more["iterations"],
-                  negative_after=neg, distance=float(bifurcation.size(sys, _distance(sys, H, H1))))
+        return (t,) + at[:4]
+    record.update(eigenvalue=lam, descent_steps=steps, iterations=more["iterations"], negative_after=neg,
+                  distance=float(bifurcation.size(sys, _distance(sys, at[0], H1))))
     stats.update(branch_switch=record, stable=neg == 0, negative_eigenvalues=neg, lowest_eigenvalue=lowest)
-    log.info("t = %.6g: switched branch along mode 1 (eigenvalue %.3g at t = %.6g) in %d descent steps; %d "
-             "negative eigenvalue(s) left", t, lam, t_c, steps, neg)
+    log.info("t = %.6g: switched branch along mode 1 (eigenvalue %.3g; crossing at t = %.6g) in %d descent "
+             "steps; %d negative eigenvalue(s) left", t, lam, t_c, steps, neg)
     if neg:
         _warn(run, f"t = {t:.6g}: after branch switching the tangent still has {neg} negative eigenvalue(s): "
                    "the state is not stable")
-    return H1, r1, info1, K1
+    return t, H1, r1, info1, K1
 
 
 def _distance(system, H0, H1):

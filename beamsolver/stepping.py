@@ -243,7 +243,7 @@ class Run:
         sys, sol = self.sys, self.sol
         contact_data = None
         if self.opt.get("check_stability"):
-            H, r, info = self._stability(stats, t_next, H, r, info)
+            t_next, H, r, info = self._stability(stats, t_next, H, r, info)
         if sys.contact is not None:
             sys.contact.commit(H)
             contact_data = sys.contact.results(H)
@@ -274,16 +274,17 @@ class Run:
     def _stability(self, stats, t, H, r, info):
         """Record whether the tangent at the converged state ``H`` is positive definite, its lowest
         modes (``modes``) and, with ``branch_switching``, move onto a stable branch
-        (``branching.switch``); warn once.  Returns the state to record ``(H, r, info)``."""
+        (``branching.switch``, which may record the step at an earlier ``t``, past a crossing); warn
+        once.  Returns the step to record ``(t, H, r, info)``."""
         sys = self.sys
         if not sys_conservative(sys):
             stats.update(stable=None)
-            return H, r, info
+            return t, H, r, info
         K = sys.matrix(*self.newton.last_tangent)
         neg, lowest = negative_eigenvalues(K)
         stats.update(stable=neg == 0, negative_eigenvalues=neg, lowest_eigenvalue=lowest)
         if branching.wanted(self.opt.get("branch_switching"), self.sol.stats, neg):
-            H, r, info, K = branching.switch(self, stats, t, H, r, info, K)
+            t, H, r, info, K = branching.switch(self, stats, t, H, r, info, K)
         if self.opt.get("modes"):
             branching.record_modes(sys, stats, H, K, self.opt["modes"])
         neg = stats["negative_eigenvalues"]
@@ -294,7 +295,7 @@ class Run:
             log.warning(text)
             warnings.warn(text, StabilityWarning, stacklevel=5)
             self.sol.message = text if not self.sol.message else self.sol.message + "; " + text
-        return H, r, info
+        return t, H, r, info
 
     # ------------------------------------------------------------------ end
     def _stop(self, failure, rotation_limit):

@@ -223,6 +223,12 @@ def test_pinned_column_under_prescribed_shortening():
     assert straight.stats[-1]["stable"] is False
     assert -straight.reaction(b.last)[0] == pytest.approx(1e6 * delta, rel=1e-3)
     sol = bs.solve(m, steps=4, verbose=False, branch_switching="auto")
+    # the first step passes ~30 critical loads: the switch is made between the first two, located
+    # by bisection (P_cr = EA delta_c / L in the straight state; the second one is 4 P_cr)
+    (k_switch,) = [k for k, s in enumerate(sol.stats) if "branch_switch" in s]
+    rec = sol.stats[k_switch]["branch_switch"]
+    assert rec["critical_t"] * delta * 1e6 / np.pi**2 == pytest.approx(1.0, rel=1e-2)
+    assert rec["critical_t"] < sol.times[k_switch] < 4.0 * rec["critical_t"] and rec["negative_before"] == 1
     k = brentq(lambda k: _pinned_reference(k)[2] - delta, 1e-6, 0.99)
     ratio, mid, _, alpha = _pinned_reference(k)
     assert -sol.reaction(b.last)[0] / (np.pi**2 * EI) == pytest.approx(ratio, rel=5e-3)   # 8 elements per half
