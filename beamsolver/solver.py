@@ -522,12 +522,14 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     ``bifurcation``); ``Solution.modes(step)``; VTU point fields ``mode_1_u``,
     ``mode_1_rotation``, ...  ``branch_switching``: ``"auto"`` at a step where
     the count of negative eigenvalues went up (a bifurcation or limit point
-    crossed), ``True`` at every step with negative eigenvalues, the state is
-    perturbed along the lowest mode (``bifurcation.AMPLITUDE``) and iterated at
-    the same load onto a stable branch (``bifurcation.descend``);
-    ``stats[k]["branch_switch"]`` records the mode, the descent and the counts
-    before and after, and a state still unstable after it is warned about.
-    Either implies ``check_stability``.
+    crossed; where one step passed several critical loads, the switch is made
+    between the first two and recorded as its own step: ``branching.locate``),
+    ``True`` at every step with negative eigenvalues, the amplitude along the
+    lowest mode is raised from ``bifurcation.AMPLITUDE`` at the same load, the
+    other unknowns relaxed, down the energy onto a stable branch
+    (``bifurcation.descend``); ``stats[k]["branch_switch"]`` records the mode,
+    the crossing, the descent and the counts before and after, and a state
+    still unstable after it is warned about.  Either implies ``check_stability``.
 
     ``Solution.stats[k]["timings"]``: wall time of the step's ``assembly``
     (residuals, tangents, sparse matrices), ``contact`` (part of assembly) and
