@@ -42,8 +42,8 @@ def lowest_modes(K, k):
     Ks, d = _scaling(K)
     A = sp.diags(d) @ Ks @ sp.diags(d)
     if n <= DENSE_MAX or k >= n - 1:
-        lam, Y = np.linalg.eigh(A.toarray())
-        lam, Y = lam[:k], Y[:, :k]
+        from scipy.linalg import eigh
+        lam, Y = eigh(A.toarray(), subset_by_index=(0, k - 1), driver="evr")
     else:
         from scipy.sparse.linalg import eigsh
         lam, Y = eigsh(A.tocsc(), k=k, sigma=-SHIFT, which="LM")
