@@ -124,12 +124,11 @@ def descend(evaluate, factorize, update, scaled_size, H, direction, weights):
     ``solve(rhs)``; ``update(H, dz_free) -> H``; ``scaled_size(dz_free)`` the unit-free size.
     """
     phi = np.asarray(direction, dtype=float)
-    weights = np.asarray(weights, dtype=float)
+    w = np.asarray(weights, dtype=float) * phi
     a, da = 0.0, AMPLITUDE
     for step in range(1, DESCENT_MAX + 1):
         H = update(H, da * phi)
         a += abs(da)
-        w = weights * phi
         H, r, K = _relax(evaluate, factorize, update, scaled_size, H, w)
         c = float(w @ phi)
         slope = float(phi @ r)

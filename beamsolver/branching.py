@@ -53,11 +53,17 @@ def _factorize(K):
         raise SingularTangent(f"branch switching: singular shifted tangent ({e})") from None
 
 
-def _weights(system):
-    """The metric of ``bifurcation.size`` on the free unknowns: ``1 / L_ref^2`` for translations, 1 for rotations."""
-    w = np.ones((system.n_nodes, 6))
-    w[:, :3] = 1.0 / system.length_scale**2
-    return w.ravel()[system.free_dofs]
+def _weights(system, phi):
+    """The metric of the amplitude (``bifurcation.descend``) on the free unknowns: the rotations of
+    ``phi`` (in body frames, their projection stays meaningful at large rotations, unlike that
+    of translations, which mixes axial and lateral motion as the frames turn), or its
+    translations scaled by ``1 / L_ref^2`` if it has no rotation."""
+    rot = np.zeros((system.n_nodes, 6), dtype=bool)
+    rot[:, 3:] = True
+    rot = rot.ravel()[system.free_dofs]
+    if np.any(phi[rot] != 0.0):
+        return rot.astype(float)
+    return (~rot) / system.length_scale**2
 
 
 def _descend(run, t, H, K):
@@ -76,7 +82,7 @@ def _descend(run, t, H, K):
 
     H1, steps = bifurcation.descend(evaluate, _factorize, update,
                                     lambda dzf: bifurcation.size(sys, bifurcation.full_increments(sys, dzf)),
-                                    H, direction, _weights(sys))
+                                    H, direction, _weights(sys, direction))
     return H1, steps, float(lam[0])
 
 
