@@ -13,10 +13,10 @@ import warnings
 import numpy as np
 
 from . import bifurcation, linsolve
-from .errors import StabilityWarning
-from .failures import StepFailed, SingularTangent
-from .modes import lowest_modes
 from .definiteness import negative_eigenvalues
+from .errors import StabilityWarning
+from .failures import SingularTangent, StepFailed
+from .modes import lowest_modes
 
 __all__ = ["wanted", "switch", "locate", "record_modes", "OPTIONS", "BISECTION"]
 
@@ -41,16 +41,16 @@ def record_modes(system, stats, H, K, k):
     """``stats["mode_eigenvalues"]`` ``(k,)`` and ``stats["modes"]`` ``(k, n, 6)``: the lowest eigenpairs
     of ``K`` at ``H`` as global node displacements and rotations, each of unit size."""
     lam, phi = lowest_modes(K, k)
-    twists = [bifurcation.normalise(system, bifurcation.node_twists(system, H, bifurcation.full_increments(system, p)))
-              for p in phi.T]
-    stats.update(mode_eigenvalues=[float(x) for x in lam], modes=[t for t in twists])
+    full = [bifurcation.full_increments(system, p) for p in phi.T]
+    twists = [bifurcation.normalise(system, bifurcation.node_twists(system, H, dz)) for dz in full]
+    stats.update(mode_eigenvalues=[float(x) for x in lam], modes=twists)
 
 
 def _factorize(K):
     try:
         return linsolve.Solver().factorize(K)
     except linsolve.SingularMatrixError as e:
-        raise SingularTangent(f"branch switching: singular shifted tangent ({e})") from None
+        raise SingularTangent(f"branch switching: singular tangent bordered with the amplitude constraint ({e})") from None
 
 
 def _weights(system, phi):
