@@ -50,7 +50,7 @@ def _factorize(K):
     try:
         return linsolve.Solver().factorize(K)
     except linsolve.SingularMatrixError as e:
-        raise SingularTangent(f"branch switching: singular tangent bordered with the amplitude constraint ({e})") from None
+        raise SingularTangent(f"branch switching: singular bordered tangent ({e})") from None
 
 
 def _weights(system, phi):
