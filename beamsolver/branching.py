@@ -8,6 +8,7 @@ the lowest modes of the recorded state (``stats["mode_eigenvalues"]``,
 ``stats["modes"]``).
 """
 import logging
+import time
 import warnings
 
 import numpy as np
@@ -131,7 +132,7 @@ def switch(run, stats, t, H, r, info, K):
     ``(t, H, r, info, K)`` of the step to record: the old one if switching failed (with a
     warning), or, where the count of negative eigenvalues went up over the step, the switched
     state at the load ``locate`` chose, which may lie before ``t`` (the stepping goes on from it)."""
-    sys = run.sys
+    sys, start = run.sys, time.perf_counter()
     before = (run.sol.stats[-1].get("negative_eigenvalues") or 0) if run.sol.stats else 0
     record = dict(mode=1, amplitude=bifurcation.AMPLITUDE)
     at, t_c = (H, r, info, K, stats["negative_eigenvalues"], stats["lowest_eigenvalue"]), t
@@ -145,12 +146,13 @@ def switch(run, stats, t, H, r, info, K):
         K1 = sys.matrix(*run.newton.last_tangent)
         neg, lowest = negative_eigenvalues(K1)
     except StepFailed as e:
-        record.update(failed=str(e))
+        record.update(failed=str(e), wall_time=time.perf_counter() - start)
         _warn(run, f"t = {t:.6g}: branch switching failed ({e}); the state stays on the unstable branch")
         stats["branch_switch"] = record
         return (t,) + at[:4]
     record.update(eigenvalue=lam, descent_steps=steps, iterations=more["iterations"], negative_after=neg,
-                  distance=float(bifurcation.size(sys, _distance(sys, at[0], H1))))
+                  distance=float(bifurcation.size(sys, _distance(sys, at[0], H1))),
+                  wall_time=time.perf_counter() - start)
     stats.update(branch_switch=record, stable=neg == 0, negative_eigenvalues=neg, lowest_eigenvalue=lowest)
     log.info("t = %.6g: switched branch along mode 1 (eigenvalue %.3g; crossing at t = %.6g) in %d descent "
              "steps; %d negative eigenvalue(s) left", t, lam, t_c, steps, neg)
