@@ -21,11 +21,15 @@ import time
 import warnings
 from pathlib import Path
 
-import numpy as np
-from scipy.optimize import brentq
-from scipy.special import ellipe, ellipk
+from _report import single_thread
 
-import beamsolver as bs
+single_thread()   # dense eigensolvers with a BLAS pool on the shared machine: 10-100 times slower
+
+import numpy as np  # noqa: E402
+from scipy.optimize import brentq  # noqa: E402
+from scipy.special import ellipe, ellipk  # noqa: E402
+
+import beamsolver as bs  # noqa: E402
 
 RESULTS = Path(__file__).resolve().parent / "results"
 P_MAX = 4.0
