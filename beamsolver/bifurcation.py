@@ -37,6 +37,7 @@ HANDOVER = 1e-3      # a Newton step in the amplitude below this: the solver's N
 DESCENT_MAX = 100    # most amplitudes tried
 RELAX_TOL = 1e-8     # size of the last relaxation step at a fixed amplitude
 RELAX_MAX = 30       # most relaxation iterations per amplitude
+CUTS = 8             # a failed relaxation halves the amplitude step, down to AMPLITUDE 2^-CUTS
 
 
 def crossing(previous, current):
@@ -117,7 +118,8 @@ def descend(evaluate, factorize, update, scaled_size, H, direction, weights):
     ``r = -mu w``: the energy's slope is ``dPi/da = phi . r`` and its curvature
     ``c^2 / (w . K^-1 w)``, ``c = w . phi`` (the bordered solve of ``(0, c)``), which give a
     Newton step in ``a``; where the curvature is not positive the amplitude doubles instead
-    (downhill, away from the saddle).  Steps are capped at ``TRUST``.  Returns ``(H, steps)``
+    (downhill, away from the saddle).  Steps are capped at ``TRUST`` and at twice the last
+    step; a relaxation that fails halves the step (down to ``AMPLITUDE 2^-CUTS``).  Returns ``(H, steps)``
     once a Newton step in ``a`` is below ``HANDOVER`` (the state then is the equilibrium
     within Newton's reach); raises ``StepFailed`` after ``DESCENT_MAX`` steps.
     ``evaluate(H) -> (r, K)`` free residual and tangent; ``factorize(A)`` an object with
@@ -125,12 +127,17 @@ def descend(evaluate, factorize, update, scaled_size, H, direction, weights):
     """
     phi = np.asarray(direction, dtype=float)
     w = np.asarray(weights, dtype=float) * phi
-    a, da = 0.0, AMPLITUDE
+    c = float(w @ phi)
+    a, da, last = 0.0, AMPLITUDE, AMPLITUDE
     for step in range(1, DESCENT_MAX + 1):
-        H = update(H, da * phi)
-        a += abs(da)
-        H, r, K = _relax(evaluate, factorize, update, scaled_size, H, w)
-        c = float(w @ phi)
+        try:
+            H1, r, K = _relax(evaluate, factorize, update, scaled_size, update(H, da * phi), w)
+        except StepFailed as e:
+            da *= 0.5                                 # the relaxation failed: a shorter step from H
+            if abs(da) < AMPLITUDE * 2.0**-CUTS:
+                raise StepFailed(f"branch switching: {e} (amplitude steps cut down to {abs(da):.2g})") from None
+            continue
+        H, a, last = H1, a + abs(da), abs(da)
         slope = float(phi @ r)
         curvature = -c * float(factorize(_bordered(K, w)).solve(np.append(np.zeros(len(phi)), c))[-1])
         if curvature > 0.0:
@@ -139,5 +146,5 @@ def descend(evaluate, factorize, update, scaled_size, H, direction, weights):
                 return H, step
         else:
             da = -np.sign(slope) * max(a, AMPLITUDE)
-        da = float(np.clip(da, -TRUST, TRUST))
+        da = float(np.clip(da, -min(TRUST, 2.0 * last), min(TRUST, 2.0 * last)))
     raise StepFailed(f"branch switching: no stable state within {DESCENT_MAX} amplitudes")

@@ -334,3 +334,36 @@ def test_modes_reach_the_saved_result_the_vtu_and_info(tmp_path, capsys):
     assert cli.main(["info", str(tmp_path / "out")]) == 0
     out = capsys.readouterr().out
     assert "switched" in out and "mode 1" in out and "neg. eig." in out
+
+
+def _argyris(imperfection, n=10):
+    """Argyris' right-angle frame (legs 240 mm, section 30 x 0.6 mm, E = 71240 N/mm^2, nu = 0.31),
+    clamped, in-plane tip force ``F = t * 1.5 N`` along the clamped leg (benchmarks/argyris_frame.py)."""
+    m = bs.Model()
+    sec = bs.Section.rectangular(width=0.6, height=30.0, E=71240.0, nu=0.31)
+    a = m.add_beam(bs.geometry.straight((0, 0, 0), (0, 240, 0), n, e2=(0, 0, 1)), sec)
+    b = m.add_beam(bs.geometry.straight((0, 240, 0), (240, 240, 0), n, e2=(0, 0, 1)), sec)
+    m.join(a.last, b.first)
+    m.clamp(a.first)
+    m.add_load(b.last, force=(0.0, 1.5, imperfection * 1.5))
+    return m, b
+
+
+def test_argyris_frame_perfect_switches_at_the_published_load_onto_the_imperfect_path():
+    """The perfect frame: lateral buckling located at the published F_cr = 1.088 N (Argyris et al.
+    1979, as in Simo & Vu-Quoc 1986) within 1 % (10 elements per leg), and at 1.5 N the switched
+    state is the one force control reaches with a 1e-4 out-of-plane imperfection (to O(1e-4))."""
+    m, b = _argyris(0.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", bs.StabilityWarning)
+        sol = bs.solve(m, steps=15, verbose=False, branch_switching="auto")
+    (k,) = [k for k, s in enumerate(sol.stats) if "branch_switch" in s]
+    rec = sol.stats[k]["branch_switch"]
+    assert 1.5 * rec["critical_t"] == pytest.approx(1.088, rel=1e-2)
+    assert rec["negative_after"] == 0 and all(s["stable"] for s in sol.stats[1:])
+    m2, b2 = _argyris(1e-4)
+    imperfect = bs.solve(m2, steps=15, verbose=False)
+    lateral = sol.position(b.last)[2]
+    assert abs(lateral) > 50.0                                          # well past buckling
+    np.testing.assert_allclose(np.abs(sol.position(b.last)), np.abs(imperfect.position(b2.last)),
+                               atol=1e-3 * abs(lateral))
