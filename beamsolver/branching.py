@@ -69,17 +69,16 @@ def _weights(system, phi):
 
 def _descend(run, t, H, K):
     """``bifurcation.descend`` from ``H`` along the lowest mode of ``K``; ``(H, steps, lam)``."""
-    sys, newton = run.sys, run.newton
-    lf = sys.load_factors(t) if len(sys.load_scales) else np.zeros(0)
+    sys, newton, problem = run.sys, run.newton, run.problem
     lam, phi = lowest_modes(K, 1)
     direction = bifurcation.normalise(sys, bifurcation.full_increments(sys, phi[:, 0])).ravel()[sys.free_dofs]
 
     def evaluate(H):
-        r, kvals, info = newton._evaluate(H, lf)
-        return r[sys.free_dofs], sys.matrix(kvals, info["extra"])
+        ev = newton._evaluate(H, t)
+        return ev.r[sys.free_dofs], problem.tangent(ev)
 
     def update(H, dzf):
-        return sys.update(H, bifurcation.full_increments(sys, dzf))
+        return problem.update(H, bifurcation.full_increments(sys, dzf))
 
     H1, steps = bifurcation.descend(evaluate, _factorize, update,
                                     lambda dzf: bifurcation.size(sys, bifurcation.full_increments(sys, dzf)),
@@ -89,7 +88,7 @@ def _descend(run, t, H, K):
 
 def _bisect(run, t_a, t_b, at_b, above):
     """The first load in ``(t_a, t_b]`` (to ``BISECTION`` of the step from ``run.t``) whose count of
-    negative eigenvalues exceeds ``above``, and its state ``(H, r, info, K, count, lowest)``
+    negative eigenvalues exceeds ``above``, and its state ``(H, ev, K, count, lowest)``
     (``at_b``: that of ``t_b``).  Each trial is a Newton step from the last recorded state."""
     for _ in range(BISECTION_MAX):
         if t_b - t_a <= BISECTION * (t_b - run.t):
@@ -99,7 +98,7 @@ def _bisect(run, t_a, t_b, at_b, above):
             at_m = _state(run, t_m)
         except StepFailed:
             break
-        if at_m[4] > above:
+        if at_m[3] > above:
             t_b, at_b = t_m, at_m
         else:
             t_a = t_m
@@ -107,10 +106,10 @@ def _bisect(run, t_a, t_b, at_b, above):
 
 
 def _state(run, t):
-    """The equilibrium at ``t`` reached from the last recorded state: ``(H, r, info, K, count, lowest)``."""
-    H, r, info, _ = run._newton_step(t)
-    K = run.sys.matrix(*run.newton.last_tangent)
-    return (H, r, info, K) + tuple(negative_eigenvalues(K))
+    """The equilibrium at ``t`` reached from the last recorded state: ``(H, ev, K, count, lowest)``."""
+    H, ev, _ = run._newton_step(t)
+    K = run.problem.tangent(run.newton.last_evaluation)
+    return (H, ev, K) + tuple(negative_eigenvalues(K))
 
 
 def locate(run, t, at_t, before):
@@ -120,36 +119,37 @@ def locate(run, t, at_t, before):
     between them, where only the first mode is unstable (the other unknowns can then be relaxed
     about it), else the step's end."""
     t_c, at_c = _bisect(run, run.t, t, at_t, before)
-    if at_t[4] <= at_c[4]:
+    if at_t[3] <= at_c[3]:
         return t, at_t, t_c
-    t_2, _ = _bisect(run, t_c, t, at_t, at_c[4])
+    t_2, _ = _bisect(run, t_c, t, at_t, at_c[3])
     t_s = 0.5 * (t_c + t_2)
     return t_s, _state(run, t_s), t_c
 
 
-def switch(run, stats, t, H, r, info, K):
-    """Move the unstable state ``H`` at ``t`` onto a stable branch along the lowest mode; returns
-    ``(t, H, r, info, K)`` of the step to record: the old one if switching failed (with a
-    warning), or, where the count of negative eigenvalues went up over the step, the switched
-    state at the load ``locate`` chose, which may lie before ``t`` (the stepping goes on from it)."""
+def switch(run, stats, t, H, ev, K):
+    """Move the unstable state ``H`` (evaluation ``ev``, tangent ``K``) at ``t`` onto a stable branch
+    along the lowest mode; returns ``(t, H, ev, K)`` of the step to record: the old one if
+    switching failed (with a warning), or, where the count of negative eigenvalues went up over
+    the step, the switched state at the load ``locate`` chose, which may lie before ``t`` (the
+    stepping goes on from it)."""
     sys, start = run.sys, time.perf_counter()
     before = (run.sol.stats[-1].get("negative_eigenvalues") or 0) if run.sol.stats else 0
     record = dict(mode=1, amplitude=bifurcation.AMPLITUDE)
-    at, t_c = (H, r, info, K, stats["negative_eigenvalues"], stats["lowest_eigenvalue"]), t
+    at, t_c = (H, ev, K, stats["negative_eigenvalues"], stats["lowest_eigenvalue"]), t
     try:
         if stats["negative_eigenvalues"] > before:
             t, at, t_c = locate(run, t, at, before)
-        record.update(critical_t=t_c, negative_before=at[4])
-        stats.update(negative_eigenvalues=at[4], lowest_eigenvalue=at[5], stable=at[4] == 0, dt=t - run.t)
-        H1, steps, lam = _descend(run, t, at[0], at[3])
-        H1, r1, info1, more = run._newton_step(t, start=H1)
-        K1 = sys.matrix(*run.newton.last_tangent)
+        record.update(critical_t=t_c, negative_before=at[3])
+        stats.update(negative_eigenvalues=at[3], lowest_eigenvalue=at[4], stable=at[3] == 0, dt=t - run.t)
+        H1, steps, lam = _descend(run, t, at[0], at[2])
+        H1, ev1, more = run._newton_step(t, start=H1)
+        K1 = run.problem.tangent(run.newton.last_evaluation)
         neg, lowest = negative_eigenvalues(K1)
     except StepFailed as e:
         record.update(failed=str(e), wall_time=time.perf_counter() - start)
         _warn(run, f"t = {t:.6g}: branch switching failed ({e}); the state stays on the unstable branch")
         stats["branch_switch"] = record
-        return (t,) + at[:4]
+        return (t,) + at[:3]
     record.update(eigenvalue=lam, descent_steps=steps, iterations=more["iterations"], negative_after=neg,
                   distance=float(bifurcation.size(sys, _distance(sys, at[0], H1))),
                   wall_time=time.perf_counter() - start)
@@ -159,7 +159,7 @@ def switch(run, stats, t, H, r, info, K):
     if neg:
         _warn(run, f"t = {t:.6g}: after branch switching the tangent still has {neg} negative eigenvalue(s): "
                    "the state is not stable")
-    return t, H1, r1, info1, K1
+    return t, H1, ev1, K1
 
 
 def _distance(system, H0, H1):
