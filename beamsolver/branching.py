@@ -26,6 +26,7 @@ log = logging.getLogger("beamsolver")
 OPTIONS = (False, True, "auto")
 BISECTION = 1e-3     # the crossing is located to this fraction of the step from the last stable state
 BISECTION_MAX = 40   # most bisections
+CLUSTER = 0.05       # crossings closer than this fraction of the step to the first are one crossing
 
 
 def wanted(option, recorded, negative):
@@ -115,15 +116,19 @@ def _state(run, t):
 def locate(run, t, at_t, before):
     """Where to switch over the step ``run.t -> t`` whose count of negative eigenvalues went up
     from ``before``: ``(t_s, state, t_c)``.  ``t_c`` is the first load past the crossing; if the
-    step also passed the next critical load ``t_2`` (the count grew again), ``t_s`` is halfway
-    between them, where only the first mode is unstable (the other unknowns can then be relaxed
-    about it), else the step's end."""
+    step also passed a further critical load ``t_2`` (the count grew again more than ``CLUSTER``
+    of the step to ``t_c`` later: closer ones are one crossing, a double eigenvalue split by
+    round-off), ``t_s`` is halfway to it, where only the first mode is unstable (the other
+    unknowns can then be relaxed about it), else the step's end."""
     t_c, at_c = _bisect(run, run.t, t, at_t, before)
-    if at_t[3] <= at_c[3]:
-        return t, at_t, t_c
-    t_2, _ = _bisect(run, t_c, t, at_t, at_c[3])
-    t_s = 0.5 * (t_c + t_2)
-    return t_s, _state(run, t_s), t_c
+    t_lo, at_lo = t_c, at_c
+    while at_t[3] > at_lo[3]:
+        t_2, at_2 = _bisect(run, t_lo, t, at_t, at_lo[3])
+        if t_2 - t_c > CLUSTER * (t_c - run.t):
+            t_s = 0.5 * (t_lo + t_2)
+            return t_s, _state(run, t_s), t_c
+        t_lo, at_lo = t_2, at_2
+    return t, at_t, t_c
 
 
 def switch(run, stats, t, H, ev, K):

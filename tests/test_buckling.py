@@ -367,3 +367,19 @@ def test_argyris_frame_perfect_switches_at_the_published_load_onto_the_imperfect
     assert abs(lateral) > 50.0                                          # well past buckling
     np.testing.assert_allclose(np.abs(sol.position(b.last)), np.abs(imperfect.position(b2.last)),
                                atol=1e-3 * abs(lateral))
+
+
+@pytest.mark.parametrize("second, switch_at", [(0.5004, 1.0), (0.8, 0.65)])
+def test_locate_switches_between_distinct_crossings_only(monkeypatch, second, switch_at):
+    """Counts 0 -> 1 at t = 0.5 and 1 -> 2 at ``second``: a second crossing within CLUSTER of the
+    step is the same (a double eigenvalue split by round-off): switch at the step's end; a distinct
+    one: switch halfway between them, where only the first mode is unstable."""
+    from types import SimpleNamespace
+    from beamsolver import branching
+
+    def state(run, t):
+        return (None, None, None, int(t >= 0.5) + int(t >= second), None)
+    monkeypatch.setattr(branching, "_state", state)
+    t_s, at, t_c = branching.locate(SimpleNamespace(t=0.0), 1.0, state(None, 1.0), 0)
+    assert t_c == pytest.approx(0.5, abs=1e-3) and t_s == pytest.approx(switch_at, abs=2e-3)
+    assert at[3] == (2 if switch_at == 1.0 else 1)
