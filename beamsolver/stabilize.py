@@ -17,7 +17,8 @@ carries an artificial viscous force, body frame, translation first:
 The factor ``c`` follows from a dissipated-energy fraction ``fraction`` (Abaqus' default 2e-4):
 the first step with a positive strain energy ``E_1`` and motion is solved without damping, then
 ``c = fraction E_1 dt_1 / (h_1^T M* h_1)``, so that the same step would have dissipated
-``fraction E_1``; ``c`` is then kept for the whole solve.  Each stabilised step is a step of
+``fraction E_1``; ``c`` is then kept for the whole solve (a restarted solve calibrates it
+again from its first step, and its dissipated total starts from zero).  Each stabilised step is a step of
 implicit Euler on the viscous flow ``c M* v = -r``, i.e. a minimiser of the potential plus
 ``(c / 2 dt) h^T M* h``: a converged step whose stabilised tangent ``K + (c / dt) M*`` is not
 positive definite overshot an unstable mode (it lands on the far side of the unstable
