@@ -25,7 +25,7 @@ Measured (16 elements per wire, 40 steps, one run each on a loaded 2-core machin
 - defaults (``mu = 0.3``, imperfection 1e-2, ``stabilize = 2e-2``): writhing from 2.08 turns
   (10.9 N m), a loop at the top; stops at 2.12 of the 5 turns (Newton fails as the loop
   tightens on itself), ``Wr / Lk = 0.41``, ``|Lk - Tw - Wr| / Lk <= 1.5e-3``, dissipated 0.40 of
-  the strain energy (warned: polluted), 286 s;
+  the strain energy (warned: polluted), solve 134 s (286 s on a loaded machine);
 - ``--stabilize 0.2``: 2.62 turns, ``Wr / Lk = 0.37``, dissipated 0.48; ``--stabilize 2e-3``:
   no writhing, stops at 4.16 turns as the unstabilised run (sticking friction stiffens the pair);
 - ``--mu 0 --imperfection 1e-3 --stabilize 2e-3 --steps 80``: writhing from 1.63 turns at
