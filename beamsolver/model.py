@@ -337,7 +337,7 @@ class Model:
         - ``margin``: search margin around every element (default twice the largest radius).
         - ``law``: the contact law, a ``contact.law.ContactLaw`` of compiled functions
           (default None: the penalty / augmented-Lagrangian / smoothed normal law with
-          Coulomb friction; docs/theory.md section 11).
+          Coulomb friction; docs/theory.md section 14).
 
         Unknown options are refused.  The same beams on both
         sides (``add_contact(group, group)``, as for the wires of a cable) declare every
