@@ -7,7 +7,7 @@ all active, friction on), ``n`` slave points from 1e2 to 1e5.  Per size, in one 
 - kernel + tangent: the compiled kernel (``contact.kernel_jit``, forward-mode exact tangent)
   and the numpy oracle (``contact.pairs``, 24 complex-step kernel evaluations; up to 1e4 points);
 - search + kernel + tangent (the issue's measure: target 2e5 points/s at 1e4 points);
-- a whole ``ContactSystem.evaluate`` (search + kernel + tangent + scatter), compiled kernel.
+- a whole ``ContactSystem.evaluate`` (search + kernel + tangent, the local blocks), compiled kernel.
 
 Plus the JIT start-up: the first call in a fresh process with an empty numba cache
 (compiles) and in a second process (loads the cache; numba's cache hit/miss counts printed).
@@ -159,9 +159,10 @@ on.  Search = broad phase (bounding spheres, scipy cKDTree) + pair rules + SE(3)
 (numba, forward-mode exact tangent: gradients with respect to the 24 node increments carried
 through the projection, the frames, the laws and the node Jacobians); numpy oracle =
 `contact.pairs.kernel_and_tangent` (24 complex-step kernel evaluations per point, measured up
-to 1e4 points); evaluate = search + compiled kernel + tangent + scatter (after `begin_step`: the
-contact system keeps its last evaluation for the same poses); the rest of evaluate is
-the active set, the parameter look-up and the COO triplets of the tangent.  Times are CPU
+to 1e4 points); evaluate = `ContactSystem.evaluate` (search + compiled kernel + tangent, the
+local blocks handed to the assembler; after `begin_step`: the contact system keeps its last
+evaluation for the same poses); the rest of evaluate is the refusals, the active set, the
+parameter look-up and the blocks.  Times are CPU
 times of the process (least of 3; the machine is shared with other jobs).  The start-up rows run
 a one-point kernel call in fresh processes sharing one numba cache directory.
 

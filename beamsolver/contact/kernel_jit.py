@@ -606,7 +606,9 @@ def _code_bytes(code):
 
 
 def _digest(law):
-    """Identity of a law's code: a law edited in place gets a new compiled kernel (and cache entry)."""
+    """Identity of a law's code: a law edited in place gets a new compiled kernel (and cache entry).
+    Only the two functions' own code counts: after editing a helper they call, clear the numba
+    cache (``__pycache__``) or rename the law."""
     code = [_code_bytes(getattr(f, "py_func", f).__code__) for f in (law.normal, law.tangential)]
     return hashlib.sha1(b"".join(code)).hexdigest()[:10]
 
