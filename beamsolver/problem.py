@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import contributions
 from .assembly import System
 
 __all__ = ["Problem", "Evaluation"]
@@ -68,7 +69,11 @@ class Problem:
 
     @classmethod
     def from_model(cls, model, check_rigid_modes=True):
-        return cls(System(model, check_rigid_modes=check_rigid_modes))
+        """The Problem of ``model``: its System, its contact (if declared) and its user contributions
+        (``Model.add_contribution``, checked: ``contributions.checked``)."""
+        user = contributions.checked(model)
+        system = System(model, check_rigid_modes=check_rigid_modes)
+        return cls(system, ([] if system.contact is None else [system.contact]) + user)
 
     # ------------------------------------------------------------ properties
     @property
