@@ -78,10 +78,6 @@ class System:
         self._build_loads(model)
         self._build_pattern()
         self._build_chains(model)
-        self.contact = None
-        if model.contacts:   # scenes without contact never import or run contact code
-            from .contact.system import ContactSystem
-            self.contact = ContactSystem(self)
         if check_rigid_modes:
             self._check_rigid_modes(model)
 

@@ -57,13 +57,11 @@ class Evaluation:
 
 
 class Problem:
-    """Elements, loads and constraints of ``system`` plus ``contributions`` (default: the
-    system's contact, if any); see the module docstring for the protocol."""
+    """Elements, loads and constraints of ``system`` plus ``contributions`` (``Problem.from_model``
+    builds them from the model: contact, then the user's); see the module docstring for the protocol."""
 
-    def __init__(self, system, contributions=None):
+    def __init__(self, system, contributions=()):
         self.system = system
-        if contributions is None:
-            contributions = [] if system.contact is None else [system.contact]
         self.contributions = list(contributions)
         self._lf = (None, np.zeros(0))
 
@@ -73,7 +71,12 @@ class Problem:
         (``Model.add_contribution``, checked: ``contributions.checked``)."""
         user = contributions.checked(model)
         system = System(model, check_rigid_modes=check_rigid_modes)
-        return cls(system, ([] if system.contact is None else [system.contact]) + user)
+        return cls(system, _contact(system) + user)
+
+    @property
+    def contact(self):
+        """The contact contribution (``contact.system.ContactSystem``), ``None`` without contact."""
+        return next((c for c in self.contributions if c.name == "contact"), None)
 
     # ------------------------------------------------------------ properties
     @property
@@ -172,3 +175,11 @@ class Problem:
     def set_state(self, state):
         for c in self.contributions:
             c.set_state(dict(state))
+
+
+def _contact(system):
+    """``[ContactSystem]`` for a model with contact declarations, else ``[]``."""
+    if not system.model.contacts:    # scenes without contact never import or run contact code
+        return []
+    from .contact.system import ContactSystem
+    return [ContactSystem(system)]

@@ -163,9 +163,9 @@ def test_life_cycle_outer_iteration_commit_and_globalisation():
     problem, spring = _problem(k=50.0)
     assert problem.smooth and problem.conservative
     assert Problem(problem.system, []).get_state() == {} and problem.timing_names == ("contact", "spring")
-    from beamsolver.solver import Convergence, _Newton
+    from beamsolver.solver import Convergence, Newton
     from beamsolver.stepping import Run
-    newton = _Newton(problem, Convergence(), True, None)
+    newton = Newton(problem, Convergence(), True, None)
     grid = np.linspace(0.0, 1.0, 3)
     run = Run(problem, newton, None, grid, 1e-3, False, dict(advice=lambda *a: ""))
     run.start(None, None)
@@ -183,10 +183,10 @@ def test_outer_iterations_are_bounded():
     """A contribution that always asks to re-solve the step: a typed failure after MAX_OUTER."""
     from beamsolver import failures, stepping
     from beamsolver.errors import ConvergenceError
-    from beamsolver.solver import Convergence, _Newton
+    from beamsolver.solver import Convergence, Newton
     problem, spring = _problem(k=50.0)
     spring.repeat_step = lambda H: True
-    run = stepping.Run(problem, _Newton(problem, Convergence(), True, None), None, np.linspace(0.0, 1.0, 2),
+    run = stepping.Run(problem, Newton(problem, Convergence(), True, None), None, np.linspace(0.0, 1.0, 2),
                        1e-3, False, dict(advice=lambda *a: ""))
     run.start(None, None)
     with pytest.raises(ConvergenceError) as err:
@@ -257,3 +257,19 @@ def test_contact_tangent_at_a_global_type_node_matches_finite_differences(monkey
                                                                    + (np.zeros(0),)))
     K_without = problem.tangent(problem.evaluate(H, 0.0)).toarray()[:, cols]
     assert rel_err(K_without, fd) > 10 * rel_err(K, fd), (rel_err(K_without, fd), rel_err(K, fd))
+
+
+def test_problem_owns_the_contact_contribution():
+    """``System`` knows elements, loads and constraints only; ``Problem.from_model`` builds contact and
+    shows it read-only as ``Problem.contact`` (``None`` without contact)."""
+    from beamsolver.contact.system import ContactSystem
+    m, b1, b2, extra = _model()
+    assert Problem.from_model(m, check_rigid_modes=False).contact is None
+    m.add_contact(b2, b1)
+    problem = Problem.from_model(m, check_rigid_modes=False)
+    assert isinstance(problem.contact, ContactSystem) and problem.contributions == [problem.contact]
+    assert problem.contact.sys is problem.system and not hasattr(problem.system, "contact")
+    with pytest.raises(AttributeError):
+        problem.contact = None
+    assert Problem(problem.system).contributions == []
+    assert "contact" not in _names(PACKAGE / "assembly.py") - {"contacts", "in_contact"}
