@@ -23,7 +23,8 @@ def _contact_residual(contact, H):
 def test_state_round_trip_gives_the_same_contact_forces():
     model, slave, _ = rolling.build(mu=0.5, n_elements=3)
     sol = bs.solve(model, steps=2)
-    state = sol.contact_state
+    assert all(k.startswith("contact/") for k in sol.contact_state)     # Problem.get_state: name/key
+    state = {k[len("contact/"):]: v for k, v in sol.contact_state.items()}
     assert len(state["history.key"]) > 0 and "prev_owners" in state
     fresh = Problem.from_model(model).contact
     fresh.set_state(state)

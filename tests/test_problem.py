@@ -273,3 +273,36 @@ def test_problem_owns_the_contact_contribution():
         problem.contact = None
     assert Problem(problem.system).contributions == []
     assert "contact" not in _names(PACKAGE / "assembly.py") - {"contacts", "in_contact"}
+
+
+class _Counter(Contribution):
+    """No forces; a committed count under the key ``n`` (the same key in every instance)."""
+
+    def __init__(self, name):
+        self.name, self.n = name, 0
+
+    def evaluate(self, H, tangent=True):
+        return Blocks.empty(1, tangent), {}
+
+    def commit(self, H):
+        self.n += 1
+
+    def get_state(self):
+        return dict(n=np.array(self.n))
+
+    def set_state(self, state):
+        self.n = int(state["n"])
+
+
+def test_state_of_contributions_with_equal_keys_is_kept_apart():
+    m, *_ = _model()
+    system = System(m, check_rigid_modes=False)
+    a, b = _Counter("a"), _Counter("b")
+    problem = Problem(system, [a, b])
+    problem.commit(system.poses0)
+    a.commit(system.poses0)
+    state = problem.get_state()
+    assert set(state) == {"a/n", "b/n"} and (int(state["a/n"]), int(state["b/n"])) == (2, 1)
+    a2, b2 = _Counter("a"), _Counter("b")
+    Problem(system, [a2, b2]).set_state(state)
+    assert (a2.n, b2.n) == (2, 1)

@@ -149,3 +149,17 @@ def test_names_are_made_unique_and_life_cycle_defaults():
     H = problem.system.poses0
     problem.begin_step(H, 0.0)
     assert not problem.repeat_step(H) and problem.unmet(1.0) is None and problem.commit(H) is None
+
+
+class _NaNForces(GroundSprings):
+    def evaluate(self, H, tangent=True):
+        out = super().evaluate(H, tangent)
+        out.f[:] = np.nan
+        return out
+
+
+def test_non_finite_forces_of_a_contribution_are_named():
+    m, b = _cantilever(n=4)
+    m.add_contribution(_NaNForces(m, [b.last], 1.0))
+    with pytest.raises(bs.InputError, match=r"forces of contribution 'foundation' are not finite at nodes \[4\]"):
+        bs.solve(m, steps=1)
