@@ -362,9 +362,10 @@ class System:
         blocks into ``kvals`` (if given), the ``ElementState`` per element, force levels and ``M``."""
         fs, states, f_level, m_level = [], [], 0.0, 0.0
         M = self.node_transforms(H)
-        for g, a, b, et in zip(self.groups, self.group_kslices[:-1], self.group_kslices[1:], self.group_transformed):
-            m = 6 * g.element_type.n_nodes
-            out = None if kvals is None else kvals[a:b].reshape(len(g.nodes), m, m)
+        for j, g in enumerate(self.groups):
+            m, et = 6 * g.element_type.n_nodes, self.group_transformed[j]
+            out = None if kvals is None else \
+                kvals[self.group_kslices[j]:self.group_kslices[j + 1]].reshape(len(g.nodes), m, m)
             f, K, state = g.element_type.evaluate(H, g.nodes, g.ref, kvals is not None, out)
             levels = np.abs(f).max(axis=0, initial=0.0).reshape(-1, 3).max(axis=1)   # f, m of each node
             f_level, m_level = max(f_level, *levels[0::2]), max(m_level, *levels[1::2])
@@ -377,10 +378,10 @@ class System:
                 f[et] = np.einsum("nij,nj->ni", Tt, f[et])
                 if K is not None:
                     K[et] = Tt @ K[et] @ T
+            if len(self.groups) == 1:
+                return f.ravel(), state, f_level, m_level, M
             fs.append(f.ravel())
             states.append(state)
-        if len(self.groups) == 1:
-            return fs[0], states[0], f_level, m_level, M
         n = self.n_elements
         merged = [np.empty((n, 6)) for _ in range(3)]
         for g, state in zip(self.groups, states):

@@ -138,7 +138,7 @@ def cantilever():
 
 
 def test_cantilever_converges_to_the_two_node_answer(cantilever):
-    """Under refinement both elements reach the same tip; the 3-node error falls at least as h^2
+    """Under refinement both elements reach the same tip; the 3-node error falls as h^4
     (measured rate in ``benchmarks/element_convergence.py``)."""
     ns, tips3, tips2 = cantilever
     # the two-node element converges as h^2: Richardson from 32 and 64 elements
@@ -146,7 +146,7 @@ def test_cantilever_converges_to_the_two_node_answer(cantilever):
     err3 = np.array([np.linalg.norm(tips3[n] - ref) for n in ns])
     assert err3[-1] < 1e-6, err3
     rate = -np.polyfit(np.log(ns), np.log(err3), 1)[0]
-    assert rate > 2.0, (rate, err3)
+    assert rate > 3.5, (rate, err3)          # measured 3.9: h^4
     # at equal unknowns (8 three-node vs 16 two-node elements) the three-node element is closer
     assert err3[-1] < np.linalg.norm(_cantilever_tip(16, "se3-2") - ref)
 

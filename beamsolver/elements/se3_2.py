@@ -23,7 +23,8 @@ class SE3Two(ElementType):
         return Reference(L, eps0, C, is_diagonal(C))
 
     def evaluate(self, H, nodes, ref, tangent, out=None):
-        H, nodes = self.poses(H, nodes)
+        if nodes is None:
+            H, nodes = self.poses(H, nodes)
         return element.evaluate_nodes(H, nodes, ref.L, ref.eps0, ref.C, tangent, out, ref.diagonal)
 
     def interpolate(self, H_el, e, xi):
