@@ -105,13 +105,14 @@ def measure(n):
 def loop_rate(n=LOOP_SUBSET):
     """Elements per second of the same kernel called once per element (plain Python loop)."""
     system, H = scene(n)
-    HA, HB = H[system.enodes[:, 0]], H[system.enodes[:, 1]]
-    L, eps0, C = system.L, system.eps0, system.C
+    group = system.groups[0]
+    etype, nodes, ref = group.element_type, group.nodes, group.ref
+    refs = [bs.elements.Reference(ref.L[e:e + 1], ref.eps0[e:e + 1], ref.C[e:e + 1], ref.diagonal)
+            for e in range(n)]
 
     def loop():
         for e in range(n):
-            element.internal_forces_and_tangent(HA[e:e + 1], HB[e:e + 1], L[e:e + 1], eps0[e:e + 1],
-                                                C[e:e + 1])
+            etype.evaluate(H, nodes[e:e + 1], refs[e], True)
     return n / _best(loop, min_time=0.5, max_repeat=5)
 
 
