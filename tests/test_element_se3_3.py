@@ -225,3 +225,23 @@ def test_rotation_limit_of_the_type_stops_the_solver():
     m.add_load(b.last, moment=(0.0, 0.0, 1.2 * np.pi * SEC.C[5, 5]))
     with pytest.raises(bs.ConvergenceError, match="MAX_ELEMENT_ROTATION"):
         bs.solve(m, steps=4, min_step_ratio=2.0**-4)
+
+
+def test_a_step_through_pi_of_the_mid_pair_is_refused():
+    """The continuity check reads every logarithm pair of the type: a 3-node element whose
+    mid node turns from 0.7 pi to 1.3 pi within one step is refused, naming the element."""
+    from beamsolver import solver
+    m = bs.Model()
+    bs_ = [m.add_beam(geometry.straight((0, y, 0), (1, y, 0), 2), SEC, element="se3-3") for y in (0.0, 1.0)]
+    for b in bs_:
+        m.clamp(b.first)
+    newton = solver._Newton(System(m), solver.Convergence(), True, None)
+
+    def poses(angle):
+        H = m.poses0.copy()
+        H[4, :3, :3] = se3.exp_so3([0.0, 0.0, angle])        # mid node of the second element
+        return H
+    assert len(newton.sys.rotation_pairs) == 4
+    newton._check_continuity(poses(0.7 * np.pi), poses(0.75 * np.pi))
+    with pytest.raises(solver._StepFailed, match="element 1 .*may have passed pi"):
+        newton._check_continuity(poses(0.7 * np.pi), poses(1.3 * np.pi))
