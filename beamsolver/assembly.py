@@ -216,9 +216,9 @@ class System:
             if ra != rb:
                 parent[ra] = rb
         for g in self.groups:
-            for nodes in g.nodes:
+            for nodes in g.nodes.tolist():
                 for b in nodes[1:]:
-                    union(int(nodes[0]), int(b))
+                    union(nodes[0], b)
         for i in range(n):
             union(i, int(self.rep[i]))
         for decl in model.contacts:
