@@ -200,6 +200,10 @@ def test_mixed_model_solves_and_draws(tmp_path):
     # points of the 3-node beam are its own interpolation; its nodes are among them
     for node in b2.nodes:
         assert np.abs(P[:, :3, 3] - sol.position(node)).sum(axis=1).min() < 1e-12
+    # node fields run piecewise linear through all nodes of an element: the mid node's value at xi = 1/2
+    F = lay.node_field(np.arange(m.n_nodes, dtype=float)[:, None] ** 2)
+    at = lay.point_index[(lay.point_el == b2.elements[1]) & (lay.point_xi == 0.5)]
+    assert F[at, 0].tolist() == [float(b2.nodes[3]) ** 2]
     loaded = bs.load(tmp_path)
     np.testing.assert_array_equal(LineLayout(loaded.description, refine=4).poses(loaded.poses[-1]), P)
 
