@@ -1,7 +1,7 @@
 """The element contract: what an element type provides to the model, the assembly, the solver and the output.
 
 An element type maps the poses of its ``k`` nodes to body-frame nodal forces
-and their tangent, batched over elements (docs/theory.md eqs. 12.1-12.2):
+and their tangent, batched over elements (docs/theory.md eqs. 14.1-14.2):
 
 - ``reference(P0, C)``: reference data from reference poses ``(n, k, 4, 4)``
   and section stiffnesses ``(n, 6, 6)`` (``Reference``: length ``L``, the

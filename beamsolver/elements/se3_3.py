@@ -2,7 +2,7 @@
 
 Nodes 0, 1, 2 sit at ``s = 0, 1/2, 1`` along the element.  With the relative
 twists ``h_i = log(H_0^-1 H_i)`` (``i = 1, 2``) and the quadratic Lagrange
-functions ``N_1 = 4 s (1 - s)``, ``N_2 = s (2 s - 1)`` (docs/theory.md eqs. 12.3-12.7):
+functions ``N_1 = 4 s (1 - s)``, ``N_2 = s (2 s - 1)`` (docs/theory.md eqs. 14.3-14.7):
 
 - poses ``H(s) = H_0 exp(hat(phi(s)))``, ``phi = N_1 h_1 + N_2 h_2``; a beam at
   constant strain ``e`` has ``h_i = s_i L e``, so ``phi = s L e`` is linear and
