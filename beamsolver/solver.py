@@ -4,8 +4,8 @@ Per step ``t -> t + dt``: loads are evaluated at ``t + dt``; the first
 iteration carries the prescribed motions into the free unknowns through the
 tangent (``K_ff dz_f = -r_f - K_fc dz_c``), later iterations are Newton
 ``K dz = -r``, damped on the size of the Newton correction for a smooth problem
-(``_Newton._damped``) and by a backtracking line search on the scaled residual
-otherwise (``_Newton._line_search``).  The physics is reached only through the
+(``Newton._damped``) and by a backtracking line search on the scaled residual
+otherwise (``Newton._line_search``).  The physics is reached only through the
 ``problem.Problem`` interface (residual, tangent, update, step life cycle).
 Elements may not turn by more than ``MAX_ELEMENT_ROTATION`` (nor pass pi
 within a step): such steps fail with a message saying how many elements the
@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import diagnosis, linsolve, se3
+from . import diagnosis, elements, linsolve, se3
 from .errors import InputError
 from .failures import DampingStalled, Diverged, NonFinite, NotConverged, RotationLimit, SingularTangent, StepFailed
 from .problem import Problem
@@ -29,13 +29,12 @@ from .stabilize import from_option as stabilize_option
 from .stepping import Run
 from .validation import check_solve_arguments, check_stability_options
 
-_StepFailed = StepFailed      # the base of the typed failures (``beamsolver.failures``)
 
-__all__ = ["solve", "Convergence"]
+__all__ = ["solve", "Convergence", "Newton"]
 
 log = logging.getLogger("beamsolver")
 
-MAX_ELEMENT_ROTATION = 0.8 * np.pi   # an iterate turning an element further is rejected
+MAX_ELEMENT_ROTATION = elements.MAX_ELEMENT_ROTATION   # an iterate turning an element further is rejected
 LS_GROWTH = 10.0                     # full Newton steps are kept unless the merit grows this much
 DAMPING_MIN = 1.0 / 64.0             # shortest damped Newton step (smooth problems)
 STALL_RATIO = 1.5                    # undamped fallback if the shortest damped step grows the correction less
@@ -118,8 +117,9 @@ def _solve_linear(lu, rhs):
 
 
 def _relative_rotations(system, H):
-    """Rotations ``R_A^T R_B`` between the two nodes of every element, ``(n_elements, 3, 3)``."""
-    en = system.enodes
+    """Rotations ``R_i^T R_j`` of the node pairs an element represents by a logarithm
+    (``system.rotation_pairs``: one per element for two-node elements), ``(n_pairs, 3, 3)``."""
+    en = system.rotation_pairs
     return np.swapaxes(H[en[:, 0], :3, :3], 1, 2) @ H[en[:, 1], :3, :3]
 
 
@@ -138,7 +138,8 @@ def _largest_element_rotation(system, H):
 def _refine_advice(system, H, t, t_start, t_end):
     """How many elements the beams whose elements turn most would need (rotations taken to grow
     in proportion to the pseudo-time), as a message tail."""
-    ang = _angle(_relative_rotations(system, H))
+    ang = np.zeros(system.n_elements)
+    np.maximum.at(ang, system.pair_element, _angle(_relative_rotations(system, H)))   # per element
     grow = (t_end - t_start) / (t - t_start) if t > t_start else 1.0
     parts = []
     for b in system.model.beams:
@@ -153,13 +154,15 @@ def _refine_advice(system, H, t, t_start, t_end):
     return "".join("; " + p for p in parts)
 
 
-class _Newton:
-    """Newton iterations of one step (``step``) on a ``problem.Problem``; ``timings`` accumulates
-    the wall time of ``assembly`` (residual, tangent, sparse matrix), of each of the problem's
-    contributions (``Problem.timing_names``, part of assembly) and ``linear_solve``
-    (factorisation and solves) until ``reset_timings``."""
+class Newton:
+    """Newton iterations of one step (``step``) on a ``problem.Problem`` with the ``Convergence``
+    ``conv``; ``evaluate`` is the checked, timed evaluation it uses (also for branch switching),
+    ``last_evaluation`` that of the last converged state.  ``timings`` accumulates the wall time
+    of ``assembly`` (residual, tangent, sparse matrix), of each of the problem's contributions
+    (``Problem.timing_names``, part of assembly) and ``linear_solve`` (factorisation and solves)
+    until ``reset_timings``."""
 
-    def __init__(self, problem, conv, line_search, callback):
+    def __init__(self, problem, conv, line_search=True, callback=None):
         self.problem = problem
         self.sys = system = problem.system
         self.conv = conv
@@ -196,13 +199,14 @@ class _Newton:
 
     def _check_rotation(self, state):
         ang = se3.rotation_angle(state.h[:, 3:])
-        worst = int(np.argmax(ang)) if len(ang) else 0
-        if len(ang) and ang[worst] > MAX_ELEMENT_ROTATION:
+        limit = self.sys.rotation_limit          # of each element's type, MAX_ELEMENT_ROTATION for se3-2
+        worst = int(np.argmax(ang - limit)) if len(ang) else 0
+        if len(ang) and ang[worst] > limit[worst]:
             raise RotationLimit(f"{self._element_label(worst)} turns by {ang[worst]:.4f} rad within one element "
-                                f"(limit MAX_ELEMENT_ROTATION = {MAX_ELEMENT_ROTATION / np.pi:.2g} pi = "
-                                f"{MAX_ELEMENT_ROTATION:.4f} rad; an element cannot turn by pi): refine the mesh")
+                                f"(limit MAX_ELEMENT_ROTATION = {limit[worst] / np.pi:.2g} pi = "
+                                f"{limit[worst]:.4f} rad; an element cannot turn by pi): refine the mesh")
 
-    def _check_continuity(self, H0, H1):
+    def check_continuity(self, H0, H1):
         """Refuse a step over which an element's relative rotation may have passed through pi.
 
         The element only sees ``log(H_A^-1 H_B)``, whose angle lies in ``[0, pi]``: an element
@@ -218,7 +222,8 @@ class _Newton:
         bad = np.flatnonzero(change >= (np.pi - _angle(R0)) + (np.pi - _angle(R1)) - 1e-9)
         if len(bad):
             e = int(bad[np.argmax(change[bad])])
-            raise RotationLimit(f"{self._element_label(e)} turns by {change[e]:.3f} rad within one element in "
+            raise RotationLimit(f"{self._element_label(self.sys.pair_element[e])} turns by {change[e]:.3f} rad "
+                                "within one element in "
                                 "one load step and may have passed pi, which an element cannot represent: "
                                 "use smaller steps or refine the mesh")
 
@@ -250,7 +255,9 @@ class _Newton:
             raise SingularTangent("the linear solve returned non-finite values")
         return lu, dzf
 
-    def _evaluate(self, H, t, tangent=True):
+    def evaluate(self, H, t, tangent=True):
+        """``Problem.evaluate`` timed into ``timings`` and checked (finite residual, element rotations
+        below ``MAX_ELEMENT_ROTATION``: ``NonFinite`` / ``RotationLimit``)."""
         t0 = time.perf_counter()
         ev = self.problem.evaluate(H, t, tangent=tangent)
         self.timings["assembly"] += time.perf_counter() - t0
@@ -310,7 +317,7 @@ class _Newton:
         stats_extra = {}
         for it in range(conv.max_iter + 1):
             if ahead is None:
-                ev = self._evaluate(H, t)
+                ev = self.evaluate(H, t)
                 lu = dzf = None
             else:
                 ev, lu, dzf = ahead
@@ -323,7 +330,7 @@ class _Newton:
                 self.callback(dict(t=t, iteration=it, residual=ratio, poses=H))
             verdict = conv.decide(ratio, last_inc, it, floor, final=dz_c is None)
             if verdict == CONVERGED:
-                self._check_continuity(H_start, H)
+                self.check_continuity(H_start, H)
                 if damped_its:
                     stats_extra["damped"] = damped_its
                 self.last_evaluation = ev     # of the converged state (its tangent: stability check)
@@ -408,7 +415,7 @@ class _Newton:
             self.stall_ratio = np.inf
             H1 = problem.update(H, lam * dz)
             try:
-                ev1 = self._evaluate(H1, t)
+                ev1 = self.evaluate(H1, t)
                 if self._ratio(ev1.r, conv.scales(ev1, self.L_ref)) <= conv.rtol:
                     return H1, lam, (ev1, None, None), None
                 lu1, d1 = self._direction(ev1)
@@ -440,7 +447,7 @@ class _Newton:
         best = (np.inf, H1)
         for _ in range(8):
             try:
-                phi = self._merit(self._evaluate(H1, t, tangent=False).r, scales)
+                phi = self._merit(self.evaluate(H1, t, tangent=False).r, scales)
             except StepFailed:
                 phi = np.inf
             if phi < best[0]:
@@ -562,13 +569,13 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     grid = np.linspace(t_start, t_end, int(steps) + 1)
     dt_min = _step_floor(min_step_ratio, grid)
     conv = Convergence(rtol=rtol, dtol=dtol, max_iter=max_iter)
-    newton = _Newton(problem, conv, line_search, callback)
+    newton = Newton(problem, conv, line_search, callback)
     newton.linsolver = linsolve.Solver(linear_solver)
     modes, branch_switching = check_stability_options(modes, branch_switching)
     stabilizer = stabilize_option(system, stabilize, check=problem.conservative)
     if stabilizer is not None:
         problem.contributions.append(stabilizer)
-    options = dict(allow_unmet_tolerance=allow_unmet_tolerance, advice=_advice(system, t_start, t_end),
+    options = dict(allow_unmet_tolerance=allow_unmet_tolerance, advice=_advice(problem, t_start, t_end),
                    check_stability=bool(check_stability or modes or branch_switching), modes=modes,
                    branch_switching=branch_switching, stabilizer=stabilizer)
     run = None
@@ -615,8 +622,10 @@ def _writer(output, system, checkpoint):
     return StepWriter(output, system, checkpoint=checkpoint)
 
 
-def _advice(system, t_start, t_end):
+def _advice(problem, t_start, t_end):
     """``advice(failure, rotation_limit, H, t)``: the tail of a ``ConvergenceError`` message."""
+    system = problem.system
+
     def advice(failure, rotation_limit, H, t):
         msg = str(failure)
         hint = "" if rotation_limit is None or rotation_limit == msg else \
@@ -628,6 +637,6 @@ def _advice(system, t_start, t_end):
         if failure.rotation or rotation_limit is not None or turned > 0.75 * MAX_ELEMENT_ROTATION:
             hint += _refine_advice(system, H, t, t_start, t_end)
         if not hint:
-            hint = diagnosis.advice(failure, system, H, t)
+            hint = diagnosis.advice(failure, problem, H, t)
         return hint
     return advice

@@ -51,7 +51,7 @@ def _cpu(fn):
 def one_iteration(problem, H):
     """CPU seconds of each part of one Newton iteration (contact evaluated afresh) and the
     number of active contact points."""
-    system, c = problem.system, problem.system.contact
+    system, c = problem.system, problem.contact
     problem.begin_step(H, 0.0)                     # a new step: nothing kept from the last evaluation
     for k in c.timings:
         c.timings[k] = 0.0

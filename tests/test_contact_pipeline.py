@@ -8,7 +8,7 @@ import numpy as np
 
 import beamsolver as bs
 from beamsolver import se3
-from beamsolver.assembly import System
+from beamsolver.problem import Problem
 from beamsolver.contact import pairs, projection
 from beamsolver.contact.system import TIMED
 
@@ -80,13 +80,14 @@ def test_kept_evaluation_equals_a_fresh_one_and_follows_state_changes():
     sol = bs.solve(model, steps=2)
     H = sol.poses[-1].copy()
     H[slave.nodes, 0, 3] += 1e-4
-    c = System(model).contact
-    c.set_state(sol.contact_state)
+    state = {k[len("contact/"):]: v for k, v in sol.contact_state.items()}     # Problem.get_state: name/key
+    c = Problem.from_model(model).contact
+    c.set_state(state)
     c.begin_step(sol.poses[-1], 1.0)
     r0, _, _, _ = _residual(c, H, False)               # a line-search trial, residual only
     r1, coo1, _, _ = _residual(c, H, True)              # the tangent at the same poses: kept
-    fresh = System(model).contact
-    fresh.set_state(sol.contact_state)
+    fresh = Problem.from_model(model).contact
+    fresh.set_state(state)
     fresh.begin_step(sol.poses[-1], 1.0)
     r2, coo2, _, _ = _residual(fresh, H, True)
     np.testing.assert_array_equal(r0, r2)
@@ -96,7 +97,7 @@ def test_kept_evaluation_equals_a_fresh_one_and_follows_state_changes():
     c.set_state({})
     c.begin_step(sol.poses[-1], 1.0)
     r3, _, _, _ = _residual(c, H, True)
-    none = System(model).contact
+    none = Problem.from_model(model).contact
     none.begin_step(sol.poses[-1], 1.0)
     np.testing.assert_array_equal(r3, _residual(none, H, True)[0])
     assert np.abs(r3 - r2).max() > 1e-6 * np.abs(r2).max()
@@ -104,9 +105,9 @@ def test_kept_evaluation_equals_a_fresh_one_and_follows_state_changes():
 
 def test_stage_timings_are_public_and_accumulate():
     model, _, _ = rolling.build(mu=0.5, n_elements=3)
-    system = System(model)
-    c = system.contact
-    H = system.poses0.copy()
+    problem = Problem.from_model(model)
+    c = problem.contact
+    H = problem.system.poses0.copy()
     c.begin_step(H, 0.0)
     assert set(c.timings) == set(TIMED) and all(v == 0.0 for v in c.timings.values())
     for _ in range(20):
