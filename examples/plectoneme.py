@@ -51,7 +51,7 @@ LK_MIN = 0.1                 # Lk = Tw + Wr is checked (relative error) from thi
 solve_options = dict(steps=40, stabilize=2e-2)   # for `beamsolver run examples/plectoneme.py`
 
 
-def build(turns=5.0, n_elements=16, mu=0.3, imperfection=1e-2, pull=PULL, E=200e9, nu=0.3):
+def build(turns=5.0, n_elements=16, mu=0.3, imperfection=1e-2, pull=PULL, E=200e9, nu=0.3, length=LENGTH):
     """Returns ``(model, plate node, (wire a, wire b))``, each wire a pair ``(lower, upper)`` of
     beams of ``n_elements // 2`` elements."""
     sec = bs.Section.circular(radius=R, E=E, nu=nu)
@@ -59,14 +59,14 @@ def build(turns=5.0, n_elements=16, mu=0.3, imperfection=1e-2, pull=PULL, E=200e
     half = n_elements // 2
     wires = []
     for x, name in ((R, "wire a"), (-R, "wire b")):
-        lo = model.add_beam(bs.geometry.straight((x, 0, 0), (x, 0, LENGTH / 2), half), sec, name=name + " lower")
-        up = model.add_beam(bs.geometry.straight((x, 0, LENGTH / 2), (x, 0, LENGTH), half), sec,
+        lo = model.add_beam(bs.geometry.straight((x, 0, 0), (x, 0, length / 2), half), sec, name=name + " lower")
+        up = model.add_beam(bs.geometry.straight((x, 0, length / 2), (x, 0, length), half), sec,
                             name=name + " upper")
         model.join(lo.last, up.first, rigid=True)
         model.clamp(lo.first)
         model.add_load(lo.last, force=(0.0, imperfection * pull, 0.0), scale=lambda t: 1.0)
         wires.append((lo, up))
-    plate = model.add_node((0.0, 0.0, LENGTH), name="plate")
+    plate = model.add_node((0.0, 0.0, length), name="plate")
     for lo, up in wires:
         model.join(plate, up.last, rigid=True)
     model.fix(plate, ("ux", "uy", "rx", "ry", "rz"), values={"rz": lambda t: 2.0 * np.pi * turns * t})
@@ -123,9 +123,10 @@ def onset(rows):
 
 
 def main(output=None, turns=5.0, steps=40, n_elements=16, mu=0.3, stabilize=2e-2, imperfection=1e-2,
-         verbose=False):
+         verbose=False, length=LENGTH, pull=PULL):
     """Solve, print the table and the checks; returns ``(solution, rows, wall time, checks)``."""
-    model, plate, wires = build(turns=turns, n_elements=n_elements, mu=mu, imperfection=imperfection)
+    model, plate, wires = build(turns=turns, n_elements=n_elements, mu=mu, imperfection=imperfection,
+                                 length=length, pull=pull)
     t0 = time.perf_counter()
     try:
         sol = bs.solve(model, steps=steps, output=output, verbose=verbose, stabilize=stabilize)
@@ -134,8 +135,8 @@ def main(output=None, turns=5.0, steps=40, n_elements=16, mu=0.3, stabilize=2e-2
         sol = e.solution
     wall = time.perf_counter() - t0
     rows = table(sol, plate, wires, turns)
-    print(f"plectoneme: 2 wires R = {R * 1e3:g} mm, L = {LENGTH * 1e3:g} mm, {n_elements} elements each, mu = {mu}, "
-          f"{turns:g} turns in {steps} steps, stabilize = {stabilize}, imperfection {imperfection:g} x pull")
+    print(f"plectoneme: 2 wires R = {R * 1e3:g} mm, L = {length * 1e3:g} mm, pull {pull:g} N, "
+          f"{n_elements} elements each, mu = {mu}, {turns:g} turns in {steps} steps, stabilize = {stabilize}, imperfection {imperfection:g} x pull")
     print("| " + " | ".join(COLUMNS) + " |")
     print("|" + "---:|" * len(COLUMNS))
     for lk, tq, z, tw, wr, err, fw, fd, nc, it in rows:
@@ -145,7 +146,7 @@ def main(output=None, turns=5.0, steps=40, n_elements=16, mu=0.3, stabilize=2e-2
     worst = max((r[5] for r in rows if r[0] >= LK_MIN), default=np.nan)     # relative error: Lk not near 0
     tw_c, m_c = onset(rows)
     checks = dict(reached=turns * sol.times[-1], lk_error=worst, onset_turns=tw_c, onset_torque=m_c,
-                  onset_ratio=m_c * LENGTH / B, wall=wall, writhe=rows[-1][6])
+                  onset_ratio=m_c * length / B, wall=wall, writhe=rows[-1][6])
     print(f"reached {checks['reached']:.3f} of {turns:g} turns in {wall:.1f} s; Newton iterations "
           f"{int(sol.iterations.sum())}; writhe at the end {rows[-1][6]:.1%} of Lk")
     print(f"Lk = Tw + Wr: largest |Lk - Tw - Wr| / Lk {worst:.2e} ({'within' if worst <= 0.02 else 'NOT within'} 2 %)")
@@ -174,6 +175,8 @@ if __name__ == "__main__":
     ap.add_argument("--mu", type=float, default=0.3)
     ap.add_argument("--stabilize", type=float, default=2e-2)
     ap.add_argument("--imperfection", type=float, default=1e-2)
+    ap.add_argument("--length", type=float, default=LENGTH, help="wire length [m]")
+    ap.add_argument("--pull", type=float, default=PULL, help="dead pull on the plate [N]")
     a = ap.parse_args()
     main(output=a.output, turns=a.turns, steps=a.steps, n_elements=a.elements, mu=a.mu, stabilize=a.stabilize,
-         imperfection=a.imperfection, verbose=True)
+         imperfection=a.imperfection, verbose=True, length=a.length, pull=a.pull)

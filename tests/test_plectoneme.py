@@ -39,3 +39,11 @@ def test_self_contact_is_declared_between_the_wire_halves():
     (a_lo, a_up), (b_lo, b_up) = wires
     assert (a_lo.id, a_up.id) in pairs and (b_lo.id, b_up.id) in pairs
     assert len(plectoneme.wire_nodes(wires[0])) == 9
+
+
+def test_length_and_pull_are_build_arguments():
+    model, plate, wires = plectoneme.build(n_elements=8, length=0.06, pull=50.0)
+    z = model.poses0[plectoneme.wire_nodes(wires[0]), 2, 3]
+    assert z[-1] == pytest.approx(0.06) and z[4] == pytest.approx(0.03)
+    pulls = [ld.force[2] for ld in model.loads if ld.node == plate]
+    assert pulls == [pytest.approx(50.0)]
