@@ -32,10 +32,23 @@ Measured (16 elements per wire, 40 steps, one run each on a loaded 2-core machin
   8.31 N m (``M L / B = 8.47``; the frictionless tangent turns indefinite at 8.36), the wires
   separate into two loops, stops at 1.64 turns with ``Wr / Lk = 0.56``.
 
+Longer pairs (``--length 0.06 --pull 50 --elements 24 --steps 50``: ``sqrt(B / F) = 20 mm``, a
+third of the length, so that a loop fits) writhe later and further but still stop once one loop
+has formed (``Wr`` about 1 turn, the plate fallen from 60 to about 30 mm), as the loop closes on
+itself: defaults 2.78 turns (onset 2.6 turns, 4.22 N m; dissipated 0.40); ``--stabilize 0.2``
+3.63 turns (dissipated 0.33); ``--pull 200`` 3.32 turns (0.24); ``--pull 100 --stabilize 0.2``
+3.51 turns, ``Wr / Lk = 0.42`` (0.41); ``--elements 32 --stabilize 0.2`` 3.37 turns,
+``Wr / Lk = 0.55`` (0.76); ``--mu 0`` 2.43 turns, onset at 2.23 turns and 3.58 N m (the
+tension-stiffened Greenhill estimate ``M = 2 B sqrt((4.49 / L)^2 + F / B)`` gives 3.54).
+``|Lk - Tw - Wr| / Lk <= 6.4e-3`` in all of them.  At ``--length 0.1`` (24 or 40 elements) the
+contact of the straight touching wires finds no equilibrium at ``t = 0`` (Newton stalls at a
+scaled residual of 2e-3, also without friction or imperfection; 0.06 m is fine).
+
 The writhing torque with friction lies above Greenhill's ``8.99 B / L`` for ``B = 2 E I``: the
 sticking wires bend stiffer than two free ones, and the damping delays the snap.
 
     python examples/plectoneme.py [--output plectoneme_output] [--turns 5] [--steps 40] [--mu 0.3] [--stabilize 2e-2]
+        [--elements 16] [--imperfection 1e-2] [--length 0.02] [--pull 5]
 """
 import argparse
 import time
