@@ -40,7 +40,8 @@ itself: defaults 2.78 turns (onset 2.6 turns, 4.22 N m; dissipated 0.40); ``--st
 3.51 turns, ``Wr / Lk = 0.42`` (0.41); ``--elements 32 --stabilize 0.2`` 3.37 turns,
 ``Wr / Lk = 0.55`` (0.76); ``--mu 0`` 2.43 turns, onset at 2.23 turns and 3.58 N m (the
 tension-stiffened Greenhill estimate ``M = 2 B sqrt((4.49 / L)^2 + F / B)`` gives 3.54).
-``|Lk - Tw - Wr| / Lk <= 6.4e-3`` in all of them.  At ``--length 0.1`` (24 or 40 elements) the
+48 elements, 80 steps, a ten times softer contact penalty or a five times wider smoothing
+change this by less than 0.3 turn.  ``|Lk - Tw - Wr| / Lk <= 6.7e-3`` in all of them.  At ``--length 0.1`` (24 or 40 elements) the
 contact of the straight touching wires finds no equilibrium at ``t = 0`` (Newton stalls at a
 scaled residual of 2e-3, also without friction or imperfection; 0.06 m is fine).
 
