@@ -25,12 +25,12 @@ def contact_restore(contact, state):
 
 def restart_from(restart, model, system):
     """The ``Solution`` to continue (a copy bound to ``model``) from a Solution or a saved file."""
-    if not hasattr(restart, "_poses"):
-        from .results import load
+    from .results import Solution, load
+    if not isinstance(restart, Solution):
         restart = load(restart)
-    if not restart._times:
+    if not len(restart.times):
         raise InputError("solve: the restart solution has no steps")
-    H = restart._poses[-1]
+    H = restart.poses[-1]
     P0 = restart.description["poses0"]
     if H.shape[0] != model.n_nodes or P0.shape != system.poses0.shape or \
             np.abs(P0 - system.poses0).max() > 1e-9 * system.length_scale:

@@ -458,7 +458,7 @@ def _starting_point(restart, model, system, t_start, t_end):
     sol = None
     if restart is not None:
         sol = restart_from(restart, model, system)
-        t_start = sol._times[0]
+        t_start = float(sol.times[0])
     if not (np.isfinite(t_end) and np.isfinite(t_start) and t_end > t_start):
         raise InputError(f"solve: need t_end > t_start, got t_start={t_start!r}, t_end={t_end!r}")
     return sol, t_start

@@ -42,7 +42,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from ..errors import InputError
-from .files import follow_umask, previous_series
+from ..files import follow_umask, previous_series
 from .lines import LineLayout
 
 __all__ = ["StepWriter", "write_vtk", "write_pvd"]
@@ -152,16 +152,16 @@ class StepWriter:
             if self.contact is None:
                 self.contact = int(solution.description.get("n_contact_declarations", 0)) > 0
         lay = self.layout
-        H = solution._poses[step]
-        t = solution._times[step]
-        pdata, points = lay.point_data(H)
-        cdata = lay.cell_data(solution._sigma[step], solution._strain[step])
+        rec = solution.step(step)
+        t = rec.time
+        pdata, points = lay.point_data(rec.poses)
+        cdata = lay.cell_data(rec.section_forces, rec.strains)
         mesh = meshio.Mesh(points, [("line", lay.segments)], point_data=pdata,
                            cell_data={k: [v] for k, v in cdata.items()})
         self._write_mesh(self.folder / self._name(BEAMS, step), mesh)
         if self.contact:
             path = self.folder / self._name(CONTACT, step)
-            table = solution.contacts[step]
+            table = rec.contact
             if len(active_points(table)):
                 self._write_mesh(path, contact_mesh(table))
             else:
@@ -245,7 +245,7 @@ def _write_empty_points(path):
 def write_vtk(solution, folder, steps=None, refine=8, compression="zlib"):
     """Write the steps (default all) of a (saved or fresh) ``solution`` to ``folder``; returns the .pvd path."""
     writer = StepWriter(folder, None, refine=refine, compression=compression, checkpoint=None)
-    n = len(solution._times)
+    n = len(solution)
     for k in (range(n) if steps is None else [s % n for s in steps]):
         writer.write(solution, k)
     writer.close()
