@@ -12,9 +12,11 @@ Fallbacks: Debian ``libosmesa6`` (then set ``VTK_DEFAULT_OPENGL_WINDOW=
 vtkOSOpenGLRenderWindow``), or run under ``xvfb-run``.
 """
 import os
+from pathlib import Path
 
 import numpy as np
 
+from .errors import InputError
 from .io.lines import FORCE_NAMES, LineLayout
 
 __all__ = ["render", "plot_history", "FIELDS"]
@@ -30,6 +32,19 @@ def _pyvista():
     except ImportError as e:
         raise ImportError("beamsolver.viz.render needs pyvista: pip install 'beamsolver[viz]'") from e
     return pyvista
+
+
+def _folder_for(path, owner):
+    """Create the folder of the image file ``path`` (``InputError`` naming it if that fails)."""
+    if path is None:
+        return None
+    parent = Path(path).parent
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise InputError(f"{owner}: cannot create the folder of path {str(path)!r} "
+                         f"({e.strerror or e})") from None
+    return path
 
 
 def _lines(pv, solution, step, refine):
@@ -91,6 +106,7 @@ def render(solution, step=-1, path=None, color_by="displacement", component=None
     ``"xy"``, ``"xz"``, ``"yz"`` or ``"iso"``; ``zoom`` > 1 magnifies.
     ``contacts``: draw the active contact points as red spheres.
     """
+    _folder_for(path, "render")
     pv = _pyvista()
     n = len(solution)
     steps = [step] if np.ndim(step) == 0 else list(step)
@@ -242,6 +258,6 @@ def plot_history(solution, what="reaction", node=None, component=None, path=None
     if len(whats) > 1:
         ax.legend(lines, [ln.get_label() for ln in lines])
     ax.grid(True, alpha=0.3)
-    if path is not None:
+    if _folder_for(path, "plot_history") is not None:
         fig.savefig(path, dpi=100, bbox_inches="tight")
     return fig
