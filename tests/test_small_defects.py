@@ -127,3 +127,16 @@ def test_render_into_a_file_as_folder_names_it(tmp_path):
     sol = bs.solve(m, steps=1)
     with pytest.raises(bs.InputError, match=r"render: cannot create the folder of path '.*afile/x\.png' \("):
         viz.render(sol, path=tmp_path / "afile" / "x.png", window_size=(64, 48))
+
+
+# ------------------------------------------------------------------ packaging
+def test_pyproject_license_and_extras():
+    """SPDX license string (no setuptools deprecation warning on install; needs setuptools >= 77)
+    and bokeh in ``[distributed]`` (the dashboard every sweep prints the address of)."""
+    tomllib = pytest.importorskip("tomllib")
+    from pathlib import Path
+    meta = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml").read_text())
+    assert meta["project"]["license"] == "MIT"
+    assert "setuptools>=77" in meta["build-system"]["requires"]
+    assert any(r.replace(" ", "").startswith("bokeh>=3.1") for r in meta["project"]["optional-dependencies"]
+               ["distributed"])
