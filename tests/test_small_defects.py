@@ -140,3 +140,31 @@ def test_pyproject_license_and_extras():
     assert "setuptools>=77" in meta["build-system"]["requires"]
     assert any(r.replace(" ", "").startswith("bokeh>=3.1") for r in meta["project"]["optional-dependencies"]
                ["distributed"])
+
+
+# ------------------------------------------------------------------ contact projection
+def test_projection_branches_not_taken_never_overflow():
+    """Two crossing beams in small units, rotated by a rotation vector of 1e-300 (the case
+    hypothesis found in tests/test_invariance_property.py): the LINE step of the crossing
+    pairs divides by ``x2' . e1`` ~ 1e-303, a value ``where`` then throws away.  It must not
+    warn (overflow), and the answer is that of the unrotated scene."""
+    def crossing(G, lam=0.01):
+        r = 0.05 * lam
+        sec = bs.Section.circular(radius=r, E=1e7 / lam**2, nu=0.3)
+        m = bs.Model()
+        lower = m.add_beam(G @ bs.geometry.straight((0, -lam, 0), (0, lam, 0), 7), sec)
+        upper = m.add_beam(G @ bs.geometry.straight((-lam, 0, 2 * r), (lam, 0, 2 * r), 7), sec)
+        for node in (lower.first, lower.last, upper.first, upper.last):
+            m.clamp(node)
+        m.add_load(upper.nodes[3], force=G[:3, :3] @ np.array([0.0, 0.0, -50.0]))
+        m.add_contact(lower, upper)
+        return bs.solve(m, steps=1, verbose=False), upper.nodes[3]
+    G = np.eye(4)
+    G[:3, 3] = (0.0, 0.0, -1.0)
+    ref, node = crossing(G)
+    G[:3, :3] = bs.se3.exp_so3(np.array([1e-300, 0.0, 0.0]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sol, _ = crossing(G)
+    assert sol.contact()["normal_force"].sum() > 1.0
+    np.testing.assert_allclose(sol.position(node), ref.position(node), rtol=0, atol=1e-12)
