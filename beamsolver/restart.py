@@ -9,6 +9,7 @@ augmented-Lagrangian multipliers and point set (``Solution.contact_state``).
 import numpy as np
 
 from .errors import InputError
+from .results import Solution, load
 
 __all__ = ["restart_from", "contact_snapshot", "contact_restore"]
 
@@ -25,7 +26,6 @@ def contact_restore(contact, state):
 
 def restart_from(restart, model, system):
     """The ``Solution`` to continue (a copy bound to ``model``) from a Solution or a saved file."""
-    from .results import Solution, load
     if not isinstance(restart, Solution):
         restart = load(restart)
     if not len(restart.times):

@@ -85,20 +85,40 @@ class Step:
 
 
 class _Growing:
-    """A ``(s, *shape)`` array grown one step at a time: capacity doubles, reads are views."""
+    """A ``(s, *shape)`` array grown one step at a time, read as one array (a view).
+
+    A full buffer is not copied: the next steps go to a new chunk as large as everything so
+    far (so there are O(log s) chunks and each step is written once).  Reading joins the
+    chunks into one buffer with room for as many steps again, so reads after every append
+    copy O(s) only when a chunk was added: appending and reading stay amortised O(1).
+    """
 
     def __init__(self, shape, dtype=float):
-        self.data = np.empty((4,) + tuple(shape), dtype=dtype)
+        self.chunks, self.starts = [np.empty((4,) + tuple(shape), dtype=dtype)], [0]
+
+    @classmethod
+    def holding(cls, rows):
+        """A copy of the array ``rows`` (one row per step)."""
+        g = cls(rows.shape[1:], rows.dtype)
+        g.chunks = [np.array(rows) if len(rows) else g.chunks[0]]
+        return g
 
     def put(self, k, value):
-        if k >= len(self.data):
-            bigger = np.empty((2 * len(self.data),) + self.data.shape[1:], dtype=self.data.dtype)
-            bigger[:k] = self.data[:k]
-            self.data = bigger
-        self.data[k] = value
+        """Write step ``k`` (``k`` >= the start of the last chunk: a step is written in order)."""
+        if k - self.starts[-1] >= len(self.chunks[-1]):
+            self.chunks.append(np.empty((max(k, 4),) + self.chunks[0].shape[1:], dtype=self.chunks[0].dtype))
+            self.starts.append(k)
+        self.chunks[-1][k - self.starts[-1]] = value
 
     def view(self, n):
-        v = self.data[:n]
+        """The first ``n`` steps, read-only."""
+        if len(self.chunks) > 1:
+            one = np.empty((max(2 * n, 4),) + self.chunks[0].shape[1:], dtype=self.chunks[0].dtype)
+            ends = self.starts[1:] + [n]
+            for c, a, b in zip(self.chunks, self.starts, ends):
+                one[a:b] = c[:b - a]
+            self.chunks, self.starts = [one], [0]
+        v = self.chunks[0][:n]
         v.flags.writeable = False
         return v
 
@@ -191,6 +211,7 @@ class Solution:
         self.system = system
         self._description = description
         self._n = 0
+        self._last_time = None
         self._arrays = {}
         self._stats, self._contacts, self._extra = [], [], {}
         self.converged = True
@@ -243,9 +264,9 @@ class Solution:
         """A new ``Solution`` of ``model``/``system`` holding copies of these steps."""
         new = Solution(model, system, self._description if model is None else None)
         n = new._n = self._n
+        new._last_time = self._last_time
         for name, g in self._arrays.items():
-            new._arrays[name] = _Growing(g.data.shape[1:])
-            new._arrays[name].data = g.data[:max(n, 1)].copy()
+            new._arrays[name] = _Growing.holding(g.view(n))
         new._stats, new._contacts = list(self.stats), list(self.contacts)
         new._extra = {k: list(v) for k, v in self.extra.items()}
         new.resume = dict(self.resume)
@@ -261,7 +282,7 @@ class Solution:
 
     def _counts(self, H):
         if self._n:
-            return self._arrays["poses"].data.shape[1], self._arrays["section_forces"].data.shape[1]
+            return self._arrays["poses"].chunks[0].shape[1], self._arrays["section_forces"].chunks[0].shape[1]
         if self._description is not None:
             return len(self._description["poses0"]), len(self._description["enodes"])
         if self.system is not None:
@@ -273,7 +294,7 @@ class Solution:
         nn, ne = self._counts(H)
         if ne is None:
             ne = np.shape(sigma)[0] if np.ndim(sigma) == 2 else 0
-        values = dict(times=_time(where, t, float(self._arrays["times"].data[n - 1]) if n else None),
+        values = dict(times=_time(where, t, self._last_time),
                       poses=_array(where, "poses", H, (nn, 4, 4), "one pose per node"),
                       reactions=_array(where, "reactions", reactions, (nn, 6), "force and moment per node"),
                       section_forces=_array(where, "section_forces", sigma, (ne, 6), "per element"),
@@ -294,6 +315,7 @@ class Solution:
             self._extra.setdefault(name, [None] * n)
         for name, series in self._extra.items():
             series.append(extra.get(name))
+        self._last_time = values["times"]
         self._n = n + 1        # last: a step interrupted above is not recorded (``_trim``)
 
     def _trim(self):
@@ -369,7 +391,7 @@ class Solution:
         return int(step) % n
 
     def _node(self, node):
-        nn = self._arrays["poses"].data.shape[1] if self._n else 0
+        nn = self._arrays["poses"].chunks[0].shape[1] if self._n else 0
         if isinstance(node, (bool, np.bool_)) or int(node) != node or not 0 <= node < nn:
             raise InputError(f"Solution: unknown node id {node!r} (nodes 0..{nn - 1})")
         return int(node)

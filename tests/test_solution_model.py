@@ -135,6 +135,30 @@ def test_fields_are_read_only_views_and_appending_reallocates_rarely(solved):
     np.testing.assert_array_equal(new.times, np.arange(1000.0))
 
 
+def test_steps_written_without_reads_read_back_in_order(solved):
+    """Steps go to chunks (none copied while appending); the first read joins them in order, and a
+    view taken earlier keeps its values after later appends."""
+    _, _, sol = solved
+    new = empty_like(sol)
+    t, H, R, S, E, st = step_args(sol, 0)
+    early = None
+    for k in range(70):
+        HK = H.copy()
+        HK[:, :3, 3] += k
+        new.append(float(k), HK, R + k, S - k, E, dict(st, k=k))
+        if k == 5:
+            early = new.poses
+    assert np.array_equal(new.times, np.arange(70.0)) and [s["k"] for s in new.stats] == list(range(70))
+    np.testing.assert_array_equal(new.poses[:, :, :3, 3] - H[:, :3, 3], np.arange(70.0)[:, None, None]
+                                  * np.ones((70, 5, 3)))
+    np.testing.assert_array_equal(new.reactions[:, 0, 0], np.arange(70.0) + R[0, 0])
+    np.testing.assert_array_equal(new.section_forces[:, 1, 2], S[1, 2] - np.arange(70.0))
+    assert early.shape[0] == 6 and np.array_equal(early, new.poses[:6])
+    copy = new.copy_steps()
+    copy.append(70.0, H, R, S, E, st)
+    assert len(copy) == 71 and len(new) == 70 and np.array_equal(copy.poses[:70], new.poses)
+
+
 def test_step_record_and_extra(solved):
     _, _, sol = solved
     new = empty_like(sol)
