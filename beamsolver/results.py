@@ -3,7 +3,7 @@
 The data model is the docstring of ``Solution``.  ``append`` (one step) and
 ``Solution.from_steps`` (all at once) check shapes, finiteness and increasing times and raise ``InputError`` naming the field and the value.  ``step(k)`` gives
 one step as a ``Step`` record.  ``save`` writes everything to a versioned ``.npz`` file
-(``beamsolver.solution_file``, documented at ``beamsolver.io.archive``); ``load`` reads it.
+(format documented in ``beamsolver.solution_file``); ``load`` reads it.
 """
 from dataclasses import dataclass
 
@@ -256,7 +256,7 @@ class Solution:
     def save(self, path):
         """Write every field to ``path`` (.npz), atomically (temporary name, then rename).
 
-        Read it back with ``beamsolver.load``; the format is documented in ``beamsolver.io.archive``.
+        Read it back with ``beamsolver.load``; the format is documented in ``beamsolver.solution_file``.
         """
         return _save_file(self, path)
 
