@@ -1,9 +1,10 @@
 """The ``Solution`` of a solve: a public, validated record of every converged pseudo-time step.
 
 The data model is the docstring of ``Solution``.  ``append`` (one step) and
-``Solution.from_steps`` (all at once) check shapes, finiteness and increasing times and raise ``InputError`` naming the field and the value.  ``step(k)`` gives
-one step as a ``Step`` record.  ``save`` writes everything to a versioned ``.npz`` file
-(format documented in ``beamsolver.solution_file``); ``load`` reads it.
+``Solution.from_steps`` (all at once) check shapes, finiteness and increasing times and
+raise ``InputError`` naming the field and the value.  ``step(k)`` gives one step as a
+``Step`` record.  ``save`` writes everything to a versioned ``.npz`` file (format
+documented in ``beamsolver.solution_file``); ``load`` reads it.
 """
 from dataclasses import dataclass
 
