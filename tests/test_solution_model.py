@@ -6,6 +6,7 @@ Every bad field gives an ``InputError`` naming the field and the value; appendin
 ``linearize``, restart) work on a ``Solution`` built only through the public API; and no
 module outside ``results.py`` touches its private attributes.
 """
+import importlib.util
 import re
 import subprocess
 import sys
@@ -290,6 +291,9 @@ def test_consumers_use_only_public_fields(solved, tmp_path):
     from beamsolver import viz
     fig = viz.plot_history(pub, "reaction", node=b.first, component="fy")
     np.testing.assert_array_equal(fig.axes[0].lines[0].get_ydata(), sol.reactions[:, b.first, 1])
+    if importlib.util.find_spec("pyvista") is not None:
+        img = viz.render(pub, step=[0, -1], window_size=(64, 48))
+        assert img.shape == (48, 64, 3) and np.array_equal(img, viz.render(sol, step=[0, -1], window_size=(64, 48)))
     pub.save(tmp_path / "pub")
     out = subprocess.run([sys.executable, "-m", "beamsolver.cli", "info", str(tmp_path / "pub.npz")],
                          capture_output=True, text=True, cwd=tmp_path, timeout=300)
