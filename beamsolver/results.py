@@ -6,6 +6,7 @@ raise ``InputError`` naming the field and the value.  ``step(k)`` gives one step
 ``Step`` record.  ``save`` writes everything to a versioned ``.npz`` file (format
 documented in ``beamsolver.solution_file``); ``load`` reads it.
 """
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -133,16 +134,17 @@ def _array(where, name, value, shape, what):
                          f"got {type(value).__name__}") from None
     if a.shape != shape:
         raise InputError(f"{where}: {name} must have shape {shape} ({what}), got {a.shape}")
-    bad = ~np.isfinite(a)
-    if bad.any():
-        i = np.argwhere(bad)[0]
-        raise InputError(f"{where}: {name} must be finite, got {a[tuple(i)]} at index {tuple(int(j) for j in i)}")
+    if not math.isfinite(a.sum()):          # NaN and inf reach the sum; a finite sum: all finite
+        bad = np.argwhere(~np.isfinite(a))
+        if len(bad):
+            i = tuple(int(j) for j in bad[0])
+            raise InputError(f"{where}: {name} must be finite, got {a[i]} at index {i}")
     return a
 
 
 def _time(where, t, last):
     if isinstance(t, (bool, np.bool_)) or not isinstance(t, (int, float, np.integer, np.floating)) \
-            or not np.isfinite(t):
+            or not math.isfinite(t):
         raise InputError(f"{where}: times must be finite numbers, got t = {t!r}")
     if last is not None and not t > last:
         raise InputError(f"{where}: times must increase, got t = {float(t)!r} after {last!r}")

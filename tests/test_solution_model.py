@@ -77,6 +77,15 @@ def test_append_names_the_bad_field_and_value(solved, field, bad, match):
     assert new.n_steps == 1
 
 
+def test_huge_finite_values_are_accepted(solved):
+    """The finiteness check sums first; a sum that overflows from finite values is not an error."""
+    _, _, sol = solved
+    new = empty_like(sol)
+    t, H, R, S, E, st = step_args(sol, 0)
+    new.append(t, H, np.full_like(R, 1e308), S, E, st)
+    assert np.all(new.reactions == 1e308)
+
+
 def test_contact_and_extra_are_checked(solved):
     _, _, sol = solved
     new = empty_like(sol)
