@@ -134,7 +134,9 @@ def _array(where, name, value, shape, what):
                          f"got {type(value).__name__}") from None
     if a.shape != shape:
         raise InputError(f"{where}: {name} must have shape {shape} ({what}), got {a.shape}")
-    if not math.isfinite(a.sum()):          # NaN and inf reach the sum; a finite sum: all finite
+    with np.errstate(over="ignore"):
+        total = a.sum()
+    if not math.isfinite(total):            # NaN and inf reach the sum; a finite sum: all finite
         bad = np.argwhere(~np.isfinite(a))
         if len(bad):
             i = tuple(int(j) for j in bad[0])

@@ -5,7 +5,7 @@ A ``Solution`` of a straight beam of ``n`` elements is filled with ``S`` steps b
 table gives the mean time per append, the first read of ``sol.poses`` once all steps are in
 (it joins the chunks the steps were written to), later reads, and ``sol.position(node, k)``.  For comparison, the same steps kept as
 lists of copies (how ``Solution`` stored them before it grew arrays): the time per step of
-those copies, and of one stacking ``np.array(list)`` (what reading ``sol.poses`` cost then).
+those copies, and of stacking them ``np.array(list)`` (what every read of ``sol.poses`` cost then).
 Each number is the best of ``REPEATS`` runs (the machine is shared; the best is the least
 disturbed).  Run: ``python benchmarks/solution_append.py``; prints a table.
 """
@@ -41,13 +41,16 @@ def beam(n_elements):
 
 
 def lists(sol):
-    """Per-step time of the former append (a copy of each array into a list), and the lists."""
+    """The former storage: per-step time of its append (a copy of each array into a list), and
+    of its first read of ``poses`` (stacking the list into new memory, as ``filled`` measures)."""
     out = ([], [], [], [])
     t0 = time.perf_counter()
     for k in range(len(sol)):
         for lst, a in zip(out, (sol.poses[k], sol.reactions[k], sol.section_forces[k], sol.strains[k])):
             lst.append(np.array(a))
-    return (time.perf_counter() - t0) / len(sol), out[0]
+    t1 = time.perf_counter()
+    np.array(out[0])
+    return (t1 - t0) / len(sol), time.perf_counter() - t1
 
 
 def best(fn, repeats=5):
@@ -60,20 +63,23 @@ def best(fn, repeats=5):
 
 
 def main():
-    head = ("elements", "steps", "append [us/step]", "first read [ms]", "read poses [us]", "position [us]", "lists: append [us/step]",
-            "lists: read poses [ms]")
+    head = ("elements", "steps", "append [us/step]", "first read [ms]", "read poses [us]", "position [us]",
+            "lists: append [us/step]", "lists: read poses [ms]")
     print(" | ".join(head))
     for n_elements in (10, 1000):
         model = beam(n_elements)
         for n_steps in (100, 1000, 3000):
-            runs = [filled(model, n_steps) for _ in range(REPEATS)]
-            sol, per, first = runs[-1][0], min(r[1] for r in runs), min(r[2] for r in runs)
-            per_list, steps = min((lists(sol) for _ in range(REPEATS)), key=lambda r: r[0])
-            del runs
+            per = first = np.inf
+            for _ in range(REPEATS):           # one solution alive at a time (memory reused, as for the lists)
+                sol = None
+                sol, p, f = filled(model, n_steps)
+                per, first = min(per, p), min(first, f)
+            old = [lists(sol) for _ in range(REPEATS)]
+            per_list, first_list = min(r[0] for r in old), min(r[1] for r in old)
             print(" | ".join([f"{n_elements:8d}", f"{n_steps:5d}", f"{1e6 * per:16.1f}", f"{1e3 * first:15.2f}",
                               f"{1e6 * best(lambda: sol.poses):15.2f}",
                               f"{1e6 * best(lambda: sol.position(0, n_steps // 2)):13.2f}",
-                              f"{1e6 * per_list:23.1f}", f"{1e3 * best(lambda: np.array(steps)):22.2f}"]))
+                              f"{1e6 * per_list:23.1f}", f"{1e3 * first_list:22.2f}"]))
 
 
 if __name__ == "__main__":
