@@ -168,12 +168,18 @@ def _table(where, contact):
 
 
 def _extra(where, extra):
+    """Per-step values by name: numbers, bools, strings or arrays of them (what ``save`` stores)."""
     if extra is None:
         return {}
     if not isinstance(extra, dict) or not all(isinstance(k, str) and k for k in extra):
         raise InputError(f"{where}: extra must be a dict keyed by non-empty names, got {extra!r}")
-    return {k: np.asarray(v) if isinstance(v, (list, tuple, np.ndarray)) else v.item() if isinstance(v, np.generic)
-            else v for k, v in extra.items()}
+    out = {}
+    for k, v in extra.items():
+        a = np.asarray(v)
+        if a.dtype.kind not in "biufU":
+            raise InputError(f"{where}: extra[{k!r}] must be a number, bool, string or array of them, got {v!r}")
+        out[k] = a if isinstance(v, (list, tuple, np.ndarray)) else v.item() if isinstance(v, np.generic) else v
+    return out
 
 
 class Solution:

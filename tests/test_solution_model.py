@@ -96,6 +96,9 @@ def test_contact_and_extra_are_checked(solved):
         new.append(*step_args(sol, 0), contact=[1.0])
     with pytest.raises(bs.InputError, match=r"extra must be a dict keyed by non-empty names, got \{'': 1\}"):
         new.append(*step_args(sol, 0), extra={"": 1})
+    with pytest.raises(bs.InputError, match=r"extra\['info'\] must be a number, bool, string or array of them, "
+                                            r"got \{'a': 1\}"):
+        new.append(*step_args(sol, 0), extra={"info": {"a": 1}})
     assert len(new) == 0
 
 
@@ -189,7 +192,7 @@ def with_everything(sol):
     new = empty_like(sol)
     tables = [{}, dict(gap=np.array([1e-3, -2e-4]), position=np.arange(6.0).reshape(2, 3),
                        stick=np.array([True, False])), dict(gap=np.zeros(0), position=np.zeros((0, 3)))]
-    extras = [dict(stable=True), dict(mode=np.arange(30.0).reshape(5, 6), n_neg=np.int64(1)),
+    extras = [dict(stable=True, branch="main"), dict(mode=np.arange(30.0).reshape(5, 6), n_neg=np.int64(1)),
               dict(mode=np.zeros((0, 6)), arc=0.125)]
     for k in range(3):
         new.append(*step_args(sol, k), contact=tables[k], extra=extras[k])
