@@ -77,6 +77,30 @@ def test_append_names_the_bad_field_and_value(solved, field, bad, match):
     assert new.n_steps == 1
 
 
+def test_an_append_interrupted_halfway_records_nothing(solved, monkeypatch):
+    """Ctrl-C inside ``append`` (here: while writing the third array): the step is not recorded,
+    every field keeps the same number of steps, and the next append goes on from there."""
+    from beamsolver import results
+    _, _, sol = solved
+    new = empty_like(sol)
+    new.append(*step_args(sol, 0))
+    put, calls = results._Growing.put, []
+
+    def interrupted(self, k, value):
+        calls.append(k)
+        if len(calls) == 3:
+            raise KeyboardInterrupt
+        put(self, k, value)
+    monkeypatch.setattr(results._Growing, "put", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        new.append(*step_args(sol, 1), contact=None, extra={"x": 1.0})
+    monkeypatch.setattr(results._Growing, "put", put)
+    assert len(new) == 1 and [len(new.times), len(new.poses), len(new.stats), len(new.contacts)] == [1] * 4
+    new.append(*step_args(sol, 1), extra={"x": 2.0})
+    assert len(new.stats) == 2 and new.extra == {"x": [None, 2.0]}
+    np.testing.assert_array_equal(new.reactions, sol.reactions[:2])
+
+
 def test_huge_finite_values_are_accepted(solved):
     """The finiteness check sums first; a sum that overflows from finite values is not an error."""
     _, _, sol = solved
