@@ -190,7 +190,8 @@ class Solution:
     ===================  ==========================================================================
     field                content
     ===================  ==========================================================================
-    ``times``            ``(s,)`` pseudo-times, strictly increasing (step 0: the state at ``t_start``)
+    ``times``            ``(s,)`` pseudo-times (step 0: the state at ``t_start``), strictly increasing
+                         unless ``path`` is ``"arc-length"`` (then ``t`` may go back)
     ``poses``            ``(s, n, 4, 4)`` node poses (finite)
     ``reactions``        ``(s, n, 6)`` global force and moment on every node (non-zero where constrained)
     ``section_forces``   ``(s, n_el, 6)`` ``N, Q2, Q3, T, M2, M3`` in the section frame
@@ -207,7 +208,8 @@ class Solution:
                          path-following data) without a new field
     ``description``      arrays describing the model (``describe_model``)
     ``converged``        bool; ``message`` (str) why not, and warnings
-    ``resume``           stepping state after the last step (``stepping.next_step``), for restart
+    ``resume``           stepping state after the last step (``stepping.next_step``), for restart;
+                         ``path`` (read-only) is its ``"path"`` entry, ``"load"`` by default
     ``contact_state``    committed contact history of the last step (dict of arrays), for restart
     ``model, system``    the ``Model`` and its assembly (``None`` for a loaded solution)
     ===================  ==========================================================================
@@ -249,12 +251,12 @@ class Solution:
                 raise InputError(f"{where}: {name} must have one entry per step ({s} times), "
                                  f"got {len(v) if hasattr(v, '__len__') else repr(v)}")
         sol = cls(model, system, description)
+        sol.resume = dict(resume or {})          # first: its "path" says whether times must increase
         for k in range(s):
             ex = {n: v[k] for n, v in (extra or {}).items() if v[k] is not None}
             sol._append(f"{where} (step {k})", times[k], poses[k], reactions[k], section_forces[k], strains[k],
                         given["stats"][k], given["contacts"][k], ex)
         sol.converged, sol.message = bool(converged), str(message)
-        sol.resume = dict(resume or {})
         sol.contact_state = dict(contact_state or {})
         return sol
 
@@ -305,7 +307,7 @@ class Solution:
         nn, ne = self._counts(H)
         if ne is None:
             ne = np.shape(sigma)[0] if np.ndim(sigma) == 2 else 0
-        values = dict(times=_time(where, t, self._last_time),
+        values = dict(times=_time(where, t, self._last_time if self.path == "load" else None),
                       poses=_array(where, "poses", H, (nn, 4, 4), "one pose per node"),
                       reactions=_array(where, "reactions", reactions, (nn, 6), "force and moment per node"),
                       section_forces=_array(where, "section_forces", sigma, (ne, 6), "per element"),
@@ -386,6 +388,13 @@ class Solution:
         """Dict ``name -> list`` of per-step values (``None`` where a step has none)."""
         self._trim()
         return self._extra
+
+    @property
+    def path(self):
+        """How the steps were taken: ``"load"`` (pseudo-time steps: ``times`` strictly increase) or
+        ``"arc-length"`` (along the equilibrium path: ``t`` may go back past a limit point), as
+        ``resume["path"]`` records it (absent: ``"load"``)."""
+        return self.resume.get("path", "load") if isinstance(self.resume, dict) else "load"
 
     @property
     def n_steps(self):

@@ -144,6 +144,28 @@ def test_from_steps_checks_lengths_and_every_step(solved):
         Solution.from_steps(**dict(f, poses=sol.poses[:, :3]))
 
 
+def test_an_arc_length_path_may_go_back_in_time(solved, tmp_path):
+    """Steps along an equilibrium path (``resume["path"] == "arc-length"``) may decrease ``t``
+    past a limit point; they stay finite, and the order survives save/load."""
+    _, _, sol = solved
+    new = empty_like(sol)
+    assert new.path == "load"
+    new.append(*step_args(sol, 0))
+    new.resume = dict(path="arc-length", t0=0.0, t_end=1.0)
+    args = list(step_args(sol, 1))
+    for t in (0.5, 0.75, 0.25, 0.25 + 1e-3):
+        args[0] = t
+        new.append(*args)
+    args[0] = np.nan
+    with pytest.raises(bs.InputError, match=r"times must be finite numbers, got t = nan"):
+        new.append(*args)
+    back = bs.load(new.save(tmp_path / "arc"))
+    assert back.path == "arc-length" and back.times.tolist() == [0.0, 0.5, 0.75, 0.25, 0.25 + 1e-3]
+    with pytest.raises(bs.InputError, match=r"times must increase, got t = 0\.25 after 0\.75"):
+        Solution.from_steps(new.description, new.times, new.poses, new.reactions, new.section_forces,
+                            new.strains)                                   # without its resume: load path
+
+
 def test_step_and_node_arguments_are_checked(solved):
     _, _, sol = solved
     for bad in (3, -4, 1.5, True):

@@ -16,7 +16,7 @@ Files in the output folder (``solve(model, output=folder)``, or
   without contact has no points and one empty poly-vertex cell (VTK type 2):
   meshio cannot read a file without cells, and skips that one with a warning.
 - ``beams.pvd`` and ``contact.pvd``: the collections with the pseudo-times.
-- ``solution.npz``: the ``Solution`` (``Solution.save``, format ``solution_file``), saved at the end of the
+- ``solution.npz``: the ``Solution`` (``io.archive``), saved at the end of the
   run (also when it stops with ``ConvergenceError``) and every
   ``checkpoint`` seconds of wall time (``0``: after every step), for
   ``beamsolver info`` and ``solve(..., restart=folder)``.
