@@ -155,6 +155,7 @@ class StepWriter:
         rec = solution.step(step)
         t = rec.time
         pdata, points = lay.point_data(rec.poses)
+        pdata.update(mode_fields(lay, rec.stats))
         cdata = lay.cell_data(rec.section_forces, rec.strains)
         mesh = meshio.Mesh(points, [("line", lay.segments)], point_data=pdata,
                            cell_data={k: [v] for k, v in cdata.items()})
@@ -194,6 +195,17 @@ class StepWriter:
     def close(self):
         """Save ``solution.npz`` (every VTU/PVD file is already complete when ``write`` returns)."""
         self.save()
+
+
+def mode_fields(layout, stats):
+    """Point data ``mode_j_u``, ``mode_j_rotation`` (j = 1..k) of a step's recorded modes (``solve(modes=k)``)."""
+    modes = np.asarray(stats.get("modes", ()), dtype=float)
+    out = {}
+    for j, m in enumerate(modes if modes.ndim == 3 else ()):
+        f = layout.node_field(m)
+        out[f"mode_{j + 1}_u"] = np.ascontiguousarray(f[:, :3])
+        out[f"mode_{j + 1}_rotation"] = np.ascontiguousarray(f[:, 3:])
+    return out
 
 
 def active_points(table):
