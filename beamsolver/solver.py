@@ -25,6 +25,7 @@ from .errors import InputError
 from .failures import DampingStalled, Diverged, NonFinite, NotConverged, RotationLimit, SingularTangent, StepFailed
 from .problem import Problem
 from .restart import restart_from
+from .stabilize import from_option as stabilize_option
 from .stepping import Run
 from .validation import check_solve_arguments, check_stability_options
 
@@ -475,7 +476,7 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
           max_iter=30, line_search=True, min_step_ratio=2.0**-12, callback=None,
           check_rigid_modes=True, verbose=None, initial_poses=None, restart=None, checkpoint=60.0,
           linear_solver=None, allow_unmet_tolerance=False, check_stability=False, modes=0,
-          branch_switching=False):
+          branch_switching=False, stabilize=None):
     """Quasi-static solve of ``model`` from ``t_start`` to ``t_end`` in ``steps`` equal steps.
 
     Every converged (sub)step is recorded in the returned ``Solution``.  Step 0 is
@@ -538,6 +539,11 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     the crossing, the descent and the counts before and after, and a state
     still unstable after it is warned about.  Either implies ``check_stability``.
 
+    ``stabilize``: artificial viscous damping in pseudo-time (Abaqus ``*STATIC, STABILIZE``) to pass
+    instabilities under load control: ``True`` (dissipated-energy fraction 2e-4), a fraction, or
+    ``dict(fraction=, factor=, warn=)``; the energy it dissipates is recorded per step in
+    ``stats[k]["stabilization"]`` and warned about above ``warn`` (``beamsolver.stabilize``).
+
     ``Solution.stats[k]["timings"]``: wall time of the step's ``assembly``
     (residuals, tangents, sparse matrices), of each contribution to it (``contact``
     for scenes with contact, part of assembly) and ``linear_solve``
@@ -559,9 +565,12 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     newton = _Newton(problem, conv, line_search, callback)
     newton.linsolver = linsolve.Solver(linear_solver)
     modes, branch_switching = check_stability_options(modes, branch_switching)
+    stabilizer = stabilize_option(system, stabilize, check=problem.conservative)
+    if stabilizer is not None:
+        problem.contributions.append(stabilizer)
     options = dict(allow_unmet_tolerance=allow_unmet_tolerance, advice=_advice(system, t_start, t_end),
                    check_stability=bool(check_stability or modes or branch_switching), modes=modes,
-                   branch_switching=branch_switching)
+                   branch_switching=branch_switching, stabilizer=stabilizer)
     run = None
     try:
         run = Run(problem, newton, _writer(output, system, checkpoint), grid, dt_min, verbose, options)
