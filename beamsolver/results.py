@@ -213,7 +213,8 @@ class Solution:
     ``converged``        bool; ``message`` (str) why not, and warnings
     ``resume``           stepping state after the last step (``stepping.next_step``), for restart;
                          ``path`` (read-only) is its ``"path"`` entry, ``"load"`` by default
-    ``contact_state``    committed contact history of the last step (dict of arrays), for restart
+    ``contact_state``    committed history of the contributions (contact, ...) at the last step
+                         (dict of arrays, keys ``name/key``: ``Problem.get_state``), for restart
     ``model, system``    the ``Model`` and its assembly (``None`` for a loaded solution)
     ===================  ==========================================================================
 
