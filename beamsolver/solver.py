@@ -23,6 +23,7 @@ from .assembly import System
 from .errors import InputError
 from .failures import DampingStalled, Diverged, NonFinite, NotConverged, RotationLimit, SingularTangent, StepFailed
 from .restart import restart_from
+from .arclength import ArcLengthRun, check_arc_length_arguments
 from .stepping import Run
 from .validation import check_solve_arguments
 
@@ -467,7 +468,7 @@ def _starting_point(restart, model, system, t_start, t_end):
 def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dtol=1e-11,
           max_iter=30, line_search=True, min_step_ratio=2.0**-12, callback=None,
           check_rigid_modes=True, verbose=None, initial_poses=None, restart=None, checkpoint=60.0,
-          linear_solver=None, allow_unmet_tolerance=False, check_stability=False):
+          linear_solver=None, allow_unmet_tolerance=False, check_stability=False, path="load", arc_length=None):
     """Quasi-static solve of ``model`` from ``t_start`` to ``t_end`` in ``steps`` equal steps.
 
     Every converged (sub)step is recorded in the returned ``Solution``.  Step 0 is
@@ -510,6 +511,14 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     (``StabilityWarning``) on an unstable equilibrium; opt-in: 5-16 % of the
     solve time (``benchmarks/stability_check.py``).
 
+    ``path``: ``"load"`` (default) steps the pseudo-time on the grid above;
+    ``"arc-length"`` follows the equilibrium path by arc length through limit
+    points and snap-backs, ``t`` going down as well as up
+    (``beamsolver.arclength``; options ``arc_length``, a dict or
+    ``arclength.ArcLength``: ``initial``, ``min``, ``max``,
+    ``target_iterations``, ``max_steps``, ``psi``).  Its ``times`` are not
+    monotonic; ``stats[k]`` adds ``arc_length``, ``t`` and ``linearised``.
+
     ``Solution.stats[k]["timings"]``: wall time of the step's ``assembly``
     (residuals, tangents, sparse matrices), ``contact`` (part of assembly) and
     ``linear_solve`` (factorisations and solves), in seconds.
@@ -521,6 +530,7 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
         raise InputError("solve: give either restart or initial_poses, not both")
     if int(steps) != steps or steps < 1:
         raise InputError(f"solve: steps must be a positive integer, got {steps!r}")
+    arc = check_arc_length_arguments(path, arc_length, restart)
     system = System(model, check_rigid_modes=check_rigid_modes)
     sol, t_start = _starting_point(restart, model, system, t_start, t_end)
     grid = np.linspace(t_start, t_end, int(steps) + 1)
@@ -532,7 +542,8 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
                    advice=_advice(system, t_start, t_end))
     run = None
     try:
-        run = Run(system, newton, _writer(output, system, checkpoint), grid, dt_min, verbose, options)
+        args = (system, newton, _writer(output, system, checkpoint), grid, dt_min, verbose, options)
+        run = Run(*args) if arc is None else ArcLengthRun(*args, arc)
         run.start(sol, initial_poses)
         run.loop()
     except BaseException as e:
