@@ -388,7 +388,7 @@ class ArcLengthRun(Run):
             sol.message = text if not sol.message else sol.message + "; " + text
         stats["t"] = t
         sol.append(t, H, sys.reactions(H, r), info["state"].sigma, info["state"].strain, stats, contact_data)
-        sol.resume = dict(path="arc-length")
+        sol.resume = dict(path="arc-length", t0=float(self.grid[0]), t_end=self.t_end)
         ds = next_arc_length(self.ds, stats["iterations"], self.arc.target_iterations, stats["cutbacks"] > 0,
                              stats["linearised"] > 0)
         self.ds = float(np.clip(ds, self.ds_min, self.ds_max))

@@ -1,0 +1,341 @@
+"""Arc-length path following (``solve(..., path="arc-length")``): limit points against closed forms
+and published values, the bordering's pseudo-time rate, the root choice, Newton's rate, constraints,
+contact, options and the consumers of non-monotonic times."""
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import beamsolver as bs
+from beamsolver import arclength
+from beamsolver.arclength import next_arc_length, rate, sphere_root
+from beamsolver.assembly import System
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import crossing_beams  # noqa: E402
+from test_newton import assert_quadratic  # noqa: E402
+
+
+# ------------------------------------------------------------------ the shallow two-bar truss
+A_HALF, RISE, EA = 1.0, 0.1, 1e4      # half span, rise, axial stiffness of a bar
+
+
+def truss_load(y):
+    """Vertical apex load carried by one bar of the von Mises truss with the apex at height ``y``
+    (pinned straight bar, ``N = EA (L / L0 - 1)``): ``P = EA y (1 / L - 1 / L0)``."""
+    L0, L = np.hypot(A_HALF, RISE), np.hypot(A_HALF, y)
+    return EA * y * (1.0 / L - 1.0 / L0)
+
+
+def truss_limit():
+    """Closed-form limit load and apex height: ``dP/dy = 0`` at ``L^3 = L0 a^2``."""
+    L0 = np.hypot(A_HALF, RISE)
+    y = np.sqrt((L0 * A_HALF**2) ** (2.0 / 3.0) - A_HALF**2)
+    return truss_load(y), y
+
+
+def truss(load):
+    """Half of the symmetric von Mises truss: one bar pinned at ``(-a, 0)`` (only ``rz`` free), the
+    apex on the symmetry line (``ux`` fixed, ``rz`` free: no moment at either end, so the bar stays
+    straight and carries only its axial force); apex load ``(0, -load t, 0)``."""
+    sec = bs.Section(EA=EA, GA2=EA, GA3=EA, GJ=1.0, EI2=1.0, EI3=1.0, radius=0.01)
+    m = bs.Model()
+    b = m.add_beam(bs.geometry.straight(start=(-A_HALF, 0, 0), end=(0, RISE, 0), n_elements=2), sec)
+    m.fix(b.first, dofs=("ux", "uy", "uz", "rx", "ry"))
+    m.fix(b.last, dofs=("ux", "uz", "rx", "ry"))
+    m.add_load(b.last, force=(0, -load, 0))
+    return m, b.last
+
+
+def apex_heights(sol, node):
+    return np.array([sol.position(node, k)[1] for k in range(sol.n_steps + 1)])
+
+
+def first_peak(t):
+    """Index of the first local maximum of ``t`` along the path (the limit point)."""
+    down = np.flatnonzero(np.diff(t) < 0)
+    return int(down[0]) if len(down) else len(t) - 1
+
+
+def peak(t, y):
+    """``t`` at the limit point, refined by the parabola through the first local maximum of the path
+    and its neighbours (as a function of ``y``)."""
+    k = first_peak(t)
+    if 0 < k < len(t) - 1:
+        c = np.polyfit(y[k - 1:k + 2], t[k - 1:k + 2], 2)
+        if c[0] < 0:
+            return float(np.polyval(c, -c[1] / (2 * c[0])))
+    return float(t[k])
+
+
+@pytest.fixture(scope="module")
+def truss_path():
+    P_lim, _ = truss_limit()
+    m, apex = truss(P_lim)
+    sol = bs.solve(m, steps=10, t_end=1.5, path="arc-length", verbose=False)
+    return sol, apex, P_lim
+
+
+def test_truss_snap_through_follows_the_closed_form(truss_path):
+    """Every converged point lies on ``P(y)`` (closed form); the path passes the limit, goes down
+    to negative loads (the apex below the supports pulls) and back up to exactly ``t_end``."""
+    sol, apex, P_lim = truss_path
+    t, y = sol.times, apex_heights(sol, apex)
+    assert sol.converged and sol.message == ""
+    np.testing.assert_allclose(t * P_lim, truss_load(y), atol=1e-5 * P_lim)
+    assert t[-1] == 1.5
+    assert t.min() < -0.9                  # the unstable branch down to the lower limit -P_lim
+    assert y[-1] < -RISE                   # snapped through: the inverted truss carrying 1.5 P_lim
+    assert np.any(np.diff(t) < 0) and np.all(np.diff(y) < 0)   # t goes down and up, y only down
+    steps = [s["arc_length"] for s in sol.stats[1:]]
+    assert all(np.isfinite(steps)) and all(s > 0 for s in steps)
+    np.testing.assert_allclose([s["t"] for s in sol.stats[1:]], t[1:])
+
+
+def test_truss_limit_load_within_one_percent(truss_path):
+    sol, apex, P_lim = truss_path
+    t, y = sol.times, apex_heights(sol, apex)
+    P_top, y_top = truss_limit()
+    k = first_peak(t)
+    assert abs(t[k] * P_lim / P_top - 1.0) < 1e-2          # the sampled peak
+    assert abs(peak(t, y) * P_lim / P_top - 1.0) < 1e-3    # refined through its neighbours
+    assert abs(y[k] - y_top) < 0.1 * RISE
+
+
+def test_load_control_stops_at_the_truss_limit():
+    """Today's default (``path="load"``) cannot pass the limit point: the reason for the option."""
+    P_lim, _ = truss_limit()
+    m, _ = truss(P_lim)
+    with pytest.raises(bs.ConvergenceError):
+        bs.solve(m, steps=10, t_end=1.5, verbose=False)
+
+
+# ------------------------------------------------------------------ DaDeppo & Schmidt's deep arch
+R_ARCH, EI_ARCH = 100.0, 1e6
+P_CR_DADEPPO = 8.97 * EI_ARCH / R_ARCH**2     # 897 (DaDeppo & Schmidt 1975)
+
+
+def deep_arch(n_elements=40):
+    """Clamped-hinged circular arch of radius 100 over 215 degrees, crown load ``(0, -1000 t, 0)``.
+
+    DaDeppo, D.A. and Schmidt, R. (1975), "Instability of clamped-hinged circular arches subjected
+    to a point load", J. Appl. Mech. 42, 894-896: limit load ``P_cr = 8.97 EI / R^2`` (inextensible
+    elastica); the standard arc-length benchmark (Simo & Vu-Quoc 1986; Kadapa 2021, Eng. Struct.
+    234, 111755, with ``EI = 1e6``, ``EA = GA = 100 EI``, used here).  Square-like section
+    (``EI2 = EI3 = GJ``); the path stays in the plane.
+    """
+    sec = bs.Section(EA=1e8, GA2=1e8, GA3=1e8, GJ=EI_ARCH, EI2=EI_ARCH, EI3=EI_ARCH, radius=1.0)
+    P = bs.geometry.arc(radius=R_ARCH, angle=np.radians(215.0), n_elements=n_elements)
+    c, a = np.array([0.0, R_ARCH, 0.0]), np.radians(72.5)      # turn about the centre: crown on top
+    G = np.eye(4)
+    G[:3, :3] = [[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]]
+    G[:3, 3] = c - G[:3, :3] @ c
+    m = bs.Model()
+    b = m.add_beam(G @ P, sec)
+    m.fix(b.first, dofs=("ux", "uy", "uz", "rx", "ry"))
+    m.clamp(b.last)
+    crown = int(b.nodes[n_elements // 2])
+    m.add_load(crown, force=(0, -1000.0, 0))
+    return m, crown
+
+
+def test_deep_arch_limit_load_within_one_percent_of_dadeppo_schmidt():
+    m, crown = deep_arch()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        sol = bs.solve(m, steps=40, t_end=1.0, path="arc-length", arc_length=dict(max_steps=230), verbose=False)
+    assert not sol.converged and "not reached" in sol.message            # stopped on max_steps, said so
+    assert any("not reached" in str(w.message) for w in caught)
+    t, v = sol.times, np.array([sol.position(crown, k)[1] for k in range(sol.n_steps + 1)])
+    k = first_peak(t)
+    assert 0 < k < sol.n_steps - 10                                       # traced past the limit ...
+    assert t[-1] < t[k] - 0.05                                            # ... and down after it
+    assert abs(peak(t, v) * 1000.0 / P_CR_DADEPPO - 1.0) < 0.01
+
+
+# ------------------------------------------------------------------ Newton's rate
+def test_newton_inside_an_arc_length_step_is_quadratic():
+    P_lim, _ = truss_limit()
+    m, _ = truss(P_lim)
+    sol = bs.solve(m, steps=3, t_end=0.9, path="arc-length", rtol=1e-13, verbose=False)
+    histories = [s["residuals"] for s in sol.stats[1:] if s["iterations"] >= 3]
+    assert histories
+    for r in histories:
+        assert_quadratic(r)
+
+
+def test_a_wrong_pseudo_time_rate_would_fail_the_quadratic_check(monkeypatch):
+    """The check can fail: a rate off by 20 % makes the bordered Newton converge linearly."""
+    P_lim, _ = truss_limit()
+    m, _ = truss(P_lim)
+    true_rate = arclength.rate
+    monkeypatch.setattr(arclength, "rate", lambda *a: 0.8 * true_rate(*a))
+    with pytest.warns(RuntimeWarning, match="not reached"):
+        sol = bs.solve(m, steps=3, t_end=0.9, path="arc-length", rtol=1e-13, arc_length=dict(max_steps=4),
+                       verbose=False)
+    failed = 0
+    for s in sol.stats[1:]:
+        try:
+            assert_quadratic(s["residuals"])
+        except AssertionError:
+            failed += 1
+    assert failed
+
+
+# ------------------------------------------------------------------ dr/dt
+def _driven_frame():
+    """Two beams joined at a corner (``join``), one end clamped, the other prescribed (translation
+    and rotation), a dead load with a non-linear scale and a ``fix(values=)`` node."""
+    sec = bs.Section.circular(radius=0.01, E=2e9, nu=0.3)
+    m = bs.Model()
+    a = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 4), sec)
+    b = m.add_beam(bs.geometry.straight((1, 0, 0), (1, 1, 0), 4), sec)
+    c = m.add_beam(bs.geometry.straight((0, 0, 0.5), (1, 0, 0.5), 3), sec)
+    m.join(a.last, b.first)
+    m.clamp(a.first)
+    m.prescribe(b.last, bs.motion.compose(bs.motion.translation(lambda t: (0.05 * t, 0.0, 0.02 * t * t)),
+                                          bs.motion.rotation((0, 0, 1), lambda t: 0.3 * t, center=(1, 1, 0))))
+    m.add_load(a.nodes[2], force=(0, 0, -2.0), moment=(0.1, 0, 0), scale=lambda t: np.sin(t))
+    m.add_load(b.nodes[2], force=(1.0, 0, 0), follower=True, scale=lambda t: t * t)
+    m.clamp(c.first)
+    m.fix(c.last, dofs=("ux", "uy", "uz"), values={"uz": lambda t: 0.03 * t, "ux": lambda t: -0.01 * t * t})
+    return m
+
+
+def test_rate_matches_the_finite_difference_of_the_residual():
+    """``dr_f/dt`` of ``rate`` (analytic in the load factors, ``K_fc dz_c/dt`` for the constrained
+    nodes) against a central difference of the residual at fixed free unknowns, the constrained
+    nodes moved onto their targets at ``t +- h``."""
+    m = _driven_frame()
+    sol = bs.solve(m, steps=4, t_end=0.6, verbose=False)     # a deformed equilibrium to test at
+    system = System(m)
+    H, t = sol.poses[-1], float(sol.times[-1])
+    r, kvals, info = system.evaluate(H, system.load_factors(t))
+    got = rate(system, H, t, kvals, info["extra"], 1e-6, 0.0)
+
+    def residual(tt):
+        Hs = H.copy()
+        Hs[system.prescribed_nodes] = system.prescribed_poses(tt)
+        system.enforce_fixed_values(Hs, tt)
+        system.sync_members(Hs)
+        return system.evaluate(Hs, system.load_factors(tt), tangent=False)[0][system.free_dofs]
+
+    h = 1e-5
+    want = (residual(t + h) - residual(t - h)) / (2 * h)
+    assert np.abs(want).max() > 1.0                          # every source contributes
+    np.testing.assert_allclose(got, want, atol=1e-6 * np.abs(want).max())
+
+
+def test_joins_prescribed_motion_and_fixed_values_reach_the_load_path_answer():
+    """A stable driven scene: the arc-length run ends at ``t_end`` on the load-controlled answer."""
+    m = _driven_frame()
+    ref = bs.solve(m, steps=6, t_end=1.0, verbose=False)
+    sol = bs.solve(m, steps=6, t_end=1.0, path="arc-length", verbose=False)
+    assert sol.converged and sol.times[-1] == 1.0 and np.all(np.diff(sol.times) > 0)
+    scale = np.abs(ref.displacement()).max()
+    np.testing.assert_allclose(sol.displacement(), ref.displacement(), atol=1e-7 * scale)
+    np.testing.assert_allclose(sol.reactions[-1], ref.reactions[-1], atol=1e-6 * np.abs(ref.reactions[-1]).max())
+
+
+# ------------------------------------------------------------------ root choice and arc-length rule
+def test_sphere_root_keeps_the_direction_and_lands_on_the_sphere():
+    rng = np.random.default_rng(3)
+    w, dw_r, dw_t = rng.normal(size=5), 0.05 * rng.normal(size=5), rng.normal(size=5)
+    psi, tau = 0.7, 0.2
+    ds = np.sqrt(w @ w + psi**2 * tau**2)
+    dt, lin = sphere_root(w, tau, dw_r, dw_t, psi, ds)
+    assert not lin
+    new = w + dw_r + dt * dw_t
+    np.testing.assert_allclose(new @ new + psi**2 * (tau + dt) ** 2, ds**2, rtol=1e-12)
+    other = -(2 * ((w + dw_r) @ dw_t + psi**2 * tau)) / (dw_t @ dw_t + psi**2) - dt   # sum of the roots
+    back = w + dw_r + other * dw_t
+    assert new @ w + psi**2 * tau * (tau + dt) > back @ w + psi**2 * tau * (tau + other)
+
+
+def test_sphere_root_without_real_roots_takes_the_linearised_constraint():
+    w, tau = np.array([1.0, 0.0]), 0.0
+    dw_r, dw_t = np.array([0.0, 3.0]), np.array([1.0, 0.0])       # far off the sphere: no real root
+    dt, lin = sphere_root(w, tau, dw_r, dw_t, 0.0, 1.0)
+    assert lin
+    p = w + dw_r
+    np.testing.assert_allclose(dt, -(p @ p - 1.0) / (2 * p @ dw_t))
+
+
+def test_next_arc_length_follows_the_iterations():
+    assert next_arc_length(1.0, 5, 5, False, False) == 1.0
+    assert next_arc_length(1.0, 1, 5, False, False) == 2.0
+    assert next_arc_length(1.0, 20, 5, False, False) == 0.5
+    assert next_arc_length(1.0, 2, 5, True, False) == 1.0
+    assert next_arc_length(1.0, 2, 5, False, True) == 0.5
+
+
+# ------------------------------------------------------------------ ends of a run
+def test_max_steps_never_reports_converged():
+    P_lim, _ = truss_limit()
+    m, _ = truss(P_lim)
+    with pytest.warns(RuntimeWarning, match="not reached"):
+        sol = bs.solve(m, steps=10, t_end=1.5, path="arc-length", arc_length=dict(max_steps=5), verbose=False)
+    assert sol.n_steps == 5 and not sol.converged and "t_end = 1.5 not reached after 5 steps" in sol.message
+
+
+def test_a_step_that_cannot_converge_is_cut_back_then_stops_with_the_solution():
+    P_lim, _ = truss_limit()
+    m, _ = truss(P_lim)
+    with pytest.raises(bs.ConvergenceError, match="arc-length could not advance") as e:
+        bs.solve(m, steps=10, t_end=1.5, path="arc-length", max_iter=1, verbose=False,
+                 arc_length=dict(initial=2.0, min=0.5, max=2.0))
+    failed = e.value.solution
+    assert failed is not None and not failed.converged and failed.n_steps == 0
+    assert "arc length 0.5" in str(e.value)          # halved from 2 down to min, then stopped
+
+
+def test_contact_scene_runs_with_arc_length():
+    """Contact makes the path non-smooth where points open or close (docs/theory.md): on a scene
+    whose contact state does not change, the arc-length run reaches the load-controlled answer."""
+    model, slave, master = crossing_beams.build(load=50.0, n_elements=8, tolerance=1e-6)
+    sol = bs.solve(model, steps=2, path="arc-length", verbose=False)
+    assert sol.converged and sol.times[-1] == 1.0
+    c = sol.contact()
+    np.testing.assert_allclose(c["normal_force"].sum(), 50.0, rtol=1e-6)
+    assert -c["gap"].min() < 1e-6
+
+
+# ------------------------------------------------------------------ input
+@pytest.mark.parametrize("kw, match", [
+    (dict(path="arclength"), "path must be 'load' or 'arc-length'"),
+    (dict(arc_length=dict(initial=0.1)), "need path='arc-length'"),
+    (dict(path="arc-length", arc_length=dict(start=0.1)), "unknown arc_length option"),
+    (dict(path="arc-length", arc_length=dict(initial=-1.0)), "initial must be a finite number > 0"),
+    (dict(path="arc-length", arc_length=dict(max_steps=0)), "max_steps must be a positive integer"),
+    (dict(path="arc-length", arc_length=dict(min=2.0, max=1.0)), "min 2.0 exceeds max 1.0"),
+    (dict(path="arc-length", arc_length=dict(psi=float("nan"))), "psi must be a finite number >= 0"),
+    (dict(path="arc-length", arc_length=[1.0]), "arc_length must be a dict"),
+    (dict(path="arc-length", arc_length=dict(initial=10.0, max=1.0)), "min <= initial <= max"),
+])
+def test_bad_arc_length_input_is_refused(kw, match):
+    m, _ = truss(1.0)
+    with pytest.raises(bs.InputError, match=match):
+        bs.solve(m, steps=2, verbose=False, **kw)
+
+
+def test_restart_is_refused_with_arc_length(truss_path):
+    sol, _, _ = truss_path
+    with pytest.raises(bs.InputError, match="restart is not supported"):
+        bs.solve(sol.model, steps=2, t_end=2.0, path="arc-length", restart=sol, verbose=False)
+
+
+# ------------------------------------------------------------------ consumers of non-monotonic times
+def test_output_and_archive_keep_the_path_order(tmp_path):
+    P_lim, _ = truss_limit()
+    m, apex = truss(P_lim)
+    sol = bs.solve(m, steps=10, t_end=1.5, path="arc-length", output=tmp_path / "out", verbose=False)
+    assert np.any(np.diff(sol.times) < 0)
+    pvd = (tmp_path / "out" / "beams.pvd").read_text()
+    stamps = [float(s.split('"')[1]) for s in pvd.split("timestep=")[1:]]
+    assert stamps == list(range(sol.n_steps + 1))      # step numbers: ParaView keeps the path order
+    back = bs.load(tmp_path / "out")
+    np.testing.assert_array_equal(back.times, sol.times)
+    assert back.converged and back.resume["path"] == "arc-length"
