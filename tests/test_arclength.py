@@ -16,61 +16,12 @@ from beamsolver.assembly import System
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import crossing_beams  # noqa: E402
+from limit_points import (P_CR_DADEPPO, RISE, deep_arch, first_peak, heights, lee_frame, peak,  # noqa: E402
+                          truss, truss_limit, truss_load)
 from test_newton import assert_quadratic  # noqa: E402
 
 
 # ------------------------------------------------------------------ the shallow two-bar truss
-A_HALF, RISE, EA = 1.0, 0.1, 1e4      # half span, rise, axial stiffness of a bar
-
-
-def truss_load(y):
-    """Vertical apex load carried by one bar of the von Mises truss with the apex at height ``y``
-    (pinned straight bar, ``N = EA (L / L0 - 1)``): ``P = EA y (1 / L - 1 / L0)``."""
-    L0, L = np.hypot(A_HALF, RISE), np.hypot(A_HALF, y)
-    return EA * y * (1.0 / L - 1.0 / L0)
-
-
-def truss_limit():
-    """Closed-form limit load and apex height: ``dP/dy = 0`` at ``L^3 = L0 a^2``."""
-    L0 = np.hypot(A_HALF, RISE)
-    y = np.sqrt((L0 * A_HALF**2) ** (2.0 / 3.0) - A_HALF**2)
-    return truss_load(y), y
-
-
-def truss(load):
-    """Half of the symmetric von Mises truss: one bar pinned at ``(-a, 0)`` (only ``rz`` free), the
-    apex on the symmetry line (``ux`` fixed, ``rz`` free: no moment at either end, so the bar stays
-    straight and carries only its axial force); apex load ``(0, -load t, 0)``."""
-    sec = bs.Section(EA=EA, GA2=EA, GA3=EA, GJ=1.0, EI2=1.0, EI3=1.0, radius=0.01)
-    m = bs.Model()
-    b = m.add_beam(bs.geometry.straight(start=(-A_HALF, 0, 0), end=(0, RISE, 0), n_elements=2), sec)
-    m.fix(b.first, dofs=("ux", "uy", "uz", "rx", "ry"))
-    m.fix(b.last, dofs=("ux", "uz", "rx", "ry"))
-    m.add_load(b.last, force=(0, -load, 0))
-    return m, b.last
-
-
-def apex_heights(sol, node):
-    return np.array([sol.position(node, k)[1] for k in range(sol.n_steps + 1)])
-
-
-def first_peak(t):
-    """Index of the first local maximum of ``t`` along the path (the limit point)."""
-    down = np.flatnonzero(np.diff(t) < 0)
-    return int(down[0]) if len(down) else len(t) - 1
-
-
-def peak(t, y):
-    """``t`` at the limit point, refined by the parabola through the first local maximum of the path
-    and its neighbours (as a function of ``y``)."""
-    k = first_peak(t)
-    if 0 < k < len(t) - 1:
-        c = np.polyfit(y[k - 1:k + 2], t[k - 1:k + 2], 2)
-        if c[0] < 0:
-            return float(np.polyval(c, -c[1] / (2 * c[0])))
-    return float(t[k])
-
-
 @pytest.fixture(scope="module")
 def truss_path():
     P_lim, _ = truss_limit()
@@ -83,7 +34,7 @@ def test_truss_snap_through_follows_the_closed_form(truss_path):
     """Every converged point lies on ``P(y)`` (closed form); the path passes the limit, goes down
     to negative loads (the apex below the supports pulls) and back up to exactly ``t_end``."""
     sol, apex, P_lim = truss_path
-    t, y = sol.times, apex_heights(sol, apex)
+    t, y = sol.times, heights(sol, apex)
     assert sol.converged and sol.message == ""
     np.testing.assert_allclose(t * P_lim, truss_load(y), atol=1e-5 * P_lim)
     assert t[-1] == 1.5
@@ -97,7 +48,7 @@ def test_truss_snap_through_follows_the_closed_form(truss_path):
 
 def test_truss_limit_load_within_one_percent(truss_path):
     sol, apex, P_lim = truss_path
-    t, y = sol.times, apex_heights(sol, apex)
+    t, y = sol.times, heights(sol, apex)
     P_top, y_top = truss_limit()
     k = first_peak(t)
     assert abs(t[k] * P_lim / P_top - 1.0) < 1e-2          # the sampled peak
@@ -114,46 +65,48 @@ def test_load_control_stops_at_the_truss_limit():
 
 
 # ------------------------------------------------------------------ DaDeppo & Schmidt's deep arch
-R_ARCH, EI_ARCH = 100.0, 1e6
-P_CR_DADEPPO = 8.97 * EI_ARCH / R_ARCH**2     # 897 (DaDeppo & Schmidt 1975)
-
-
-def deep_arch(n_elements=40):
-    """Clamped-hinged circular arch of radius 100 over 215 degrees, crown load ``(0, -1000 t, 0)``.
-
-    DaDeppo, D.A. and Schmidt, R. (1975), "Instability of clamped-hinged circular arches subjected
-    to a point load", J. Appl. Mech. 42, 894-896: limit load ``P_cr = 8.97 EI / R^2`` (inextensible
-    elastica); the standard arc-length benchmark (Simo & Vu-Quoc 1986; Kadapa 2021, Eng. Struct.
-    234, 111755, with ``EI = 1e6``, ``EA = GA = 100 EI``, used here).  Square-like section
-    (``EI2 = EI3 = GJ``); the path stays in the plane.
-    """
-    sec = bs.Section(EA=1e8, GA2=1e8, GA3=1e8, GJ=EI_ARCH, EI2=EI_ARCH, EI3=EI_ARCH, radius=1.0)
-    P = bs.geometry.arc(radius=R_ARCH, angle=np.radians(215.0), n_elements=n_elements)
-    c, a = np.array([0.0, R_ARCH, 0.0]), np.radians(72.5)      # turn about the centre: crown on top
-    G = np.eye(4)
-    G[:3, :3] = [[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]]
-    G[:3, 3] = c - G[:3, :3] @ c
-    m = bs.Model()
-    b = m.add_beam(G @ P, sec)
-    m.fix(b.first, dofs=("ux", "uy", "uz", "rx", "ry"))
-    m.clamp(b.last)
-    crown = int(b.nodes[n_elements // 2])
-    m.add_load(crown, force=(0, -1000.0, 0))
-    return m, crown
-
-
 def test_deep_arch_limit_load_within_one_percent_of_dadeppo_schmidt():
+    """DaDeppo & Schmidt (1975), J. Appl. Mech. 42, 894-896: the clamped-hinged 215-degree arch's
+    limit load ``8.97 EI / R^2`` (``examples/limit_points.deep_arch``); 40 elements."""
     m, crown = deep_arch()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         sol = bs.solve(m, steps=40, t_end=1.0, path="arc-length", arc_length=dict(max_steps=230), verbose=False)
     assert not sol.converged and "not reached" in sol.message            # stopped on max_steps, said so
     assert any("not reached" in str(w.message) for w in caught)
-    t, v = sol.times, np.array([sol.position(crown, k)[1] for k in range(sol.n_steps + 1)])
+    t, v = sol.times, heights(sol, crown)
     k = first_peak(t)
     assert 0 < k < sol.n_steps - 10                                       # traced past the limit ...
     assert t[-1] < t[k] - 0.05                                            # ... and down after it
     assert abs(peak(t, v) * 1000.0 / P_CR_DADEPPO - 1.0) < 0.01
+
+
+def test_lee_frame_snap_back_is_traced():
+    """Lee's frame snaps back: past the limit both the load and the deflection of the loaded point
+    decrease for a while, then the path climbs again to ``t_end`` (reached exactly)."""
+    m, node = lee_frame()
+    sol = bs.solve(m, steps=20, path="arc-length", verbose=False)
+    assert sol.converged and sol.times[-1] == 1.0
+    t, v = sol.times, -(heights(sol, node) - heights(sol, node)[0])     # downward deflection
+    dt, dv = np.diff(t), np.diff(v)
+    assert np.any((dt < 0) & (dv < 0))              # snap-back: load and deflection both fall
+    assert np.any((dt < 0) & (dv > 0))              # snap-through part before it
+    assert 18.0 < 20.0 * peak(t, v) * 120.0**2 / (720.0 * 2.0) < 19.5     # P L^2 / EI at the limit, about 18.5
+
+
+def test_stability_check_sees_the_unstable_branch(truss_path):
+    """With ``check_stability`` the tangent has one negative eigenvalue exactly between the two
+    limit points of the truss (``dP/dy > 0`` there) and none outside."""
+    P_lim = truss_path[2]
+    m, apex = truss(P_lim)
+    with pytest.warns(bs.StabilityWarning, match="unstable"):
+        sol = bs.solve(m, steps=10, t_end=1.5, path="arc-length", check_stability=True, verbose=False)
+    y = heights(sol, apex)
+    y_top = truss_limit()[1]
+    neg = np.array([s["negative_eigenvalues"] for s in sol.stats[1:]])
+    inside = np.abs(y[1:]) < 0.98 * y_top
+    outside = np.abs(y[1:]) > 1.02 * y_top
+    assert np.all(neg[inside] == 1) and np.all(neg[outside] == 0) and inside.any() and outside.any()
 
 
 # ------------------------------------------------------------------ Newton's rate
