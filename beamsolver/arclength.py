@@ -185,6 +185,7 @@ class ArcLengthRun(Run):
         scale.reshape(-1, 6)[:, :3] = 1.0 / newton.L_ref
         self.S = scale[sys.free_dofs]           # unit-free weights of the free increments
         self.prev = None                        # (w, tau) of the last converged step
+        self._converged = None                  # (H, t, r, kvals, info) of the last converged iterate
 
     # ------------------------------------------------------------ linear algebra
     def _solve2(self, r, kvals, info, t):
@@ -221,9 +222,15 @@ class ArcLengthRun(Run):
         return newton._reach_targets(H, dz + dz_c, H_target, bool(targets), t_new)
 
     def _tangent_at(self, H, t):
-        """``dz/dt`` ``(n_free,)`` along the path at the equilibrium ``(H, t)``."""
+        """``dz/dt`` ``(n_free,)`` along the path at the equilibrium ``(H, t)``; without contact the
+        evaluation of the converged iterate is reused (with contact, committing the history may
+        change the tangent)."""
         self.Hcur = H
-        r, kvals, info = self.newton._evaluate(H, self._lf(t))
+        last = self._converged
+        if last is not None and last[0] is H and last[1] == t and self.sys.contact is None:
+            r, kvals, info = last[2:]
+        else:
+            r, kvals, info = self.newton._evaluate(H, self._lf(t))
         return self._solve2(r, kvals, info, t)[1]
 
     # ------------------------------------------------------------ one step
@@ -244,6 +251,7 @@ class ArcLengthRun(Run):
             verdict = conv.decide(ratio, last_inc, it, floor)
             if verdict == "converged":
                 newton.last_tangent = (kvals, info["extra"])
+                self._converged = (H, t, r, kvals, info)
                 return H, t, w, tau, r, info, dict(iterations=it, residuals=residuals, linearised=linearised)
             if verdict != "continue":
                 raise newton._failure(verdict, ratio)

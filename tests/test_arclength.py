@@ -256,6 +256,27 @@ def test_contact_scene_runs_with_arc_length():
     assert -c["gap"].min() < 1e-6
 
 
+def test_contact_that_closes_during_the_run_reaches_the_load_path_answer():
+    """A clamped beam pushed onto a crossing one: the contact closes within the first step (a kink in
+    the path, then a stiffer branch with longer steps in ``t``); the end state is the load-controlled one."""
+    r = 0.05
+    sec = bs.Section.circular(radius=r, E=1e7, nu=0.3)
+    m = bs.Model()
+    master = m.add_beam(bs.geometry.straight((0, -1, 0), (0, 1, 0), 8), sec)
+    slave = m.add_beam(bs.geometry.straight((-1, 0, 2 * r + 0.02), (1, 0, 2 * r + 0.02), 8), sec)
+    for node in (master.first, master.last, slave.first, slave.last):
+        m.clamp(node)
+    mid = slave.nodes[4]
+    m.add_load(mid, force=(0, 0, -400.0))
+    m.add_contact(slave, master)
+    ref = bs.solve(m, steps=8, verbose=False)
+    sol = bs.solve(m, steps=8, path="arc-length", verbose=False)
+    assert sol.converged and sol.times[-1] == 1.0
+    assert len(sol.contacts[0].get("gap", ())) == 0 or not np.any(sol.contacts[0]["normal_force"] > 0)
+    np.testing.assert_allclose(sol.position(mid), ref.position(mid), atol=1e-9)
+    np.testing.assert_allclose(sol.contact()["normal_force"].sum(), ref.contact()["normal_force"].sum(), rtol=1e-6)
+
+
 # ------------------------------------------------------------------ input
 @pytest.mark.parametrize("kw, match", [
     (dict(path="arclength"), "path must be 'load' or 'arc-length'"),
