@@ -30,7 +30,7 @@ import numpy as np
 
 from . import linsolve, se3
 from .errors import ConvergenceError, InputError
-from .failures import AugmentationFailed, SingularTangent, StepFailed
+from .failures import AugmentationFailed, NonFinite, SingularTangent, StepFailed
 from .restart import contact_snapshot
 from .stepping import Run, STEP_TOLERANCE
 
@@ -186,6 +186,7 @@ class ArcLengthRun(Run):
         self.S = scale[sys.free_dofs]           # unit-free weights of the free increments
         self.prev = None                        # (w, tau) of the last converged step
         self._converged = None                  # (H, t, r, kvals, info) of the last converged iterate
+        self.t_iter = float(grid[0])            # pseudo-time of the current iterate (failure messages)
 
     # ------------------------------------------------------------ linear algebra
     def _solve2(self, r, kvals, info, t):
@@ -194,6 +195,8 @@ class ArcLengthRun(Run):
         t0 = time.perf_counter()
         K = sys.matrix(kvals, info["extra"])
         drdt = rate(sys, self.Hcur, t, kvals, info["extra"], RATE_STEP * self.span, float(self.grid[0]))
+        if not np.all(np.isfinite(drdt)):
+            raise NonFinite(f"the pseudo-time rate dr/dt is not finite at t = {t:.6g}")
         t1 = time.perf_counter()
         try:
             lu = newton.linsolver.factorize(K)
@@ -242,7 +245,7 @@ class ArcLengthRun(Run):
         floor = conv.floor(H, newton.L_ref)
         residuals, last_inc, linearised = [], np.inf, 0
         for it in range(conv.max_iter + 1):
-            self.Hcur = H
+            self.Hcur, self.t_iter = H, t
             r, kvals, info = newton._evaluate(H, self._lf(t))
             ratio = newton._ratio(r, conv.scales(info, newton.L_ref))
             residuals.append(ratio)
@@ -298,6 +301,9 @@ class ArcLengthRun(Run):
         return H, t, w, tau, r, info, stats
 
     def _arc_step_to_end(self, H0, t0, v, ds):
+        """The step from ``(H0, t0)`` with ``t = t_end`` held (predictor along ``v``)."""
+        if self.sys.contact is not None:
+            self.sys.contact.begin_step(H0, t0)        # forget the first attempt's multiplier updates
         tau = self.t_end - t0
         H = self._move(H0, t0, tau * v, self.t_end)
         out = self._augment(self._correct(H, self.t_end, self.S * tau * v, tau, ds, self.t_end))
@@ -379,6 +385,8 @@ class ArcLengthRun(Run):
                 self.ds = ds
                 return out
             except StepFailed as e:
+                if isinstance(e, NonFinite):
+                    self._name_nonfinite(self.t_iter)      # InputError when a scale or motion gave it
                 failed.append(ds)
                 ds *= 0.5
                 log.info("t = %.6g: arc-length step %.3g failed (%s); cutting back to %.3g", self.t, 2 * ds, e, ds)

@@ -295,6 +295,16 @@ def test_bad_arc_length_input_is_refused(kw, match):
         bs.solve(m, steps=2, verbose=False, **kw)
 
 
+def test_a_load_scale_giving_nan_on_the_path_is_named():
+    m = bs.Model()
+    b = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 4), bs.Section.circular(radius=0.01, E=2e11))
+    m.clamp(b.first)
+    m.add_load(b.last, force=(0, 0, 100.0), scale=lambda t: float("nan") if 0.4 < t < 0.6 else t)
+    with pytest.raises(bs.InputError, match="scale") as e:
+        bs.solve(m, steps=10, path="arc-length", verbose=False)
+    assert e.value.solution.n_steps >= 3          # the steps before 0.4 stand
+
+
 def test_restart_is_refused_with_arc_length(truss_path):
     sol, _, _ = truss_path
     with pytest.raises(bs.InputError, match="restart is not supported"):
