@@ -295,6 +295,16 @@ def test_bad_arc_length_input_is_refused(kw, match):
         bs.solve(m, steps=2, verbose=False, **kw)
 
 
+def test_options_object_and_dict_are_the_same():
+    P_lim, _ = truss_limit()
+    runs = []
+    for opts in (dict(initial=0.05, target_iterations=3), bs.ArcLength(initial=0.05, target_iterations=3)):
+        m, _ = truss(P_lim)
+        runs.append(bs.solve(m, steps=10, t_end=0.5, path="arc-length", arc_length=opts, verbose=False))
+    np.testing.assert_array_equal(runs[0].times, runs[1].times)
+    assert runs[0].stats[1]["arc_length"] == 0.05
+
+
 def test_a_load_scale_giving_nan_on_the_path_is_named():
     m = bs.Model()
     b = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 4), bs.Section.circular(radius=0.01, E=2e11))
