@@ -333,3 +333,20 @@ def test_output_and_archive_keep_the_path_order(tmp_path):
     back = bs.load(tmp_path / "out")
     np.testing.assert_array_equal(back.times, sol.times)
     assert back.converged and back.resume["path"] == "arc-length"
+
+
+def test_history_plot_and_info_of_an_arc_length_run(tmp_path):
+    """``viz.plot_history`` draws the path in step order (t back and forth); ``beamsolver info``
+    reports the finished run as converged."""
+    import subprocess
+    pytest.importorskip("matplotlib")
+    from beamsolver import viz
+    P_lim, _ = truss_limit()
+    m, apex = truss(P_lim)
+    sol = bs.solve(m, steps=10, t_end=1.5, path="arc-length", output=tmp_path / "out", verbose=False)
+    fig = viz.plot_history(sol, "position", node=apex, component="y", path=tmp_path / "h.png")
+    x, _ = fig.axes[0].lines[0].get_data()
+    np.testing.assert_array_equal(x, sol.times)
+    out = subprocess.run([sys.executable, "-m", "beamsolver.cli", "info", str(tmp_path / "out")],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0 and "; converged" in out.stdout, out.stderr
