@@ -56,6 +56,17 @@ def test_truss_limit_load_within_one_percent(truss_path):
     assert abs(y[k] - y_top) < 0.1 * RISE
 
 
+def test_cylindrical_constraint_traces_the_same_curve():
+    """``psi=0`` (Crisfield's cylindrical constraint: displacements only) through the same snap."""
+    P_lim, _ = truss_limit()
+    m, apex = truss(P_lim)
+    sol = bs.solve(m, steps=10, t_end=1.5, path="arc-length", arc_length=dict(psi=0.0), verbose=False)
+    t, y = sol.times, heights(sol, apex)
+    assert sol.converged and t[-1] == 1.5 and t.min() < -0.9
+    np.testing.assert_allclose(t * P_lim, truss_load(y), atol=1e-5 * P_lim)
+    assert all(s["psi"] == 0.0 for s in sol.stats[1:])
+
+
 def test_load_control_stops_at_the_truss_limit():
     """Today's default (``path="load"``) cannot pass the limit point: the reason for the option."""
     P_lim, _ = truss_limit()
