@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import linsolve, se3
+from . import linsolve, motion_path, se3
 from .errors import ConvergenceError, InputError
 from .failures import AugmentationFailed, NonFinite, SingularTangent, StepFailed
 from .restart import contact_snapshot
@@ -288,6 +288,10 @@ class ArcLengthRun(Run):
             sys.contact.begin_step(H0, t0)
         v = self._tangent_at(H0, t0)
         tau = self._predict(v, ds)
+        t_try, _ = motion_path.limit_step(sys, t0, t0 + tau)
+        if t_try != t0 + tau:                     # a prescribed rotation would be ambiguous: shorter arc
+            ds, tau = ds * (t_try - t0) / tau, t_try - t0
+        self.ds_used = ds
         crossing = t0 < self.t_end <= t0 + tau * (1.0 + STEP_TOLERANCE)
         if crossing:                              # the last step: load control onto t_end
             tau = self.t_end - t0
@@ -297,6 +301,10 @@ class ArcLengthRun(Run):
         if not crossing and t0 < self.t_end <= t:    # passed t_end on the sphere: redo by load control
             return self._arc_step_to_end(H0, t0, v, ds)
         self._check_turn(w, tau)
+        rot = motion_path.path_rotation(sys, t0, t)
+        if rot > motion_path.MAX_MOTION_ROTATION:
+            raise StepFailed(f"a prescribed rotation turns by {rot:.3g} rad over the step (more than "
+                             f"MAX_MOTION_ROTATION = {motion_path.MAX_MOTION_ROTATION:.3g} rad)")
         self.newton._check_continuity(H0, H)
         return H, t, w, tau, r, info, stats
 
@@ -378,11 +386,11 @@ class ArcLengthRun(Run):
             try:
                 out = self._arc_step(ds)
                 self._check_finite(out[0], out[4], out[5]["state"], out[1])
-                out[6].update(cutbacks=len(failed), arc_length=ds, psi=self.psi,
+                out[6].update(cutbacks=len(failed), arc_length=self.ds_used, psi=self.psi,
                               timings=dict(self.newton.timings))
                 if failed:
                     out[6]["failed_arc_length"] = failed
-                self.ds = ds
+                self.ds = self.ds_used
                 return out
             except StepFailed as e:
                 if isinstance(e, NonFinite):

@@ -204,6 +204,24 @@ def test_joins_prescribed_motion_and_fixed_values_reach_the_load_path_answer():
     np.testing.assert_allclose(sol.reactions[-1], ref.reactions[-1], atol=1e-6 * np.abs(ref.reactions[-1]).max())
 
 
+def test_a_fast_prescribed_rotation_shortens_the_arc_as_it_shortens_a_load_step():
+    """Two turns of twist prescribed over the run in two steps: each arc-length step is shortened so
+    the motion turns by less than ``MAX_MOTION_ROTATION`` (a whole turn per step would look like
+    none); the end state is the load path's."""
+    m = bs.Model()
+    b = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 16), bs.Section.circular(radius=0.01, E=2e9))
+    m.clamp(b.first)
+    m.prescribe(b.last, bs.motion.rotation((1, 0, 0), lambda t: 4 * np.pi * t))
+    ref = bs.solve(m, steps=2, verbose=False)
+    sol = bs.solve(m, steps=2, path="arc-length", verbose=False)
+    assert sol.converged and sol.times[-1] == 1.0 and sol.n_steps >= 7        # 4 pi in steps below 0.6 pi
+    assert all(s["arc_length"] > 0 for s in sol.stats[1:])
+    np.testing.assert_allclose(sol.poses[-1], ref.poses[-1], atol=1e-9)
+    rot = [bs.se3.rotation_angle(bs.se3.log(bs.se3.relative(a[b.last], c[b.last]))[None, 3:])[0]
+           for a, c in zip(sol.poses[:-1], sol.poses[1:])]
+    assert max(rot) < 0.6 * np.pi + 1e-9                       # per step, as the load path's steps
+
+
 # ------------------------------------------------------------------ root choice and arc-length rule
 def test_sphere_root_keeps_the_direction_and_lands_on_the_sphere():
     rng = np.random.default_rng(3)
