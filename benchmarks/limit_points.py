@@ -8,7 +8,8 @@ maximum of the path and its neighbours (``limit_points.peak``).
 
     python benchmarks/limit_points.py [--quick] [--docs]
 
-Prints a Markdown table (limit computed vs reference, error, steps, Newton iterations, wall time);
+Prints a Markdown table (limit computed vs reference, error, steps, Newton iterations, wall time),
+also written to the ``limit_points`` section of ``docs/benchmarks.md`` (full run only);
 writes load-deflection pictures (computed vs reference) to ``benchmarks/results/limit_*.png``
 and, with ``--docs``, the three side by side to ``docs/limit_points.png``.
 """
@@ -20,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "examples"))
 
 import beamsolver as bs  # noqa: E402
@@ -146,17 +148,29 @@ def pictures(curves, docs=False):
 
 
 def main(quick=False, docs=False):
+    from _report import machine, table, write_section
     curves = {}
     rows = truss_rows(curves)
     rows += arch_rows(curves, (20, 40) if quick else (20, 40, 80))
     rows += lee_rows(curves, (10,) if quick else (10, 20))
     keys = list(rows[0])
-    print("| " + " | ".join(keys) + " |")
-    print("|" + "---|" * len(keys))
-    for r in rows:
-        print("| " + " | ".join(str(r[k]) for k in keys) + " |")
+    text = table(keys, [[r[k] for k in keys] for r in rows])
+    print(text)
     for p in pictures(curves, docs):
         print(f"written: {p}")
+    if not quick:
+        write_section("limit_points", f"""## Limit points by arc length (issue 15)
+
+`python benchmarks/limit_points.py` ({machine()}). `solve(..., path="arc-length")`
+on the scenes of `examples/limit_points.py`; the limit is the vertex of the parabola through
+the first local maximum of the path and its neighbours; error against the closed form (truss)
+or DaDeppo & Schmidt's `8.97 EI / R^2` (arch; second order in the mesh). Lee's frame: no
+published value is checked (its limit `P L^2 / EI` converges towards about 18.5).
+
+{text}
+
+![load-deflection paths](limit_points.png)
+""")
     return rows
 
 
