@@ -105,6 +105,19 @@ def test_lee_frame_snap_back_is_traced():
     assert 18.0 < 20.0 * peak(t, v) * 120.0**2 / (720.0 * 2.0) < 19.5     # P L^2 / EI at the limit, about 18.5
 
 
+def test_long_arcs_use_the_linearised_constraint_and_still_trace_lee_frame():
+    """Arcs three times longer than needed: some iterations find no real root (the linearised
+    constraint is taken, the next arc halved); the run still ends on the same state at ``t_end``."""
+    m, node = lee_frame()
+    fine = bs.solve(m, steps=20, t_end=0.3, path="arc-length", verbose=False)
+    m, node = lee_frame()
+    coarse = bs.solve(m, steps=20, t_end=0.3, path="arc-length", arc_length=dict(initial=1.0, max=1.0),
+                      verbose=False)
+    assert coarse.converged and coarse.times[-1] == 0.3
+    assert sum(s["linearised"] for s in coarse.stats[1:]) > 0
+    np.testing.assert_allclose(coarse.poses[-1], fine.poses[-1], atol=1e-7 * 120.0)
+
+
 def test_stability_check_sees_the_unstable_branch(truss_path):
     """With ``check_stability`` the tangent has one negative eigenvalue exactly between the two
     limit points of the truss (``dP/dy > 0`` there) and none outside."""
