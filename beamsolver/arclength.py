@@ -4,7 +4,7 @@ The pseudo-time ``t`` (which drives the load scales, the prescribed motions and
 the ``fix(values=)`` targets) becomes an unknown next to the free increments
 ``z``.  Each step from the equilibrium ``(H_0, t_0)`` seeks ``(H, t)`` with
 
-    r_f(H, t) = 0,     |S dz|^2 + psi^2 (t - t_0)^2 = ds^2        (docs/theory.md eq. 10.1)
+    r_f(H, t) = 0,     |S dz|^2 + psi^2 (t - t_0)^2 = ds^2        (docs/theory.md eq. 11.1)
 
 (Crisfield's spherical constraint), ``dz`` the sum of the step's free increments,
 ``S`` the unit-free scaling of ``Convergence`` (translations over the model size,
@@ -31,8 +31,7 @@ import numpy as np
 from . import linsolve, motion_path, se3
 from .errors import ConvergenceError, InputError
 from .failures import AugmentationFailed, NonFinite, SingularTangent, StepFailed
-from .restart import contact_snapshot
-from .stepping import Run, STEP_TOLERANCE
+from .stepping import MAX_OUTER, STEP_TOLERANCE, Run
 
 __all__ = ["ArcLength", "arc_length_options", "check_arc_length_arguments", "ArcLengthRun", "sphere_root",
            "next_arc_length", "rate", "RATE_STEP", "TURN_BACK"]
@@ -104,7 +103,7 @@ def arc_length_options(value):
 
 def sphere_root(w, tau, dw_r, dw_t, psi, ds):
     """Pseudo-time correction ``dt`` on the sphere ``|w + dw_r + dt dw_t|^2 + psi^2 (tau + dt)^2 = ds^2``
-    (docs/theory.md eq. 10.4).
+    (docs/theory.md eq. 11.4).
 
     ``w``, ``tau``: the step's scaled increment and pseudo-time change so far; ``dw_r``, ``dw_t``:
     the scaled solves ``S dz_r``, ``S dz_t``.  Of the two real roots the one whose new increment
@@ -129,7 +128,7 @@ def sphere_root(w, tau, dw_r, dw_t, psi, ds):
 def next_arc_length(ds, iterations, target, cut, linearised):
     """Arc length after a converged step of ``ds`` in ``iterations``: ``ds sqrt(target / iterations)``
     by a factor 0.5 to 2 (at most 1 after a cut-back, at most 0.5 after a linearised iteration),
-    before the cap to ``[min, max]`` (docs/theory.md eq. 10.6)."""
+    before the cap to ``[min, max]`` (docs/theory.md eq. 11.6)."""
     f = float(np.clip(np.sqrt(target / max(iterations, 1)), 0.5, 2.0))
     if cut:
         f = min(f, 1.0)
@@ -138,16 +137,16 @@ def next_arc_length(ds, iterations, target, cut, linearised):
     return ds * f
 
 
-def rate(system, H, t, kvals, extra, delta, t_start):
+def rate(problem, H, t, ev, delta, t_start):
     """``dr_f/dt`` ``(n_free,)`` at the state ``H`` (constrained nodes on their targets at ``t``;
-    docs/theory.md eq. 10.3).
+    ``ev`` its ``problem.Evaluation`` with the tangent; docs/theory.md eq. 11.3).
 
     Loads: ``-f_ext(H, dlf/dt)`` (the residual is linear in the load factors; ``dlf/dt`` by a central
     difference of the scale functions); prescribed motions and ``fix(values=)``: ``K_fc dz_c/dt``
     with the velocity ``dz_c/dt`` (body increments of the motion, global ones of the fixed values)
     by a central difference of step ``delta`` (forward where ``t - delta < t_start``).
     """
-    sys = system
+    sys = problem.system
     lo = t - delta if t - delta >= t_start else t
     span = t + delta - lo
     out = np.zeros(sys.n_free)
@@ -168,39 +167,39 @@ def rate(system, H, t, kvals, extra, delta, t_start):
         for node, comp, f in sys.fix_values:
             v[node, comp] = (float(f(t + delta)) - float(f(lo))) / span
         if np.any(v):
-            out += sys.prescribed_coupling(kvals, v.ravel(), extra)
+            out += problem.coupling(ev, v)
     return out
 
 
 class ArcLengthRun(Run):
     """``stepping.Run`` with ``loop`` following the path by arc length (see the module docstring)."""
 
-    def __init__(self, system, newton, writer, grid, dt_min, verbose, options, arc):
-        super().__init__(system, newton, writer, grid, dt_min, verbose, options)
+    def __init__(self, problem, newton, writer, grid, dt_min, verbose, options, arc):
+        super().__init__(problem, newton, writer, grid, dt_min, verbose, options)
         self.arc = arc
         self.t_end = float(grid[-1])
         self.span = float(grid[-1] - grid[0])
-        sys = system
+        sys = self.sys
         scale = np.ones(6 * sys.n_nodes)
         scale.reshape(-1, 6)[:, :3] = 1.0 / newton.L_ref
         self.S = scale[sys.free_dofs]           # unit-free weights of the free increments
         self.prev = None                        # (w, tau) of the last converged step
-        self._converged = None                  # (H, t, r, kvals, info) of the last converged iterate
+        self._converged = None                  # (H, t, evaluation) of the last converged iterate
         self.t_iter = float(grid[0])            # pseudo-time of the current iterate (failure messages)
 
     # ------------------------------------------------------------ linear algebra
-    def _solve2(self, r, kvals, info, t):
+    def _solve2(self, ev, t):
         """``(dz_r, dz_t)``: one factorisation of ``K_ff``, two solves (``-r_f`` and ``-dr_f/dt``)."""
         newton, sys = self.newton, self.sys
         t0 = time.perf_counter()
-        K = sys.matrix(kvals, info["extra"])
-        drdt = rate(sys, self.Hcur, t, kvals, info["extra"], RATE_STEP * self.span, float(self.grid[0]))
+        K = self.problem.tangent(ev)
+        drdt = rate(self.problem, self.Hcur, t, ev, RATE_STEP * self.span, float(self.grid[0]))
         if not np.all(np.isfinite(drdt)):
             raise NonFinite(f"the pseudo-time rate dr/dt is not finite at t = {t:.6g}")
         t1 = time.perf_counter()
         try:
             lu = newton.linsolver.factorize(K)
-            dz_r = lu.solve(-r[sys.free_dofs])
+            dz_r = lu.solve(-ev.r[sys.free_dofs])
             dz_t = lu.solve(-drdt)
         except linsolve.SingularMatrixError as e:
             raise SingularTangent(f"singular tangent ({e})") from None
@@ -211,9 +210,6 @@ class ArcLengthRun(Run):
             raise SingularTangent("the linear solve returned non-finite values")
         return dz_r, dz_t
 
-    def _lf(self, t):
-        return self.sys.load_factors(t) if len(self.sys.load_scales) else np.zeros(0)
-
     def _move(self, H, t, dzf, t_new):
         """Free nodes by ``dzf``, constrained ones onto their targets at ``t_new``."""
         sys, newton = self.sys, self.newton
@@ -221,44 +217,44 @@ class ArcLengthRun(Run):
         H_target = sys.prescribed_poses(t_new) if len(sys.prescribed_nodes) else None
         dz_c, targets = newton._predictor(H, t_new, t, H_target)
         if dz_c is None:
-            return sys.update(H, dz)
+            return self.problem.update(H, dz)
         return newton._reach_targets(H, dz + dz_c, H_target, bool(targets), t_new)
 
     def _tangent_at(self, H, t):
-        """``dz/dt`` ``(n_free,)`` along the path at the equilibrium ``(H, t)``; without contact the
-        evaluation of the converged iterate is reused (with contact, committing the history may
-        change the tangent)."""
+        """``dz/dt`` ``(n_free,)`` along the path at the equilibrium ``(H, t)``; without contributions
+        (contact) the evaluation of the converged iterate is reused (committing a contribution's
+        history may change the tangent)."""
         self.Hcur = H
         last = self._converged
-        if last is not None and last[0] is H and last[1] == t and self.sys.contact is None:
-            r, kvals, info = last[2:]
+        if last is not None and last[0] is H and last[1] == t and not self.problem.contributions:
+            ev = last[2]
         else:
-            r, kvals, info = self.newton._evaluate(H, self._lf(t))
-        return self._solve2(r, kvals, info, t)[1]
+            ev = self.newton._evaluate(H, t)
+        return self._solve2(ev, t)[1]
 
     # ------------------------------------------------------------ one step
     def _correct(self, H, t, w, tau, ds, t_fixed=None):
         """Newton iterations from the iterate ``(H, t)`` of a step (scaled increment ``w``, pseudo-time
         change ``tau`` so far) onto the sphere of radius ``ds``, or at ``t = t_fixed`` if given.
-        Returns ``(H, t, w, tau, r, info, stats)``; raises a ``failures.StepFailed``."""
+        Returns ``(H, t, w, tau, ev, stats)``; raises a ``failures.StepFailed``."""
         newton, conv, sys = self.newton, self.newton.conv, self.sys
         floor = conv.floor(H, newton.L_ref)
         residuals, last_inc, linearised = [], np.inf, 0
         for it in range(conv.max_iter + 1):
             self.Hcur, self.t_iter = H, t
-            r, kvals, info = newton._evaluate(H, self._lf(t))
-            ratio = newton._ratio(r, conv.scales(info, newton.L_ref))
+            ev = newton._evaluate(H, t)
+            ratio = newton._ratio(ev.r, conv.scales(ev, newton.L_ref))
             residuals.append(ratio)
             if newton.callback is not None:
                 newton.callback(dict(t=t, iteration=it, residual=ratio, poses=H))
             verdict = conv.decide(ratio, last_inc, it, floor)
             if verdict == "converged":
-                newton.last_tangent = (kvals, info["extra"])
-                self._converged = (H, t, r, kvals, info)
-                return H, t, w, tau, r, info, dict(iterations=it, residuals=residuals, linearised=linearised)
+                newton.last_evaluation = ev
+                self._converged = (H, t, ev)
+                return H, t, w, tau, ev, dict(iterations=it, residuals=residuals, linearised=linearised)
             if verdict != "continue":
                 raise newton._failure(verdict, ratio)
-            dz_r, dz_t = self._solve2(r, kvals, info, t)
+            dz_r, dz_t = self._solve2(ev, t)
             if t_fixed is None:
                 dt, lin = sphere_root(w, tau, self.S * dz_r, self.S * dz_t, self.psi, ds)
                 linearised += lin
@@ -284,8 +280,7 @@ class ArcLengthRun(Run):
     def _arc_step(self, ds):
         """One converged step of arc length ``ds`` from ``(self.H, self.t)``."""
         H0, t0, sys = self.H, self.t, self.sys
-        if sys.contact is not None:
-            sys.contact.begin_step(H0, t0)
+        self.problem.begin_step(H0, t0)
         v = self._tangent_at(H0, t0)
         tau = self._predict(v, ds)
         t_try, _ = motion_path.limit_step(sys, t0, t0 + tau)
@@ -297,7 +292,7 @@ class ArcLengthRun(Run):
             tau = self.t_end - t0
         H = self._move(H0, t0, tau * v, t0 + tau)
         out = self._correct(H, t0 + tau, self.S * tau * v, tau, ds, self.t_end if crossing else None)
-        H, t, w, tau, r, info, stats = self._augment(out)
+        H, t, w, tau, ev, stats = self._augment(out)
         if not crossing and t0 < self.t_end <= t:    # passed t_end on the sphere: redo by load control
             return self._arc_step_to_end(H0, t0, v, ds)
         self._check_turn(w, tau)
@@ -306,12 +301,11 @@ class ArcLengthRun(Run):
             raise StepFailed(f"a prescribed rotation turns by {rot:.3g} rad over the step (more than "
                              f"MAX_MOTION_ROTATION = {motion_path.MAX_MOTION_ROTATION:.3g} rad)")
         self.newton._check_continuity(H0, H)
-        return H, t, w, tau, r, info, stats
+        return H, t, w, tau, ev, stats
 
     def _arc_step_to_end(self, H0, t0, v, ds):
         """The step from ``(H0, t0)`` with ``t = t_end`` held (predictor along ``v``)."""
-        if self.sys.contact is not None:
-            self.sys.contact.begin_step(H0, t0)        # forget the first attempt's multiplier updates
+        self.problem.begin_step(H0, t0)              # forget the first attempt's outer iterations
         tau = self.t_end - t0
         H = self._move(H0, t0, tau * v, self.t_end)
         out = self._augment(self._correct(H, self.t_end, self.S * tau * v, tau, ds, self.t_end))
@@ -319,23 +313,25 @@ class ArcLengthRun(Run):
         return out
 
     def _augment(self, out):
-        """Augmented-Lagrangian updates at the converged ``t`` until the contact tolerance holds."""
-        sys = self.sys
-        H, t, w, tau, r, info, stats = out
-        while sys.contact is not None and sys.contact.augment(H):
-            H, t, w, tau, r, info, more = self._correct(H, t, w, tau, 0.0, t_fixed=t)
+        """Outer iterations at the converged ``t`` (``Problem.repeat_step``, e.g. augmented-Lagrangian
+        updates) with ``t`` held; refused or warned if ``Problem.unmet``."""
+        problem = self.problem
+        H, t, w, tau, ev, stats = out
+        while problem.repeat_step(H):
+            if stats.get("augmentations", 0) >= MAX_OUTER:
+                raise AugmentationFailed(f"the outer iterations (augmented-Lagrangian updates) still ask to "
+                                         f"re-solve the step at t = {t:.6g} after MAX_OUTER = {MAX_OUTER}")
+            H, t, w, tau, ev, more = self._correct(H, t, w, tau, 0.0, t_fixed=t)
             stats["iterations"] += more["iterations"]
             stats["residuals"] += more["residuals"]
             stats["augmentations"] = stats.get("augmentations", 0) + 1
-        unmet = getattr(sys.contact, "unmet_tolerance", None) if sys.contact is not None else None
-        if unmet:
-            text = (f"augmented Lagrangian: the penetration is {unmet:.3g} times the requested tolerance "
-                    f"at t = {t:.6g}")
+        text = problem.unmet(t)
+        if text:
             if not self.opt.get("allow_unmet_tolerance"):
                 raise AugmentationFailed(text + " (solve(..., allow_unmet_tolerance=True) accepts it)")
             stats.setdefault("warnings", []).append(text)
             warnings.warn(text, RuntimeWarning, stacklevel=4)
-        return H, t, w, tau, r, info, stats
+        return H, t, w, tau, ev, stats
 
     def _check_turn(self, w, tau):
         """Refuse a step that turned back along the path (``cos <= TURN_BACK`` with the previous one)."""
@@ -374,9 +370,9 @@ class ArcLengthRun(Run):
                 self._not_reached()
                 return
             t0 = time.perf_counter()
-            H, t, w, tau, r, info, stats = self._attempt_arc()
+            H, t, w, tau, ev, stats = self._attempt_arc()
             stats.update(wall_time=time.perf_counter() - t0, dt=t - self.t)
-            self._record_arc(H, t, w, tau, r, info, stats)
+            self._record_arc(H, t, w, tau, ev, stats)
 
     def _attempt_arc(self):
         """Converge one step, halving the arc length on a retryable failure down to ``min``."""
@@ -385,11 +381,11 @@ class ArcLengthRun(Run):
             self.newton.reset_timings()
             try:
                 out = self._arc_step(ds)
-                self._check_finite(out[0], out[4], out[5]["state"], out[1])
-                out[6].update(cutbacks=len(failed), arc_length=self.ds_used, psi=self.psi,
+                self._check_finite(out[0], out[4].r, out[4].state, out[1])
+                out[5].update(cutbacks=len(failed), arc_length=self.ds_used, psi=self.psi,
                               timings=dict(self.newton.timings))
                 if failed:
-                    out[6]["failed_arc_length"] = failed
+                    out[5]["failed_arc_length"] = failed
                 self.ds = self.ds_used
                 return out
             except StepFailed as e:
@@ -401,19 +397,17 @@ class ArcLengthRun(Run):
                 if not e.retry or ds < self.ds_min * (1.0 - STEP_TOLERANCE):
                     self._stop_arc(e, 2.0 * ds)
 
-    def _record_arc(self, H, t, w, tau, r, info, stats):
-        sys, sol = self.sys, self.sol
-        contact_data = None
-        if sys.contact is not None:
-            sys.contact.commit(H)
-            contact_data = sys.contact.results(H)
-            sol.contact_state = contact_snapshot(sys.contact)
+    def _record_arc(self, H, t, w, tau, ev, stats):
+        sys, sol, problem = self.sys, self.sol, self.problem
+        record = problem.commit(H)
+        if problem.contributions:
+            sol.contact_state = problem.get_state()
         if self.opt.get("check_stability"):
             self._stability(stats, t)
         for text in stats.get("warnings", ()):
             sol.message = text if not sol.message else sol.message + "; " + text
         stats["t"] = t
-        sol.append(t, H, sys.reactions(H, r), info["state"].sigma, info["state"].strain, stats, contact_data)
+        sol.append(t, H, sys.reactions(H, ev.r), ev.state.sigma, ev.state.strain, stats, record)
         sol.resume = dict(path="arc-length", t0=float(self.grid[0]), t_end=self.t_end)
         ds = next_arc_length(self.ds, stats["iterations"], self.arc.target_iterations, stats["cutbacks"] > 0,
                              stats["linearised"] > 0)

@@ -15,12 +15,11 @@ global-type nodes the term ``[[0, -hat(r_u)], [0, -hat(r_w)]]`` from the
 dependence of ``M`` on ``R`` (``r`` in global components), which keeps Newton
 quadratic.
 """
-import time
-
 import numpy as np
 import scipy.sparse as sp
 
 from . import assembly_jit, element, se3
+from . import blocks as _blocks
 from .errors import InputError
 from .se3 import skew
 from .validation import check_pose
@@ -297,6 +296,40 @@ class System:
             M[self.members] = self.Ad_Xinv @ M[self.rep[self.members]]
         return M
 
+    def assemble_blocks(self, H, blocks):
+        """Generic assembly of local blocks (``blocks.Blocks``, any ``k`` nodes per block;
+        docs/theory.md eqs. 10.2-10.3).
+
+        Node transforms (joins, global-type nodes) are applied to the blocks touching a
+        transformed node.  Returns ``(r, coo, f_level, m_level)``: the residual ``(6 n,)``,
+        the tangent as COO ``(rows, cols, vals)`` in full ``z`` numbering (empty without
+        ``blocks.K``) and the largest transformed nodal force and moment.
+        """
+        nodes, f, K = blocks.nodes, blocks.f, blocks.K
+        if self.transformed.any() and len(nodes):
+            which = np.flatnonzero(self.transformed[nodes].any(axis=1))
+            f, K = _blocks.transform(self.node_transforms(H), nodes, f, K, which)
+        d = _blocks.dofs(self.rep, nodes)
+        r = np.bincount(d.ravel(), weights=f.ravel(), minlength=6 * self.n_nodes)
+        coo = (np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0))
+        if K is not None and len(nodes):
+            n = d.shape[1]
+            coo = (np.repeat(d, n, axis=1).ravel(), np.tile(d, (1, n)).ravel(), K.ravel())
+            g = np.intersect1d(self.global_nodes, self.rep[nodes])
+            if len(g):
+                coo = _concat(coo, self._global_node_terms(r, g))
+        return (r, coo) + _blocks.levels(f)
+
+    @staticmethod
+    def _global_node_terms(r, g):
+        """COO of ``[[0, -hat(r_u)], [0, -hat(r_w)]]`` at global-type nodes ``g`` (the dependence of
+        ``M`` on ``R``, see the module docstring) for the residual ``r`` of one contribution."""
+        rg = r.reshape(-1, 6)[g]
+        vals = -np.concatenate([skew(rg[:, :3]), skew(rg[:, 3:])], axis=1)          # (k, 6, 3)
+        rows = np.broadcast_to((6 * g)[:, None, None] + np.arange(6)[:, None], vals.shape)
+        cols = np.broadcast_to((6 * g)[:, None, None] + 3 + np.arange(3), vals.shape)
+        return rows.ravel(), cols.ravel(), vals.ravel()
+
     # ------------------------------------------------------------ evaluation
     def evaluate(self, H, load_factors, tangent=True):
         """Residual ``r = f_int - f_ext`` in ``z`` (``(6 n,)``) and, with ``tangent``, K values.
@@ -342,17 +375,7 @@ class System:
             blocks[where, 3:, 3:] -= skew(rg[:, 3:])
         if tangent:
             kvals[n_k:] = blocks.ravel()
-        info = dict(state=state, f_level=f_level, m_level=m_level, extra=None)
-        if self.contact is not None:
-            # contact residual (6 n,) in z numbering and COO tangent (rows, cols, vals)
-            t0 = time.perf_counter()
-            rc, coo, cinfo = self.contact.evaluate(H, tangent)
-            info["contact_time"] = time.perf_counter() - t0
-            r = r + rc
-            info["extra"] = coo
-            info["contact"] = cinfo
-            info["f_level"] = max(f_level, cinfo.get("f_level", 0.0))
-            info["m_level"] = max(m_level, cinfo.get("m_level", 0.0))
+        info = dict(state=state, f_level=f_level, m_level=m_level)
         return r, kvals, info
 
     def _add_loads(self, H, lf, M, r, blocks, f_level, m_level):
@@ -388,7 +411,7 @@ class System:
         """Reduced tangent (free x free) as CSC from the COO values.
 
         ``extra``: optional ``(rows, cols, vals)`` COO entries in full ``z``
-        numbering (contact), whose pattern may change between iterations.
+        numbering (``assemble_blocks``), whose pattern may change between iterations.
         """
         data = np.empty(self.nnz + 1)
         assembly_jit.scatter(self.pos, kvals, data)
@@ -514,3 +537,8 @@ class System:
         out[body, 3:] = np.einsum("nij,nj->ni", R[body], rr[body, 3:])
         out[~body] = rr[~body]
         return out
+
+
+def _concat(a, b):
+    """Two COO triplets ``(rows, cols, vals)`` as one."""
+    return tuple(np.concatenate([x, y]) for x, y in zip(a, b))

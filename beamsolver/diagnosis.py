@@ -9,6 +9,7 @@ import numpy as np
 from .definiteness import negative_eigenvalues
 from .element import internal_forces
 from .failures import DampingStalled, NotConverged, SingularTangent
+from .problem import Problem
 
 __all__ = ["nonfinite_source", "advice", "stiffness_spread", "ILL_CONDITIONED"]
 
@@ -39,7 +40,7 @@ def nonfinite_source(system, H, t):
         if len(e):
             return False, f"the internal forces of element {int(e[0])} are not finite"
     if system.contact is not None:
-        rc, _, _ = system.contact.evaluate(H, False)
+        rc = system.assemble_blocks(H, system.contact.evaluate(H, False)[0])[0]
         nodes = np.flatnonzero(~np.all(np.isfinite(rc.reshape(-1, 6)), axis=1))
         if len(nodes):
             decl = _contact_declaration(model, nodes)
@@ -71,9 +72,8 @@ def stiffness_spread(system, K):
 def _tangent_state(system, H, t):
     """``(negative eigenvalues, stiffness spread)`` of the tangent at ``H`` (``None`` if unknown)."""
     try:
-        lf = system.load_factors(t) if len(system.load_scales) else np.zeros(0)
-        _, kvals, info = system.evaluate(H, lf, tangent=True)
-        K = system.matrix(kvals, info["extra"])
+        problem = Problem(system)
+        K = problem.tangent(problem.evaluate(H, t, tangent=True))
         spread = stiffness_spread(system, K)
         return (negative_eigenvalues(K)[0] if np.isfinite(spread) else None), spread
     except Exception:           # advice only: never hide the failure being reported

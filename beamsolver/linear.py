@@ -2,7 +2,7 @@
 
 ``linearize(model, solution, step)`` re-assembles, at the poses and
 pseudo-time of ``step``, exactly the matrix the Newton loop factorises
-(``assembly.System``): element tangents, follower/dead load terms and, for
+(``problem.Problem``): element tangents, follower/dead load terms and, for
 scenes with contact, the contact tangent.  Unknowns are those of
 ``assembly``: six per representative node, body increments
 ``H <- H exp(hat(z))`` (translation first) for free and prescribed nodes,
@@ -18,9 +18,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .assembly import GLOBAL, System
+from .assembly import GLOBAL
 from .model import DOF_NAMES
-from .restart import contact_restore
+from .problem import Problem
 
 __all__ = ["linearize", "Linearization", "DofMap"]
 
@@ -76,20 +76,20 @@ def linearize(model, solution, step=-1):
     if k is None:
         from .errors import InputError
         raise InputError(f"linearize: step {step} out of range (the solution has steps 0..{n - 1})")
-    system = System(model, check_rigid_modes=False)
+    problem = Problem.from_model(model, check_rigid_modes=False)
+    system = problem.system
     H = np.array(solution._poses[k], dtype=float)
     if H.shape[0] != system.n_nodes:
         from .errors import InputError
         raise InputError(f"linearize: the solution has {H.shape[0]} nodes, the model {system.n_nodes}")
     t = solution._times[k]
-    if system.contact is not None:
-        if k == n - 1 and solution.contact_state:
-            contact_restore(system.contact, solution.contact_state)
-        system.contact.begin_step(H, t)
-    lf = system.load_factors(t) if len(system.load_scales) else np.zeros(0)
-    r, kvals, info = system.evaluate(H, lf, tangent=True)
-    K = system.matrix(kvals, info["extra"]).tocsr()
-    K_full = system.full_matrix(kvals, info["extra"])
+    if k == n - 1 and solution.contact_state:
+        problem.set_state(solution.contact_state)
+    problem.begin_step(H, t)
+    ev = problem.evaluate(H, t, tangent=True)
+    r = ev.r
+    K = problem.tangent(ev).tocsr()
+    K_full = problem.full_tangent(ev)
     free = system.free_dofs
     node, comp = free // 6, free % 6
     node_beam = solution.description["node_beam"]

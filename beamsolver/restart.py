@@ -14,17 +14,21 @@ __all__ = ["restart_from", "contact_snapshot", "contact_restore"]
 
 
 def contact_snapshot(contact):
-    """Committed contact history (flat dict of arrays) for saving and restart: ``contact.get_state()``."""
+    """Committed history (flat dict of arrays) for saving and restart: ``contact.get_state()``
+    (a contact system or a ``problem.Problem``)."""
     return dict(contact.get_state())
 
 
 def contact_restore(contact, state):
-    """Give ``contact`` the state ``contact_snapshot`` took: ``contact.set_state(state)``."""
+    """Give ``contact`` (a contact system or a ``problem.Problem``) the state
+    ``contact_snapshot`` took: ``contact.set_state(state)``."""
     contact.set_state(dict(state))
 
 
-def restart_from(restart, model, system):
-    """The ``Solution`` to continue (a copy bound to ``model``) from a Solution or a saved file."""
+def restart_from(restart, model, problem):
+    """The ``Solution`` to continue (a copy bound to ``model``) from a Solution or a saved file;
+    ``problem`` (``problem.Problem``) takes the committed history of its last step."""
+    system = problem.system
     if not hasattr(restart, "_poses"):
         from .results import load
         restart = load(restart)
@@ -38,6 +42,6 @@ def restart_from(restart, model, system):
                          f"({model.n_nodes} nodes, or other reference poses)")
     sol = restart.copy_steps(model, system)
     sol.converged, sol.message = True, ""
-    if system.contact is not None and sol.contact_state:
-        contact_restore(system.contact, sol.contact_state)
+    if sol.contact_state:
+        contact_restore(problem, sol.contact_state)
     return sol

@@ -3,11 +3,13 @@
 Per step ``t -> t + dt``: loads are evaluated at ``t + dt``; the first
 iteration carries the prescribed motions into the free unknowns through the
 tangent (``K_ff dz_f = -r_f - K_fc dz_c``), later iterations are Newton
-``K dz = -r``, damped on the size of the Newton correction without contact
+``K dz = -r``, damped on the size of the Newton correction for a smooth problem
 (``_Newton._damped``) and by a backtracking line search on the scaled residual
-with contact (``_Newton._line_search``).  Elements may not turn by more than
-``MAX_ELEMENT_ROTATION`` (nor pass pi within a step): such steps fail with a
-message saying how many elements the beam needs.
+otherwise (``_Newton._line_search``).  The physics is reached only through the
+``problem.Problem`` interface (residual, tangent, update, step life cycle).
+Elements may not turn by more than ``MAX_ELEMENT_ROTATION`` (nor pass pi
+within a step): such steps fail with a message saying how many elements the
+beam needs.
 Failures are typed (``beamsolver.failures``); ``Convergence.decide`` gives
 the verdict on every iterate.  The stepping (cut-back, regrowth, landing on
 the user's grid, keeping what converged when a run stops) is ``stepping.Run``.
@@ -19,11 +21,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import diagnosis, linsolve, se3
-from .assembly import System
+from .arclength import ArcLengthRun, check_arc_length_arguments
 from .errors import InputError
 from .failures import DampingStalled, Diverged, NonFinite, NotConverged, RotationLimit, SingularTangent, StepFailed
+from .problem import Problem
 from .restart import restart_from
-from .arclength import ArcLengthRun, check_arc_length_arguments
 from .stepping import Run
 from .validation import check_solve_arguments
 
@@ -35,7 +37,7 @@ log = logging.getLogger("beamsolver")
 
 MAX_ELEMENT_ROTATION = 0.8 * np.pi   # an iterate turning an element further is rejected
 LS_GROWTH = 10.0                     # full Newton steps are kept unless the merit grows this much
-DAMPING_MIN = 1.0 / 64.0             # shortest damped Newton step (scenes without contact)
+DAMPING_MIN = 1.0 / 64.0             # shortest damped Newton step (smooth problems)
 STALL_RATIO = 1.5                    # undamped fallback if the shortest damped step grows the correction less
 MIN_STEP_RATIO = 1e-15               # smallest min_step_ratio: below, t + dt rounds to t
 ROUNDOFF = 64.0 * np.finfo(float).eps   # position round-off, relative to the distance from the origin
@@ -63,8 +65,10 @@ class Convergence:
     max_iter: int = 30
     divergence: float = 1e12
 
-    def scales(self, info, L_ref):
-        f, m = info["f_level"], info["m_level"]
+    def scales(self, ev, L_ref):
+        """``(F_ref, M_ref)`` from the force levels of an evaluation (``problem.Evaluation``, or a
+        dict with ``f_level`` and ``m_level``)."""
+        f, m = (ev["f_level"], ev["m_level"]) if isinstance(ev, dict) else (ev.f_level, ev.m_level)
         F = max(f, m / L_ref)
         M = max(m, f * L_ref)
         return F, M
@@ -150,12 +154,14 @@ def _refine_advice(system, H, t, t_start, t_end):
 
 
 class _Newton:
-    """Newton iterations of one step (``step``); ``timings`` accumulates the wall time of
-    ``assembly`` (residual, tangent, sparse matrix), ``contact`` (part of it) and
-    ``linear_solve`` (factorisation and solves) until ``reset_timings``."""
+    """Newton iterations of one step (``step``) on a ``problem.Problem``; ``timings`` accumulates
+    the wall time of ``assembly`` (residual, tangent, sparse matrix), of each of the problem's
+    contributions (``Problem.timing_names``, part of assembly) and ``linear_solve``
+    (factorisation and solves) until ``reset_timings``."""
 
-    def __init__(self, system, conv, line_search, callback):
-        self.sys = system
+    def __init__(self, problem, conv, line_search, callback):
+        self.problem = problem
+        self.sys = system = problem.system
         self.conv = conv
         self.line_search = line_search
         self.callback = callback
@@ -170,7 +176,7 @@ class _Newton:
         self.reset_timings()
 
     def reset_timings(self):
-        self.timings = dict(assembly=0.0, contact=0.0, linear_solve=0.0)
+        self.timings = dict(assembly=0.0, linear_solve=0.0, **dict.fromkeys(self.problem.timing_names, 0.0))
 
     def _ratio(self, r, scales):
         rf = r[self.sys.free_dofs]
@@ -224,14 +230,14 @@ class _Newton:
         """``Convergence.increment_ratio`` of free increments."""
         return max(np.abs(dzf[self.fu]).max(initial=0.0) / self.L_ref, np.abs(dzf[self.fw]).max(initial=0.0))
 
-    def _direction(self, r, kvals, info, dz_c=None):
+    def _direction(self, ev, dz_c=None):
         """Newton increment on the free unknowns (with the prescribed-motion coupling ``dz_c``)."""
-        sys = self.sys
+        problem = self.problem
         t0 = time.perf_counter()
-        rhs = -r[sys.free_dofs]
+        rhs = -ev.r[self.sys.free_dofs]
         if dz_c is not None:
-            rhs -= sys.prescribed_coupling(kvals, dz_c.ravel(), info["extra"])
-        K = sys.matrix(kvals, info["extra"])
+            rhs -= problem.coupling(ev, dz_c)
+        K = problem.tangent(ev)
         t1 = time.perf_counter()
         try:
             lu = _factorize(K, self.linsolver)
@@ -244,15 +250,16 @@ class _Newton:
             raise SingularTangent("the linear solve returned non-finite values")
         return lu, dzf
 
-    def _evaluate(self, H, lf, tangent=True):
+    def _evaluate(self, H, t, tangent=True):
         t0 = time.perf_counter()
-        r, kvals, info = self.sys.evaluate(H, lf, tangent=tangent)
+        ev = self.problem.evaluate(H, t, tangent=tangent)
         self.timings["assembly"] += time.perf_counter() - t0
-        self.timings["contact"] += info.get("contact_time", 0.0)
-        if not np.all(np.isfinite(r)):
+        for name, seconds in ev.timings.items():
+            self.timings[name] = self.timings.get(name, 0.0) + seconds
+        if not np.all(np.isfinite(ev.r)):
             raise NonFinite("the residual is not finite")
-        self._check_rotation(info["state"])
-        return r, kvals, info
+        self._check_rotation(ev.state)
+        return ev
 
     def _predictor(self, H, t, t_prev, H_target):
         """Increments ``dz_c`` ``(n, 6)`` carrying the constrained nodes to their targets at ``t``
@@ -272,7 +279,7 @@ class _Newton:
     def _reach_targets(self, H, dz, H_target, fix_values, t):
         """The predictor update: free nodes by ``dz``, constrained ones exactly onto their targets."""
         sys = self.sys
-        H = sys.update(H, dz)
+        H = self.problem.update(H, dz)
         if len(sys.prescribed_nodes):
             H[sys.prescribed_nodes] = H_target
         if fix_values:
@@ -282,33 +289,34 @@ class _Newton:
 
     def step(self, H, t, H_target, t_prev=None):
         """Solve for equilibrium at ``t`` (from the equilibrium ``H`` at ``t_prev``); returns
-        ``(H, r, info, stats)`` or raises a ``failures.StepFailed``.
+        ``(H, ev, stats)`` (``ev`` the ``problem.Evaluation`` of the converged state) or raises a
+        ``failures.StepFailed``.
 
-        Without contact, with ``line_search``, the Newton step is damped on the Newton correction
-        (``_damped``); with contact the residual line search ``_line_search`` is used.
+        With ``line_search``, the Newton step of a smooth problem (``Problem.smooth``) is damped
+        on the Newton correction (``_damped``); otherwise the residual line search
+        ``_line_search`` is used.
         """
-        sys, conv = self.sys, self.conv
-        lf = sys.load_factors(t) if len(sys.load_scales) else np.zeros(0)
+        conv, problem = self.conv, self.problem
         H_start = H
         residuals = []
         damped_its = 0
         dz_c, targets = self._predictor(H, t, t_prev, H_target)
         floor = conv.floor(H, self.L_ref)
-        damping = self.line_search and sys.contact is None
+        damping = self.line_search and problem.smooth
         last_inc = np.inf
-        ahead = None                 # (r, kvals, info, lu, dzf) of an accepted damped trial
+        ahead = None                 # (ev, lu, dzf) of an accepted damped trial
         lam = 1.0
         rotation_streak = 0
         stats_extra = {}
         for it in range(conv.max_iter + 1):
             if ahead is None:
-                r, kvals, info = self._evaluate(H, lf)
+                ev = self._evaluate(H, t)
                 lu = dzf = None
             else:
-                r, kvals, info, lu, dzf = ahead
+                ev, lu, dzf = ahead
                 ahead = None
-            scales = conv.scales(info, self.L_ref)
-            ratio = self._ratio(r, scales)
+            scales = conv.scales(ev, self.L_ref)
+            ratio = self._ratio(ev.r, scales)
             residuals.append(ratio)
             log.debug("t = %.6g  iteration %d  scaled residual %.3e", t, it, ratio)
             if self.callback is not None:
@@ -318,12 +326,12 @@ class _Newton:
                 self._check_continuity(H_start, H)
                 if damped_its:
                     stats_extra["damped"] = damped_its
-                self.last_tangent = (kvals, info["extra"])     # of the converged state
-                return H, r, info, dict(iterations=it, residuals=residuals, **stats_extra)
+                self.last_evaluation = ev     # of the converged state (its tangent: stability check)
+                return H, ev, dict(iterations=it, residuals=residuals, **stats_extra)
             if verdict != CONTINUE:
                 raise self._failure(verdict, ratio)
             if dzf is None:
-                lu, dzf = self._direction(r, kvals, info, dz_c)
+                lu, dzf = self._direction(ev, dz_c)
             dz = self._full(dzf)
             if dz_c is not None:
                 H = self._reach_targets(H, dz + dz_c, H_target, bool(targets), t)
@@ -332,11 +340,11 @@ class _Newton:
                 continue
             if not damping:
                 last_inc = conv.increment_ratio(dz, self.L_ref)
-                H = self._line_search(H, dz, r, scales, lf) if self.line_search else sys.update(H, dz)
+                H = self._line_search(H, dz, ev.r, scales, t) if self.line_search else problem.update(H, dz)
                 continue
             lam0 = min(1.0, 2.0 * lam)          # after a damped iteration, try twice its length
             try:
-                H, lam, ahead, rotation = self._damped(H, dz, dzf, lf, lam0)
+                H, lam, ahead, rotation = self._damped(H, dz, dzf, t, lam0)
             except DampingStalled:
                 if not self.stall_ratio <= STALL_RATIO:
                     raise
@@ -348,7 +356,7 @@ class _Newton:
                 damping = False
                 stats_extra["undamped"] = it
                 last_inc = conv.increment_ratio(dz, self.L_ref)
-                H = sys.update(H, dz)
+                H = problem.update(H, dz)
                 continue
             damped_its += lam < 1.0
             # the full step turned an element past the limit in two iterations running: the
@@ -372,8 +380,8 @@ class _Newton:
         dz[self.sys.free_dofs] = dzf
         return dz.reshape(-1, 6)
 
-    def _damped(self, H, dz, dzf, lf, lam):
-        """Damped Newton update ``H exp(lam dz)`` (scenes without contact).
+    def _damped(self, H, dz, dzf, t, lam):
+        """Damped Newton update ``H exp(lam dz)`` (smooth problems).
 
         A trial length is accepted when the Newton correction at the trial point is smaller than
         the current one (``|dz(trial)| < |dz|``, translations scaled by the model size): an
@@ -385,28 +393,28 @@ class _Newton:
         halved (a trial that is not finite, is singular or turns an element past the limit is
         rejected too) down to ``DAMPING_MIN``.
 
-        Returns ``(H, lam, ahead, rotation)``: ``ahead`` the trial's ``(r, kvals, info, lu,
-        dzf)`` (``None`` if it converged), ``rotation`` the rotation-limit failure of the full
+        Returns ``(H, lam, ahead, rotation)``: ``ahead`` the trial's ``(ev, lu, dzf)`` (``None``
+        if it converged), ``rotation`` the rotation-limit failure of the full
         first trial, if that is what rejected it.
         """
-        sys, conv = self.sys, self.conv
+        problem, conv = self.problem, self.conv
         if self._inc(dzf) <= 1e3 * conv.dtol:     # round-off level: nothing to damp
-            return sys.update(H, dz), 1.0, None, None
+            return problem.update(H, dz), 1.0, None, None
         nrm = self._norm(dzf)
         rotation = None
         failure = None
         first = True
         while True:
             self.stall_ratio = np.inf
-            H1 = sys.update(H, lam * dz)
+            H1 = problem.update(H, lam * dz)
             try:
-                r1, k1, info1 = self._evaluate(H1, lf)
-                if self._ratio(r1, conv.scales(info1, self.L_ref)) <= conv.rtol:
-                    return H1, lam, (r1, k1, info1, None, None), None
-                lu1, d1 = self._direction(r1, k1, info1)
+                ev1 = self._evaluate(H1, t)
+                if self._ratio(ev1.r, conv.scales(ev1, self.L_ref)) <= conv.rtol:
+                    return H1, lam, (ev1, None, None), None
+                lu1, d1 = self._direction(ev1)
                 self.stall_ratio = self._norm(d1) / nrm
                 if self._norm(d1) < nrm or self._inc(d1) <= conv.dtol:
-                    return H1, lam, (r1, k1, info1, lu1, d1), rotation
+                    return H1, lam, (ev1, lu1, d1), rotation
             except StepFailed as e:
                 failure = e
                 if first and e.rotation:
@@ -419,21 +427,20 @@ class _Newton:
                 raise DampingStalled(f"damped Newton stalled: no step length down to {DAMPING_MIN:g} of the "
                                      "Newton increment reduces the Newton correction")
 
-    def _line_search(self, H, dz, r0, scales, lf):
-        """Backtracking on the scaled residual (scenes with contact; the others use the damped
-        Newton of ``_damped``: a piecewise smooth contact residual made its natural-monotonicity
+    def _line_search(self, H, dz, r0, scales, t):
+        """Backtracking on the scaled residual (problems that are not smooth; the others use the
+        damped Newton of ``_damped``: a piecewise smooth residual made its natural-monotonicity
         test accept steps that later stalled, e.g. in the twisted pair)."""
-        sys = self.sys
+        problem = self.problem
         phi0 = self._merit(r0, scales)
-        H1 = sys.update(H, dz)
-        if phi0 <= (10.0 * self.conv.rtol) ** 2 * len(sys.free_dofs):
+        H1 = problem.update(H, dz)
+        if phi0 <= (10.0 * self.conv.rtol) ** 2 * len(self.sys.free_dofs):
             return H1
         alpha = 1.0
         best = (np.inf, H1)
         for _ in range(8):
             try:
-                r1, _, _ = self._evaluate(H1, lf, tangent=False)
-                phi = self._merit(r1, scales)
+                phi = self._merit(self._evaluate(H1, t, tangent=False).r, scales)
             except StepFailed:
                 phi = np.inf
             if phi < best[0]:
@@ -448,17 +455,17 @@ class _Newton:
             else:
                 a_new = 0.1 * alpha
             alpha = float(np.clip(a_new, 0.1 * alpha, 0.5 * alpha))
-            H1 = sys.update(H, alpha * dz)
+            H1 = problem.update(H, alpha * dz)
         if not np.isfinite(best[0]):
             raise NonFinite("line search found no finite residual along the Newton direction")
         return best[1]
 
 
-def _starting_point(restart, model, system, t_start, t_end):
+def _starting_point(restart, model, problem, t_start, t_end):
     """``(solution to continue or None, t_start)``: a restart starts at its first saved time."""
     sol = None
     if restart is not None:
-        sol = restart_from(restart, model, system)
+        sol = restart_from(restart, model, problem)
         t_start = sol._times[0]
     if not (np.isfinite(t_end) and np.isfinite(t_start) and t_end > t_start):
         raise InputError(f"solve: need t_end > t_start, got t_start={t_start!r}, t_end={t_end!r}")
@@ -520,8 +527,9 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     monotonic; ``stats[k]`` adds ``arc_length``, ``t`` and ``linearised``.
 
     ``Solution.stats[k]["timings"]``: wall time of the step's ``assembly``
-    (residuals, tangents, sparse matrices), ``contact`` (part of assembly) and
-    ``linear_solve`` (factorisations and solves), in seconds.
+    (residuals, tangents, sparse matrices), of each contribution to it (``contact``
+    for scenes with contact, part of assembly) and ``linear_solve``
+    (factorisations and solves), in seconds.
     """
     check_solve_arguments(model, steps=steps, t_end=t_end, t_start=t_start, rtol=rtol, dtol=dtol, max_iter=max_iter,
                           min_step_ratio=min_step_ratio, checkpoint=checkpoint, initial_poses=initial_poses,
@@ -531,18 +539,19 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     if int(steps) != steps or steps < 1:
         raise InputError(f"solve: steps must be a positive integer, got {steps!r}")
     arc = check_arc_length_arguments(path, arc_length, restart)
-    system = System(model, check_rigid_modes=check_rigid_modes)
-    sol, t_start = _starting_point(restart, model, system, t_start, t_end)
+    problem = Problem.from_model(model, check_rigid_modes=check_rigid_modes)
+    system = problem.system
+    sol, t_start = _starting_point(restart, model, problem, t_start, t_end)
     grid = np.linspace(t_start, t_end, int(steps) + 1)
     dt_min = _step_floor(min_step_ratio, grid)
     conv = Convergence(rtol=rtol, dtol=dtol, max_iter=max_iter)
-    newton = _Newton(system, conv, line_search, callback)
+    newton = _Newton(problem, conv, line_search, callback)
     newton.linsolver = linsolve.Solver(linear_solver)
     options = dict(allow_unmet_tolerance=allow_unmet_tolerance, check_stability=check_stability,
                    advice=_advice(system, t_start, t_end))
     run = None
     try:
-        args = (system, newton, _writer(output, system, checkpoint), grid, dt_min, verbose, options)
+        args = (problem, newton, _writer(output, system, checkpoint), grid, dt_min, verbose, options)
         run = Run(*args) if arc is None else ArcLengthRun(*args, arc)
         run.start(sol, initial_poses)
         run.loop()

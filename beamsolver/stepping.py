@@ -27,7 +27,6 @@ from .definiteness import negative_eigenvalues
 from .errors import ConvergenceError, InputError, StabilityWarning
 from .failures import AugmentationFailed, MotionTooFast, NonFinite, StepFailed
 from .progress import Progress
-from .restart import contact_snapshot
 from .results import Solution
 
 __all__ = ["Run", "growth", "next_step", "after_failure", "STEP_TOLERANCE", "EASY_ITERATIONS", "WAIT_MAX"]
@@ -39,6 +38,7 @@ LANDING = 0.1              # a step ending within this fraction of a step before
 EASY_ITERATIONS = 6        # a step converging within these iterations is easy (growth)
 EASY_RUN = 2               # easy steps running before the step grows (growth)
 WAIT_MAX = 32              # most easy steps running before a step regrows to a size that failed again
+MAX_OUTER = 100            # outer iterations of a step (Problem.repeat_step) before it fails
 
 
 def growth(iterations, easy):
@@ -73,8 +73,9 @@ def after_failure(size, failed=np.inf, wait=EASY_RUN):
 class Run:
     """One call of ``solve``: ``start``, then ``loop``; ``abort(exc)`` on any exception."""
 
-    def __init__(self, system, newton, writer, grid, dt_min, verbose, options):
-        self.sys, self.newton, self.writer, self.grid = system, newton, writer, grid
+    def __init__(self, problem, newton, writer, grid, dt_min, verbose, options):
+        self.problem, self.sys = problem, problem.system
+        self.newton, self.writer, self.grid = newton, writer, grid
         self.dt_user = grid[1] - grid[0]
         self.dt_min = dt_min
         self.verbose = verbose
@@ -115,17 +116,17 @@ class Run:
     def _step_zero(self, H0, t_start):
         """Step 0: the state ``H0`` at ``t_start`` (prescribed nodes on their motion) or, when loads,
         motions or ``fix`` values act there, the equilibrium solved there from ``H0``."""
-        sys = self.sys
+        sys, problem = self.sys, self.problem
         H = H0.copy()
         if len(sys.prescribed_nodes):
             H[sys.prescribed_nodes] = sys.prescribed_poses(t_start)
             sys.sync_members(H)
-        stats, contact = dict(iterations=0, residuals=[], wall_time=0.0, dt=0.0, cutbacks=0), None
+        stats, record = dict(iterations=0, residuals=[], wall_time=0.0, dt=0.0, cutbacks=0), None
         if _acts_at(sys, H0, t_start):
             t0 = time.perf_counter()
             self.H, self.t = H0, None
             try:
-                H, r0, info0, stats = self._newton_step(t_start)
+                H, ev0, stats = self._newton_step(t_start)
             except StepFailed as e:
                 self.sol.converged, self.sol.message = False, str(e)
                 err = ConvergenceError(f"solve: no equilibrium at t_start = {t_start:.6g}, where loads or motions "
@@ -135,15 +136,13 @@ class Run:
             finally:
                 self.t = t_start
             stats.update(wall_time=time.perf_counter() - t0, dt=0.0, cutbacks=0)
-            if sys.contact is not None:
-                sys.contact.commit(H)
-                contact = sys.contact.results(H)
-                self.sol.contact_state = contact_snapshot(sys.contact)
+            record = problem.commit(H)
+            if problem.contributions:
+                self.sol.contact_state = problem.get_state()
         else:
-            lf0 = sys.load_factors(t_start) if len(sys.load_scales) else np.zeros(0)
-            r0, _, info0 = sys.evaluate(H, lf0, tangent=False)
-        self._check_finite(H, r0, info0["state"], t_start)
-        self.sol.append(t_start, H, sys.reactions(H, r0), info0["state"].sigma, info0["state"].strain, stats, contact)
+            ev0 = problem.evaluate(H, t_start, tangent=False)
+        self._check_finite(H, ev0.r, ev0.state, t_start)
+        self.sol.append(t_start, H, sys.reactions(H, ev0.r), ev0.state.sigma, ev0.state.strain, stats, record)
         self.H = H
         if self.writer is not None:
             self.writer.write(self.sol, 0)
@@ -172,9 +171,9 @@ class Run:
             if grid[self.k] - t_next < max(1e-9 * self.dt_user, LANDING * self.dt):
                 t_next = grid[self.k]           # no sliver before the grid point
             t0 = time.perf_counter()
-            t_next, H, r, info, stats = self._attempt(t_next)
+            t_next, H, ev, stats = self._attempt(t_next)
             stats.update(wall_time=time.perf_counter() - t0, dt=t_next - self.t)
-            self._record(t_next, H, r, info, stats)
+            self._record(t_next, H, ev, stats)
 
     def _attempt(self, t_next):
         """Converge the step ``t -> t_next``, halving it on failure; returns the step reached."""
@@ -188,14 +187,14 @@ class Run:
                            rotation_limit)
             self.newton.reset_timings()
             try:
-                H, r, info, stats = self._newton_step(t_try)
-                self._check_finite(H, r, info["state"], t_try)
+                H, ev, stats = self._newton_step(t_try)
+                self._check_finite(H, ev.r, ev.state, t_try)
                 stats.update(cutbacks=cutbacks, timings=dict(self.newton.timings))
                 if failed_sizes:
                     stats["failed_dt"] = failed_sizes
                 if t_try < t_next:
                     stats["motion_rotation"] = rot
-                return t_try, H, r, info, stats
+                return t_try, H, ev, stats
             except StepFailed as e:
                 if isinstance(e, NonFinite):
                     self._name_nonfinite(t_try)
@@ -214,35 +213,33 @@ class Run:
                 self.easy = 0
 
     def _newton_step(self, t_next):
-        """Newton at ``t_next``, then augmented-Lagrangian updates until the contact tolerance holds."""
-        sys, newton = self.sys, self.newton
+        """Newton at ``t_next``, repeated while the problem asks to re-solve the step (outer
+        iterations, e.g. augmented-Lagrangian updates); refused or warned if ``Problem.unmet``."""
+        sys, newton, problem = self.sys, self.newton, self.problem
         H_target = sys.prescribed_poses(t_next) if len(sys.prescribed_nodes) else None
-        if sys.contact is not None:
-            sys.contact.begin_step(self.H, t_next)
-        H, r, info, stats = newton.step(self.H, t_next, H_target, self.t)
-        while sys.contact is not None and sys.contact.augment(H):
-            H, r, info, more = newton.step(H, t_next, H_target, self.t)
+        problem.begin_step(self.H, t_next)
+        H, ev, stats = newton.step(self.H, t_next, H_target, self.t)
+        while problem.repeat_step(H):
+            if stats.get("augmentations", 0) >= MAX_OUTER:
+                raise AugmentationFailed(f"the outer iterations (augmented-Lagrangian updates) still ask to re-solve "
+                                         f"the step at t = {t_next:.6g} after MAX_OUTER = {MAX_OUTER}")
+            H, ev, more = newton.step(H, t_next, H_target, self.t)
             stats["iterations"] += more["iterations"]
             stats["residuals"] += more["residuals"]
             stats["augmentations"] = stats.get("augmentations", 0) + 1
-        unmet = getattr(sys.contact, "unmet_tolerance", None) if sys.contact is not None else None
-        if unmet:
-            text = (f"augmented Lagrangian: after {stats.get('augmentations', 0)} updates the penetration "
-                    f"is {unmet:.3g} times the requested tolerance at t = {t_next:.6g}")
+        text = problem.unmet(t_next)
+        if text:
             if not self.opt.get("allow_unmet_tolerance"):
                 raise AugmentationFailed(text + " (solve(..., allow_unmet_tolerance=True) accepts it "
                                          "with a warning)")
             stats.setdefault("warnings", []).append(text)
             log.warning(text)
             warnings.warn(text, RuntimeWarning, stacklevel=4)
-        return H, r, info, stats
+        return H, ev, stats
 
-    def _record(self, t_next, H, r, info, stats):
-        sys, sol = self.sys, self.sol
-        contact_data = None
-        if sys.contact is not None:
-            sys.contact.commit(H)
-            contact_data = sys.contact.results(H)
+    def _record(self, t_next, H, ev, stats):
+        sys, sol, problem = self.sys, self.sol, self.problem
+        record = problem.commit(H)
         if self.opt.get("check_stability"):
             self._stability(stats, t_next)
         for w in stats.get("warnings", ()):
@@ -255,9 +252,9 @@ class Run:
         easy = self.easy + 1 if stats["iterations"] <= EASY_ITERATIONS and stats["cutbacks"] == 0 else 0
         dt, self.failed, self.wait = next_step(dt, stats["iterations"], easy, self.failed, self.wait)
         dt = min(dt, self.dt_user)
-        if sys.contact is not None:
-            sol.contact_state = contact_snapshot(sys.contact)
-        sol.append(t_next, H, sys.reactions(H, r), info["state"].sigma, info["state"].strain, stats, contact_data)
+        if problem.contributions:
+            sol.contact_state = problem.get_state()
+        sol.append(t_next, H, sys.reactions(H, ev.r), ev.state.sigma, ev.state.strain, stats, record)
         sol.resume = dict(t0=float(self.grid[0]), t_end=float(self.grid[-1]), steps=len(self.grid) - 1,
                           dt=float(dt), easy=int(easy), **self._memory_state())
         self.H, self.t, self.k, self.dt, self.easy = H, t, k, dt, easy
@@ -271,12 +268,11 @@ class Run:
 
     def _stability(self, stats, t):
         """Record whether the tangent at the converged state is positive definite; warn once."""
-        sys = self.sys
-        if not sys_conservative(sys):
+        problem = self.problem
+        if not problem.conservative:
             stats.update(stable=None)
             return
-        kvals, extra = self.newton.last_tangent
-        neg, lowest = negative_eigenvalues(sys.matrix(kvals, extra))
+        neg, lowest = negative_eigenvalues(problem.tangent(self.newton.last_evaluation))
         stats.update(stable=neg == 0, negative_eigenvalues=neg, lowest_eigenvalue=lowest)
         if neg and not self.warned_unstable:
             self.warned_unstable = True
@@ -350,16 +346,6 @@ def _acts_at(system, H, t):
     if len(system.prescribed_nodes) and np.any(system.prescribed_poses(t) != H[system.prescribed_nodes]):
         return True
     return any(dx != 0 for _, _, dx in system.fixed_value_increments(H, t)) if system.fix_values else False
-
-
-def sys_conservative(system):
-    """True when the tangent of ``system`` is symmetric at equilibrium: no follower loads and
-    no friction (conservative loads, frictionless contact)."""
-    if np.any(system.load_follower) if len(system.load_nodes) else False:
-        return False
-    if system.contact is not None and any(d.mu > 0 for d in system.model.contacts):
-        return False
-    return True
 
 
 def _truncate(sol):

@@ -12,20 +12,21 @@ Two scenes, sizes ~1e2, 3e2, 1e3, ... up to ``max_elements`` (default 1e5):
     between touching neighbours of a layer (as ``cables.build_strand``), 5
     Gauss points, mu = 0.3; the size grows with the length.
 
-Each part is timed by calling what ``solver._Newton.step`` calls, once per
-Newton iteration:
+Each part is timed by calling what one Newton iteration calls through the
+public ``problem.Problem`` interface and its ``System``, once per Newton iteration:
 
-- ``element``: ``System.evaluate`` without the contact part (element
-  kernels, transforms, loads, residual scatter);
+- ``element``: ``System.evaluate`` (element kernels, transforms, loads,
+  residual scatter; contact is a separate contribution of the ``Problem``);
 - ``contact search`` (``ContactSystem.pairs`` + ``_active``), ``contact
   kernels`` (``_params`` history look-up + ``kernel_and_tangent``) and
-  ``contact other`` (transforms, residual and COO build), all from one
-  ``ContactSystem.evaluate`` with the methods wrapped by timers;
+  ``contact other`` (the rest of ``ContactSystem.evaluate`` and the generic
+  assembler ``System.assemble_blocks``: transforms, residual and COO build),
+  with the methods wrapped by timers;
 - ``assembly``: ``System.matrix`` (CSC scatter of the element values and the
   contact COO);
 - ``solve``: ``linsolve`` factorisation + solve with the default back-end
   (scipy ``splu``);
-- ``update`` (``System.update``) and ``residual`` (``System.evaluate(...,
+- ``update`` (``Problem.update``) and ``residual`` (``Problem.evaluate(...,
   tangent=False)``, the line search's evaluation, with contact);
 - ``output``: ``io.vtk.StepWriter.write`` of one step (default refine 8, zlib),
   a per-step cost, and for the bundle ``commit`` (friction history +
@@ -165,9 +166,11 @@ def _maxrss_mb():
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
-def contact_parts(c, H, tangent=True):
-    """One ``ContactSystem.evaluate`` with its stages timed; returns (rc, coo, info, times)."""
+def contact_parts(system, H, tangent=True):
+    """One contact evaluation and its assembly (``System.assemble_blocks``) with its stages timed;
+    returns (rc, coo, info, times)."""
     import beamsolver.contact.system as cs
+    c = system.contact
     acc = dict(contact_search=0.0, contact_kernels=0.0)
     seen = {}
 
@@ -194,7 +197,8 @@ def contact_parts(c, H, tangent=True):
             setattr(cs, name, wrap("contact_kernels", kernels[name]))
     try:
         t0 = clock()
-        rc, coo, info = c.evaluate(H, tangent=tangent)
+        blocks, info = c.evaluate(H, tangent=tangent)
+        rc, coo, _, _ = system.assemble_blocks(H, blocks)
         total = clock() - t0
     finally:
         for attr in patched:
@@ -273,7 +277,7 @@ def measure_cable(n, skip=()):
     lf = system.load_factors(1.0)
     out = dict(scene="cable", n_elements=system.n_elements, n_dofs=system.n_free, rss_setup_mb=_maxrss_mb())
     out["element"], (r, kvals, info) = _best(lambda: system.evaluate(H, lf, tangent=True))
-    out["assembly"], K = _best(lambda: system.matrix(kvals, info["extra"]))
+    out["assembly"], K = _best(lambda: system.matrix(kvals))
     out["nnz_per_col"] = K.nnz / K.shape[0]
     rhs = -r[system.free_dofs]
     out["rss_before_solve_mb"] = _maxrss_mb()
@@ -310,7 +314,7 @@ def replicated_contact(system, wires, per_wire, unit=None):
         else:
             H = us.poses0.copy()
             us.contact.begin_step(H, 0.0)
-            _, coo, _ = us.contact.evaluate(H, tangent=True)
+            _, coo, _, _ = us.assemble_blocks(H, us.contact.evaluate(H, tangent=True)[0])
             if cache:
                 np.savez(cache, rows=coo[0], cols=coo[1], vals=coo[2])
         unit = (us, uw, coo)
@@ -343,30 +347,28 @@ def replicated_contact(system, wires, per_wire, unit=None):
 
 
 def measure_bundle(n, cap, predicted_contact, skip=()):
-    from beamsolver.assembly import System
+    from beamsolver.problem import Problem
     from beamsolver.results import Solution
     warm_up()
     per_wire = bundle_per_wire(n)
     m, wires = bundle_model(per_wire)
-    system = System(m)
+    problem = Problem.from_model(m)
+    system = problem.system
     H = system.poses0.copy()
     lf = system.load_factors(1.0)
-    c = system.contact
     out = dict(scene="bundle", n_elements=system.n_elements, n_dofs=system.n_free, rss_setup_mb=_maxrss_mb())
-    system.contact = None                   # the element part alone
-    out["element"], (r, kvals, info) = _best(lambda: system.evaluate(H, lf, tangent=True))
-    system.contact = c
+    out["element"], (r, kvals, info) = _best(lambda: system.evaluate(H, lf, tangent=True))  # elements alone
     real = n <= cap and predicted_contact <= CONTACT_BUDGET
     out["contact_measured"] = bool(real)
-    c.begin_step(H, 0.0)
+    problem.begin_step(H, 0.0)
     if real:
-        rc, coo, cinfo, ct = contact_parts(c, H)
+        rc, coo, cinfo, ct = contact_parts(system, H)
         out.update(ct)
         out["contact_points"] = int(cinfo.get("n_active", 0))
         out["contact_candidates"] = int(cinfo.get("candidates", -1))
         out["contact_coo_entries"] = int(len(coo[2]))
         r = r + rc
-        out["residual"], _ = _best(lambda: system.evaluate(H, lf, tangent=False), min_time=0.0, max_repeat=1)
+        out["residual"], _ = _best(lambda: problem.evaluate(H, 1.0, tangent=False), min_time=0.0, max_repeat=1)
     else:
         coo, _ = replicated_contact(system, wires, per_wire)
         for p in ("contact_search", "contact_kernels", "contact_other", "contact_total", "residual"):
@@ -397,13 +399,12 @@ def measure_bundle(n, cap, predicted_contact, skip=()):
     out["solve"] = out["splu_s"]
     rng = np.random.default_rng(1)
     dz = 1e-6 * rng.standard_normal((system.n_nodes, 6))
-    out["update"], _ = _best(lambda: system.update(H, dz))
+    out["update"], _ = _best(lambda: problem.update(H, dz))
     sol = Solution(m, system)
     contact_data = None
     if real:
         t0 = clock()
-        c.commit(H)
-        contact_data = c.results(H)
+        contact_data = problem.commit(H)
         out["commit"] = clock() - t0
     else:
         out["commit"] = np.nan
@@ -415,45 +416,38 @@ def measure_bundle(n, cap, predicted_contact, skip=()):
 
 
 def measure_pays_nothing(n=10_000):
-    """One Newton iteration of ``bs.solve`` on the cable (no contact, no output) vs the sum of its parts."""
+    """One Newton iteration of ``bs.solve`` on the cable (no contact, no output) vs the sum of its parts
+    (called through the public ``problem.Problem``) and the solve's own ``stats["timings"]``."""
     import beamsolver as bs
     from beamsolver import linsolve
-    from beamsolver.solver import Convergence, _Newton
+    from beamsolver.problem import Problem
     m, system, H = cable(n)
-    lf = system.load_factors(1.0)
+    problem = Problem(system)
     med = _median
-    t_eval, (r, kvals, info) = med(lambda: system.evaluate(H, lf, tangent=True))
-    t_mat, K = med(lambda: system.matrix(kvals, info["extra"]))
-    rhs = -r[system.free_dofs]
+    t_eval, ev = med(lambda: problem.evaluate(H, 1.0, tangent=True))
+    t_mat, K = med(lambda: problem.tangent(ev))
+    rhs = -ev.r[system.free_dofs]
     t_sol, x = med(lambda: linsolve.factorize(K).solve(rhs))
     dz = np.zeros(6 * system.n_nodes)
     dz[system.free_dofs] = x
-    t_upd, H1 = med(lambda: system.update(H, dz.reshape(-1, 6)))
-    t_res, _ = med(lambda: system.evaluate(H1, lf, tangent=False))
-    newton = _Newton(system, Convergence(), True, None)
-
-    def bookkeeping():        # what step() does besides the parts: rotation check, scales, ratio, 2 merits
-        newton._check_rotation(info["state"])
-        sc = newton.conv.scales(info, newton.L_ref)
-        newton._ratio(r, sc)
-        newton._merit(r, sc)
-        newton._merit(r, sc)
-    t_book, _ = med(bookkeeping)
+    t_upd, H1 = med(lambda: problem.update(H, dz.reshape(-1, 6)))
+    t_res, _ = med(lambda: problem.evaluate(H1, 1.0, tangent=False))
     stamps = []
     t0 = clock()
     sol = bs.solve(m, steps=1, verbose=False, callback=lambda d: stamps.append(clock()))
     wall = clock() - t0
     it = np.diff(stamps)
+    st = sol.stats[-1]
+    per_it = {k: v / max(int(st["iterations"]), 1) for k, v in st["timings"].items()}
     mods = sorted(k for k in sys.modules if k.startswith("beamsolver.contact."))
     cs = sys.modules.get("beamsolver.contact.system")
-    return dict(n_elements=n, iterations=int(sol.stats[-1]["iterations"]), solve_wall_s=wall,
-                cutbacks=int(sol.stats[-1]["cutbacks"]), meshio_imported="meshio" in sys.modules,
+    return dict(n_elements=n, iterations=int(st["iterations"]), solve_wall_s=wall,
+                cutbacks=int(st["cutbacks"]), meshio_imported="meshio" in sys.modules,
                 iteration_median_s=float(np.median(it)) if len(it) else np.nan,
-                parts_sum_s=t_eval + t_mat + t_sol + t_upd + t_res + t_book,
-                parts=dict(element=t_eval, assembly=t_mat, solve=t_sol, update=t_upd, residual=t_res,
-                           bookkeeping=t_book),
-                contact_system_imported=cs is not None,
-                system_contact_is_none=system.contact is None, modules_loaded=mods)
+                parts_sum_s=t_eval + t_mat + t_sol + t_upd + t_res,
+                parts=dict(element=t_eval, assembly=t_mat, solve=t_sol, update=t_upd, residual=t_res),
+                timings_per_iteration=per_it, contact_system_imported=cs is not None,
+                no_contributions=not problem.contributions, modules_loaded=mods)
 
 
 def child(argv):
@@ -524,7 +518,8 @@ def report(rows, base, nothing, max_elements, cap, wall):
     out = lines.append
     out(f"`python benchmarks/scaling.py {max_elements}` ({machine()}; one thread; whole run {wall:.0f} s). "
         "Cost of one Newton iteration split into its parts, in ms of CPU time (one thread), each part timed "
-        "by calling what `solver._Newton.step` calls (best of up to 5 calls); `output` (one VTU step, refine 8, zlib) and "
+        "by calling what one Newton iteration calls through `problem.Problem` (best of up to 5 calls); "
+        "`output` (one VTU step, refine 8, zlib) and "
         "`commit` (contact history + point table) are per converged step, not per iteration. "
         "`residual` is the line search's residual-only evaluation (contact included). "
         "`iteration` = element + contact + assembly + solve + update + residual. "
@@ -620,9 +615,10 @@ def report(rows, base, nothing, max_elements, cap, wall):
         f"median {ms(nt['iteration_median_s'])} ms per iteration (between `callback` calls) against "
         f"{ms(nt['parts_sum_s'])} ms for the sum of its parts measured alone (medians of 7: element "
         f"{ms(nt['parts']['element'])}, assembly {ms(nt['parts']['assembly'])}, solve {ms(nt['parts']['solve'])}, "
-        f"update {ms(nt['parts']['update'])}, residual {ms(nt['parts']['residual'])}, convergence bookkeeping "
-        f"{ms(nt['parts']['bookkeeping'])}). "
-        f"`System.contact is None`: {nt['system_contact_is_none']}; `beamsolver.contact.system` imported: "
+        f"update {ms(nt['parts']['update'])}, residual {ms(nt['parts']['residual'])}); the solve's own "
+        f"`stats['timings']` per iteration: assembly {ms(nt['timings_per_iteration']['assembly'])}, linear solve "
+        f"{ms(nt['timings_per_iteration']['linear_solve'])}. "
+        f"`Problem` without contributions: {nt['no_contributions']}; `beamsolver.contact.system` imported: "
         f"{nt['contact_system_imported']} (modules of `beamsolver.contact` loaded: "
         f"{', '.join(nt['modules_loaded']) or 'none'}; `kinematics` is the public `bs.contact.slip_increment`); "
         f"meshio imported: {nt['meshio_imported']}.")

@@ -11,7 +11,7 @@ import pytest
 import beamsolver as bs
 from beamsolver import arclength
 from beamsolver.arclength import next_arc_length, rate, sphere_root
-from beamsolver.assembly import System
+from beamsolver.problem import Problem
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -188,17 +188,17 @@ def test_rate_matches_the_finite_difference_of_the_residual():
     nodes moved onto their targets at ``t +- h``."""
     m = _driven_frame()
     sol = bs.solve(m, steps=4, t_end=0.6, verbose=False)     # a deformed equilibrium to test at
-    system = System(m)
+    problem = Problem.from_model(m)
+    system = problem.system
     H, t = sol.poses[-1], float(sol.times[-1])
-    r, kvals, info = system.evaluate(H, system.load_factors(t))
-    got = rate(system, H, t, kvals, info["extra"], 1e-6, 0.0)
+    got = rate(problem, H, t, problem.evaluate(H, t), 1e-6, 0.0)
 
     def residual(tt):
         Hs = H.copy()
         Hs[system.prescribed_nodes] = system.prescribed_poses(tt)
         system.enforce_fixed_values(Hs, tt)
         system.sync_members(Hs)
-        return system.evaluate(Hs, system.load_factors(tt), tangent=False)[0][system.free_dofs]
+        return problem.evaluate(Hs, tt, tangent=False).r[system.free_dofs]
 
     h = 1e-5
     want = (residual(t + h) - residual(t - h)) / (2 * h)

@@ -13,6 +13,7 @@ import pytest
 import beamsolver as bs
 from beamsolver import se3
 from beamsolver.assembly import System
+from beamsolver.problem import Problem
 from beamsolver.contact.pairs import LINE, ORTHOGONAL, POINT
 
 R = 0.05
@@ -81,11 +82,12 @@ def _towards_master(system, H, slave, master, depth):
 
 
 def _fd_error(system, H, eps=1e-7):
-    r, kv, info = system.evaluate(H, np.zeros(0), tangent=True)
-    K = system.full_matrix(kv, info["extra"]).toarray()
+    problem = Problem(system)
+    ev = problem.evaluate(H, 0.0, tangent=True)
+    K = problem.full_tangent(ev).toarray()
     free = system.free_dofs
     n = system.n_nodes
-    ext = info["extra"]
+    ext = ev.extra
     Kc = np.zeros_like(K)
     if ext is not None and len(ext[2]):
         np.add.at(Kc, (ext[0], ext[1]), ext[2])
@@ -96,11 +98,11 @@ def _fd_error(system, H, eps=1e-7):
     for d in free:
         dz = np.zeros(6 * n)
         dz[d] = eps
-        rp, _, _ = system.evaluate(system.update(H, dz.reshape(n, 6)), np.zeros(0), tangent=False)
-        rm, _, _ = system.evaluate(system.update(H, -dz.reshape(n, 6)), np.zeros(0), tangent=False)
+        rp = problem.evaluate(problem.update(H, dz.reshape(n, 6)), 0.0, tangent=False).r
+        rm = problem.evaluate(problem.update(H, -dz.reshape(n, 6)), 0.0, tangent=False).r
         col = (rp - rm) / (2 * eps)
         worst = max(worst, np.abs(col[free] - K[free, d]).max() / scale)
-    return worst, info["contact"]
+    return worst, ev.details["contact"]
 
 
 def _state(scene, regime):

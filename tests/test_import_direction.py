@@ -1,4 +1,4 @@
-"""Imports run one way (maths -> element/contact kernels -> assembly -> results -> solver -> io/cli/viz)
+"""Imports run one way (maths -> element/contact kernels -> assembly -> problem -> results -> solver -> io/cli/viz)
 and form no cycle, counting lazy imports inside functions too.
 
 The walk reads every module of the package with ``ast`` (nothing is imported),
@@ -20,10 +20,12 @@ LAYER = {
     # 1: maths and geometry (Lie groups, sections, node poses, motions)
     "se3": 1, "se3_jit": 1, "section": 1, "geometry": 1, "motion": 1, "motion_path": 1, "definiteness": 1,
     # 2: element and contact kernels
-    "element": 2, "element_jit": 2, "contact": 2, "contact.law": 2, "contact.kinematics": 2,
+    "element": 2, "element_jit": 2, "blocks": 2, "contact": 2, "contact.law": 2, "contact.kinematics": 2,
     "contact.pairs": 2, "contact.search": 2, "contact.kernel_jit": 2, "contact.options": 2, "contact.record": 2,
     # 3: model declarations and their assembly
     "model": 3, "cables": 3, "assembly": 3, "assembly_jit": 3, "contact.system": 3, "linsolve": 3,
+    # 4: the Problem interface between the solver and the physics
+    "problem": 4,
     # 5: results
     "results": 5, "restart": 5, "study": 5,
     # 6: solver, its stepping and failure diagnosis, linearisation
@@ -137,6 +139,6 @@ def test_the_walk_sees_known_edges():
     """The checker itself: it finds the edges it must (so an empty list of violations means something)."""
     _, edges = _edges()
     pairs = {(a, b) for a, b, _ in edges}
-    assert {("assembly", "element"), ("element", "se3"), ("solver", "assembly"), ("results", "io.archive"),
+    assert {("assembly", "element"), ("element", "se3"), ("solver", "problem"), ("problem", "assembly"), ("results", "io.archive"),
             ("contact.pairs", "se3"), ("assembly", "contact.system"), ("", "solver")} <= pairs
     assert _cycle([("a", "b", False), ("b", "c", True), ("c", "a", True)]) is not None

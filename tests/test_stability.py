@@ -105,11 +105,11 @@ def test_a_step_through_pi_is_refused():
     """An element whose relative rotation goes from 0.7 pi to 1.3 pi (which its log sees as
     0.7 pi the other way round) within one step: refused, not accepted as a short turn."""
     from beamsolver import solver
-    from beamsolver.assembly import System
+    from beamsolver.problem import Problem
     model = S.bs.Model()
     b = model.add_beam(S.bs.geometry.straight((0, 0, 0), (1, 0, 0), 1), S.bs.Section.circular(radius=0.01, E=1e9))
     model.clamp(b.first)
-    newton = solver._Newton(System(model), solver.Convergence(), True, None)
+    newton = solver._Newton(Problem.from_model(model), solver.Convergence(), True, None)
 
     def poses(angle):
         H = np.array([np.eye(4), np.eye(4)])

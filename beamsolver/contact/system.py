@@ -10,7 +10,8 @@ contact declarations.  Per evaluation it runs the stages
 3. refusals (``_check_sides``: tunnelling; ``_check_normals``: no normal);
 4. kernel parameters and history look-up (``_params``), the kernel (forces and
    complex-step tangent, ``pairs.py``) on the active pairs;
-5. scatter into the residual and COO tangent in the unknowns' numbering.
+5. local force and tangent blocks over the pairs' 4 nodes, which the generic assembler
+   (``assembly.System.assemble_blocks``) transforms and scatters like any contribution.
 
 Per step it keeps the friction history and augmented-Lagrangian multipliers,
 keyed by material slave point and master beam, committed only when a step is
@@ -31,6 +32,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .. import se3
+from ..blocks import Blocks, Contribution
 from ..errors import InputError
 from ..failures import ContactTunnelling, NoContactNormal
 from .law import default_penalty
@@ -79,7 +81,7 @@ class _Decl:
         self.smoothing = o.smoothing          # None: SMOOTHING * (R1 + R2) per pair
 
 
-class ContactSystem:
+class ContactSystem(Contribution):
     def __init__(self, system):
         self.sys = system
         model = system.model
@@ -497,19 +499,30 @@ class ContactSystem:
                                 f"step (one beam passed through the other; {len(flip)} such pairs)")
 
     # ------------------------------------------------------------ evaluation
+    name = "contact"         # of the contribution, in timings and evaluation details (problem.Problem)
+    smooth = False           # a piecewise smooth residual: the solver backtracks on the residual
+
+    @property
+    def conservative(self):
+        """Frictionless contact has a potential (symmetric tangent at equilibrium)."""
+        return not any(d.mu > 0 for d in self.decls)
+
     def evaluate(self, H, tangent=True):
-        """Contact residual ``(6 n,)``, COO tangent ``(rows, cols, vals)`` and point data."""
-        sysm = self.sys
-        ndof = 6 * sysm.n_nodes
-        r = np.zeros(ndof)
-        empty = (np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0))
+        """Local blocks of the active pairs and point data: ``(blocks.Blocks, info)``.
+
+        Blocks over the pair's 4 nodes (slave A, B, master A, B): ``f`` ``(m, 24)`` is the
+        contact's part of the residual (minus the contact forces on the nodes) and ``K``
+        ``(m, 24, 24)`` its derivative in the nodes' body increments; the generic assembler
+        (``assembly.System.assemble_blocks``) transforms and scatters them.
+        """
+        empty = Blocks.empty(4, tangent)
         P = self.pairs(H)
         if P is None:
-            return r, empty, dict(n_active=0)
+            return empty, dict(n_active=0)
         self._check_sides(P, H)
         sel = self._active(P, H)
         if len(sel) == 0:
-            return r, empty, dict(n_active=0)
+            return empty, dict(n_active=0)
         self._check_normals(P, sel, H)
         p = self._params(P, sel, H)
         X = H[P.nodes[sel]]
@@ -534,28 +547,7 @@ class ContactSystem:
         # kept for commit/augment at the same poses (the converged iterate): no second pass
         if fric.all() or not fric.any():
             self._cache = (H.copy(), P, sel, p, out)
-        nodes = P.nodes[sel]
-        f = f.reshape(-1, 24)
-        M = sysm.node_transforms(H)
-        if M is not None:
-            T = np.zeros((len(sel), 24, 24))
-            for j in range(4):
-                T[:, 6 * j:6 * j + 6, 6 * j:6 * j + 6] = M[nodes[:, j]]
-            Tt = np.swapaxes(T, 1, 2)
-            f = np.einsum("nij,nj->ni", Tt, f)
-            if tangent:
-                K = Tt @ K @ T
-        dofs = ((6 * sysm.rep[nodes])[:, :, None] + np.arange(6)).reshape(-1, 24)
-        r -= np.bincount(dofs.ravel(), weights=f.ravel(), minlength=ndof)
-        coo = empty
-        if tangent:
-            rows = np.repeat(dofs, 24, axis=1).ravel()
-            cols = np.tile(dofs, (1, 24)).ravel()
-            coo = (rows, cols, -K.ravel())
-        fl = np.abs(f.reshape(-1, 4, 6)[:, :, :3]).max(initial=0.0)
-        ml = np.abs(f.reshape(-1, 4, 6)[:, :, 3:]).max(initial=0.0)
-        info = dict(n_active=len(sel), f_level=fl, m_level=ml)
-        return r, coo, info
+        return Blocks(P.nodes[sel], -f.reshape(-1, 24), -K if tangent else None), dict(n_active=len(sel))
 
     # ------------------------------------------------------------ per step
     def begin_step(self, H, t):
@@ -583,6 +575,18 @@ class ContactSystem:
             if not fric.any():
                 out["slip"] = np.zeros((len(sel), 2))
         return P, sel, (p, out)
+
+    def repeat_step(self, H):
+        """The outer iteration of ``problem.Problem``: an augmented-Lagrangian update (``augment``)."""
+        return self.augment(H)
+
+    def unmet(self, t):
+        """Why the last step may not be accepted (penetration above the tolerance after
+        ``MAX_AUGMENT`` updates), or ``None``."""
+        if not getattr(self, "unmet_tolerance", None):
+            return None
+        return (f"augmented Lagrangian: after {self._augments} updates the penetration "
+                f"is {self.unmet_tolerance:.3g} times the requested tolerance at t = {t:.6g}")
 
     def augment(self, H):
         """Augmented-Lagrangian update; True when the step must be re-solved.
