@@ -154,6 +154,10 @@ def cmd_info(args):
     if contact:
         head += ["contacts", "contact force", "min gap"]
         widths += [8, 13, 11]
+    checked = any("stable" in s for s in sol.stats)
+    if checked:
+        head += ["stable", "neg. eig.", "lowest eig.", "switched"]
+        widths += [6, 9, 11, 8]
     print(_row(head, widths))
     steps = range(n) if args.all or n <= 22 else list(range(10)) + [None] + list(range(n - 10, n))
     for k in steps:
@@ -169,6 +173,8 @@ def cmd_info(args):
             gap = np.asarray(c.get("gap", np.zeros(0)))
             fn = np.asarray(c.get("normal_force", np.zeros(0)))
             cells += [int(np.sum(fn > 0)), f"{fn.sum():.4g}", f"{gap.min():.3g}" if len(gap) else "-"]
+        if checked:
+            cells += _stability_cells(s)
         print(_row(cells, widths))
     gaps = [np.min(c["gap"]) for c in sol.contacts if len(c.get("gap", ()))]
     if gaps:
@@ -181,6 +187,16 @@ def cmd_info(args):
         for node, kind in zip(nodes, kinds):
             print(_row([int(node), kind] + [f"{v:.4g}" for v in R[node]], [5, 9] + [11] * 6))
     return 0
+
+
+def _stability_cells(s):
+    """``stable``, negative eigenvalue count, lowest (scaled) eigenvalue and branch switch of a step's
+    stats (``solve(check_stability=True, modes=, branch_switching=)``; ``-``: not checked)."""
+    stable = {True: "yes", False: "NO", None: "-"}[s.get("stable")]
+    lowest = (s.get("mode_eigenvalues") or [s.get("lowest_eigenvalue")])[0]
+    switch = s.get("branch_switch")
+    switched = "-" if switch is None else ("failed" if "failed" in switch else f"mode {switch['mode']}")
+    return [stable, s.get("negative_eigenvalues", "-"), "-" if lowest is None else f"{lowest:.3g}", switched]
 
 
 def cmd_render(args):

@@ -193,6 +193,15 @@ class Solution:
         """Per active contact point: dict of arrays (empty when the scene has no contact)."""
         return self.contacts[self._step(step)]
 
+    def modes(self, step=-1):
+        """``(eigenvalues (k,), modes (k, n_nodes, 6))`` recorded at ``step`` by ``solve(modes=k)``:
+        the lowest eigenvalues of the scaled tangent and each mode's global displacement and
+        rotation vector per node (unit-free size 1, ``bifurcation``); ``k = 0`` where none were."""
+        s = self.stats[self._step(step)]
+        n = self._poses[0].shape[0]
+        lam = np.asarray(s.get("mode_eigenvalues", ()), dtype=float)
+        return lam, np.asarray(s.get("modes", np.zeros((0, n, 6))), dtype=float).reshape(len(lam), n, 6)
+
     @property
     def iterations(self):
         return np.array([s.get("iterations", 0) for s in self.stats])

@@ -27,7 +27,7 @@ from .failures import DampingStalled, Diverged, NonFinite, NotConverged, Rotatio
 from .problem import Problem
 from .restart import restart_from
 from .stepping import Run
-from .validation import check_solve_arguments
+from .validation import check_solve_arguments, check_stability_options
 
 _StepFailed = StepFailed      # the base of the typed failures (``beamsolver.failures``)
 
@@ -475,7 +475,8 @@ def _starting_point(restart, model, problem, t_start, t_end):
 def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dtol=1e-11,
           max_iter=30, line_search=True, min_step_ratio=2.0**-12, callback=None,
           check_rigid_modes=True, verbose=None, initial_poses=None, restart=None, checkpoint=60.0,
-          linear_solver=None, allow_unmet_tolerance=False, check_stability=False, path="load", arc_length=None):
+          linear_solver=None, allow_unmet_tolerance=False, check_stability=False, modes=0,
+          branch_switching=False, path="load", arc_length=None):
     """Quasi-static solve of ``model`` from ``t_start`` to ``t_end`` in ``steps`` equal steps.
 
     Every converged (sub)step is recorded in the returned ``Solution``.  Step 0 is
@@ -516,7 +517,27 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     ``stable``, ``negative_eigenvalues`` and ``lowest_eigenvalue`` (scaled;
     ``None`` where not computed) in ``stats`` and warn once
     (``StabilityWarning``) on an unstable equilibrium; opt-in: 5-16 % of the
-    solve time (``benchmarks/stability_check.py``).
+    solve time (``benchmarks/stability_check.py``).  "Stable" means the
+    symmetric tangent is positive definite: the converged state is a strict
+    minimum of the potential energy.  With friction or follower loads the
+    tangent is unsymmetric and depends on the history, there is no potential,
+    and the definiteness of its symmetric part would prove nothing either way:
+    such steps record ``stable=None`` and are not switched.
+    ``modes``: with it (a count ``k``), the ``k`` lowest eigenpairs of the
+    scaled tangent (``modes.lowest_modes``) of every checked step, in
+    ``stats[k]["mode_eigenvalues"]`` and ``stats[k]["modes"]`` ``(k, n_nodes, 6)``
+    (global displacement and rotation vector per node, unit-free size 1:
+    ``bifurcation``); ``Solution.modes(step)``; VTU point fields ``mode_1_u``,
+    ``mode_1_rotation``, ...  ``branch_switching``: ``"auto"`` at a step where
+    the count of negative eigenvalues went up (a bifurcation or limit point
+    crossed; where one step passed several critical loads, the switch is made
+    between the first two and recorded as its own step: ``branching.locate``),
+    ``True`` at every step with negative eigenvalues, the amplitude along the
+    lowest mode is raised from ``bifurcation.AMPLITUDE`` at the same load, the
+    other unknowns relaxed, down the energy onto a stable branch
+    (``bifurcation.descend``); ``stats[k]["branch_switch"]`` records the mode,
+    the crossing, the descent and the counts before and after, and a state
+    still unstable after it is warned about.  Either implies ``check_stability``.
 
     ``path``: ``"load"`` (default) steps the pseudo-time on the grid above;
     ``"arc-length"`` follows the equilibrium path by arc length through limit
@@ -524,7 +545,8 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     (``beamsolver.arclength``; options ``arc_length``, a dict or
     ``arclength.ArcLength``: ``initial``, ``min``, ``max``,
     ``target_iterations``, ``max_steps``, ``psi``).  Its ``times`` are not
-    monotonic; ``stats[k]`` adds ``arc_length``, ``t`` and ``linearised``.
+    monotonic; ``stats[k]`` adds ``arc_length``, ``t`` and ``linearised``;
+    ``restart`` and ``branch_switching`` are refused with it.
 
     ``Solution.stats[k]["timings"]``: wall time of the step's ``assembly``
     (residuals, tangents, sparse matrices), of each contribution to it (``contact``
@@ -538,7 +560,7 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
         raise InputError("solve: give either restart or initial_poses, not both")
     if int(steps) != steps or steps < 1:
         raise InputError(f"solve: steps must be a positive integer, got {steps!r}")
-    arc = check_arc_length_arguments(path, arc_length, restart)
+    arc = check_arc_length_arguments(path, arc_length, restart, branch_switching)
     problem = Problem.from_model(model, check_rigid_modes=check_rigid_modes)
     system = problem.system
     sol, t_start = _starting_point(restart, model, problem, t_start, t_end)
@@ -547,8 +569,10 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     conv = Convergence(rtol=rtol, dtol=dtol, max_iter=max_iter)
     newton = _Newton(problem, conv, line_search, callback)
     newton.linsolver = linsolve.Solver(linear_solver)
-    options = dict(allow_unmet_tolerance=allow_unmet_tolerance, check_stability=check_stability,
-                   advice=_advice(system, t_start, t_end))
+    modes, branch_switching = check_stability_options(modes, branch_switching)
+    options = dict(allow_unmet_tolerance=allow_unmet_tolerance, advice=_advice(system, t_start, t_end),
+                   check_stability=bool(check_stability or modes or branch_switching), modes=modes,
+                   branch_switching=branch_switching)
     run = None
     try:
         args = (problem, newton, _writer(output, system, checkpoint), grid, dt_min, verbose, options)

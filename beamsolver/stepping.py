@@ -22,7 +22,7 @@ import warnings
 
 import numpy as np
 
-from . import diagnosis, motion_path
+from . import branching, diagnosis, motion_path
 from .definiteness import negative_eigenvalues
 from .errors import ConvergenceError, InputError, StabilityWarning
 from .failures import AugmentationFailed, MotionTooFast, NonFinite, StepFailed
@@ -212,13 +212,15 @@ class Run:
                 t_next = t + h
                 self.easy = 0
 
-    def _newton_step(self, t_next):
-        """Newton at ``t_next``, repeated while the problem asks to re-solve the step (outer
-        iterations, e.g. augmented-Lagrangian updates); refused or warned if ``Problem.unmet``."""
+    def _newton_step(self, t_next, start=None):
+        """Newton at ``t_next`` (from the last converged state, or from ``start`` at ``t_next``),
+        repeated while the problem asks to re-solve the step (outer iterations, e.g.
+        augmented-Lagrangian updates); refused or warned if ``Problem.unmet``."""
         sys, newton, problem = self.sys, self.newton, self.problem
         H_target = sys.prescribed_poses(t_next) if len(sys.prescribed_nodes) else None
         problem.begin_step(self.H, t_next)
-        H, ev, stats = newton.step(self.H, t_next, H_target, self.t)
+        H0, t_prev = (self.H, self.t) if start is None else (start, t_next)
+        H, ev, stats = newton.step(H0, t_next, H_target, t_prev)
         while problem.repeat_step(H):
             if stats.get("augmentations", 0) >= MAX_OUTER:
                 raise AugmentationFailed(f"the outer iterations (augmented-Lagrangian updates) still ask to re-solve "
@@ -239,9 +241,9 @@ class Run:
 
     def _record(self, t_next, H, ev, stats):
         sys, sol, problem = self.sys, self.sol, self.problem
-        record = problem.commit(H)
         if self.opt.get("check_stability"):
-            self._stability(stats, t_next)
+            t_next, H, ev = self._stability(stats, t_next, H, ev)
+        record = problem.commit(H)
         for w in stats.get("warnings", ()):
             sol.message = w if not sol.message else sol.message + "; " + w
         # the stepping state after this step, set together with the step (restart reads both)
@@ -266,14 +268,23 @@ class Run:
         """The failed-size memory of ``next_step`` for ``resume`` (JSON: no inf)."""
         return dict(failed=None if not np.isfinite(self.failed) else float(self.failed), wait=int(self.wait))
 
-    def _stability(self, stats, t):
-        """Record whether the tangent at the converged state is positive definite; warn once."""
+    def _stability(self, stats, t, H, ev):
+        """Record whether the tangent at the converged state ``H`` (evaluation ``ev``) is positive
+        definite, its lowest modes (``modes``) and, with ``branch_switching``, move onto a stable
+        branch (``branching.switch``, which may record the step at an earlier ``t``, past a
+        crossing); warn once.  Returns the step to record ``(t, H, ev)``."""
         problem = self.problem
         if not problem.conservative:
             stats.update(stable=None)
-            return
-        neg, lowest = negative_eigenvalues(problem.tangent(self.newton.last_evaluation))
+            return t, H, ev
+        K = problem.tangent(self.newton.last_evaluation)
+        neg, lowest = negative_eigenvalues(K)
         stats.update(stable=neg == 0, negative_eigenvalues=neg, lowest_eigenvalue=lowest)
+        if branching.wanted(self.opt.get("branch_switching"), self.sol.stats, neg):
+            t, H, ev, K = branching.switch(self, stats, t, H, ev, K)
+        if self.opt.get("modes"):
+            branching.record_modes(self.sys, stats, H, K, self.opt["modes"])
+        neg = stats["negative_eigenvalues"]
         if neg and not self.warned_unstable:
             self.warned_unstable = True
             text = (f"t = {t:.6g}: the equilibrium is unstable (the tangent has {neg} negative "
@@ -281,6 +292,7 @@ class Run:
             log.warning(text)
             warnings.warn(text, StabilityWarning, stacklevel=5)
             self.sol.message = text if not self.sol.message else self.sol.message + "; " + text
+        return t, H, ev
 
     # ------------------------------------------------------------------ end
     def _stop(self, failure, rotation_limit):

@@ -245,3 +245,14 @@ def _last_saved_time(restart):
     from .io.archive import saved_times
     times = saved_times(restart)
     return float(times[-1]) if len(times) else -np.inf
+
+
+def check_stability_options(modes, branch_switching):
+    """``(modes, branch_switching)`` of ``solve`` checked: a count >= 0 and one of ``False``,
+    ``True``, ``"auto"``."""
+    if isinstance(modes, bool) or not isinstance(modes, (int, np.integer)) or modes < 0:
+        raise InputError(f"solve: modes must be a whole number >= 0 (eigenpairs per step), got {modes!r}")
+    if not any(branch_switching is v or (isinstance(v, str) and branch_switching == v)
+               for v in (False, True, "auto")):
+        raise InputError(f"solve: branch_switching must be False, True or 'auto', got {branch_switching!r}")
+    return int(modes), branch_switching

@@ -118,6 +118,17 @@ def test_long_arcs_use_the_linearised_constraint_and_still_trace_lee_frame():
     np.testing.assert_allclose(coarse.poses[-1], fine.poses[-1], atol=1e-7 * 120.0)
 
 
+def test_modes_along_the_arc_length_path(truss_path):
+    """``modes=1`` records the lowest mode per step; on the unstable branch its eigenvalue is negative."""
+    P_lim = truss_path[2]
+    m, apex = truss(P_lim)
+    with pytest.warns(bs.StabilityWarning):
+        sol = bs.solve(m, steps=10, t_end=1.5, path="arc-length", modes=1, verbose=False)
+    lowest = np.array([s["mode_eigenvalues"][0] for s in sol.stats[1:]])
+    neg = np.array([s["negative_eigenvalues"] for s in sol.stats[1:]])
+    assert np.all((lowest < 0) == (neg > 0)) and neg.any() and not neg.all()
+
+
 def test_stability_check_sees_the_unstable_branch(truss_path):
     """With ``check_stability`` the tangent has one negative eigenvalue exactly between the two
     limit points of the truss (``dP/dy > 0`` there) and none outside."""
@@ -330,6 +341,8 @@ def test_contact_that_closes_during_the_run_reaches_the_load_path_answer():
     (dict(path="arc-length", arc_length=dict(psi=float("nan"))), "psi must be a finite number >= 0"),
     (dict(path="arc-length", arc_length=[1.0]), "arc_length must be a dict"),
     (dict(path="arc-length", arc_length=dict(initial=10.0, max=1.0)), "min <= initial <= max"),
+    (dict(path="arc-length", branch_switching="auto"), "branch_switching='auto' is not supported"),
+    (dict(path=["arc-length"]), "path must be 'load' or 'arc-length'"),
 ])
 def test_bad_arc_length_input_is_refused(kw, match):
     m, _ = truss(1.0)

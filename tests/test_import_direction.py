@@ -19,17 +19,19 @@ LAYER = {
     "failures": 0,
     # 1: maths and geometry (Lie groups, sections, node poses, motions)
     "se3": 1, "se3_jit": 1, "section": 1, "geometry": 1, "motion": 1, "motion_path": 1, "definiteness": 1,
+    "modes": 1,
     # 2: element and contact kernels
     "element": 2, "element_jit": 2, "blocks": 2, "contact": 2, "contact.law": 2, "contact.kinematics": 2,
     "contact.pairs": 2, "contact.search": 2, "contact.kernel_jit": 2, "contact.options": 2, "contact.record": 2,
     # 3: model declarations and their assembly
     "model": 3, "cables": 3, "assembly": 3, "assembly_jit": 3, "contact.system": 3, "linsolve": 3,
+    "bifurcation": 3,
     # 4: the Problem interface between the solver and the physics
     "problem": 4,
     # 5: results
     "results": 5, "restart": 5, "study": 5,
     # 6: solver, its stepping and failure diagnosis, linearisation
-    "solver": 6, "stepping": 6, "arclength": 6, "diagnosis": 6, "linear": 6,
+    "solver": 6, "stepping": 6, "arclength": 6, "diagnosis": 6, "linear": 6, "branching": 6,
     # 7: output, pictures, command line, the package's public face
     "io": 7, "io.lines": 7, "io.vtk": 7, "viz": 7, "cli": 7, "sweep_engine": 7, "sweep_cli": 7, "": 7,
 }

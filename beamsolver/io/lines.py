@@ -9,7 +9,9 @@ however coarse the mesh.  Shared by ``io.vtk`` (ParaView files) and ``viz``
 
 Point data: ``displacement`` (3), ``e1``, ``e2``, ``e3`` (section axes,
 the columns of ``R``), ``radius`` (contact radius of the section, for tubes),
-``beam_id``.  Segment (cell) data: the section forces of the element
+``beam_id``; with ``solve(modes=k)``, ``mode_j_u`` and ``mode_j_rotation``
+(global displacement and rotation vector of mode ``j = 1..k``, unit-free size 1,
+``Solution.modes``; ``node_field``: linear between the nodes).  Segment (cell) data: the section forces of the element
 ``N, Q2, Q3, T, M2, M3`` (section frame) and ``strain`` (6: ``Gamma_1..3,
 kappa_1..3`` minus the reference, so ``sigma = C strain`` and a beam at rest
 shows 0; ``Solution.strains`` is the strain itself, reference included:
@@ -84,6 +86,18 @@ class LineLayout:
         return dict(displacement=P[:, :3, 3] - self.reference, e1=P[:, :3, 0].copy(),
                     e2=P[:, :3, 1].copy(), e3=P[:, :3, 2].copy(), radius=self.point_radius,
                     beam_id=self.point_beam), P[:, :3, 3].copy()
+
+    def node_field(self, values):
+        """Node values ``(n_nodes, m)`` at the refined points, linear in ``xi`` along each element."""
+        values = np.asarray(values, dtype=float)
+        out = np.empty((self.n_points,) + values.shape[1:])
+        if self.n_elements == 0:
+            return out
+        a, b = values[self.enodes[self.point_el, 0]], values[self.enodes[self.point_el, 1]]
+        xi = self.point_xi.reshape((-1,) + (1,) * (values.ndim - 1))
+        out[self.point_index] = (1.0 - xi) * a + xi * b
+        out[self.end_index] = values[self.end_node]
+        return out
 
     def cell_data(self, sigma, strain):
         e = self.segment_el

@@ -158,6 +158,7 @@ class StepWriter:
         H = solution._poses[step]
         t = solution._times[step]
         pdata, points = lay.point_data(H)
+        pdata.update(mode_fields(lay, solution.stats[step]))
         cdata = lay.cell_data(solution._sigma[step], solution._strain[step])
         mesh = meshio.Mesh(points, [("line", lay.segments)], point_data=pdata,
                            cell_data={k: [v] for k, v in cdata.items()})
@@ -199,6 +200,17 @@ class StepWriter:
     def close(self):
         """Save ``solution.npz`` (every VTU/PVD file is already complete when ``write`` returns)."""
         self.save()
+
+
+def mode_fields(layout, stats):
+    """Point data ``mode_j_u``, ``mode_j_rotation`` (j = 1..k) of a step's recorded modes (``solve(modes=k)``)."""
+    modes = np.asarray(stats.get("modes", ()), dtype=float)
+    out = {}
+    for j, m in enumerate(modes if modes.ndim == 3 else ()):
+        f = layout.node_field(m)
+        out[f"mode_{j + 1}_u"] = np.ascontiguousarray(f[:, :3])
+        out[f"mode_{j + 1}_rotation"] = np.ascontiguousarray(f[:, 3:])
+    return out
 
 
 def active_points(table):
