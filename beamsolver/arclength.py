@@ -362,6 +362,11 @@ class ArcLengthRun(Run):
             raise InputError(f"solve: arc_length needs min <= initial <= max, got {lo:.3g}, {ds0:.3g}, {hi:.3g}")
         self.ds, self.ds_min, self.ds_max = ds0, lo, hi
         self.max_steps = arc.max_steps if arc.max_steps is not None else 25 * steps
+        self.sol.resume = self._resume()      # before any step: its "path" lets times go back (Solution)
+
+    def _resume(self):
+        """``Solution.resume`` of an arc-length run: ``path`` (times need not increase), ``t0``, ``t_end``."""
+        return dict(path="arc-length", t0=float(self.grid[0]), t_end=self.t_end)
 
     def loop(self):
         self._setup()
@@ -408,7 +413,7 @@ class ArcLengthRun(Run):
             sol.message = text if not sol.message else sol.message + "; " + text
         stats["t"] = t
         sol.append(t, H, sys.reactions(H, ev.r), ev.state.sigma, ev.state.strain, stats, record)
-        sol.resume = dict(path="arc-length", t0=float(self.grid[0]), t_end=self.t_end)
+        sol.resume = self._resume()
         ds = next_arc_length(self.ds, stats["iterations"], self.arc.target_iterations, stats["cutbacks"] > 0,
                              stats["linearised"] > 0)
         self.ds = float(np.clip(ds, self.ds_min, self.ds_max))
