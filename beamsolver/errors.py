@@ -1,6 +1,6 @@
 """Exceptions raised by beamsolver."""
 
-__all__ = ["InputError", "ConvergenceError", "StabilityWarning"]
+__all__ = ["InputError", "ConvergenceError", "StabilityWarning", "StabilizationWarning"]
 
 
 class InputError(ValueError):
@@ -19,3 +19,7 @@ class ConvergenceError(RuntimeError):
 
 class StabilityWarning(RuntimeWarning):
     """A converged equilibrium is unstable (its tangent is indefinite): see ``solve(check_stability=)``."""
+
+
+class StabilizationWarning(RuntimeWarning):
+    """The viscous stabilisation has dissipated a large part of the strain energy: see ``solve(stabilize=)``."""

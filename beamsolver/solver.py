@@ -26,6 +26,7 @@ from .errors import InputError
 from .failures import DampingStalled, Diverged, NonFinite, NotConverged, RotationLimit, SingularTangent, StepFailed
 from .problem import Problem
 from .restart import restart_from
+from .stabilize import from_option as stabilize_option
 from .stepping import Run
 from .validation import check_solve_arguments, check_stability_options
 
@@ -476,7 +477,7 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
           max_iter=30, line_search=True, min_step_ratio=2.0**-12, callback=None,
           check_rigid_modes=True, verbose=None, initial_poses=None, restart=None, checkpoint=60.0,
           linear_solver=None, allow_unmet_tolerance=False, check_stability=False, modes=0,
-          branch_switching=False, path="load", arc_length=None):
+          branch_switching=False, stabilize=None, path="load", arc_length=None):
     """Quasi-static solve of ``model`` from ``t_start`` to ``t_end`` in ``steps`` equal steps.
 
     Every converged (sub)step is recorded in the returned ``Solution``.  Step 0 is
@@ -539,6 +540,11 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     the crossing, the descent and the counts before and after, and a state
     still unstable after it is warned about.  Either implies ``check_stability``.
 
+    ``stabilize``: artificial viscous damping in pseudo-time (Abaqus ``*STATIC, STABILIZE``) to pass
+    instabilities under load control: ``True`` (dissipated-energy fraction 2e-4), a fraction, or
+    ``dict(fraction=, factor=, warn=)``; the energy it dissipates is recorded per step in
+    ``stats[k]["stabilization"]`` and warned about above ``warn`` (``beamsolver.stabilize``).
+
     ``path``: ``"load"`` (default) steps the pseudo-time on the grid above;
     ``"arc-length"`` follows the equilibrium path by arc length through limit
     points and snap-backs, ``t`` going down as well as up
@@ -546,7 +552,7 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     ``arclength.ArcLength``: ``initial``, ``min``, ``max``,
     ``target_iterations``, ``max_steps``, ``psi``).  Its ``times`` are not
     monotonic; ``stats[k]`` adds ``arc_length``, ``t`` and ``linearised``;
-    ``restart`` and ``branch_switching`` are refused with it.
+    ``restart``, ``branch_switching`` and ``stabilize`` are refused with it.
 
     ``Solution.stats[k]["timings"]``: wall time of the step's ``assembly``
     (residuals, tangents, sparse matrices), of each contribution to it (``contact``
@@ -560,7 +566,7 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
         raise InputError("solve: give either restart or initial_poses, not both")
     if int(steps) != steps or steps < 1:
         raise InputError(f"solve: steps must be a positive integer, got {steps!r}")
-    arc = check_arc_length_arguments(path, arc_length, restart, branch_switching)
+    arc = check_arc_length_arguments(path, arc_length, restart, branch_switching, stabilize)
     problem = Problem.from_model(model, check_rigid_modes=check_rigid_modes)
     system = problem.system
     sol, t_start = _starting_point(restart, model, problem, t_start, t_end)
@@ -570,9 +576,12 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     newton = _Newton(problem, conv, line_search, callback)
     newton.linsolver = linsolve.Solver(linear_solver)
     modes, branch_switching = check_stability_options(modes, branch_switching)
+    stabilizer = stabilize_option(system, stabilize, check=problem.conservative)
+    if stabilizer is not None:
+        problem.contributions.append(stabilizer)
     options = dict(allow_unmet_tolerance=allow_unmet_tolerance, advice=_advice(system, t_start, t_end),
                    check_stability=bool(check_stability or modes or branch_switching), modes=modes,
-                   branch_switching=branch_switching)
+                   branch_switching=branch_switching, stabilizer=stabilizer)
     run = None
     try:
         args = (problem, newton, _writer(output, system, checkpoint), grid, dt_min, verbose, options)

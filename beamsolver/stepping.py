@@ -112,6 +112,8 @@ class Run:
         self.sol.resume = dict(t0=float(grid[0]), t_end=float(grid[-1]), steps=int(steps), dt=float(self.dt),
                                easy=int(self.easy), **self._memory_state())
         self.progress = Progress(self.verbose, t_start, grid[-1], self.t)
+        if self.opt.get("stabilizer") is not None:
+            self.opt["stabilizer"].t_last = self.t      # the converged state the first step starts from
 
     def _step_zero(self, H0, t_start):
         """Step 0: the state ``H0`` at ``t_start`` (prescribed nodes on their motion) or, when loads,
@@ -229,6 +231,8 @@ class Run:
             stats["iterations"] += more["iterations"]
             stats["residuals"] += more["residuals"]
             stats["augmentations"] = stats.get("augmentations", 0) + 1
+        if self.opt.get("stabilizer") is not None:
+            self.opt["stabilizer"].check(problem.tangent(newton.last_evaluation), t_next)
         text = problem.unmet(t_next)
         if text:
             if not self.opt.get("allow_unmet_tolerance"):
@@ -244,6 +248,8 @@ class Run:
         if self.opt.get("check_stability"):
             t_next, H, ev = self._stability(stats, t_next, H, ev)
         record = problem.commit(H)
+        if self.opt.get("stabilizer") is not None:
+            stats["stabilization"] = self.opt["stabilizer"].record(H, t_next)
         for w in stats.get("warnings", ()):
             sol.message = w if not sol.message else sol.message + "; " + w
         # the stepping state after this step, set together with the step (restart reads both)

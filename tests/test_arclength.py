@@ -343,6 +343,7 @@ def test_contact_that_closes_during_the_run_reaches_the_load_path_answer():
     (dict(path="arc-length", arc_length=dict(initial=10.0, max=1.0)), "min <= initial <= max"),
     (dict(path="arc-length", branch_switching="auto"), "branch_switching='auto' is not supported"),
     (dict(path=["arc-length"]), "path must be 'load' or 'arc-length'"),
+    (dict(path="arc-length", stabilize=True), "stabilize=True is not supported"),
 ])
 def test_bad_arc_length_input_is_refused(kw, match):
     m, _ = truss(1.0)

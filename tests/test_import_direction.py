@@ -24,8 +24,8 @@ LAYER = {
     "element": 2, "element_jit": 2, "blocks": 2, "contact": 2, "contact.law": 2, "contact.kinematics": 2,
     "contact.pairs": 2, "contact.search": 2, "contact.kernel_jit": 2, "contact.options": 2, "contact.record": 2,
     # 3: model declarations and their assembly
-    "model": 3, "cables": 3, "assembly": 3, "assembly_jit": 3, "contact.system": 3, "linsolve": 3,
-    "bifurcation": 3,
+    "model": 3, "cables": 3, "assembly": 3, "stabilize": 3, "topology": 1, "assembly_jit": 3, "contact.system": 3,
+    "linsolve": 3, "bifurcation": 3,
     # 4: the Problem interface between the solver and the physics
     "problem": 4,
     # 5: results
