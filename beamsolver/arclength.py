@@ -4,7 +4,7 @@ The pseudo-time ``t`` (which drives the load scales, the prescribed motions and
 the ``fix(values=)`` targets) becomes an unknown next to the free increments
 ``z``.  Each step from the equilibrium ``(H_0, t_0)`` seeks ``(H, t)`` with
 
-    r_f(H, t) = 0,     |S dz|^2 + psi^2 (t - t_0)^2 = ds^2        (docs/theory.md eq. 14.1)
+    r_f(H, t) = 0,     |S dz|^2 + psi^2 (t - t_0)^2 = ds^2        (docs/theory.md eq. 15.1)
 
 (Crisfield's spherical constraint), ``dz`` the sum of the step's free increments,
 ``S`` the unit-free scaling of ``Convergence`` (translations over the model size,
@@ -103,7 +103,7 @@ def arc_length_options(value):
 
 def sphere_root(w, tau, dw_r, dw_t, psi, ds):
     """Pseudo-time correction ``dt`` on the sphere ``|w + dw_r + dt dw_t|^2 + psi^2 (tau + dt)^2 = ds^2``
-    (docs/theory.md eq. 14.4).
+    (docs/theory.md eq. 15.4).
 
     ``w``, ``tau``: the step's scaled increment and pseudo-time change so far; ``dw_r``, ``dw_t``:
     the scaled solves ``S dz_r``, ``S dz_t``.  Of the two real roots the one whose new increment
@@ -128,7 +128,7 @@ def sphere_root(w, tau, dw_r, dw_t, psi, ds):
 def next_arc_length(ds, iterations, target, cut, linearised):
     """Arc length after a converged step of ``ds`` in ``iterations``: ``ds sqrt(target / iterations)``
     by a factor 0.5 to 2 (at most 1 after a cut-back, at most 0.5 after a linearised iteration),
-    before the cap to ``[min, max]`` (docs/theory.md eq. 14.6)."""
+    before the cap to ``[min, max]`` (docs/theory.md eq. 15.6)."""
     f = float(np.clip(np.sqrt(target / max(iterations, 1)), 0.5, 2.0))
     if cut:
         f = min(f, 1.0)
@@ -139,7 +139,7 @@ def next_arc_length(ds, iterations, target, cut, linearised):
 
 def rate(problem, H, t, ev, delta, t_start):
     """``dr_f/dt`` ``(n_free,)`` at the state ``H`` (constrained nodes on their targets at ``t``;
-    ``ev`` its ``problem.Evaluation`` with the tangent; docs/theory.md eq. 14.3).
+    ``ev`` its ``problem.Evaluation`` with the tangent; docs/theory.md eq. 15.3).
 
     Loads: ``-f_ext(H, dlf/dt)`` (the residual is linear in the load factors; ``dlf/dt`` by a central
     difference of the scale functions); prescribed motions and ``fix(values=)``: ``K_fc dz_c/dt``

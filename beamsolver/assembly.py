@@ -18,7 +18,7 @@ quadratic.
 import numpy as np
 import scipy.sparse as sp
 
-from . import assembly_jit, element, se3
+from . import assembly_jit, se3
 from . import blocks as _blocks
 from .errors import InputError
 from .se3 import skew
@@ -68,10 +68,12 @@ class System:
         self.model = model
         n = model.n_nodes
         self.n_nodes = n
-        self.enodes, self.L, self.eps0, self.C = model.element_table()
+        self.groups = model.element_groups()          # one per element type (model.ElementGroup)
+        self.enodes, self.L, self.eps0, self.C = model.element_table(self.groups)   # end nodes (n_el, 2)
         self.C = np.ascontiguousarray(self.C, dtype=float)
         self.C_diagonal = bool(not np.any(self.C[:, ~np.eye(6, dtype=bool)]))
         self.n_elements = len(self.L)
+        self._build_rotation_pairs()
         self.poses0 = model.poses0
         self.length_scale = model.characteristic_length()
         self._build_reps(model)
@@ -115,6 +117,19 @@ class System:
         self.chain_index = np.concatenate([c[0] for c in chains]).astype(np.int64) if chains \
             else np.zeros(0, dtype=np.int64)
         self.chain_ptr = np.cumsum([0] + [len(c[0]) for c in chains]).astype(np.int64)
+
+    def _build_rotation_pairs(self):
+        """Node pairs ``(n_p, 2)`` whose relative rotation an element represents by a logarithm, their
+        element ids and per element the largest rotation its type accepts (``rotation_limit``)."""
+        pairs, owner = [], []
+        self.rotation_limit = np.empty(self.n_elements)
+        for g in self.groups:
+            for i, j in g.element_type.rotation_pairs:
+                pairs.append(g.nodes[:, [i, j]])
+                owner.append(g.elements)
+            self.rotation_limit[g.elements] = g.element_type.max_rotation
+        self.rotation_pairs = np.concatenate(pairs) if len(self.groups) > 1 or len(pairs) > 1 else self.enodes
+        self.pair_element = np.concatenate(owner)
 
     # ------------------------------------------------------------ dof map
     def _build_reps(self, model):
@@ -181,7 +196,7 @@ class System:
         transformed[self.global_nodes] = True
         transformed |= np.isin(rep, self.global_nodes)
         self.transformed = transformed
-        self.el_transformed = np.flatnonzero(transformed[self.enodes].any(axis=1))
+        self.group_transformed = [np.flatnonzero(transformed[g.nodes].any(axis=1)) for g in self.groups]
         self.body_nodes = np.flatnonzero(is_rep & ((kind == FREE) | (kind == PRESCRIBED)))
 
     @staticmethod
@@ -200,8 +215,10 @@ class System:
             ra, rb = _find(parent, a), _find(parent, b)
             if ra != rb:
                 parent[ra] = rb
-        for a, b in self.enodes:
-            union(int(a), int(b))
+        for g in self.groups:
+            for nodes in g.nodes.tolist():
+                for b in nodes[1:]:
+                    union(nodes[0], b)
         for i in range(n):
             union(i, int(self.rep[i]))
         for decl in model.contacts:
@@ -242,8 +259,9 @@ class System:
     def _build_pattern(self):
         n = self.n_nodes
         k6 = np.arange(6)
-        edofs = (6 * self.rep[self.enodes])[:, :, None] + k6                # (n_el, 2, 6)
-        self.edofs = edofs.reshape(-1, 12)
+        # per element group: dofs (n_g, 6k) of its elements, k from the connectivity
+        self.group_edofs = [_blocks.dofs(self.rep, g.nodes) for g in self.groups]
+        self.edofs_flat = np.concatenate([ed.ravel() for ed in self.group_edofs])
         # node blocks: dead-loaded nodes and global-type representatives
         bn = np.unique(np.concatenate([self.load_nodes[self.dead], self.global_nodes]))
         self.block_nodes = bn.astype(int)
@@ -251,14 +269,14 @@ class System:
         self.dead_where = np.searchsorted(self.block_nodes, self.load_nodes[self.dead])
         self.dead_unique = len(np.unique(self.dead_where)) == len(self.dead_where)
         ndofs = (6 * self.rep[self.block_nodes])[:, None] + k6
-        # element entries in the order of the compiled kernel's tangent storage, (n_el, 12, 12),
+        # element entries group by group in the order of the kernels' tangent storage, (n_g, 6k, 6k),
         # then the node blocks (n_b, 6, 6)
-        ed = self.edofs
-        n_el = len(ed)
-        rows = np.concatenate([np.broadcast_to(ed[:, :, None], (n_el, 12, 12)).ravel(),
-                               np.repeat(ndofs, 6, axis=1).ravel()])
-        cols = np.concatenate([np.broadcast_to(ed[:, None, :], (n_el, 12, 12)).ravel(),
-                               np.tile(ndofs, (1, 6)).ravel()])
+        shapes = [(len(ed), ed.shape[1], ed.shape[1]) for ed in self.group_edofs]
+        self.group_kslices = np.cumsum([0] + [int(np.prod(sh)) for sh in shapes])
+        rows = np.concatenate([np.broadcast_to(ed[:, :, None], sh).ravel() for ed, sh in zip(self.group_edofs, shapes)]
+                              + [np.repeat(ndofs, 6, axis=1).ravel()])
+        cols = np.concatenate([np.broadcast_to(ed[:, None, :], sh).ravel() for ed, sh in zip(self.group_edofs, shapes)]
+                              + [np.tile(ndofs, (1, 6)).ravel()])
         self.coo_rows, self.coo_cols = rows, cols
         rr, rc = self.red[rows], self.red[cols]
         keep = (rr >= 0) & (rc >= 0)
@@ -338,31 +356,14 @@ class System:
         pattern (``None`` without tangent); ``info`` holds the element state
         and force levels for the convergence test.
         """
-        HA, HB = H[self.enodes[:, 0]], H[self.enodes[:, 1]]
         kvals = None
+        n_k = self.group_kslices[-1]
         if tangent:
-            # the kernel writes its tangent straight into the COO value array (no copy)
-            n_k = 144 * self.n_elements
+            # the kernels write their tangents straight into the COO value array (no copy)
             kvals = np.empty(n_k + 36 * len(self.block_nodes))
-            f, K, state = element.evaluate(HA, HB, self.L, self.eps0, self.C, True,
-                                           kvals[:n_k].reshape(self.n_elements, 12, 12), self.C_diagonal)
-        else:
-            f, K, state = element.evaluate(HA, HB, self.L, self.eps0, self.C, False, diagonal=self.C_diagonal)
-        levels = np.abs(f).max(axis=0, initial=0.0).reshape(4, 3).max(axis=1)     # f_A, m_A, f_B, m_B
-        f_level, m_level = max(levels[0], levels[2]), max(levels[1], levels[3])
-        M = self.node_transforms(H)
-        if M is not None and len(self.el_transformed):
-            e = self.el_transformed
-            T = np.zeros((len(e), 12, 12))
-            T[:, :6, :6] = M[self.enodes[e, 0]]
-            T[:, 6:, 6:] = M[self.enodes[e, 1]]
-            Tt = np.swapaxes(T, 1, 2)
-            f = f.copy()
-            f[e] = np.einsum("nij,nj->ni", Tt, f[e])
-            if K is not None:
-                K[e] = Tt @ K[e] @ T
+        f, state, f_level, m_level, M = self._element_forces(H, kvals)
         ndof = 6 * self.n_nodes
-        r = np.bincount(self.edofs.ravel(), weights=f.ravel(), minlength=ndof)
+        r = np.bincount(self.edofs_flat, weights=f, minlength=ndof)
         # external loads (body components at their node, then transformed)
         blocks = np.zeros((len(self.block_nodes), 6, 6)) if tangent else None
         if len(self.load_nodes):
@@ -377,6 +378,37 @@ class System:
             kvals[n_k:] = blocks.ravel()
         info = dict(state=state, f_level=f_level, m_level=m_level)
         return r, kvals, info
+
+    def _element_forces(self, H, kvals):
+        """Element forces of all groups (flat, in ``edofs_flat`` order, transformed to ``z``), tangent
+        blocks into ``kvals`` (if given), the ``ElementState`` per element, force levels and ``M``."""
+        fs, states, f_level, m_level = [], [], 0.0, 0.0
+        M = self.node_transforms(H)
+        for j, g in enumerate(self.groups):
+            m, et = 6 * g.element_type.n_nodes, self.group_transformed[j]
+            out = None if kvals is None else \
+                kvals[self.group_kslices[j]:self.group_kslices[j + 1]].reshape(len(g.nodes), m, m)
+            f, K, state = g.element_type.evaluate(H, g.nodes, g.ref, kvals is not None, out)
+            levels = _blocks.levels(f)
+            f_level, m_level = max(f_level, levels[0]), max(m_level, levels[1])
+            if M is not None and len(et):
+                # the generic block transform on the blocks touching a transformed node; the
+                # tangent goes back into kvals
+                ft, Kt = _blocks.transform(M, g.nodes[et], f[et], None if K is None else K[et])
+                f = f.copy()
+                f[et] = ft
+                if K is not None:
+                    K[et] = Kt
+            if len(self.groups) == 1:
+                return f.ravel(), state, f_level, m_level, M
+            fs.append(f.ravel())
+            states.append(state)
+        n = self.n_elements
+        merged = [np.empty((n, 6)) for _ in range(3)]
+        for g, state in zip(self.groups, states):
+            for out, x in zip(merged, state):
+                out[g.elements] = x
+        return np.concatenate(fs), type(states[0])(*merged), f_level, m_level, M
 
     def _add_loads(self, H, lf, M, r, blocks, f_level, m_level):
         """``r - f_ext`` and the dead-load stiffness added to ``blocks`` (if given); updated force levels.

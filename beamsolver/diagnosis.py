@@ -7,7 +7,6 @@ add advice to a ``ConvergenceError`` (``advice``).
 import numpy as np
 
 from .definiteness import negative_eigenvalues
-from .element import internal_forces
 from .failures import DampingStalled, NotConverged, SingularTangent
 from .problem import Problem
 
@@ -33,12 +32,11 @@ def nonfinite_source(system, H, t):
         v = float(f(t))
         if not np.isfinite(v):
             return True, f"fix(node {node}): values[{comp}]({t:.6g}) = {v!r} is not finite"
-    en = system.enodes
-    if len(en):
-        f, _ = internal_forces(H[en[:, 0]], H[en[:, 1]], system.L, system.eps0, system.C)
+    for g in system.groups:                 # per element type (k nodes each)
+        f = g.element_type.evaluate(H, g.nodes, g.ref, False)[0]
         e = np.flatnonzero(~np.all(np.isfinite(f), axis=1))
         if len(e):
-            return False, f"the internal forces of element {int(e[0])} are not finite"
+            return False, f"the internal forces of element {int(g.elements[e[0]])} are not finite"
     if system.contact is not None:
         rc = system.assemble_blocks(H, system.contact.evaluate(H, False)[0])[0]
         nodes = np.flatnonzero(~np.all(np.isfinite(rc.reshape(-1, 6)), axis=1))

@@ -46,7 +46,7 @@ from . import se3
 from .se3 import coefficient
 
 __all__ = ["ElementState", "element_state", "reference_strain", "energy",
-           "internal_forces", "internal_forces_and_tangent", "evaluate", "internal_forces_numpy",
+           "internal_forces", "internal_forces_and_tangent", "evaluate", "evaluate_nodes", "is_diagonal", "geometric", "internal_forces_numpy",
            "internal_forces_and_tangent_numpy", "CHUNK"]
 
 # elements per chunk, measured (benchmarks/element_throughput.py): larger chunks amortise the
@@ -200,6 +200,25 @@ def _geometric(u, w, n, mo, k):
     return DAn, G21, G22
 
 
+def geometric(h, s):
+    """``G(h, s) = d(T(h)^-T s)/dh`` ``(n, 6, 6)`` for twists ``h`` and vectors ``s`` ``(n, 6)``.
+
+    The closed form of ``_geometric`` (docs/theory.md eq. 3.7) in element-first layout: the
+    geometric stiffness of one logarithm pair with the generalised force ``s`` held fixed.
+    """
+    h, s = np.asarray(h, dtype=float), np.asarray(s, dtype=float)
+    u, w = h[:, :3].T, h[:, 3:].T
+    t = np.sqrt(_dot(w, w))
+    k = se3.coefficients(TANGENT_COEFFICIENTS, t)
+    k.update(d=coefficient("d", t), t2=t * t)
+    G12, G21, G22 = _geometric(u, w, s[:, :3].T, s[:, 3:].T, k)
+    out = np.zeros((len(h), 6, 6))
+    out[:, :3, 3:] = G12.transpose(2, 0, 1)
+    out[:, 3:, :3] = G21.transpose(2, 0, 1)
+    out[:, 3:, 3:] = G22.transpose(2, 0, 1)
+    return out
+
+
 # ---------------------------------------------------------------- the kernel
 _OFF_DIAGONAL = ~np.eye(6, dtype=bool)
 
@@ -209,6 +228,11 @@ def _diagonal(C):
     if np.any(C[:, _OFF_DIAGONAL]):
         return None
     return np.ascontiguousarray(np.einsum("nii->in", C))
+
+
+def is_diagonal(C):
+    """True if every ``C`` ``(n, 6, 6)`` is diagonal."""
+    return not np.any(C[:, _OFF_DIAGONAL])
 
 
 def _twice(x):
@@ -293,11 +317,24 @@ def evaluate(H_A, H_B, L, eps0, C, tangent, out=None, diagonal=None):
     The tangent is a C-contiguous ``(n, 12, 12)`` array (``out`` if given, of that shape).
     ``diagonal``: whether every ``C`` is diagonal, if known (else checked).
     """
+    n = len(L)
+    H = np.concatenate([np.asarray(H_A, dtype=float).reshape(n, 4, 4), np.asarray(H_B, dtype=float).reshape(n, 4, 4)])
+    nodes = np.stack([np.arange(n), np.arange(n, 2 * n)], axis=1)
+    return evaluate_nodes(H, nodes, L, eps0, C, tangent, out, diagonal)
+
+
+def evaluate_nodes(H, nodes, L, eps0, C, tangent, out=None, diagonal=None):
+    """``evaluate`` for elements whose node poses are ``H[nodes[e, 0]], H[nodes[e, 1]]``.
+
+    ``H``: poses ``(N, 4, 4)``; ``nodes``: ``(n, 2)`` integer rows of ``H``.  The kernel reads
+    the poses in place (no gathered copies); this is the path ``elements.se3_2`` runs.
+    """
     from . import element_jit   # numba compiles (or loads its cache) on first use
     n = len(L)
-    H_A, H_B, L, eps0, C = (np.ascontiguousarray(x, dtype=float) for x in (H_A, H_B, L, eps0, C))
+    H, L, eps0, C = (np.ascontiguousarray(x, dtype=float) for x in (H, L, eps0, C))
+    nodes = np.ascontiguousarray(nodes, dtype=np.int64)
     if diagonal is None:
-        diagonal = element_jit.is_diagonal(C)
+        diagonal = is_diagonal(C)
     f = np.empty((n, 12))
     h, strain, sigma = np.empty((n, 6)), np.empty((n, 6)), np.empty((n, 6))
     K = np.empty((0, 12, 12))
@@ -305,7 +342,7 @@ def evaluate(H_A, H_B, L, eps0, C, tangent, out=None, diagonal=None):
         K = np.empty((n, 12, 12)) if out is None else out
         if K.shape != (n, 12, 12):
             raise ValueError(f"out must have shape ({n}, 12, 12), got {K.shape}")
-    element_jit.evaluate(H_A, H_B, L, eps0, C, diagonal, tangent, f, h, strain, sigma, K)
+    element_jit.evaluate(H, nodes, L, eps0, C, diagonal, tangent, f, h, strain, sigma, K)
     return f, (K if tangent else None), ElementState(h, strain, sigma)
 
 

@@ -8,7 +8,8 @@ and the geometric blocks ``G12, G21, G22`` of ``element._geometric``
 (docs/theory.md eqs. 3.4-3.7).  The tangent goes to an array ``(n, 12, 12)``,
 element-major (each element's 144 entries contiguous: element-axis-last storage
 made every element touch 144 pages, measured 2x slower at 1e4 elements), the
-order ``assembly.System`` scatters.
+order ``assembly.System`` scatters.  Node poses are read through a node table
+``(n, 2)`` from the model's pose array (``elements.se3_2``), not gathered first.
 """
 import numpy as np
 from ._jit import jit, jit_inline
@@ -121,10 +122,11 @@ def _z_rows(TiT, XT, G12, G21, G22, C, e, invL, diagonal):
 
 
 @jit_inline
-def element_kernel(HA, HB, L, eps0, C, e, diagonal, tangent, f, h, strain, sigma, K):
-    """Forces (and with ``tangent`` the tangent) of element ``e``, written to row/column ``e``."""
-    RA, xA = pose(HA, e)
-    RB, xB = pose(HB, e)
+def element_kernel(H, nodes, L, eps0, C, e, diagonal, tangent, f, h, strain, sigma, K):
+    """Forces (and with ``tangent`` the tangent) of element ``e`` with node poses ``H[nodes[e]]``,
+    written to row/column ``e``."""
+    RA, xA = pose(H, nodes[e, 0])
+    RB, xB = pose(H, nodes[e, 1])
     u, w, t, d = log_relative(RA, xA, RB, xB)
     invL = 1.0 / L[e]
     for i in range(3):
@@ -172,16 +174,14 @@ def element_kernel(HA, HB, L, eps0, C, e, diagonal, tangent, f, h, strain, sigma
 
 
 @jit
-def evaluate(HA, HB, L, eps0, C, diagonal, tangent, f, h, strain, sigma, K):
-    """Batch driver: ``element_kernel`` over all elements (a plain loop; one core)."""
+def evaluate(H, nodes, L, eps0, C, diagonal, tangent, f, h, strain, sigma, K):
+    """Batch driver: ``element_kernel`` over all elements (a plain loop; one core).
+
+    ``H``: node poses ``(N, 4, 4)``, ``nodes``: ``(n, 2)`` rows of ``H`` of each element (A, B);
+    reading the poses through the node table saves gathering them into copies.
+    """
     for e in range(len(L)):
-        element_kernel(HA, HB, L, eps0, C, e, diagonal, tangent, f, h, strain, sigma, K)
-
-
-def is_diagonal(C):
-    """True if every ``C`` (n, 6, 6) is diagonal."""
-    return not np.any(C[:, ~np.eye(6, dtype=bool)])
-
+        element_kernel(H, nodes, L, eps0, C, e, diagonal, tangent, f, h, strain, sigma, K)
 
 
 @jit

@@ -11,14 +11,13 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from . import se3
-from .element import reference_strain
+from . import elements
 from .errors import InputError
 from .section import Section
 from .validation import (MAX_REFERENCE_ELEMENT_ROTATION, ORTHONORMAL_TOL, CheckedScalar, as_array, check_contact_options,
                          check_node_id, check_pose, real)
 
-__all__ = ["Model", "Beam", "Load", "ContactDeclaration", "DOF_NAMES"]
+__all__ = ["Model", "Beam", "Load", "ContactDeclaration", "ElementGroup", "DOF_NAMES"]
 
 DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
 JOIN_TOL = 1e-9                       # coincidence tolerance relative to the model size
@@ -33,6 +32,12 @@ class Beam:
     elements: np.ndarray
     section: Section
     name: Optional[str] = None
+    element_type: elements.ElementType = elements.get()
+
+    @property
+    def connectivity(self):
+        """Global node ids of every element ``(n_elements, k)`` (``k`` nodes of its element type)."""
+        return self.nodes[self.element_type.connectivity(self.n_elements)]
 
     @property
     def first(self):
@@ -49,6 +54,15 @@ class Beam:
     def __repr__(self):
         label = f" {self.name!r}" if self.name else ""
         return f"Beam {self.id}{label} (nodes {self.first}..{self.last}, {self.n_elements} elements)"
+
+
+@dataclass
+class ElementGroup:
+    """The elements of one element type: global element ids, node ids ``(n, k)``, reference data."""
+    element_type: elements.ElementType
+    elements: np.ndarray
+    nodes: np.ndarray
+    ref: elements.Reference
 
 
 @dataclass
@@ -128,10 +142,16 @@ class Model:
             return np.zeros((0, 4, 4))
         return np.concatenate(self._poses)
 
-    def add_beam(self, poses, section, name=None):
-        """Add a beam through node poses ``(n + 1, 4, 4)`` with ``section``; returns the ``Beam``."""
+    def add_beam(self, poses, section, name=None, element=None):
+        """Add a beam through node poses ``(m (k - 1) + 1, 4, 4)`` with ``section``; returns the ``Beam``.
+
+        ``element``: the element type, a name of ``beamsolver.elements.TYPES`` or an
+        ``ElementType`` (default ``"se3-2"``, the two-node SE(3) element; ``"se3-3"``:
+        three-node quadratic elements, so ``2 m + 1`` poses with every second one a mid node).
+        """
         bid = len(self.beams)
         label = f"Beam {bid}" + (f" {name!r}" if name else "")
+        etype = elements.get(element)
         if not isinstance(section, Section):
             raise InputError(f"{label}: section must be a beamsolver.Section, got {type(section).__name__}")
         P = as_array(poses, "poses", label)
@@ -151,14 +171,18 @@ class Model:
                              f"det = {det[i]:.6g}); use beamsolver.geometry or orthonormalise it")
         if np.any(np.abs(P[:, 3] - [0, 0, 0, 1]) > 0):
             raise InputError(f"{label}: the last row of every pose must be (0, 0, 0, 1)")
-        L, eps0 = reference_strain(P[:-1], P[1:])
+        n_el = etype.n_elements(len(P), label)
+        conn = etype.connectivity(n_el)
+        ref = etype.reference(P[conn], np.broadcast_to(section.C, (n_el, 6, 6)))
+        L = ref.L
         size = max(np.ptp(P[:, :3, 3], axis=0).max(), L.sum())
         short = np.flatnonzero(L <= ZERO_LENGTH_TOL * size)
         if len(short):
             i = int(short[0])
-            raise InputError(f"{label}: element {i} has zero length (nodes {i} and {i + 1} coincide at "
-                             f"{P[i, :3, 3].tolist()})")
-        ang = se3.rotation_angle(eps0[:, 3:] * L[:, None])
+            a, b = conn[i, 0], conn[i, -1]
+            raise InputError(f"{label}: element {i} has zero length (nodes {a} and {b} coincide at "
+                             f"{P[a, :3, 3].tolist()})")
+        ang = etype.rotation_angles(P[conn]).max(axis=1)
         big = np.flatnonzero(ang > MAX_REFERENCE_ELEMENT_ROTATION)
         if len(big):
             i = int(big[0])
@@ -166,12 +190,12 @@ class Model:
                              f"(limit {MAX_REFERENCE_ELEMENT_ROTATION:.3f} rad, MAX_REFERENCE_ELEMENT_ROTATION); "
                              "use more elements")
         nodes = np.arange(self._n_nodes, self._n_nodes + len(P))
-        elements = np.arange(self._n_elements, self._n_elements + len(P) - 1)
-        beam = Beam(bid, nodes, elements, section, name)
+        element_ids = np.arange(self._n_elements, self._n_elements + n_el)
+        beam = Beam(bid, nodes, element_ids, section, name, etype)
         self.beams.append(beam)
         self._poses.append(P)
         self._n_nodes += len(P)
-        self._n_elements += len(P) - 1
+        self._n_elements += n_el
         return beam
 
     def add_node(self, pose, name=None):
@@ -351,6 +375,9 @@ class Model:
         for b in s + m:
             if not isinstance(b, Beam) or b.id >= len(self.beams) or self.beams[b.id] is not b:
                 raise InputError(f"add_contact: {b!r} is not a beam of this model")
+            if b.element_type.n_nodes != 2:
+                raise InputError(f"add_contact: {b!r} has {b.element_type.name!r} elements; contact works on "
+                                 "two-node elements only")
         mu = real(mu, "mu", "add_contact", minimum=0.0)
         penalty = real(penalty, "penalty", "add_contact", above=0.0, none=True)
         options = check_contact_options(options)
@@ -370,16 +397,34 @@ class Model:
         return decls
 
     # ------------------------------------------------------------ summary
-    def element_table(self):
-        """Per element: node ids ``(n_el, 2)``, reference length, reference strain, C."""
-        nodes, C = [], []
+    def element_groups(self):
+        """``ElementGroup`` per element type, in the order the types first appear among the beams."""
+        by_type = {}
         for b in self.beams:
-            nodes.append(np.stack([b.nodes[:-1], b.nodes[1:]], axis=1))
-            C.append(np.broadcast_to(b.section.C, (b.n_elements, 6, 6)))
-        nodes = np.concatenate(nodes)
+            by_type.setdefault(b.element_type.name, []).append(b)
         P = self.poses0
-        L, eps0 = reference_strain(P[nodes[:, 0]], P[nodes[:, 1]])
-        return nodes, L, eps0, np.concatenate(C)
+        groups = []
+        for beams in by_type.values():
+            etype = beams[0].element_type
+            nodes = np.concatenate([b.connectivity for b in beams])
+            C = np.concatenate([np.broadcast_to(b.section.C, (b.n_elements, 6, 6)) for b in beams])
+            groups.append(ElementGroup(etype, np.concatenate([b.elements for b in beams]), nodes,
+                                       etype.reference(P[nodes], C)))
+        return groups
+
+    def element_table(self, groups=None):
+        """Per element: end node ids ``(n_el, 2)`` (first and last node), reference length, reference
+        strain, C (from ``element_groups``, or ``groups`` if given)."""
+        groups = self.element_groups() if groups is None else groups
+        if len(groups) == 1:
+            g = groups[0]
+            return np.ascontiguousarray(g.nodes[:, [0, -1]]), g.ref.L, g.ref.eps0, g.ref.C
+        n = self.n_elements
+        nodes, L, eps0, C = np.zeros((n, 2), dtype=int), np.zeros(n), np.zeros((n, 6)), np.zeros((n, 6, 6))
+        for g in groups:
+            nodes[g.elements] = g.nodes[:, [0, -1]]
+            L[g.elements], eps0[g.elements], C[g.elements] = g.ref.L, g.ref.eps0, g.ref.C
+        return nodes, L, eps0, C
 
     def characteristic_length(self):
         P = self.poses0

@@ -36,7 +36,9 @@ def describe_model(model, system=None):
     ``beam_first_node``, ``beam_n_nodes``, ``beam_radius`` (n_beams,); ``beam_C``
     (n_beams, 6, 6); ``beam_name`` (str); ``constrained_nodes`` and
     ``constraint_kind`` ('clamp', 'fix' or 'prescribe'); ``load_nodes``;
-    ``joins`` (k, 2); ``n_contact_declarations``.
+    ``joins`` (k, 2); ``n_contact_declarations``; ``beam_element`` (n_beams,) element type names
+    (``elements.TYPES``; element ``j`` of a beam with ``k``-node elements has its nodes
+    ``first + (k - 1) j + (0 .. k - 1)``; ``enodes`` holds the first and the last).
     """
     if system is not None:
         enodes, L, eps0 = system.enodes, system.L, system.eps0
@@ -59,6 +61,7 @@ def describe_model(model, system=None):
         beam_radius=np.array([b.section.radius for b in beams], dtype=float),
         beam_C=np.array([b.section.C for b in beams], dtype=float).reshape(-1, 6, 6),
         beam_name=np.array([b.name or "" for b in beams], dtype=str),
+        beam_element=np.array([b.element_type.name for b in beams], dtype=str),
         constrained_nodes=np.array([c[0] for c in cons], dtype=np.int64),
         constraint_kind=np.array([c[1][0] for c in cons], dtype=str),
         load_nodes=np.array([ld.node for ld in model.loads], dtype=np.int64),

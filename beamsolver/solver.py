@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import diagnosis, linsolve, se3
+from . import diagnosis, elements, linsolve, se3
 from .arclength import ArcLengthRun, check_arc_length_arguments
 from .errors import InputError
 from .failures import DampingStalled, Diverged, NonFinite, NotConverged, RotationLimit, SingularTangent, StepFailed
@@ -36,7 +36,7 @@ __all__ = ["solve", "Convergence"]
 
 log = logging.getLogger("beamsolver")
 
-MAX_ELEMENT_ROTATION = 0.8 * np.pi   # an iterate turning an element further is rejected
+MAX_ELEMENT_ROTATION = elements.MAX_ELEMENT_ROTATION   # an iterate turning an element further is rejected
 LS_GROWTH = 10.0                     # full Newton steps are kept unless the merit grows this much
 DAMPING_MIN = 1.0 / 64.0             # shortest damped Newton step (smooth problems)
 STALL_RATIO = 1.5                    # undamped fallback if the shortest damped step grows the correction less
@@ -119,8 +119,9 @@ def _solve_linear(lu, rhs):
 
 
 def _relative_rotations(system, H):
-    """Rotations ``R_A^T R_B`` between the two nodes of every element, ``(n_elements, 3, 3)``."""
-    en = system.enodes
+    """Rotations ``R_i^T R_j`` of the node pairs an element represents by a logarithm
+    (``system.rotation_pairs``: one per element for two-node elements), ``(n_pairs, 3, 3)``."""
+    en = system.rotation_pairs
     return np.swapaxes(H[en[:, 0], :3, :3], 1, 2) @ H[en[:, 1], :3, :3]
 
 
@@ -139,7 +140,8 @@ def _largest_element_rotation(system, H):
 def _refine_advice(system, H, t, t_start, t_end):
     """How many elements the beams whose elements turn most would need (rotations taken to grow
     in proportion to the pseudo-time), as a message tail."""
-    ang = _angle(_relative_rotations(system, H))
+    ang = np.zeros(system.n_elements)
+    np.maximum.at(ang, system.pair_element, _angle(_relative_rotations(system, H)))   # per element
     grow = (t_end - t_start) / (t - t_start) if t > t_start else 1.0
     parts = []
     for b in system.model.beams:
@@ -197,11 +199,12 @@ class _Newton:
 
     def _check_rotation(self, state):
         ang = se3.rotation_angle(state.h[:, 3:])
-        worst = int(np.argmax(ang)) if len(ang) else 0
-        if len(ang) and ang[worst] > MAX_ELEMENT_ROTATION:
+        limit = self.sys.rotation_limit          # of each element's type, MAX_ELEMENT_ROTATION for se3-2
+        worst = int(np.argmax(ang - limit)) if len(ang) else 0
+        if len(ang) and ang[worst] > limit[worst]:
             raise RotationLimit(f"{self._element_label(worst)} turns by {ang[worst]:.4f} rad within one element "
-                                f"(limit MAX_ELEMENT_ROTATION = {MAX_ELEMENT_ROTATION / np.pi:.2g} pi = "
-                                f"{MAX_ELEMENT_ROTATION:.4f} rad; an element cannot turn by pi): refine the mesh")
+                                f"(limit MAX_ELEMENT_ROTATION = {limit[worst] / np.pi:.2g} pi = "
+                                f"{limit[worst]:.4f} rad; an element cannot turn by pi): refine the mesh")
 
     def _check_continuity(self, H0, H1):
         """Refuse a step over which an element's relative rotation may have passed through pi.
@@ -219,7 +222,8 @@ class _Newton:
         bad = np.flatnonzero(change >= (np.pi - _angle(R0)) + (np.pi - _angle(R1)) - 1e-9)
         if len(bad):
             e = int(bad[np.argmax(change[bad])])
-            raise RotationLimit(f"{self._element_label(e)} turns by {change[e]:.3f} rad within one element in "
+            raise RotationLimit(f"{self._element_label(self.sys.pair_element[e])} turns by {change[e]:.3f} rad "
+                                "within one element in "
                                 "one load step and may have passed pi, which an element cannot represent: "
                                 "use smaller steps or refine the mesh")
 

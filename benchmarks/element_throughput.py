@@ -4,8 +4,10 @@ Scene: one clamped helix (curved and twisted elements, so every coefficient of
 the kernel is non-trivial) of ``n`` elements with a dead tip load, in a
 deformed, non-equilibrium state.  Per size ``n = 1e2 .. 1e5``:
 
-- kernel: ``element.internal_forces_and_tangent`` (forces + exact tangent, the
-  compiled numba path), and the same by the numpy kernel kept as its oracle
+- kernel: the element type ``"se3-2"`` of the element contract
+  (``bs.elements.get("se3-2").evaluate(H, nodes, ref, True)``: forces + exact
+  tangent by the compiled numba path, poses read through the node table), and
+  the same by the numpy kernel kept as its oracle
   (``element.internal_forces_and_tangent_numpy``), measured in the same run;
 - assembly: ``System.evaluate`` (kernel + loads + residual scatter) and
   ``System.matrix`` (tangent values scattered into the CSC pattern built once);
@@ -77,10 +79,12 @@ def measure(n):
     HA, HB = H[system.enodes[:, 0]], H[system.enodes[:, 1]]
     args = (HA, HB, system.L, system.eps0, system.C)
     lf = system.load_factors(1.0)
-    element.internal_forces_and_tangent(*args)             # compile (or load the cache) before timing
-    t_kernel = _best(lambda: element.internal_forces_and_tangent(*args), min_time=1.0, max_repeat=200)
+    group = system.groups[0]                               # the element contract: type, node table, reference
+    etype, nodes, ref = group.element_type, group.nodes, group.ref
+    etype.evaluate(H, nodes, ref, True)                    # compile (or load the cache) before timing
+    t_kernel = _best(lambda: etype.evaluate(H, nodes, ref, True), min_time=1.0, max_repeat=200)
     t_numpy = _best(lambda: element.internal_forces_and_tangent_numpy(*args))
-    t_forces = _best(lambda: element.internal_forces(*args), min_time=1.0, max_repeat=200)
+    t_forces = _best(lambda: etype.evaluate(H, nodes, ref, False), min_time=1.0, max_repeat=200)
 
     def assemble():
         r, kvals, _ = system.evaluate(H, lf, tangent=True)
@@ -101,13 +105,14 @@ def measure(n):
 def loop_rate(n=LOOP_SUBSET):
     """Elements per second of the same kernel called once per element (plain Python loop)."""
     system, H = scene(n)
-    HA, HB = H[system.enodes[:, 0]], H[system.enodes[:, 1]]
-    L, eps0, C = system.L, system.eps0, system.C
+    group = system.groups[0]
+    etype, nodes, ref = group.element_type, group.nodes, group.ref
+    refs = [bs.elements.Reference(ref.L[e:e + 1], ref.eps0[e:e + 1], ref.C[e:e + 1], ref.diagonal)
+            for e in range(n)]
 
     def loop():
         for e in range(n):
-            element.internal_forces_and_tangent(HA[e:e + 1], HB[e:e + 1], L[e:e + 1], eps0[e:e + 1],
-                                                C[e:e + 1])
+            etype.evaluate(H, nodes[e:e + 1], refs[e], True)
     return n / _best(loop, min_time=0.5, max_repeat=5)
 
 

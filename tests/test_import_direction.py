@@ -21,7 +21,8 @@ LAYER = {
     "se3": 1, "se3_jit": 1, "section": 1, "geometry": 1, "motion": 1, "motion_path": 1, "definiteness": 1,
     "modes": 1,
     # 2: element and contact kernels
-    "element": 2, "element_jit": 2, "blocks": 2, "contact": 2, "contact.law": 2, "contact.kinematics": 2,
+    "element": 2, "element_jit": 2, "elements": 2, "elements.base": 2, "elements.se3_2": 2, "elements.se3_3": 2,
+    "blocks": 2, "contact": 2, "contact.law": 2, "contact.kinematics": 2,
     "contact.pairs": 2, "contact.search": 2, "contact.kernel_jit": 2, "contact.options": 2, "contact.record": 2,
     # 3: model declarations and their assembly
     "model": 3, "cables": 3, "assembly": 3, "stabilize": 3, "topology": 1, "assembly_jit": 3, "contact.system": 3,
@@ -141,6 +142,7 @@ def test_the_walk_sees_known_edges():
     """The checker itself: it finds the edges it must (so an empty list of violations means something)."""
     _, edges = _edges()
     pairs = {(a, b) for a, b, _ in edges}
-    assert {("assembly", "element"), ("element", "se3"), ("solver", "problem"), ("problem", "assembly"), ("results", "io.archive"),
+    assert {("elements.se3_2", "element"), ("element", "se3"), ("solver", "problem"), ("problem", "assembly"),
+            ("results", "io.archive"),
             ("contact.pairs", "se3"), ("assembly", "contact.system"), ("", "solver")} <= pairs
     assert _cycle([("a", "b", False), ("b", "c", True), ("c", "a", True)]) is not None

@@ -1,8 +1,9 @@
 """Beams as refined poly-lines for drawing: points, segments and their data (numpy only).
 
 Every element is cut into ``refine`` segments at ``xi = k / refine``; the
-points are the constant-strain SE(3) interpolation ``H_A exp(xi h)`` with
-``h = log(H_A^-1 H_B)`` (``se3.interpolate``, the element's own kinematics),
+points are the element type's own interpolation (``ElementType.interpolate``;
+for two-node elements the constant-strain ``H_A exp(xi h)`` with
+``h = log(H_A^-1 H_B)``),
 so a beam bent at constant curvature is drawn on its exact circle or helix
 however coarse the mesh.  Shared by ``io.vtk`` (ParaView files) and ``viz``
 (pictures); works from a ``Solution`` alone (a loaded one too).
@@ -19,7 +20,7 @@ shows 0; ``Solution.strains`` is the strain itself, reference included:
 """
 import numpy as np
 
-from .. import se3
+from .. import elements
 
 __all__ = ["LineLayout", "FORCE_NAMES", "STRAIN_NAMES"]
 
@@ -67,17 +68,32 @@ class LineLayout:
         self.point_beam = pbeam
         self.point_radius = radius[pbeam]
         self.eps0 = np.asarray(d["eps0"], dtype=float)
+        self.groups = self._groups(d)
         self.reference = self.poses(np.asarray(d["poses0"], dtype=float))[:, :3, 3]
+
+    def _groups(self, d):
+        """Per element type: the type, node ids ``(m, k)`` of its elements and, for the points on
+        them, their rows of ``point_index`` and local element numbers."""
+        names = np.asarray(d.get("beam_element", np.full(len(d["beam_radius"]), elements.DEFAULT)))
+        el_type = names[np.asarray(d["element_beam"], dtype=int)] if self.n_elements else names[:0]
+        local = np.empty(self.n_elements, dtype=np.int64)
+        out = []
+        for name in dict.fromkeys(el_type.tolist()):
+            etype = elements.get(str(name))
+            els = np.flatnonzero(el_type == name)
+            local[els] = np.arange(len(els))
+            nodes = self.enodes[els, :1] + np.arange(etype.n_nodes)   # nodes of an element are consecutive
+            rows = np.flatnonzero(el_type[self.point_el] == name)
+            out.append((etype, nodes, rows, local[self.point_el[rows]]))
+        return out
 
     def poses(self, H):
         """Poses ``(n_points, 4, 4)`` of the refined points for node poses ``H``."""
         out = np.empty((self.n_points, 4, 4))
         if self.n_elements == 0:
             return out
-        HA, HB = H[self.enodes[:, 0]], H[self.enodes[:, 1]]
-        h = se3.log(se3.relative(HA, HB))
-        e = self.point_el
-        out[self.point_index] = se3.interpolate(HA[e], h[e], self.point_xi)
+        for etype, nodes, rows, e in self.groups:
+            out[self.point_index[rows]] = etype.interpolate(H[nodes], e, self.point_xi[rows])
         out[self.end_index] = H[self.end_node]
         return out
 
@@ -88,14 +104,18 @@ class LineLayout:
                     beam_id=self.point_beam), P[:, :3, 3].copy()
 
     def node_field(self, values):
-        """Node values ``(n_nodes, m)`` at the refined points, linear in ``xi`` along each element."""
+        """Node values ``(n_nodes, m)`` at the refined points, linear in ``xi`` between the nodes of each element."""
         values = np.asarray(values, dtype=float)
         out = np.empty((self.n_points,) + values.shape[1:])
         if self.n_elements == 0:
             return out
-        a, b = values[self.enodes[self.point_el, 0]], values[self.enodes[self.point_el, 1]]
-        xi = self.point_xi.reshape((-1,) + (1,) * (values.ndim - 1))
-        out[self.point_index] = (1.0 - xi) * a + xi * b
+        for etype, nodes, rows, e in self.groups:      # piecewise linear through the element's k nodes
+            k = etype.n_nodes
+            x = self.point_xi[rows] * (k - 1)
+            seg = np.minimum(np.floor(x).astype(int), k - 2)
+            a, b = values[nodes[e, seg]], values[nodes[e, seg + 1]]
+            xi = (x - seg).reshape((-1,) + (1,) * (values.ndim - 1))
+            out[self.point_index[rows]] = (1.0 - xi) * a + xi * b
         out[self.end_index] = values[self.end_node]
         return out
 
