@@ -57,12 +57,14 @@ def build():
     return truss()
 
 
-def deep_arch(n_elements=40):
+def deep_arch(n_elements=40, element=None):
     """Clamped-hinged circular arch (radius 100, 215 degrees), crown load ``(0, -1000 t, 0)``.
 
     ``EI = 1e6``, ``EA = GA = 100 EI`` (as in Kadapa 2021, Eng. Struct. 234, 111755), square-like
     section (``EI2 = EI3 = GJ``): the path stays in the plane.  Hinge at the first node (``rz``
-    free), clamp at the last.  Returns ``(model, crown node)``.
+    free), clamp at the last.  ``n_elements`` segments between nodes; ``element``: the element type
+    (``Model.add_beam``; ``"se3-3"``: ``n_elements / 2`` three-node elements).  Returns
+    ``(model, crown node)``.
     """
     sec = bs.Section(EA=100 * EI_ARCH, GA2=100 * EI_ARCH, GA3=100 * EI_ARCH, GJ=EI_ARCH, EI2=EI_ARCH,
                      EI3=EI_ARCH, radius=1.0)
@@ -72,10 +74,10 @@ def deep_arch(n_elements=40):
     G[:3, :3] = [[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]]
     G[:3, 3] = c - G[:3, :3] @ c
     m = bs.Model()
-    b = m.add_beam(G @ P, sec)
+    b = m.add_beam(G @ P, sec, element=element)
     m.fix(b.first, dofs=("ux", "uy", "uz", "rx", "ry"))
     m.clamp(b.last)
-    crown = int(b.nodes[n_elements // 2])
+    crown = int(b.nodes[len(b.nodes) // 2])
     m.add_load(crown, force=(0, -1000.0, 0))
     return m, crown
 
