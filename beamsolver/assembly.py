@@ -18,7 +18,7 @@ quadratic.
 import numpy as np
 import scipy.sparse as sp
 
-from . import assembly_jit, se3
+from . import assembly_jit, contributions, se3
 from . import blocks as _blocks
 from .errors import InputError
 from .se3 import skew
@@ -80,10 +80,6 @@ class System:
         self._build_loads(model)
         self._build_pattern()
         self._build_chains(model)
-        self.contact = None
-        if model.contacts:   # scenes without contact never import or run contact code
-            from .contact.system import ContactSystem
-            self.contact = ContactSystem(self)
         if check_rigid_modes:
             self._check_rigid_modes(model)
 
@@ -98,6 +94,7 @@ class System:
         """
         busy = set(self.members.tolist()) | set(self.rep[self.members].tolist())
         in_contact = {b.id for d in model.contacts for b in d.slave + d.master}
+        busy |= set(contributions.declared_nodes(model).tolist())   # user contributions: as contact
         chains = []
         for b in model.beams:
             if b.id in in_contact or any(int(i) in busy for i in b.nodes):

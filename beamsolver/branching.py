@@ -75,7 +75,7 @@ def _descend(run, t, H, K):
     direction = bifurcation.normalise(sys, bifurcation.full_increments(sys, phi[:, 0])).ravel()[sys.free_dofs]
 
     def evaluate(H):
-        ev = newton._evaluate(H, t)
+        ev = newton.evaluate(H, t)
         return ev.r[sys.free_dofs], problem.tangent(ev)
 
     def update(H, dzf):
@@ -108,7 +108,7 @@ def _bisect(run, t_a, t_b, at_b, above):
 
 def _state(run, t):
     """The equilibrium at ``t`` reached from the last recorded state: ``(H, ev, K, count, lowest)``."""
-    H, ev, _ = run._newton_step(t)
+    H, ev, _ = run.newton_step(t)
     K = run.problem.tangent(run.newton.last_evaluation)
     return (H, ev, K) + tuple(negative_eigenvalues(K))
 
@@ -147,7 +147,7 @@ def switch(run, stats, t, H, ev, K):
         record.update(critical_t=t_c, negative_before=at[3])
         stats.update(negative_eigenvalues=at[3], lowest_eigenvalue=at[4], stable=at[3] == 0, dt=t - run.t)
         H1, steps, lam = _descend(run, t, at[0], at[2])
-        H1, ev1, more = run._newton_step(t, start=H1)
+        H1, ev1, more = run.newton_step(t, start=H1)
         K1 = run.problem.tangent(run.newton.last_evaluation)
         neg, lowest = negative_eigenvalues(K1)
     except StepFailed as e:

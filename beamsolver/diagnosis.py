@@ -8,16 +8,16 @@ import numpy as np
 
 from .definiteness import negative_eigenvalues
 from .failures import DampingStalled, NotConverged, SingularTangent
-from .problem import Problem
 
 __all__ = ["nonfinite_source", "advice", "stiffness_spread", "ILL_CONDITIONED"]
 
 ILL_CONDITIONED = 1e10     # ratio of scaled diagonal stiffnesses called ill-conditioned
 
 
-def nonfinite_source(system, H, t):
-    """``(input, message)`` naming what makes the residual at poses ``H`` and time ``t``
-    non-finite (``input``: True when it is the user's input), or ``None`` if all is finite."""
+def nonfinite_source(problem, H, t):
+    """``(input, message)`` naming what makes the residual of ``problem`` at poses ``H`` and time
+    ``t`` non-finite (``input``: True when it is the user's input), or ``None`` if all is finite."""
+    system = problem.system
     bad = np.flatnonzero(~np.all(np.isfinite(H.reshape(len(H), -1)), axis=1))
     if len(bad):
         return True, f"the poses of nodes {bad[:10].tolist()} are not finite (initial_poses or a prescribed motion)"
@@ -37,13 +37,15 @@ def nonfinite_source(system, H, t):
         e = np.flatnonzero(~np.all(np.isfinite(f), axis=1))
         if len(e):
             return False, f"the internal forces of element {int(g.elements[e[0]])} are not finite"
-    if system.contact is not None:
-        rc = system.assemble_blocks(H, system.contact.evaluate(H, False)[0])[0]
+    for c in problem.contributions:
+        rc = system.assemble_blocks(H, c.evaluate(H, False)[0])[0]
         nodes = np.flatnonzero(~np.all(np.isfinite(rc.reshape(-1, 6)), axis=1))
-        if len(nodes):
+        if len(nodes) and c is problem.contact:
             decl = _contact_declaration(model, nodes)
             return True, (f"the contact forces of {decl} are not finite at nodes {nodes[:10].tolist()}: "
                           "do two beams share a centre line (no contact normal)?")
+        if len(nodes):
+            return True, f"the forces of contribution {c.name!r} are not finite at nodes {nodes[:10].tolist()}"
     return None
 
 
@@ -67,22 +69,22 @@ def stiffness_spread(system, K):
     return float(d.max() / d.min()) if len(d) and d.min() > 0 else np.inf
 
 
-def _tangent_state(system, H, t):
+def _tangent_state(problem, H, t):
     """``(negative eigenvalues, stiffness spread)`` of the tangent at ``H`` (``None`` if unknown)."""
     try:
-        problem = Problem(system)
         K = problem.tangent(problem.evaluate(H, t, tangent=True))
-        spread = stiffness_spread(system, K)
+        spread = stiffness_spread(problem.system, K)
         return (negative_eigenvalues(K)[0] if np.isfinite(spread) else None), spread
     except Exception:           # advice only: never hide the failure being reported
         return None, None
 
 
-def advice(failure, system, H, t):
-    """Advice for a ``ConvergenceError`` after ``failure`` from the converged state ``H`` at ``t``."""
+def advice(failure, problem, H, t):
+    """Advice for a ``ConvergenceError`` after ``failure`` of ``problem`` from the converged state
+    ``H`` at ``t``."""
     if not isinstance(failure, (NotConverged, DampingStalled, SingularTangent)):
         return ""
-    neg, cond = _tangent_state(system, H, t)
+    neg, cond = _tangent_state(problem, H, t)
     if isinstance(failure, SingularTangent):
         if cond is not None and cond > ILL_CONDITIONED:
             return (f"; the tangent is ill-conditioned (its diagonal stiffnesses, translations scaled by the "

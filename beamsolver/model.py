@@ -112,7 +112,8 @@ def _constant(value, what):
 
 
 class Model:
-    """A scene: ``add_beam``, ``clamp``, ``fix``, ``prescribe``, ``join``, ``add_load``, ``add_contact``."""
+    """A scene: ``add_beam``, ``clamp``, ``fix``, ``prescribe``, ``join``, ``add_load``, ``add_contact``,
+    ``add_contribution``."""
 
     def __init__(self):
         self.beams = []
@@ -123,6 +124,7 @@ class Model:
         self.joins = []           # (node_a, node_b)
         self.loads = []
         self.contacts = []
+        self.contributions = []   # user contributions (blocks.Contribution protocol), checked at solve
         self.free_nodes = []      # nodes created by add_node (no elements)
         self.fix_values = {}      # node -> {component: callable} prescribed global translations
 
@@ -395,6 +397,14 @@ class Model:
         decls = [ContactDeclaration([a], [b], mu, penalty, dict(options)) for a, b in pairs]
         self.contacts.extend(decls)
         return decls
+
+    def add_contribution(self, contribution):
+        """Add a physics contribution: an object with ``nodes`` (the node ids it acts on) and
+        ``evaluate(H, tangent)`` -> ``blocks.Blocks`` of local forces and tangents, optionally
+        ``name``, ``smooth``, ``conservative`` and the step life cycle of ``blocks.Contribution``.
+        It is checked when a problem is built (``solve``: ``contributions.checked``); returns it."""
+        self.contributions.append(contribution)
+        return contribution
 
     # ------------------------------------------------------------ summary
     def element_groups(self):

@@ -18,7 +18,8 @@ solver uses, and nothing else of the physics:
   iteration of an augmented Lagrangian), ``unmet(t)`` (why the step may not be
   accepted, or ``None``), ``commit(H)`` when it is accepted (returns the step's
   record of the contributions, e.g. the contact point table, or ``None``);
-- ``get_state()``/``set_state(state)``: the committed history (restart);
+- ``get_state()``/``set_state(state)``: the committed history (restart), keys
+  ``name/key`` per contribution;
 - ``smooth``: True when every contribution is smooth (the solver damps Newton on
   its correction), else the solver backtracks on the residual;
   ``conservative``: no follower loads and every contribution derives from a potential.
@@ -32,11 +33,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import contributions
 from .assembly import System
 
 __all__ = ["Problem", "Evaluation"]
 
 ALWAYS_TIMED = ("contact",)      # parts reported in the timings of every step, 0 when absent
+SEP = "/"                        # between a contribution's name and its own keys in ``get_state``
 
 
 @dataclass
@@ -56,19 +59,26 @@ class Evaluation:
 
 
 class Problem:
-    """Elements, loads and constraints of ``system`` plus ``contributions`` (default: the
-    system's contact, if any); see the module docstring for the protocol."""
+    """Elements, loads and constraints of ``system`` plus ``contributions`` (``Problem.from_model``
+    builds them from the model: contact, then the user's); see the module docstring for the protocol."""
 
-    def __init__(self, system, contributions=None):
+    def __init__(self, system, contributions=()):
         self.system = system
-        if contributions is None:
-            contributions = [] if system.contact is None else [system.contact]
         self.contributions = list(contributions)
         self._lf = (None, np.zeros(0))
 
     @classmethod
     def from_model(cls, model, check_rigid_modes=True):
-        return cls(System(model, check_rigid_modes=check_rigid_modes))
+        """The Problem of ``model``: its System, its contact (if declared) and its user contributions
+        (``Model.add_contribution``, checked: ``contributions.checked``)."""
+        user = contributions.checked(model)
+        system = System(model, check_rigid_modes=check_rigid_modes)
+        return cls(system, _contact(system) + user)
+
+    @property
+    def contact(self):
+        """The contact contribution (``contact.system.ContactSystem``), ``None`` without contact."""
+        return next((c for c in self.contributions if c.name == "contact"), None)
 
     # ------------------------------------------------------------ properties
     @property
@@ -158,12 +168,24 @@ class Problem:
         return record
 
     def get_state(self):
-        """Committed history of the contributions as one flat dict of arrays."""
-        out = {}
-        for c in self.contributions:
-            out.update(c.get_state())
-        return out
+        """Committed history of the contributions as one flat dict of arrays, keys ``name/key``
+        (``name`` the contribution's, ``key`` its own: equal keys of two contributions are kept apart)."""
+        return {f"{c.name}{SEP}{k}": v for c in self.contributions for k, v in c.get_state().items()}
 
     def set_state(self, state):
+        """Give every contribution its part of ``state`` (``get_state``), its own keys.  Keys without
+        ``/`` come from archives written before the keys were namespaced, which held only the contact
+        history: they go to the contribution named ``contact``."""
+        legacy = {k: v for k, v in state.items() if SEP not in k}
         for c in self.contributions:
-            c.set_state(dict(state))
+            prefix = c.name + SEP
+            part = {k[len(prefix):]: v for k, v in state.items() if k.startswith(prefix)}
+            c.set_state({**legacy, **part} if c.name == "contact" else part)
+
+
+def _contact(system):
+    """``[ContactSystem]`` for a model with contact declarations, else ``[]``."""
+    if not system.model.contacts:    # scenes without contact never import or run contact code
+        return []
+    from .contact.system import ContactSystem
+    return [ContactSystem(system)]

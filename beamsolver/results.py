@@ -87,8 +87,9 @@ class Solution:
     ``resume``: the stepping state after the last step (``t0``, ``t_end``,
     ``steps``, ``dt``, ``easy``, ``failed``, ``wait``: ``stepping.next_step``), used by
     ``solve(..., restart=)``;
-    ``contact_state``: committed contact history of the last step (dict of
-    arrays, empty without contact).  ``model`` and ``system`` are ``None`` for
+    ``contact_state``: committed history of the contributions (contact, ...) at the
+    last step (dict of arrays, keys ``name/key``: ``Problem.get_state``; empty
+    without any).  ``model`` and ``system`` are ``None`` for
     a loaded solution.
     """
 

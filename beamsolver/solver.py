@@ -4,8 +4,8 @@ Per step ``t -> t + dt``: loads are evaluated at ``t + dt``; the first
 iteration carries the prescribed motions into the free unknowns through the
 tangent (``K_ff dz_f = -r_f - K_fc dz_c``), later iterations are Newton
 ``K dz = -r``, damped on the size of the Newton correction for a smooth problem
-(``_Newton._damped``) and by a backtracking line search on the scaled residual
-otherwise (``_Newton._line_search``).  The physics is reached only through the
+(``Newton._damped``) and by a backtracking line search on the scaled residual
+otherwise (``Newton._line_search``).  The physics is reached only through the
 ``problem.Problem`` interface (residual, tangent, update, step life cycle).
 Elements may not turn by more than ``MAX_ELEMENT_ROTATION`` (nor pass pi
 within a step): such steps fail with a message saying how many elements the
@@ -30,9 +30,8 @@ from .stabilize import from_option as stabilize_option
 from .stepping import Run
 from .validation import check_solve_arguments, check_stability_options
 
-_StepFailed = StepFailed      # the base of the typed failures (``beamsolver.failures``)
 
-__all__ = ["solve", "Convergence"]
+__all__ = ["solve", "Convergence", "Newton"]
 
 log = logging.getLogger("beamsolver")
 
@@ -156,13 +155,15 @@ def _refine_advice(system, H, t, t_start, t_end):
     return "".join("; " + p for p in parts)
 
 
-class _Newton:
-    """Newton iterations of one step (``step``) on a ``problem.Problem``; ``timings`` accumulates
-    the wall time of ``assembly`` (residual, tangent, sparse matrix), of each of the problem's
-    contributions (``Problem.timing_names``, part of assembly) and ``linear_solve``
-    (factorisation and solves) until ``reset_timings``."""
+class Newton:
+    """Newton iterations of one step (``step``) on a ``problem.Problem`` with the ``Convergence``
+    ``conv``; ``evaluate`` is the checked, timed evaluation it uses (also for branch switching),
+    ``last_evaluation`` that of the last converged state.  ``timings`` accumulates the wall time
+    of ``assembly`` (residual, tangent, sparse matrix), of each of the problem's contributions
+    (``Problem.timing_names``, part of assembly) and ``linear_solve`` (factorisation and solves)
+    until ``reset_timings``."""
 
-    def __init__(self, problem, conv, line_search, callback):
+    def __init__(self, problem, conv, line_search=True, callback=None):
         self.problem = problem
         self.sys = system = problem.system
         self.conv = conv
@@ -206,7 +207,7 @@ class _Newton:
                                 f"(limit MAX_ELEMENT_ROTATION = {limit[worst] / np.pi:.2g} pi = "
                                 f"{limit[worst]:.4f} rad; an element cannot turn by pi): refine the mesh")
 
-    def _check_continuity(self, H0, H1):
+    def check_continuity(self, H0, H1):
         """Refuse a step over which an element's relative rotation may have passed through pi.
 
         The element only sees ``log(H_A^-1 H_B)``, whose angle lies in ``[0, pi]``: an element
@@ -255,7 +256,9 @@ class _Newton:
             raise SingularTangent("the linear solve returned non-finite values")
         return lu, dzf
 
-    def _evaluate(self, H, t, tangent=True):
+    def evaluate(self, H, t, tangent=True):
+        """``Problem.evaluate`` timed into ``timings`` and checked (finite residual, element rotations
+        below ``MAX_ELEMENT_ROTATION``: ``NonFinite`` / ``RotationLimit``)."""
         t0 = time.perf_counter()
         ev = self.problem.evaluate(H, t, tangent=tangent)
         self.timings["assembly"] += time.perf_counter() - t0
@@ -315,7 +318,7 @@ class _Newton:
         stats_extra = {}
         for it in range(conv.max_iter + 1):
             if ahead is None:
-                ev = self._evaluate(H, t)
+                ev = self.evaluate(H, t)
                 lu = dzf = None
             else:
                 ev, lu, dzf = ahead
@@ -328,7 +331,7 @@ class _Newton:
                 self.callback(dict(t=t, iteration=it, residual=ratio, poses=H))
             verdict = conv.decide(ratio, last_inc, it, floor, final=dz_c is None)
             if verdict == CONVERGED:
-                self._check_continuity(H_start, H)
+                self.check_continuity(H_start, H)
                 if damped_its:
                     stats_extra["damped"] = damped_its
                 self.last_evaluation = ev     # of the converged state (its tangent: stability check)
@@ -413,7 +416,7 @@ class _Newton:
             self.stall_ratio = np.inf
             H1 = problem.update(H, lam * dz)
             try:
-                ev1 = self._evaluate(H1, t)
+                ev1 = self.evaluate(H1, t)
                 if self._ratio(ev1.r, conv.scales(ev1, self.L_ref)) <= conv.rtol:
                     return H1, lam, (ev1, None, None), None
                 lu1, d1 = self._direction(ev1)
@@ -445,7 +448,7 @@ class _Newton:
         best = (np.inf, H1)
         for _ in range(8):
             try:
-                phi = self._merit(self._evaluate(H1, t, tangent=False).r, scales)
+                phi = self._merit(self.evaluate(H1, t, tangent=False).r, scales)
             except StepFailed:
                 phi = np.inf
             if phi < best[0]:
@@ -577,13 +580,13 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     grid = np.linspace(t_start, t_end, int(steps) + 1)
     dt_min = _step_floor(min_step_ratio, grid)
     conv = Convergence(rtol=rtol, dtol=dtol, max_iter=max_iter)
-    newton = _Newton(problem, conv, line_search, callback)
+    newton = Newton(problem, conv, line_search, callback)
     newton.linsolver = linsolve.Solver(linear_solver)
     modes, branch_switching = check_stability_options(modes, branch_switching)
     stabilizer = stabilize_option(system, stabilize, check=problem.conservative)
     if stabilizer is not None:
         problem.contributions.append(stabilizer)
-    options = dict(allow_unmet_tolerance=allow_unmet_tolerance, advice=_advice(system, t_start, t_end),
+    options = dict(allow_unmet_tolerance=allow_unmet_tolerance, advice=_advice(problem, t_start, t_end),
                    check_stability=bool(check_stability or modes or branch_switching), modes=modes,
                    branch_switching=branch_switching, stabilizer=stabilizer)
     run = None
@@ -631,8 +634,10 @@ def _writer(output, system, checkpoint):
     return StepWriter(output, system, checkpoint=checkpoint)
 
 
-def _advice(system, t_start, t_end):
+def _advice(problem, t_start, t_end):
     """``advice(failure, rotation_limit, H, t)``: the tail of a ``ConvergenceError`` message."""
+    system = problem.system
+
     def advice(failure, rotation_limit, H, t):
         msg = str(failure)
         hint = "" if rotation_limit is None or rotation_limit == msg else \
@@ -644,6 +649,6 @@ def _advice(system, t_start, t_end):
         if failure.rotation or rotation_limit is not None or turned > 0.75 * MAX_ELEMENT_ROTATION:
             hint += _refine_advice(system, H, t, t_start, t_end)
         if not hint:
-            hint = diagnosis.advice(failure, system, H, t)
+            hint = diagnosis.advice(failure, problem, H, t)
         return hint
     return advice

@@ -128,7 +128,7 @@ class Run:
             t0 = time.perf_counter()
             self.H, self.t = H0, None
             try:
-                H, ev0, stats = self._newton_step(t_start)
+                H, ev0, stats = self.newton_step(t_start)
             except StepFailed as e:
                 self.sol.converged, self.sol.message = False, str(e)
                 err = ConvergenceError(f"solve: no equilibrium at t_start = {t_start:.6g}, where loads or motions "
@@ -151,7 +151,7 @@ class Run:
 
     def _name_nonfinite(self, t):
         """A non-finite residual from the user's input (a load scale or motion at ``t``): InputError."""
-        found = diagnosis.nonfinite_source(self.sys, self.H, t)
+        found = diagnosis.nonfinite_source(self.problem, self.H, t)
         if found is not None and found[0]:
             raise InputError(f"solve: at t = {t:.6g} {found[1]}")
 
@@ -159,7 +159,7 @@ class Run:
         """Never record a non-finite state: name the input behind it (``InputError``) or fail."""
         if np.all(np.isfinite(r)) and np.all(np.isfinite(H)) and np.all(np.isfinite(state.sigma)):
             return
-        found = diagnosis.nonfinite_source(self.sys, H, t)
+        found = diagnosis.nonfinite_source(self.problem, H, t)
         if found is not None and found[0]:
             raise InputError(f"solve: at t = {t:.6g} {found[1]}")
         raise NonFinite(f"non-finite state at t = {t:.6g}" + (f": {found[1]}" if found else ""))
@@ -189,7 +189,7 @@ class Run:
                            rotation_limit)
             self.newton.reset_timings()
             try:
-                H, ev, stats = self._newton_step(t_try)
+                H, ev, stats = self.newton_step(t_try)
                 self._check_finite(H, ev.r, ev.state, t_try)
                 stats.update(cutbacks=cutbacks, timings=dict(self.newton.timings))
                 if failed_sizes:
@@ -214,7 +214,7 @@ class Run:
                 t_next = t + h
                 self.easy = 0
 
-    def _newton_step(self, t_next, start=None):
+    def newton_step(self, t_next, start=None):
         """Newton at ``t_next`` (from the last converged state, or from ``start`` at ``t_next``),
         repeated while the problem asks to re-solve the step (outer iterations, e.g.
         augmented-Lagrangian updates); refused or warned if ``Problem.unmet``."""

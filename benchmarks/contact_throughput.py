@@ -28,7 +28,7 @@ single_thread()
 import numpy as np  # noqa: E402
 
 import beamsolver as bs  # noqa: E402
-from beamsolver.assembly import System  # noqa: E402
+from beamsolver.problem import Problem  # noqa: E402
 from beamsolver.contact import kernel_jit, pairs  # noqa: E402
 from beamsolver.contact.system import use_numpy_kernel  # noqa: E402
 
@@ -45,10 +45,10 @@ def scene(n_points, gauss_points=5, mu=0.3):
     m.clamp(master.first)
     m.clamp(slave.first)
     m.add_contact(slave, master, mu=mu, gauss_points=gauss_points)
-    system = System(m, check_rigid_modes=False)
-    H = system.poses0.copy()
-    system.contact.commit(H)          # friction history for every point
-    return system, H
+    contact = Problem.from_model(m, check_rigid_modes=False).contact
+    H = contact.sys.poses0.copy()
+    contact.commit(H)          # friction history for every point
+    return contact, H
 
 
 def _best(fn, repeat):
@@ -63,8 +63,7 @@ def _best(fn, repeat):
 
 
 def measure(n_points, oracle_max=10_000):
-    system, H = scene(n_points)
-    c = system.contact
+    c, H = scene(n_points)
     repeat = 3 if n_points <= 10_000 else 1
     t_search = _best(lambda: c.pairs(H), repeat)
     P = c.pairs(H)

@@ -166,11 +166,11 @@ def _maxrss_mb():
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
-def contact_parts(system, H, tangent=True):
+def contact_parts(problem, H, tangent=True):
     """One contact evaluation and its assembly (``System.assemble_blocks``) with its stages timed;
     returns (rc, coo, info, times)."""
     import beamsolver.contact.system as cs
-    c = system.contact
+    system, c = problem.system, problem.contact
     acc = dict(contact_search=0.0, contact_kernels=0.0)
     seen = {}
 
@@ -303,18 +303,19 @@ def replicated_contact(system, wires, per_wire, unit=None):
     """Contact COO of the long bundle from the interior lay of a 1.5-lay one (see module docstring)."""
     import scipy.sparse as sp
 
-    from beamsolver.assembly import System
+    from beamsolver.problem import Problem
     if unit is None:
         um, uw = bundle_model(UNIT)
-        us = System(um)
+        up = Problem.from_model(um)
+        us = up.system
         cache = os.environ.get("SCALING_UNIT_CACHE")
         if cache and os.path.exists(cache):
             z = np.load(cache)
             coo = (z["rows"], z["cols"], z["vals"])
         else:
             H = us.poses0.copy()
-            us.contact.begin_step(H, 0.0)
-            _, coo, _, _ = us.assemble_blocks(H, us.contact.evaluate(H, tangent=True)[0])
+            up.contact.begin_step(H, 0.0)
+            _, coo, _, _ = us.assemble_blocks(H, up.contact.evaluate(H, tangent=True)[0])
             if cache:
                 np.savez(cache, rows=coo[0], cols=coo[1], vals=coo[2])
         unit = (us, uw, coo)
@@ -362,7 +363,7 @@ def measure_bundle(n, cap, predicted_contact, skip=()):
     out["contact_measured"] = bool(real)
     problem.begin_step(H, 0.0)
     if real:
-        rc, coo, cinfo, ct = contact_parts(system, H)
+        rc, coo, cinfo, ct = contact_parts(problem, H)
         out.update(ct)
         out["contact_points"] = int(cinfo.get("n_active", 0))
         out["contact_candidates"] = int(cinfo.get("candidates", -1))

@@ -11,7 +11,7 @@
 import numpy as np
 
 import beamsolver as bs
-from beamsolver.assembly import System
+from beamsolver.problem import Problem
 
 
 def test_crossing_at_a_kink_node_keeps_its_contact_point():
@@ -46,7 +46,7 @@ def _master_node_under_a_gauss_point(lift):
     m.clamp(master.first)
     m.clamp(slave.first)
     m.add_contact(slave, master)
-    return System(m, check_rigid_modes=False), slave
+    return Problem.from_model(m, check_rigid_modes=False), slave
 
 
 def _shift(system, nodes, dx):
@@ -56,8 +56,8 @@ def _shift(system, nodes, dx):
 
 
 def test_gauss_point_on_a_shared_master_node_has_one_stable_owner():
-    system, slave = _master_node_under_a_gauss_point(lift=1e-4)
-    cs = system.contact
+    problem, slave = _master_node_under_a_gauss_point(lift=1e-4)
+    system, cs = problem.system, problem.contact
     owners, forces = [], []
     for dx in (2e-11, -2e-11, 2e-11, -2e-11):
         H = _shift(system, slave.nodes, dx)

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
+from beamsolver.problem import Problem
 from beamsolver import se3
-from beamsolver.assembly import System
 from beamsolver.contact.pairs import PENALTY_T_MIN
 from beamsolver.errors import InputError
 
@@ -21,18 +21,18 @@ def _crossing(depth, **options):
     m.clamp(master.first)
     m.clamp(slave.first)
     m.add_contact(slave, master, mu=MU, **options)
-    system = System(m, check_rigid_modes=False)
-    H = system.poses0.copy()
-    system.contact.commit(H)                 # friction history at the start
-    return system, H, slave
+    problem = Problem.from_model(m, check_rigid_modes=False)
+    H = problem.system.poses0.copy()
+    problem.contact.commit(H)                 # friction history at the start
+    return problem, H, slave
 
 
-def _slide(system, H, slave, s):
+def _slide(problem, H, slave, s):
     G = se3.exp(np.array([s, 0, 0, 0, 0, 0.0]))
     H = H.copy()
     H[slave.nodes] = se3.compose(np.broadcast_to(G, (len(slave.nodes), 4, 4)), H[slave.nodes])
-    system.contact.commit(H)
-    return system.contact.results(H)
+    problem.contact.commit(H)
+    return problem.contact.results(H)
 
 
 @pytest.mark.parametrize("depth,fraction", [(1e-2 * R, f) for f in (0.25, 0.5, 0.9, 0.99, 1.01, 1.5, 4.0)]
@@ -40,9 +40,9 @@ def _slide(system, H, slave, s):
 def test_sliding_starts_at_the_elastic_slip(depth, fraction):
     """Above the floor's traction ``lam_min = PENALTY_T_MIN penalty es`` (here 20 N/m, the
     traction of a 4e-5 R penetration) sliding starts at the elastic slip ``es`` exactly."""
-    system, H, slave = _crossing(depth)
+    problem, H, slave = _crossing(depth)
     es = 0.005 * 0.4                         # slip tolerance x slave element length
-    res = _slide(system, H, slave, fraction * es)
+    res = _slide(problem, H, slave, fraction * es)
     on = res["normal_force"] > 0
     assert on.sum() == 1
     lam_n = res["normal_force"][on] / res["weight"][on]
@@ -58,10 +58,10 @@ def test_sliding_starts_at_the_elastic_slip(depth, fraction):
 
 def test_measured_stick_slope_is_mu_normal_force_over_the_elastic_slip():
     """d|F_T|/ds of a sticking point = mu N / (slip_tolerance L_e), N the point's normal force."""
-    system, H, slave = _crossing(1e-3 * R)
+    problem, H, slave = _crossing(1e-3 * R)
     es = 0.005 * 0.4
     s1, s2 = 0.1 * es, 0.3 * es
-    f1, f2 = (_slide(system, H, slave, s) for s in (s1, s2))
+    f1, f2 = (_slide(problem, H, slave, s) for s in (s1, s2))
     on = f1["normal_force"] > 0
     slope = (np.linalg.norm(f2["tangential_force"][on]) - np.linalg.norm(f1["tangential_force"][on])) / (s2 - s1)
     np.testing.assert_allclose(slope, MU * f1["normal_force"][on] / es, rtol=1e-3)
@@ -70,10 +70,10 @@ def test_measured_stick_slope_is_mu_normal_force_over_the_elastic_slip():
 def test_below_the_floor_the_stiffness_is_held():
     """A just-touching point (lam_N < lam_min) keeps the stiffness ``mu lam_min / es`` and
     slides at the smaller slip ``es lam_N / lam_min`` (documented in stick_penalty)."""
-    system, H, slave = _crossing(1e-6 * R)
+    problem, H, slave = _crossing(1e-6 * R)
     es = 0.005 * 0.4
     s = 0.01 * es
-    res = _slide(system, H, slave, s)
+    res = _slide(problem, H, slave, s)
     on = res["normal_force"] > 0
     lam_n = res["normal_force"][on] / res["weight"][on]
     lam_min = PENALTY_T_MIN * 1e7 * es
@@ -83,9 +83,9 @@ def test_below_the_floor_the_stiffness_is_held():
 
 
 def test_explicit_penalty_t_overrides_the_slip_tolerance():
-    system, H, slave = _crossing(1e-2 * R, penalty_t=1e3)
+    problem, H, slave = _crossing(1e-2 * R, penalty_t=1e3)
     s = 1e-5
-    res = _slide(system, H, slave, s)
+    res = _slide(problem, H, slave, s)
     on = res["normal_force"] > 0
     w = res["weight"][on]
     assert res["stick"][on].all()

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
-from beamsolver.assembly import System
+from beamsolver.problem import Problem
 from beamsolver.contact.options import SLIP_TOLERANCE, SMOOTHING, ContactOptions
 
 
@@ -39,7 +39,7 @@ def test_the_contact_system_reads_the_object():
     m.clamp(a.first)
     m.clamp(b.first)
     m.add_contact(b, a, gauss_points=3, margin=0.2)
-    d = System(m, check_rigid_modes=False).contact.decls[0]
+    d = Problem.from_model(m, check_rigid_modes=False).contact.decls[0]
     assert d.options == ContactOptions(gauss_points=3, margin=0.2)
     assert (d.n_gp, d.margin) == (3, 0.2)
 
@@ -53,8 +53,9 @@ def test_the_search_returns_one_typed_pair_record():
     c = m.add_beam(bs.geometry.straight((-1, 0.3, 0.1), (1, 0.3, 0.1), 3), sec)   # crossing, touching
     m.clamp(a.first)
     m.add_contact([b, c], a)
-    system = System(m, check_rigid_modes=False)
-    P = system.contact.pairs(system.poses0)
+    problem = Problem.from_model(m, check_rigid_modes=False)
+    system = problem.system
+    P = problem.contact.pairs(system.poses0)
     assert isinstance(P, PairSet) and len(P) == 2
     assert set(P.e.tolist()) == {b.elements[1], c.elements[1]} and set(P.m.tolist()) <= set(a.elements.tolist())
     np.testing.assert_array_equal(P.nodes[:, :2], system.enodes[P.e])
@@ -73,7 +74,7 @@ def test_default_smoothing_only_for_line_contact():
     m.clamp(a.first)
     m.add_contact([line, cross], a)
     m.add_contact(line, cross, smoothing=1e-3)
-    cs = System(m, check_rigid_modes=False).contact
+    cs = Problem.from_model(m, check_rigid_modes=False).contact
     P = cs.pairs(cs.sys.poses0)
     w = cs._smoothing(P, slice(None))
     from beamsolver.contact.pairs import LINE, POINT

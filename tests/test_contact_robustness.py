@@ -55,11 +55,12 @@ def test_intersecting_centre_lines_name_the_pair():
 
 
 def test_tunnelling_is_a_typed_step_failure_naming_the_pair():
-    from beamsolver.assembly import System
+    from beamsolver.problem import Problem
     from beamsolver.failures import ContactTunnelling
     m, slave, master = _pushed_crossing(6.5 * R, height=2.5 * R)
-    system = System(m)
-    cs = system.contact
+    problem = Problem.from_model(m)
+    system = problem.system
+    cs = problem.contact
     H = system.poses0.copy()
     cs.begin_step(H, 1.0)
     H[slave.nodes, 2, 3] -= 6.5 * R                     # the slave's centre line now under the master's

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
-from beamsolver.assembly import System
+from beamsolver.problem import Problem
 from beamsolver.contact.pairs import LINE, ORTHOGONAL, POINT
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
@@ -113,8 +113,8 @@ def _pair_kinds(angle_deg, wrap=False, **options):
                                  0.1 * np.array([0, 0, 1.0]) + 0.7 * d + [0.1, 0, 0], 3)
     slave = m.add_beam(P, sec)
     m.add_contact(slave, master, **options)
-    s = System(m, check_rigid_modes=False)
-    P = s.contact.pairs(s.poses0)
+    problem = Problem.from_model(m, check_rigid_modes=False)
+    P = problem.contact.pairs(problem.system.poses0)
     return set(P.kind.tolist())
 
 

@@ -12,7 +12,6 @@ import pytest
 
 import beamsolver as bs
 from beamsolver import se3
-from beamsolver.assembly import System
 from beamsolver.problem import Problem
 from beamsolver.contact.pairs import LINE, ORTHOGONAL, POINT
 
@@ -66,9 +65,10 @@ def _move(H, nodes, G):
     return H
 
 
-def _towards_master(system, H, slave, master, depth):
+def _towards_master(problem, H, slave, master, depth):
     """Translate the slave so that its closest contact point penetrates by ``depth``."""
-    P = system.contact.pairs(H)
+    system = problem.system
+    P = problem.contact.pairs(H)
     from beamsolver.contact.system import _interp_pos
     xC = _interp_pos(H, system.enodes, P.e, P.xi1)
     xF = _interp_pos(H, system.enodes, P.m, P.xi2)
@@ -81,8 +81,8 @@ def _towards_master(system, H, slave, master, depth):
     return _move(H, slave.nodes, G)
 
 
-def _fd_error(system, H, eps=1e-7):
-    problem = Problem(system)
+def _fd_error(problem, H, eps=1e-7):
+    system = problem.system
     ev = problem.evaluate(H, 0.0, tangent=True)
     K = problem.full_tangent(ev).toarray()
     free = system.free_dofs
@@ -109,32 +109,32 @@ def _state(scene, regime):
     build, kind = SCENES[scene]
     mu = {"open": 0.3, "frictionless": 0.0, "stick": 0.5, "slip": 0.1, "stick_new": 0.5}[regime]
     model, slave, master, axis = build(mu)
-    system = System(model, check_rigid_modes=False)
-    H = system.poses0.copy()
+    problem = Problem.from_model(model, check_rigid_modes=False)
+    H = problem.system.poses0.copy()
     depth = -1e-3 * R if regime == "open" else 2e-3 * R
-    H = _towards_master(system, H, slave, master, depth)
+    H = _towards_master(problem, H, slave, master, depth)
     if regime == "stick_new":
-        system.contact.begin_step(H, 0.0)             # no history: it starts from the step's poses
+        problem.contact.begin_step(H, 0.0)             # no history: it starts from the step's poses
     else:
-        system.contact.commit(H)                      # friction history at H
+        problem.contact.commit(H)                      # friction history at H
     # then slide the slave (and turn it a little): within the cone, or far beyond the
     # elastic slip (0.005 of the slave element length, at most 0.04 R here) for "slip"
     slide = {"open": 1e-4, "frictionless": 1e-3, "stick": 1e-6, "slip": 0.08, "stick_new": 1e-6}[regime] * R
     G = se3.exp(np.concatenate([slide * axis + [0, slide, 0], [slide, 0.0, 0.5 * slide]]))
     H = _move(H, slave.nodes, G)
-    return system, H, kind
+    return problem, H, kind
 
 
 @pytest.mark.parametrize("regime", ["open", "frictionless", "stick", "slip", "stick_new"])
 @pytest.mark.parametrize("scene", ["line", "orthogonal", "point"])
 def test_contact_tangent_matches_finite_differences(scene, regime):
-    system, H, kind = _state(scene, regime)
-    P = system.contact.pairs(H)
+    problem, H, kind = _state(scene, regime)
+    P = problem.contact.pairs(H)
     assert set(P.kind.tolist()) == {kind}
-    err, cinfo = _fd_error(system, H)
+    err, cinfo = _fd_error(problem, H)
     # the regime is the one asked for
-    system.contact.commit(H)
-    res = system.contact.results(H)
+    problem.contact.commit(H)
+    res = problem.contact.results(H)
     if regime == "open":
         assert np.all(res["normal_force"] == 0.0) and np.all(res["gap"] > 0)
     else:

@@ -234,18 +234,19 @@ def test_a_step_through_pi_of_the_mid_pair_is_refused():
     """The continuity check reads every logarithm pair of the type: a 3-node element whose
     mid node turns from 0.7 pi to 1.3 pi within one step is refused, naming the element."""
     from beamsolver import solver
+    from beamsolver.failures import RotationLimit
     m = bs.Model()
     bs_ = [m.add_beam(geometry.straight((0, y, 0), (1, y, 0), 2), SEC, element="se3-3") for y in (0.0, 1.0)]
     for b in bs_:
         m.clamp(b.first)
     from beamsolver.problem import Problem
-    newton = solver._Newton(Problem.from_model(m), solver.Convergence(), True, None)
+    newton = solver.Newton(Problem.from_model(m), solver.Convergence(), True, None)
 
     def poses(angle):
         H = m.poses0.copy()
         H[4, :3, :3] = se3.exp_so3([0.0, 0.0, angle])        # mid node of the second element
         return H
     assert len(newton.sys.rotation_pairs) == 4
-    newton._check_continuity(poses(0.7 * np.pi), poses(0.75 * np.pi))
-    with pytest.raises(solver._StepFailed, match="element 1 .*may have passed pi"):
-        newton._check_continuity(poses(0.7 * np.pi), poses(1.3 * np.pi))
+    newton.check_continuity(poses(0.7 * np.pi), poses(0.75 * np.pi))
+    with pytest.raises(RotationLimit, match="element 1 .*may have passed pi"):
+        newton.check_continuity(poses(0.7 * np.pi), poses(1.3 * np.pi))

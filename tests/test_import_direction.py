@@ -25,8 +25,8 @@ LAYER = {
     "blocks": 2, "contact": 2, "contact.law": 2, "contact.kinematics": 2,
     "contact.pairs": 2, "contact.search": 2, "contact.kernel_jit": 2, "contact.options": 2, "contact.record": 2,
     # 3: model declarations and their assembly
-    "model": 3, "cables": 3, "assembly": 3, "stabilize": 3, "topology": 1, "assembly_jit": 3, "contact.system": 3,
-    "linsolve": 3, "bifurcation": 3,
+    "model": 3, "contributions": 3, "cables": 3, "assembly": 3, "stabilize": 3, "topology": 1, "assembly_jit": 3,
+    "contact.system": 3, "linsolve": 3, "bifurcation": 3,
     # 4: the Problem interface between the solver and the physics
     "problem": 4,
     # 5: results
@@ -144,5 +144,5 @@ def test_the_walk_sees_known_edges():
     pairs = {(a, b) for a, b, _ in edges}
     assert {("elements.se3_2", "element"), ("element", "se3"), ("solver", "problem"), ("problem", "assembly"),
             ("results", "io.archive"),
-            ("contact.pairs", "se3"), ("assembly", "contact.system"), ("", "solver")} <= pairs
+            ("contact.pairs", "se3"), ("problem", "contact.system"), ("", "solver")} <= pairs
     assert _cycle([("a", "b", False), ("b", "c", True), ("c", "a", True)]) is not None

@@ -135,3 +135,25 @@ def test_restart_continues_a_solution_object_and_checks_the_model():
     other, _ = cantilever(n_elements=3)
     with pytest.raises(bs.InputError, match="does not belong"):
         bs.solve(other, steps=4, restart=half)
+
+
+def test_restart_reads_archives_with_the_contact_state_not_namespaced(tmp_path):
+    """Archives written before ``Problem.get_state`` namespaced its keys (``contact_state/<key>``, the
+    contact history alone) restart exactly as the namespaced ones (``contact_state/contact/<key>``)."""
+    model, slave, _ = rolling.build(mu=0.5, n_elements=3)
+    full = bs.solve(model, steps=4)
+    model, slave, _ = rolling.build(mu=0.5, n_elements=3)
+    with pytest.raises(_Stop):
+        bs.solve(model, steps=4, output=tmp_path, checkpoint=0, callback=_stop_after(0.6))
+    with np.load(tmp_path / "solution.npz") as z:
+        arrays = dict(z)
+    keys = [k for k in arrays if k.startswith("contact_state/")]
+    assert keys and all(k.startswith("contact_state/contact/") for k in keys)
+    for k in keys:                                    # the layout of the archives written before
+        arrays["contact_state/" + k[len("contact_state/contact/"):]] = arrays.pop(k)
+    np.savez_compressed(tmp_path / "old.npz", **arrays)
+    assert bs.load(tmp_path / "old.npz").contact_state.keys() >= {"history.key", "prev_owners"}
+    model, slave, _ = rolling.build(mu=0.5, n_elements=3)
+    rest = bs.solve(model, steps=4, restart=tmp_path / "old.npz")
+    np.testing.assert_array_equal(rest.poses[-1], full.poses[-1])
+    np.testing.assert_array_equal(rest.contact()["tangential_force"], full.contact()["tangential_force"])

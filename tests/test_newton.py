@@ -133,7 +133,7 @@ def test_joined_roll_up_smaller_moment_is_quadratic():
 def test_joined_roll_up_with_line_search_converges_in_a_few_iterations():
     """The first Newton iterate raises the residual a lot (axial forces after a large rotation
     increment); the damped Newton accepts it because the Newton correction there is smaller
-    (``solver._Newton._damped``), as plain Newton would (4 iterations; the residual line search
+    (``solver.Newton._damped``), as plain Newton would (4 iterations; the residual line search
     it replaced took 22, and 7 with its natural-monotonicity test)."""
     model, _ = _joined_roll_up(fraction=0.05)
     sol = bs.solve(model, steps=1, max_iter=15, min_step_ratio=0.5)

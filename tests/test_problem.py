@@ -163,9 +163,9 @@ def test_life_cycle_outer_iteration_commit_and_globalisation():
     problem, spring = _problem(k=50.0)
     assert problem.smooth and problem.conservative
     assert Problem(problem.system, []).get_state() == {} and problem.timing_names == ("contact", "spring")
-    from beamsolver.solver import Convergence, _Newton
+    from beamsolver.solver import Convergence, Newton
     from beamsolver.stepping import Run
-    newton = _Newton(problem, Convergence(), True, None)
+    newton = Newton(problem, Convergence(), True, None)
     grid = np.linspace(0.0, 1.0, 3)
     run = Run(problem, newton, None, grid, 1e-3, False, dict(advice=lambda *a: ""))
     run.start(None, None)
@@ -183,10 +183,10 @@ def test_outer_iterations_are_bounded():
     """A contribution that always asks to re-solve the step: a typed failure after MAX_OUTER."""
     from beamsolver import failures, stepping
     from beamsolver.errors import ConvergenceError
-    from beamsolver.solver import Convergence, _Newton
+    from beamsolver.solver import Convergence, Newton
     problem, spring = _problem(k=50.0)
     spring.repeat_step = lambda H: True
-    run = stepping.Run(problem, _Newton(problem, Convergence(), True, None), None, np.linspace(0.0, 1.0, 2),
+    run = stepping.Run(problem, Newton(problem, Convergence(), True, None), None, np.linspace(0.0, 1.0, 2),
                        1e-3, False, dict(advice=lambda *a: ""))
     run.start(None, None)
     with pytest.raises(ConvergenceError) as err:
@@ -257,3 +257,52 @@ def test_contact_tangent_at_a_global_type_node_matches_finite_differences(monkey
                                                                    + (np.zeros(0),)))
     K_without = problem.tangent(problem.evaluate(H, 0.0)).toarray()[:, cols]
     assert rel_err(K_without, fd) > 10 * rel_err(K, fd), (rel_err(K_without, fd), rel_err(K, fd))
+
+
+def test_problem_owns_the_contact_contribution():
+    """``System`` knows elements, loads and constraints only; ``Problem.from_model`` builds contact and
+    shows it read-only as ``Problem.contact`` (``None`` without contact)."""
+    from beamsolver.contact.system import ContactSystem
+    m, b1, b2, extra = _model()
+    assert Problem.from_model(m, check_rigid_modes=False).contact is None
+    m.add_contact(b2, b1)
+    problem = Problem.from_model(m, check_rigid_modes=False)
+    assert isinstance(problem.contact, ContactSystem) and problem.contributions == [problem.contact]
+    assert problem.contact.sys is problem.system and not hasattr(problem.system, "contact")
+    with pytest.raises(AttributeError):
+        problem.contact = None
+    assert Problem(problem.system).contributions == []
+    assert "contact" not in _names(PACKAGE / "assembly.py") - {"contacts", "in_contact"}
+
+
+class _Counter(Contribution):
+    """No forces; a committed count under the key ``n`` (the same key in every instance)."""
+
+    def __init__(self, name):
+        self.name, self.n = name, 0
+
+    def evaluate(self, H, tangent=True):
+        return Blocks.empty(1, tangent), {}
+
+    def commit(self, H):
+        self.n += 1
+
+    def get_state(self):
+        return dict(n=np.array(self.n))
+
+    def set_state(self, state):
+        self.n = int(state["n"])
+
+
+def test_state_of_contributions_with_equal_keys_is_kept_apart():
+    m, *_ = _model()
+    system = System(m, check_rigid_modes=False)
+    a, b = _Counter("a"), _Counter("b")
+    problem = Problem(system, [a, b])
+    problem.commit(system.poses0)
+    a.commit(system.poses0)
+    state = problem.get_state()
+    assert set(state) == {"a/n", "b/n"} and (int(state["a/n"]), int(state["b/n"])) == (2, 1)
+    a2, b2 = _Counter("a"), _Counter("b")
+    Problem(system, [a2, b2]).set_state(state)
+    assert (a2.n, b2.n) == (2, 1)

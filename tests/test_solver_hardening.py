@@ -251,10 +251,12 @@ def test_failure_advice_reads_the_tangent():
     """A failure after an unstable equilibrium says the tangent is indefinite (a limit point or
     bifurcation), not "lower min_step_ratio"; after a stable one it says it is positive definite."""
     from beamsolver import diagnosis
+    from beamsolver.problem import Problem
     for factor, expect in ((2.0, "already indefinite"), (0.5, "positive definite")):
         model = _column(factor)
         sol = bs.solve(model, steps=1, verbose=False)
-        advice = diagnosis.advice(failures.NotConverged("no convergence"), sol.system, sol.poses[-1], 1.0)
+        problem = Problem.from_model(model)
+        advice = diagnosis.advice(failures.NotConverged("no convergence"), problem, sol.poses[-1], 1.0)
         assert expect in advice and ("min_step_ratio" in advice) == (factor < 1)
 
 
@@ -272,10 +274,12 @@ def _two_stiffnesses(ratio, unit=1.0):
 
 def test_singular_tangent_advice_tells_ill_conditioning_from_a_free_mode():
     from beamsolver import diagnosis
+    from beamsolver.problem import Problem
     from beamsolver.assembly import System
     for ratio, expect in ((1.0, "rigid-body mode"), (1e12, "ill-conditioned")):
-        system = System(_two_stiffnesses(ratio))
-        assert expect in diagnosis.advice(failures.SingularTangent("singular"), system, system.poses0, 0.0)
+        problem = Problem.from_model(_two_stiffnesses(ratio))
+        H0 = problem.system.poses0
+        assert expect in diagnosis.advice(failures.SingularTangent("singular"), problem, H0, 0.0)
     # units do not change the estimate: the same scene in millimetres
     spread = []
     for unit in (1.0, 1e3):

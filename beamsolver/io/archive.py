@@ -20,7 +20,8 @@ key                    content
 ``model/<name>``       ``results.describe_model`` arrays (poses0, enodes, radii, ...)
 ``contact/<key>``      per-step contact tables, concatenated along axis 0, with
 ``contact_count/<key>`` ``(s,)`` rows per step (-1: the step has no such key)
-``contact_state/<k>``  committed contact history of the last step (restart)
+``contact_state/<k>``  committed history of the last step (restart), ``<k>`` = ``name/key`` per
+                       contribution (``Problem.get_state``; older archives: contact keys alone)
 =====================  ===============================================================
 
 Floats are stored in binary (``poses``, ...) or as shortest-repr JSON

@@ -135,7 +135,7 @@ class StepWriter:
         self.refine = refine
         self.compression = compression
         if contact is None and system is not None:
-            contact = system.contact is not None
+            contact = bool(system.model.contacts)
         self.contact = contact     # None: decided from the solution's model description
         self.layout = None
         self.entries = {}          # step -> time
