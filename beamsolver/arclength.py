@@ -229,7 +229,7 @@ class ArcLengthRun(Run):
         if last is not None and last[0] is H and last[1] == t and not self.problem.contributions:
             ev = last[2]
         else:
-            ev = self.newton._evaluate(H, t)
+            ev = self.newton.evaluate(H, t)
         return self._solve2(ev, t)[1]
 
     # ------------------------------------------------------------ one step
@@ -242,7 +242,7 @@ class ArcLengthRun(Run):
         residuals, last_inc, linearised = [], np.inf, 0
         for it in range(conv.max_iter + 1):
             self.Hcur, self.t_iter = H, t
-            ev = newton._evaluate(H, t)
+            ev = newton.evaluate(H, t)
             ratio = newton._ratio(ev.r, conv.scales(ev, newton.L_ref))
             residuals.append(ratio)
             if newton.callback is not None:
@@ -300,7 +300,7 @@ class ArcLengthRun(Run):
         if rot > motion_path.MAX_MOTION_ROTATION:
             raise StepFailed(f"a prescribed rotation turns by {rot:.3g} rad over the step (more than "
                              f"MAX_MOTION_ROTATION = {motion_path.MAX_MOTION_ROTATION:.3g} rad)")
-        self.newton._check_continuity(H0, H)
+        self.newton.check_continuity(H0, H)
         return H, t, w, tau, ev, stats
 
     def _arc_step_to_end(self, H0, t0, v, ds):
@@ -309,7 +309,7 @@ class ArcLengthRun(Run):
         tau = self.t_end - t0
         H = self._move(H0, t0, tau * v, self.t_end)
         out = self._augment(self._correct(H, self.t_end, self.S * tau * v, tau, ds, self.t_end))
-        self.newton._check_continuity(H0, out[0])
+        self.newton.check_continuity(H0, out[0])
         return out
 
     def _augment(self, out):
