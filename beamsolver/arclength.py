@@ -4,7 +4,7 @@ The pseudo-time ``t`` (which drives the load scales, the prescribed motions and
 the ``fix(values=)`` targets) becomes an unknown next to the free increments
 ``z``.  Each step from the equilibrium ``(H_0, t_0)`` seeks ``(H, t)`` with
 
-    r_f(H, t) = 0,     |S dz|^2 + psi^2 (t - t_0)^2 = ds^2        (docs/theory.md eq. 15.1)
+    r_f(H, t) = 0,     |S dz|^2 + psi^2 (t - t_0)^2 = ds^2        (docs/theory.md eq. 16.1)
 
 (Crisfield's spherical constraint), ``dz`` the sum of the step's free increments,
 ``S`` the unit-free scaling of ``Convergence`` (translations over the model size,
@@ -30,7 +30,7 @@ import numpy as np
 
 from . import linsolve, motion_path, se3
 from .errors import ConvergenceError, InputError
-from .failures import AugmentationFailed, NonFinite, SingularTangent, StepFailed
+from .failures import AugmentationFailed, Diverged, NonFinite, NotConverged, SingularTangent, StepFailed
 from .stepping import MAX_OUTER, STEP_TOLERANCE, Run
 
 __all__ = ["ArcLength", "arc_length_options", "check_arc_length_arguments", "ArcLengthRun", "sphere_root",
@@ -103,7 +103,7 @@ def arc_length_options(value):
 
 def sphere_root(w, tau, dw_r, dw_t, psi, ds):
     """Pseudo-time correction ``dt`` on the sphere ``|w + dw_r + dt dw_t|^2 + psi^2 (tau + dt)^2 = ds^2``
-    (docs/theory.md eq. 15.4).
+    (docs/theory.md eq. 16.4).
 
     ``w``, ``tau``: the step's scaled increment and pseudo-time change so far; ``dw_r``, ``dw_t``:
     the scaled solves ``S dz_r``, ``S dz_t``.  Of the two real roots the one whose new increment
@@ -128,7 +128,7 @@ def sphere_root(w, tau, dw_r, dw_t, psi, ds):
 def next_arc_length(ds, iterations, target, cut, linearised):
     """Arc length after a converged step of ``ds`` in ``iterations``: ``ds sqrt(target / iterations)``
     by a factor 0.5 to 2 (at most 1 after a cut-back, at most 0.5 after a linearised iteration),
-    before the cap to ``[min, max]`` (docs/theory.md eq. 15.6)."""
+    before the cap to ``[min, max]`` (docs/theory.md eq. 16.6)."""
     f = float(np.clip(np.sqrt(target / max(iterations, 1)), 0.5, 2.0))
     if cut:
         f = min(f, 1.0)
@@ -139,10 +139,10 @@ def next_arc_length(ds, iterations, target, cut, linearised):
 
 def rate(problem, H, t, ev, delta, t_start):
     """``dr_f/dt`` ``(n_free,)`` at the state ``H`` (constrained nodes on their targets at ``t``;
-    ``ev`` its ``problem.Evaluation`` with the tangent; docs/theory.md eq. 15.3).
+    ``ev`` its ``problem.Evaluation`` with the tangent; docs/theory.md eq. 16.3).
 
-    Loads: ``-f_ext(H, dlf/dt)`` (the residual is linear in the load factors; ``dlf/dt`` by a central
-    difference of the scale functions); prescribed motions and ``fix(values=)``: ``K_fc dz_c/dt``
+    Loads: ``-f_ext(H, dlf/dt) = r(H, dlf/dt) - r(H, 0)`` (the residual is linear in the load factors;
+    ``dlf/dt`` by a central difference of the scale functions); prescribed motions and ``fix(values=)``: ``K_fc dz_c/dt``
     with the velocity ``dz_c/dt`` (body increments of the motion, global ones of the fixed values)
     by a central difference of step ``delta`` (forward where ``t - delta < t_start``).
     """
@@ -153,8 +153,7 @@ def rate(problem, H, t, ev, delta, t_start):
     if len(sys.load_scales):
         dlf = (sys.load_factors(t + delta) - sys.load_factors(lo)) / span
         if np.any(dlf):
-            r = np.zeros(6 * sys.n_nodes)
-            r = sys._add_loads(H, dlf, sys.node_transforms(H), r, None, 0.0, 0.0)[0]
+            r = sys.evaluate(H, dlf, tangent=False)[0] - sys.evaluate(H, np.zeros_like(dlf), tangent=False)[0]
             out += r[sys.free_dofs]
     if len(sys.prescribed_nodes) or sys.fix_values:
         v = np.zeros((sys.n_nodes, 6))
@@ -210,15 +209,37 @@ class ArcLengthRun(Run):
             raise SingularTangent("the linear solve returned non-finite values")
         return dz_r, dz_t
 
+    def _full(self, dzf):
+        """Increments ``(n, 6)`` of all nodes from those of the free unknowns (zero elsewhere)."""
+        dz = np.zeros(6 * self.sys.n_nodes)
+        dz[self.sys.free_dofs] = dzf
+        return dz.reshape(-1, 6)
+
     def _move(self, H, t, dzf, t_new):
-        """Free nodes by ``dzf``, constrained ones onto their targets at ``t_new``."""
-        sys, newton = self.sys, self.newton
-        dz = newton._full(dzf)
-        H_target = sys.prescribed_poses(t_new) if len(sys.prescribed_nodes) else None
-        dz_c, targets = newton._predictor(H, t_new, t, H_target)
-        if dz_c is None:
-            return self.problem.update(H, dz)
-        return newton._reach_targets(H, dz + dz_c, H_target, bool(targets), t_new)
+        """Free nodes by ``dzf``, constrained ones onto their targets at ``t_new`` (prescribed poses
+        exactly, ``fix(values=)`` components by their increments, as the load path's predictor)."""
+        sys = self.sys
+        dz = self._full(dzf)
+        p = sys.prescribed_nodes
+        H_target = sys.prescribed_poses(t_new) if len(p) else None
+        if len(p):
+            dz[p] = se3.log(se3.relative(H[p], H_target))
+        targets = sys.fixed_value_increments(H, t_new, t) if sys.fix_values else []
+        for node, comp, dx in targets:
+            dz[node, comp] = dx
+        H = self.problem.update(H, dz)
+        if len(p):
+            H[p] = H_target
+        if targets:
+            sys.enforce_fixed_values(H, t_new)
+        sys.sync_members(H)
+        return H
+
+    def _ratio(self, ev):
+        """``Convergence.residual_ratio`` of the free residual of ``ev``."""
+        newton = self.newton
+        rf = ev.r[self.sys.free_dofs]
+        return newton.conv.residual_ratio(rf[newton.fu], rf[newton.fw], *newton.conv.scales(ev, newton.L_ref))
 
     def _tangent_at(self, H, t):
         """``dz/dt`` ``(n_free,)`` along the path at the equilibrium ``(H, t)``; without contributions
@@ -243,7 +264,7 @@ class ArcLengthRun(Run):
         for it in range(conv.max_iter + 1):
             self.Hcur, self.t_iter = H, t
             ev = newton.evaluate(H, t)
-            ratio = newton._ratio(ev.r, conv.scales(ev, newton.L_ref))
+            ratio = self._ratio(ev)
             residuals.append(ratio)
             if newton.callback is not None:
                 newton.callback(dict(t=t, iteration=it, residual=ratio, poses=H))
@@ -253,7 +274,9 @@ class ArcLengthRun(Run):
                 self._converged = (H, t, ev)
                 return H, t, w, tau, ev, dict(iterations=it, residuals=residuals, linearised=linearised)
             if verdict != "continue":
-                raise newton._failure(verdict, ratio)
+                raise (NotConverged(f"no convergence in {conv.max_iter} iterations (scaled residual "
+                                    f"{ratio:.3g})", ratio) if verdict == "max_iter"
+                       else Diverged(f"diverging (scaled residual {ratio:.3g})"))
             dz_r, dz_t = self._solve2(ev, t)
             if t_fixed is None:
                 dt, lin = sphere_root(w, tau, self.S * dz_r, self.S * dz_t, self.psi, ds)
@@ -262,7 +285,7 @@ class ArcLengthRun(Run):
                 dt = t_fixed - t
             dzf = dz_r + dt * dz_t
             w, tau = w + self.S * dzf, tau + dt
-            last_inc = newton._inc(dzf)
+            last_inc = conv.increment_ratio(self._full(dzf), newton.L_ref)
             H, t = self._move(H, t, dzf, t + dt), t + dt
         raise AssertionError("unreachable: decide() returns MAX_ITER at iteration max_iter")
 

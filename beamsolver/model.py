@@ -361,6 +361,9 @@ class Model:
         - ``point_ratio``: from this ``sin^2`` of the crossing angle up a pair is one
           point contact, below it orthogonal projection (0.5);
         - ``margin``: search margin around every element (default twice the largest radius).
+        - ``law``: the contact law, a ``contact.law.ContactLaw`` of compiled functions
+          (default None: the penalty / augmented-Lagrangian / smoothed normal law with
+          Coulomb friction; docs/theory.md section 15).
 
         Unknown options are refused.  The same beams on both
         sides (``add_contact(group, group)``, as for the wires of a cable) declare every

@@ -103,6 +103,11 @@ class Stabilization(Contribution):
     conservative = False          # viscous: no potential
 
     def __init__(self, system, fraction=DEFAULT_FRACTION, factor=None, warn=WARN_FRACTION, check=True):
+        for g in system.groups:
+            if g.element_type.n_nodes != 2:
+                # M* lumps each element at its two end nodes and the strain energy is the two-node one
+                raise InputError(f"solve: stabilize supports two-node elements only; element type "
+                                 f"{g.element_type.name!r} ({g.element_type.n_nodes} nodes) is in the model")
         self.sys = system
         self.check_saddle = check
         self.nodes = np.flatnonzero(system.is_rep & (system.kind == FREE))

@@ -173,7 +173,18 @@ CONTACT_OPTIONS = {   # name -> check(value, owner) returning the stored value (
     "line_angle": _line_angle,
     "point_ratio": lambda v, o: real(v, "point_ratio", o, minimum=0.0, maximum=1.0),
     "margin": lambda v, o: real(v, "margin", o, minimum=0.0),
+    "law": lambda v, o: _contact_law(v, o),
 }
+
+
+def _contact_law(v, owner):
+    """A ``contact.law.ContactLaw`` (checked by its fields: ``name``, compiled ``normal`` and
+    ``tangential``) or None."""
+    if v is None or (isinstance(getattr(v, "name", None), str) and callable(getattr(v, "normal", None))
+                     and callable(getattr(v, "tangential", None))):
+        return v
+    raise InputError(f"{owner}: law must be a beamsolver.contact.law.ContactLaw (name, normal, tangential) "
+                     f"or None, got {type(v).__name__} {v!r}")
 
 
 def check_contact_options(options, owner="add_contact"):

@@ -17,11 +17,11 @@ public ``problem.Problem`` interface and its ``System``, once per Newton iterati
 
 - ``element``: ``System.evaluate`` (element kernels, transforms, loads,
   residual scatter; contact is a separate contribution of the ``Problem``);
-- ``contact search`` (``ContactSystem.pairs`` + ``_active``), ``contact
-  kernels`` (``_params`` history look-up + ``kernel_and_tangent``) and
-  ``contact other`` (the rest of ``ContactSystem.evaluate`` and the generic
-  assembler ``System.assemble_blocks``: transforms, residual and COO build),
-  with the methods wrapped by timers;
+- ``contact search`` (search + rules + projection of the public
+  ``ContactSystem.timings``), ``contact kernels`` (params + kernel: refusals, active
+  set, history look-up and the compiled kernel) and ``contact other`` (the rest of
+  ``ContactSystem.evaluate`` and the generic assembler ``System.assemble_blocks``:
+  transforms, residual and COO build); ``benchmarks/contact_bundle.py`` shows every stage;
 - ``assembly``: ``System.matrix`` (CSC scatter of the element values and the
   contact COO);
 - ``solve``: ``linsolve`` factorisation + solve with the default back-end
@@ -167,53 +167,19 @@ def _maxrss_mb():
 
 
 def contact_parts(problem, H, tangent=True):
-    """One contact evaluation and its assembly (``System.assemble_blocks``) with its stages timed;
-    returns (rc, coo, info, times)."""
-    import beamsolver.contact.system as cs
+    """One contact evaluation and its assembly (``System.assemble_blocks``), timed by stage from
+    ``ContactSystem.timings`` (CPU time); returns (rc, coo, info, times)."""
     system, c = problem.system, problem.contact
-    acc = dict(contact_search=0.0, contact_kernels=0.0)
-    seen = {}
-
-    def wrap(part, f, key=None):
-        def g(*a, **k):
-            t0 = clock()
-            try:
-                out = f(*a, **k)
-                if key:
-                    seen[key] = out
-                return out
-            finally:
-                acc[part] += clock() - t0
-        return g
-    patched = []
-    for attr, part in (("pairs", "contact_search"), ("_active", "contact_search"), ("_params", "contact_kernels")):
-        if hasattr(c, attr):
-            setattr(c, attr, wrap(part, getattr(c, attr), attr))
-            patched.append(attr)
-    kernels = {}
-    for name in ("kernel_and_tangent", "contact_kernel"):
-        if hasattr(cs, name):
-            kernels[name] = getattr(cs, name)
-            setattr(cs, name, wrap("contact_kernels", kernels[name]))
-    try:
-        t0 = clock()
-        blocks, info = c.evaluate(H, tangent=tangent)
-        rc, coo, _, _ = system.assemble_blocks(H, blocks)
-        total = clock() - t0
-    finally:
-        for attr in patched:
-            delattr(c, attr)
-        for name, f in kernels.items():
-            setattr(cs, name, f)
-    times = dict(acc)
-    if not patched:          # the contact code changed: only the total is known
-        times = dict(contact_search=np.nan, contact_kernels=np.nan)
-        times["contact_other"] = total
-    else:
-        times["contact_other"] = max(total - acc["contact_search"] - acc["contact_kernels"], 0.0)
+    for k in c.timings:
+        c.timings[k] = 0.0
+    t0 = clock()
+    blocks, info = c.evaluate(H, tangent=tangent)
+    rc, coo, _, _ = system.assemble_blocks(H, blocks)
+    total = clock() - t0
+    t = c.timings
+    times = dict(contact_search=t["search"] + t["rules"] + t["projection"], contact_kernels=t["params"] + t["kernel"])
+    times["contact_other"] = max(total - times["contact_search"] - times["contact_kernels"], 0.0)
     times["contact_total"] = total
-    P = seen.get("pairs")
-    info = dict(info, candidates=len(P) if P is not None else -1)
     return rc, coo, info, times
 
 
@@ -366,15 +332,16 @@ def measure_bundle(n, cap, predicted_contact, skip=()):
         rc, coo, cinfo, ct = contact_parts(problem, H)
         out.update(ct)
         out["contact_points"] = int(cinfo.get("n_active", 0))
-        out["contact_candidates"] = int(cinfo.get("candidates", -1))
         out["contact_coo_entries"] = int(len(coo[2]))
         r = r + rc
-        out["residual"], _ = _best(lambda: problem.evaluate(H, 1.0, tangent=False), min_time=0.0, max_repeat=1)
+        # after begin_step: contact keeps its last evaluation for the same poses and state
+        out["residual"], _ = _best(lambda: (problem.begin_step(H, 0.0), problem.evaluate(H, 1.0, tangent=False)),
+                                   min_time=0.0, max_repeat=1)
     else:
         coo, _ = replicated_contact(system, wires, per_wire)
         for p in ("contact_search", "contact_kernels", "contact_other", "contact_total", "residual"):
             out[p] = np.nan
-        out["contact_points"] = out["contact_candidates"] = -1
+        out["contact_points"] = -1
         out["contact_coo_entries"] = int(len(coo[2]))      # pre-summed per matrix entry
     extra = coo
     out["assembly"], K = _best(lambda: system.matrix(kvals, extra))

@@ -24,7 +24,7 @@ solve_options = dict(steps=10, t_end=1.5, path="arc-length")   # for `beamsolver
 
 def truss_load(y):
     """Apex load carried by one bar with the apex at height ``y`` (a pinned straight bar,
-    ``N = EA (L / L0 - 1)``): ``P = EA y (1 / L - 1 / L0)`` (docs/theory.md eq. 15.9)."""
+    ``N = EA (L / L0 - 1)``): ``P = EA y (1 / L - 1 / L0)`` (docs/theory.md eq. 16.9)."""
     L0, L = np.hypot(A_HALF, RISE), np.hypot(A_HALF, y)
     return EA * y * (1.0 / L - 1.0 / L0)
 

@@ -137,3 +137,15 @@ def test_explicit_factor_damps_from_the_first_step():
         sol = bs.solve(m, steps=2, stabilize=dict(factor=1e-3), verbose=False)
     assert sol.stats[1]["stabilization"]["factor"] == 1e-3
     assert sol.stats[1]["stabilization"]["dissipated"] > 0
+
+
+def test_stabilisation_of_three_node_elements_is_refused_naming_the_type():
+    """The damping's lumped mass and strain energy are those of two-node elements: a model with
+    another element type must be refused, not damped with wrong masses."""
+    sec = bs.Section.circular(radius=1e-3, E=200e9, nu=0.3)
+    m = bs.Model()
+    b = m.add_beam(bs.geometry.straight(start=(0, 0, 0), end=(1, 0, 0), n_elements=8), sec, element="se3-3")
+    m.clamp(b.first)
+    m.add_load(b.last, force=(0, 0, 1.0))
+    with pytest.raises(bs.InputError, match="se3-3"):
+        bs.solve(m, steps=2, stabilize=1e-3, verbose=False)

@@ -24,22 +24,31 @@ One difference from the numpy kernel, where that one decides on a whole batch:
 the ``active`` flag of the normal law is decided per point (the numpy kernel uses
 the smoothed rule for every point of a batch in which any point has a smoothing
 gap; the two differ only at a trial traction of exactly zero).
-The law formulas (``law.normal_force``, ``law.coulomb_return_mapping``, the
-``PENALTY_T_MIN`` floor of ``pairs``) are repeated here in scalar form: a change
-to them must be made in both places, and the oracle test catches a mismatch.
+The contact law is pluggable: the kernel calls ``_normal_law`` and
+``_tangential_law``, which ``make_kernel`` binds to a ``law.ContactLaw``'s compiled
+scalar functions (default ``law.PENALTY_COULOMB``, tested equal to the numpy forms
+``law.normal_force`` and ``law.coulomb_return_mapping`` the oracle uses).
 ``NUMBA_DISABLE_JIT=1`` runs this module as plain Python (slowly).
 """
+import hashlib
+import types
+
 import numpy as np
 
 from .._jit import jit
 from ..element_jit import _geometric
 from ..se3_jit import (A_, B_, C_, CP_, D_, DP_, Q2P_, Q2_, Q3P_, Q3_, add, add_outer, coefficient, cross, dot,
                        log_relative, mat, mm, mv, q_matrix, scale, ti_matrix, transpose)
+from .law import PENALTY_COULOMB
 from .pairs import LINE, ORTHOGONAL, PENALTY_T_MIN
 
 # columns of the per-point parameter table ``par``
 XI1, XI2, R1_, R2_, WEIGHT, PENALTY, MULT, MU, PEN_T, SMOOTH, ESLIP, XI1P, XI2P = range(13)
 N_PAR = 13
+
+
+# the law, bound per kernel by ``make_kernel`` (the templates below call these names)
+_normal_law = _tangential_law = None
 
 
 # ---------------------------------------------------------------- small algebra (tuples, 6x6 arrays)
@@ -392,22 +401,6 @@ def _axes(RC, xC, RF, xF, VC, VF):
     return n, t1, t2, dist, Dn, Dt1, Dt2, Ddist
 
 
-@jit
-def _normal_law(gap, penalty, multiplier, smoothing):
-    """``law.normal_force`` for one point: ``lam``, ``d lam / d gap`` and ``active``."""
-    x = multiplier - penalty * gap
-    W = penalty * smoothing
-    if W > 0.0:
-        if x >= W:
-            return x, -penalty, True
-        if x > -W:
-            return (x + W) ** 2 / (4.0 * W), -penalty * (x + W) / (2.0 * W), True
-        return 0.0, 0.0, False
-    if x >= 0.0:
-        return x, -penalty, True
-    return 0.0, 0.0, False
-
-
 # ---------------------------------------------------------------- friction
 @jit
 def _pose4(H):
@@ -450,24 +443,9 @@ def _slip(side1, side2, Ti1, Ti2, xi1p, xi2p, HCL, HFK, HLKp):
     return (dyu[1], dyu[2]), D
 
 
-@jit
-def _coulomb(lam_prev, Dprev, slip, Dslip, pen_t, Dpt, mu, lam, Dlam):
-    """Trial traction and the Coulomb return mapping (``law.coulomb_return_mapping``) with gradients."""
-    tr = (lam_prev[0] + pen_t * slip[0], lam_prev[1] + pen_t * slip[1])
-    Dtr = Dprev + np.outer(np.array(slip), Dpt) + pen_t * Dslip
-    norm = np.sqrt(tr[0] * tr[0] + tr[1] * tr[1])
-    limit = mu * lam
-    if norm <= limit:
-        return tr, Dtr, True
-    tt = np.array([tr[0] / norm, tr[1] / norm])
-    proj = tt[0] * Dtr[0] + tt[1] * Dtr[1]
-    D = np.outer(tt, mu * Dlam) + (limit / norm) * (Dtr - np.outer(tt, proj))
-    return (limit * tt[0], limit * tt[1]), D, False
-
-
-@jit
 def _friction(slip, Dslip, lamp, t1, t2, Dt1, Dt2, lam, Dlam, par):
-    """Transported stored traction, tangential penalty and return mapping; ``lam_t``, gradient, ``stick``."""
+    """Transported stored traction, tangential penalty, trial traction and the law's tangential part
+    (``_tangential_law``, bound by ``make_kernel``); ``lam_t``, its gradient ``(2, 24)``, ``stick``."""
     lp = (dot(lamp, t1), dot(lamp, t2))
     Dlp = np.empty((2, 24))
     Dlp[0] = _row_dot(lamp, Dt1, 0)
@@ -492,7 +470,10 @@ def _friction(slip, Dslip, lamp, t1, t2, Dt1, Dt2, lam, Dlam, par):
             Dpt = (mu / par[ESLIP]) * Dlam
         else:
             pen_t = mu * lam_min / par[ESLIP]
-    return _coulomb(lam_prev, Dprev, slip, Dslip, pen_t, Dpt, mu, lam, Dlam)
+    tr0, tr1 = lam_prev[0] + pen_t * slip[0], lam_prev[1] + pen_t * slip[1]
+    Dtr = Dprev + np.outer(np.array(slip), Dpt) + pen_t * Dslip
+    lt0, lt1, D, stick = _tangential_law(tr0, tr1, Dtr, mu, lam, Dlam)
+    return (lt0, lt1), D, stick
 
 
 # ---------------------------------------------------------------- one contact point
@@ -553,7 +534,6 @@ def _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2):
         frames[2, i, 3], frames[3, i, 3] = xC[i], xF[i]
 
 
-@jit
 def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames):
     """Forces ``f (4, 6)``, tangent ``K (24, 24)`` and point data of one contact point."""
     side1, side2 = _element_side(Xp, 0, 0.0), _element_side(Xp, 2, 0.0)
@@ -576,7 +556,7 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
     n, t1, t2, dist, Dn, Dt1, Dt2, Ddist = _axes(RC, xC, RF, xF, VC, VF)
     R1, R2, wgt = par[R1_], par[R2_], par[WEIGHT]
     gap = dist - R1 - R2
-    lam, dlam, active = _normal_law(gap, par[PENALTY], par[MULT], par[SMOOTH])
+    lam, dlam, active = _normal_law(gap, par[PENALTY], par[MULT], par[SMOOTH])      # bound by make_kernel
     Dlam = dlam * Ddist
     F = scale(-wgt * lam, n)
     DF = -wgt * (np.outer(np.array(n), Dlam) + lam * Dn)
@@ -605,12 +585,57 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
     flags[0], flags[1] = active, stick
 
 
-@jit
-def evaluate(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames):
-    """Batch driver: ``_point`` over all pairs (a plain loop; one core)."""
+def _evaluate(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames):
+    """Batch driver: ``_point`` over all pairs (a plain loop; one core).  A template: ``make_kernel``
+    compiles it per contact law; the module's ``evaluate`` is the default law's."""
     for p in range(X.shape[0]):
         _point(X[p], kind[p], par[p], has[p], HCL[p], HFK[p], HLKp[p], lamp[p], friction, f[p], K[p], sc[p],
                vec[p], two[p], flags[p], frames[p])
+
+
+# ---------------------------------------------------------------- the kernel of a contact law
+_LAW_PATH = ("_friction", "_point", "_evaluate")      # the templates on the call path to the law, callee first
+_TEMPLATES = {name: globals()[name] for name in _LAW_PATH}
+_KERNELS = {}
+
+
+def _code_bytes(code):
+    """Bytes identifying a code object's instructions, names and constants (stable across processes)."""
+    consts = b"".join(_code_bytes(c) if isinstance(c, types.CodeType) else repr(c).encode() for c in code.co_consts)
+    return code.co_code + repr(code.co_names).encode() + consts
+
+
+def _digest(law):
+    """Identity of a law's code: a law edited in place gets a new compiled kernel (and cache entry).
+    Only the two functions' own code counts: after editing a helper they call, clear the numba
+    cache (``__pycache__``) or rename the law."""
+    code = [_code_bytes(getattr(f, "py_func", f).__code__) for f in (law.normal, law.tangential)]
+    return hashlib.sha1(b"".join(code)).hexdigest()[:10]
+
+
+def make_kernel(law):
+    """The compiled batch driver ``_evaluate`` for ``law`` (a ``law.ContactLaw``), built once per process.
+
+    The templates on the law's call path (``_friction``, ``_point``, ``_evaluate``) are copied
+    with ``_normal_law`` and ``_tangential_law`` bound to the law's functions as globals, under
+    the name ``<template>__<law name>_<code digest>``: numba's disk cache (``cache=True``) keys
+    on that name and the template's source file, so each law's kernel compiles once per machine
+    and loads from the cache afterwards (closures or functions passed as arguments are
+    recompiled in every process, measured with numba 0.68).
+    """
+    key = f"{law.name}_{_digest(law)}"
+    if key not in _KERNELS:
+        glb = dict(globals(), _normal_law=law.normal, _tangential_law=law.tangential)
+        for name in _LAW_PATH:
+            t = _TEMPLATES[name]
+            f = types.FunctionType(t.__code__, glb, f"{name}__{key}", t.__defaults__)
+            f.__qualname__, f.__doc__ = f.__name__, t.__doc__
+            glb[name] = jit(f)
+        _KERNELS[key] = glb["_evaluate"]
+    return _KERNELS[key]
+
+
+evaluate = make_kernel(PENALTY_COULOMB)
 
 
 @jit
@@ -658,12 +683,12 @@ def _table(X, p):
     return kind, par, has, frames, lamp
 
 
-def kernel_and_tangent(X, p, friction=True):
+def kernel_and_tangent(X, p, friction=True, law=None):
     """Wrenches ``(P, 4, 6)``, exact tangent ``(P, 24, 24)`` and point data (``pairs.kernel_and_tangent``).
 
     ``X``: ``(P, 4, 4, 4)`` node poses ``A1, B1, A2, B2``; ``p``: the per-pair parameters of
     ``pairs.contact_kernel``.  Column ``6 j + k`` of the tangent is the body increment ``k``
-    of node ``j``.
+    of node ``j``.  ``law``: a ``law.ContactLaw`` (default ``PENALTY_COULOMB``, the law of ``pairs.py``).
     """
     X = np.ascontiguousarray(X, dtype=float)
     P = X.shape[0]
@@ -671,7 +696,8 @@ def kernel_and_tangent(X, p, friction=True):
     f, K = np.empty((P, 4, 6)), np.empty((P, 24, 24))
     sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
     flags, frames = np.empty((P, 2), dtype=np.bool_), np.empty((P, 4, 4, 4))
-    evaluate(X, kind, par, has, HCL, HFK, HLKp, lamp, bool(friction), f, K, sc, vec, two, flags, frames)
+    kern = evaluate if law is None else make_kernel(law)
+    kern(X, kind, par, has, HCL, HFK, HLKp, lamp, bool(friction), f, K, sc, vec, two, flags, frames)
     out = dict(gap=sc[:, 0], lam_n=sc[:, 1], active=flags[:, 0], n=vec[:, 0], t1=vec[:, 1], t2=vec[:, 2],
                xC=vec[:, 3], xF=vec[:, 4], xi1=sc[:, 2], xi2=sc[:, 3], lam_t=two[:, 0], stick=flags[:, 1],
                slip=two[:, 1], F_slave=vec[:, 5])
@@ -680,7 +706,7 @@ def kernel_and_tangent(X, p, friction=True):
     return f, K, out
 
 
-def contact_kernel(X, p, friction=True):
+def contact_kernel(X, p, friction=True, law=None):
     """Wrenches ``(P, 4, 6)`` and point data (``pairs.contact_kernel``, for batches ``(P, 4, 4, 4)``)."""
-    f, _, out = kernel_and_tangent(X, p, friction)
+    f, _, out = kernel_and_tangent(X, p, friction, law)
     return f, out

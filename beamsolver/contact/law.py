@@ -1,11 +1,21 @@
-"""Contact laws, batched over contact points (docs/theory.md section 7).
+"""Contact laws (docs/theory.md section 7): batched numpy forms and the compiled law interface.
 
-Complex inputs are allowed (complex-step tangents): every branch is decided on
-the real part, arithmetic stays analytic.
+``normal_force`` and ``coulomb_return_mapping`` are batched over contact points and
+accept complex inputs (the complex-step oracle, ``pairs.py``): every branch is decided
+on the real part, arithmetic stays analytic.  ``ContactLaw`` bundles the scalar
+compiled forms with their derivatives (``penalty_normal``, ``coulomb``, tested equal to
+the numpy forms) that the compiled kernel calls; a new law is a new ``ContactLaw``,
+no kernel edit (``kernel_jit.make_kernel``).
 """
+from dataclasses import dataclass
+from typing import Callable
+
 import numpy as np
 
-__all__ = ["normal_force", "coulomb_return_mapping", "default_penalty"]
+from .._jit import jit
+
+__all__ = ["normal_force", "coulomb_return_mapping", "default_penalty", "ContactLaw", "penalty_normal",
+           "coulomb", "PENALTY_COULOMB"]
 
 
 def normal_force(gap, penalty, multiplier=0.0, smoothing=0.0):
@@ -53,3 +63,56 @@ def default_penalty(section_a, section_b):
     """
     e = [s.C[0, 0] / (np.pi * s.radius**2) for s in (section_a, section_b)]
     return float(min(e))
+
+
+# ---------------------------------------------------------------- the law interface of the compiled kernel
+@dataclass(frozen=True)
+class ContactLaw:
+    """A contact law for the compiled kernel (``kernel_jit.make_kernel`` builds a kernel from it).
+
+    ``normal(gap, penalty, multiplier, smoothing) -> (lam, dlam_dgap, active)``: normal traction per
+    unit weight, its derivative with respect to the gap and whether the point carries force or
+    stiffness; ``tangential(trial0, trial1, Dtrial, mu, lam, Dlam) -> (lt0, lt1, D, stick)``:
+    tangential traction from the trial ``(trial0, trial1)`` (in ``t1, t2``) in forward mode, ``D``
+    ``(2, k)`` its gradient from the gradients ``Dtrial`` ``(2, k)`` of the trial and ``Dlam`` ``(k,)``
+    of the normal traction.  Both are numba-jitted (``_jit.jit``).  ``name`` names the compiled kernel (and its numba cache entry).
+    """
+    name: str
+    normal: Callable
+    tangential: Callable
+
+
+@jit
+def penalty_normal(gap, penalty, multiplier, smoothing):
+    """``normal_force`` for one point: penalty ``<multiplier - penalty gap>`` (augmented Lagrangian
+    with a multiplier), C1 parabola on ``|x| < penalty smoothing``; ``(lam, dlam/dgap, active)``."""
+    x = multiplier - penalty * gap
+    W = penalty * smoothing
+    if W > 0.0:
+        if x >= W:
+            return x, -penalty, True
+        if x > -W:
+            return (x + W) ** 2 / (4.0 * W), -penalty * (x + W) / (2.0 * W), True
+        return 0.0, 0.0, False
+    if x >= 0.0:
+        return x, -penalty, True
+    return 0.0, 0.0, False
+
+
+@jit
+def coulomb(trial0, trial1, Dtrial, mu, lam, Dlam):
+    """``coulomb_return_mapping`` for one point in forward mode (``ContactLaw.tangential``): stick
+    inside the disk ``|trial| <= mu lam``, else ``mu lam trial / |trial|``.  ``Dtrial`` ``(2, k)``,
+    ``Dlam`` ``(k,)``: gradients of the trial traction and of ``lam``; returns ``(lt0, lt1, D, stick)``
+    with ``D`` ``(2, k)`` the gradient of the traction."""
+    norm = np.sqrt(trial0 * trial0 + trial1 * trial1)
+    limit = mu * lam
+    if norm <= limit:
+        return trial0, trial1, Dtrial, True
+    tt = np.array([trial0 / norm, trial1 / norm])
+    proj = tt[0] * Dtrial[0] + tt[1] * Dtrial[1]
+    D = np.outer(tt, mu * Dlam) + (limit / norm) * (Dtrial - np.outer(tt, proj))
+    return limit * tt[0], limit * tt[1], D, False
+
+
+PENALTY_COULOMB = ContactLaw("penalty_coulomb", penalty_normal, coulomb)

@@ -7,7 +7,7 @@ only.  Lengths are in model units; ``None`` means "derived per pair" where
 stated.
 """
 from dataclasses import asdict, dataclass
-from typing import Optional
+from typing import Any, Optional
 
 import numpy as np
 
@@ -28,7 +28,9 @@ class ContactOptions:
     (None: from ``slip_tolerance``); ``slip_tolerance``: elastic slip at the onset of sliding /
     slave element length; ``tolerance``: penetration enabling augmented-Lagrangian updates
     (None: pure penalty); ``line_angle`` [rad], ``point_ratio``: the search's kind rules;
-    ``margin``: search margin (None: twice the largest radius)."""
+    ``margin``: search margin (None: twice the largest radius); ``law``: the contact law of the
+    compiled kernel, a ``law.ContactLaw`` (None: ``law.PENALTY_COULOMB``, the penalty /
+    augmented-Lagrangian / smoothed normal law with Coulomb friction)."""
     smoothing: Optional[float] = None
     gauss_points: int = 5
     penalty_t: Optional[float] = None
@@ -37,6 +39,7 @@ class ContactOptions:
     line_angle: float = LINE_ANGLE
     point_ratio: float = 0.5
     margin: Optional[float] = None
+    law: Optional[Any] = None
 
     @classmethod
     def from_dict(cls, options, owner="add_contact"):
@@ -44,4 +47,6 @@ class ContactOptions:
         return cls(**check_contact_options(dict(options), owner))
 
     def as_dict(self):
-        return asdict(self)
+        out = asdict(self)
+        out["law"] = self.law                 # the law itself, not a dict of its fields
+        return out

@@ -17,7 +17,7 @@ class Candidates(NamedTuple):
     """Element pairs from the broad phase and pair rules, arrays over ``n`` element pairs:
     slave and master elements ``e``, ``m``, their ``kind``, closest points ``xi1``, ``xi2`` (non-line
     pairs), element twists ``h1``, ``h2`` ``(n, 6)``, master bounding-sphere centres ``c2``
-    ``(n, 4, 4)`` and radii ``r2``."""
+    ``(n, 3)`` and radii ``r2``."""
     e: np.ndarray
     m: np.ndarray
     kind: np.ndarray

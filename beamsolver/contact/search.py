@@ -22,7 +22,7 @@ the README, tested on both sides of each switch):
    shares a node with an orthogonal one against the same master beam (a
    straight rope leaving a wrap tangentially) is projected orthogonally too:
    its closest point sits at its end, and a point pair there would switch on
-   and off as the tangent point moves (``ContactSystem._extend_wrap``).
+   and off as the tangent point moves (``rules.extend_wrap``).
 
 Projections are accepted on ``[0, 1]`` of the master element (so they continue
 across element boundaries along the whole master beam); per slave Gauss point
@@ -31,45 +31,26 @@ and master beam the closest accepted projection is kept.
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .. import se3
-from .pairs import POINT, _project, _section
+from .projection import section_points
 
 XI_TOL = 1e-9
 
 
-def element_spheres(H, enodes, radii, margin):
-    """Mid-points ``(n, 3)``, bounding radii ``(n,)`` and twists ``(n, 6)`` of elements."""
-    HA, HB = H[enodes[:, 0]], H[enodes[:, 1]]
-    h = se3.log(se3.relative(HA, HB))
-    mid = se3.interpolate(HA, h, np.full(len(h), 0.5))
+def element_spheres(H, enodes, h, radii, margin):
+    """Mid-points ``(n, 3)``, bounding radii ``(n,)``, twists ``h`` ``(n, 6)`` (given) and mid-point
+    tangents ``(n, 3)`` of elements ``enodes`` at poses ``H`` (compiled, ``projection.section_points``)."""
+    mid, tangent = section_points(H, enodes[:, 0], h, np.full(len(h), 0.5))
     arc = np.sqrt(np.sum(h[:, :3] ** 2, axis=1))
-    return mid, 0.5 * arc + radii + margin, h, mid[:, :3, 0]
+    return mid, 0.5 * arc + radii + margin, h, tangent
 
 
 def broad_phase(c_s, r_s, c_m, r_m):
     """Slave/master element index pairs whose bounding spheres overlap."""
     if len(c_s) == 0 or len(c_m) == 0:
         return np.zeros(0, dtype=int), np.zeros(0, dtype=int)
-    ts, tm = cKDTree(c_s[:, :3, 3]), cKDTree(c_m[:, :3, 3])
+    ts, tm = cKDTree(c_s), cKDTree(c_m)
     D = ts.sparse_distance_matrix(tm, float(r_s.max() + r_m.max()), output_type="coo_matrix")
     i, j = D.row, D.col
-    d = np.linalg.norm(c_s[i, :3, 3] - c_m[j, :3, 3], axis=1)
+    d = np.linalg.norm(c_s[i] - c_m[j], axis=1)
     keep = d <= r_s[i] + r_m[j]
     return i[keep], j[keep]
-
-
-def closest_points(HA1, h1, HA2, h2, iterations=8):
-    """Closest points ``(xi1, xi2)`` of two element centre lines and the reduced-Hessian ratio."""
-    n = len(h1)
-    kind = np.full(n, POINT)
-    xi1, xi2 = _project(kind, HA1, h1, np.full(n, 0.5), HA2, h2, np.full(n, 0.5), iterations)
-    H1, x1p, x1pp = _section(HA1, h1, xi1)
-    H2, x2p, x2pp = _section(HA2, h2, xi2)
-    d = H2[:, :3, 3] - H1[:, :3, 3]
-    h11 = np.sum(x1p * x1p, 1) - np.sum(d * x1pp, 1)
-    h12 = -np.sum(x1p * x2p, 1)
-    h22 = np.sum(x2p * x2p, 1) + np.sum(d * x2pp, 1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = (h11 - h12**2 / h22) / np.sum(x1p * x1p, 1)
-    ratio = np.where(np.isfinite(ratio), ratio, 0.0)
-    return xi1, xi2, ratio

@@ -1,17 +1,25 @@
-"""Contact as a pipeline inside the Newton loop: search -> pairs -> kernel -> scatter.
+"""Contact as a pipeline inside the Newton loop: search -> pair rules -> projection -> kernel.
 
 ``ContactSystem`` is created by ``assembly.System`` only when the model has
-contact declarations.  Per evaluation it runs the stages
+contact declarations.  It orchestrates pure stages kept in their own modules:
 
-1. broad phase and pair rules (``_candidates``: element spheres, no pair between
-   elements sharing a node, the kind of each element pair);
-2. projection and ownership (``_point_pairs``, ``_gauss_pairs``: one owner per
-   slave point, stable at shared nodes), giving one typed ``record.PairSet``;
-3. refusals (``_check_sides``: tunnelling; ``_check_normals``: no normal);
-4. kernel parameters and history look-up (``_params``), the kernel (forces and
-   complex-step tangent, ``pairs.py``) on the active pairs;
-5. local force and tangent blocks over the pairs' 4 nodes, which the generic assembler
+1. broad phase (``search.py``: element spheres, ``scipy.spatial.cKDTree``) on the element
+   twists computed once per evaluation (``projection.element_twists``);
+2. pair rules (``rules.py``: no pair between elements sharing a node, the kind of each
+   element pair, closest points of crossings from ``projection.closest_points``);
+3. projection of the slave Gauss points (``projection.project_points``, compiled) and
+   ownership (``rules.owners``, ``rules.dedupe_points``: one owner per slave point, stable
+   at shared nodes), giving one typed ``record.PairSet``;
+4. refusals (``_check_sides``: tunnelling; ``_check_normals``: no normal);
+5. kernel parameters and history look-up (``_params``), then the compiled kernel of the
+   contact law (``kernel_jit``, ``law.ContactLaw``) on the active pairs (``_local_blocks``,
+   kept for the same poses and state);
+6. local force and tangent blocks over the pairs' 4 nodes, which the generic assembler
    (``assembly.System.assemble_blocks``) transforms and scatters like any contribution.
+
+``ContactSystem.timings`` accumulates the CPU time (``time.process_time``) of these parts
+(``TIMED``: search = twists, spheres and broad phase; rules; projection; params = refusals,
+active set and history look-up; kernel; blocks) for benchmarks and profiles.
 
 Per step it keeps the friction history and augmented-Lagrangian multipliers,
 keyed by material slave point and master beam, committed only when a step is
@@ -28,6 +36,8 @@ at the onset of sliding is ``slip_tolerance`` times the slave element length
 ``pairs.stick_penalty``).
 """
 
+import time
+
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -39,13 +49,14 @@ from .law import default_penalty
 from . import kernel_jit, pairs
 from .kernel_jit import contact_kernel, kernel_and_tangent      # compiled; pairs.py's are the oracle
 from .options import SMOOTHING, ContactOptions
-from .pairs import LINE, NORMAL_TOL, ORTHOGONAL, POINT, _section, material_frames, no_normal
+from .pairs import LINE, NORMAL_TOL, POINT, material_frames, no_normal
 from .record import Candidates, PairSet
-from .search import XI_TOL, broad_phase, closest_points, element_spheres
+from .projection import closest_points, element_twists, project_points, section_points
+from .search import broad_phase, element_spheres
+from . import rules
 
 MAX_AUGMENT = 30
-XI_OVERHANG = 0.05        # accepted projection past an inner node, in element lengths (kinks of the C0 line)
-OWNER_TIE = 1e-9          # distances equal within this fraction of R1 + R2 tie (a point on a shared node)
+TIMED = ("search", "rules", "projection", "params", "kernel", "blocks")   # parts of ``ContactSystem.timings``
 
 
 def use_numpy_kernel(flag=True):
@@ -79,6 +90,7 @@ class _Decl:
         self.point_ratio = o.point_ratio
         self.margin = 2.0 * max(s.radius for s in secs) if o.margin is None else o.margin
         self.smoothing = o.smoothing          # None: SMOOTHING * (R1 + R2) per pair
+        self.law = o.law                      # None: the kernel's default law
 
 
 class ContactSystem(Contribution):
@@ -114,6 +126,10 @@ class ContactSystem(Contribution):
         self._prev_points = np.zeros(0, dtype=np.int64)
         self._prev_owners = np.zeros(0, dtype=np.int64)   # Gauss-point key * n_elements + master element
         self._H_prev = None        # last converged poses (start of the step)
+        self._geo = self._geo_prev = None    # (poses, element twists) of the last evaluation / of H_prev
+        self._blocks = None        # (poses, local blocks) of the last evaluation, for the same state
+        self.timings = dict.fromkeys(TIMED, 0.0)
+        self._clock = time.process_time()
 
     # ------------------------------------------------------------ history
     def get_state(self):
@@ -132,6 +148,7 @@ class ContactSystem(Contribution):
 
     def set_state(self, state):
         """Restore a state from ``get_state`` (missing parts: empty; older archives lack some)."""
+        self._blocks = None
         hist = self._empty_history()
         for k in hist:
             if f"history.{k}" in state:
@@ -143,7 +160,7 @@ class ContactSystem(Contribution):
         self._mult = self._mult_committed
         for name in ("prev_points", "prev_owners"):
             if name in state:
-                setattr(self, f"_{name}", np.asarray(state[name], dtype=np.int64))
+                setattr(self, f"_{name}", np.sort(np.asarray(state[name], dtype=np.int64)))
 
     @staticmethod
     def _empty_history():
@@ -158,6 +175,32 @@ class ContactSystem(Contribution):
         idx = np.clip(np.searchsorted(keys_sorted, keys), 0, len(keys_sorted) - 1)
         return idx, keys_sorted[idx] == keys
 
+    def _lap(self, part=None):
+        """Add the CPU time since the last lap to ``timings[part]`` (``None``: start a lap)."""
+        t = time.process_time()
+        if part is not None:
+            self.timings[part] += t - self._clock
+        self._clock = t
+
+    # ------------------------------------------------------------ geometry
+    def _twists(self, H):
+        """Twists ``(n_elements, 6)`` of all elements at ``H`` (compiled; kept for the same poses)."""
+        g = self._geo
+        if g is None or g[0].shape != H.shape or not np.array_equal(g[0], H):
+            g = self._geo = (np.array(H, dtype=float), element_twists(H, self.sys.enodes))
+        return g
+
+    def _points(self, H, e, xi, prev=False):
+        """Centre points ``(k, 3)`` of the sections ``xi`` of elements ``e`` at ``H`` (``prev``: at the
+        last converged poses, whose twists are kept for the step)."""
+        if prev:
+            if self._geo_prev is None:
+                self._geo_prev = (self._H_prev, element_twists(self._H_prev, self.sys.enodes))
+            Hc, h = self._geo_prev
+        else:
+            Hc, h = self._twists(H)
+        return section_points(Hc, self.sys.enodes[e, 0], h[e], xi)[0]
+
     # ------------------------------------------------------------ search
     def pairs(self, H):
         """All potential contact pairs at poses ``H`` (a ``PairSet``, None if there are none).
@@ -167,6 +210,7 @@ class ContactSystem(Contribution):
         owner per slave point; the owners are remembered for the next evaluation.
         """
         out, chosen, owners = [], [], []
+        self._lap()
         for d in self.decls:
             c = self._candidates(d, H)
             part, ids = self._point_pairs(d, H, c)
@@ -175,8 +219,8 @@ class ContactSystem(Contribution):
             part, ids = self._gauss_pairs(d, H, c)
             out.append(part)
             owners.append(ids)
-        self._prev_points = np.concatenate(chosen) if chosen else np.zeros(0, dtype=np.int64)
-        self._prev_owners = np.concatenate(owners) if owners else np.zeros(0, dtype=np.int64)
+        self._prev_points = np.sort(np.concatenate(chosen)) if chosen else np.zeros(0, dtype=np.int64)
+        self._prev_owners = np.sort(np.concatenate(owners)) if owners else np.zeros(0, dtype=np.int64)
         out = [p for p in out if len(p)]
         return PairSet.concatenate(out) if out else None
 
@@ -185,25 +229,25 @@ class ContactSystem(Contribution):
         their kind (line below ``line_angle``, else point or orthogonal by the reduced-Hessian
         ratio; search.py) and the closest points of non-line pairs."""
         en = self.sys.enodes
-        cs, rs, hs, ts = element_spheres(H, en[d.slave_el], self.el_radius[d.slave_el], d.margin)
-        cm, rm, hm, tm = element_spheres(H, en[d.master_el], self.el_radius[d.master_el], d.margin)
+        H, h = self._twists(H)
+        cs, rs, hs, ts = element_spheres(H, en[d.slave_el], h[d.slave_el], self.el_radius[d.slave_el], d.margin)
+        cm, rm, hm, tm = element_spheres(H, en[d.master_el], h[d.master_el], self.el_radius[d.master_el], d.margin)
         i, j = broad_phase(cs, rs, cm, rm)
+        self._lap("search")
         e, m = d.slave_el[i], d.master_el[j]
-        # elements sharing a node (a beam joined to another) never pair
-        share = np.isin(en[e], en[m]).any(axis=1)
-        i, j, e, m = i[~share], j[~share], e[~share], m[~share]
-        angle = np.arccos(np.clip(np.abs(np.sum(ts[i] * tm[j], axis=1)), 0.0, 1.0))
-        big = angle >= d.line_angle
+        keep = rules.apart(en, e, m)
+        i, j, e, m = i[keep], j[keep], e[keep], m[keep]
         kinds = np.full(len(i), LINE)
         xi1, xi2 = np.zeros(len(i)), np.zeros(len(i))
-        if big.any():
-            b = np.flatnonzero(big)
-            x1, x2, ratio = closest_points(H[en[e[b], 0]], hs[i[b]], H[en[m[b], 0]], hm[j[b]])
-            pt = ratio >= d.point_ratio
-            kinds[b[pt]] = POINT
-            kinds[b[~pt]] = ORTHOGONAL
+        b = np.flatnonzero(rules.crossing(ts[i], tm[j], d.line_angle))
+        if len(b):
+            self._lap("rules")
+            x1, x2, ratio = closest_points(H, en[e[b], 0], hs[i[b]], en[m[b], 0], hm[j[b]])
+            self._lap("projection")
+            kinds[b] = rules.point_or_orthogonal(ratio, d.point_ratio)
             xi1[b], xi2[b] = x1, x2
-            kinds = self._extend_wrap(e, m, kinds)
+            kinds = rules.extend_wrap(en, self.el_beam[m], self.n_beams, e, m, kinds)
+        self._lap("rules")
         return Candidates(e=e, m=m, kind=kinds, xi1=xi1, xi2=xi2, h1=hs[i], h2=hm[j], c2=cm[j], r2=rm[j])
 
     def _record(self, d, kind, e, m, xi1, xi2, weight, key, gp):
@@ -213,25 +257,28 @@ class ContactSystem(Contribution):
                        decl=np.full(len(e), d.index), nodes=nodes, R1=self.el_radius[e], R2=self.el_radius[m])
 
     def _point_pairs(self, d, H, c):
-        """Point-to-point pairs: one per crossing (``_dedupe_points``), on both elements up to
-        ``XI_OVERHANG`` past an inner node.  Returns the record and the chosen element pairs."""
+        """Point-to-point pairs: one per crossing (``rules.dedupe_points``), on both elements up to
+        ``rules.XI_OVERHANG`` past an inner node.  Returns the record and the chosen element pairs."""
         n_el = len(self.sys.enodes)
         pt = np.flatnonzero(c.kind == POINT)
         e, m, x1, x2 = c.e[pt], c.m[pt], c.xi1[pt], c.xi2[pt]
         lo1, hi1 = self._xi_range(e)
         lo2, hi2 = self._xi_range(m)
         pt = pt[(x1 >= lo1) & (x1 <= hi1) & (x2 >= lo2) & (x2 <= hi2)]
-        e, m = c.e[pt], c.m[pt]
-        keep = self._dedupe_points(H, e, m, c.xi1[pt], c.xi2[pt], np.arange(len(pt)))
+        e, m, x1, x2 = c.e[pt], c.m[pt], c.xi1[pt], c.xi2[pt]
+        keep = rules.dedupe_points(self._points(H, e, x1), self._points(H, m, x2), x1, x2,
+                                   self.el_radius[e] + self.el_radius[m], self.el_beam[e] * self.n_beams + self.el_beam[m],
+                                   _member(e * n_el + m, self._prev_points))
         pt, e, m = pt[keep], e[keep], m[keep]
         key = self.point_offset + (np.int64(d.index) * n_el + e) * n_el + m
         rec = self._record(d, np.full(len(pt), POINT), e, m, c.xi1[pt], c.xi2[pt], self.sys.L[e], key,
                            np.zeros(len(pt), int))
+        self._lap("rules")
         return rec, e * n_el + m
 
     def _gauss_pairs(self, d, H, c):
         """Line and orthogonal projections of the slave Gauss points; one owner per slave
-        point and master beam (``_owners``).  Returns the record and the owner ids."""
+        point and master beam (``rules.owners``).  Returns the record and the owner ids."""
         en = self.sys.enodes
         gp = np.flatnonzero(c.kind != POINT)
         xg, wg = np.polynomial.legendre.leggauss(d.n_gp)
@@ -240,119 +287,29 @@ class ContactSystem(Contribution):
         g = np.tile(np.arange(d.n_gp), len(gp))
         e, m, h1, h2 = c.e[rep], c.m[rep], c.h1[rep], c.h2[rep]
         xi1 = xg[g]
-        HC, _, _ = _section(H[en[e, 0]], h1, xi1)
+        H, _ = self._twists(H)
+        xc, _ = section_points(H, en[e, 0], h1, xi1)
         # a slave Gauss point outside the master element's sphere (grown by R1) cannot
         # touch that element: no projection for it
-        xc = HC[:, :3, 3]
-        near = np.sum((xc - c.c2[rep, :3, 3]) ** 2, axis=1) <= (c.r2[rep] + self.el_radius[e]) ** 2
-        rep, g, e, m, h1, h2, xi1, xc = rep[near], g[near], e[near], m[near], h1[near], h2[near], xi1[near], xc[near]
+        near = np.sum((xc - c.c2[rep]) ** 2, axis=1) <= (c.r2[rep] + self.el_radius[e]) ** 2
+        rep, g, e, m, h1, h2, xi1 = rep[near], g[near], e[near], m[near], h1[near], h2[near], xi1[near]
         kind = c.kind[rep]
-        # start from the projection on the master chord (8 Newton iterations, compiled: kernel_jit.project
-        # equals pairs._project; the kernel polishes the point with 2 more and needs it converged for an
-        # exact tangent)
-        xa, xb = H[en[m, 0], :3, 3], H[en[m, 1], :3, 3]
-        chord = xb - xa
-        xi2 = np.clip(np.sum((xc - xa) * chord, axis=1) / np.maximum(np.sum(chord * chord, axis=1), 1e-300),
-                      0.0, 1.0)
-        _, xi2 = kernel_jit.project(kind, H[en[e, 0]], h1, xi1, H[en[m, 0]], h2, xi2, iterations=8)
-        HF, _, _ = _section(H[en[m, 0]], h2, xi2)
-        dist = np.linalg.norm(HF[:, :3, 3] - xc, axis=1)
+        # from the projection on the master chord, 8 Newton iterations (compiled, projection.py; the
+        # kernel polishes the point with 2 more and needs it converged for an exact tangent)
+        xi2, dist = project_points(H, kind, en[e, 0], h1, xi1, en[m, 0], en[m, 1], h2, iterations=8)
+        self._lap("projection")
         lo, hi = self._xi_range(m)
         ok = (xi2 >= lo) & (xi2 <= hi) & np.isfinite(dist)
         key = ((np.int64(d.index) * len(en) + e) * self.max_gp + g) * self.n_beams + self.el_beam[m]
-        s = self._owners(np.flatnonzero(ok), key, m, xi2, dist, self.el_radius[e] + self.el_radius[m])
+        known = _member(key * len(en) + m, self._prev_owners)
+        s = rules.owners(np.flatnonzero(ok), key, xi2, dist, self.el_radius[e] + self.el_radius[m], known)
         rec = self._record(d, kind[s], e[s], m[s], xi1[s], xi2[s], wg[g[s]] * self.sys.L[e[s]], key[s], g[s])
+        self._lap("rules")
         return rec, key[s] * len(en) + m[s]
 
     def _xi_range(self, el):
-        """Accepted projections ``[lo, hi]`` on elements ``el``: ``XI_OVERHANG`` past an inner
-        node (at a kink of the C0 centre line the closest point of either element's extension
-        lies just past the shared node: without it the point would be lost), ``XI_TOL`` at a
-        beam end."""
-        lo = np.where(self.el_first[el], -XI_TOL, -XI_OVERHANG)
-        hi = np.where(self.el_last[el], 1.0 + XI_TOL, 1.0 + XI_OVERHANG)
-        return lo, hi
-
-    def _owners(self, cand, key, m, xi2, dist, rsum):
-        """One master element per slave Gauss point and master beam (``key``), among ``cand``.
-
-        Priority: a projection inside its element over one on an extension (overhang);
-        then the nearest, where distances within ``OWNER_TIE`` (R1 + R2) count as equal
-        (a point projecting on a node shared by two elements, to round-off); among equals
-        the owner of the last evaluation (no flip-flop inside Newton), then the element
-        on which the point lies at its start (smaller ``xi2``).
-        """
-        if len(cand) == 0:
-            return cand
-        k, x = key[cand], xi2[cand]
-        outside = (x < -XI_TOL) | (x > 1.0 + XI_TOL)
-        order = np.lexsort((dist[cand], outside, k))
-        c = cand[order]
-        head = np.concatenate([[True], (k[order][1:] != k[order][:-1]) | (outside[order][1:] != outside[order][:-1])])
-        best = np.maximum.accumulate(np.where(head, np.arange(len(c)), 0))
-        tie = dist[c] <= dist[c[best]] + OWNER_TIE * rsum[c]
-        known = np.isin(key[c] * len(self.sys.enodes) + m[c], self._prev_owners)
-        order = np.lexsort((xi2[c], ~known, ~tie, outside[order], key[c]))
-        c = c[order]
-        first = np.concatenate([[True], key[c][1:] != key[c][:-1]])
-        return c[first]
-
-    def _extend_wrap(self, e, m, kinds):
-        """A straight slave element leaving a wrap tangentially (it shares a node with an
-        ``ORTHOGONAL`` element against the same master beam) is projected orthogonally
-        too: its closest point to the master sits at its end, where a point pair would
-        switch on and off as the tangent point moves (search.py, rule 3)."""
-        orth = kinds == ORTHOGONAL
-        if not orth.any() or orth.all():
-            return kinds
-        en = self.sys.enodes
-        nb = self.n_beams
-        mb = self.el_beam[m]
-        wrap = np.unique((en[e[orth]] * nb + mb[orth, None]).ravel())
-        pt = np.flatnonzero(kinds == POINT)
-        near = np.isin(en[e[pt]] * nb + mb[pt, None], wrap).any(axis=1)
-        kinds = kinds.copy()
-        kinds[pt[near]] = ORTHOGONAL
-        return kinds
-
-    def _dedupe_points(self, H, e, m, xi1, xi2, idx):
-        """One point pair per crossing: at a node where two elements meet (a kink of the
-        C0 centre line) each element has its own closest point; keep the nearest
-        of pairs of the same two beams lying within ``R1 + R2`` of each other."""
-        if len(idx) < 2:
-            return idx
-        en = self.sys.enodes
-        xC = _interp_pos(H, en, e, xi1)
-        xF = _interp_pos(H, en, m, xi2)
-        dist = np.linalg.norm(xF - xC, axis=1)
-        rad = self.el_radius[e] + self.el_radius[m]
-        group = self.el_beam[e] * self.n_beams + self.el_beam[m]
-        # hysteresis: a pair chosen at the last evaluation keeps priority, so the
-        # choice cannot flip between the two elements of a kink inside Newton
-        known = np.isin(e * len(en) + m, self._prev_points)
-        outside = (xi1 < -XI_TOL) | (xi1 > 1.0 + XI_TOL) | (xi2 < -XI_TOL) | (xi2 > 1.0 + XI_TOL)
-        order = np.lexsort((dist, ~known, outside, group))
-        rank = np.empty(len(order), dtype=int)
-        rank[order] = np.arange(len(order))
-        # candidate pairs (a dominates b: higher priority, same beams, both points close)
-        ij = cKDTree(xC).query_pairs(float(rad.max()), output_type="ndarray")
-        if len(ij) == 0:
-            return idx
-        a, b = ij[:, 0], ij[:, 1]
-        swap = rank[a] > rank[b]
-        a, b = np.where(swap, b, a), np.where(swap, a, b)
-        close = ((group[a] == group[b]) & (np.linalg.norm(xC[a] - xC[b], axis=1) < rad[b])
-                 & (np.linalg.norm(xF[a] - xF[b], axis=1) < rad[b]))
-        a, b = a[close], b[close]
-        # greedy in priority order, as a fixed point: dropped iff a kept pair dominates it
-        dropped = np.zeros(len(idx), dtype=bool)
-        for _ in range(len(idx)):
-            new = np.zeros(len(idx), dtype=bool)
-            new[b[~dropped[a]]] = True
-            if np.array_equal(new, dropped):
-                break
-            dropped = new
-        return idx[~dropped]
+        """Accepted projections ``[lo, hi]`` on elements ``el`` (``rules.xi_range``)."""
+        return rules.xi_range(self.el_first[el], self.el_last[el])
 
     def _params(self, P, sel, H):
         """Kernel parameters for the pairs ``sel`` (history and multipliers looked up)."""
@@ -410,9 +367,9 @@ class ContactSystem(Contribution):
         hist = self._history
         en, nb = self.sys.enodes, self.n_beams
         e, m = P.e[sel][cand], P.m[sel][cand]
-        x = _interp_pos(H, en, e, p["xi1"][cand])
+        x = self._points(H, e, p["xi1"][cand])
         he, hm = hist["e"][hp], hist["m"][hp]
-        hx = _interp_pos(H, en, he, hist["xi1"][hp])       # the stored material points, now
+        hx = self._points(H, he, hist["xi1"][hp])       # the stored material points, now
         hdecl = (hist["key"][hp] - self.point_offset) // (np.int64(len(en)) * len(en))
         g_new = (P.decl[sel][cand] * nb + self.el_beam[e]) * nb + self.el_beam[m]
         g_old = (hdecl * nb + self.el_beam[he]) * nb + self.el_beam[hm]
@@ -446,8 +403,7 @@ class ContactSystem(Contribution):
 
     def _active(self, P, H):
         """Pairs whose trial normal traction is positive, with their kernel parameters."""
-        xC = _interp_pos(H, self.sys.enodes, P.e, P.xi1)
-        xF = _interp_pos(H, self.sys.enodes, P.m, P.xi2)
+        xC, xF = self._points(H, P.e, P.xi1), self._points(H, P.m, P.xi2)
         gap = np.linalg.norm(xF - xC, axis=1) - P.R1 - P.R2
         pen = self._decl_penalty[P.decl]
         mi, mf = self._lookup(self._mult[0], P.key)
@@ -466,8 +422,7 @@ class ContactSystem(Contribution):
 
     def _check_normals(self, P, sel, H):
         """Refuse (a step failure: cut back) pairs whose centre lines intersect: no normal."""
-        xC = _interp_pos(H, self.sys.enodes, P.e[sel], P.xi1[sel])
-        xF = _interp_pos(H, self.sys.enodes, P.m[sel], P.xi2[sel])
+        xC, xF = self._points(H, P.e[sel], P.xi1[sel]), self._points(H, P.m[sel], P.xi2[sel])
         bad = np.flatnonzero(no_normal(np.linalg.norm(xF - xC, axis=1), P.R1[sel], P.R2[sel]))
         if len(bad):
             k = sel[bad[0]]
@@ -487,9 +442,8 @@ class ContactSystem(Contribution):
         """
         if self._H_prev is None or self._H_prev.shape != H.shape:
             return
-        en = self.sys.enodes
-        d = _interp_pos(H, en, P.m, P.xi2) - _interp_pos(H, en, P.e, P.xi1)
-        d0 = _interp_pos(self._H_prev, en, P.m, P.xi2) - _interp_pos(self._H_prev, en, P.e, P.xi1)
+        d = self._points(H, P.m, P.xi2) - self._points(H, P.e, P.xi1)
+        d0 = self._points(H, P.m, P.xi2, prev=True) - self._points(H, P.e, P.xi1, prev=True)
         rsum = P.R1 + P.R2
         seen = ~no_normal(np.linalg.norm(d0, axis=1), P.R1, P.R2)
         flip = np.flatnonzero(seen & (np.sum(d * d0, axis=1) < -(NORMAL_TOL * rsum) ** 2))
@@ -507,51 +461,100 @@ class ContactSystem(Contribution):
         """Frictionless contact has a potential (symmetric tangent at equilibrium)."""
         return not any(d.mu > 0 for d in self.decls)
 
+    def _local_blocks(self, H, tangent):
+        """``(P, sel, p, f, K, out)`` at poses ``H``: pairs, active ones, kernel parameters, local
+        wrenches ``(m, 4, 6)``, tangent blocks ``(m, 24, 24)`` and point data; None without active pairs.
+
+        Kept for the same poses and contact state (``_blocks``, cleared when the state changes):
+        the tangent evaluation at an accepted line-search trial reuses the trial's (the compiled
+        kernel computes the tangent with the forces; the numpy oracle only when asked).
+        """
+        c = self._blocks
+        if c is not None and np.array_equal(c[0], H) and (c[1] is None or c[1][4] is not None or not tangent):
+            return c[1]
+        tangent = tangent or kernel_and_tangent is not pairs.kernel_and_tangent
+        P = self.pairs(H)
+        self._lap()
+        sel = np.zeros(0, dtype=int)
+        if P is not None:
+            self._check_sides(P, H)
+            sel = self._active(P, H)
+        if len(sel) == 0:
+            self._blocks = (np.array(H), None)
+            return None
+        self._check_normals(P, sel, H)
+        p = self._params(P, sel, H)
+        self._lap("params")
+        f, K, out = self._kernels(H[P.nodes[sel]], p, P.decl[sel], tangent)
+        self._lap("kernel")
+        # kept for commit/augment at the same poses (the converged iterate): no second pass
+        if (p["mu"] > 0).all() or not (p["mu"] > 0).any():
+            self._cache = (H.copy(), P, sel, p, out)
+        self._blocks = (np.array(H), (P, sel, p, f, K, out))
+        return self._blocks[1]
+
+    def kernel_inputs(self, H):
+        """Node poses ``(m, 4, 4, 4)`` and kernel parameters (dict of arrays) of the pairs active at
+        ``H``, as the kernel receives them (benchmarks, tests); ``None`` without active pairs."""
+        P = self.pairs(H)
+        if P is None:
+            return None
+        sel = self._active(P, H)
+        if len(sel) == 0:
+            return None
+        return H[P.nodes[sel]], self._params(P, sel, H)
+
+    def _kernels(self, X, p, decl, tangent, friction=None):
+        """The kernel of each declaration's law on the pairs with friction and on those without
+        (``friction``: the friction branch for all): ``f``, ``K`` (or None), ``out``."""
+        laws = [d.law for d in self.decls]
+        if any(law is not None for law in laws) and kernel_and_tangent is pairs.kernel_and_tangent:
+            raise InputError("contact: the numpy oracle kernel (use_numpy_kernel) has only the default law; "
+                             f"add_contact declared law={next(law for law in laws if law is not None)!r}")
+        fric = p["mu"] > 0 if friction is None else np.full(len(X), friction)
+        group = np.unique([id(law) for law in laws], return_inverse=True)[1][decl] * 2 + fric
+        kinds = np.unique(group)
+        if len(kinds) == 1:                     # one kind: no masked copies of the (m, 24, 24) blocks
+            return _kernel(X, p, bool(kinds[0] % 2), laws[decl[0]], tangent)
+        f = np.zeros((len(X), 4, 6))
+        K = np.zeros((len(X), 24, 24)) if tangent else None
+        out = {}
+        for g in kinds:
+            mask = group == g
+            pm = {k: (v[mask] if np.ndim(v) else v) for k, v in p.items()}
+            fm, Km, om = _kernel(X[mask], pm, bool(g % 2), laws[decl[np.argmax(mask)]], tangent)
+            if tangent:
+                K[mask] = Km
+            f[mask] = fm
+            for k, v in om.items():
+                if k not in out:
+                    out[k] = np.zeros((len(X),) + np.shape(v)[1:], dtype=np.asarray(v).dtype)
+                out[k][mask] = v
+        return f, K, out
+
     def evaluate(self, H, tangent=True):
         """Local blocks of the active pairs and point data: ``(blocks.Blocks, info)``.
 
         Blocks over the pair's 4 nodes (slave A, B, master A, B): ``f`` ``(m, 24)`` is the
         contact's part of the residual (minus the contact forces on the nodes) and ``K``
         ``(m, 24, 24)`` its derivative in the nodes' body increments; the generic assembler
-        (``assembly.System.assemble_blocks``) transforms and scatters them.
+        (``assembly.System.assemble_blocks``) transforms and scatters them.  The kernel's results
+        are kept for the same poses and state (``_local_blocks``).
         """
-        empty = Blocks.empty(4, tangent)
-        P = self.pairs(H)
-        if P is None:
-            return empty, dict(n_active=0)
-        self._check_sides(P, H)
-        sel = self._active(P, H)
-        if len(sel) == 0:
-            return empty, dict(n_active=0)
-        self._check_normals(P, sel, H)
-        p = self._params(P, sel, H)
-        X = H[P.nodes[sel]]
-        fric = p["mu"] > 0
-        f = np.zeros((len(sel), 4, 6))
-        K = np.zeros((len(sel), 24, 24)) if tangent else None
-        out = {}
-        for mask, use_fric in ((fric, True), (~fric, False)):
-            if not mask.any():
-                continue
-            pm = {k: (v[mask] if np.ndim(v) else v) for k, v in p.items()}
-            if tangent:
-                fm, Km, om = kernel_and_tangent(X[mask], pm, friction=use_fric)
-                K[mask] = Km
-            else:
-                fm, om = contact_kernel(X[mask], pm, friction=use_fric)
-            f[mask] = fm
-            for k, v in om.items():
-                if k not in out:
-                    out[k] = np.zeros((len(sel),) + np.shape(v)[1:], dtype=np.asarray(v).dtype)
-                out[k][mask] = v
-        # kept for commit/augment at the same poses (the converged iterate): no second pass
-        if fric.all() or not fric.any():
-            self._cache = (H.copy(), P, sel, p, out)
-        return Blocks(P.nodes[sel], -f.reshape(-1, 24), -K if tangent else None), dict(n_active=len(sel))
+        blocks = self._local_blocks(H, tangent)
+        self._lap()
+        if blocks is None:
+            return Blocks.empty(4, tangent), dict(n_active=0)
+        P, sel, p, f, K, out = blocks
+        b = Blocks(P.nodes[sel], -f.reshape(-1, 24), -K if tangent else None)
+        self._lap("blocks")
+        return b, dict(n_active=len(sel))
 
     # ------------------------------------------------------------ per step
     def begin_step(self, H, t):
+        self._blocks = None
         self._H_prev = np.array(H, dtype=float)
+        self._geo_prev = None
         self._mult = self._mult_committed
         self._augments = 0
 
@@ -570,8 +573,7 @@ class ContactSystem(Contribution):
         if len(sel):
             fric = p["mu"] > 0
             # the full kernel (with friction frames) for every active pair
-            _, out = contact_kernel(H[P.nodes[sel]], p, friction=True) if fric.any() else \
-                contact_kernel(H[P.nodes[sel]], p, friction=False)
+            _, _, out = self._kernels(H[P.nodes[sel]], p, P.decl[sel], False, friction=bool(fric.any()))
             if not fric.any():
                 out["slip"] = np.zeros((len(sel), 2))
         return P, sel, (p, out)
@@ -613,10 +615,12 @@ class ContactSystem(Contribution):
         order = np.argsort(keys)
         self._mult = (keys[order], lam[order])
         self._augments += 1
+        self._blocks = None
         return True
 
     def commit(self, H):
         """Store friction history and multipliers of the converged state."""
+        self._blocks = None
         self._mult_committed = self._mult
         P, sel, po = self._state(H)
         if P is None or len(sel) == 0:
@@ -680,6 +684,22 @@ def _frames(out):
     HL[:, :3, 3] = out["xC"]
     HK[:, :3, 3] = out["xF"]
     return HL, HK
+
+
+def _kernel(X, p, friction, law, tangent):
+    """``f``, ``K`` (None without ``tangent`` on the numpy path) and point data of one kernel call."""
+    if tangent:
+        return kernel_and_tangent(X, p, friction=friction, **({} if law is None else dict(law=law)))
+    f, out = contact_kernel(X, p, friction=friction, **({} if law is None else dict(law=law)))
+    return f, None, out
+
+
+def _member(a, b_sorted):
+    """``np.isin(a, b_sorted)`` for a sorted ``b_sorted`` (binary search)."""
+    if len(b_sorted) == 0:
+        return np.zeros(len(a), dtype=bool)
+    i = np.minimum(np.searchsorted(b_sorted, a), len(b_sorted) - 1)
+    return b_sorted[i] == a
 
 
 def _interp_pose(H, enodes, e, xi):

@@ -1,0 +1,121 @@
+"""Pair rules of the contact search: which element pairs and slave points become contact pairs.
+
+Pure functions over arrays (no state: the hysteresis inputs, the owners chosen at the
+last evaluation, are arguments).  The stages, in the order ``ContactSystem.pairs`` runs them:
+
+1. ``apart``: elements sharing a node (a beam joined to another) never pair;
+2. ``crossing``: line contact below ``line_angle``, else ``point_or_orthogonal`` by the
+   reduced-Hessian ratio (search.py, rules 1-2), and ``extend_wrap`` (rule 3);
+3. ``xi_range``: accepted projection parameters on an element;
+4. ownership: ``owners`` (one master element per slave Gauss point and master beam) and
+   ``dedupe_points`` (one point pair per crossing).
+"""
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .pairs import ORTHOGONAL, POINT
+from .search import XI_TOL
+
+__all__ = ["apart", "crossing", "point_or_orthogonal", "extend_wrap", "xi_range", "owners", "dedupe_points", "XI_OVERHANG", "OWNER_TIE"]
+
+XI_OVERHANG = 0.05        # accepted projection past an inner node, in element lengths (kinks of the C0 line)
+OWNER_TIE = 1e-9          # distances equal within this fraction of R1 + R2 tie (a point on a shared node)
+
+
+def apart(enodes, e, m):
+    """Mask of the element pairs ``(e, m)`` that share no node."""
+    return ~np.isin(enodes[e], enodes[m]).any(axis=1)
+
+
+def point_or_orthogonal(ratio, point_ratio):
+    """Kind of crossing element pairs: ``POINT`` where the reduced-Hessian ``ratio`` is at least
+    ``point_ratio`` (an isolated crossing), else ``ORTHOGONAL`` (wrapping)."""
+    return np.where(ratio >= point_ratio, POINT, ORTHOGONAL)
+
+
+def crossing(t_slave, t_master, line_angle):
+    """Mask of the element pairs at or above ``line_angle`` (those needing their closest points)."""
+    return np.arccos(np.clip(np.abs(np.sum(t_slave * t_master, axis=1)), 0.0, 1.0)) >= line_angle
+
+
+def extend_wrap(enodes, master_beam, n_beams, e, m, kind):
+    """A straight slave element leaving a wrap tangentially (it shares a node with an
+    ``ORTHOGONAL`` element against the same master beam, ``master_beam[k]`` the beam of ``m[k]``)
+    is projected orthogonally too: its closest point to the master sits at its end, where a
+    point pair would switch on and off as the tangent point moves (search.py, rule 3)."""
+    orth = kind == ORTHOGONAL
+    if not orth.any() or orth.all():
+        return kind
+    wrap = np.unique((enodes[e[orth]] * n_beams + master_beam[orth, None]).ravel())
+    pt = np.flatnonzero(kind == POINT)
+    near = np.isin(enodes[e[pt]] * n_beams + master_beam[pt, None], wrap).any(axis=1)
+    kind = kind.copy()
+    kind[pt[near]] = ORTHOGONAL
+    return kind
+
+
+def xi_range(first, last):
+    """Accepted projections ``[lo, hi]`` on elements, given whether each is the first / last of
+    its beam: ``XI_OVERHANG`` past an inner node (at a kink of the C0 centre line the closest
+    point of either element's extension lies just past the shared node: without it the point
+    would be lost), ``XI_TOL`` at a beam end."""
+    return np.where(first, -XI_TOL, -XI_OVERHANG), np.where(last, 1.0 + XI_TOL, 1.0 + XI_OVERHANG)
+
+
+def owners(cand, key, xi2, dist, rsum, known):
+    """One master element per slave Gauss point and master beam (``key``), among ``cand``.
+
+    Priority: a projection inside its element over one on an extension (overhang);
+    then the nearest, where distances within ``OWNER_TIE`` (R1 + R2) count as equal
+    (a point projecting on a node shared by two elements, to round-off); among equals
+    the owner of the last evaluation (``known``, over all rows: no flip-flop inside
+    Newton), then the element on which the point lies at its start (smaller ``xi2``).
+    """
+    if len(cand) == 0:
+        return cand
+    k, x = key[cand], xi2[cand]
+    outside = (x < -XI_TOL) | (x > 1.0 + XI_TOL)
+    order = np.lexsort((dist[cand], outside, k))
+    c = cand[order]
+    head = np.concatenate([[True], (k[order][1:] != k[order][:-1]) | (outside[order][1:] != outside[order][:-1])])
+    best = np.maximum.accumulate(np.where(head, np.arange(len(c)), 0))
+    tie = dist[c] <= dist[c[best]] + OWNER_TIE * rsum[c]
+    order = np.lexsort((xi2[c], ~known[c], ~tie, outside[order], key[c]))
+    c = c[order]
+    first = np.concatenate([[True], key[c][1:] != key[c][:-1]])
+    return c[first]
+
+
+def dedupe_points(xC, xF, xi1, xi2, rad, group, known):
+    """Indices of the point pairs kept, one per crossing: at a node where two elements meet
+    (a kink of the C0 centre line) each element has its own closest point; of pairs of the
+    same two beams (``group``) lying within ``R1 + R2`` (``rad``) of each other the nearest is
+    kept, a pair chosen at the last evaluation (``known``) first, so the choice cannot flip
+    between the two elements of a kink inside Newton.  ``xC``, ``xF``: centre points ``(k, 3)``."""
+    idx = np.arange(len(xC))
+    if len(idx) < 2:
+        return idx
+    dist = np.linalg.norm(xF - xC, axis=1)
+    outside = (xi1 < -XI_TOL) | (xi1 > 1.0 + XI_TOL) | (xi2 < -XI_TOL) | (xi2 > 1.0 + XI_TOL)
+    order = np.lexsort((dist, ~known, outside, group))
+    rank = np.empty(len(order), dtype=int)
+    rank[order] = np.arange(len(order))
+    # candidate pairs (a dominates b: higher priority, same beams, both points close)
+    ij = cKDTree(xC).query_pairs(float(rad.max()), output_type="ndarray")
+    if len(ij) == 0:
+        return idx
+    a, b = ij[:, 0], ij[:, 1]
+    swap = rank[a] > rank[b]
+    a, b = np.where(swap, b, a), np.where(swap, a, b)
+    close = ((group[a] == group[b]) & (np.linalg.norm(xC[a] - xC[b], axis=1) < rad[b])
+             & (np.linalg.norm(xF[a] - xF[b], axis=1) < rad[b]))
+    a, b = a[close], b[close]
+    # greedy in priority order, as a fixed point: dropped iff a kept pair dominates it
+    dropped = np.zeros(len(idx), dtype=bool)
+    for _ in range(len(idx)):
+        new = np.zeros(len(idx), dtype=bool)
+        new[b[~dropped[a]]] = True
+        if np.array_equal(new, dropped):
+            break
+        dropped = new
+    return idx[~dropped]

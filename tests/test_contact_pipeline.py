@@ -1,0 +1,116 @@
+"""The staged contact pipeline (issue 14): compiled projections equal their numpy oracle, the
+evaluation kept for the same poses and state is the one a fresh evaluation gives, and the
+public per-stage timings."""
+import sys
+from pathlib import Path
+
+import numpy as np
+
+import beamsolver as bs
+from beamsolver import se3
+from beamsolver.problem import Problem
+from beamsolver.contact import pairs, projection
+from beamsolver.contact.system import TIMED
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+from test_contact_kernel_jit import _pairs  # noqa: E402
+
+import rolling  # noqa: E402
+
+
+def _poses(seed):
+    rng = np.random.default_rng(seed)
+    X, kinds, _, _ = _pairs(rng, 12, np.tile([1e-3, 0.1, 0.5, 0.7, 1.2, np.pi / 2], 2))
+    H = X.reshape(-1, 4, 4)                      # nodes 4 k .. 4 k + 3: A1, B1, A2, B2 of pair k
+    A1, A2 = 4 * np.arange(12), 4 * np.arange(12) + 2
+    h1 = se3.log(se3.relative(H[A1], H[A1 + 1]))
+    h2 = se3.log(se3.relative(H[A2], H[A2 + 1]))
+    return rng, H, kinds, A1, A2, h1, h2
+
+
+def test_element_twists_and_section_points_equal_the_numpy_sections():
+    rng, H, _, A1, _, h1, _ = _poses(1)
+    enodes = np.stack([A1, A1 + 1], axis=1)
+    np.testing.assert_array_equal(projection.element_twists(H, enodes), h1)
+    xi = rng.uniform(-0.05, 1.05, len(A1))
+    HC, _, _ = pairs._section(H[A1], h1, xi)
+    x, e1 = projection.section_points(H, A1, h1, xi)
+    np.testing.assert_allclose(x, HC[:, :3, 3], rtol=0, atol=1e-14)
+    np.testing.assert_allclose(e1, HC[:, :3, 0], rtol=0, atol=1e-14)
+
+
+def test_closest_points_equal_the_numpy_projection_and_ratio():
+    _, H, _, A1, A2, h1, h2 = _poses(2)
+    n = len(A1)
+    x1, x2 = pairs._project(np.full(n, pairs.POINT), H[A1], h1, np.full(n, 0.5), H[A2], h2, np.full(n, 0.5), 8)
+    H1, x1p, x1pp = pairs._section(H[A1], h1, x1)
+    H2, x2p, x2pp = pairs._section(H[A2], h2, x2)
+    d = H2[:, :3, 3] - H1[:, :3, 3]
+    h11 = np.sum(x1p * x1p, 1) - np.sum(d * x1pp, 1)
+    h22 = np.sum(x2p * x2p, 1) + np.sum(d * x2pp, 1)
+    ratio = (h11 - np.sum(x1p * x2p, 1) ** 2 / h22) / np.sum(x1p * x1p, 1)
+    y1, y2, r = projection.closest_points(H, A1, h1, A2, h2)
+    np.testing.assert_allclose(y1, x1, atol=1e-12)
+    np.testing.assert_allclose(y2, x2, atol=1e-12)
+    np.testing.assert_allclose(r, ratio, rtol=1e-10, atol=1e-12)
+
+
+def test_gauss_point_projection_equals_the_numpy_projection_from_the_chord():
+    rng, H, kinds, A1, A2, h1, h2 = _poses(3)
+    kinds = np.where(kinds == pairs.POINT, pairs.ORTHOGONAL, kinds)
+    xi1 = rng.uniform(0.1, 0.9, len(A1))
+    xc = pairs._section(H[A1], h1, xi1)[0][:, :3, 3]
+    xa, xb = H[A2, :3, 3], H[A2 + 1, :3, 3]
+    start = np.clip(np.sum((xc - xa) * (xb - xa), 1) / np.sum((xb - xa) ** 2, 1), 0.0, 1.0)
+    _, x2 = pairs._project(kinds, H[A1], h1, xi1, H[A2], h2, start, 8)
+    dist = np.linalg.norm(pairs._section(H[A2], h2, x2)[0][:, :3, 3] - xc, axis=1)
+    y2, ydist = projection.project_points(H, kinds, A1, h1, xi1, A2, A2 + 1, h2)
+    np.testing.assert_allclose(y2, x2, atol=1e-12)
+    np.testing.assert_allclose(ydist, dist, rtol=1e-12)
+
+
+def _residual(contact, H, tangent):
+    blocks, _ = contact.evaluate(H, tangent=tangent)
+    return contact.sys.assemble_blocks(H, blocks)
+
+
+def test_kept_evaluation_equals_a_fresh_one_and_follows_state_changes():
+    model, slave, _ = rolling.build(mu=0.5, n_elements=3)
+    sol = bs.solve(model, steps=2)
+    H = sol.poses[-1].copy()
+    H[slave.nodes, 0, 3] += 1e-4
+    state = {k[len("contact/"):]: v for k, v in sol.contact_state.items()}     # Problem.get_state: name/key
+    c = Problem.from_model(model).contact
+    c.set_state(state)
+    c.begin_step(sol.poses[-1], 1.0)
+    r0, _, _, _ = _residual(c, H, False)               # a line-search trial, residual only
+    r1, coo1, _, _ = _residual(c, H, True)              # the tangent at the same poses: kept
+    fresh = Problem.from_model(model).contact
+    fresh.set_state(state)
+    fresh.begin_step(sol.poses[-1], 1.0)
+    r2, coo2, _, _ = _residual(fresh, H, True)
+    np.testing.assert_array_equal(r0, r2)
+    np.testing.assert_array_equal(r1, r2)
+    np.testing.assert_array_equal(coo1[2], coo2[2])
+    # a new state at the same poses: not the kept evaluation (no history: no friction)
+    c.set_state({})
+    c.begin_step(sol.poses[-1], 1.0)
+    r3, _, _, _ = _residual(c, H, True)
+    none = Problem.from_model(model).contact
+    none.begin_step(sol.poses[-1], 1.0)
+    np.testing.assert_array_equal(r3, _residual(none, H, True)[0])
+    assert np.abs(r3 - r2).max() > 1e-6 * np.abs(r2).max()
+
+
+def test_stage_timings_are_public_and_accumulate():
+    model, _, _ = rolling.build(mu=0.5, n_elements=3)
+    problem = Problem.from_model(model)
+    c = problem.contact
+    H = problem.system.poses0.copy()
+    c.begin_step(H, 0.0)
+    assert set(c.timings) == set(TIMED) and all(v == 0.0 for v in c.timings.values())
+    for _ in range(20):
+        c.begin_step(H, 0.0)
+        c.evaluate(H, tangent=True)
+    assert all(c.timings[k] >= 0.0 for k in TIMED) and sum(c.timings.values()) > 0.0
