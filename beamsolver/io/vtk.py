@@ -15,7 +15,10 @@ Files in the output folder (``solve(model, output=folder)``, or
   frictionless), ``slip_increment`` (2), ``normal`` (3), ``kind``.  A step
   without contact has no points and one empty poly-vertex cell (VTK type 2):
   meshio cannot read a file without cells, and skips that one with a warning.
-- ``beams.pvd`` and ``contact.pvd``: the collections with the pseudo-times.
+- ``beams.pvd`` and ``contact.pvd``: the collections with the pseudo-times,
+  or with the step numbers when the pseudo-times do not increase from step to
+  step (an arc-length run, ``solve(path="arc-length")``, goes back in ``t``
+  past a limit point; ParaView sorts a collection by its times).
 - ``solution.npz``: the ``Solution`` (``io.archive``), saved at the end of the
   run (also when it stops with ``ConvergenceError``) and every
   ``checkpoint`` seconds of wall time (``0``: after every step), for
@@ -187,10 +190,12 @@ class StepWriter:
 
     def _write_collections(self):
         steps = sorted(self.entries)
-        write_pvd(self.folder / f"{BEAMS}.pvd", [(self.entries[k], self._name(BEAMS, k)) for k in steps])
+        times = [self.entries[k] for k in steps]
+        if np.any(np.diff(times) <= 0.0):       # not increasing: ParaView would reorder; step numbers
+            times = [float(k) for k in steps]
+        write_pvd(self.folder / f"{BEAMS}.pvd", [(t, self._name(BEAMS, k)) for t, k in zip(times, steps)])
         if self.contact:
-            write_pvd(self.folder / f"{CONTACT}.pvd",
-                      [(self.entries[k], self._name(CONTACT, k)) for k in steps])
+            write_pvd(self.folder / f"{CONTACT}.pvd", [(t, self._name(CONTACT, k)) for t, k in zip(times, steps)])
 
     def close(self):
         """Save ``solution.npz`` (every VTU/PVD file is already complete when ``write`` returns)."""
