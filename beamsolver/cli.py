@@ -129,7 +129,7 @@ def _status(sol):
     checkpoint, ``stopped at t = ... of ...``."""
     if not sol.converged:
         return f"STOPPED: {sol.message}"
-    t, t0, t_end = sol._times[-1], sol._times[0], sol.resume.get("t_end")
+    t, t0, t_end = float(sol.times[-1]), float(sol.times[0]), sol.resume.get("t_end")
     if t_end is not None and t < t_end - 1e-9 * abs(t_end - t0):
         return (f"stopped at t = {t:.6g} of {t_end:.6g} (interrupted; `beamsolver run SCRIPT --restart "
                 "RESULT` continues it)")
@@ -144,7 +144,7 @@ def cmd_info(args):
         return 0
     sol = bs.load(args.result)
     d = sol.description
-    n = len(sol._times)
+    n = len(sol)
     print(f"{args.result}: {len(d['beam_radius'])} beams, {len(d['poses0'])} nodes, {len(d['enodes'])} elements, "
           f"{int(d['n_contact_declarations'])} contact declarations")
     print(f"{sol.summary()}; {_status(sol)}")
@@ -166,7 +166,7 @@ def cmd_info(args):
             continue
         s = sol.stats[k]
         res = s.get("residuals") or []
-        cells = [k, f"{sol._times[k]:.4g}", s.get("iterations", 0), f"{res[-1]:.1e}" if res else "-",
+        cells = [k, f"{sol.times[k]:.4g}", s.get("iterations", 0), f"{res[-1]:.1e}" if res else "-",
                  s.get("cutbacks", 0), f"{s.get('wall_time', 0.0):.3f}"]
         if contact:
             c = sol.contacts[k]
@@ -183,7 +183,7 @@ def cmd_info(args):
     if len(nodes):
         print("reactions at the last step (global force, moment about the node):")
         print(_row(["node", "kind", "Fx", "Fy", "Fz", "Mx", "My", "Mz"], [5, 9] + [11] * 6))
-        R = sol._reactions[-1]
+        R = sol.reactions[-1]
         for node, kind in zip(nodes, kinds):
             print(_row([int(node), kind] + [f"{v:.4g}" for v in R[node]], [5, 9] + [11] * 6))
     return 0

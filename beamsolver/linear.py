@@ -71,18 +71,18 @@ class Linearization:
 
 def linearize(model, solution, step=-1):
     """Tangent stiffness and residual of ``model`` at ``step`` of ``solution`` (a fresh or loaded one)."""
-    n = len(solution._times)
+    n = len(solution)
     k = step % n if -n <= step < n else None
     if k is None:
         from .errors import InputError
         raise InputError(f"linearize: step {step} out of range (the solution has steps 0..{n - 1})")
     problem = Problem.from_model(model, check_rigid_modes=False)
     system = problem.system
-    H = np.array(solution._poses[k], dtype=float)
+    H = np.array(solution.poses[k], dtype=float)
     if H.shape[0] != system.n_nodes:
         from .errors import InputError
         raise InputError(f"linearize: the solution has {H.shape[0]} nodes, the model {system.n_nodes}")
-    t = solution._times[k]
+    t = float(solution.times[k])
     if k == n - 1 and solution.contact_state:
         problem.set_state(solution.contact_state)
     problem.begin_step(H, t)

@@ -9,6 +9,7 @@ augmented-Lagrangian multipliers and point set (``Solution.contact_state``).
 import numpy as np
 
 from .errors import InputError
+from .results import Solution, load
 
 __all__ = ["restart_from", "contact_snapshot", "contact_restore"]
 
@@ -29,12 +30,11 @@ def restart_from(restart, model, problem):
     """The ``Solution`` to continue (a copy bound to ``model``) from a Solution or a saved file;
     ``problem`` (``problem.Problem``) takes the committed history of its last step."""
     system = problem.system
-    if not hasattr(restart, "_poses"):
-        from .results import load
+    if not isinstance(restart, Solution):
         restart = load(restart)
-    if not restart._times:
+    if not len(restart.times):
         raise InputError("solve: the restart solution has no steps")
-    H = restart._poses[-1]
+    H = restart.poses[-1]
     P0 = restart.description["poses0"]
     if H.shape[0] != model.n_nodes or P0.shape != system.poses0.shape or \
             np.abs(P0 - system.poses0).max() > 1e-9 * system.length_scale:

@@ -17,6 +17,22 @@ def _positive(name, value, owner="Section"):
     return real(value, name, owner, above=0.0)
 
 
+def _stiffness(owner, args, compute):
+    """``compute(**args)`` (a dict of stiffnesses) in float64, each checked finite and positive.
+
+    Products of extreme dimensions overflow to inf (or underflow to 0) without an error of their
+    own; the ``InputError`` names the arguments that led there and the first bad stiffness.
+    """
+    with np.errstate(all="ignore"):
+        vals = compute(**{k: np.float64(v) for k, v in args.items()})
+    bad = [f"{k} = {float(v):g}" for k, v in vals.items() if not (np.isfinite(v) and v > 0.0)]
+    if bad:
+        given = ", ".join(f"{k}={v:g}" for k, v in args.items())
+        raise InputError(f"{owner}: {given} give a stiffness that is not a finite positive number "
+                         f"({', '.join(bad)}); check the units")
+    return {k: float(v) for k, v in vals.items()}
+
+
 class Section:
     """Cross-section: stiffness matrix ``C`` (6x6, symmetric positive definite) and ``radius``.
 
@@ -64,11 +80,12 @@ class Section:
         if not (-1.0 < real(nu, "nu", "Section.circular") < 0.5):
             raise InputError(f"Section.circular: nu must lie in (-1, 0.5), got {nu!r}")
         k = 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu) if shear_factor is None else _positive("shear_factor", shear_factor)
-        G = E / (2.0 * (1.0 + nu))
-        A = np.pi * r**2
-        I = np.pi * r**4 / 4.0
-        return cls(EA=E * A, GA2=k * G * A, GA3=k * G * A, GJ=G * 2.0 * I, EI2=E * I, EI3=E * I,
-                   radius=r, name=name)
+        def compute(radius, E):
+            G = E / (2.0 * (1.0 + nu))
+            A = np.pi * radius**2
+            I = np.pi * radius**4 / 4.0
+            return dict(EA=E * A, GA2=k * G * A, GA3=k * G * A, GJ=G * 2.0 * I, EI2=E * I, EI3=E * I)
+        return cls(**_stiffness("Section.circular", dict(radius=r, E=E), compute), radius=r, name=name)
 
     @classmethod
     def rectangular(cls, width, height, E, nu=0.3, shear_factor=None, radius=None, name=None):
@@ -84,13 +101,16 @@ class Section:
         if not (-1.0 < real(nu, "nu", "Section.rectangular") < 0.5):
             raise InputError(f"Section.rectangular: nu must lie in (-1, 0.5), got {nu!r}")
         k = 10.0 * (1.0 + nu) / (12.0 + 11.0 * nu) if shear_factor is None else _positive("shear_factor", shear_factor)
-        G = E / (2.0 * (1.0 + nu))
-        A = b_ * h_
-        a, b = max(b_, h_), min(b_, h_)
-        J = a * b**3 * (1.0 / 3.0 - 0.21 * (b / a) * (1.0 - b**4 / (12.0 * a**4)))
-        radius = 0.5 * b if radius is None else radius
-        return cls(EA=E * A, GA2=k * G * A, GA3=k * G * A, GJ=G * J,
-                   EI2=E * b_ * h_**3 / 12.0, EI3=E * h_ * b_**3 / 12.0, radius=radius, name=name)
+        def compute(width, height, E):
+            G = E / (2.0 * (1.0 + nu))
+            A = width * height
+            a, b = max(width, height), min(width, height)
+            J = a * b**3 * (1.0 / 3.0 - 0.21 * (b / a) * (1.0 - b**4 / (12.0 * a**4)))
+            return dict(EA=E * A, GA2=k * G * A, GA3=k * G * A, GJ=G * J,
+                        EI2=E * width * height**3 / 12.0, EI3=E * height * width**3 / 12.0)
+        C = _stiffness("Section.rectangular", dict(width=b_, height=h_, E=E), compute)
+        radius = 0.5 * min(b_, h_) if radius is None else radius
+        return cls(**C, radius=radius, name=name)
 
     def __repr__(self):
         d = np.diag(self.C)

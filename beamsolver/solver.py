@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import diagnosis, elements, linsolve, se3
+from .arclength import ArcLengthRun, check_arc_length_arguments
 from .errors import InputError
 from .failures import DampingStalled, Diverged, NonFinite, NotConverged, RotationLimit, SingularTangent, StepFailed
 from .problem import Problem
@@ -473,7 +474,7 @@ def _starting_point(restart, model, problem, t_start, t_end):
     sol = None
     if restart is not None:
         sol = restart_from(restart, model, problem)
-        t_start = sol._times[0]
+        t_start = float(sol.times[0])
     if not (np.isfinite(t_end) and np.isfinite(t_start) and t_end > t_start):
         raise InputError(f"solve: need t_end > t_start, got t_start={t_start!r}, t_end={t_end!r}")
     return sol, t_start
@@ -483,7 +484,7 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
           max_iter=30, line_search=True, min_step_ratio=2.0**-12, callback=None,
           check_rigid_modes=True, verbose=None, initial_poses=None, restart=None, checkpoint=60.0,
           linear_solver=None, allow_unmet_tolerance=False, check_stability=False, modes=0,
-          branch_switching=False, stabilize=None):
+          branch_switching=False, stabilize=None, path="load", arc_length=None):
     """Quasi-static solve of ``model`` from ``t_start`` to ``t_end`` in ``steps`` equal steps.
 
     Every converged (sub)step is recorded in the returned ``Solution``.  Step 0 is
@@ -551,6 +552,15 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     ``dict(fraction=, factor=, warn=)``; the energy it dissipates is recorded per step in
     ``stats[k]["stabilization"]`` and warned about above ``warn`` (``beamsolver.stabilize``).
 
+    ``path``: ``"load"`` (default) steps the pseudo-time on the grid above;
+    ``"arc-length"`` follows the equilibrium path by arc length through limit
+    points and snap-backs, ``t`` going down as well as up
+    (``beamsolver.arclength``; options ``arc_length``, a dict or
+    ``arclength.ArcLength``: ``initial``, ``min``, ``max``,
+    ``target_iterations``, ``max_steps``, ``psi``).  Its ``times`` are not
+    monotonic; ``stats[k]`` adds ``arc_length``, ``t`` and ``linearised``;
+    ``restart``, ``branch_switching`` and ``stabilize`` are refused with it.
+
     ``Solution.stats[k]["timings"]``: wall time of the step's ``assembly``
     (residuals, tangents, sparse matrices), of each contribution to it (``contact``
     for scenes with contact, part of assembly) and ``linear_solve``
@@ -563,6 +573,7 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
         raise InputError("solve: give either restart or initial_poses, not both")
     if int(steps) != steps or steps < 1:
         raise InputError(f"solve: steps must be a positive integer, got {steps!r}")
+    arc = check_arc_length_arguments(path, arc_length, restart, branch_switching, stabilize)
     problem = Problem.from_model(model, check_rigid_modes=check_rigid_modes)
     system = problem.system
     sol, t_start = _starting_point(restart, model, problem, t_start, t_end)
@@ -580,7 +591,8 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
                    branch_switching=branch_switching, stabilizer=stabilizer)
     run = None
     try:
-        run = Run(problem, newton, _writer(output, system, checkpoint), grid, dt_min, verbose, options)
+        args = (problem, newton, _writer(output, system, checkpoint), grid, dt_min, verbose, options)
+        run = Run(*args) if arc is None else ArcLengthRun(*args, arc)
         run.start(sol, initial_poses)
         run.loop()
     except BaseException as e:

@@ -96,8 +96,8 @@ class Run:
             self._step_zero(H0, t_start)
         else:
             self.sol = sol = restart_solution
-            self.H = sol._poses[-1].copy()
-            self.t = sol._times[-1]
+            self.H = sol.poses[-1].copy()
+            self.t = float(sol.times[-1])
             self.k = int(np.searchsorted(grid, self.t + 1e-12 * self.dt_user, side="right"))
             rs = sol.resume
             if rs.get("t0") == t_start and rs.get("t_end") == grid[-1] and rs.get("steps") == steps:
@@ -106,7 +106,7 @@ class Run:
                     self.dt, self.easy = min(dt, self.dt_user), int(rs["easy"])
                     self.failed, self.wait = _memory(rs)
             if self.writer is not None:
-                for j in range(len(sol._times)):
+                for j in range(len(sol)):
                     self.writer.write(sol, j)
         # the stepping state before the first step: a checkpoint of a run stopped at once says how far it went
         self.sol.resume = dict(t0=float(grid[0]), t_end=float(grid[-1]), steps=int(steps), dt=float(self.dt),
@@ -318,7 +318,6 @@ class Run:
             self.progress.close()
         sol = self.sol
         if sol is not None:
-            _truncate(sol)
             if not isinstance(exc, ConvergenceError):   # interrupted: what converged stands (restartable)
                 sol.message = f"stopped by {type(exc).__name__}: {exc}" if str(exc) else \
                     f"stopped by {type(exc).__name__}"
@@ -366,9 +365,3 @@ def _acts_at(system, H, t):
     return any(dx != 0 for _, _, dx in system.fixed_value_increments(H, t)) if system.fix_values else False
 
 
-def _truncate(sol):
-    """Cut a ``Solution`` interrupted inside ``append`` back to its complete steps."""
-    names = ("_times", "_poses", "_reactions", "_sigma", "_strain", "stats", "contacts")
-    n = min(len(getattr(sol, a)) for a in names)
-    for a in names:
-        del getattr(sol, a)[n:]

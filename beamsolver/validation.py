@@ -220,7 +220,8 @@ def check_solve_arguments(model, *, steps, t_end, t_start, rtol, dtol, max_iter,
         raise InputError(f"solve: callback must be callable or None, got {callback!r}")
     if output is not None and not isinstance(output, (str, os.PathLike)) and not hasattr(output, "write"):
         raise InputError(f"solve: output must be a folder (str or Path), a writer or None, got {output!r}")
-    if restart is not None and not isinstance(restart, (str, os.PathLike)) and not hasattr(restart, "_times"):
+    if restart is not None and not isinstance(restart, (str, os.PathLike)) and \
+            not (hasattr(restart, "times") and hasattr(restart, "poses")):
         raise InputError(f"solve: restart must be a Solution or the path of a saved one, got {restart!r}")
     if initial_poses is not None:
         _check_initial_poses(initial_poses, model.n_nodes)
@@ -251,9 +252,10 @@ def _check_initial_poses(P, n_nodes):
 
 def _last_saved_time(restart):
     """Last time of a restart ``Solution`` or saved file (only ``times`` is read from a file)."""
-    if hasattr(restart, "_times"):
-        return float(restart._times[-1]) if restart._times else -np.inf
-    from .io.archive import saved_times
+    if not isinstance(restart, (str, os.PathLike)):
+        times = restart.times
+        return float(times[-1]) if len(times) else -np.inf
+    from .solution_file import saved_times
     times = saved_times(restart)
     return float(times[-1]) if len(times) else -np.inf
 

@@ -12,9 +12,11 @@ Fallbacks: Debian ``libosmesa6`` (then set ``VTK_DEFAULT_OPENGL_WINDOW=
 vtkOSOpenGLRenderWindow``), or run under ``xvfb-run``.
 """
 import os
+from pathlib import Path
 
 import numpy as np
 
+from .errors import InputError
 from .io.lines import FORCE_NAMES, LineLayout
 
 __all__ = ["render", "plot_history", "FIELDS"]
@@ -32,11 +34,25 @@ def _pyvista():
     return pyvista
 
 
+def _folder_for(path, owner):
+    """Create the folder of the image file ``path`` (``InputError`` naming it if that fails)."""
+    if path is None:
+        return None
+    parent = Path(path).parent
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise InputError(f"{owner}: cannot create the folder of path {str(path)!r} "
+                         f"({e.strerror or e})") from None
+    return path
+
+
 def _lines(pv, solution, step, refine):
     """Poly-lines (one per beam) with point data; cell (element) fields averaged onto points."""
     lay = LineLayout(solution.description, refine)
-    pdata, points = lay.point_data(solution._poses[step])
-    cdata = lay.cell_data(solution._sigma[step], solution._strain[step])
+    rec = solution.step(step)
+    pdata, points = lay.point_data(rec.poses)
+    cdata = lay.cell_data(rec.section_forces, rec.strains)
     # segment values onto points: mean of the (one or two) segments meeting at a point
     acc, cnt = {}, np.zeros(lay.n_points)
     np.add.at(cnt, lay.segments.ravel(), 1.0)
@@ -90,8 +106,9 @@ def render(solution, step=-1, path=None, color_by="displacement", component=None
     ``"xy"``, ``"xz"``, ``"yz"`` or ``"iso"``; ``zoom`` > 1 magnifies.
     ``contacts``: draw the active contact points as red spheres.
     """
+    _folder_for(path, "render")
     pv = _pyvista()
-    n = len(solution._times)
+    n = len(solution)
     steps = [step] if np.ndim(step) == 0 else list(step)
     for k in steps:
         if int(k) != k or not -n <= k < n:
@@ -158,7 +175,7 @@ _COMPONENTS = {"x": 0, "y": 1, "z": 2, "fx": 0, "fy": 1, "fz": 2, "mx": 3, "my":
 
 def _series(solution, what, node, component):
     """Values over the steps, a label and the kind of unit (curves of one kind share an axis)."""
-    n = len(solution._times)
+    n = len(solution)
     if callable(what):
         name = getattr(what, "__name__", "value")
         return np.array([float(what(solution, k)) for k in range(n)]), name, getattr(what, "unit", name)
@@ -167,10 +184,10 @@ def _series(solution, what, node, component):
         if node is None:
             raise ValueError(f"plot_history: {what!r} needs node=")
         if what == "reaction":
-            v = np.array([solution._reactions[k][node] for k in range(n)])
+            v = np.array(solution.reactions[:, node])
             unit = "moment" if c is not None and int(c) >= 3 else "force"
         else:
-            v = np.array([solution._poses[k][node, :3, 3] for k in range(n)])
+            v = np.array(solution.poses[:, node, :3, 3])
             if what == "displacement":
                 v = v - v[0]
             unit = "length"
@@ -226,7 +243,7 @@ def plot_history(solution, what="reaction", node=None, component=None, path=None
         ax = fig.subplots()
     else:
         fig = ax.figure
-    t = np.array(solution._times)
+    t = np.array(solution.times)
     whats = what if isinstance(what, (list, tuple)) else [what]
     curves = [_series(solution, w, node, component) for w in whats]
     axes = _unit_axes(ax, [u for _, _, u in curves])
@@ -241,6 +258,6 @@ def plot_history(solution, what="reaction", node=None, component=None, path=None
     if len(whats) > 1:
         ax.legend(lines, [ln.get_label() for ln in lines])
     ax.grid(True, alpha=0.3)
-    if path is not None:
+    if _folder_for(path, "plot_history") is not None:
         fig.savefig(path, dpi=100, bbox_inches="tight")
     return fig

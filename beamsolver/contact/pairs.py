@@ -68,7 +68,13 @@ def _section(HA, h, xi):
 
 
 def _project(kind, HA1, h1, xi1, HA2, h2, xi2, iterations=3):
-    """Newton on the projection conditions, starting from the search's real solution."""
+    """Newton on the projection conditions, starting from the search's real solution.
+
+    Each kind's step is computed for every pair and selected with ``where``; a denominator is
+    replaced by 1 where its kind is not the pair's (or where it is 0), so the branches a pair
+    does not take never divide by a tiny number (an overflow warning for a value thrown away).
+    """
+    line, point = np.asarray(kind) == LINE, np.asarray(kind) == POINT
     for _ in range(iterations):
         H1, x1p, x1pp = _section(HA1, h1, xi1)
         H2, x2p, x2pp = _section(HA2, h2, xi2)
@@ -80,19 +86,18 @@ def _project(kind, HA1, h1, xi1, HA2, h2, xi2, iterations=3):
         # ORTHOGONAL: f = d . x2', df/dxi2 = x2'.x2' + d . x2''
         f_orth = _dot(d, x2p)
         j_orth = _dot(x2p, x2p) + _dot(d, x2pp)
-        step2 = np.where(kind == LINE, -f_line / np.where(j_line == 0, 1.0, j_line),
-                         -f_orth / np.where(j_orth == 0, 1.0, j_orth))
+        step2 = np.where(line, -f_line / np.where(line & (j_line != 0), j_line, 1.0),
+                         -f_orth / np.where(np.logical_not(line) & (j_orth != 0), j_orth, 1.0))
         # POINT: F = (d . x1', d . x2') = 0, 2x2 Newton
         a11 = -_dot(x1p, x1p) + _dot(d, x1pp)
         a12 = _dot(x2p, x1p)
         a21 = -_dot(x1p, x2p)
         a22 = _dot(x2p, x2p) + _dot(d, x2pp)
         det = a11 * a22 - a12 * a21
-        det = np.where(det == 0, 1.0, det)
+        det = np.where(point & (det != 0), det, 1.0)
         g1, g2 = _dot(d, x1p), f_orth
         p1 = -(a22 * g1 - a12 * g2) / det
         p2 = -(-a21 * g1 + a11 * g2) / det
-        point = kind == POINT
         xi1 = xi1 + np.where(point, p1, 0.0)
         xi2 = xi2 + np.where(point, p2, step2)
     return xi1, xi2

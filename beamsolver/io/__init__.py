@@ -6,8 +6,7 @@
 """
 import importlib
 
-from ..results import load
-from .archive import FORMAT_VERSION, save
+from .archive import FORMAT_VERSION, load, save
 
 __all__ = ["load", "save", "write_vtk", "FORMAT_VERSION"]
 

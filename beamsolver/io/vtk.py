@@ -15,7 +15,10 @@ Files in the output folder (``solve(model, output=folder)``, or
   frictionless), ``slip_increment`` (2), ``normal`` (3), ``kind``.  A step
   without contact has no points and one empty poly-vertex cell (VTK type 2):
   meshio cannot read a file without cells, and skips that one with a warning.
-- ``beams.pvd`` and ``contact.pvd``: the collections with the pseudo-times.
+- ``beams.pvd`` and ``contact.pvd``: the collections with the pseudo-times,
+  or with the step numbers when the pseudo-times do not increase from step to
+  step (an arc-length run, ``solve(path="arc-length")``, goes back in ``t``
+  past a limit point; ParaView sorts a collection by its times).
 - ``solution.npz``: the ``Solution`` (``io.archive``), saved at the end of the
   run (also when it stops with ``ConvergenceError``) and every
   ``checkpoint`` seconds of wall time (``0``: after every step), for
@@ -42,7 +45,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from ..errors import InputError
-from .files import follow_umask, previous_series
+from ..files import follow_umask, previous_series
 from .lines import LineLayout
 
 __all__ = ["StepWriter", "write_vtk", "write_pvd"]
@@ -152,17 +155,17 @@ class StepWriter:
             if self.contact is None:
                 self.contact = int(solution.description.get("n_contact_declarations", 0)) > 0
         lay = self.layout
-        H = solution._poses[step]
-        t = solution._times[step]
-        pdata, points = lay.point_data(H)
-        pdata.update(mode_fields(lay, solution.stats[step]))
-        cdata = lay.cell_data(solution._sigma[step], solution._strain[step])
+        rec = solution.step(step)
+        t = rec.time
+        pdata, points = lay.point_data(rec.poses)
+        pdata.update(mode_fields(lay, rec.stats))
+        cdata = lay.cell_data(rec.section_forces, rec.strains)
         mesh = meshio.Mesh(points, [("line", lay.segments)], point_data=pdata,
                            cell_data={k: [v] for k, v in cdata.items()})
         self._write_mesh(self.folder / self._name(BEAMS, step), mesh)
         if self.contact:
             path = self.folder / self._name(CONTACT, step)
-            table = solution.contacts[step]
+            table = rec.contact
             if len(active_points(table)):
                 self._write_mesh(path, contact_mesh(table))
             else:
@@ -187,10 +190,12 @@ class StepWriter:
 
     def _write_collections(self):
         steps = sorted(self.entries)
-        write_pvd(self.folder / f"{BEAMS}.pvd", [(self.entries[k], self._name(BEAMS, k)) for k in steps])
+        times = [self.entries[k] for k in steps]
+        if np.any(np.diff(times) <= 0.0):       # not increasing: ParaView would reorder; step numbers
+            times = [float(k) for k in steps]
+        write_pvd(self.folder / f"{BEAMS}.pvd", [(t, self._name(BEAMS, k)) for t, k in zip(times, steps)])
         if self.contact:
-            write_pvd(self.folder / f"{CONTACT}.pvd",
-                      [(self.entries[k], self._name(CONTACT, k)) for k in steps])
+            write_pvd(self.folder / f"{CONTACT}.pvd", [(t, self._name(CONTACT, k)) for t, k in zip(times, steps)])
 
     def close(self):
         """Save ``solution.npz`` (every VTU/PVD file is already complete when ``write`` returns)."""
@@ -257,7 +262,7 @@ def _write_empty_points(path):
 def write_vtk(solution, folder, steps=None, refine=8, compression="zlib"):
     """Write the steps (default all) of a (saved or fresh) ``solution`` to ``folder``; returns the .pvd path."""
     writer = StepWriter(folder, None, refine=refine, compression=compression, checkpoint=None)
-    n = len(solution._times)
+    n = len(solution)
     for k in (range(n) if steps is None else [s % n for s in steps]):
         writer.write(solution, k)
     writer.close()

@@ -1,0 +1,137 @@
+"""Limit points traced by arc length (``solve(..., path="arc-length")``): three classic scenes.
+
+- ``truss``: the shallow von Mises (two-bar) truss, its symmetric half, with the closed-form
+  load-deflection curve ``truss_load`` and limit ``truss_limit``; snaps through and back up.
+- ``deep_arch``: DaDeppo & Schmidt's clamped-hinged 215-degree arch under a crown load, limit
+  load ``P_CR_DADEPPO = 8.97 EI / R^2`` (DaDeppo, D.A. and Schmidt, R., 1975, "Instability of
+  clamped-hinged circular arches subjected to a point load", J. Appl. Mech. 42, 894-896).
+- ``lee_frame``: Lee's right-angle frame, a snap-back (the deflection turns back as well).
+
+``first_peak`` and ``peak`` find the limit point on a traced path.  Run
+``python examples/limit_points.py`` to print the limit loads; ``beamsolver run`` solves the truss.
+"""
+import numpy as np
+
+import beamsolver as bs
+
+A_HALF, RISE, EA = 1.0, 0.1, 1e4               # truss: half span, rise, axial stiffness of a bar
+R_ARCH, EI_ARCH = 100.0, 1e6                   # deep arch: radius, bending stiffness
+P_CR_DADEPPO = 8.97 * EI_ARCH / R_ARCH**2      # 897
+LEE_L, LEE_E, LEE_A, LEE_I = 120.0, 720.0, 6.0, 2.0    # Lee's frame: member length, E, A, I
+
+solve_options = dict(steps=10, t_end=1.5, path="arc-length")   # for `beamsolver run`: the truss
+
+
+def truss_load(y):
+    """Apex load carried by one bar with the apex at height ``y`` (a pinned straight bar,
+    ``N = EA (L / L0 - 1)``): ``P = EA y (1 / L - 1 / L0)`` (docs/theory.md eq. 16.9)."""
+    L0, L = np.hypot(A_HALF, RISE), np.hypot(A_HALF, y)
+    return EA * y * (1.0 / L - 1.0 / L0)
+
+
+def truss_limit():
+    """Closed-form limit ``(load, apex height)``: ``dP/dy = 0`` where ``L^3 = L0 a^2``."""
+    L0 = np.hypot(A_HALF, RISE)
+    y = np.sqrt((L0 * A_HALF**2) ** (2.0 / 3.0) - A_HALF**2)
+    return truss_load(y), y
+
+
+def truss(load=None):
+    """Half of the symmetric von Mises truss: one bar pinned at ``(-a, 0)`` (only ``rz`` free), the
+    apex on the symmetry line (``ux`` fixed, ``rz`` free: no end moments, the bar stays straight; it is
+    stiff in bending, so it does not buckle itself);
+    apex load ``(0, -load t, 0)`` (default: the limit load, so the limit is at ``t = 1``).
+    Returns ``(model, apex node)``."""
+    load = truss_limit()[0] if load is None else load
+    # bars stiff in bending: Euler load pi^2 EI / L^2 about 200 times the largest compression
+    sec = bs.Section(EA=EA, GA2=EA, GA3=EA, GJ=1e3, EI2=1e3, EI3=1e3, radius=0.01)
+    m = bs.Model()
+    b = m.add_beam(bs.geometry.straight(start=(-A_HALF, 0, 0), end=(0, RISE, 0), n_elements=2), sec)
+    m.fix(b.first, dofs=("ux", "uy", "uz", "rx", "ry"))
+    m.fix(b.last, dofs=("ux", "uz", "rx", "ry"))
+    m.add_load(b.last, force=(0, -load, 0))
+    return m, b.last
+
+
+def build():
+    return truss()
+
+
+def deep_arch(n_elements=40, element=None):
+    """Clamped-hinged circular arch (radius 100, 215 degrees), crown load ``(0, -1000 t, 0)``.
+
+    ``EI = 1e6``, ``EA = GA = 100 EI`` (as in Kadapa 2021, Eng. Struct. 234, 111755), square-like
+    section (``EI2 = EI3 = GJ``): the path stays in the plane.  Hinge at the first node (``rz``
+    free), clamp at the last.  ``n_elements`` segments between nodes; ``element``: the element type
+    (``Model.add_beam``; ``"se3-3"``: ``n_elements / 2`` three-node elements).  Returns
+    ``(model, crown node)``.
+    """
+    sec = bs.Section(EA=100 * EI_ARCH, GA2=100 * EI_ARCH, GA3=100 * EI_ARCH, GJ=EI_ARCH, EI2=EI_ARCH,
+                     EI3=EI_ARCH, radius=1.0)
+    P = bs.geometry.arc(radius=R_ARCH, angle=np.radians(215.0), n_elements=n_elements)
+    c, a = np.array([0.0, R_ARCH, 0.0]), np.radians(72.5)       # turn about the centre: crown on top
+    G = np.eye(4)
+    G[:3, :3] = [[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]]
+    G[:3, 3] = c - G[:3, :3] @ c
+    m = bs.Model()
+    b = m.add_beam(G @ P, sec, element=element)
+    m.fix(b.first, dofs=("ux", "uy", "uz", "rx", "ry"))
+    m.clamp(b.last)
+    crown = int(b.nodes[len(b.nodes) // 2])
+    m.add_load(crown, force=(0, -1000.0, 0))
+    return m, crown
+
+
+def lee_frame(n_per_member=10):
+    """Lee's frame: a column ``(0, 0) -> (0, L)`` and a beam ``(0, L) -> (L, L)`` rigidly joined, both
+    far ends pinned (``rz`` free), a downward load ``20 t`` at ``L / 5`` from the corner; ``E = 720``,
+    ``A = 6``, ``I = 2``, ``L = 120`` (load in units of ``EI / L^2`` is ``P L^2 / EI``).
+    Returns ``(model, loaded node)``."""
+    G = LEE_E / 2.6 * LEE_A * 5.0 / 6.0
+    sec = bs.Section(EA=LEE_E * LEE_A, GA2=G, GA3=G, GJ=LEE_E * LEE_I, EI2=LEE_E * LEE_I, EI3=LEE_E * LEE_I,
+                     radius=1.0)
+    m = bs.Model()
+    col = m.add_beam(bs.geometry.straight((0, 0, 0), (0, LEE_L, 0), n_per_member), sec)
+    beam = m.add_beam(bs.geometry.straight((0, LEE_L, 0), (LEE_L, LEE_L, 0), n_per_member), sec)
+    m.join(col.last, beam.first)
+    m.fix(col.first, dofs=("ux", "uy", "uz", "rx", "ry"))
+    m.fix(beam.last, dofs=("ux", "uy", "uz", "rx", "ry"))
+    node = int(beam.nodes[n_per_member // 5])
+    m.add_load(node, force=(0, -20.0, 0))
+    return m, node
+
+
+def first_peak(t):
+    """Index of the first local maximum of ``t`` along a path (the limit point)."""
+    down = np.flatnonzero(np.diff(t) < 0)
+    return int(down[0]) if len(down) else len(t) - 1
+
+
+def peak(t, y):
+    """``t`` at the limit point: the parabola in ``y`` through the first local maximum of the path
+    and its two neighbours, at its vertex."""
+    k = first_peak(t)
+    if 0 < k < len(t) - 1:
+        c = np.polyfit(y[k - 1:k + 2], t[k - 1:k + 2], 2)
+        if c[0] < 0:
+            return float(np.polyval(c, -c[1] / (2 * c[0])))
+    return float(t[k])
+
+
+def heights(sol, node):
+    """Vertical position of ``node`` at every step."""
+    return np.array([sol.position(node, k)[1] for k in range(sol.n_steps + 1)])
+
+
+if __name__ == "__main__":
+    import warnings
+    m, apex = truss()
+    sol = bs.solve(m, path="arc-length", **{k: v for k, v in solve_options.items() if k != "path"})
+    print(f"truss: limit t = {peak(sol.times, heights(sol, apex)):.5f} (closed form 1), "
+          f"{sol.n_steps} steps, lowest t {sol.times.min():.3f}")
+    m, crown = deep_arch()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)        # stops on max_steps past the limit
+        sol = bs.solve(m, steps=40, path="arc-length", arc_length=dict(max_steps=230))
+    print(f"deep arch: limit load {1000 * peak(sol.times, heights(sol, crown)):.1f} "
+          f"(DaDeppo & Schmidt {P_CR_DADEPPO:.0f})")
