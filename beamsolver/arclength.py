@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import linsolve, motion_path, se3
-from .errors import ConvergenceError, InputError
+from .errors import InputError
 from .failures import AugmentationFailed, Diverged, NonFinite, NotConverged, SingularTangent, StepFailed
 from .stepping import MAX_OUTER, STEP_TOLERANCE, Run
 
@@ -258,7 +258,7 @@ class ArcLengthRun(Run):
         """Newton iterations from the iterate ``(H, t)`` of a step (scaled increment ``w``, pseudo-time
         change ``tau`` so far) onto the sphere of radius ``ds``, or at ``t = t_fixed`` if given.
         Returns ``(H, t, w, tau, ev, stats)``; raises a ``failures.StepFailed``."""
-        newton, conv, sys = self.newton, self.newton.conv, self.sys
+        newton, conv = self.newton, self.newton.conv
         floor = conv.floor(H, newton.L_ref)
         residuals, last_inc, linearised = [], np.inf, 0
         for it in range(conv.max_iter + 1):
@@ -454,14 +454,8 @@ class ArcLengthRun(Run):
         warnings.warn(text, RuntimeWarning, stacklevel=4)
 
     def _stop_arc(self, failure, ds):
-        sol = self.sol
-        hint = self.opt["advice"](failure, None, self.H, self.t)
-        sol.converged = False
-        sol.message = str(failure)
-        err = ConvergenceError(f"solve: arc-length could not advance from t = {self.t:.6g} (arc length "
-                               f"{ds:.3g}, min {self.ds_min:.3g}): {failure}{hint}", sol)
-        err.failure = failure
-        raise err from None
+        self._stop(failure, None, f"arc-length could not advance from t = {self.t:.6g} (arc length "
+                                  f"{ds:.3g}, min {self.ds_min:.3g})")
 
 
 def check_arc_length_arguments(path, arc_length, restart, branch_switching=False, stabilize=None):

@@ -11,7 +11,6 @@ made every element touch 144 pages, measured 2x slower at 1e4 elements), the
 order ``assembly.System`` scatters.  Node poses are read through a node table
 ``(n, 2)`` from the model's pose array (``elements.se3_2``), not gathered first.
 """
-import numpy as np
 from ._jit import jit, jit_inline
 
 from .se3_jit import (CP_, C_, DP_, Q2P_, Q2_, Q3P_, Q3_, add, add_outer, axpy, coefficient, cross, dot,

@@ -301,14 +301,15 @@ class Run:
         return t, H, ev
 
     # ------------------------------------------------------------------ end
-    def _stop(self, failure, rotation_limit):
-        """Raise ``ConvergenceError`` for ``failure`` at the current step."""
+    def _stop(self, failure, rotation_limit, why=None):
+        """Raise ``ConvergenceError`` for ``failure`` at the current step; ``why``: what could not
+        advance (default: the step fell below its floor)."""
         sol = self.sol
         hint = self.opt["advice"](failure, rotation_limit, self.H, self.t)
         sol.converged = False
         sol.message = str(failure)
-        err = ConvergenceError(f"solve: could not advance from t = {self.t:.6g} (step fell below "
-                               f"{self.dt_min:.3g}): {failure}{hint}", sol)
+        why = why or f"could not advance from t = {self.t:.6g} (step fell below {self.dt_min:.3g})"
+        err = ConvergenceError(f"solve: {why}: {failure}{hint}", sol)
         err.failure = failure
         raise err from None
 
