@@ -16,19 +16,12 @@ steps); "all iterations" counts the failed attempts' too (``callback``).
 """
 import sys
 import time
+from pathlib import Path
 
 import beamsolver as bs
 
-
-def frame(F, imperfection=1e-4, n=10):
-    m = bs.Model()
-    sec = bs.Section.rectangular(width=0.6, height=30.0, E=71240.0, nu=0.31)
-    a = m.add_beam(bs.geometry.straight((0, 0, 0), (0, 240, 0), n, e2=(0, 0, 1)), sec)
-    b = m.add_beam(bs.geometry.straight((0, 240, 0), (240, 240, 0), n, e2=(0, 0, 1)), sec)
-    m.join(a.last, b.first)
-    m.clamp(a.first)
-    m.add_load(b.last, force=(0, F, imperfection * F))
-    return m, b
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+from limit_points import argyris_frame as frame  # noqa: E402
 
 
 def run(F_max, steps, n, imperfection=1e-4, wait_max=None):

@@ -101,6 +101,21 @@ def lee_frame(n_per_member=10):
     return m, node
 
 
+def argyris_frame(F, imperfection=1e-4, n=10):
+    """Argyris' right-angle frame: legs of 240 mm, section 30 x 0.6 mm, ``E = 71240`` N/mm^2,
+    ``nu = 0.31``, clamped at one end; at the tip an in-plane force ``F`` (N) along the clamped leg
+    with an out-of-plane ``imperfection * F``; lateral buckling near ``F = 1.09`` N.  ``n``
+    elements per leg.  Returns ``(model, tip beam)``."""
+    m = bs.Model()
+    sec = bs.Section.rectangular(width=0.6, height=30.0, E=71240.0, nu=0.31)
+    a = m.add_beam(bs.geometry.straight((0, 0, 0), (0, 240, 0), n, e2=(0, 0, 1)), sec)
+    b = m.add_beam(bs.geometry.straight((0, 240, 0), (240, 240, 0), n, e2=(0, 0, 1)), sec)
+    m.join(a.last, b.first)
+    m.clamp(a.first)
+    m.add_load(b.last, force=(0, F, imperfection * F))
+    return m, b
+
+
 def first_peak(t):
     """Index of the first local maximum of ``t`` along a path (the limit point)."""
     down = np.flatnonzero(np.diff(t) < 0)

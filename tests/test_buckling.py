@@ -11,7 +11,9 @@ a clamped-free column of length ``L`` under an axial tip load ``P`` beyond
 length ``L`` is two such columns of length ``L / 2`` (``P_cr = pi^2 EI / L^2``): midspan
 deflection ``k / K(k) L``, end shortening ``delta / L = 2 - 2 E(k) / K(k)``, end rotation ``alpha``.
 """
+import sys
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -24,6 +26,9 @@ from beamsolver import bifurcation
 from beamsolver.assembly import System
 from beamsolver.definiteness import DENSE_MAX
 from beamsolver.modes import lowest_modes
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+from limit_points import argyris_frame  # noqa: E402
 
 EI = 1.0
 
@@ -336,24 +341,11 @@ def test_modes_reach_the_saved_result_the_vtu_and_info(tmp_path, capsys):
     assert "switched" in out and "mode 1" in out and "neg. eig." in out
 
 
-def _argyris(imperfection, n=10):
-    """Argyris' right-angle frame (legs 240 mm, section 30 x 0.6 mm, E = 71240 N/mm^2, nu = 0.31),
-    clamped, in-plane tip force ``F = t * 1.5 N`` along the clamped leg (benchmarks/argyris_frame.py)."""
-    m = bs.Model()
-    sec = bs.Section.rectangular(width=0.6, height=30.0, E=71240.0, nu=0.31)
-    a = m.add_beam(bs.geometry.straight((0, 0, 0), (0, 240, 0), n, e2=(0, 0, 1)), sec)
-    b = m.add_beam(bs.geometry.straight((0, 240, 0), (240, 240, 0), n, e2=(0, 0, 1)), sec)
-    m.join(a.last, b.first)
-    m.clamp(a.first)
-    m.add_load(b.last, force=(0.0, 1.5, imperfection * 1.5))
-    return m, b
-
-
 def test_argyris_frame_perfect_switches_at_the_published_load_onto_the_imperfect_path():
     """The perfect frame: lateral buckling located at the published F_cr = 1.088 N (Argyris et al.
     1979, as in Simo & Vu-Quoc 1986) within 1 % (10 elements per leg), and at 1.5 N the switched
     state is the one force control reaches with a 1e-4 out-of-plane imperfection (to O(1e-4))."""
-    m, b = _argyris(0.0)
+    m, b = argyris_frame(1.5, 0.0)
     with warnings.catch_warnings():
         warnings.simplefilter("error", bs.StabilityWarning)
         sol = bs.solve(m, steps=15, verbose=False, branch_switching="auto")
@@ -361,7 +353,7 @@ def test_argyris_frame_perfect_switches_at_the_published_load_onto_the_imperfect
     rec = sol.stats[k]["branch_switch"]
     assert 1.5 * rec["critical_t"] == pytest.approx(1.088, rel=1e-2)
     assert rec["negative_after"] == 0 and all(s["stable"] for s in sol.stats[1:])
-    m2, b2 = _argyris(1e-4)
+    m2, b2 = argyris_frame(1.5, 1e-4)
     imperfect = bs.solve(m2, steps=15, verbose=False)
     lateral = sol.position(b.last)[2]
     assert abs(lateral) > 50.0                                          # well past buckling

@@ -14,6 +14,7 @@ from beamsolver import failures
 from beamsolver.solver import CONTINUE, CONVERGED, DIVERGED, MAX_ITER
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+from limit_points import argyris_frame  # noqa: E402
 
 STEEL = dict(E=200e9, nu=0.3)
 
@@ -213,24 +214,10 @@ def test_failures_are_typed_and_timings_recorded():
 
 
 # ------------------------------------------------------------------ item 8: damped Newton stall
-def _argyris_frame(F, imperfection=1e-4, n=4):
-    """Argyris' right-angle frame (legs 240 mm, section 30 x 0.6 mm, E = 71240 N/mm^2), clamped at
-    one end, in-plane tip force ``F`` (N) with an out-of-plane ``imperfection * F``; lateral
-    buckling near F = 1.09 N."""
-    m = bs.Model()
-    sec = bs.Section.rectangular(width=0.6, height=30.0, E=71240.0, nu=0.31)
-    a = m.add_beam(bs.geometry.straight((0, 0, 0), (0, 240, 0), n, e2=(0, 0, 1)), sec)
-    b = m.add_beam(bs.geometry.straight((0, 240, 0), (240, 240, 0), n, e2=(0, 0, 1)), sec)
-    m.join(a.last, b.first)
-    m.clamp(a.first)
-    m.add_load(b.last, force=(0, F, imperfection * F))
-    return m, b
-
-
 def test_argyris_frame_on_the_unstable_side_is_flagged():
     """Undamped Newton in one step to 1.5 N lands on the flat, unstable branch of the imperfect
     frame (tip barely out of plane): a converged but unstable equilibrium, now flagged."""
-    m, b = _argyris_frame(1.5)
+    m, b = argyris_frame(1.5, n=4)
     with pytest.warns(bs.StabilityWarning):
         sol = bs.solve(m, steps=1, verbose=False, line_search=False, check_stability=True)
     assert abs(sol.position(b.last)[2]) < 0.1 and sol.stats[-1]["stable"] is False
@@ -239,7 +226,7 @@ def test_argyris_frame_on_the_unstable_side_is_flagged():
 def test_damped_newton_falls_back_to_newton_past_the_argyris_buckling_load():
     """Before: "damped Newton stalled" at F = 1.093 N with a positive definite tangent.  Now the
     stable imperfect path is followed past the buckling load, every step stable."""
-    m, b = _argyris_frame(1.1)
+    m, b = argyris_frame(1.1, n=4)
     sol = bs.solve(m, steps=11, verbose=False, check_stability=True)
     assert sol.times[-1] == 1.0 and all(s["stable"] for s in sol.stats[1:])
     assert sol.position(b.last)[2] > 10.0                      # buckled sideways
