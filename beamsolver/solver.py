@@ -569,26 +569,16 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     check_solve_arguments(model, steps=steps, t_end=t_end, t_start=t_start, rtol=rtol, dtol=dtol, max_iter=max_iter,
                           min_step_ratio=min_step_ratio, checkpoint=checkpoint, initial_poses=initial_poses,
                           restart=restart, callback=callback, output=output)
-    if restart is not None and initial_poses is not None:
-        raise InputError("solve: give either restart or initial_poses, not both")
-    if int(steps) != steps or steps < 1:
-        raise InputError(f"solve: steps must be a positive integer, got {steps!r}")
     arc = check_arc_length_arguments(path, arc_length, restart, branch_switching, stabilize)
     problem = Problem.from_model(model, check_rigid_modes=check_rigid_modes)
     system = problem.system
     sol, t_start = _starting_point(restart, model, problem, t_start, t_end)
     grid = np.linspace(t_start, t_end, int(steps) + 1)
     dt_min = _step_floor(min_step_ratio, grid)
-    conv = Convergence(rtol=rtol, dtol=dtol, max_iter=max_iter)
-    newton = Newton(problem, conv, line_search, callback)
+    newton = Newton(problem, Convergence(rtol=rtol, dtol=dtol, max_iter=max_iter), line_search, callback)
     newton.linsolver = linsolve.Solver(linear_solver)
-    modes, branch_switching = check_stability_options(modes, branch_switching)
-    stabilizer = stabilize_option(system, stabilize, check=problem.conservative)
-    if stabilizer is not None:
-        problem.contributions.append(stabilizer)
-    options = dict(allow_unmet_tolerance=allow_unmet_tolerance, advice=_advice(problem, t_start, t_end),
-                   check_stability=bool(check_stability or modes or branch_switching), modes=modes,
-                   branch_switching=branch_switching, stabilizer=stabilizer)
+    options = _run_options(problem, t_start, t_end, allow_unmet_tolerance, check_stability, modes,
+                           branch_switching, stabilize)
     run = None
     try:
         args = (problem, newton, _writer(output, system, checkpoint), grid, dt_min, verbose, options)
@@ -600,6 +590,18 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
             run.abort(e)
         raise
     return run.finish()
+
+
+def _run_options(problem, t_start, t_end, allow_unmet_tolerance, check_stability, modes, branch_switching,
+                 stabilize):
+    """The options of ``stepping.Run``; a stabilisation joins ``problem``'s contributions."""
+    modes, branch_switching = check_stability_options(modes, branch_switching)
+    stabilizer = stabilize_option(problem.system, stabilize, check=problem.conservative)
+    if stabilizer is not None:
+        problem.contributions.append(stabilizer)
+    return dict(allow_unmet_tolerance=allow_unmet_tolerance, advice=_advice(problem, t_start, t_end),
+                check_stability=bool(check_stability or modes or branch_switching), modes=modes,
+                branch_switching=branch_switching, stabilizer=stabilizer)
 
 
 def _step_floor(min_step_ratio, grid):

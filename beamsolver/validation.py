@@ -237,6 +237,8 @@ def check_solve_arguments(model, *, steps, t_end, t_start, rtol, dtol, max_iter,
         for fns in model.fix_values.values():
             for fn in fns.values():
                 fn(t)
+    if restart is not None and initial_poses is not None:
+        raise InputError("solve: give either restart or initial_poses, not both")
 
 
 def _check_initial_poses(P, n_nodes):
