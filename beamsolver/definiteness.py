@@ -38,13 +38,27 @@ def scaled_symmetric(K, dense=False):
         S = 0.5 * (Kd + Kd.T)
         d = _inverse_root(np.diag(S))
         return S * d[:, None] * d[None, :], d
-    K = sp.csr_matrix(K)
-    S = sp.csr_matrix(K + K.T)
-    S.sum_duplicates()
-    d = _inverse_root(0.5 * S.diagonal())
+    S = _symmetric_part(K)
+    d = _inverse_root(S.diagonal())
     rows = np.repeat(np.arange(S.shape[0]), np.diff(S.indptr))
-    S.data *= 0.5 * d[rows] * d[S.indices]
+    S.data *= d[rows] * d[S.indices]
     return S, d
+
+
+def _symmetric_part(K):
+    """``(K + K^T) / 2`` as CSR.  A structurally symmetric ``K`` (a beam tangent) needs no sparse
+    sum: its CSC and CSR forms then have the same index arrays, and the CSR data read as CSC is
+    ``K^T``'s."""
+    C = sp.csc_matrix(K, copy=True)
+    C.sum_duplicates()
+    R = C.tocsr()
+    if np.array_equal(C.indptr, R.indptr) and np.array_equal(C.indices, R.indices):
+        S = sp.csr_matrix((0.5 * (C.data + R.data), R.indices, R.indptr), shape=C.shape)
+        S.eliminate_zeros()          # as the sparse sum does: a narrower band for ``bandfactor``
+        return S
+    S = sp.csr_matrix(0.5 * (R + R.T))
+    S.sum_duplicates()
+    return S
 
 
 def _inverse_root(diagonal):

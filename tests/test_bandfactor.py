@@ -46,8 +46,13 @@ def test_shifted_inverse_solves_the_shifted_system(rng, wide):
     assert np.abs(residual).max() < 1e-10 * np.abs(y).max()
 
 
-def test_scaled_symmetric_dense_and_sparse_agree(rng):
+@pytest.mark.parametrize("pattern", ["unsymmetric", "symmetric"])
+def test_scaled_symmetric_dense_and_sparse_agree(rng, pattern):
+    """Against ``D (K + K^T) / 2 D``; a structurally symmetric ``K`` (unsymmetric values) takes the
+    path without a sparse sum."""
     K = sp.random(50, 50, density=0.2, random_state=rng, format="csc") + sp.diags(rng.uniform(-5, 5, 50))
+    if pattern == "symmetric":
+        K = sp.csc_matrix(K + 2.0 * K.T)
     Ad, d = scaled_symmetric(K, dense=True)
     As, d2 = scaled_symmetric(K)
     Kd = K.toarray()
