@@ -332,7 +332,7 @@ class System:
             coo = self._block_coo(d) + (K.ravel(),)
             g = np.intersect1d(self.global_nodes, self.rep[nodes])
             if len(g):
-                coo = _concat(coo, self._global_node_terms(r, g))
+                coo = self._concat_coo(coo, self._global_node_terms(r, g))
         return (r, coo) + _blocks.levels(f)
 
     def _block_coo(self, d):
@@ -346,6 +346,17 @@ class System:
                 a.flags.writeable = False
             self._coo_index = c
         return c[1], c[2]
+
+    def _concat_coo(self, a, b):
+        """``_concat(a, b)`` whose index arrays are kept (the same read-only arrays) while ``a``'s are the
+        same arrays (``_block_coo``) and ``b``'s equal."""
+        c = getattr(self, "_coo_concat", None)
+        if c is None or c[0] is not a[0] or c[1] is not a[1] or not (
+                np.array_equal(c[2], b[0]) and np.array_equal(c[3], b[1])):
+            rows, cols = np.concatenate([a[0], b[0]]), np.concatenate([a[1], b[1]])
+            rows.flags.writeable = cols.flags.writeable = False
+            c = self._coo_concat = (a[0], a[1], np.array(b[0]), np.array(b[1]), rows, cols)
+        return c[4], c[5], np.concatenate([a[2], b[2]])
 
     @staticmethod
     def _global_node_terms(r, g):

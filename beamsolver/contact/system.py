@@ -86,6 +86,8 @@ class _Decl:
         self.mu = decl.mu
         self.tolerance = o.tolerance
         self.n_gp = o.gauss_points
+        xg, wg = np.polynomial.legendre.leggauss(self.n_gp)
+        self.gauss = 0.5 * (xg + 1.0), 0.5 * wg        # Gauss points and weights on [0, 1]
         self.line_angle = o.line_angle
         self.point_ratio = o.point_ratio
         self.margin = 2.0 * max(s.radius for s in secs) if o.margin is None else o.margin
@@ -190,6 +192,12 @@ class ContactSystem(Contribution):
             g = self._geo = (np.array(H, dtype=float), element_twists(H, self.sys.enodes))
         return g
 
+    def _centres(self, H, P, prev=False):
+        """Centre points ``x_C``, ``x_F`` ``(P, 3)`` of the pairs ``P`` at ``H`` (``prev``: at the last
+        converged poses), one compiled call for both."""
+        x = self._points(H, np.concatenate([P.e, P.m]), np.concatenate([P.xi1, P.xi2]), prev)
+        return x[:len(P)], x[len(P):]
+
     def _points(self, H, e, xi, prev=False):
         """Centre points ``(k, 3)`` of the sections ``xi`` of elements ``e`` at ``H`` (``prev``: at the
         last converged poses, whose twists are kept for the step)."""
@@ -281,8 +289,7 @@ class ContactSystem(Contribution):
         point and master beam (``rules.owners``).  Returns the record and the owner ids."""
         en = self.sys.enodes
         gp = np.flatnonzero(c.kind != POINT)
-        xg, wg = np.polynomial.legendre.leggauss(d.n_gp)
-        xg, wg = 0.5 * (xg + 1.0), 0.5 * wg
+        xg, wg = d.gauss
         rep = np.repeat(gp, d.n_gp)
         g = np.tile(np.arange(d.n_gp), len(gp))
         e, m, h1, h2 = c.e[rep], c.m[rep], c.h1[rep], c.h2[rep]
@@ -401,9 +408,9 @@ class ContactSystem(Contribution):
         given = self._decl_smoothing[P.decl[sel]]
         return np.where(np.isnan(given), np.where(P.kind[sel] == LINE, SMOOTHING * rsum, 0.0), given)
 
-    def _active(self, P, H):
-        """Pairs whose trial normal traction is positive, with their kernel parameters."""
-        xC, xF = self._points(H, P.e, P.xi1), self._points(H, P.m, P.xi2)
+    def _active(self, P, H, centres=None):
+        """Pairs whose trial normal traction is positive (``centres``: ``_centres(H, P)`` if known)."""
+        xC, xF = self._centres(H, P) if centres is None else centres
         gap = np.linalg.norm(xF - xC, axis=1) - P.R1 - P.R2
         pen = self._decl_penalty[P.decl]
         mi, mf = self._lookup(self._mult[0], P.key)
@@ -420,9 +427,10 @@ class ContactSystem(Contribution):
         return (f"{name(be)} element {e - be.elements[0]} (global {e}) against "
                 f"{name(bm)} element {m - bm.elements[0]} (global {m})")
 
-    def _check_normals(self, P, sel, H):
-        """Refuse (a step failure: cut back) pairs whose centre lines intersect: no normal."""
-        xC, xF = self._points(H, P.e[sel], P.xi1[sel]), self._points(H, P.m[sel], P.xi2[sel])
+    def _check_normals(self, P, sel, H, centres):
+        """Refuse (a step failure: cut back) pairs whose centre lines intersect: no normal
+        (``centres``: ``_centres(H, P)``)."""
+        xC, xF = centres[0][sel], centres[1][sel]
         bad = np.flatnonzero(no_normal(np.linalg.norm(xF - xC, axis=1), P.R1[sel], P.R2[sel]))
         if len(bad):
             k = sel[bad[0]]
@@ -432,7 +440,7 @@ class ContactSystem(Contribution):
                 raise InputError(msg + " in the given poses: do two beams share a centre line? Separate them")
             raise NoContactNormal(msg)
 
-    def _check_sides(self, P, H):
+    def _check_sides(self, P, H, centres):
         """Tunnelling: refuse (cut back) a step over which a pair changed sides.
 
         The centre-line distance vector ``d = x_F - x_C`` of each candidate pair (same
@@ -442,8 +450,9 @@ class ContactSystem(Contribution):
         """
         if self._H_prev is None or self._H_prev.shape != H.shape:
             return
-        d = self._points(H, P.m, P.xi2) - self._points(H, P.e, P.xi1)
-        d0 = self._points(H, P.m, P.xi2, prev=True) - self._points(H, P.e, P.xi1, prev=True)
+        d = centres[1] - centres[0]
+        x0C, x0F = self._centres(H, P, prev=True)
+        d0 = x0F - x0C
         rsum = P.R1 + P.R2
         seen = ~no_normal(np.linalg.norm(d0, axis=1), P.R1, P.R2)
         flip = np.flatnonzero(seen & (np.sum(d * d0, axis=1) < -(NORMAL_TOL * rsum) ** 2))
@@ -477,12 +486,13 @@ class ContactSystem(Contribution):
         self._lap()
         sel = np.zeros(0, dtype=int)
         if P is not None:
-            self._check_sides(P, H)
-            sel = self._active(P, H)
+            centres = self._centres(H, P)
+            self._check_sides(P, H, centres)
+            sel = self._active(P, H, centres)
         if len(sel) == 0:
             self._blocks = (np.array(H), None)
             return None
-        self._check_normals(P, sel, H)
+        self._check_normals(P, sel, H, centres)
         p = self._params(P, sel, H)
         self._lap("params")
         f, K, out = self._kernels(H[P.nodes[sel]], p, P.decl[sel], tangent)
