@@ -30,19 +30,33 @@ __all__ = ["ExtraPattern"]
 
 
 @jit
-def _bucket(col, n_col, ptr, slot):
-    """Stable bucketing of the entries by column (``coo_tocsr``): ``ptr`` ``(n_col + 1,)`` column
-    starts, ``slot`` the entry numbers in bucket order."""
+def _count(rows, cols, red, ptr):
+    """Entries per column of the reduced matrix (``ptr[j + 1]``) and their number: those whose row
+    and column are both free (``red >= 0``)."""
     ptr[:] = 0
-    for c in col:
-        ptr[c + 1] += 1
-    for j in range(n_col):
+    n = 0
+    for k in range(len(rows)):
+        c = red[cols[k]]
+        if c >= 0 and red[rows[k]] >= 0:
+            ptr[c + 1] += 1
+            n += 1
+    for j in range(len(ptr) - 1):
         ptr[j + 1] += ptr[j]
+    return n
+
+
+@jit
+def _bucket(rows, cols, red, ptr, number, row):
+    """Stable bucketing of the kept entries by column (``coo_tocsr``): their entry numbers
+    ``number`` (float: scipy's sort moves them as values) and reduced rows ``row``, column by column."""
     nxt = ptr[:-1].copy()
-    for k in range(len(col)):
-        c = col[k]
-        slot[nxt[c]] = k
-        nxt[c] += 1
+    for k in range(len(rows)):
+        c = red[cols[k]]
+        r = red[rows[k]]
+        if c >= 0 and r >= 0:
+            number[nxt[c]] = k
+            row[nxt[c]] = r
+            nxt[c] += 1
 
 
 @jit
@@ -104,9 +118,9 @@ def _values(el_data, el_pos, vals, order, start, c_pos, out):
     for k in range(len(el_pos)):
         out[el_pos[k]] = el_data[k]
     for u in range(len(c_pos)):
-        x = vals[order[start[u]]]
+        x = vals[np.int64(order[start[u]])]
         for s in range(start[u] + 1, start[u + 1]):
-            x += vals[order[s]]
+            x += vals[np.int64(order[s])]
         out[c_pos[u]] += x
     for k in range(len(out)):
         if out[k] == 0.0:
@@ -125,19 +139,17 @@ class ExtraPattern:
 
     def __init__(self, rows, cols, red, n_free, el_indptr, el_indices):
         self.rows, self.cols, self.n_free = rows, cols, n_free
-        rr, rc = red[rows], red[cols]
-        kept = np.flatnonzero((rr >= 0) & (rc >= 0))
-        rr, rc = rr[kept], rc[kept]
+        red = np.ascontiguousarray(red, dtype=np.int64)
         ptr = np.empty(n_free + 1, dtype=np.int64)
-        slot = np.empty(len(kept), dtype=np.int64)
-        _bucket(rc, n_free, ptr, slot)
+        n_kept = _count(rows, cols, red, ptr)
+        number, row = np.empty(n_kept), np.empty(n_kept, dtype=np.int32)
+        _bucket(rows, cols, red, ptr, number, row)
         # scipy's own column sort, on the entry numbers (exact as floats below 2^53)
-        tmp = sp.csc_matrix((slot.astype(float), rr[slot].astype(np.int32), ptr.astype(np.int32)),
-                            shape=(n_free, n_free))
+        tmp = sp.csc_matrix((number, row, ptr.astype(np.int32)), shape=(n_free, n_free), copy=False)
         tmp.sort_indices()
         c_row = tmp.indices
-        self.order = kept[tmp.data.astype(np.int64)]          # entry of ``vals`` of each sorted slot
-        start = np.empty(len(kept) + 1, dtype=np.int64)
+        self.order = tmp.data              # entry of ``vals`` (as a float) of each sorted slot
+        start = np.empty(n_kept + 1, dtype=np.int64)
         n_runs = _runs(c_row, ptr, start)
         self.start = start[:n_runs + 1].copy()
         size = len(el_indices) + n_runs

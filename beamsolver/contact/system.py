@@ -471,8 +471,9 @@ class ContactSystem(Contribution):
         return not any(d.mu > 0 for d in self.decls)
 
     def _local_blocks(self, H, tangent):
-        """``(P, sel, p, f, K, out)`` at poses ``H``: pairs, active ones, kernel parameters, local
-        wrenches ``(m, 4, 6)``, tangent blocks ``(m, 24, 24)`` and point data; None without active pairs.
+        """``(P, sel, p, f, K, out)`` at poses ``H``: pairs, active ones, kernel parameters, the contact's
+        part of the residual ``f`` ``(m, 4, 6)`` (minus the kernel's wrenches, negated in place: no copy
+        of the blocks), its tangent blocks ``K`` ``(m, 24, 24)`` and point data; None without active pairs.
 
         Kept for the same poses and contact state (``_blocks``, cleared when the state changes):
         the tangent evaluation at an accepted line-search trial reuses the trial's (the compiled
@@ -496,6 +497,9 @@ class ContactSystem(Contribution):
         p = self._params(P, sel, H)
         self._lap("params")
         f, K, out = self._kernels(H[P.nodes[sel]], p, P.decl[sel], tangent)
+        np.negative(f, out=f)
+        if K is not None:
+            np.negative(K, out=K)
         self._lap("kernel")
         # kept for commit/augment at the same poses (the converged iterate): no second pass
         if (p["mu"] > 0).all() or not (p["mu"] > 0).any():
@@ -556,7 +560,7 @@ class ContactSystem(Contribution):
         if blocks is None:
             return Blocks.empty(4, tangent), dict(n_active=0)
         P, sel, p, f, K, out = blocks
-        b = Blocks(P.nodes[sel], -f.reshape(-1, 24), -K if tangent else None)
+        b = Blocks(P.nodes[sel], f.reshape(-1, 24), K if tangent else None)
         self._lap("blocks")
         return b, dict(n_active=len(sel))
 
