@@ -105,3 +105,14 @@ def test_contact_scene_tangent_bit_identical():
     el = sp.csc_matrix((data[:s.nnz], s.indices, s.indptr), shape=(s.n_free, s.n_free))
     for _ in range(2):                       # built, then reused
         assert _identical(problem.tangent(ev), _scipy(el, *ev.extra, s.red))
+
+
+def test_entries_only_on_constrained_unknowns():
+    """No entry kept: the element matrix with its exact zeros dropped, as ``K_el + empty``."""
+    el = sp.eye(5, format="csc")
+    el.data[2] = 0.0
+    red = np.array([0, 1, 2, 3, 4, -1, -1])
+    rows, cols = np.array([5, 6, 5]), np.array([5, 5, 0])
+    vals = np.array([1.0, 2.0, 3.0])
+    K = ExtraPattern(rows, cols, red, 5, el.indptr, el.indices).matrix(el.data, vals)
+    assert _identical(K, _scipy(el, rows, cols, vals, red)) and K.nnz == 4

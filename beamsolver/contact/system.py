@@ -230,6 +230,8 @@ class ContactSystem(Contribution):
         self._prev_points = np.sort(np.concatenate(chosen)) if chosen else np.zeros(0, dtype=np.int64)
         self._prev_owners = np.sort(np.concatenate(owners)) if owners else np.zeros(0, dtype=np.int64)
         out = [p for p in out if len(p)]
+        if len(out) == 1:
+            return out[0]
         return PairSet.concatenate(out) if out else None
 
     def _candidates(self, d, H):
@@ -260,7 +262,7 @@ class ContactSystem(Contribution):
 
     def _record(self, d, kind, e, m, xi1, xi2, weight, key, gp):
         en = self.sys.enodes
-        nodes = np.stack([en[e, 0], en[e, 1], en[m, 0], en[m, 1]], axis=1)
+        nodes = np.concatenate([en[e], en[m]], axis=1)
         return PairSet(kind=kind, e=e, m=m, xi1=xi1, xi2=xi2, weight=weight, key=key, gp=gp,
                        decl=np.full(len(e), d.index), nodes=nodes, R1=self.el_radius[e], R2=self.el_radius[m])
 
