@@ -198,13 +198,17 @@ class ContactSystem(Contribution):
         x = self._points(H, np.concatenate([P.e, P.m]), np.concatenate([P.xi1, P.xi2]), prev)
         return x[:len(P)], x[len(P):]
 
+    def _prev_twists(self):
+        """Twists ``(n_elements, 6)`` of all elements at the last converged poses (once per step)."""
+        if self._geo_prev is None:
+            self._geo_prev = (self._H_prev, element_twists(self._H_prev, self.sys.enodes))
+        return self._geo_prev[1]
+
     def _points(self, H, e, xi, prev=False):
         """Centre points ``(k, 3)`` of the sections ``xi`` of elements ``e`` at ``H`` (``prev``: at the
         last converged poses, whose twists are kept for the step)."""
         if prev:
-            if self._geo_prev is None:
-                self._geo_prev = (self._H_prev, element_twists(self._H_prev, self.sys.enodes))
-            Hc, h = self._geo_prev
+            Hc, h = self._H_prev, self._prev_twists()
         else:
             Hc, h = self._twists(H)
         return section_points(Hc, self.sys.enodes[e, 0], h[e], xi)[0]
@@ -358,8 +362,9 @@ class ContactSystem(Contribution):
         new = np.flatnonzero(~hf & (p["mu"] > 0))
         if len(new) and self._H_prev is not None:
             X = self._H_prev[P.nodes[sel][new]]
+            h = self._prev_twists()           # the element twists at the last converged poses
             H_CL, H_FK, H_LK = material_frames(X, p["kind"][new], p["xi1"][new], p["xi2"][new],
-                                               p["R1"][new], p["R2"][new])
+                                               p["R1"][new], p["R2"][new], h[P.e[sel][new]], h[P.m[sel][new]])
             ok = np.isfinite(H_LK).all(axis=(1, 2))
             new = new[ok]
             p["H_CL"][new], p["H_FK"][new], p["H_LK_prev"][new] = H_CL[ok], H_FK[ok], H_LK[ok]
