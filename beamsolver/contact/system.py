@@ -204,6 +204,12 @@ class ContactSystem(Contribution):
             self._geo_prev = (self._H_prev, element_twists(self._H_prev, self.sys.enodes))
         return self._geo_prev[1]
 
+    def _pose_at(self, H, e, xi):
+        """Section poses ``(k, 4, 4)`` ``H_A exp(xi h)`` of elements ``e`` at ``H`` (numpy, the twists kept
+        for these poses)."""
+        Hc, h = self._twists(H)
+        return se3.interpolate(Hc[self.sys.enodes[e, 0]], h[e], xi)
+
     def _points(self, H, e, xi, prev=False):
         """Centre points ``(k, 3)`` of the sections ``xi`` of elements ``e`` at ``H`` (``prev``: at the
         last converged poses, whose twists are kept for the step)."""
@@ -652,8 +658,7 @@ class ContactSystem(Contribution):
         keys = P.key[sel]
         order = np.argsort(keys)
         HL, HK = _frames(out)
-        HC = _interp_pose(H, self.sys.enodes, P.e[sel], out["xi1"])
-        HF = _interp_pose(H, self.sys.enodes, P.m[sel], out["xi2"])
+        HC, HF = self._pose_at(H, P.e[sel], out["xi1"]), self._pose_at(H, P.m[sel], out["xi2"])
         lam_t = out["lam_t"]
         lam_vec = lam_t[:, :1] * out["t1"] + lam_t[:, 1:] * out["t2"]
         self._history = dict(key=keys[order], H_CL=se3.relative(HC, HL)[order],
@@ -683,8 +688,8 @@ class ContactSystem(Contribution):
         w = p["weight"]
         lam_t = out["lam_t"]
         ft = (w * lam_t[:, 0])[:, None] * out["t1"] + (w * lam_t[:, 1])[:, None] * out["t2"]
-        e1s = _interp_pose(H, self.sys.enodes, P.e[sel], out["xi1"])[:, :3, 0]
-        e1m = _interp_pose(H, self.sys.enodes, P.m[sel], out["xi2"])[:, :3, 0]
+        e1s = self._pose_at(H, P.e[sel], out["xi1"])[:, :3, 0]
+        e1m = self._pose_at(H, P.m[sel], out["xi2"])[:, :3, 0]
         ang = np.degrees(np.arccos(np.clip(np.abs(np.sum(e1s * e1m, axis=1)), 0.0, 1.0)))
         active = out["lam_n"] > 0
         return dict(position=0.5 * (out["xC"] + out["xF"]) + 0.5 * (p["R1"] - p["R2"])[:, None] * out["n"],
