@@ -20,10 +20,11 @@ Times are CPU times of the process (``time.process_time``, least of ``REPEAT`` r
 the machine is shared), one thread: the first iteration on the bundle (a new pattern of the
 tangent: ``System.matrix`` and the ``splu-rcm`` ordering build their maps) and the least of the
 ``REPEAT`` next ones (the same active pairs, as between most Newton iterations: the maps are
-reused).  The iteration uses the default linear solver; the other
-back-ends are timed after the iterations (a back-end with a large fill, such as plain ``splu``
-here, leaves freshly mapped memory that slows the next large allocations: the CSC assembly of
-the contact tangent measured 1.0 s right after one, 0.24 s otherwise).
+reused).  The iteration uses the default linear solver; the other back-ends are timed after
+the iterations.  CPU time includes the kernel's (system) time of page faults on freshly mapped
+memory: a new array of tens of MB costs up to 1 s of system time when the machine's memory is
+fragmented (the COO -> CSC conversion of scipy, with several 65 MB temporaries per iteration,
+took 0.2-1.2 s for that reason; the cached pattern allocates none).
 
 ``python benchmarks/contact_bundle.py [n_elements]``
 """
