@@ -476,7 +476,8 @@ class System:
         stays: the same active contact pairs)."""
         p = getattr(self, "_extra_cache", None)
         if p is None or not p.same(extra[0], extra[1]):
-            p = self._extra_cache = ExtraPattern(extra[0], extra[1], self.red, self.n_free, self.indptr, self.indices)
+            p = self._extra_cache = ExtraPattern(extra[0], extra[1], self.red, self.n_free, self.indptr,
+                                                 self.indices, spare=p)
         return p
 
     def full_matrix(self, kvals, extra=None):

@@ -149,3 +149,26 @@ def test_solve_bit_identical_to_the_scipy_assembly(monkeypatch):
     np.testing.assert_array_equal(cached.reactions, plain.reactions)
     for k in range(len(plain.times)):
         np.testing.assert_array_equal(cached.contact(k)["normal_force"], plain.contact(k)["normal_force"])
+
+
+def test_pattern_built_on_the_buffers_of_the_last_one():
+    """A new pattern reuses the buffers of the one it replaces when they are large enough (and only
+    then) and gives the matrix a fresh build gives; the replaced pattern is not usable any more."""
+    rng = np.random.default_rng(9)
+    n = 300
+    red = np.arange(n)
+    el = _element_matrix(rng, n, 0.02)
+    big = _blocks(rng, n, 200, 24, 150)
+    small = _blocks(rng, n, 150, 24, 150)
+    first = ExtraPattern(*big, red, n, el.indptr, el.indices)
+    second = ExtraPattern(*small, red, n, el.indptr, el.indices, spare=first)
+    assert first.buffers is None and second.buffers[0] is not None
+    vals = rng.standard_normal(len(small[0]))
+    assert _identical(second.matrix(el.data, vals), _scipy(el, *small, vals, red))
+    fresh = ExtraPattern(*small, red, n, el.indptr, el.indices)
+    assert _identical(second.matrix(el.data, vals), fresh.matrix(el.data, vals))
+    third = ExtraPattern(*big, red, n, el.indptr, el.indices, spare=fresh)    # too small: fresh buffers
+    assert fresh.buffers is not None and third.buffers[0] is not fresh.buffers[0]
+    assert _identical(fresh.matrix(el.data, vals), _scipy(el, *small, vals, red))
+    vals = rng.standard_normal(len(big[0]))
+    assert _identical(third.matrix(el.data, vals), _scipy(el, *big, vals, red))
