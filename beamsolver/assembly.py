@@ -475,7 +475,7 @@ class System:
         """The ``extra_pattern.ExtraPattern`` of the COO entries ``extra`` (kept while their pattern
         stays: the same active contact pairs)."""
         p = getattr(self, "_extra_cache", None)
-        if p is None or not p.same(extra[0], extra[1]):
+        if p is None or not p.same(extra[0], extra[1], (self.red, self.indptr, self.indices)):
             p = self._extra_cache = ExtraPattern(extra[0], extra[1], self.red, self.n_free, self.indptr,
                                                  self.indices, spare=p)
         return p

@@ -141,6 +141,7 @@ class ExtraPattern:
 
     def __init__(self, rows, cols, red, n_free, el_indptr, el_indices, spare=None):
         self.rows, self.cols, self.n_free = rows, cols, n_free
+        self.base = (red, el_indptr, el_indices)       # the arrays it was built on (``same``)
         red = np.ascontiguousarray(red, dtype=np.int64)
         ptr = np.empty(n_free + 1, dtype=np.int64)
         n_kept = _count(rows, cols, red, ptr)
@@ -172,8 +173,11 @@ class ExtraPattern:
         self.indices, self.col = u_row[:n].copy(), u_col[:n].copy()
         self.indptr = u_ptr.astype(np.int32)
 
-    def same(self, rows, cols):
-        """Whether ``(rows, cols)`` is this pattern (the same arrays, or equal ones)."""
+    def same(self, rows, cols, base=None):
+        """Whether ``(rows, cols)`` is this pattern (the same arrays, or equal ones), on the same
+        reduction and element pattern ``base = (red, el_indptr, el_indices)`` (the same arrays)."""
+        if base is not None and any(a is not b for a, b in zip(base, self.base)):
+            return False
         if rows is self.rows and cols is self.cols:
             return True
         return rows.shape == self.rows.shape and np.array_equal(rows, self.rows) and np.array_equal(cols, self.cols)
