@@ -293,19 +293,33 @@ def _jacobian_derivatives(u, w, xi, S, v):
 
 # ---------------------------------------------------------------- projection and its derivative
 @jit
+def _same(a, b):
+    """``a`` and ``b`` are the same float, bit for bit (not nan)."""
+    return a == b and np.signbit(a) == np.signbit(b)
+
+
+@jit
 def _project(kind, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations=2):
-    """Newton iterations of ``pairs._project`` (two in the kernel, from the search's converged point)."""
-    for _ in range(iterations):
-        R1, x1, x1p, x1pp = _section(RA1, xA1, u1, w1, xi1)
+    """Newton iterations of ``pairs._project`` (two in the kernel, from the search's converged point).
+
+    The slave section is computed once where ``xi1`` is fixed (line, orthogonal), and the iterations
+    stop at an exact fixed point (an iterate equal to the last, bit for bit, fixes all later ones), so
+    the result is that of all ``iterations``."""
+    moving = kind != LINE and kind != ORTHOGONAL
+    R1, x1, x1p, x1pp = _section(RA1, xA1, u1, w1, xi1)
+    for it in range(iterations):
+        if moving and it > 0:
+            R1, x1, x1p, x1pp = _section(RA1, xA1, u1, w1, xi1)
         R2, x2, x2p, x2pp = _section(RA2, xA2, u2, w2, xi2)
         d = add(x2, scale(-1.0, x1))
         e1 = _col(R1, 0)
+        xi1_new, xi2_new = xi1, xi2
         if kind == LINE:
             j = dot(x2p, e1)
-            xi2 = xi2 - dot(d, e1) / (j if j != 0.0 else 1.0)
+            xi2_new = xi2 - dot(d, e1) / (j if j != 0.0 else 1.0)
         elif kind == ORTHOGONAL:
             j = dot(x2p, x2p) + dot(d, x2pp)
-            xi2 = xi2 - dot(d, x2p) / (j if j != 0.0 else 1.0)
+            xi2_new = xi2 - dot(d, x2p) / (j if j != 0.0 else 1.0)
         else:
             a11 = -dot(x1p, x1p) + dot(d, x1pp)
             a12, a21 = dot(x2p, x1p), -dot(x1p, x2p)
@@ -313,8 +327,11 @@ def _project(kind, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations=2):
             det = a11 * a22 - a12 * a21
             det = det if det != 0.0 else 1.0
             g1, g2 = dot(d, x1p), dot(d, x2p)
-            xi1 = xi1 - (a22 * g1 - a12 * g2) / det
-            xi2 = xi2 - (-a21 * g1 + a11 * g2) / det
+            xi1_new = xi1 - (a22 * g1 - a12 * g2) / det
+            xi2_new = xi2 - (-a21 * g1 + a11 * g2) / det
+        if _same(xi1_new, xi1) and _same(xi2_new, xi2):
+            return xi1_new, xi2_new
+        xi1, xi2 = xi1_new, xi2_new
     return xi1, xi2
 
 
