@@ -455,8 +455,8 @@ def _compose(RA, xA, RB, xB):
 
 
 @jit
-def _slip_rows(Tdy, Ad, J, sign, D, c0, tmp):
-    """``D[:, c0:c0+6] = sign Tdy[1:3] Ad J`` (``Tdy``, ``Ad``, ``J`` ``(6, 6)``; ``tmp`` ``(6, 6)``)."""
+def _slip_rows(Tdy, Ad, JA, JB, sign, D, c0, tmp):
+    """``D[:, c0:c0+12] = sign (Tdy[1:3] Ad) [J_A, J_B]`` (``Tdy``, ``Ad``, ``J`` ``(6, 6)``; ``tmp`` ``(6, 6)``)."""
     for i in range(2):
         for j in range(6):
             acc = 0.0
@@ -465,21 +465,27 @@ def _slip_rows(Tdy, Ad, J, sign, D, c0, tmp):
             tmp[i, j] = acc
     for i in range(2):
         for j in range(6):
-            acc = 0.0
+            a = 0.0
+            b = 0.0
             for l in range(6):
-                acc += tmp[i, l] * J[l, j]
-            D[i, c0 + j] = -acc if sign < 0.0 else acc
+                a += tmp[i, l] * JA[l, j]
+                b += tmp[i, l] * JB[l, j]
+            D[i, c0 + j] = -a if sign < 0.0 else a
+            D[i, c0 + 6 + j] = -b if sign < 0.0 else b
 
 
 @jit
-def _slip(side1, side2, S1, S2, xi1, xi2, xi1p, xi2p, HCL, HFK, HLKp, D):
+def _slip(side1, side2, S1, S2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp, D):
     """Slip ``log(H_LK_prev^-1 H_LK)[1:3]`` of the material frames (``kinematics.slip_increment``)
-    and its gradient into ``D`` ``(2, 24)``; the node Jacobians at ``xi_prev`` into ``S[S_JAP], S[S_JBP]``
-    (a copy of those at ``xi`` where ``xi_prev`` is ``xi``, bit for bit)."""
+    and its gradient into ``D`` ``(2, 24)``; ``sec1``, ``sec2``: ``(xi, R, x)`` of the sections at the
+    point.  The node Jacobians at ``xi_prev`` go to ``S[S_JAP], S[S_JBP]``; where ``xi_prev`` is ``xi``
+    (bit for bit) the section and the Jacobians at ``xi`` are reused."""
     RA1, xA1, u1, w1 = side1
     RA2, xA2, u2, w2 = side2
-    RCm, xCm, _, _ = _section(RA1, xA1, u1, w1, xi1p)
-    RFm, xFm, _, _ = _section(RA2, xA2, u2, w2, xi2p)
+    xi1, RC, xC = sec1
+    xi2, RF, xF = sec2
+    RCm, xCm = (RC, xC) if _same(xi1p, xi1) else _section(RA1, xA1, u1, w1, xi1p)[:2]
+    RFm, xFm = (RF, xF) if _same(xi2p, xi2) else _section(RA2, xA2, u2, w2, xi2p)[:2]
     RCL, xCL = _pose4(HCL)
     RFK, xFK = _pose4(HFK)
     RL, xL = _compose(RCm, xCm, RCL, xCL)
@@ -494,18 +500,16 @@ def _slip(side1, side2, S1, S2, xi1, xi2, xi1p, xi2p, HCL, HFK, HLKp, D):
     _tangent_inv(dyu, dyw, Tdy)
     Rs, xs = _compose(RCL, xCL, RLK, xLK)
     _adjoint_inv(Rs, xs, Ad)
-    _slip_rows(Tdy, Ad, S1[S_JAP], -1.0, D, 0, tmp)
-    _slip_rows(Tdy, Ad, S1[S_JBP], -1.0, D, 6, tmp)
+    _slip_rows(Tdy, Ad, S1[S_JAP], S1[S_JBP], -1.0, D, 0, tmp)
     _adjoint_inv(RFK, xFK, Ad)
-    _slip_rows(Tdy, Ad, S2[S_JAP], 1.0, D, 12, tmp)
-    _slip_rows(Tdy, Ad, S2[S_JBP], 1.0, D, 18, tmp)
+    _slip_rows(Tdy, Ad, S2[S_JAP], S2[S_JBP], 1.0, D, 12, tmp)
     return (dyu[1], dyu[2])
 
 
 @jit
 def _jacobians_at(u, w, xi, xip, S):
     """Node Jacobians at ``xip`` into ``S[S_JAP], S[S_JBP]``; copied from those at ``xi`` if ``xip`` is ``xi``."""
-    if xip == xi and np.signbit(xip) == np.signbit(xi):
+    if _same(xip, xi):
         JA, JB, JAP, JBP = S[S_JA], S[S_JB], S[S_JAP], S[S_JBP]
         for i in range(6):
             for j in range(6):
@@ -700,7 +704,8 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
         Dslip = g2[G2_DSLIP]
         _zero(Dslip)
         if has:
-            slip = _slip(side1, side2, S1, S2, xi1, xi2, par[XI1P], par[XI2P], HCL, HFK, HLKp, Dslip)
+            slip = _slip(side1, side2, S1, S2, (xi1, RC, xC), (xi2, RF, xF), par[XI1P], par[XI2P], HCL, HFK, HLKp,
+                         Dslip)
         lt, Dlt, stick = _friction(slip, Dslip, lamp, t1, t2, Dt1, Dt2, lam, Dlam, par, g2, r[R_DPT])
         if active:
             F = _add_friction_force(F, DF, wgt, lt, Dlt, t1, t2, Dt1, Dt2)
