@@ -29,6 +29,13 @@ The contact law is pluggable: the kernel calls ``_normal_law`` and
 scalar functions (default ``law.PENALTY_COULOMB``, tested equal to the numpy forms
 ``law.normal_force`` and ``law.coulomb_return_mapping`` the oracle uses).
 ``NUMBA_DISABLE_JIT=1`` runs this module as plain Python (slowly).
+
+Nothing is allocated per point: small algebra stays in tuples, and the 6x6 matrices,
+6-vectors and ``(k, 24)`` gradients live in scratch arrays made once per batch
+(``_scratch``; named slots ``S_*``, ``V_*``, ``G*_*``, ``R_*``) and written in place.
+Every sum keeps its terms and their order (the Newton iteration counts of the contact
+examples are round-off sensitive); values that are needed twice are computed once only
+where the two computations are the same operations on the same inputs.
 """
 import hashlib
 import types
