@@ -119,18 +119,17 @@ class Run:
 
     def _step_zero(self, H0, t_start):
         """Step 0: the state ``H0`` at ``t_start`` (prescribed nodes on their motion) or, when loads,
-        motions or ``fix`` values act there or contributions (contact) leave ``H0`` out of balance,
-        the equilibrium solved there from ``H0`` with ``STEP_ZERO_ITERATIONS`` times the Newton
-        budget ``max_iter``: no step can be cut back there, and the first state of touching wires
-        converges only linearly (docs/theory.md section 17, touching wires at t_start)."""
+        motions or ``fix`` values act there, the equilibrium solved there from ``H0`` with
+        ``STEP_ZERO_ITERATIONS`` times the Newton budget ``max_iter``: no step can be cut back
+        there, and the first state of touching wires converges only linearly (docs/theory.md
+        section 17, touching wires at t_start)."""
         sys, problem = self.sys, self.problem
         H = H0.copy()
         if len(sys.prescribed_nodes):
             H[sys.prescribed_nodes] = sys.prescribed_poses(t_start)
             sys.sync_members(H)
         stats, record = dict(iterations=0, residuals=[], wall_time=0.0, dt=0.0, cutbacks=0), None
-        ev0 = None if _acts_at(sys, H0, t_start) else problem.evaluate(H, t_start, tangent=False)
-        if ev0 is None or (problem.contributions and np.all(np.isfinite(ev0.r)) and not self._balanced(ev0)):
+        if _acts_at(sys, H0, t_start):
             t0 = time.perf_counter()
             self.H, self.t = H0, None
             conv = self.newton.conv
@@ -139,9 +138,8 @@ class Run:
                 H, ev0, stats = self.newton_step(t_start)
             except StepFailed as e:
                 self.sol.converged, self.sol.message = False, str(e)
-                err = ConvergenceError(f"solve: no equilibrium at t_start = {t_start:.6g}, where loads, motions or "
-                                       f"contact forces already act: {e}; start the loads from zero or use more steps",
-                                       self.sol)
+                err = ConvergenceError(f"solve: no equilibrium at t_start = {t_start:.6g}, where loads or motions "
+                                       f"already act: {e}; start the loads from zero or use more steps", self.sol)
                 err.failure = e
                 raise err from None
             finally:
@@ -150,17 +148,13 @@ class Run:
             record = problem.commit(H)
             if problem.contributions:
                 self.sol.contact_state = problem.get_state()
+        else:
+            ev0 = problem.evaluate(H, t_start, tangent=False)
         self._check_finite(H, ev0.r, ev0.state, t_start)
         self.sol.append(t_start, H, sys.reactions(H, ev0.r), ev0.state.sigma, ev0.state.strain, stats, record)
         self.H = H
         if self.writer is not None:
             self.writer.write(self.sol, 0)
-
-    def _balanced(self, ev):
-        """Whether the evaluation ``ev`` is an equilibrium (Newton's residual test)."""
-        n, conv = self.newton, self.newton.conv
-        rf = ev.r[self.sys.free_dofs]
-        return conv.residual_ratio(rf[n.fu], rf[n.fw], *conv.scales(ev, n.L_ref)) <= conv.rtol
 
     def _name_nonfinite(self, t):
         """A non-finite residual from the user's input (a load scale or motion at ``t``): InputError."""

@@ -50,16 +50,3 @@ def test_step_zero_budget_is_bounded_by_the_options():
     with pytest.raises(bs.ConvergenceError, match=f"no equilibrium at t_start = 0.*in {5 * STEP_ZERO_ITERATIONS} "
                                                   "iterations"):
         bs.solve(model, steps=1, t_end=1e-9, max_iter=5)
-
-
-def test_touching_pair_without_load_starts_from_its_equilibrium():
-    """No load at t_start: the touching reference state is still out of balance (the smoothed law
-    pushes touching points apart), so step 0 is that equilibrium, not the reference poses; before,
-    the reference was recorded and the first step could not advance at any size (the contact's
-    push does not shrink with the step)."""
-    model, _, (a, b) = twisted_pair.build(length=L, n_elements=24, turns=0.5, mu=0.0, pull=0.0)
-    sol = bs.solve(model, steps=2, t_end=1e-9)
-    assert sol.converged and sol.times[-1] == pytest.approx(1e-9)
-    assert sol.stats[0]["iterations"] > 0 and all(s.get("cutbacks", 0) == 0 for s in sol.stats)
-    x = sol.poses[0][a.nodes][:, 0, 3] - 0.5e-3
-    assert x.max() > 0 and x.min() > -1e-12                # wire a bowed away from wire b, never into it
