@@ -20,6 +20,7 @@ import beamsolver as bs
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 
+import three_wires  # noqa: E402
 import twisted_pair  # noqa: E402
 
 L, PULL = 0.1, 5.0
@@ -40,6 +41,15 @@ def test_touching_long_pair_finds_its_first_equilibrium(mu):
     # the wires bow apart symmetrically: the contact pushes wire a (x > 0) towards +x
     fx = np.sum(c["normal_force"][on] * -c["normal"][on, 0])
     assert fx > 0
+
+
+def test_three_touching_wires_with_default_options_find_their_first_equilibrium():
+    """``examples/three_wires.py`` (default contact options) at 0.1 m: step 0 needs 50 iterations."""
+    model, plate, wires = three_wires.build(length=L, n_elements=24, turns=0.5, mu=0.3, pull=PULL)
+    sol = bs.solve(model, steps=1, t_end=1e-9)
+    assert sol.converged and sol.stats[0]["iterations"] > 30
+    axial = -sum(sol.reaction(w.first, 0)[2] for w in wires)
+    assert axial == pytest.approx(PULL, rel=1e-6)
 
 
 def test_step_zero_budget_is_bounded_by_the_options():
