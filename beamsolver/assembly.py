@@ -59,6 +59,38 @@ def _find(parent, i):
     return i
 
 
+def _beams_anchored(model, kind):
+    """The rigid-mode check's exact shortcut: without joins, contact or nodes outside beams the
+    connected groups are the beams (a beam's elements chain all its nodes), and a beam with a
+    clamped or prescribed node has no free rigid-body mode."""
+    if model.joins or model.contacts or model.free_nodes:
+        return False
+    anchored = (kind == CLAMPED) | (kind == PRESCRIBED)
+    return all(anchored[b.nodes].any() for b in model.beams)
+
+
+def _representatives(n, joins, cons, group_constraint):
+    """Representative node of every node ``(n,)``: joined groups merged by union-find, the
+    constrained node of a group (``group_constraint``) chosen as its representative."""
+    if not joins:
+        return np.arange(n)
+    parent = list(range(n))
+    for a, b in joins:
+        ra, rb = _find(parent, a), _find(parent, b)
+        if ra == rb:
+            continue
+        # the constrained node of a group becomes its representative
+        ca, cb = group_constraint(parent, ra, cons), group_constraint(parent, rb, cons)
+        if ca is not None and cb is not None:
+            raise InputError(f"join({a}, {b}): both joined groups carry constraints "
+                             f"(nodes {ca} and {cb}); constrain only one node of a joint")
+        if cb is not None:
+            parent[ra] = rb
+        else:
+            parent[rb] = ra
+    return np.array([_find(parent, i) for i in range(n)])
+
+
 class System:
     """Compiled, validated model: DOF map, element table, load arrays, sparse pattern."""
 
@@ -131,22 +163,15 @@ class System:
     # ------------------------------------------------------------ dof map
     def _build_reps(self, model):
         n = self.n_nodes
-        parent = list(range(n))
         cons = model.constraints
-        for a, b in model.joins:
-            ra, rb = _find(parent, a), _find(parent, b)
-            if ra == rb:
-                continue
-            # the constrained node of a group becomes its representative
-            ca, cb = self._group_constraint(parent, ra, cons), self._group_constraint(parent, rb, cons)
-            if ca is not None and cb is not None:
-                raise InputError(f"join({a}, {b}): both joined groups carry constraints "
-                                 f"(nodes {ca} and {cb}); constrain only one node of a joint")
-            if cb is not None:
-                parent[ra] = rb
-            else:
-                parent[rb] = ra
-        rep = np.array([_find(parent, i) for i in range(n)])
+        rep = _representatives(n, model.joins, cons, self._group_constraint)
+        self._set_constraints(model, rep)
+
+    def _set_constraints(self, model, rep):
+        """Node kinds, fixed unknowns, joined members and the free/fixed DOF numbering from the
+        representatives ``rep`` ``(n,)``."""
+        n = self.n_nodes
+        cons = model.constraints
         # a constrained member hands its constraint to the representative
         kind = np.full(n, FREE)
         fixed = np.zeros((n, 6), dtype=bool)
@@ -171,8 +196,11 @@ class System:
         self.is_rep = is_rep
         P = self.poses0
         self.members = np.flatnonzero(~is_rep)
-        self.X = se3.relative(P[rep[self.members]], P[self.members])   # H_i = H_rep X_i
-        self.Ad_Xinv = se3.adjoint(se3.inverse(self.X))
+        if len(self.members):
+            self.X = se3.relative(P[rep[self.members]], P[self.members])   # H_i = H_rep X_i
+            self.Ad_Xinv = se3.adjoint(se3.inverse(self.X))
+        else:
+            self.X, self.Ad_Xinv = np.zeros((0, 4, 4)), np.zeros((0, 6, 6))
         self.global_nodes = np.flatnonzero(kind == GLOBAL)
         # prescribed global translations of fixed components: (node, component, f)
         self.fix_values = []
@@ -191,8 +219,10 @@ class System:
         transformed = np.zeros(n, dtype=bool)
         transformed[self.members] = True
         transformed[self.global_nodes] = True
-        transformed |= np.isin(rep, self.global_nodes)
+        if len(self.global_nodes):
+            transformed |= np.isin(rep, self.global_nodes)
         self.transformed = transformed
+        self.any_transformed = bool(transformed.any())
         self.group_transformed = [np.flatnonzero(transformed[g.nodes].any(axis=1)) for g in self.groups]
         self.body_nodes = np.flatnonzero(is_rep & ((kind == FREE) | (kind == PRESCRIBED)))
 
@@ -205,6 +235,8 @@ class System:
 
     def _check_rigid_modes(self, model):
         """Every connected group (joints, contact) needs 6 independent constraints."""
+        if _beams_anchored(model, self.kind):
+            return
         n = self.n_nodes
         parent = list(range(n))
 

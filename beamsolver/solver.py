@@ -320,11 +320,11 @@ class Newton:
             if ahead is None:
                 ev = self.evaluate(H, t)
                 lu = dzf = None
+                scales = conv.scales(ev, self.L_ref)
+                ratio = self._ratio(ev.r, scales)
             else:
-                ev, lu, dzf = ahead
+                ev, lu, dzf, scales, ratio = ahead     # the damped trial's, already measured
                 ahead = None
-            scales = conv.scales(ev, self.L_ref)
-            ratio = self._ratio(ev.r, scales)
             residuals.append(ratio)
             log.debug("t = %.6g  iteration %d  scaled residual %.3e", t, it, ratio)
             if self.callback is not None:
@@ -401,9 +401,9 @@ class Newton:
         halved (a trial that is not finite, is singular or turns an element past the limit is
         rejected too) down to ``DAMPING_MIN``.
 
-        Returns ``(H, lam, ahead, rotation)``: ``ahead`` the trial's ``(ev, lu, dzf)`` (``None``
-        if it converged), ``rotation`` the rotation-limit failure of the full
-        first trial, if that is what rejected it.
+        Returns ``(H, lam, ahead, rotation)``: ``ahead`` the trial's ``(ev, lu, dzf, scales, ratio)``
+        (``lu``, ``dzf`` ``None`` if it converged), ``rotation`` the rotation-limit failure of the
+        full first trial, if that is what rejected it.
         """
         problem, conv = self.problem, self.conv
         if self._inc(dzf) <= 1e3 * conv.dtol:     # round-off level: nothing to damp
@@ -417,12 +417,15 @@ class Newton:
             H1 = problem.update(H, lam * dz)
             try:
                 ev1 = self.evaluate(H1, t)
-                if self._ratio(ev1.r, conv.scales(ev1, self.L_ref)) <= conv.rtol:
-                    return H1, lam, (ev1, None, None), None
+                scales1 = conv.scales(ev1, self.L_ref)
+                ratio1 = self._ratio(ev1.r, scales1)
+                if ratio1 <= conv.rtol:
+                    return H1, lam, (ev1, None, None, scales1, ratio1), None
                 lu1, d1 = self._direction(ev1)
-                self.stall_ratio = self._norm(d1) / nrm
-                if self._norm(d1) < nrm or self._inc(d1) <= conv.dtol:
-                    return H1, lam, (ev1, lu1, d1), rotation
+                nrm1 = self._norm(d1)
+                self.stall_ratio = nrm1 / nrm
+                if nrm1 < nrm or self._inc(d1) <= conv.dtol:
+                    return H1, lam, (ev1, lu1, d1, scales1, ratio1), rotation
             except StepFailed as e:
                 failure = e
                 if first and e.rotation:
