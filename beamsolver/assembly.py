@@ -59,6 +59,53 @@ def _find(parent, i):
     return i
 
 
+DENSE_KEYS = 1 << 16        # _unique_inverse marks keys in a dense table up to this bound (or 16 per key)
+
+
+def _unique_inverse(key, bound):
+    """``np.unique(key, return_inverse=True)`` for integer keys in ``[0, bound)``; for a small
+    ``bound`` by a dense table of the keys present (no sort)."""
+    if bound > max(DENSE_KEYS, 16 * len(key)):
+        return np.unique(key, return_inverse=True)
+    present = np.zeros(bound, dtype=bool)
+    present[key] = True
+    return np.flatnonzero(present), (np.cumsum(present) - 1)[key]
+
+
+def _csc_by_constructor(data, indices, indptr, n):
+    return sp.csc_matrix((data, indices, indptr), shape=(n, n))
+
+
+def _csc_direct(data, indices, indptr, n):
+    K = sp.csc_matrix.__new__(sp.csc_matrix)
+    K.data, K.indices, K.indptr, K._shape, K.maxprint = data, indices, indptr, (n, n), _MAXPRINT
+    K._has_canonical_format = K._has_sorted_indices = True
+    return K
+
+
+def _pick_csc():
+    """``_csc_direct`` where it builds what scipy's constructor builds (the same attributes), else the
+    constructor: scipy's checks cost more than a small model's factorisation."""
+    args = (np.ones(2), np.array([0, 1], dtype=np.int32), np.array([0, 1, 2], dtype=np.int32), 2)
+    try:
+        ref, fast = _csc_by_constructor(*args), _csc_direct(*args)
+        same = set(vars(ref)) | {"_has_canonical_format", "_has_sorted_indices"} == set(vars(fast)) \
+            and (ref != fast).nnz == 0
+    except Exception:
+        same = False
+    return _csc_direct if same else _csc_by_constructor
+
+
+_MAXPRINT = _csc_by_constructor(np.ones(1), np.zeros(1, dtype=np.int32), np.array([0, 1], dtype=np.int32), 1).maxprint
+
+
+def canonical_csc(data, indices, indptr, n):
+    """Square ``(n, n)`` ``scipy.sparse.csc_matrix`` of a canonical pattern (sorted, unique row
+    indices per column, int32, as ``System._build_pattern`` makes it) and its ``data``; the arrays
+    are not copied."""
+    return _CSC(data, indices, indptr, n)
+
+
 def _beams_anchored(model, kind):
     """The rigid-mode check's exact shortcut: without joins, contact or nodes outside beams the
     connected groups are the beams (a beam's elements chain all its nodes), and a beam with a
@@ -89,6 +136,9 @@ def _representatives(n, joins, cons, group_constraint):
         else:
             parent[rb] = ra
     return np.array([_find(parent, i) for i in range(n)])
+
+
+_CSC = _pick_csc()
 
 
 class System:
@@ -280,6 +330,7 @@ class System:
         self.load_follower = np.array([ld.follower for ld in loads], dtype=bool)
         self.load_scales = [ld.scale for ld in loads]
         self.dead = np.flatnonzero(~self.load_follower)
+        self.dead_nodes = self.load_nodes[self.dead]
 
     def load_factors(self, t):
         return np.array([float(s(t)) for s in self.load_scales])
@@ -296,7 +347,8 @@ class System:
         self.block_nodes = bn.astype(int)
         self.load_dofs = ((6 * self.rep[self.load_nodes])[:, None] + k6).ravel()
         self.dead_where = np.searchsorted(self.block_nodes, self.load_nodes[self.dead])
-        self.dead_unique = len(np.unique(self.dead_where)) == len(self.dead_where)
+        self.dead_unique = len(set(self.dead_where.tolist())) == len(self.dead_where)
+        self.dead_blocks_in_order = bool(np.array_equal(self.dead_where, np.arange(len(bn))))
         ndofs = (6 * self.rep[self.block_nodes])[:, None] + k6
         # element entries group by group in the order of the kernels' tangent storage, (n_g, 6k, 6k),
         # then the node blocks (n_b, 6, 6)
@@ -311,7 +363,7 @@ class System:
         keep = (rr >= 0) & (rc >= 0)
         nf = self.n_free
         key = rc[keep].astype(np.int64) * max(nf, 1) + rr[keep]
-        ukey, inv = np.unique(key, return_inverse=True)
+        ukey, inv = _unique_inverse(key, max(nf, 1) ** 2)
         self.nnz = len(ukey)
         pos = np.full(len(rows), self.nnz)        # dropped entries go to a dummy slot
         pos[keep] = inv
@@ -330,9 +382,9 @@ class System:
     # ------------------------------------------------------------ transforms
     def node_transforms(self, H):
         """``M_i`` for the transformed nodes: dict of arrays ``(n, 6, 6)`` (identity elsewhere)."""
-        M = np.broadcast_to(np.eye(6), (self.n_nodes, 6, 6)).copy() if self.transformed.any() else None
-        if M is None:
+        if not self.any_transformed:
             return None
+        M = np.broadcast_to(np.eye(6), (self.n_nodes, 6, 6)).copy()
         g = self.global_nodes
         if len(g):
             Rt = np.swapaxes(H[g, :3, :3], 1, 2)
@@ -385,16 +437,18 @@ class System:
         pattern (``None`` without tangent); ``info`` holds the element state
         and force levels for the convergence test.
         """
-        kvals = None
+        kvals = blocks = None
         n_k = self.group_kslices[-1]
         if tangent:
-            # the kernels write their tangents straight into the COO value array (no copy)
+            # the kernels write their tangents straight into the COO value array (no copy), the node
+            # blocks follow them
             kvals = np.empty(n_k + 36 * len(self.block_nodes))
+            blocks = kvals[n_k:].reshape(-1, 6, 6)
+            blocks[...] = 0.0
         f, state, f_level, m_level, M = self._element_forces(H, kvals)
         ndof = 6 * self.n_nodes
         r = np.bincount(self.edofs_flat, weights=f, minlength=ndof)
         # external loads (body components at their node, then transformed)
-        blocks = np.zeros((len(self.block_nodes), 6, 6)) if tangent else None
         if len(self.load_nodes):
             r, f_level, m_level = self._add_loads(H, load_factors, M, r, blocks, f_level, m_level)
         if tangent and len(self.global_nodes):
@@ -403,8 +457,6 @@ class System:
             where = np.searchsorted(self.block_nodes, g)
             blocks[where, :3, 3:] -= skew(rg[:, :3])
             blocks[where, 3:, 3:] -= skew(rg[:, 3:])
-        if tangent:
-            kvals[n_k:] = blocks.ravel()
         info = dict(state=state, f_level=f_level, m_level=m_level)
         return r, kvals, info
 
@@ -448,13 +500,17 @@ class System:
         Fs, Ms = self.load_F * lf[:, None], self.load_M * lf[:, None]
         f_level = max(f_level, np.abs(Fs).max(initial=0.0))
         m_level = max(m_level, np.abs(Ms).max(initial=0.0))
-        fext = np.concatenate([Fs, Ms], axis=1)
         d = self.dead
         kb = np.empty((len(d) if blocks is not None else 0, 6, 6))
-        if len(d):
-            fd = np.empty((len(d), 6))
-            assembly_jit.dead_loads(H, self.load_nodes[d], Fs[d], Ms[d], fd, kb)
-            fext[d] = fd
+        if len(d) == len(Fs):                  # dead loads only
+            fext = np.empty((len(d), 6))
+            assembly_jit.dead_loads(H, self.dead_nodes, Fs, Ms, fext, kb)
+        else:
+            fext = np.concatenate([Fs, Ms], axis=1)
+            if len(d):
+                fd = np.empty((len(d), 6))
+                assembly_jit.dead_loads(H, self.dead_nodes, Fs[d], Ms[d], fd, kb)
+                fext[d] = fd
         if M is not None:
             fext = np.einsum("nji,nj->ni", M[self.load_nodes], fext)
         r = r - np.bincount(self.load_dofs, weights=fext.ravel(), minlength=len(r))
@@ -462,7 +518,9 @@ class System:
             if M is not None:
                 Md = M[self.load_nodes[d]]
                 kb = np.swapaxes(Md, 1, 2) @ kb @ Md
-            if self.dead_unique:
+            if self.dead_blocks_in_order:      # the node blocks are the dead loads' blocks, in order
+                blocks += kb
+            elif self.dead_unique:
                 blocks[self.dead_where] += kb
             else:
                 np.add.at(blocks, self.dead_where, kb)
@@ -476,7 +534,7 @@ class System:
         """
         data = np.empty(self.nnz + 1)
         assembly_jit.scatter(self.pos, kvals, data)
-        K = sp.csc_matrix((data[:self.nnz], self.indices, self.indptr), shape=(self.n_free, self.n_free))
+        K = canonical_csc(data[:self.nnz], self.indices, self.indptr, self.n_free)
         if extra is not None and len(extra[2]):
             rows, cols, vals = extra
             rr, rc = self.red[rows], self.red[cols]

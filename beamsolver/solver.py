@@ -41,6 +41,7 @@ DAMPING_MIN = 1.0 / 64.0             # shortest damped Newton step (smooth probl
 STALL_RATIO = 1.5                    # undamped fallback if the shortest damped step grows the correction less
 MIN_STEP_RATIO = 1e-15               # smallest min_step_ratio: below, t + dt rounds to t
 ROUNDOFF = 64.0 * np.finfo(float).eps   # position round-off, relative to the distance from the origin
+SQRT3 = np.sqrt(3.0)                 # |w|_2 <= SQRT3 |w|_inf (the rotation check's shortcut)
 
 CONVERGED, CONTINUE, MAX_ITER, DIVERGED = "converged", "continue", "max_iter", "diverged"
 
@@ -175,6 +176,7 @@ class Newton:
         fu = dof_u.ravel()[system.free_dofs]
         self.fu, self.fw = np.flatnonzero(fu), np.flatnonzero(~fu)
         self.L_ref = system.length_scale
+        self._smallest_limit = (1.0 - 1e-9) * float(system.rotation_limit.min(initial=np.inf))
         self.linsolver = linsolve.Solver()    # solve(linear_solver=...) replaces it
         self.stall_ratio = np.inf             # correction growth of the shortest damped trial
         self.reset_timings()
@@ -199,7 +201,11 @@ class Newton:
         return f"element {e}"
 
     def _check_rotation(self, state):
-        ang = se3.rotation_angle(state.h[:, 3:])
+        w = state.h[:, 3:]
+        # |w| <= sqrt(3) max|w_i|: far below every limit, nothing to measure
+        if len(w) and np.abs(w).max() * SQRT3 < self._smallest_limit:
+            return
+        ang = se3.rotation_angle(w)
         limit = self.sys.rotation_limit          # of each element's type, MAX_ELEMENT_ROTATION for se3-2
         worst = int(np.argmax(ang - limit)) if len(ang) else 0
         if len(ang) and ang[worst] > limit[worst]:
@@ -264,7 +270,7 @@ class Newton:
         self.timings["assembly"] += time.perf_counter() - t0
         for name, seconds in ev.timings.items():
             self.timings[name] = self.timings.get(name, 0.0) + seconds
-        if not np.all(np.isfinite(ev.r)):
+        if not np.isfinite(ev.r).all():
             raise NonFinite("the residual is not finite")
         self._check_rotation(ev.state)
         return ev
@@ -312,18 +318,18 @@ class Newton:
         floor = conv.floor(H, self.L_ref)
         damping = self.line_search and problem.smooth
         last_inc = np.inf
-        ahead = None                 # (ev, lu, dzf) of an accepted damped trial
+        ahead = None                 # (ev, lu, dzf, scales, ratio, norm) of an accepted damped trial
         lam = 1.0
         rotation_streak = 0
         stats_extra = {}
         for it in range(conv.max_iter + 1):
             if ahead is None:
                 ev = self.evaluate(H, t)
-                lu = dzf = None
+                lu = dzf = nrm = None
                 scales = conv.scales(ev, self.L_ref)
                 ratio = self._ratio(ev.r, scales)
             else:
-                ev, lu, dzf, scales, ratio = ahead     # the damped trial's, already measured
+                ev, lu, dzf, scales, ratio, nrm = ahead     # the damped trial's, already measured
                 ahead = None
             residuals.append(ratio)
             log.debug("t = %.6g  iteration %d  scaled residual %.3e", t, it, ratio)
@@ -352,7 +358,7 @@ class Newton:
                 continue
             lam0 = min(1.0, 2.0 * lam)          # after a damped iteration, try twice its length
             try:
-                H, lam, ahead, rotation = self._damped(H, dz, dzf, t, lam0)
+                H, lam, ahead, rotation = self._damped(H, dz, dzf, t, lam0, nrm)
             except DampingStalled:
                 if not self.stall_ratio <= STALL_RATIO:
                     raise
@@ -388,7 +394,7 @@ class Newton:
         dz[self.sys.free_dofs] = dzf
         return dz.reshape(-1, 6)
 
-    def _damped(self, H, dz, dzf, t, lam):
+    def _damped(self, H, dz, dzf, t, lam, nrm=None):
         """Damped Newton update ``H exp(lam dz)`` (smooth problems).
 
         A trial length is accepted when the Newton correction at the trial point is smaller than
@@ -401,14 +407,16 @@ class Newton:
         halved (a trial that is not finite, is singular or turns an element past the limit is
         rejected too) down to ``DAMPING_MIN``.
 
-        Returns ``(H, lam, ahead, rotation)``: ``ahead`` the trial's ``(ev, lu, dzf, scales, ratio)``
-        (``lu``, ``dzf`` ``None`` if it converged), ``rotation`` the rotation-limit failure of the
-        full first trial, if that is what rejected it.
+        ``nrm``: ``_norm(dzf)`` if known.  Returns ``(H, lam, ahead, rotation)``: ``ahead`` the
+        trial's ``(ev, lu, dzf, scales, ratio, norm)`` (``lu``, ``dzf``, ``norm`` ``None`` if it
+        converged), ``rotation`` the rotation-limit failure of the full first trial, if that is what
+        rejected it.
         """
         problem, conv = self.problem, self.conv
         if self._inc(dzf) <= 1e3 * conv.dtol:     # round-off level: nothing to damp
             return problem.update(H, dz), 1.0, None, None
-        nrm = self._norm(dzf)
+        if nrm is None:
+            nrm = self._norm(dzf)
         rotation = None
         failure = None
         first = True
@@ -420,12 +428,12 @@ class Newton:
                 scales1 = conv.scales(ev1, self.L_ref)
                 ratio1 = self._ratio(ev1.r, scales1)
                 if ratio1 <= conv.rtol:
-                    return H1, lam, (ev1, None, None, scales1, ratio1), None
+                    return H1, lam, (ev1, None, None, scales1, ratio1, None), None
                 lu1, d1 = self._direction(ev1)
                 nrm1 = self._norm(d1)
                 self.stall_ratio = nrm1 / nrm
                 if nrm1 < nrm or self._inc(d1) <= conv.dtol:
-                    return H1, lam, (ev1, lu1, d1, scales1, ratio1), rotation
+                    return H1, lam, (ev1, lu1, d1, scales1, ratio1, nrm1), rotation
             except StepFailed as e:
                 failure = e
                 if first and e.rotation:
