@@ -353,11 +353,10 @@ class System:
         # element entries group by group in the order of the kernels' tangent storage, (n_g, 6k, 6k),
         # then the node blocks (n_b, 6, 6)
         shapes = [(len(ed), ed.shape[1], ed.shape[1]) for ed in self.group_edofs]
-        self.group_kslices = np.cumsum([0] + [int(np.prod(sh)) for sh in shapes])
-        rows = np.concatenate([np.broadcast_to(ed[:, :, None], sh).ravel() for ed, sh in zip(self.group_edofs, shapes)]
-                              + [np.repeat(ndofs, 6, axis=1).ravel()])
-        cols = np.concatenate([np.broadcast_to(ed[:, None, :], sh).ravel() for ed, sh in zip(self.group_edofs, shapes)]
-                              + [np.tile(ndofs, (1, 6)).ravel()])
+        self.group_kslices = np.cumsum([0] + [a * b * c for a, b, c in shapes])
+        blocks = list(zip(self.group_edofs, shapes)) + [(ndofs, (len(ndofs), 6, 6))]
+        rows = np.concatenate([np.broadcast_to(ed[:, :, None], sh).ravel() for ed, sh in blocks])
+        cols = np.concatenate([np.broadcast_to(ed[:, None, :], sh).ravel() for ed, sh in blocks])
         self.coo_rows, self.coo_cols = rows, cols
         rr, rc = self.red[rows], self.red[cols]
         keep = (rr >= 0) & (rc >= 0)
