@@ -496,15 +496,16 @@ class System:
         Dead loads: body components ``R^T F`` with the stiffness ``-[[0, hat(R^T F)], [0, hat(R^T M)]]``
         (docs/theory.md eq. 4.2); follower loads are constant in the body frame.
         """
-        Fs, Ms = self.load_F * lf[:, None], self.load_M * lf[:, None]
-        f_level = max(f_level, np.abs(Fs).max(initial=0.0))
-        m_level = max(m_level, np.abs(Ms).max(initial=0.0))
         d = self.dead
         kb = np.empty((len(d) if blocks is not None else 0, 6, 6))
-        if len(d) == len(Fs):                  # dead loads only
+        if len(d) == len(self.load_F):                  # dead loads only: one compiled call
             fext = np.empty((len(d), 6))
-            assembly_jit.dead_loads(H, self.dead_nodes, Fs, Ms, fext, kb)
+            fl, ml = assembly_jit.scaled_dead_loads(H, self.dead_nodes, self.load_F, self.load_M, lf, fext, kb)
+            f_level, m_level = max(f_level, fl), max(m_level, ml)
         else:
+            Fs, Ms = self.load_F * lf[:, None], self.load_M * lf[:, None]
+            f_level = max(f_level, np.abs(Fs).max(initial=0.0))
+            m_level = max(m_level, np.abs(Ms).max(initial=0.0))
             fext = np.concatenate([Fs, Ms], axis=1)
             if len(d):
                 fd = np.empty((len(d), 6))

@@ -175,6 +175,7 @@ class Newton:
         dof_u[:, :3] = True
         fu = dof_u.ravel()[system.free_dofs]
         self.fu, self.fw = np.flatnonzero(fu), np.flatnonzero(~fu)
+        self._dofs_u, self._dofs_w = system.free_dofs[self.fu], system.free_dofs[self.fw]   # in all 6 n unknowns
         self.L_ref = system.length_scale
         self._smallest_limit = (1.0 - 1e-9) * float(system.rotation_limit.min(initial=np.inf))
         self.linsolver = linsolve.Solver()    # solve(linear_solver=...) replaces it
@@ -185,8 +186,7 @@ class Newton:
         self.timings = dict(assembly=0.0, linear_solve=0.0, **dict.fromkeys(self.problem.timing_names, 0.0))
 
     def _ratio(self, r, scales):
-        rf = r[self.sys.free_dofs]
-        return self.conv.residual_ratio(rf[self.fu], rf[self.fw], *scales)
+        return self.conv.residual_ratio(r[self._dofs_u], r[self._dofs_w], *scales)
 
     def _merit(self, r, scales):
         rf = r[self.sys.free_dofs]
@@ -357,8 +357,9 @@ class Newton:
                 H = self._line_search(H, dz, ev.r, scales, t) if self.line_search else problem.update(H, dz)
                 continue
             lam0 = min(1.0, 2.0 * lam)          # after a damped iteration, try twice its length
+            inc = conv.increment_ratio(dz, self.L_ref)
             try:
-                H, lam, ahead, rotation = self._damped(H, dz, dzf, t, lam0, nrm)
+                H, lam, ahead, rotation = self._damped(H, dz, dzf, t, lam0, nrm, inc)
             except DampingStalled:
                 if not self.stall_ratio <= STALL_RATIO:
                     raise
@@ -369,7 +370,7 @@ class Newton:
                           self.stall_ratio)
                 damping = False
                 stats_extra["undamped"] = it
-                last_inc = conv.increment_ratio(dz, self.L_ref)
+                last_inc = inc
                 H = problem.update(H, dz)
                 continue
             damped_its += lam < 1.0
@@ -378,7 +379,7 @@ class Newton:
             rotation_streak = rotation_streak + 1 if rotation is not None else 0
             if rotation_streak >= 2:
                 raise rotation
-            last_inc = conv.increment_ratio(dz, self.L_ref) if lam == 1.0 else np.inf
+            last_inc = inc if lam == 1.0 else np.inf
         raise AssertionError("unreachable: decide() returns MAX_ITER at iteration max_iter")
 
     def _failure(self, verdict, ratio):
@@ -394,7 +395,7 @@ class Newton:
         dz[self.sys.free_dofs] = dzf
         return dz.reshape(-1, 6)
 
-    def _damped(self, H, dz, dzf, t, lam, nrm=None):
+    def _damped(self, H, dz, dzf, t, lam, nrm=None, inc=None):
         """Damped Newton update ``H exp(lam dz)`` (smooth problems).
 
         A trial length is accepted when the Newton correction at the trial point is smaller than
@@ -407,13 +408,14 @@ class Newton:
         halved (a trial that is not finite, is singular or turns an element past the limit is
         rejected too) down to ``DAMPING_MIN``.
 
-        ``nrm``: ``_norm(dzf)`` if known.  Returns ``(H, lam, ahead, rotation)``: ``ahead`` the
-        trial's ``(ev, lu, dzf, scales, ratio, norm)`` (``lu``, ``dzf``, ``norm`` ``None`` if it
-        converged), ``rotation`` the rotation-limit failure of the full first trial, if that is what
-        rejected it.
+        ``nrm``, ``inc``: ``_norm(dzf)`` and ``_inc(dzf)`` if known.  Returns ``(H, lam, ahead,
+        rotation)``: ``ahead`` the trial's ``(ev, lu, dzf, scales, ratio, norm)`` (``lu``, ``dzf``,
+        ``norm`` ``None`` if it converged), ``rotation`` the rotation-limit failure of the full first
+        trial, if that is what rejected it.
         """
         problem, conv = self.problem, self.conv
-        if self._inc(dzf) <= 1e3 * conv.dtol:     # round-off level: nothing to damp
+        inc = self._inc(dzf) if inc is None else inc
+        if inc <= 1e3 * conv.dtol:     # round-off level: nothing to damp
             return problem.update(H, dz), 1.0, None, None
         if nrm is None:
             nrm = self._norm(dzf)

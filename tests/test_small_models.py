@@ -172,3 +172,25 @@ def test_bend45_single_step_keeps_six_newton_iterations():
     model, beam = bend45.build(8)
     sol = bs.solve(model, steps=1, verbose=False)
     assert int(sol.iterations[1:].sum()) == 6 and sol.n_steps == 1
+
+
+@pytest.mark.parametrize("bad", [None, "nan_first", "nan_last"])
+def test_scaled_dead_loads_kernel_equals_numpy(bad):
+    """``assembly_jit.scaled_dead_loads`` gives ``dead_loads`` of the numpy-scaled loads and
+    numpy's ``max(|F lf|)``, ``max(|M lf|)`` (a NaN anywhere gives NaN, as numpy's max)."""
+    from beamsolver import assembly_jit
+    rng = np.random.default_rng(3)
+    k = 4
+    H = np.stack([np.eye(4)] * 6)
+    H[:, :3, :3] = bs.se3.exp_so3(rng.normal(size=(6, 3)))
+    nodes = np.array([5, 1, 1, 3])
+    F, M, lf = rng.normal(size=(k, 3)), rng.normal(size=(k, 3)), rng.normal(size=k)
+    if bad:
+        F[0 if bad == "nan_first" else -1, 1] = np.nan
+    fb, kb = np.empty((k, 6)), np.empty((k, 6, 6))
+    fl, ml = assembly_jit.scaled_dead_loads(H, nodes, F, M, lf, fb, kb)
+    Fs, Ms = F * lf[:, None], M * lf[:, None]
+    fb0, kb0 = np.empty((k, 6)), np.empty((k, 6, 6))
+    assembly_jit.dead_loads(H, nodes, Fs, Ms, fb0, kb0)
+    assert np.array_equal(fb, fb0, equal_nan=True) and np.array_equal(kb, kb0, equal_nan=True)
+    assert np.array_equal([fl, ml], [np.abs(Fs).max(initial=0.0), np.abs(Ms).max(initial=0.0)], equal_nan=True)
