@@ -59,10 +59,10 @@ def _find(parent, i):
     return i
 
 
-DENSE_KEYS = 1 << 16        # _unique_inverse marks keys in a dense table up to this bound (or 16 per key)
+DENSE_KEYS = 1 << 16        # unique_inverse marks keys in a dense table up to this bound (or 16 per key)
 
 
-def _unique_inverse(key, bound):
+def unique_inverse(key, bound):
     """``np.unique(key, return_inverse=True)`` for integer keys in ``[0, bound)``; for a small
     ``bound`` by a dense table of the keys present (no sort)."""
     if bound > max(DENSE_KEYS, 16 * len(key)):
@@ -106,7 +106,7 @@ def canonical_csc(data, indices, indptr, n):
     return _CSC(data, indices, indptr, n)
 
 
-def _beams_anchored(model, kind):
+def beams_anchored(model, kind):
     """The rigid-mode check's exact shortcut: without joins, contact or nodes outside beams the
     connected groups are the beams (a beam's elements chain all its nodes), and a beam with a
     clamped or prescribed node has no free rigid-body mode."""
@@ -285,7 +285,7 @@ class System:
 
     def _check_rigid_modes(self, model):
         """Every connected group (joints, contact) needs 6 independent constraints."""
-        if _beams_anchored(model, self.kind):
+        if beams_anchored(model, self.kind):
             return
         n = self.n_nodes
         parent = list(range(n))
@@ -362,7 +362,7 @@ class System:
         keep = (rr >= 0) & (rc >= 0)
         nf = self.n_free
         key = rc[keep].astype(np.int64) * max(nf, 1) + rr[keep]
-        ukey, inv = _unique_inverse(key, max(nf, 1) ** 2)
+        ukey, inv = unique_inverse(key, max(nf, 1) ** 2)
         self.nnz = len(ukey)
         pos = np.full(len(rows), self.nnz)        # dropped entries go to a dummy slot
         pos[keep] = inv
