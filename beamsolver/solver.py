@@ -177,6 +177,7 @@ class Newton:
         self.fu, self.fw = np.flatnonzero(fu), np.flatnonzero(~fu)
         self._dofs_u, self._dofs_w = system.free_dofs[self.fu], system.free_dofs[self.fw]   # in all 6 n unknowns
         self.L_ref = system.length_scale
+        # the rotation check's shortcut bound, a margin far above the round-off of |w|
         self._smallest_limit = (1.0 - 1e-9) * float(system.rotation_limit.min(initial=np.inf))
         self.linsolver = linsolve.Solver()    # solve(linear_solver=...) replaces it
         self.stall_ratio = np.inf             # correction growth of the shortest damped trial
