@@ -118,6 +118,7 @@ class Model:
     def __init__(self):
         self.beams = []
         self._poses = []          # list of (n_i + 1, 4, 4)
+        self._refs = {}           # beam id -> (section, its C, element type, Reference) when added
         self._n_nodes = 0
         self._n_elements = 0
         self.constraints = {}     # node -> ("clamp",) | ("fix", frozenset) | ("prescribe", motion)
@@ -194,6 +195,7 @@ class Model:
         nodes = np.arange(self._n_nodes, self._n_nodes + len(P))
         element_ids = np.arange(self._n_elements, self._n_elements + n_el)
         beam = Beam(bid, nodes, element_ids, section, name, etype)
+        self._refs[bid] = (section, section.C.copy(), etype, ref)
         self.beams.append(beam)
         self._poses.append(P)
         self._n_nodes += len(P)
@@ -415,15 +417,29 @@ class Model:
         by_type = {}
         for b in self.beams:
             by_type.setdefault(b.element_type.name, []).append(b)
-        P = self.poses0
+        P = None
         groups = []
         for beams in by_type.values():
             etype = beams[0].element_type
+            ref = self._reference_when_added(beams[0]) if len(beams) == 1 else None
+            if ref is not None:
+                b = beams[0]
+                groups.append(ElementGroup(etype, b.elements.copy(), b.connectivity, ref))
+                continue
+            P = self.poses0 if P is None else P
             nodes = np.concatenate([b.connectivity for b in beams])
             C = np.concatenate([np.broadcast_to(b.section.C, (b.n_elements, 6, 6)) for b in beams])
             groups.append(ElementGroup(etype, np.concatenate([b.elements for b in beams]), nodes,
                                        etype.reference(P[nodes], C)))
         return groups
+
+    def _reference_when_added(self, beam):
+        """The ``Reference`` ``add_beam`` computed for ``beam`` (the same numbers ``element_groups``
+        computes), if its section, stiffness and element type are still those it was added with."""
+        section, C, etype, ref = self._refs.get(beam.id, (None,) * 4)
+        if section is beam.section and etype is beam.element_type and np.array_equal(C, section.C):
+            return ref
+        return None
 
     def element_table(self, groups=None):
         """Per element: end node ids ``(n_el, 2)`` (first and last node), reference length, reference

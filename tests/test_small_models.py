@@ -196,3 +196,29 @@ def test_scaled_dead_loads_kernel_equals_numpy(bad):
     assembly_jit.dead_loads(H, nodes, Fs, Ms, fb0, kb0)
     assert np.array_equal(fb, fb0, equal_nan=True) and np.array_equal(kb, kb0, equal_nan=True)
     assert np.array_equal([fl, ml], [np.abs(Fs).max(initial=0.0), np.abs(Ms).max(initial=0.0)], equal_nan=True)
+
+
+def test_element_groups_reuse_add_beams_reference_only_while_it_holds():
+    """A beam alone in its element type reuses the ``Reference`` ``add_beam`` computed: the same
+    numbers as computing it again; a section replaced or changed afterwards is taken instead."""
+    model, beam = bend45.build(8)
+    g = model.element_groups()[0]
+    P = model.poses0[g.nodes]
+    fresh = g.element_type.reference(P, np.broadcast_to(beam.section.C, (beam.n_elements, 6, 6)))
+    for name in ("L", "eps0", "C", "diagonal"):
+        assert np.array_equal(getattr(g.ref, name), getattr(fresh, name))
+    assert g.ref.data.keys() == fresh.data.keys()
+    tip = bs.solve(model, steps=1, verbose=False).position(beam.last)
+    stiffer = bs.Section(EA=2e7, GA2=1e7, GA3=1e7, GJ=2e7 / 12, EI2=2e7 / 12, EI3=2e7 / 12, radius=0.5)
+    other, b2 = bend45.build(8)
+    other.beams[0].section = stiffer                          # replaced after add_beam
+    expected = bs.Model()
+    b3 = expected.add_beam(geometry.arc(radius=100.0, angle=np.pi / 4.0, n_elements=8), stiffer)
+    expected.clamp(b3.first)
+    expected.add_load(b3.last, force=(0.0, 0.0, 600.0))
+    tip2 = bs.solve(other, steps=1, verbose=False).position(b2.last)
+    assert np.array_equal(tip2, bs.solve(expected, steps=1, verbose=False).position(b3.last))
+    assert not np.allclose(tip2, tip)
+    changed, b4 = bend45.build(8)
+    changed.beams[0].section.C *= 2.0                         # changed in place after add_beam
+    assert np.array_equal(bs.solve(changed, steps=1, verbose=False).position(b4.last), tip2)
