@@ -22,6 +22,7 @@ __all__ = ["Model", "Beam", "Load", "ContactDeclaration", "ElementGroup", "DOF_N
 DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
 JOIN_TOL = 1e-9                       # coincidence tolerance relative to the model size
 ZERO_LENGTH_TOL = 1e-12               # an element shorter than this times the model size has zero length
+LAST_ROW = np.array([0.0, 0.0, 0.0, 1.0])   # of every pose
 
 
 @dataclass
@@ -160,19 +161,17 @@ class Model:
         P = as_array(poses, "poses", label)
         if P.ndim != 3 or P.shape[1:] != (4, 4) or P.shape[0] < 2:
             raise InputError(f"{label}: poses must have shape (n + 1, 4, 4) with n >= 1, got {P.shape}")
-        bad = np.argwhere(~np.all(np.isfinite(P), axis=(1, 2)))
-        if len(bad):
-            i = int(bad[0, 0])
+        if not np.isfinite(P).all():
+            i = int(np.argwhere(~np.all(np.isfinite(P), axis=(1, 2)))[0, 0])
             raise InputError(f"{label}: node {i} has non-finite coordinates {P[i, :3, 3].tolist()}")
         R = P[:, :3, :3]
         err = np.abs(np.swapaxes(R, 1, 2) @ R - np.eye(3)).max(axis=(1, 2))
         det = np.linalg.det(R)
-        badR = np.flatnonzero((err > ORTHONORMAL_TOL) | (det <= 0.0))
-        if len(badR):
-            i = int(badR[0])
+        if err.max() > ORTHONORMAL_TOL or det.min() <= 0.0:
+            i = int(np.flatnonzero((err > ORTHONORMAL_TOL) | (det <= 0.0))[0])
             raise InputError(f"{label}: pose of node {i} is not a rotation (|R^T R - I| = {err[i]:.3g}, "
                              f"det = {det[i]:.6g}); use beamsolver.geometry or orthonormalise it")
-        if np.any(np.abs(P[:, 3] - [0, 0, 0, 1]) > 0):
+        if (P[:, 3] != LAST_ROW).any():
             raise InputError(f"{label}: the last row of every pose must be (0, 0, 0, 1)")
         n_el = etype.n_elements(len(P), label)
         conn = etype.connectivity(n_el)
