@@ -222,3 +222,36 @@ def test_element_groups_reuse_add_beams_reference_only_while_it_holds():
     changed, b4 = bend45.build(8)
     changed.beams[0].section.C *= 2.0                         # changed in place after add_beam
     assert np.array_equal(bs.solve(changed, steps=1, verbose=False).position(b4.last), tip2)
+
+
+def test_continuity_shortcut_bound_holds():
+    """``check_continuity`` skips its test when every element's ``a0 + a1 < pi - CONTINUITY_MARGIN``
+    (angles of the relative rotations before and after the step): then the change ``angle(R0^T R1)
+    <= a0 + a1`` can never reach ``(pi - a0) + (pi - a1) - 1e-9``, checked on random rotations, and
+    a turn through pi within a step is still refused."""
+    from beamsolver.solver import CONTINUITY_MARGIN
+
+    def angle(R):
+        return np.arccos(np.clip(0.5 * (np.trace(R, axis1=-2, axis2=-1) - 1.0), -1.0, 1.0))
+    rng = np.random.default_rng(7)
+    w0, w1 = rng.normal(size=(2, 20000, 3))
+    w0 *= (np.pi * rng.random(20000) / np.linalg.norm(w0, axis=1))[:, None]
+    w1 *= (np.pi * rng.random(20000) / np.linalg.norm(w1, axis=1))[:, None]
+    R0, R1 = bs.se3.exp_so3(w0), bs.se3.exp_so3(w1)
+    a0, a1 = angle(R0), angle(R1)
+    skipped = a0 + a1 < np.pi - CONTINUITY_MARGIN
+    change = angle(np.swapaxes(R0, 1, 2) @ R1)
+    assert skipped.sum() > 5000
+    assert not np.any(change[skipped] >= (np.pi - a0[skipped]) + (np.pi - a1[skipped]) - 1e-9)
+    m = bs.Model()
+    b = m.add_beam(geometry.straight((0, 0, 0), (1, 0, 0), 1), SEC)
+    m.clamp(b.first)
+    newton = Newton(Problem.from_model(m), Convergence())
+
+    def poses(a):
+        H = newton.sys.poses0.copy()
+        H[1, :3, :3] = bs.se3.exp_so3(np.array([a, 0.0, 0.0])) @ H[1, :3, :3]
+        return H
+    newton.check_continuity(poses(0.2), poses(0.3))                   # the shortcut
+    with pytest.raises(RotationLimit, match="may have passed pi"):
+        newton.check_continuity(poses(0.7 * np.pi), poses(1.3 * np.pi))
