@@ -343,12 +343,13 @@ class System:
         self.group_edofs = [_blocks.dofs(self.rep, g.nodes) for g in self.groups]
         self.edofs_flat = np.concatenate([ed.ravel() for ed in self.group_edofs])
         # node blocks: dead-loaded nodes and global-type representatives
-        bn = np.unique(np.concatenate([self.load_nodes[self.dead], self.global_nodes]))
-        self.block_nodes = bn.astype(int)
+        bn = sorted(set(self.dead_nodes.tolist()) | set(self.global_nodes.tolist()))
+        self.block_nodes = np.array(bn, dtype=int)
         self.load_dofs = ((6 * self.rep[self.load_nodes])[:, None] + k6).ravel()
         self.dead_where = np.searchsorted(self.block_nodes, self.load_nodes[self.dead])
         self.dead_unique = len(set(self.dead_where.tolist())) == len(self.dead_where)
-        self.dead_blocks_in_order = bool(np.array_equal(self.dead_where, np.arange(len(bn))))
+        self.dead_blocks_in_order = len(self.dead_where) == len(bn) and \
+            bool((self.dead_where == np.arange(len(bn))).all())
         ndofs = (6 * self.rep[self.block_nodes])[:, None] + k6
         # element entries group by group in the order of the kernels' tangent storage, (n_g, 6k, 6k),
         # then the node blocks (n_b, 6, 6)
@@ -371,6 +372,9 @@ class System:
         counts = np.bincount((ukey // max(nf, 1)).astype(np.int64), minlength=nf)
         self.indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
         # entries (free row, prescribed column) for the predictor
+        if not (len(self.prescribed_nodes) or self.fix_values):
+            self.fc = np.zeros(0, dtype=np.intp)
+            return
         presc = np.zeros(6 * n, dtype=bool)
         for r in self.prescribed_nodes:
             presc[6 * r:6 * r + 6] = True
