@@ -19,7 +19,7 @@ def run():
 def test_reduced_run_reaches_its_turns_with_lk_equal_tw_plus_wr(run):
     sol, rows, _, checks = run
     assert checks["reached"] == pytest.approx(0.5)
-    lk, tw, wr = (np.array([r[i] for r in rows]) for i in (0, 3, 4))
+    lk, tw, wr = (np.array([getattr(r, f) for r in rows]) for f in ("lk", "tw", "wr"))
     assert np.allclose(tw + wr, lk, atol=1e-6)           # straight two-ply: all twist, no writhe
     assert np.abs(wr).max() < 1e-4 and checks["lk_error"] < 0.02
 
@@ -27,7 +27,7 @@ def test_reduced_run_reaches_its_turns_with_lk_equal_tw_plus_wr(run):
 def test_torque_and_stabilisation_are_reported(run):
     sol, rows, _, _ = run
     G, J = 200e9 / 2.6, np.pi * plectoneme.R**4 / 2
-    assert rows[-1][1] == pytest.approx(2 * G * J * np.pi / plectoneme.LENGTH, rel=0.1)
+    assert rows[-1].torque == pytest.approx(2 * G * J * np.pi / plectoneme.LENGTH, rel=0.1)
     st = [s["stabilization"] for s in sol.stats[1:]]
     assert st[0]["factor"] > 0 and all(s["fraction"] < 0.05 for s in st)
     assert all(s["dissipated"] > 0 for s in st[1:])
@@ -47,3 +47,26 @@ def test_length_and_pull_are_build_arguments():
     assert z[-1] == pytest.approx(0.06) and z[4] == pytest.approx(0.03)
     pulls = [ld.force[2] for ld in model.loads if ld.node == plate]
     assert pulls == [pytest.approx(50.0)]
+
+
+def test_extension_control_prescribes_the_plate_height_with_its_turns():
+    model, plate, wires = plectoneme.build(n_elements=8, length=0.06, approach=0.25, turns=2.0)
+    kind, motion = model.constraints[plate]
+    assert kind == "prescribe" and not [ld for ld in model.loads if ld.node == plate]
+    G, angle = motion(0.3), 2 * np.pi * 2.0 * 0.3
+    assert np.allclose(G[:3, :3] @ [1.0, 0.0, 0.0], [np.cos(angle), np.sin(angle), 0.0], atol=1e-12)
+    assert np.allclose((G @ model.poses0[plate])[:3, 3], [0.0, 0.0, 0.06 * (1 - 0.25 * 0.3)])
+
+
+def test_wires_in_pieces_have_self_contact_between_every_two_pieces():
+    model, plate, wires = plectoneme.build(n_elements=12, pieces=3)
+    pairs = {(d.slave[0].id, d.master[0].id) for d in model.contacts if len(d.slave) == 1}
+    for wire in wires:
+        ids = [b.id for b in wire]
+        assert len(ids) == 3 and {(ids[0], ids[1]), (ids[0], ids[2]), (ids[1], ids[2])} <= pairs
+    nodes = plectoneme.wire_nodes(wires[0])
+    assert len(nodes) == 13 and np.allclose(np.diff(model.poses0[nodes, 2, 3]), 0.02 / 12)
+    mid = [ld.node for ld in model.loads if ld.force[1] != 0.0]
+    assert np.allclose(model.poses0[mid, 2, 3], 0.01)
+    with pytest.raises(plectoneme.bs.InputError, match="pieces"):
+        plectoneme.build(n_elements=8, pieces=3)
