@@ -154,14 +154,15 @@ def onset(rows):
 
 
 def main(output=None, turns=5.0, steps=40, n_elements=16, mu=0.3, stabilize=2e-2, imperfection=1e-2,
-         verbose=False, length=LENGTH, pull=PULL, approach=None, pieces=2):
+         verbose=False, length=LENGTH, pull=PULL, approach=None, pieces=2, min_step_ratio=2.0**-12):
     """Solve, print the table and the checks; returns ``(solution, rows, wall time, checks)``."""
     model, plate, wires = build(turns=turns, n_elements=n_elements, mu=mu, imperfection=imperfection,
                                  length=length, pull=pull, approach=approach,
                                  pieces=pieces)
     t0 = time.perf_counter()
     try:
-        sol = bs.solve(model, steps=steps, output=output, verbose=verbose, stabilize=stabilize)
+        sol = bs.solve(model, steps=steps, output=output, verbose=verbose, stabilize=stabilize,
+                       min_step_ratio=min_step_ratio)
     except bs.ConvergenceError as e:
         print(f"stopped: {e}")
         sol = e.solution
@@ -209,10 +210,11 @@ if __name__ == "__main__":
     ap.add_argument("--imperfection", type=float, default=1e-2)
     ap.add_argument("--length", type=float, default=LENGTH, help="wire length [m]")
     ap.add_argument("--pull", type=float, default=PULL, help="dead pull on the plate [N]")
+    ap.add_argument("--min-step-ratio", type=float, default=2.0**-12, help="solve(min_step_ratio=)")
     ap.add_argument("--pieces", type=int, default=2, help="beams per wire (self-contact between them)")
     ap.add_argument("--approach", type=float, default=None,
                     help="extension control: the plate's height prescribed as length (1 - approach t)")
     a = ap.parse_args()
     main(output=a.output, turns=a.turns, steps=a.steps, n_elements=a.elements, mu=a.mu, stabilize=a.stabilize,
          imperfection=a.imperfection, verbose=True, length=a.length, pull=a.pull,
-         approach=a.approach, pieces=a.pieces)
+         approach=a.approach, pieces=a.pieces, min_step_ratio=a.min_step_ratio)

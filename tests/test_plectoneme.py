@@ -70,3 +70,16 @@ def test_wires_in_pieces_have_self_contact_between_every_two_pieces():
     assert np.allclose(model.poses0[mid, 2, 3], 0.01)
     with pytest.raises(plectoneme.bs.InputError, match="pieces"):
         plectoneme.build(n_elements=8, pieces=3)
+
+
+def test_extension_control_buckles_the_pair_at_its_euler_load():
+    """Shortened by 1.2 mm of 60 mm with a tenth of a turn, the clamped-clamped pair buckles: the
+    axial force (the support's reaction, tension positive) sits on the Euler load
+    ``4 pi^2 B / L^2`` of the pair (``B = 2 E I``; 8 coarse elements per wire: a few % stiff)."""
+    sol, rows, _, checks = plectoneme.main(turns=0.1, steps=4, n_elements=8, stabilize=None, length=0.06,
+                                           approach=0.02, pull=50.0)
+    assert checks["reached"] == pytest.approx(0.1) and checks["lk_error"] < 0.02
+    B = 2 * 200e9 * np.pi * plectoneme.R**4 / 4
+    euler = 4 * np.pi**2 * B / 0.06**2
+    assert rows[-1].axial == pytest.approx(-euler, rel=0.06)
+    assert rows[-1].z == pytest.approx(60.0 * (1 - 0.02))
