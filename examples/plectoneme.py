@@ -48,8 +48,26 @@ scaled residual of 2e-3, also without friction or imperfection; 0.06 m is fine).
 The writhing torque with friction lies above Greenhill's ``8.99 B / L`` for ``B = 2 E I``: the
 sticking wires bend stiffer than two free ones, and the damping delays the snap.
 
+Extension control (``--approach s``: the plate's height prescribed as ``L (1 - s t)`` together
+with its turns, so the plate cannot fall; the axial force, the pull plus the support's reaction in
+``z``, tension positive, is then an output) removes the dead-load snap of the plate but not the
+pop of the loop.  ``--length 0.06 --pull 50 --elements 24 --steps 50 --stabilize 2e-3
+--approach 0.3`` (``mu = 0.3``): the shortened pair first buckles in the plane of the imperfection
+at its Euler load (-211 N; ``4 pi^2 B / L^2 = 215 N``) and twists bent (``Wr / Lk <= 0.06`` to
+1.5 turns); from 1.8 turns the twisted pair takes up more length than the plate gives and the
+axial force turns tensile (298 N at 3 turns, 5.5 N m); a loop grows at mid-height from about 3.5
+turns and the solve stops at 3.972 turns, ``Wr = 0.55``, ``Wr / Lk = 0.14``, 990 N, where the
+loop pops (a limit point: 3 negative eigenvalues), ``|Lk - Tw - Wr| / Lk <= 3.2e-3``, dissipated
+at most 1.4e-2 of the strain energy (the first steps; 2.6e-4 at the end), 519 s on a loaded
+machine.  It stops at the same pop with ``--mu 0`` (3.952 turns), ``--pieces 4`` (each wire four
+beams in self-contact: 3.972), ``--elements 32`` (3.943) and ``--stabilize 5e-2`` (3.978);
+``--approach 0.5`` pops earlier (3.116 turns, ``Wr = 0.57``); ``--stabilize 0.2
+--min-step-ratio 1e-7`` creeps through the pop to 4.02 turns and then stalls in steps of 1e-9
+(stopped by hand).  None reaches the 5 turns.
+
     python examples/plectoneme.py [--output plectoneme_output] [--turns 5] [--steps 40] [--mu 0.3] [--stabilize 2e-2]
-        [--elements 16] [--imperfection 1e-2] [--length 0.02] [--pull 5]
+        [--elements 16] [--imperfection 1e-2] [--length 0.02] [--pull 5] [--approach s] [--pieces 2]
+        [--min-step-ratio 2**-12]
 """
 import argparse
 import time
@@ -67,11 +85,12 @@ solve_options = dict(steps=40, stabilize=2e-2)   # for `beamsolver run examples/
 
 
 def build(turns=5.0, n_elements=16, mu=0.3, imperfection=1e-2, pull=PULL, E=200e9, nu=0.3, length=LENGTH,
-          approach=None, pieces=2):
+          approach=None, pieces=2, self_options=None):
     """Returns ``(model, plate node, (wire a, wire b))``, each wire a tuple of ``pieces`` beams
     (bottom to top) of ``n_elements // pieces`` elements joined rigidly.  ``approach=None``: a dead ``pull`` on the plate (free
     in ``z``); a number ``s``: extension control, the plate's height prescribed as
-    ``length (1 - s t)`` together with its turns (``pull`` then only scales the imperfection)."""
+    ``length (1 - s t)`` together with its turns (``pull`` then only scales the imperfection).
+    ``self_options``: extra ``add_contact`` options of the self-contact (e.g. ``line_angle``)."""
     sec = bs.Section.circular(radius=R, E=E, nu=nu)
     model = bs.Model()
     if pieces < 2 or n_elements % pieces:
@@ -101,7 +120,7 @@ def build(turns=5.0, n_elements=16, mu=0.3, imperfection=1e-2, pull=PULL, E=200e
     model.add_contact(list(wires[0]), list(wires[1]), **opts)
     for wire in wires:
         for i, j in zip(*np.triu_indices(pieces, 1)):
-            model.add_contact(wire[i], wire[j], **opts)
+            model.add_contact(wire[i], wire[j], **opts, **(self_options or {}))
     return model, plate, tuple(wires)
 
 
@@ -154,11 +173,12 @@ def onset(rows):
 
 
 def main(output=None, turns=5.0, steps=40, n_elements=16, mu=0.3, stabilize=2e-2, imperfection=1e-2,
-         verbose=False, length=LENGTH, pull=PULL, approach=None, pieces=2, min_step_ratio=2.0**-12):
+         verbose=False, length=LENGTH, pull=PULL, approach=None, pieces=2, min_step_ratio=2.0**-12,
+         self_options=None):
     """Solve, print the table and the checks; returns ``(solution, rows, wall time, checks)``."""
     model, plate, wires = build(turns=turns, n_elements=n_elements, mu=mu, imperfection=imperfection,
                                  length=length, pull=pull, approach=approach,
-                                 pieces=pieces)
+                                 pieces=pieces, self_options=self_options)
     t0 = time.perf_counter()
     try:
         sol = bs.solve(model, steps=steps, output=output, verbose=verbose, stabilize=stabilize,
@@ -211,10 +231,13 @@ if __name__ == "__main__":
     ap.add_argument("--length", type=float, default=LENGTH, help="wire length [m]")
     ap.add_argument("--pull", type=float, default=PULL, help="dead pull on the plate [N]")
     ap.add_argument("--min-step-ratio", type=float, default=2.0**-12, help="solve(min_step_ratio=)")
+    ap.add_argument("--self-line-angle", type=float, default=None,
+                    help="line_angle [rad] of the self-contact (default: the contact default)")
     ap.add_argument("--pieces", type=int, default=2, help="beams per wire (self-contact between them)")
     ap.add_argument("--approach", type=float, default=None,
                     help="extension control: the plate's height prescribed as length (1 - approach t)")
     a = ap.parse_args()
     main(output=a.output, turns=a.turns, steps=a.steps, n_elements=a.elements, mu=a.mu, stabilize=a.stabilize,
          imperfection=a.imperfection, verbose=True, length=a.length, pull=a.pull,
-         approach=a.approach, pieces=a.pieces, min_step_ratio=a.min_step_ratio)
+         approach=a.approach, pieces=a.pieces, min_step_ratio=a.min_step_ratio,
+         self_options=None if a.self_line_angle is None else dict(line_angle=a.self_line_angle))

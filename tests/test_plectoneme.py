@@ -83,3 +83,15 @@ def test_extension_control_buckles_the_pair_at_its_euler_load():
     euler = 4 * np.pi**2 * B / 0.06**2
     assert rows[-1].axial == pytest.approx(-euler, rel=0.06)
     assert rows[-1].z == pytest.approx(60.0 * (1 - 0.02))
+
+
+@pytest.mark.slow
+def test_frictionless_pair_writhes_at_greenhills_torque():
+    """Frictionless, with a small imperfection, the pair leaves the straight two-ply at the torque
+    where its tangent turns indefinite (``M L / B = 8.36``, ``B = 2 E I``; Greenhill's single
+    clamped rod 8.99) and converts a large part of the twist to writhe, Lk = Tw + Wr holding."""
+    sol, rows, _, checks = plectoneme.main(turns=2.0, steps=20, n_elements=8, mu=0.0, stabilize=2e-3,
+                                           imperfection=1e-3)
+    assert checks["onset_ratio"] == pytest.approx(8.36, rel=0.03)
+    assert checks["onset_ratio"] == pytest.approx(plectoneme.GREENHILL, rel=0.1)
+    assert checks["writhe"] > 0.3 and checks["lk_error"] < 0.02
