@@ -60,10 +60,15 @@ turns and the solve stops at 3.972 turns, ``Wr = 0.55``, ``Wr / Lk = 0.14``, 990
 loop pops (a limit point: 3 negative eigenvalues), ``|Lk - Tw - Wr| / Lk <= 3.2e-3``, dissipated
 at most 1.4e-2 of the strain energy (the first steps; 2.6e-4 at the end), 519 s on a loaded
 machine.  It stops at the same pop with ``--mu 0`` (3.952 turns), ``--pieces 4`` (each wire four
-beams in self-contact: 3.972), ``--elements 32`` (3.943) and ``--stabilize 5e-2`` (3.978);
-``--approach 0.5`` pops earlier (3.116 turns, ``Wr = 0.57``); ``--stabilize 0.2
---min-step-ratio 1e-7`` creeps through the pop to 4.02 turns and then stalls in steps of 1e-9
-(stopped by hand).  None reaches the 5 turns.
+beams in self-contact: 3.972; a self-contact of point kind only, ``line_angle = 0``: 3.972),
+``--elements 32`` (3.943) and ``--stabilize 5e-2`` (3.978); ``--approach 0.5`` pops earlier
+(3.116 turns, ``Wr = 0.57``).  More damping and shorter steps carry the pop in pseudo-time but
+not past it: ``--mu 0 --stabilize 0.2 --min-step-ratio 1.5e-5`` completes the loop at 3.972
+turns (``Wr = 0.94``, ``Wr / Lk = 0.24``, 1809 N, dissipated 5.2e-2, warned) and stops there;
+with ``mu = 0.3``, ``--stabilize 5e-2 --min-step-ratio 1e-7`` creeps to 4.07 turns and
+``--stabilize 0.2 --min-step-ratio 1e-7`` to 4.02 turns in steps of 1e-9 (both stopped by hand).
+None reaches the 5 turns: the tight, tensioned loop (its radius about two wire diameters) is
+where every run stalls.
 
     python examples/plectoneme.py [--output plectoneme_output] [--turns 5] [--steps 40] [--mu 0.3] [--stabilize 2e-2]
         [--elements 16] [--imperfection 1e-2] [--length 0.02] [--pull 5] [--approach s] [--pieces 2]
@@ -85,12 +90,11 @@ solve_options = dict(steps=40, stabilize=2e-2)   # for `beamsolver run examples/
 
 
 def build(turns=5.0, n_elements=16, mu=0.3, imperfection=1e-2, pull=PULL, E=200e9, nu=0.3, length=LENGTH,
-          approach=None, pieces=2, self_options=None):
+          approach=None, pieces=2):
     """Returns ``(model, plate node, (wire a, wire b))``, each wire a tuple of ``pieces`` beams
     (bottom to top) of ``n_elements // pieces`` elements joined rigidly.  ``approach=None``: a dead ``pull`` on the plate (free
     in ``z``); a number ``s``: extension control, the plate's height prescribed as
-    ``length (1 - s t)`` together with its turns (``pull`` then only scales the imperfection).
-    ``self_options``: extra ``add_contact`` options of the self-contact (e.g. ``line_angle``)."""
+    ``length (1 - s t)`` together with its turns (``pull`` then only scales the imperfection)."""
     sec = bs.Section.circular(radius=R, E=E, nu=nu)
     model = bs.Model()
     if pieces < 2 or n_elements % pieces:
@@ -120,7 +124,7 @@ def build(turns=5.0, n_elements=16, mu=0.3, imperfection=1e-2, pull=PULL, E=200e
     model.add_contact(list(wires[0]), list(wires[1]), **opts)
     for wire in wires:
         for i, j in zip(*np.triu_indices(pieces, 1)):
-            model.add_contact(wire[i], wire[j], **opts, **(self_options or {}))
+            model.add_contact(wire[i], wire[j], **opts)
     return model, plate, tuple(wires)
 
 
@@ -173,12 +177,11 @@ def onset(rows):
 
 
 def main(output=None, turns=5.0, steps=40, n_elements=16, mu=0.3, stabilize=2e-2, imperfection=1e-2,
-         verbose=False, length=LENGTH, pull=PULL, approach=None, pieces=2, min_step_ratio=2.0**-12,
-         self_options=None):
+         verbose=False, length=LENGTH, pull=PULL, approach=None, pieces=2, min_step_ratio=2.0**-12):
     """Solve, print the table and the checks; returns ``(solution, rows, wall time, checks)``."""
     model, plate, wires = build(turns=turns, n_elements=n_elements, mu=mu, imperfection=imperfection,
                                  length=length, pull=pull, approach=approach,
-                                 pieces=pieces, self_options=self_options)
+                                 pieces=pieces)
     t0 = time.perf_counter()
     try:
         sol = bs.solve(model, steps=steps, output=output, verbose=verbose, stabilize=stabilize,
@@ -231,13 +234,10 @@ if __name__ == "__main__":
     ap.add_argument("--length", type=float, default=LENGTH, help="wire length [m]")
     ap.add_argument("--pull", type=float, default=PULL, help="dead pull on the plate [N]")
     ap.add_argument("--min-step-ratio", type=float, default=2.0**-12, help="solve(min_step_ratio=)")
-    ap.add_argument("--self-line-angle", type=float, default=None,
-                    help="line_angle [rad] of the self-contact (default: the contact default)")
     ap.add_argument("--pieces", type=int, default=2, help="beams per wire (self-contact between them)")
     ap.add_argument("--approach", type=float, default=None,
                     help="extension control: the plate's height prescribed as length (1 - approach t)")
     a = ap.parse_args()
     main(output=a.output, turns=a.turns, steps=a.steps, n_elements=a.elements, mu=a.mu, stabilize=a.stabilize,
          imperfection=a.imperfection, verbose=True, length=a.length, pull=a.pull,
-         approach=a.approach, pieces=a.pieces, min_step_ratio=a.min_step_ratio,
-         self_options=None if a.self_line_angle is None else dict(line_angle=a.self_line_angle))
+         approach=a.approach, pieces=a.pieces, min_step_ratio=a.min_step_ratio)
