@@ -92,9 +92,10 @@ solve_options = dict(steps=40, stabilize=2e-2)   # for `beamsolver run examples/
 def build(turns=5.0, n_elements=16, mu=0.3, imperfection=1e-2, pull=PULL, E=200e9, nu=0.3, length=LENGTH,
           approach=None, pieces=2):
     """Returns ``(model, plate node, (wire a, wire b))``, each wire a tuple of ``pieces`` beams
-    (bottom to top) of ``n_elements // pieces`` elements joined rigidly.  ``approach=None``: a dead ``pull`` on the plate (free
-    in ``z``); a number ``s``: extension control, the plate's height prescribed as
-    ``length (1 - s t)`` together with its turns (``pull`` then only scales the imperfection)."""
+    (bottom to top) of ``n_elements // pieces`` elements joined rigidly.  ``approach=None``: a
+    dead ``pull`` on the plate (free in ``z``); a number ``s``: extension control, the plate's
+    height prescribed as ``length (1 - s t)`` together with its turns (``pull`` then only scales
+    the imperfection)."""
     sec = bs.Section.circular(radius=R, E=E, nu=nu)
     model = bs.Model()
     if pieces < 2 or n_elements % pieces:
@@ -191,13 +192,15 @@ def main(output=None, turns=5.0, steps=40, n_elements=16, mu=0.3, stabilize=2e-2
         sol = e.solution
     wall = time.perf_counter() - t0
     rows = table(sol, plate, wires, turns, pull=pull if approach is None else 0.0)
-    print(f"plectoneme: 2 wires R = {R * 1e3:g} mm, L = {length * 1e3:g} mm, pull {pull:g} N, "
-          f"{n_elements} elements each, mu = {mu}, {turns:g} turns in {steps} steps, stabilize = {stabilize}, imperfection {imperfection:g} x pull")
+    control = f"pull {pull:g} N" if approach is None else f"extension control, approach {approach:g}"
+    print(f"plectoneme: 2 wires R = {R * 1e3:g} mm, L = {length * 1e3:g} mm, {control}, {n_elements} elements "
+          f"each in {pieces} pieces, mu = {mu}, {turns:g} turns in {steps} steps, stabilize = {stabilize}, "
+          f"imperfection {imperfection * pull:g} N")
     print("| " + " | ".join(COLUMNS) + " |")
     print("|" + "---:|" * len(COLUMNS))
     for lk, tq, fz, z, tw, wr, err, fw, fd, nc, it in rows:
-        print(f"| {lk:.4f} | {tq:.4g} | {fz:.4g} | {z:.3f} | {tw:.4f} | {wr:.4f} | {err:.2e} | {fw:.3f} | {fd:.2e} | {nc} "
-              f"| {it} |")
+        print(f"| {lk:.4f} | {tq:.4g} | {fz:.4g} | {z:.3f} | {tw:.4f} | {wr:.4f} | {err:.2e} | {fw:.3f} "
+              f"| {fd:.2e} | {nc} | {it} |")
     B = 2.0 * model.beams[0].section.C[4, 4]
     worst = max((r.error for r in rows if r.lk >= LK_MIN), default=np.nan)     # relative error: Lk not near 0
     tw_c, m_c = onset(rows)
