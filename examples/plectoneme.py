@@ -65,7 +65,8 @@ beams in self-contact: 3.972; a self-contact of point kind only, ``line_angle = 
 (3.116 turns, ``Wr = 0.57``).  More damping and shorter steps carry the pop in pseudo-time but
 not past it: ``--mu 0 --stabilize 0.2 --min-step-ratio 1.5e-5`` completes the loop at 3.972
 turns (``Wr = 0.94``, ``Wr / Lk = 0.24``, 1809 N, dissipated 5.2e-2, warned) and stops there
-(with ``--approach 0.5``: at 3.122 turns, ``Wr = 0.89``, 964 N, dissipated 5.0e-2);
+(with ``--approach 0.5``: at 3.122 turns, ``Wr = 0.89``, 964 N, dissipated 5.0e-2; with
+``--elements 32``: at 3.945 turns, ``Wr = 0.96``, 1838 N, dissipated 5.8e-2);
 with ``mu = 0.3``, ``--stabilize 5e-2 --min-step-ratio 1e-7`` creeps to 4.07 turns and
 ``--stabilize 0.2 --min-step-ratio 1e-7`` to 4.02 turns in steps of 1e-9 (both stopped by hand).
 None reaches the 5 turns: the tight, tensioned loop (its radius about two wire diameters) is
