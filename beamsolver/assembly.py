@@ -21,6 +21,7 @@ import scipy.sparse as sp
 from . import assembly_jit, contributions, se3
 from . import blocks as _blocks
 from .errors import InputError
+from .extra_pattern import ExtraPattern
 from .se3 import skew
 from .validation import check_pose
 
@@ -328,12 +329,34 @@ class System:
         r = np.bincount(d.ravel(), weights=f.ravel(), minlength=6 * self.n_nodes)
         coo = (np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0))
         if K is not None and len(nodes):
-            n = d.shape[1]
-            coo = (np.repeat(d, n, axis=1).ravel(), np.tile(d, (1, n)).ravel(), K.ravel())
+            coo = self._block_coo(d) + (K.ravel(),)
             g = np.intersect1d(self.global_nodes, self.rep[nodes])
             if len(g):
-                coo = _concat(coo, self._global_node_terms(r, g))
+                coo = self._concat_coo(coo, self._global_node_terms(r, g))
         return (r, coo) + _blocks.levels(f)
+
+    def _block_coo(self, d):
+        """Rows and columns ``(m k^2,)`` of the COO entries of blocks over the dofs ``d`` ``(m, k)``; the
+        same (read-only) arrays while ``d`` stays the same, which ``matrix`` recognises at once."""
+        c = getattr(self, "_coo_index", None)
+        if c is None or c[0].shape != d.shape or not np.array_equal(c[0], d):
+            k, d32 = d.shape[1], d.astype(np.int32)      # int32: half the memory of a fresh pattern
+            c = (d.copy(), np.repeat(d32, k, axis=1).ravel(), np.tile(d32, (1, k)).ravel())
+            for a in c:
+                a.flags.writeable = False
+            self._coo_index = c
+        return c[1], c[2]
+
+    def _concat_coo(self, a, b):
+        """``_concat(a, b)`` whose index arrays are kept (the same read-only arrays) while ``a``'s are the
+        same arrays (``_block_coo``) and ``b``'s equal."""
+        c = getattr(self, "_coo_concat", None)
+        if c is None or c[0] is not a[0] or c[1] is not a[1] or not (
+                np.array_equal(c[2], b[0]) and np.array_equal(c[3], b[1])):
+            rows, cols = np.concatenate([a[0], b[0]]), np.concatenate([a[1], b[1]])
+            rows.flags.writeable = cols.flags.writeable = False
+            c = self._coo_concat = (a[0], a[1], np.array(b[0]), np.array(b[1]), rows, cols)
+        return c[4], c[5], np.concatenate([a[2], b[2]])
 
     @staticmethod
     def _global_node_terms(r, g):
@@ -444,13 +467,18 @@ class System:
         """
         data = np.empty(self.nnz + 1)
         assembly_jit.scatter(self.pos, kvals, data)
-        K = sp.csc_matrix((data[:self.nnz], self.indices, self.indptr), shape=(self.n_free, self.n_free))
         if extra is not None and len(extra[2]):
-            rows, cols, vals = extra
-            rr, rc = self.red[rows], self.red[cols]
-            keep = (rr >= 0) & (rc >= 0)
-            K = K + sp.csc_matrix((vals[keep], (rr[keep], rc[keep])), shape=K.shape)
-        return K
+            return self._extra_pattern(extra).matrix(data[:self.nnz], extra[2])
+        return sp.csc_matrix((data[:self.nnz], self.indices, self.indptr), shape=(self.n_free, self.n_free))
+
+    def _extra_pattern(self, extra):
+        """The ``extra_pattern.ExtraPattern`` of the COO entries ``extra`` (kept while their pattern
+        stays: the same active contact pairs)."""
+        p = getattr(self, "_extra_cache", None)
+        if p is None or not p.same(extra[0], extra[1], (self.red, self.indptr, self.indices)):
+            p = self._extra_cache = ExtraPattern(extra[0], extra[1], self.red, self.n_free, self.indptr,
+                                                 self.indices, spare=p)
+        return p
 
     def full_matrix(self, kvals, extra=None):
         """The tangent over all ``6 n`` unknowns (constrained ones included) as CSR."""

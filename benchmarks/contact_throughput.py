@@ -143,7 +143,11 @@ def main(sizes=(100, 1_000, 10_000, 100_000), out=OUT):
 if __name__ == "__main__":
     top = int(float(sys.argv[1])) if len(sys.argv) > 1 else 100_000
     sizes = [n for n in (100, 1_000, 10_000, 100_000) if n <= top]
+    load0 = os.getloadavg()[0]
     rows, md = main(sizes)
+    load = (f"machine load (1-minute load average) {load0:.1f} at the start, {os.getloadavg()[0]:.1f} at the end, "
+            f"on {os.cpu_count()} cores")
+    md += "\n\n" + load.capitalize() + "."
     print(md)
     if top >= 10_000:
         sys.path.insert(0, str(Path(__file__).resolve().parent))

@@ -178,3 +178,20 @@ def test_compiled_projection_equals_the_numpy_projection():
     a0, b0 = pairs._project(kinds, X[:, 0], h1, xi1, X[:, 2], h2, xi2, iterations=8)
     a1, b1 = kernel_jit.project(kinds, X[:, 0], h1, xi1, X[:, 2], h2, xi2, iterations=8)
     assert np.abs(a1 - a0).max() <= 1e-12 and np.abs(b1 - b0).max() <= 1e-12
+
+
+def test_projection_stopping_at_a_fixed_point_gives_every_iteration_s_result():
+    """``project`` with ``n`` iterations (which stops early at an exact fixed point and computes a fixed
+    slave section once) equals ``n`` single iterations chained, bit for bit, on all kinds, from far and
+    from converged starts."""
+    rng = np.random.default_rng(12)
+    X, kinds, xi1c, xi2c = _pairs(rng, 36, np.tile([1e-3, 0.1, 0.5, 0.7, 1.2, np.pi / 2], 6))
+    h1 = se3.log(se3.relative(X[:, 0], X[:, 1]))
+    h2 = se3.log(se3.relative(X[:, 2], X[:, 3]))
+    for xi1, xi2 in ((rng.uniform(0.0, 1.0, 36), rng.uniform(0.0, 1.0, 36)), (xi1c, xi2c)):
+        a, b = xi1, xi2
+        for n in range(1, 13):
+            a, b = kernel_jit.project(kinds, X[:, 0], h1, a, X[:, 2], h2, b, iterations=1)
+            a_n, b_n = kernel_jit.project(kinds, X[:, 0], h1, xi1, X[:, 2], h2, xi2, iterations=n)
+            np.testing.assert_array_equal(a_n, a)
+            np.testing.assert_array_equal(b_n, b)

@@ -114,3 +114,21 @@ def test_stage_timings_are_public_and_accumulate():
         c.begin_step(H, 0.0)
         c.evaluate(H, tangent=True)
     assert all(c.timings[k] >= 0.0 for k in TIMED) and sum(c.timings.values()) > 0.0
+
+
+def test_material_frames_from_the_kept_twists_are_bit_identical():
+    """``material_frames`` given the element twists of the whole table at the last converged poses
+    (``projection.element_twists``, what ``ContactSystem`` keeps per step) gives exactly the frames
+    it computes from the pair's own nodes."""
+    rng, H, kinds, A1, A2, _, _ = _poses(7)
+    enodes = np.stack([np.arange(0, len(H), 2), np.arange(1, len(H), 2)], axis=1)   # element j: 2 j, 2 j + 1
+    h = projection.element_twists(H, enodes)
+    X = np.stack([H[A1], H[A1 + 1], H[A2], H[A2 + 1]], axis=1)
+    xi1, xi2 = rng.uniform(0, 1, 12), rng.uniform(0, 1, 12)
+    R = np.full(12, 1e-3)
+    pick = rng.permutation(12)[:7]
+    own = pairs.material_frames(X[pick], kinds[pick], xi1[pick], xi2[pick], R[pick], R[pick])
+    kept = pairs.material_frames(X[pick], kinds[pick], xi1[pick], xi2[pick], R[pick], R[pick],
+                                 h[A1[pick] // 2], h[A2[pick] // 2])
+    for a, b in zip(own, kept):
+        np.testing.assert_array_equal(a, b)

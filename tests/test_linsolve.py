@@ -120,3 +120,57 @@ def test_solve_keyword_bad_name():
     m, _ = _cantilever()
     with pytest.raises(InputError, match="linear_solver"):
         bs.solve(m, steps=1, verbose=False, linear_solver="mumps")
+
+
+def _weak_diagonal(n=200, seed=4):
+    """Non-symmetric band of 2 x 2 blocks ``[[1e-12, 1], [1, 1e-12]]`` weakly coupled: elimination on
+    the diagonal grows entries by 1e12; pivoting must leave the diagonal (below
+    ``RCM_PIVOT_THRESHOLD`` of the column's largest entry)."""
+    rng = np.random.default_rng(seed)
+    A = sp.lil_matrix((n, n))
+    for i in range(0, n, 2):
+        A[i, i], A[i, i + 1], A[i + 1, i], A[i + 1, i + 1] = 1e-12, 1.0, rng.uniform(1, 2), 1e-12
+    for i in range(n - 2):
+        A[i, i + 2], A[i + 2, i] = 0.1 * rng.uniform(), 0.05 * rng.uniform()
+    return sp.csc_matrix(A)
+
+
+def test_rcm_threshold_pivoting_solves_weak_diagonals():
+    """splu-rcm with threshold pivoting: pivots away from a 1e-12 diagonal (no growth), backward
+    error at round-off, as with full partial pivoting."""
+    A = _weak_diagonal()
+    b = np.random.default_rng(5).standard_normal(A.shape[0])
+    f = linsolve.factorize(A, "splu-rcm")
+    assert not np.array_equal(f._lu.perm_r, np.arange(A.shape[0]))        # it did pivot
+    x = f.solve(b)
+    assert linsolve._backward_error(A, x, b) < 1e-14
+    np.testing.assert_allclose(x, np.linalg.solve(A.toarray(), b), rtol=1e-9)
+
+
+def test_rcm_falls_back_to_full_pivoting(monkeypatch):
+    """A factor whose solution has a large backward error (here: no pivoting at all on tiny
+    diagonals) is recomputed with full partial pivoting."""
+    monkeypatch.setattr(linsolve, "RCM_PIVOT_THRESHOLD", 0.0)
+    A = _weak_diagonal()
+    b = np.random.default_rng(5).standard_normal(A.shape[0])
+    f = linsolve.factorize(A, "splu-rcm")
+    x_bad = f._solve(b)
+    assert linsolve._backward_error(A, x_bad, b) > linsolve.BACKWARD_ERROR
+    x = f.solve(b)
+    assert linsolve._backward_error(A, x, b) < 1e-14
+
+
+def test_rcm_ordering_kept_for_the_same_pattern():
+    """The second matrix of the same pattern reuses the ordering and gives the factor of a fresh
+    ordering: the same solution bit for bit."""
+    A = nonsymmetric_matrix()
+    A2 = A.copy()
+    A2.data = A2.data * np.linspace(0.5, 2.0, A2.nnz)
+    b = np.ones(A.shape[0])
+    linsolve.factorize(A, "splu-rcm")
+    kept = linsolve._RCM_LAST[0][3]
+    x2 = linsolve.factorize(A2, "splu-rcm").solve(b)
+    assert linsolve._RCM_LAST[0][3] is kept
+    linsolve._RCM_LAST.clear()
+    np.testing.assert_array_equal(linsolve.factorize(A2, "splu-rcm").solve(b), x2)
+    np.testing.assert_allclose(x2, np.linalg.solve(A2.toarray(), b), rtol=1e-10)

@@ -29,6 +29,13 @@ The contact law is pluggable: the kernel calls ``_normal_law`` and
 scalar functions (default ``law.PENALTY_COULOMB``, tested equal to the numpy forms
 ``law.normal_force`` and ``law.coulomb_return_mapping`` the oracle uses).
 ``NUMBA_DISABLE_JIT=1`` runs this module as plain Python (slowly).
+
+Nothing is allocated per point: small algebra stays in tuples, and the 6x6 matrices,
+6-vectors and ``(k, 24)`` gradients live in scratch arrays made once per batch
+(``_scratch``; named slots ``S_*``, ``V_*``, ``G*_*``, ``R_*``) and written in place.
+Every sum keeps its terms and their order (the Newton iteration counts of the contact
+examples are round-off sensitive); values that are needed twice are computed once only
+where the two computations are the same operations on the same inputs.
 """
 import hashlib
 import types
@@ -51,7 +58,7 @@ N_PAR = 13
 _normal_law = _tangential_law = None
 
 
-# ---------------------------------------------------------------- small algebra (tuples, 6x6 arrays)
+# ---------------------------------------------------------------- small algebra (tuples; small arrays written in place)
 @jit
 def _exp(u, w):
     """``exp(hat(u, w))`` as rotation and position tuples (``se3.exp``)."""
@@ -86,65 +93,74 @@ def _put3(A, r0, c0, M):
 
 
 @jit
+def _zero3(A, r0, c0):
+    for i in range(3):
+        for j in range(3):
+            A[r0 + i, c0 + j] = 0.0
+
+
+@jit
+def _zero(A):
+    for i in range(A.shape[0]):
+        for j in range(A.shape[1]):
+            A[i, j] = 0.0
+
+
+@jit
 def _col(R, j):
     return (R[0][j], R[1][j], R[2][j])
 
 
 @jit
-def _mm6(A, B):
-    """``A @ B`` for small 2-D arrays."""
-    n, k, m = A.shape[0], A.shape[1], B.shape[1]
-    out = np.zeros((n, m))
-    for i in range(n):
-        for l in range(k):
-            a = A[i, l]
-            for j in range(m):
-                out[i, j] += a * B[l, j]
-    return out
+def _mm(A, B, out):
+    """``out = A @ B`` for ``(6, 6)`` arrays (each sum from 0 over the inner index in order)."""
+    for i in range(6):
+        for j in range(6):
+            acc = 0.0
+            for l in range(6):
+                acc += A[i, l] * B[l, j]
+            out[i, j] = acc
 
 
 @jit
-def _mtm(A, B):
-    """``A^T @ B`` for small 2-D arrays."""
-    n, k, m = A.shape[1], A.shape[0], B.shape[1]
-    out = np.zeros((n, m))
-    for l in range(k):
-        for i in range(n):
-            a = A[l, i]
-            for j in range(m):
-                out[i, j] += a * B[l, j]
-    return out
+def _mtm(A, B, out):
+    """``out = A^T @ B`` for ``(6, 6)`` arrays."""
+    for i in range(6):
+        for j in range(6):
+            acc = 0.0
+            for l in range(6):
+                acc += A[l, i] * B[l, j]
+            out[i, j] = acc
 
 
 @jit
-def _mtv(A, v):
-    """``A^T v`` for a 2-D array and a 1-D array."""
-    out = np.zeros(A.shape[1])
-    for i in range(A.shape[0]):
-        for j in range(A.shape[1]):
-            out[j] += A[i, j] * v[i]
-    return out
+def _mtv(A, v, out):
+    """``out = A^T v`` for a ``(6, 6)`` array and a 6-vector."""
+    for j in range(6):
+        acc = 0.0
+        for i in range(6):
+            acc += A[i, j] * v[i]
+        out[j] = acc
 
 
 @jit
-def _tangent(u, w):
-    """``T(h) = [[T3, Q(-u, -w)], [0, T3]]`` (``se3.tangent``), ``(6, 6)``."""
+def _tangent(u, w, T):
+    """``T = T(h) = [[T3, Q(-u, -w)], [0, T3]]`` (``se3.tangent``), ``(6, 6)``."""
     t2 = dot(w, w)
     t = np.sqrt(t2)
     b, c = coefficient(B_, t), coefficient(C_, t)
     T3 = add_outer(mat(scale(-b, w), 1.0 - c * t2), scale(c, w), w)
     Q = q_matrix(scale(-1.0, u), scale(-1.0, w), dot(w, u), cross(w, u), t2, c, coefficient(Q2_, t),
                  coefficient(Q3_, t))
-    T = np.zeros((6, 6))
     _put3(T, 0, 0, T3)
     _put3(T, 3, 3, T3)
     _put3(T, 0, 3, Q)
-    return T
+    _zero3(T, 3, 0)
 
 
 @jit
-def _tangent_inv(u, w):
-    """``T(h)^-1 = [[Ti, -Ti Q(-u, -w) Ti], [0, Ti]]`` (``se3.tangent_inv``), ``(6, 6)``."""
+def _tangent_inv(u, w, T):
+    """``T = T(h)^-1 = [[Ti, -Ti Q(-u, -w) Ti], [0, Ti]]`` (``se3.tangent_inv``), ``(6, 6)``."""
     t2 = dot(w, w)
     t = np.sqrt(t2)
     c = coefficient(C_, t)
@@ -152,85 +168,110 @@ def _tangent_inv(u, w):
     Q = q_matrix(scale(-1.0, u), scale(-1.0, w), dot(w, u), cross(w, u), t2, c, coefficient(Q2_, t),
                  coefficient(Q3_, t))
     X = mm(mm(Ti, Q), Ti)
-    T = np.zeros((6, 6))
     _put3(T, 0, 0, Ti)
     _put3(T, 3, 3, Ti)
     _put3(T, 0, 3, ((-X[0][0], -X[0][1], -X[0][2]), (-X[1][0], -X[1][1], -X[1][2]),
                     (-X[2][0], -X[2][1], -X[2][2])))
-    return T
+    _zero3(T, 3, 0)
 
 
 @jit
-def _adjoint(R, x):
-    """``Ad(H) = [[R, hat(x) R], [0, R]]``, ``(6, 6)``."""
-    A = np.zeros((6, 6))
-    _put3(A, 0, 0, R)
-    _put3(A, 3, 3, R)
-    _put3(A, 0, 3, mm(mat(x, 0.0), R))
-    return A
-
-
-@jit
-def _adjoint_inv(R, x):
-    """``Ad(H^-1)`` of the pose ``(R, x)``."""
+def _adjoint_inv(R, x, A):
+    """``A = Ad(H^-1)`` of the pose ``(R, x)``; ``Ad(H) = [[R, hat(x) R], [0, R]]``, ``(6, 6)``."""
     Rt = transpose(R)
-    return _adjoint(Rt, scale(-1.0, mv(Rt, x)))
+    xt = scale(-1.0, mv(Rt, x))
+    _put3(A, 0, 0, Rt)
+    _put3(A, 3, 3, Rt)
+    _put3(A, 0, 3, mm(mat(xt, 0.0), Rt))
+    _zero3(A, 3, 0)
 
 
 @jit
-def _geo(u, w, v):
-    """``G(h, v) = d(T(h)^-T v)/dh``, ``(6, 6)`` (``element_jit._geometric``)."""
+def _geo(u, w, v, G):
+    """``G = G(h, v) = d(T(h)^-T v)/dh``, ``(6, 6)`` (``element_jit._geometric``); ``v`` ``(6,)``."""
     t2 = dot(w, w)
     t = np.sqrt(t2)
     co = (coefficient(C_, t), coefficient(Q2_, t), coefficient(Q3_, t), coefficient(DP_, t), coefficient(CP_, t),
           coefficient(Q2P_, t), coefficient(Q3P_, t))
     G12, G21, G22 = _geometric(u, w, (v[0], v[1], v[2]), (v[3], v[4], v[5]), coefficient(D_, t), t2, co)
-    G = np.zeros((6, 6))
+    _zero3(G, 0, 0)
     _put3(G, 0, 3, G12)
     _put3(G, 3, 0, G21)
     _put3(G, 3, 3, G22)
-    return G
 
 
 @jit
-def _m_times(z, A):
-    """``M(z) A`` with ``M(z) = [[0, hat(z_f)], [hat(z_f), hat(z_m)]]``, column by column."""
+def _m_times(z, A, out):
+    """``out = M(z) A`` with ``M(z) = [[0, hat(z_f)], [hat(z_f), hat(z_m)]]``, column by column."""
     zf, zm = (z[0], z[1], z[2]), (z[3], z[4], z[5])
-    out = np.empty((6, A.shape[1]))
     for k in range(A.shape[1]):
         au, aw = (A[0, k], A[1, k], A[2, k]), (A[3, k], A[4, k], A[5, k])
         top, bot = cross(zf, aw), add(cross(zf, au), cross(zm, aw))
         for i in range(3):
             out[i, k], out[3 + i, k] = top[i], bot[i]
-    return out
 
 
-# ---------------------------------------------------------------- node Jacobians and their derivative
+# ---------------------------------------------------------------- one side of a pair: scratch slots
+# 6x6 slots of a side's scratch ``S`` (N_SIDE, 6, 6)
+(S_TI, S_AH, S_TS, S_AS, S_JA, S_JB, S_TSP, S_ASP, S_JAP, S_JBP, S_TMP, S_GS, S_M1, S_P, S_DA, S_DB, S_TMH, S_TMS, S_MS,
+ S_AHDB, S_TDY, S_AD) = range(22)
+N_SIDE = 22
+# 6-vector slots of a side's ``v`` (N_VEC, 6)
+(V_WR, V_Y, V_XY, V_DB, V_B, V_ZS, V_ZH, V_AHDB, V_DA) = range(9)
+N_VEC = 9
+# gradient slots: ``g6`` (N_G6, 6, 24), ``g3`` (N_G3, 3, 24), ``g2`` (N_G2, 2, 24), ``r`` (N_R, 24)
+(G6_VC, G6_VF, G6_DH1, G6_DH2, G6_DWC, G6_DWF), N_G6 = range(6), 6
+(G3_DN, G3_DT1, G3_DT2, G3_DF, G3_DMF), N_G3 = range(5), 5
+(G2_DSLIP, G2_DLP, G2_DPREV, G2_DTR), N_G2 = range(4), 4
+(R_DXI1, R_DXI2, R_DDIST, R_DLAM, R_DPT), N_R = range(5), 5
+
+
 @jit
-def _jacobians(u, w, xi, Ti):
-    """``J_A, J_B`` of ``H_C = H_A exp(xi h)`` (``pairs._node_jacobians``); ``Ti = T(h)^-1``."""
-    JB = _mm6(_tangent(scale(xi, u), scale(xi, w)), Ti)
-    JB *= xi
-    Rs, xs = _exp(scale(xi, u), scale(xi, w))
+def _side(u, w, S):
+    """``T(h)^-1`` and ``Ad(exp(-h))`` of an element twist into ``S[S_TI]``, ``S[S_AH]``."""
+    _tangent_inv(u, w, S[S_TI])
     Rh, xh = _exp(u, w)
-    JA = _adjoint_inv(Rs, xs) - _mm6(JB, _adjoint_inv(Rh, xh))
-    return JA, JB
+    _adjoint_inv(Rh, xh, S[S_AH])
 
 
 @jit
-def _jacobian_derivatives(u, w, xi, wr, Ti):
-    """``d(J_A^T wr)/dh, d(J_B^T wr)/dh`` ``(6, 6)`` and ``d/dxi`` ``(6,)`` at fixed ``wr``.
+def _jacobians(u, w, xi, Ti, Ah, Ts, As, JA, JB, tmp):
+    """``J_A, J_B`` of ``H_C = H_A exp(xi h)`` (``pairs._node_jacobians``); ``Ti = T(h)^-1``,
+    ``Ah = Ad(exp(-h))``; also ``Ts = T(xi h)`` and ``As = Ad(exp(-xi h))``."""
+    su, sw = scale(xi, u), scale(xi, w)
+    _tangent(su, sw, Ts)
+    _mm(Ts, Ti, JB)
+    for i in range(6):
+        for j in range(6):
+            JB[i, j] *= xi
+    Rs, xs = _exp(su, sw)
+    _adjoint_inv(Rs, xs, As)
+    _mm(JB, Ah, tmp)
+    for i in range(6):
+        for j in range(6):
+            JA[i, j] = As[i, j] - tmp[i, j]
+
+
+@jit
+def _jacobian_derivatives(u, w, xi, S, v):
+    """``d(J_A^T wr)/dh, d(J_B^T wr)/dh`` into ``S[S_DA], S[S_DB]`` and ``d/dxi`` into ``v[V_DA], v[V_DB]``
+    at fixed ``wr = v[V_WR]``; ``S`` holds ``TI, AH, TS, AS`` at this ``xi``.
 
     With ``s = xi h``, ``y = T(s)^T wr``, ``b = J_B^T wr = xi T(h)^-T y`` and ``T(-s) h = h``:
     ``dB/dh = G(h, xi y) - xi^2 T(h)^-T T(s)^T G(s, y)``, ``dB/dxi = T(h)^-T y - xi T(h)^-T T(s)^T G(s, y) h``,
     ``dA/dh = -xi M(z_s) T(-s) + M(z_h) T(-h) - Ad(exp(-h))^T dB/dh``, ``dA/dxi = -M(z_s) h - Ad(exp(-h))^T dB/dxi``.
     """
+    Ti, Ah, As, DA, DB, P = S[S_TI], S[S_AH], S[S_AS], S[S_DA], S[S_DB], S[S_P]
+    wr, y, xy, dB, b, zs, dA = v[V_WR], v[V_Y], v[V_XY], v[V_DB], v[V_B], v[V_ZS], v[V_DA]
     su, sw = scale(xi, u), scale(xi, w)
-    Ts = _tangent(su, sw)
-    y = _mtv(Ts, wr)
-    P = _mtm(Ti, _mtm(Ts, _geo(su, sw, y)))            # T(h)^-T T(s)^T G(s, y)
-    DB = _geo(u, w, xi * y)
-    dB = _mtv(Ti, y)
+    _mtv(S[S_TS], wr, y)
+    _geo(su, sw, y, S[S_GS])
+    _mtm(S[S_TS], S[S_GS], S[S_M1])
+    _mtm(Ti, S[S_M1], P)                                  # T(h)^-T T(s)^T G(s, y)
+    for i in range(6):
+        xy[i] = xi * y[i]
+    _geo(u, w, xy, DB)
+    _mtv(Ti, y, dB)
     h = (u[0], u[1], u[2], w[0], w[1], w[2])
     for i in range(6):
         acc = 0.0
@@ -238,39 +279,54 @@ def _jacobian_derivatives(u, w, xi, wr, Ti):
             DB[i, j] -= xi * xi * P[i, j]
             acc += P[i, j] * h[j]
         dB[i] -= xi * acc
-    b = _mtv(Ti, xi * y)
-    Rs, xs = _exp(su, sw)
-    Rh, xh = _exp(u, w)
-    As, Ah = _adjoint_inv(Rs, xs), _adjoint_inv(Rh, xh)
-    zs = _mtv(As, wr)
-    DA = _m_times(_mtv(Ah, b), _tangent(scale(-1.0, u), scale(-1.0, w)))
-    Ms = _m_times(zs, _tangent(scale(-xi, u), scale(-xi, w)))
-    AhDB = _mtm(Ah, DB)
-    hh = np.array(h).reshape(6, 1)
-    dA = _m_times(zs, hh)[:, 0]
-    AhdB = _mtv(Ah, dB)
+    _mtv(Ti, xy, b)
+    _mtv(As, wr, zs)
+    _mtv(Ah, b, v[V_ZH])
+    _tangent(scale(-1.0, u), scale(-1.0, w), S[S_TMH])
+    _m_times(v[V_ZH], S[S_TMH], DA)
+    _tangent(scale(-xi, u), scale(-xi, w), S[S_TMS])
+    _m_times(zs, S[S_TMS], S[S_MS])
+    _mtm(Ah, DB, S[S_AHDB])
+    zf, zm = (zs[0], zs[1], zs[2]), (zs[3], zs[4], zs[5])
+    top, bot = cross(zf, (h[3], h[4], h[5])), add(cross(zf, (h[0], h[1], h[2])), cross(zm, (h[3], h[4], h[5])))
+    AhdB = v[V_AHDB]
+    _mtv(Ah, dB, AhdB)
+    Ms, AhDB = S[S_MS], S[S_AHDB]
     for i in range(6):
-        dA[i] = -dA[i] - AhdB[i]
+        dA[i] = -(top[i] if i < 3 else bot[i - 3]) - AhdB[i]
         for j in range(6):
             DA[i, j] -= xi * Ms[i, j] + AhDB[i, j]
-    return DA, DB, dA, dB
 
 
 # ---------------------------------------------------------------- projection and its derivative
 @jit
+def _same(a, b):
+    """``a`` and ``b`` are the same float, bit for bit (not nan)."""
+    return a == b and np.signbit(a) == np.signbit(b)
+
+
+@jit
 def _project(kind, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations=2):
-    """Newton iterations of ``pairs._project`` (two in the kernel, from the search's converged point)."""
-    for _ in range(iterations):
-        R1, x1, x1p, x1pp = _section(RA1, xA1, u1, w1, xi1)
+    """Newton iterations of ``pairs._project`` (two in the kernel, from the search's converged point).
+
+    The slave section is computed once where ``xi1`` is fixed (line, orthogonal), and the iterations
+    stop at an exact fixed point (an iterate equal to the last, bit for bit, fixes all later ones), so
+    the result is that of all ``iterations``."""
+    moving = kind != LINE and kind != ORTHOGONAL
+    R1, x1, x1p, x1pp = _section(RA1, xA1, u1, w1, xi1)
+    for it in range(iterations):
+        if moving and it > 0:
+            R1, x1, x1p, x1pp = _section(RA1, xA1, u1, w1, xi1)
         R2, x2, x2p, x2pp = _section(RA2, xA2, u2, w2, xi2)
         d = add(x2, scale(-1.0, x1))
         e1 = _col(R1, 0)
+        xi1_new, xi2_new = xi1, xi2
         if kind == LINE:
             j = dot(x2p, e1)
-            xi2 = xi2 - dot(d, e1) / (j if j != 0.0 else 1.0)
+            xi2_new = xi2 - dot(d, e1) / (j if j != 0.0 else 1.0)
         elif kind == ORTHOGONAL:
             j = dot(x2p, x2p) + dot(d, x2pp)
-            xi2 = xi2 - dot(d, x2p) / (j if j != 0.0 else 1.0)
+            xi2_new = xi2 - dot(d, x2p) / (j if j != 0.0 else 1.0)
         else:
             a11 = -dot(x1p, x1p) + dot(d, x1pp)
             a12, a21 = dot(x2p, x1p), -dot(x1p, x2p)
@@ -278,28 +334,30 @@ def _project(kind, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations=2):
             det = a11 * a22 - a12 * a21
             det = det if det != 0.0 else 1.0
             g1, g2 = dot(d, x1p), dot(d, x2p)
-            xi1 = xi1 - (a22 * g1 - a12 * g2) / det
-            xi2 = xi2 - (-a21 * g1 + a11 * g2) / det
+            xi1_new = xi1 - (a22 * g1 - a12 * g2) / det
+            xi2_new = xi2 - (-a21 * g1 + a11 * g2) / det
+        if _same(xi1_new, xi1) and _same(xi2_new, xi2):
+            return xi1_new, xi2_new
+        xi1, xi2 = xi1_new, xi2_new
     return xi1, xi2
 
 
 @jit
-def _rot_rows(R, V, r0):
-    """``R @ V[r0:r0+3]`` ``(3, 24)``, ``R`` a 3x3 tuple."""
-    out = np.empty((3, V.shape[1]))
-    for i in range(3):
-        out[i] = R[i][0] * V[r0] + R[i][1] * V[r0 + 1] + R[i][2] * V[r0 + 2]
-    return out
+def _rot_col(R, V, k):
+    """``R @ V[0:3, k]``, ``R`` a 3x3 tuple."""
+    return (R[0][0] * V[0, k] + R[0][1] * V[1, k] + R[0][2] * V[2, k],
+            R[1][0] * V[0, k] + R[1][1] * V[1, k] + R[1][2] * V[2, k],
+            R[2][0] * V[0, k] + R[2][1] * V[1, k] + R[2][2] * V[2, k])
 
 
 @jit
-def _row_dot(a, M, r0):
-    """``a . M[r0:r0+3]`` over the 24 columns."""
-    return a[0] * M[r0] + a[1] * M[r0 + 1] + a[2] * M[r0 + 2]
+def _col_dot(a, M, r0, k):
+    """``a . M[r0:r0+3, k]``."""
+    return a[0] * M[r0, k] + a[1] * M[r0 + 1, k] + a[2] * M[r0 + 2, k]
 
 
 @jit
-def _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, VC0, VF0, Dh1, Dh2):
+def _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, VC0, VF0, Dh1, Dh2, dxi1, dxi2):
     """``dxi1, dxi2`` ``(24,)`` by the implicit-function theorem at the converged projection.
 
     ``VC0``, ``VF0``: section-frame variations at fixed ``xi`` ``(6, 24)``; ``Dh1``, ``Dh2``:
@@ -308,27 +366,30 @@ def _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, VC0, VF0, Dh1, Dh2):
     x1p, x2p = mv(RC, u1), mv(RF, u2)
     x1pp, x2pp = mv(RC, cross(w1, u1)), mv(RF, cross(w2, u2))
     dC, dF = mv(transpose(RC), d), mv(transpose(RF), d)
-    dxC = _rot_rows(RC, VC0, 0)                           # position variations (3, 24)
-    dxF = _rot_rows(RF, VF0, 0)
-    rel = dxF - dxC
-    # g2 = d . x2' (orthogonal / point), at fixed xi
-    g2 = _row_dot(x2p, rel, 0) + _row_dot(cross(u2, dF), VF0, 3) + _row_dot(dF, Dh2, 0)
-    z = np.zeros(24)
-    if kind == LINE:
-        e1 = _col(RC, 0)
-        g = _row_dot(e1, rel, 0) - dC[2] * VC0[4] + dC[1] * VC0[5]
-        j = dot(x2p, e1)
-        return z, -g / (j if j != 0.0 else 1.0)
-    if kind == ORTHOGONAL:
-        j = dot(x2p, x2p) + dot(d, x2pp)
-        return z, -g2 / (j if j != 0.0 else 1.0)
-    g1 = _row_dot(x1p, rel, 0) + _row_dot(cross(u1, dC), VC0, 3) + _row_dot(dC, Dh1, 0)
+    e1 = _col(RC, 0)
+    c1, c2 = cross(u1, dC), cross(u2, dF)
+    jl = dot(x2p, e1)
+    jl = jl if jl != 0.0 else 1.0
+    jo = dot(x2p, x2p) + dot(d, x2pp)
+    jo = jo if jo != 0.0 else 1.0
     a11 = -dot(x1p, x1p) + dot(d, x1pp)
     a12, a21 = dot(x2p, x1p), -dot(x1p, x2p)
     a22 = dot(x2p, x2p) + dot(d, x2pp)
     det = a11 * a22 - a12 * a21
     det = det if det != 0.0 else 1.0
-    return -(a22 * g1 - a12 * g2) / det, -(-a21 * g1 + a11 * g2) / det
+    for k in range(24):
+        dxC, dxF = _rot_col(RC, VC0, k), _rot_col(RF, VF0, k)     # position variations
+        rel = (dxF[0] - dxC[0], dxF[1] - dxC[1], dxF[2] - dxC[2])
+        # g2 = d . x2' (orthogonal / point), at fixed xi
+        g2 = dot(x2p, rel) + _col_dot(c2, VF0, 3, k) + _col_dot(dF, Dh2, 0, k)
+        if kind == LINE:
+            g = dot(e1, rel) - dC[2] * VC0[4, k] + dC[1] * VC0[5, k]
+            dxi1[k], dxi2[k] = 0.0, -g / jl
+        elif kind == ORTHOGONAL:
+            dxi1[k], dxi2[k] = 0.0, -g2 / jo
+        else:
+            g1 = dot(x1p, rel) + _col_dot(c1, VC0, 3, k) + _col_dot(dC, Dh1, 0, k)
+            dxi1[k], dxi2[k] = -(a22 * g1 - a12 * g2) / det, -(-a21 * g1 + a11 * g2) / det
 
 
 # ---------------------------------------------------------------- one side of a pair: element, section, Jacobians
@@ -342,36 +403,24 @@ def _element_side(Xp, j0, xi):
 
 
 @jit
-def _twist_variation(u, w, c0, Ti):
-    """``dh = T(h)^-1 (dq_B - Ad(exp(-h)) dq_A)`` as ``(6, 24)``; node A at column ``c0``."""
-    Rh, xh = _exp(u, w)
-    D = np.zeros((6, 24))
-    D[:, c0:c0 + 6] = -_mm6(Ti, _adjoint_inv(Rh, xh))
-    D[:, c0 + 6:c0 + 12] = Ti
-    return D
-
-
-@jit
-def _frame_variation(JA, JB, c0):
-    V = np.zeros((6, 24))
-    V[:, c0:c0 + 6] = JA
-    V[:, c0 + 6:c0 + 12] = JB
-    return V
+def _variations(S, c0, Dh, V, tmp):
+    """Twist variation ``dh = T(h)^-1 (dq_B - Ad(exp(-h)) dq_A)`` and section-frame variation at fixed
+    ``xi`` ``(J_A dq_A + J_B dq_B)``, both ``(6, 24)``, node A at column ``c0``."""
+    _zero(Dh)
+    _zero(V)
+    _mm(S[S_TI], S[S_AH], tmp)
+    Ti, JA, JB = S[S_TI], S[S_JA], S[S_JB]
+    for i in range(6):
+        for j in range(6):
+            Dh[i, c0 + j] = -tmp[i, j]
+            Dh[i, c0 + 6 + j] = Ti[i, j]
+            V[i, c0 + j] = JA[i, j]
+            V[i, c0 + 6 + j] = JB[i, j]
 
 
 # ---------------------------------------------------------------- 3-vectors with gradients (3, 24)
 @jit
-def _cross_rows(a, D):
-    """``a x D[:, k]`` for every column ``k``."""
-    out = np.empty((3, D.shape[1]))
-    out[0] = a[1] * D[2] - a[2] * D[1]
-    out[1] = a[2] * D[0] - a[0] * D[2]
-    out[2] = a[0] * D[1] - a[1] * D[0]
-    return out
-
-
-@jit
-def _axes(RC, xC, RF, xF, VC, VF):
+def _axes(RC, xC, RF, xF, VC, VF, Dn, Dt1, Dt2, Ddist):
     """``n, t1, t2`` (``pairs._axes``), centre distance, and the gradients of ``n, t1, t2, dist``
     (one pass over the 24 columns)."""
     d = add(xF, scale(-1.0, xC))
@@ -383,7 +432,6 @@ def _axes(RC, xC, RF, xF, VC, VF):
     lt = np.sqrt(dot(t1r, t1r))
     t1 = scale(1.0 / lt, t1r)
     t2 = cross(n, t1)
-    Dn, Dt1, Dt2, Ddist = np.empty((3, 24)), np.empty((3, 24)), np.empty((3, 24)), np.empty(24)
     for k in range(24):
         dF = mv(RF, (VF[0, k], VF[1, k], VF[2, k]))
         dC = mv(RC, (VC[0, k], VC[1, k], VC[2, k]))
@@ -398,7 +446,7 @@ def _axes(RC, xC, RF, xF, VC, VF):
         for i in range(3):
             Dn[i, k], Dt1[i, k], Dt2[i, k] = dn[i], dt1[i], dt2[i]
         Ddist[k] = nd
-    return n, t1, t2, dist, Dn, Dt1, Dt2, Ddist
+    return n, t1, t2, dist
 
 
 # ---------------------------------------------------------------- friction
@@ -414,13 +462,37 @@ def _compose(RA, xA, RB, xB):
 
 
 @jit
-def _slip(side1, side2, Ti1, Ti2, xi1p, xi2p, HCL, HFK, HLKp):
+def _slip_rows(Tdy, Ad, JA, JB, sign, D, c0, tmp):
+    """``D[:, c0:c0+12] = sign (Tdy[1:3] Ad) [J_A, J_B]`` (``Tdy``, ``Ad``, ``J`` ``(6, 6)``; ``tmp`` ``(6, 6)``)."""
+    for i in range(2):
+        for j in range(6):
+            acc = 0.0
+            for l in range(6):
+                acc += Tdy[1 + i, l] * Ad[l, j]
+            tmp[i, j] = acc
+    for i in range(2):
+        for j in range(6):
+            a = 0.0
+            b = 0.0
+            for l in range(6):
+                a += tmp[i, l] * JA[l, j]
+                b += tmp[i, l] * JB[l, j]
+            D[i, c0 + j] = -a if sign < 0.0 else a
+            D[i, c0 + 6 + j] = -b if sign < 0.0 else b
+
+
+@jit
+def _slip(side1, side2, S1, S2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp, D):
     """Slip ``log(H_LK_prev^-1 H_LK)[1:3]`` of the material frames (``kinematics.slip_increment``)
-    and its gradient ``(2, 24)``."""
+    and its gradient into ``D`` ``(2, 24)``; ``sec1``, ``sec2``: ``(xi, R, x)`` of the sections at the
+    point.  The node Jacobians at ``xi_prev`` go to ``S[S_JAP], S[S_JBP]``; where ``xi_prev`` is ``xi``
+    (bit for bit) the section and the Jacobians at ``xi`` are reused."""
     RA1, xA1, u1, w1 = side1
     RA2, xA2, u2, w2 = side2
-    RCm, xCm, _, _ = _section(RA1, xA1, u1, w1, xi1p)
-    RFm, xFm, _, _ = _section(RA2, xA2, u2, w2, xi2p)
+    xi1, RC, xC = sec1
+    xi2, RF, xF = sec2
+    RCm, xCm = (RC, xC) if _same(xi1p, xi1) else _section(RA1, xA1, u1, w1, xi1p)[:2]
+    RFm, xFm = (RF, xF) if _same(xi2p, xi2) else _section(RA2, xA2, u2, w2, xi2p)[:2]
     RCL, xCL = _pose4(HCL)
     RFK, xFK = _pose4(HFK)
     RL, xL = _compose(RCm, xCm, RCL, xCL)
@@ -429,93 +501,132 @@ def _slip(side1, side2, Ti1, Ti2, xi1p, xi2p, HCL, HFK, HLKp):
     RLK, xLK = mm(RLt, RK), mv(RLt, add(xK, scale(-1.0, xL)))
     RP, xP = _pose4(HLKp)
     dyu, dyw, _, _ = log_relative(RP, xP, RLK, xLK)
-    Tdy = _tangent_inv(dyu, dyw)[1:3].copy()
+    _jacobians_at(u1, w1, xi1, xi1p, S1)
+    _jacobians_at(u2, w2, xi2, xi2p, S2)
+    Tdy, Ad, tmp = S1[S_TDY], S1[S_AD], S1[S_TMP]
+    _tangent_inv(dyu, dyw, Tdy)
     Rs, xs = _compose(RCL, xCL, RLK, xLK)
-    As = _mm6(Tdy, _adjoint_inv(Rs, xs))
-    Am = _mm6(Tdy, _adjoint_inv(RFK, xFK))
-    JA1, JB1 = _jacobians(u1, w1, xi1p, Ti1)
-    JA2, JB2 = _jacobians(u2, w2, xi2p, Ti2)
-    D = np.empty((2, 24))
-    D[:, 0:6] = -_mm6(As, JA1)
-    D[:, 6:12] = -_mm6(As, JB1)
-    D[:, 12:18] = _mm6(Am, JA2)
-    D[:, 18:24] = _mm6(Am, JB2)
-    return (dyu[1], dyu[2]), D
+    _adjoint_inv(Rs, xs, Ad)
+    _slip_rows(Tdy, Ad, S1[S_JAP], S1[S_JBP], -1.0, D, 0, tmp)
+    _adjoint_inv(RFK, xFK, Ad)
+    _slip_rows(Tdy, Ad, S2[S_JAP], S2[S_JBP], 1.0, D, 12, tmp)
+    return (dyu[1], dyu[2])
 
 
-def _friction(slip, Dslip, lamp, t1, t2, Dt1, Dt2, lam, Dlam, par):
+@jit
+def _jacobians_at(u, w, xi, xip, S):
+    """Node Jacobians at ``xip`` into ``S[S_JAP], S[S_JBP]``; copied from those at ``xi`` if ``xip`` is ``xi``."""
+    if _same(xip, xi):
+        JA, JB, JAP, JBP = S[S_JA], S[S_JB], S[S_JAP], S[S_JBP]
+        for i in range(6):
+            for j in range(6):
+                JAP[i, j], JBP[i, j] = JA[i, j], JB[i, j]
+    else:
+        _jacobians(u, w, xip, S[S_TI], S[S_AH], S[S_TSP], S[S_ASP], S[S_JAP], S[S_JBP], S[S_TMP])
+
+
+def _friction(slip, Dslip, lamp, t1, t2, Dt1, Dt2, lam, Dlam, par, g2, Dpt):
     """Transported stored traction, tangential penalty, trial traction and the law's tangential part
     (``_tangential_law``, bound by ``make_kernel``); ``lam_t``, its gradient ``(2, 24)``, ``stick``."""
     lp = (dot(lamp, t1), dot(lamp, t2))
-    Dlp = np.empty((2, 24))
-    Dlp[0] = _row_dot(lamp, Dt1, 0)
-    Dlp[1] = _row_dot(lamp, Dt2, 0)
+    Dlp, Dprev, Dtr = g2[G2_DLP], g2[G2_DPREV], g2[G2_DTR]
+    for k in range(24):
+        Dlp[0, k] = lamp[0] * Dt1[0, k] + lamp[1] * Dt1[1, k] + lamp[2] * Dt1[2, k]
+        Dlp[1, k] = lamp[0] * Dt2[0, k] + lamp[1] * Dt2[1, k] + lamp[2] * Dt2[2, k]
     npv = np.sqrt(dot(lamp, lamp))
     nl = np.sqrt(lp[0] * lp[0] + lp[1] * lp[1])
     if nl > 1e-300 * (1.0 + npv):
         s = npv / nl
         l0, l1 = lp[0] / nl, lp[1] / nl
-        proj = l0 * Dlp[0] + l1 * Dlp[1]
-        Dprev = s * (Dlp - np.outer(np.array([l0, l1]), proj))
+        for k in range(24):
+            proj = l0 * Dlp[0, k] + l1 * Dlp[1, k]
+            Dprev[0, k] = s * (Dlp[0, k] - l0 * proj)
+            Dprev[1, k] = s * (Dlp[1, k] - l1 * proj)
         lam_prev = (lp[0] * s, lp[1] * s)
     else:
-        Dprev = np.zeros((2, 24))
+        _zero(Dprev)
         lam_prev = (0.0, 0.0)
     pen_t, mu = par[PEN_T], par[MU]
-    Dpt = np.zeros(24)
+    for k in range(24):
+        Dpt[k] = 0.0
     if np.isnan(pen_t) and not np.isnan(par[ESLIP]):
         lam_min = PENALTY_T_MIN * par[PENALTY] * par[ESLIP]      # pairs.stick_penalty
         if lam >= lam_min:
             pen_t = mu * lam / par[ESLIP]
-            Dpt = (mu / par[ESLIP]) * Dlam
+            for k in range(24):
+                Dpt[k] = (mu / par[ESLIP]) * Dlam[k]
         else:
             pen_t = mu * lam_min / par[ESLIP]
     tr0, tr1 = lam_prev[0] + pen_t * slip[0], lam_prev[1] + pen_t * slip[1]
-    Dtr = Dprev + np.outer(np.array(slip), Dpt) + pen_t * Dslip
+    for a in range(2):
+        for k in range(24):
+            Dtr[a, k] = Dprev[a, k] + slip[a] * Dpt[k] + pen_t * Dslip[a, k]
     lt0, lt1, D, stick = _tangential_law(tr0, tr1, Dtr, mu, lam, Dlam)
     return (lt0, lt1), D, stick
 
 
 # ---------------------------------------------------------------- one contact point
 @jit
-def _wrench(R, F, DF, m, Dm, V):
-    """Body wrench ``(R^T F, R^T m)`` and its gradient; ``V``: the frame's variation ``(6, 24)``;
-    ``d(R^T F)/dtheta = hat(R^T F)``."""
+def _wrench(R, F, DF, neg, m, DmF, sm, V, w, D):
+    """Body wrench ``w = (R^T F, R^T m)`` and its gradient ``D`` ``(6, 24)`` from ``dF = -DF`` if ``neg``
+    (else ``DF``) and ``dm = sm DmF``; ``V``: the frame's variation ``(6, 24)``; ``d(R^T F)/dtheta = hat(R^T F)``."""
     Rt = transpose(R)
     bF, bm = mv(Rt, F), mv(Rt, m)
-    w = np.array([bF[0], bF[1], bF[2], bm[0], bm[1], bm[2]])
-    D = np.empty((6, 24))
+    for i in range(3):
+        w[i], w[3 + i] = bF[i], bm[i]
     for k in range(24):
         th = (V[3, k], V[4, k], V[5, k])
-        a = add(mv(Rt, (DF[0, k], DF[1, k], DF[2, k])), cross(bF, th))
-        b = add(mv(Rt, (Dm[0, k], Dm[1, k], Dm[2, k])), cross(bm, th))
+        dF = (-DF[0, k], -DF[1, k], -DF[2, k]) if neg else (DF[0, k], DF[1, k], DF[2, k])
+        a = add(mv(Rt, dF), cross(bF, th))
+        b = add(mv(Rt, (sm * DmF[0, k], sm * DmF[1, k], sm * DmF[2, k])), cross(bm, th))
         for i in range(3):
             D[i, k], D[3 + i, k] = a[i], b[i]
-    return w, D
 
 
 @jit
-def _nodal(u, w, xi, Ti, JA, JB, wr, Dw, Dh, dxi, c0, f, K, j0):
-    """``f_j = J_j^T wr`` for the two nodes of one side and their rows of the tangent:
+def _nodal(u, w, xi, S, v, Dw, Dh, dxi, c0, f, K, j0):
+    """``f_j = J_j^T wr`` (``wr = v[V_WR]``) for the two nodes of one side and their rows of the tangent:
     ``J^T dwr + d(J^T wr)/dh dh + d(J^T wr)/dxi dxi`` (``dh`` lives in columns ``c0:c0+12``)."""
-    DA, DB, dA, dB = _jacobian_derivatives(u, w, xi, wr, Ti)
+    _jacobian_derivatives(u, w, xi, S, v)
+    wr = v[V_WR]
     for s in range(2):
-        J, D, dd = (JA, DA, dA) if s == 0 else (JB, DB, dB)
+        J, D, dd = (S[S_JA], S[S_DA], v[V_DA]) if s == 0 else (S[S_JB], S[S_DB], v[V_DB])
         r0 = 6 * (j0 + s)
         for i in range(6):
             acc = 0.0
             for l in range(6):
                 acc += J[l, i] * wr[l]
             f[j0 + s, i] = acc
-            for c in range(24):
-                K[r0 + i, c] = dd[i] * dxi[c]
-            for l in range(6):
-                a = J[l, i]
-                for c in range(24):
-                    K[r0 + i, c] += a * Dw[l, c]
-                b = D[i, l]
-                for c in range(c0, c0 + 12):
-                    K[r0 + i, c] += b * Dh[l, c]
+            _tangent_row(J[0, i], J[1, i], J[2, i], J[3, i], J[4, i], J[5, i], D[i, 0], D[i, 1], D[i, 2], D[i, 3],
+                         D[i, 4], D[i, 5], dd[i], dxi, Dw, Dh, c0, K[r0 + i])
+
+
+@jit
+def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, dxi, Dw, Dh, c0, out):
+    """One row of the tangent: ``out[c] = di dxi[c] + sum_l (j_l Dw[l, c] + d_l Dh[l, c])``, the ``Dh``
+    terms only on the columns ``c0:c0+12`` of the side's nodes (summed in this order)."""
+    for c in range(24):
+        own = c0 <= c < c0 + 12
+        acc = di * dxi[c]
+        acc += j0 * Dw[0, c]
+        if own:
+            acc += d0 * Dh[0, c]
+        acc += j1 * Dw[1, c]
+        if own:
+            acc += d1 * Dh[1, c]
+        acc += j2 * Dw[2, c]
+        if own:
+            acc += d2 * Dh[2, c]
+        acc += j3 * Dw[3, c]
+        if own:
+            acc += d3 * Dh[3, c]
+        acc += j4 * Dw[4, c]
+        if own:
+            acc += d4 * Dh[4, c]
+        acc += j5 * Dw[5, c]
+        if own:
+            acc += d5 * Dh[5, c]
+        out[c] = acc
 
 
 @jit
@@ -534,50 +645,86 @@ def _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2):
         frames[2, i, 3], frames[3, i, 3] = xC[i], xF[i]
 
 
-def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames):
-    """Forces ``f (4, 6)``, tangent ``K (24, 24)`` and point data of one contact point."""
+@jit
+def _frame_variations(u1, w1, xi1, u2, w2, xi2, kind, RC, RF, d, S1, S2, g6, r):
+    """Node Jacobians of both sides, twist variations ``g6[G6_DH1], g6[G6_DH2]``, projection gradients
+    ``r[R_DXI1], r[R_DXI2]`` and the section-frame variations ``g6[G6_VC], g6[G6_VF]`` ``(6, 24)``."""
+    _side(u1, w1, S1)
+    _side(u2, w2, S2)
+    _jacobians(u1, w1, xi1, S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB], S1[S_TMP])
+    _jacobians(u2, w2, xi2, S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB], S2[S_TMP])
+    VC, VF, dxi1, dxi2 = g6[G6_VC], g6[G6_VF], r[R_DXI1], r[R_DXI2]
+    _variations(S1, 0, g6[G6_DH1], VC, S1[S_TMP])
+    _variations(S2, 12, g6[G6_DH2], VF, S2[S_TMP])
+    _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, VC, VF, g6[G6_DH1], g6[G6_DH2], dxi1, dxi2)
+    h1 = (u1[0], u1[1], u1[2], w1[0], w1[1], w1[2])
+    h2 = (u2[0], u2[1], u2[2], w2[0], w2[1], w2[2])
+    for i in range(6):
+        for k in range(24):
+            VC[i, k] += h1[i] * dxi1[k]
+            VF[i, k] += h2[i] * dxi2[k]
+
+
+@jit
+def _add_friction_force(F, DF, wgt, lt, Dlt, t1, t2, Dt1, Dt2):
+    """``F + wgt (lt0 t1 + lt1 t2)`` and its gradient added to ``DF`` ``(3, 24)``."""
+    for i in range(3):
+        for k in range(24):
+            DF[i, k] += wgt * (t1[i] * Dlt[0, k] + lt[0] * Dt1[i, k] + t2[i] * Dlt[1, k] + lt[1] * Dt2[i, k])
+    return add(F, add(scale(wgt * lt[0], t1), scale(wgt * lt[1], t2)))
+
+
+@jit
+def _moment_gradient(n, F, DF, Dn, DmF):
+    """``d(n x F)`` ``(3, 24)`` into ``DmF``."""
+    for k in range(24):
+        DmF[0, k] = (n[1] * DF[2, k] - n[2] * DF[1, k]) - (F[1] * Dn[2, k] - F[2] * Dn[1, k])
+        DmF[1, k] = (n[2] * DF[0, k] - n[0] * DF[2, k]) - (F[2] * Dn[0, k] - F[0] * Dn[2, k])
+        DmF[2, k] = (n[0] * DF[1, k] - n[1] * DF[0, k]) - (F[0] * Dn[1, k] - F[1] * Dn[0, k])
+
+
+def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames, ws):
+    """Forces ``f (4, 6)``, tangent ``K (24, 24)`` and point data of one contact point; ``ws``: the
+    scratch arrays of ``_scratch``."""
+    S, v, g6, g3, g2, r = ws
     side1, side2 = _element_side(Xp, 0, 0.0), _element_side(Xp, 2, 0.0)
     RA1, xA1, u1, w1 = side1
     RA2, xA2, u2, w2 = side2
     xi1, xi2 = _project(kind, RA1, xA1, u1, w1, par[XI1], RA2, xA2, u2, w2, par[XI2])
     RC, xC, _, _ = _section(RA1, xA1, u1, w1, xi1)
     RF, xF, _, _ = _section(RA2, xA2, u2, w2, xi2)
-    Ti1, Ti2 = _tangent_inv(u1, w1), _tangent_inv(u2, w2)
-    JA1, JB1 = _jacobians(u1, w1, xi1, Ti1)
-    JA2, JB2 = _jacobians(u2, w2, xi2, Ti2)
-    Dh1, Dh2 = _twist_variation(u1, w1, 0, Ti1), _twist_variation(u2, w2, 12, Ti2)
-    VC, VF = _frame_variation(JA1, JB1, 0), _frame_variation(JA2, JB2, 12)
-    d = add(xF, scale(-1.0, xC))
-    dxi1, dxi2 = _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, VC, VF, Dh1, Dh2)
-    h1 = np.array([u1[0], u1[1], u1[2], w1[0], w1[1], w1[2]])
-    h2 = np.array([u2[0], u2[1], u2[2], w2[0], w2[1], w2[2]])
-    VC += np.outer(h1, dxi1)
-    VF += np.outer(h2, dxi2)
-    n, t1, t2, dist, Dn, Dt1, Dt2, Ddist = _axes(RC, xC, RF, xF, VC, VF)
+    S1, S2, VC, VF = S[0], S[1], g6[G6_VC], g6[G6_VF]
+    _frame_variations(u1, w1, xi1, u2, w2, xi2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, g6, r)
+    Dn, Dt1, Dt2, DF, DmF, Ddist, Dlam = g3[G3_DN], g3[G3_DT1], g3[G3_DT2], g3[G3_DF], g3[G3_DMF], r[R_DDIST], r[R_DLAM]
+    n, t1, t2, dist = _axes(RC, xC, RF, xF, VC, VF, Dn, Dt1, Dt2, Ddist)
     R1, R2, wgt = par[R1_], par[R2_], par[WEIGHT]
     gap = dist - R1 - R2
     lam, dlam, active = _normal_law(gap, par[PENALTY], par[MULT], par[SMOOTH])      # bound by make_kernel
-    Dlam = dlam * Ddist
+    for k in range(24):
+        Dlam[k] = dlam * Ddist[k]
     F = scale(-wgt * lam, n)
-    DF = -wgt * (np.outer(np.array(n), Dlam) + lam * Dn)
+    for i in range(3):
+        for k in range(24):
+            DF[i, k] = -wgt * (n[i] * Dlam[k] + lam * Dn[i, k])
     lt, stick, slip = (0.0, 0.0), True, (0.0, 0.0)
     if friction:
-        Dslip = np.zeros((2, 24))
+        Dslip = g2[G2_DSLIP]
+        _zero(Dslip)
         if has:
-            slip, Dslip = _slip(side1, side2, Ti1, Ti2, par[XI1P], par[XI2P], HCL, HFK, HLKp)
-        lt, Dlt, stick = _friction(slip, Dslip, lamp, t1, t2, Dt1, Dt2, lam, Dlam, par)
+            slip = _slip(side1, side2, S1, S2, (xi1, RC, xC), (xi2, RF, xF), par[XI1P], par[XI2P], HCL, HFK, HLKp,
+                         Dslip)
+        lt, Dlt, stick = _friction(slip, Dslip, lamp, t1, t2, Dt1, Dt2, lam, Dlam, par, g2, r[R_DPT])
         if active:
-            F = add(F, add(scale(wgt * lt[0], t1), scale(wgt * lt[1], t2)))
-            DF += wgt * (np.outer(np.array(t1), Dlt[0]) + lt[0] * Dt1 + np.outer(np.array(t2), Dlt[1]) + lt[1] * Dt2)
+            F = _add_friction_force(F, DF, wgt, lt, Dlt, t1, t2, Dt1, Dt2)
         else:
             lt = (0.0, 0.0)
         _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2)
     mF = cross(n, F)
-    DmF = _cross_rows(n, DF) - _cross_rows(F, Dn)
-    wC, DwC = _wrench(RC, F, DF, scale(R1, mF), R1 * DmF, VC)
-    wF, DwF = _wrench(RF, scale(-1.0, F), -DF, scale(R2, mF), R2 * DmF, VF)
-    _nodal(u1, w1, xi1, Ti1, JA1, JB1, wC, DwC, Dh1, dxi1, 0, f, K, 0)
-    _nodal(u2, w2, xi2, Ti2, JA2, JB2, wF, DwF, Dh2, dxi2, 12, f, K, 2)
+    _moment_gradient(n, F, DF, Dn, DmF)
+    _wrench(RC, F, DF, False, scale(R1, mF), DmF, R1, VC, v[0, V_WR], g6[G6_DWC])
+    _wrench(RF, scale(-1.0, F), DF, True, scale(R2, mF), DmF, R2, VF, v[1, V_WR], g6[G6_DWF])
+    _nodal(u1, w1, xi1, S1, v[0], g6[G6_DWC], g6[G6_DH1], r[R_DXI1], 0, f, K, 0)
+    _nodal(u2, w2, xi2, S2, v[1], g6[G6_DWF], g6[G6_DH2], r[R_DXI2], 12, f, K, 2)
     sc[0], sc[1], sc[2], sc[3] = gap, lam, xi1, xi2
     for i in range(3):
         vec[0, i], vec[1, i], vec[2, i], vec[3, i], vec[4, i], vec[5, i] = n[i], t1[i], t2[i], xC[i], xF[i], F[i]
@@ -585,12 +732,20 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
     flags[0], flags[1] = active, stick
 
 
+@jit
+def _scratch():
+    """Scratch arrays of one evaluation, reused by every point (the kernel allocates nothing per point)."""
+    return (np.empty((2, N_SIDE, 6, 6)), np.empty((2, N_VEC, 6)), np.empty((N_G6, 6, 24)), np.empty((N_G3, 3, 24)),
+            np.empty((N_G2, 2, 24)), np.empty((N_R, 24)))
+
+
 def _evaluate(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames):
     """Batch driver: ``_point`` over all pairs (a plain loop; one core).  A template: ``make_kernel``
     compiles it per contact law; the module's ``evaluate`` is the default law's."""
+    ws = _scratch()
     for p in range(X.shape[0]):
         _point(X[p], kind[p], par[p], has[p], HCL[p], HFK[p], HLKp[p], lamp[p], friction, f[p], K[p], sc[p],
-               vec[p], two[p], flags[p], frames[p])
+               vec[p], two[p], flags[p], frames[p], ws)
 
 
 # ---------------------------------------------------------------- the kernel of a contact law

@@ -219,15 +219,18 @@ def _contact_frames(n, t1, t2, xC, xF, R1, R2):
     return _pose(frame, xC + R1[..., None] * n), _pose(frame, xF - R2[..., None] * n)
 
 
-def material_frames(X, kind, xi1, xi2, R1, R2):
+def material_frames(X, kind, xi1, xi2, R1, R2, h1=None, h2=None):
     """Frames of a pair at fixed ``xi1, xi2`` (no projection): ``H_CL``, ``H_FK``, ``H_LK``.
 
     Used to start the friction history of a pair that has none: its material
-    frames are those of the pair at the last converged poses ``X``.
+    frames are those of the pair at the last converged poses ``X``.  ``h1``, ``h2``: the
+    elements' twists ``log(H_A^-1 H_B)`` there if known (else computed).
     """
     HA1, HB1, HA2, HB2 = X[..., 0, :, :], X[..., 1, :, :], X[..., 2, :, :], X[..., 3, :, :]
-    HC, _, _ = _section(HA1, se3.log(se3.relative(HA1, HB1)), xi1)
-    HF, _, _ = _section(HA2, se3.log(se3.relative(HA2, HB2)), xi2)
+    h1 = se3.log(se3.relative(HA1, HB1)) if h1 is None else h1
+    h2 = se3.log(se3.relative(HA2, HB2)) if h2 is None else h2
+    HC, _, _ = _section(HA1, h1, xi1)
+    HF, _, _ = _section(HA2, h2, xi2)
     xC, xF, n, t1, t2, _ = _axes(HC, HF, R1, R2)
     HL, HK = _contact_frames(n, t1, t2, xC, xF, R1, R2)
     return se3.relative(HC, HL), se3.relative(HF, HK), se3.relative(HL, HK)

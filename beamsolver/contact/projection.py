@@ -10,6 +10,11 @@ follow the constant-strain interpolation ``H_A exp(xi h)`` with the element twis
   reduced-Hessian ratio ``(H11 - H12^2 / H22) / |x1'|^2`` of the search's rule 2;
 - ``project_points``: a slave section ``xi1`` onto a master element (``LINE`` or
   ``ORTHOGONAL``), started from the projection on the master chord.
+
+``_project`` computes a fixed slave section once and stops at an exact fixed point of
+the iteration, with the result of all the iterations asked for.  (Numba's disk cache
+keys a function on its own source file only: after editing ``kernel_jit._project``,
+delete the ``__pycache__`` numba files of this module too, or it keeps the old copy.)
 """
 import numpy as np
 

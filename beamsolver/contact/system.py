@@ -86,6 +86,8 @@ class _Decl:
         self.mu = decl.mu
         self.tolerance = o.tolerance
         self.n_gp = o.gauss_points
+        xg, wg = np.polynomial.legendre.leggauss(self.n_gp)
+        self.gauss = 0.5 * (xg + 1.0), 0.5 * wg        # Gauss points and weights on [0, 1]
         self.line_angle = o.line_angle
         self.point_ratio = o.point_ratio
         self.margin = 2.0 * max(s.radius for s in secs) if o.margin is None else o.margin
@@ -190,13 +192,29 @@ class ContactSystem(Contribution):
             g = self._geo = (np.array(H, dtype=float), element_twists(H, self.sys.enodes))
         return g
 
+    def _centres(self, H, P, prev=False):
+        """Centre points ``x_C``, ``x_F`` ``(P, 3)`` of the pairs ``P`` at ``H`` (``prev``: at the last
+        converged poses), one compiled call for both."""
+        x = self._points(H, np.concatenate([P.e, P.m]), np.concatenate([P.xi1, P.xi2]), prev)
+        return x[:len(P)], x[len(P):]
+
+    def _prev_twists(self):
+        """Twists ``(n_elements, 6)`` of all elements at the last converged poses (once per step)."""
+        if self._geo_prev is None:
+            self._geo_prev = (self._H_prev, element_twists(self._H_prev, self.sys.enodes))
+        return self._geo_prev[1]
+
+    def _pose_at(self, H, e, xi):
+        """Section poses ``(k, 4, 4)`` ``H_A exp(xi h)`` of elements ``e`` at ``H`` (numpy, the twists kept
+        for these poses)."""
+        Hc, h = self._twists(H)
+        return se3.interpolate(Hc[self.sys.enodes[e, 0]], h[e], xi)
+
     def _points(self, H, e, xi, prev=False):
         """Centre points ``(k, 3)`` of the sections ``xi`` of elements ``e`` at ``H`` (``prev``: at the
         last converged poses, whose twists are kept for the step)."""
         if prev:
-            if self._geo_prev is None:
-                self._geo_prev = (self._H_prev, element_twists(self._H_prev, self.sys.enodes))
-            Hc, h = self._geo_prev
+            Hc, h = self._H_prev, self._prev_twists()
         else:
             Hc, h = self._twists(H)
         return section_points(Hc, self.sys.enodes[e, 0], h[e], xi)[0]
@@ -222,6 +240,8 @@ class ContactSystem(Contribution):
         self._prev_points = np.sort(np.concatenate(chosen)) if chosen else np.zeros(0, dtype=np.int64)
         self._prev_owners = np.sort(np.concatenate(owners)) if owners else np.zeros(0, dtype=np.int64)
         out = [p for p in out if len(p)]
+        if len(out) == 1:
+            return out[0]
         return PairSet.concatenate(out) if out else None
 
     def _candidates(self, d, H):
@@ -252,7 +272,7 @@ class ContactSystem(Contribution):
 
     def _record(self, d, kind, e, m, xi1, xi2, weight, key, gp):
         en = self.sys.enodes
-        nodes = np.stack([en[e, 0], en[e, 1], en[m, 0], en[m, 1]], axis=1)
+        nodes = np.concatenate([en[e], en[m]], axis=1)
         return PairSet(kind=kind, e=e, m=m, xi1=xi1, xi2=xi2, weight=weight, key=key, gp=gp,
                        decl=np.full(len(e), d.index), nodes=nodes, R1=self.el_radius[e], R2=self.el_radius[m])
 
@@ -281,8 +301,7 @@ class ContactSystem(Contribution):
         point and master beam (``rules.owners``).  Returns the record and the owner ids."""
         en = self.sys.enodes
         gp = np.flatnonzero(c.kind != POINT)
-        xg, wg = np.polynomial.legendre.leggauss(d.n_gp)
-        xg, wg = 0.5 * (xg + 1.0), 0.5 * wg
+        xg, wg = d.gauss
         rep = np.repeat(gp, d.n_gp)
         g = np.tile(np.arange(d.n_gp), len(gp))
         e, m, h1, h2 = c.e[rep], c.m[rep], c.h1[rep], c.h2[rep]
@@ -349,8 +368,9 @@ class ContactSystem(Contribution):
         new = np.flatnonzero(~hf & (p["mu"] > 0))
         if len(new) and self._H_prev is not None:
             X = self._H_prev[P.nodes[sel][new]]
+            h = self._prev_twists()           # the element twists at the last converged poses
             H_CL, H_FK, H_LK = material_frames(X, p["kind"][new], p["xi1"][new], p["xi2"][new],
-                                               p["R1"][new], p["R2"][new])
+                                               p["R1"][new], p["R2"][new], h[P.e[sel][new]], h[P.m[sel][new]])
             ok = np.isfinite(H_LK).all(axis=(1, 2))
             new = new[ok]
             p["H_CL"][new], p["H_FK"][new], p["H_LK_prev"][new] = H_CL[ok], H_FK[ok], H_LK[ok]
@@ -401,9 +421,9 @@ class ContactSystem(Contribution):
         given = self._decl_smoothing[P.decl[sel]]
         return np.where(np.isnan(given), np.where(P.kind[sel] == LINE, SMOOTHING * rsum, 0.0), given)
 
-    def _active(self, P, H):
-        """Pairs whose trial normal traction is positive, with their kernel parameters."""
-        xC, xF = self._points(H, P.e, P.xi1), self._points(H, P.m, P.xi2)
+    def _active(self, P, H, centres=None):
+        """Pairs whose trial normal traction is positive (``centres``: ``_centres(H, P)`` if known)."""
+        xC, xF = self._centres(H, P) if centres is None else centres
         gap = np.linalg.norm(xF - xC, axis=1) - P.R1 - P.R2
         pen = self._decl_penalty[P.decl]
         mi, mf = self._lookup(self._mult[0], P.key)
@@ -420,9 +440,10 @@ class ContactSystem(Contribution):
         return (f"{name(be)} element {e - be.elements[0]} (global {e}) against "
                 f"{name(bm)} element {m - bm.elements[0]} (global {m})")
 
-    def _check_normals(self, P, sel, H):
-        """Refuse (a step failure: cut back) pairs whose centre lines intersect: no normal."""
-        xC, xF = self._points(H, P.e[sel], P.xi1[sel]), self._points(H, P.m[sel], P.xi2[sel])
+    def _check_normals(self, P, sel, H, centres):
+        """Refuse (a step failure: cut back) pairs whose centre lines intersect: no normal
+        (``centres``: ``_centres(H, P)``)."""
+        xC, xF = centres[0][sel], centres[1][sel]
         bad = np.flatnonzero(no_normal(np.linalg.norm(xF - xC, axis=1), P.R1[sel], P.R2[sel]))
         if len(bad):
             k = sel[bad[0]]
@@ -432,7 +453,7 @@ class ContactSystem(Contribution):
                 raise InputError(msg + " in the given poses: do two beams share a centre line? Separate them")
             raise NoContactNormal(msg)
 
-    def _check_sides(self, P, H):
+    def _check_sides(self, P, H, centres):
         """Tunnelling: refuse (cut back) a step over which a pair changed sides.
 
         The centre-line distance vector ``d = x_F - x_C`` of each candidate pair (same
@@ -442,8 +463,9 @@ class ContactSystem(Contribution):
         """
         if self._H_prev is None or self._H_prev.shape != H.shape:
             return
-        d = self._points(H, P.m, P.xi2) - self._points(H, P.e, P.xi1)
-        d0 = self._points(H, P.m, P.xi2, prev=True) - self._points(H, P.e, P.xi1, prev=True)
+        d = centres[1] - centres[0]
+        x0C, x0F = self._centres(H, P, prev=True)
+        d0 = x0F - x0C
         rsum = P.R1 + P.R2
         seen = ~no_normal(np.linalg.norm(d0, axis=1), P.R1, P.R2)
         flip = np.flatnonzero(seen & (np.sum(d * d0, axis=1) < -(NORMAL_TOL * rsum) ** 2))
@@ -462,8 +484,9 @@ class ContactSystem(Contribution):
         return not any(d.mu > 0 for d in self.decls)
 
     def _local_blocks(self, H, tangent):
-        """``(P, sel, p, f, K, out)`` at poses ``H``: pairs, active ones, kernel parameters, local
-        wrenches ``(m, 4, 6)``, tangent blocks ``(m, 24, 24)`` and point data; None without active pairs.
+        """``(P, sel, p, f, K, out)`` at poses ``H``: pairs, active ones, kernel parameters, the contact's
+        part of the residual ``f`` ``(m, 4, 6)`` (minus the kernel's wrenches, negated in place: no copy
+        of the blocks), its tangent blocks ``K`` ``(m, 24, 24)`` and point data; None without active pairs.
 
         Kept for the same poses and contact state (``_blocks``, cleared when the state changes):
         the tangent evaluation at an accepted line-search trial reuses the trial's (the compiled
@@ -477,15 +500,19 @@ class ContactSystem(Contribution):
         self._lap()
         sel = np.zeros(0, dtype=int)
         if P is not None:
-            self._check_sides(P, H)
-            sel = self._active(P, H)
+            centres = self._centres(H, P)
+            self._check_sides(P, H, centres)
+            sel = self._active(P, H, centres)
         if len(sel) == 0:
             self._blocks = (np.array(H), None)
             return None
-        self._check_normals(P, sel, H)
+        self._check_normals(P, sel, H, centres)
         p = self._params(P, sel, H)
         self._lap("params")
         f, K, out = self._kernels(H[P.nodes[sel]], p, P.decl[sel], tangent)
+        np.negative(f, out=f)
+        if K is not None:
+            np.negative(K, out=K)
         self._lap("kernel")
         # kept for commit/augment at the same poses (the converged iterate): no second pass
         if (p["mu"] > 0).all() or not (p["mu"] > 0).any():
@@ -546,7 +573,7 @@ class ContactSystem(Contribution):
         if blocks is None:
             return Blocks.empty(4, tangent), dict(n_active=0)
         P, sel, p, f, K, out = blocks
-        b = Blocks(P.nodes[sel], -f.reshape(-1, 24), -K if tangent else None)
+        b = Blocks(P.nodes[sel], f.reshape(-1, 24), K if tangent else None)
         self._lap("blocks")
         return b, dict(n_active=len(sel))
 
@@ -631,8 +658,7 @@ class ContactSystem(Contribution):
         keys = P.key[sel]
         order = np.argsort(keys)
         HL, HK = _frames(out)
-        HC = _interp_pose(H, self.sys.enodes, P.e[sel], out["xi1"])
-        HF = _interp_pose(H, self.sys.enodes, P.m[sel], out["xi2"])
+        HC, HF = self._pose_at(H, P.e[sel], out["xi1"]), self._pose_at(H, P.m[sel], out["xi2"])
         lam_t = out["lam_t"]
         lam_vec = lam_t[:, :1] * out["t1"] + lam_t[:, 1:] * out["t2"]
         self._history = dict(key=keys[order], H_CL=se3.relative(HC, HL)[order],
@@ -662,8 +688,8 @@ class ContactSystem(Contribution):
         w = p["weight"]
         lam_t = out["lam_t"]
         ft = (w * lam_t[:, 0])[:, None] * out["t1"] + (w * lam_t[:, 1])[:, None] * out["t2"]
-        e1s = _interp_pose(H, self.sys.enodes, P.e[sel], out["xi1"])[:, :3, 0]
-        e1m = _interp_pose(H, self.sys.enodes, P.m[sel], out["xi2"])[:, :3, 0]
+        e1s = self._pose_at(H, P.e[sel], out["xi1"])[:, :3, 0]
+        e1m = self._pose_at(H, P.m[sel], out["xi2"])[:, :3, 0]
         ang = np.degrees(np.arccos(np.clip(np.abs(np.sum(e1s * e1m, axis=1)), 0.0, 1.0)))
         active = out["lam_n"] > 0
         return dict(position=0.5 * (out["xC"] + out["xF"]) + 0.5 * (p["R1"] - p["R2"])[:, None] * out["n"],
