@@ -35,7 +35,10 @@ Nothing is allocated per point: small algebra stays in tuples, and the 6x6 matri
 (``_scratch``; named slots ``S_*``, ``V_*``, ``G*_*``, ``R_*``) and written in place.
 Every sum keeps its terms and their order (the Newton iteration counts of the contact
 examples are round-off sensitive); values that are needed twice are computed once only
-where the two computations are the same operations on the same inputs.
+where the two computations are the same operations on the same inputs.  Terms that are
+structural zeros (the zero blocks of ``T``, ``T^-1``, ``Ad``, ``G`` and the node Jacobians)
+are skipped: a sum started at ``+0.0`` is unchanged by an exact zero term, so the results
+are the same floats (``_mm_ut``; in a tangent row up to the sign of a zero entry).
 """
 import hashlib
 import types
@@ -113,23 +116,27 @@ def _col(R, j):
 
 
 @jit
-def _mm(A, B, out):
-    """``out = A @ B`` for ``(6, 6)`` arrays (each sum from 0 over the inner index in order)."""
+def _mm_ut(A, B, out):
+    """``out = A @ B`` for block upper-triangular ``(6, 6)`` arrays (``A[3:, :3] == B[3:, :3] == 0``, as
+    ``T(h)``, ``T(h)^-1``, ``Ad(H)``): ``_mm`` without the terms of the zero blocks.  The same floats:
+    a sum started at ``+0.0`` never becomes ``-0.0``, so adding an exact zero changes nothing."""
     for i in range(6):
         for j in range(6):
             acc = 0.0
-            for l in range(6):
+            for l in range(3 if i >= 3 else 0, 3 if j < 3 else 6):
                 acc += A[i, l] * B[l, j]
             out[i, j] = acc
 
 
 @jit
-def _mtm(A, B, out):
-    """``out = A^T @ B`` for ``(6, 6)`` arrays."""
+def _mtm_ut_g(A, B, out):
+    """``out = A^T @ B`` for a block upper-triangular ``A`` and a ``B`` with ``B[:3, :3] == 0`` (as
+    ``G(h, v)``): ``_mtm`` without the terms of the zero blocks (the same floats, see ``_mm_ut``);
+    ``out[:3, :3] == 0`` again."""
     for i in range(6):
         for j in range(6):
             acc = 0.0
-            for l in range(6):
+            for l in range(3 if j < 3 else 0, 3 if i < 3 else 6):
                 acc += A[l, i] * B[l, j]
             out[i, j] = acc
 
@@ -241,13 +248,13 @@ def _jacobians(u, w, xi, Ti, Ah, Ts, As, JA, JB, tmp):
     ``Ah = Ad(exp(-h))``; also ``Ts = T(xi h)`` and ``As = Ad(exp(-xi h))``."""
     su, sw = scale(xi, u), scale(xi, w)
     _tangent(su, sw, Ts)
-    _mm(Ts, Ti, JB)
+    _mm_ut(Ts, Ti, JB)
     for i in range(6):
         for j in range(6):
             JB[i, j] *= xi
     Rs, xs = _exp(su, sw)
     _adjoint_inv(Rs, xs, As)
-    _mm(JB, Ah, tmp)
+    _mm_ut(JB, Ah, tmp)
     for i in range(6):
         for j in range(6):
             JA[i, j] = As[i, j] - tmp[i, j]
@@ -267,8 +274,8 @@ def _jacobian_derivatives(u, w, xi, S, v):
     su, sw = scale(xi, u), scale(xi, w)
     _mtv(S[S_TS], wr, y)
     _geo(su, sw, y, S[S_GS])
-    _mtm(S[S_TS], S[S_GS], S[S_M1])
-    _mtm(Ti, S[S_M1], P)                                  # T(h)^-T T(s)^T G(s, y)
+    _mtm_ut_g(S[S_TS], S[S_GS], S[S_M1])
+    _mtm_ut_g(Ti, S[S_M1], P)                                # T(h)^-T T(s)^T G(s, y)
     for i in range(6):
         xy[i] = xi * y[i]
     _geo(u, w, xy, DB)
@@ -287,7 +294,7 @@ def _jacobian_derivatives(u, w, xi, S, v):
     _m_times(v[V_ZH], S[S_TMH], DA)
     _tangent(scale(-xi, u), scale(-xi, w), S[S_TMS])
     _m_times(zs, S[S_TMS], S[S_MS])
-    _mtm(Ah, DB, S[S_AHDB])
+    _mtm_ut_g(Ah, DB, S[S_AHDB])
     zf, zm = (zs[0], zs[1], zs[2]), (zs[3], zs[4], zs[5])
     top, bot = cross(zf, (h[3], h[4], h[5])), add(cross(zf, (h[0], h[1], h[2])), cross(zm, (h[3], h[4], h[5])))
     AhdB = v[V_AHDB]
@@ -409,7 +416,7 @@ def _variations(S, c0, Dh, V, tmp):
     ``xi`` ``(J_A dq_A + J_B dq_B)``, both ``(6, 24)``, node A at column ``c0``."""
     _zero(Dh)
     _zero(V)
-    _mm(S[S_TI], S[S_AH], tmp)
+    _mm_ut(S[S_TI], S[S_AH], tmp)
     Ti, JA, JB = S[S_TI], S[S_JA], S[S_JB]
     for i in range(6):
         for j in range(6):
@@ -595,17 +602,19 @@ def _nodal(u, w, xi, S, v, Dw, Dh, dxi, c0, f, K, j0):
         r0 = 6 * (j0 + s)
         for i in range(6):
             acc = 0.0
-            for l in range(6):
+            for l in range(3 if i < 3 else 6):        # J[3:, :3] == 0 (block upper triangular)
                 acc += J[l, i] * wr[l]
             f[j0 + s, i] = acc
             _tangent_row(J[0, i], J[1, i], J[2, i], J[3, i], J[4, i], J[5, i], D[i, 0], D[i, 1], D[i, 2], D[i, 3],
-                         D[i, 4], D[i, 5], dd[i], dxi, Dw, Dh, c0, K[r0 + i])
+                         D[i, 4], D[i, 5], dd[i], dxi, Dw, Dh, c0, i < 3, K[r0 + i])
 
 
 @jit
-def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, dxi, Dw, Dh, c0, out):
+def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, dxi, Dw, Dh, c0, force, out):
     """One row of the tangent: ``out[c] = di dxi[c] + sum_l (j_l Dw[l, c] + d_l Dh[l, c])``, the ``Dh``
-    terms only on the columns ``c0:c0+12`` of the side's nodes (summed in this order)."""
+    terms only on the columns ``c0:c0+12`` of the side's nodes (summed in this order).  ``force``: a
+    force row, whose ``j3, j4, j5`` are structural zeros (``J[3:, :3] == 0``): their terms, exact
+    zeros, are skipped (the same sums up to the sign of a zero result)."""
     for c in range(24):
         own = c0 <= c < c0 + 12
         acc = di * dxi[c]
@@ -618,13 +627,16 @@ def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, dxi, Dw, Dh
         acc += j2 * Dw[2, c]
         if own:
             acc += d2 * Dh[2, c]
-        acc += j3 * Dw[3, c]
+        if not force:
+            acc += j3 * Dw[3, c]
         if own:
             acc += d3 * Dh[3, c]
-        acc += j4 * Dw[4, c]
+        if not force:
+            acc += j4 * Dw[4, c]
         if own:
             acc += d4 * Dh[4, c]
-        acc += j5 * Dw[5, c]
+        if not force:
+            acc += j5 * Dw[5, c]
         if own:
             acc += d5 * Dh[5, c]
         out[c] = acc
