@@ -142,11 +142,12 @@ def _mtm_ut_g(A, B, out):
 
 
 @jit
-def _mtv(A, v, out):
-    """``out = A^T v`` for a ``(6, 6)`` array and a 6-vector."""
+def _mtv_ut(A, v, out):
+    """``out = A^T v`` for a block upper-triangular ``(6, 6)`` array and a 6-vector, without the terms
+    of the zero block (the same floats, see ``_mm_ut``)."""
     for j in range(6):
         acc = 0.0
-        for i in range(6):
+        for i in range(3 if j < 3 else 6):
             acc += A[i, j] * v[i]
         out[j] = acc
 
@@ -272,14 +273,14 @@ def _jacobian_derivatives(u, w, xi, S, v):
     Ti, Ah, As, DA, DB, P = S[S_TI], S[S_AH], S[S_AS], S[S_DA], S[S_DB], S[S_P]
     wr, y, xy, dB, b, zs, dA = v[V_WR], v[V_Y], v[V_XY], v[V_DB], v[V_B], v[V_ZS], v[V_DA]
     su, sw = scale(xi, u), scale(xi, w)
-    _mtv(S[S_TS], wr, y)
+    _mtv_ut(S[S_TS], wr, y)
     _geo(su, sw, y, S[S_GS])
     _mtm_ut_g(S[S_TS], S[S_GS], S[S_M1])
     _mtm_ut_g(Ti, S[S_M1], P)                                # T(h)^-T T(s)^T G(s, y)
     for i in range(6):
         xy[i] = xi * y[i]
     _geo(u, w, xy, DB)
-    _mtv(Ti, y, dB)
+    _mtv_ut(Ti, y, dB)
     h = (u[0], u[1], u[2], w[0], w[1], w[2])
     for i in range(6):
         acc = 0.0
@@ -287,9 +288,9 @@ def _jacobian_derivatives(u, w, xi, S, v):
             DB[i, j] -= xi * xi * P[i, j]
             acc += P[i, j] * h[j]
         dB[i] -= xi * acc
-    _mtv(Ti, xy, b)
-    _mtv(As, wr, zs)
-    _mtv(Ah, b, v[V_ZH])
+    _mtv_ut(Ti, xy, b)
+    _mtv_ut(As, wr, zs)
+    _mtv_ut(Ah, b, v[V_ZH])
     _tangent(scale(-1.0, u), scale(-1.0, w), S[S_TMH])
     _m_times(v[V_ZH], S[S_TMH], DA)
     _tangent(scale(-xi, u), scale(-xi, w), S[S_TMS])
@@ -298,7 +299,7 @@ def _jacobian_derivatives(u, w, xi, S, v):
     zf, zm = (zs[0], zs[1], zs[2]), (zs[3], zs[4], zs[5])
     top, bot = cross(zf, (h[3], h[4], h[5])), add(cross(zf, (h[0], h[1], h[2])), cross(zm, (h[3], h[4], h[5])))
     AhdB = v[V_AHDB]
-    _mtv(Ah, dB, AhdB)
+    _mtv_ut(Ah, dB, AhdB)
     Ms, AhDB = S[S_MS], S[S_AHDB]
     for i in range(6):
         dA[i] = -(top[i] if i < 3 else bot[i - 3]) - AhdB[i]
