@@ -60,6 +60,88 @@ def _find(parent, i):
     return i
 
 
+DENSE_KEYS = 1 << 16        # unique_inverse marks keys in a dense table up to this bound (or 16 per key)
+
+
+def unique_inverse(key, bound):
+    """``np.unique(key, return_inverse=True)`` for integer keys in ``[0, bound)``; for a small
+    ``bound`` by a dense table of the keys present (no sort)."""
+    if bound > max(DENSE_KEYS, 16 * len(key)):
+        return np.unique(key, return_inverse=True)
+    present = np.zeros(bound, dtype=bool)
+    present[key] = True
+    return np.flatnonzero(present), (np.cumsum(present) - 1)[key]
+
+
+def _csc_by_constructor(data, indices, indptr, n):
+    return sp.csc_matrix((data, indices, indptr), shape=(n, n))
+
+
+def _csc_direct(data, indices, indptr, n):
+    K = sp.csc_matrix.__new__(sp.csc_matrix)
+    K.data, K.indices, K.indptr, K._shape, K.maxprint = data, indices, indptr, (n, n), _MAXPRINT
+    K._has_canonical_format = K._has_sorted_indices = True
+    return K
+
+
+def _pick_csc():
+    """``_csc_direct`` where it builds what scipy's constructor builds (the same attributes), else the
+    constructor: scipy's checks cost more than a small model's factorisation."""
+    args = (np.ones(2), np.array([0, 1], dtype=np.int32), np.array([0, 1, 2], dtype=np.int32), 2)
+    try:
+        ref, fast = _csc_by_constructor(*args), _csc_direct(*args)
+        same = set(vars(ref)) | {"_has_canonical_format", "_has_sorted_indices"} == set(vars(fast)) \
+            and (ref != fast).nnz == 0
+    except Exception:
+        same = False
+    return _csc_direct if same else _csc_by_constructor
+
+
+_MAXPRINT = _csc_by_constructor(np.ones(1), np.zeros(1, dtype=np.int32), np.array([0, 1], dtype=np.int32), 1).maxprint
+
+
+def canonical_csc(data, indices, indptr, n):
+    """Square ``(n, n)`` ``scipy.sparse.csc_matrix`` of a canonical pattern (sorted, unique row
+    indices per column, int32, as ``System._build_pattern`` makes it) and its ``data``; the arrays
+    are not copied."""
+    return _CSC(data, indices, indptr, n)
+
+
+def beams_anchored(model, kind):
+    """The rigid-mode check's exact shortcut: without joins, contact or nodes outside beams the
+    connected groups are the beams (a beam's elements chain all its nodes), and a beam with a
+    clamped or prescribed node has no free rigid-body mode."""
+    if model.joins or model.contacts or model.free_nodes:
+        return False
+    anchored = (kind == CLAMPED) | (kind == PRESCRIBED)
+    return all(anchored[b.nodes].any() for b in model.beams)
+
+
+def _representatives(n, joins, cons, group_constraint):
+    """Representative node of every node ``(n,)``: joined groups merged by union-find, the
+    constrained node of a group (``group_constraint``) chosen as its representative."""
+    if not joins:
+        return np.arange(n)
+    parent = list(range(n))
+    for a, b in joins:
+        ra, rb = _find(parent, a), _find(parent, b)
+        if ra == rb:
+            continue
+        # the constrained node of a group becomes its representative
+        ca, cb = group_constraint(parent, ra, cons), group_constraint(parent, rb, cons)
+        if ca is not None and cb is not None:
+            raise InputError(f"join({a}, {b}): both joined groups carry constraints "
+                             f"(nodes {ca} and {cb}); constrain only one node of a joint")
+        if cb is not None:
+            parent[ra] = rb
+        else:
+            parent[rb] = ra
+    return np.array([_find(parent, i) for i in range(n)])
+
+
+_CSC = _pick_csc()
+
+
 class System:
     """Compiled, validated model: DOF map, element table, load arrays, sparse pattern."""
 
@@ -132,22 +214,15 @@ class System:
     # ------------------------------------------------------------ dof map
     def _build_reps(self, model):
         n = self.n_nodes
-        parent = list(range(n))
         cons = model.constraints
-        for a, b in model.joins:
-            ra, rb = _find(parent, a), _find(parent, b)
-            if ra == rb:
-                continue
-            # the constrained node of a group becomes its representative
-            ca, cb = self._group_constraint(parent, ra, cons), self._group_constraint(parent, rb, cons)
-            if ca is not None and cb is not None:
-                raise InputError(f"join({a}, {b}): both joined groups carry constraints "
-                                 f"(nodes {ca} and {cb}); constrain only one node of a joint")
-            if cb is not None:
-                parent[ra] = rb
-            else:
-                parent[rb] = ra
-        rep = np.array([_find(parent, i) for i in range(n)])
+        rep = _representatives(n, model.joins, cons, self._group_constraint)
+        self._set_constraints(model, rep)
+
+    def _set_constraints(self, model, rep):
+        """Node kinds, fixed unknowns, joined members and the free/fixed DOF numbering from the
+        representatives ``rep`` ``(n,)``."""
+        n = self.n_nodes
+        cons = model.constraints
         # a constrained member hands its constraint to the representative
         kind = np.full(n, FREE)
         fixed = np.zeros((n, 6), dtype=bool)
@@ -172,8 +247,11 @@ class System:
         self.is_rep = is_rep
         P = self.poses0
         self.members = np.flatnonzero(~is_rep)
-        self.X = se3.relative(P[rep[self.members]], P[self.members])   # H_i = H_rep X_i
-        self.Ad_Xinv = se3.adjoint(se3.inverse(self.X))
+        if len(self.members):
+            self.X = se3.relative(P[rep[self.members]], P[self.members])   # H_i = H_rep X_i
+            self.Ad_Xinv = se3.adjoint(se3.inverse(self.X))
+        else:
+            self.X, self.Ad_Xinv = np.zeros((0, 4, 4)), np.zeros((0, 6, 6))
         self.global_nodes = np.flatnonzero(kind == GLOBAL)
         # prescribed global translations of fixed components: (node, component, f)
         self.fix_values = []
@@ -192,8 +270,10 @@ class System:
         transformed = np.zeros(n, dtype=bool)
         transformed[self.members] = True
         transformed[self.global_nodes] = True
-        transformed |= np.isin(rep, self.global_nodes)
+        if len(self.global_nodes):
+            transformed |= np.isin(rep, self.global_nodes)
         self.transformed = transformed
+        self.any_transformed = bool(transformed.any())
         self.group_transformed = [np.flatnonzero(transformed[g.nodes].any(axis=1)) for g in self.groups]
         self.body_nodes = np.flatnonzero(is_rep & ((kind == FREE) | (kind == PRESCRIBED)))
 
@@ -206,6 +286,8 @@ class System:
 
     def _check_rigid_modes(self, model):
         """Every connected group (joints, contact) needs 6 independent constraints."""
+        if beams_anchored(model, self.kind):
+            return
         n = self.n_nodes
         parent = list(range(n))
 
@@ -249,6 +331,7 @@ class System:
         self.load_follower = np.array([ld.follower for ld in loads], dtype=bool)
         self.load_scales = [ld.scale for ld in loads]
         self.dead = np.flatnonzero(~self.load_follower)
+        self.dead_nodes = self.load_nodes[self.dead]
 
     def load_factors(self, t):
         return np.array([float(s(t)) for s in self.load_scales])
@@ -261,26 +344,27 @@ class System:
         self.group_edofs = [_blocks.dofs(self.rep, g.nodes) for g in self.groups]
         self.edofs_flat = np.concatenate([ed.ravel() for ed in self.group_edofs])
         # node blocks: dead-loaded nodes and global-type representatives
-        bn = np.unique(np.concatenate([self.load_nodes[self.dead], self.global_nodes]))
-        self.block_nodes = bn.astype(int)
+        bn = sorted(set(self.dead_nodes.tolist()) | set(self.global_nodes.tolist()))
+        self.block_nodes = np.array(bn, dtype=int)
         self.load_dofs = ((6 * self.rep[self.load_nodes])[:, None] + k6).ravel()
         self.dead_where = np.searchsorted(self.block_nodes, self.load_nodes[self.dead])
-        self.dead_unique = len(np.unique(self.dead_where)) == len(self.dead_where)
+        self.dead_unique = len(set(self.dead_where.tolist())) == len(self.dead_where)
+        self.dead_blocks_in_order = len(self.dead_where) == len(bn) and \
+            bool((self.dead_where == np.arange(len(bn))).all())
         ndofs = (6 * self.rep[self.block_nodes])[:, None] + k6
         # element entries group by group in the order of the kernels' tangent storage, (n_g, 6k, 6k),
         # then the node blocks (n_b, 6, 6)
         shapes = [(len(ed), ed.shape[1], ed.shape[1]) for ed in self.group_edofs]
-        self.group_kslices = np.cumsum([0] + [int(np.prod(sh)) for sh in shapes])
-        rows = np.concatenate([np.broadcast_to(ed[:, :, None], sh).ravel() for ed, sh in zip(self.group_edofs, shapes)]
-                              + [np.repeat(ndofs, 6, axis=1).ravel()])
-        cols = np.concatenate([np.broadcast_to(ed[:, None, :], sh).ravel() for ed, sh in zip(self.group_edofs, shapes)]
-                              + [np.tile(ndofs, (1, 6)).ravel()])
+        self.group_kslices = np.cumsum([0] + [a * b * c for a, b, c in shapes])
+        blocks = list(zip(self.group_edofs, shapes)) + [(ndofs, (len(ndofs), 6, 6))]
+        rows = np.concatenate([np.broadcast_to(ed[:, :, None], sh).ravel() for ed, sh in blocks])
+        cols = np.concatenate([np.broadcast_to(ed[:, None, :], sh).ravel() for ed, sh in blocks])
         self.coo_rows, self.coo_cols = rows, cols
         rr, rc = self.red[rows], self.red[cols]
         keep = (rr >= 0) & (rc >= 0)
         nf = self.n_free
         key = rc[keep].astype(np.int64) * max(nf, 1) + rr[keep]
-        ukey, inv = np.unique(key, return_inverse=True)
+        ukey, inv = unique_inverse(key, max(nf, 1) ** 2)
         self.nnz = len(ukey)
         pos = np.full(len(rows), self.nnz)        # dropped entries go to a dummy slot
         pos[keep] = inv
@@ -289,6 +373,9 @@ class System:
         counts = np.bincount((ukey // max(nf, 1)).astype(np.int64), minlength=nf)
         self.indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
         # entries (free row, prescribed column) for the predictor
+        if not (len(self.prescribed_nodes) or self.fix_values):
+            self.fc = np.zeros(0, dtype=np.intp)
+            return
         presc = np.zeros(6 * n, dtype=bool)
         for r in self.prescribed_nodes:
             presc[6 * r:6 * r + 6] = True
@@ -299,9 +386,9 @@ class System:
     # ------------------------------------------------------------ transforms
     def node_transforms(self, H):
         """``M_i`` for the transformed nodes: dict of arrays ``(n, 6, 6)`` (identity elsewhere)."""
-        M = np.broadcast_to(np.eye(6), (self.n_nodes, 6, 6)).copy() if self.transformed.any() else None
-        if M is None:
+        if not self.any_transformed:
             return None
+        M = np.broadcast_to(np.eye(6), (self.n_nodes, 6, 6)).copy()
         g = self.global_nodes
         if len(g):
             Rt = np.swapaxes(H[g, :3, :3], 1, 2)
@@ -376,16 +463,18 @@ class System:
         pattern (``None`` without tangent); ``info`` holds the element state
         and force levels for the convergence test.
         """
-        kvals = None
+        kvals = blocks = None
         n_k = self.group_kslices[-1]
         if tangent:
-            # the kernels write their tangents straight into the COO value array (no copy)
+            # the kernels write their tangents straight into the COO value array (no copy), the node
+            # blocks follow them
             kvals = np.empty(n_k + 36 * len(self.block_nodes))
+            blocks = kvals[n_k:].reshape(-1, 6, 6)
+            blocks[...] = 0.0
         f, state, f_level, m_level, M = self._element_forces(H, kvals)
         ndof = 6 * self.n_nodes
         r = np.bincount(self.edofs_flat, weights=f, minlength=ndof)
         # external loads (body components at their node, then transformed)
-        blocks = np.zeros((len(self.block_nodes), 6, 6)) if tangent else None
         if len(self.load_nodes):
             r, f_level, m_level = self._add_loads(H, load_factors, M, r, blocks, f_level, m_level)
         if tangent and len(self.global_nodes):
@@ -394,8 +483,6 @@ class System:
             where = np.searchsorted(self.block_nodes, g)
             blocks[where, :3, 3:] -= skew(rg[:, :3])
             blocks[where, 3:, 3:] -= skew(rg[:, 3:])
-        if tangent:
-            kvals[n_k:] = blocks.ravel()
         info = dict(state=state, f_level=f_level, m_level=m_level)
         return r, kvals, info
 
@@ -436,16 +523,21 @@ class System:
         Dead loads: body components ``R^T F`` with the stiffness ``-[[0, hat(R^T F)], [0, hat(R^T M)]]``
         (docs/theory.md eq. 4.2); follower loads are constant in the body frame.
         """
-        Fs, Ms = self.load_F * lf[:, None], self.load_M * lf[:, None]
-        f_level = max(f_level, np.abs(Fs).max(initial=0.0))
-        m_level = max(m_level, np.abs(Ms).max(initial=0.0))
-        fext = np.concatenate([Fs, Ms], axis=1)
         d = self.dead
         kb = np.empty((len(d) if blocks is not None else 0, 6, 6))
-        if len(d):
-            fd = np.empty((len(d), 6))
-            assembly_jit.dead_loads(H, self.load_nodes[d], Fs[d], Ms[d], fd, kb)
-            fext[d] = fd
+        if len(d) == len(self.load_F):                  # dead loads only: one compiled call
+            fext = np.empty((len(d), 6))
+            fl, ml = assembly_jit.scaled_dead_loads(H, self.dead_nodes, self.load_F, self.load_M, lf, fext, kb)
+            f_level, m_level = max(f_level, fl), max(m_level, ml)
+        else:
+            Fs, Ms = self.load_F * lf[:, None], self.load_M * lf[:, None]
+            f_level = max(f_level, np.abs(Fs).max(initial=0.0))
+            m_level = max(m_level, np.abs(Ms).max(initial=0.0))
+            fext = np.concatenate([Fs, Ms], axis=1)
+            if len(d):
+                fd = np.empty((len(d), 6))
+                assembly_jit.dead_loads(H, self.dead_nodes, Fs[d], Ms[d], fd, kb)
+                fext[d] = fd
         if M is not None:
             fext = np.einsum("nji,nj->ni", M[self.load_nodes], fext)
         r = r - np.bincount(self.load_dofs, weights=fext.ravel(), minlength=len(r))
@@ -453,7 +545,9 @@ class System:
             if M is not None:
                 Md = M[self.load_nodes[d]]
                 kb = np.swapaxes(Md, 1, 2) @ kb @ Md
-            if self.dead_unique:
+            if self.dead_blocks_in_order:      # the node blocks are the dead loads' blocks, in order
+                blocks += kb
+            elif self.dead_unique:
                 blocks[self.dead_where] += kb
             else:
                 np.add.at(blocks, self.dead_where, kb)
@@ -469,7 +563,7 @@ class System:
         assembly_jit.scatter(self.pos, kvals, data)
         if extra is not None and len(extra[2]):
             return self._extra_pattern(extra).matrix(data[:self.nnz], extra[2])
-        return sp.csc_matrix((data[:self.nnz], self.indices, self.indptr), shape=(self.n_free, self.n_free))
+        return canonical_csc(data[:self.nnz], self.indices, self.indptr, self.n_free)
 
     def _extra_pattern(self, extra):
         """The ``extra_pattern.ExtraPattern`` of the COO entries ``extra`` (kept while their pattern

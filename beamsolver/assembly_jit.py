@@ -82,3 +82,21 @@ def dead_loads(H, nodes, F, M, fb, kb):
                 kb[k, r0, 4], kb[k, r0, 5] = z, -y
                 kb[k, r0 + 1, 3], kb[k, r0 + 1, 5] = -z, x
                 kb[k, r0 + 2, 3], kb[k, r0 + 2, 4] = y, -x
+
+
+@jit
+def scaled_dead_loads(H, nodes, F, M, lf, fb, kb):
+    """``dead_loads`` of the loads ``F * lf``, ``M * lf`` (``(k, 3)``, scales ``lf`` ``(k,)``);
+    returns the largest ``|component|`` of the scaled forces and of the moments (NaN if any is)."""
+    Fs, Ms = np.empty_like(F), np.empty_like(M)
+    f_level, m_level = 0.0, 0.0
+    for k in range(len(lf)):
+        for a in range(3):
+            Fs[k, a], Ms[k, a] = F[k, a] * lf[k], M[k, a] * lf[k]
+            f, m = abs(Fs[k, a]), abs(Ms[k, a])
+            if f > f_level or f != f:
+                f_level = f if f_level == f_level else f_level
+            if m > m_level or m != m:
+                m_level = m if m_level == m_level else m_level
+    dead_loads(H, nodes, Fs, Ms, fb, kb)
+    return f_level, m_level

@@ -22,6 +22,7 @@ __all__ = ["Model", "Beam", "Load", "ContactDeclaration", "ElementGroup", "DOF_N
 DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
 JOIN_TOL = 1e-9                       # coincidence tolerance relative to the model size
 ZERO_LENGTH_TOL = 1e-12               # an element shorter than this times the model size has zero length
+LAST_ROW = np.array([0.0, 0.0, 0.0, 1.0])   # of every pose
 
 
 @dataclass
@@ -118,6 +119,7 @@ class Model:
     def __init__(self):
         self.beams = []
         self._poses = []          # list of (n_i + 1, 4, 4)
+        self._refs = {}           # beam id -> (section, its C, element type, Reference) when added
         self._n_nodes = 0
         self._n_elements = 0
         self.constraints = {}     # node -> ("clamp",) | ("fix", frozenset) | ("prescribe", motion)
@@ -159,19 +161,17 @@ class Model:
         P = as_array(poses, "poses", label)
         if P.ndim != 3 or P.shape[1:] != (4, 4) or P.shape[0] < 2:
             raise InputError(f"{label}: poses must have shape (n + 1, 4, 4) with n >= 1, got {P.shape}")
-        bad = np.argwhere(~np.all(np.isfinite(P), axis=(1, 2)))
-        if len(bad):
-            i = int(bad[0, 0])
+        if not np.isfinite(P).all():
+            i = int(np.argwhere(~np.all(np.isfinite(P), axis=(1, 2)))[0, 0])
             raise InputError(f"{label}: node {i} has non-finite coordinates {P[i, :3, 3].tolist()}")
         R = P[:, :3, :3]
         err = np.abs(np.swapaxes(R, 1, 2) @ R - np.eye(3)).max(axis=(1, 2))
         det = np.linalg.det(R)
-        badR = np.flatnonzero((err > ORTHONORMAL_TOL) | (det <= 0.0))
-        if len(badR):
-            i = int(badR[0])
+        if err.max() > ORTHONORMAL_TOL or det.min() <= 0.0:
+            i = int(np.flatnonzero((err > ORTHONORMAL_TOL) | (det <= 0.0))[0])
             raise InputError(f"{label}: pose of node {i} is not a rotation (|R^T R - I| = {err[i]:.3g}, "
                              f"det = {det[i]:.6g}); use beamsolver.geometry or orthonormalise it")
-        if np.any(np.abs(P[:, 3] - [0, 0, 0, 1]) > 0):
+        if (P[:, 3] != LAST_ROW).any():
             raise InputError(f"{label}: the last row of every pose must be (0, 0, 0, 1)")
         n_el = etype.n_elements(len(P), label)
         conn = etype.connectivity(n_el)
@@ -194,6 +194,7 @@ class Model:
         nodes = np.arange(self._n_nodes, self._n_nodes + len(P))
         element_ids = np.arange(self._n_elements, self._n_elements + n_el)
         beam = Beam(bid, nodes, element_ids, section, name, etype)
+        self._refs[bid] = (section, section.C.copy(), etype, ref)
         self.beams.append(beam)
         self._poses.append(P)
         self._n_nodes += len(P)
@@ -415,15 +416,29 @@ class Model:
         by_type = {}
         for b in self.beams:
             by_type.setdefault(b.element_type.name, []).append(b)
-        P = self.poses0
+        P = None
         groups = []
         for beams in by_type.values():
             etype = beams[0].element_type
+            ref = self._reference_when_added(beams[0]) if len(beams) == 1 else None
+            if ref is not None:
+                b = beams[0]
+                groups.append(ElementGroup(etype, b.elements.copy(), b.connectivity, ref))
+                continue
+            P = self.poses0 if P is None else P
             nodes = np.concatenate([b.connectivity for b in beams])
             C = np.concatenate([np.broadcast_to(b.section.C, (b.n_elements, 6, 6)) for b in beams])
             groups.append(ElementGroup(etype, np.concatenate([b.elements for b in beams]), nodes,
                                        etype.reference(P[nodes], C)))
         return groups
+
+    def _reference_when_added(self, beam):
+        """The ``Reference`` ``add_beam`` computed for ``beam`` (the same numbers ``element_groups``
+        computes), if its section, stiffness and element type are still those it was added with."""
+        section, C, etype, ref = self._refs.get(beam.id, (None,) * 4)
+        if section is beam.section and etype is beam.element_type and np.array_equal(C, section.C):
+            return ref
+        return None
 
     def element_table(self, groups=None):
         """Per element: end node ids ``(n_el, 2)`` (first and last node), reference length, reference

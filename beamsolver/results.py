@@ -137,13 +137,9 @@ def _array(where, name, value, shape, what):
                          f"got {type(value).__name__}") from None
     if a.shape != shape:
         raise InputError(f"{where}: {name} must have shape {shape} ({what}), got {a.shape}")
-    with np.errstate(over="ignore"):
-        total = a.sum()
-    if not math.isfinite(total):            # NaN and inf reach the sum; a finite sum: all finite
-        bad = np.argwhere(~np.isfinite(a))
-        if len(bad):
-            i = tuple(int(j) for j in bad[0])
-            raise InputError(f"{where}: {name} must be finite, got {a[i]} at index {i}")
+    if not np.isfinite(a).all():
+        i = tuple(int(j) for j in np.argwhere(~np.isfinite(a))[0])
+        raise InputError(f"{where}: {name} must be finite, got {a[i]} at index {i}")
     return a
 
 

@@ -41,6 +41,8 @@ DAMPING_MIN = 1.0 / 64.0             # shortest damped Newton step (smooth probl
 STALL_RATIO = 1.5                    # undamped fallback if the shortest damped step grows the correction less
 MIN_STEP_RATIO = 1e-15               # smallest min_step_ratio: below, t + dt rounds to t
 ROUNDOFF = 64.0 * np.finfo(float).eps   # position round-off, relative to the distance from the origin
+SQRT3 = np.sqrt(3.0)                 # |w|_2 <= SQRT3 |w|_inf (the rotation check's shortcut)
+CONTINUITY_MARGIN = 1e-6             # check_continuity's shortcut: far above the ~1e-8 round-off of arccos at 0
 
 CONVERGED, CONTINUE, MAX_ITER, DIVERGED = "converged", "continue", "max_iter", "diverged"
 
@@ -174,7 +176,10 @@ class Newton:
         dof_u[:, :3] = True
         fu = dof_u.ravel()[system.free_dofs]
         self.fu, self.fw = np.flatnonzero(fu), np.flatnonzero(~fu)
+        self._dofs_u, self._dofs_w = system.free_dofs[self.fu], system.free_dofs[self.fw]   # in all 6 n unknowns
         self.L_ref = system.length_scale
+        # the rotation check's shortcut bound, a margin far above the round-off of |w|
+        self._smallest_limit = (1.0 - 1e-9) * float(system.rotation_limit.min(initial=np.inf))
         self.linsolver = linsolve.Solver()    # solve(linear_solver=...) replaces it
         self.stall_ratio = np.inf             # correction growth of the shortest damped trial
         self.reset_timings()
@@ -183,8 +188,7 @@ class Newton:
         self.timings = dict(assembly=0.0, linear_solve=0.0, **dict.fromkeys(self.problem.timing_names, 0.0))
 
     def _ratio(self, r, scales):
-        rf = r[self.sys.free_dofs]
-        return self.conv.residual_ratio(rf[self.fu], rf[self.fw], *scales)
+        return self.conv.residual_ratio(r[self._dofs_u], r[self._dofs_w], *scales)
 
     def _merit(self, r, scales):
         rf = r[self.sys.free_dofs]
@@ -199,7 +203,11 @@ class Newton:
         return f"element {e}"
 
     def _check_rotation(self, state):
-        ang = se3.rotation_angle(state.h[:, 3:])
+        w = state.h[:, 3:]
+        # |w| <= sqrt(3) max|w_i|: far below every limit, nothing to measure
+        if len(w) and np.abs(w).max() * SQRT3 < self._smallest_limit:
+            return
+        ang = se3.rotation_angle(w)
         limit = self.sys.rotation_limit          # of each element's type, MAX_ELEMENT_ROTATION for se3-2
         worst = int(np.argmax(ang - limit)) if len(ang) else 0
         if len(ang) and ang[worst] > limit[worst]:
@@ -219,8 +227,12 @@ class Newton:
         if self.sys.n_elements == 0:
             return
         R0, R1 = _relative_rotations(self.sys, H0), _relative_rotations(self.sys, H1)
+        a0, a1 = _angle(R0), _angle(R1)
+        # the change is at most a0 + a1: below pi (a margin above the arccos round-off) nothing can pass
+        if (a0 + a1).max() < np.pi - CONTINUITY_MARGIN:
+            return
         change = _angle(np.swapaxes(R0, 1, 2) @ R1)
-        bad = np.flatnonzero(change >= (np.pi - _angle(R0)) + (np.pi - _angle(R1)) - 1e-9)
+        bad = np.flatnonzero(change >= (np.pi - a0) + (np.pi - a1) - 1e-9)
         if len(bad):
             e = int(bad[np.argmax(change[bad])])
             raise RotationLimit(f"{self._element_label(self.sys.pair_element[e])} turns by {change[e]:.3f} rad "
@@ -264,7 +276,7 @@ class Newton:
         self.timings["assembly"] += time.perf_counter() - t0
         for name, seconds in ev.timings.items():
             self.timings[name] = self.timings.get(name, 0.0) + seconds
-        if not np.all(np.isfinite(ev.r)):
+        if not np.isfinite(ev.r).all():
             raise NonFinite("the residual is not finite")
         self._check_rotation(ev.state)
         return ev
@@ -312,19 +324,19 @@ class Newton:
         floor = conv.floor(H, self.L_ref)
         damping = self.line_search and problem.smooth
         last_inc = np.inf
-        ahead = None                 # (ev, lu, dzf) of an accepted damped trial
+        ahead = None                 # (ev, lu, dzf, scales, ratio, norm) of an accepted damped trial
         lam = 1.0
         rotation_streak = 0
         stats_extra = {}
         for it in range(conv.max_iter + 1):
             if ahead is None:
                 ev = self.evaluate(H, t)
-                lu = dzf = None
+                lu = dzf = nrm = None
+                scales = conv.scales(ev, self.L_ref)
+                ratio = self._ratio(ev.r, scales)
             else:
-                ev, lu, dzf = ahead
+                ev, lu, dzf, scales, ratio, nrm = ahead     # the damped trial's, already measured
                 ahead = None
-            scales = conv.scales(ev, self.L_ref)
-            ratio = self._ratio(ev.r, scales)
             residuals.append(ratio)
             log.debug("t = %.6g  iteration %d  scaled residual %.3e", t, it, ratio)
             if self.callback is not None:
@@ -351,8 +363,9 @@ class Newton:
                 H = self._line_search(H, dz, ev.r, scales, t) if self.line_search else problem.update(H, dz)
                 continue
             lam0 = min(1.0, 2.0 * lam)          # after a damped iteration, try twice its length
+            inc = conv.increment_ratio(dz, self.L_ref)
             try:
-                H, lam, ahead, rotation = self._damped(H, dz, dzf, t, lam0)
+                H, lam, ahead, rotation = self._damped(H, dz, dzf, t, lam0, nrm, inc)
             except DampingStalled:
                 if not self.stall_ratio <= STALL_RATIO:
                     raise
@@ -363,7 +376,7 @@ class Newton:
                           self.stall_ratio)
                 damping = False
                 stats_extra["undamped"] = it
-                last_inc = conv.increment_ratio(dz, self.L_ref)
+                last_inc = inc
                 H = problem.update(H, dz)
                 continue
             damped_its += lam < 1.0
@@ -372,7 +385,7 @@ class Newton:
             rotation_streak = rotation_streak + 1 if rotation is not None else 0
             if rotation_streak >= 2:
                 raise rotation
-            last_inc = conv.increment_ratio(dz, self.L_ref) if lam == 1.0 else np.inf
+            last_inc = inc if lam == 1.0 else np.inf
         raise AssertionError("unreachable: decide() returns MAX_ITER at iteration max_iter")
 
     def _failure(self, verdict, ratio):
@@ -388,7 +401,7 @@ class Newton:
         dz[self.sys.free_dofs] = dzf
         return dz.reshape(-1, 6)
 
-    def _damped(self, H, dz, dzf, t, lam):
+    def _damped(self, H, dz, dzf, t, lam, nrm=None, inc=None):
         """Damped Newton update ``H exp(lam dz)`` (smooth problems).
 
         A trial length is accepted when the Newton correction at the trial point is smaller than
@@ -401,28 +414,34 @@ class Newton:
         halved (a trial that is not finite, is singular or turns an element past the limit is
         rejected too) down to ``DAMPING_MIN``.
 
-        Returns ``(H, lam, ahead, rotation)``: ``ahead`` the trial's ``(ev, lu, dzf)`` (``None``
-        if it converged), ``rotation`` the rotation-limit failure of the full
-        first trial, if that is what rejected it.
+        ``nrm``, ``inc``: ``_norm(dzf)`` and ``_inc(dzf)`` if known.  Returns ``(H, lam, ahead,
+        rotation)``: ``ahead`` the trial's ``(ev, lu, dzf, scales, ratio, norm)`` (``lu``, ``dzf``,
+        ``norm`` ``None`` if it converged), ``rotation`` the rotation-limit failure of the full first
+        trial, if that is what rejected it.
         """
         problem, conv = self.problem, self.conv
-        if self._inc(dzf) <= 1e3 * conv.dtol:     # round-off level: nothing to damp
+        inc = self._inc(dzf) if inc is None else inc
+        if inc <= 1e3 * conv.dtol:     # round-off level: nothing to damp
             return problem.update(H, dz), 1.0, None, None
-        nrm = self._norm(dzf)
+        if nrm is None:
+            nrm = self._norm(dzf)
         rotation = None
         failure = None
         first = True
         while True:
             self.stall_ratio = np.inf
-            H1 = problem.update(H, lam * dz)
+            H1 = problem.update(H, dz if lam == 1.0 else lam * dz)
             try:
                 ev1 = self.evaluate(H1, t)
-                if self._ratio(ev1.r, conv.scales(ev1, self.L_ref)) <= conv.rtol:
-                    return H1, lam, (ev1, None, None), None
+                scales1 = conv.scales(ev1, self.L_ref)
+                ratio1 = self._ratio(ev1.r, scales1)
+                if ratio1 <= conv.rtol:
+                    return H1, lam, (ev1, None, None, scales1, ratio1, None), None
                 lu1, d1 = self._direction(ev1)
-                self.stall_ratio = self._norm(d1) / nrm
-                if self._norm(d1) < nrm or self._inc(d1) <= conv.dtol:
-                    return H1, lam, (ev1, lu1, d1), rotation
+                nrm1 = self._norm(d1)
+                self.stall_ratio = nrm1 / nrm
+                if nrm1 < nrm or self._inc(d1) <= conv.dtol:
+                    return H1, lam, (ev1, lu1, d1, scales1, ratio1, nrm1), rotation
             except StepFailed as e:
                 failure = e
                 if first and e.rotation:

@@ -29,7 +29,8 @@ from .failures import AugmentationFailed, MotionTooFast, NonFinite, StepFailed
 from .progress import Progress
 from .results import Solution
 
-__all__ = ["Run", "growth", "next_step", "after_failure", "STEP_TOLERANCE", "EASY_ITERATIONS", "WAIT_MAX"]
+__all__ = ["Run", "growth", "next_step", "after_failure", "STEP_TOLERANCE", "EASY_ITERATIONS", "WAIT_MAX",
+           "STEP_ZERO_ITERATIONS"]
 
 log = logging.getLogger("beamsolver")
 
@@ -39,6 +40,7 @@ EASY_ITERATIONS = 6        # a step converging within these iterations is easy (
 EASY_RUN = 2               # easy steps running before the step grows (growth)
 WAIT_MAX = 32              # most easy steps running before a step regrows to a size that failed again
 MAX_OUTER = 100            # outer iterations of a step (Problem.repeat_step) before it fails
+STEP_ZERO_ITERATIONS = 4   # Newton budget at t_start / max_iter (no cut-back there; docs/theory.md section 17)
 
 
 def growth(iterations, easy):
@@ -117,7 +119,10 @@ class Run:
 
     def _step_zero(self, H0, t_start):
         """Step 0: the state ``H0`` at ``t_start`` (prescribed nodes on their motion) or, when loads,
-        motions or ``fix`` values act there, the equilibrium solved there from ``H0``."""
+        motions or ``fix`` values act there, the equilibrium solved there from ``H0`` with
+        ``STEP_ZERO_ITERATIONS`` times the Newton budget ``max_iter``: no step can be cut back
+        there, and the first state of touching wires converges only linearly (docs/theory.md
+        section 17, touching wires at t_start)."""
         sys, problem = self.sys, self.problem
         H = H0.copy()
         if len(sys.prescribed_nodes):
@@ -127,6 +132,8 @@ class Run:
         if _acts_at(sys, H0, t_start):
             t0 = time.perf_counter()
             self.H, self.t = H0, None
+            conv = self.newton.conv
+            max_iter, conv.max_iter = conv.max_iter, STEP_ZERO_ITERATIONS * conv.max_iter
             try:
                 H, ev0, stats = self.newton_step(t_start)
             except StepFailed as e:
@@ -136,7 +143,7 @@ class Run:
                 err.failure = e
                 raise err from None
             finally:
-                self.t = t_start
+                self.t, conv.max_iter = t_start, max_iter
             stats.update(wall_time=time.perf_counter() - t0, dt=0.0, cutbacks=0)
             record = problem.commit(H)
             if problem.contributions:

@@ -6,6 +6,7 @@ them lets a raw ``TypeError``/``ValueError``/``OverflowError`` from numpy out.
 Numbers are Python or numpy reals (not ``bool``, not strings); counts are
 integers or integral floats.
 """
+import math
 import numbers
 import os
 
@@ -24,6 +25,8 @@ MAX_COUNT = 10**6                     # elements per generated beam, load steps 
 
 
 def _is_real(value):
+    if type(value) is float or type(value) is int:    # the common case, before the ABC check
+        return True
     if isinstance(value, (bool, np.bool_)):
         return False
     if isinstance(value, numbers.Real):
@@ -46,7 +49,7 @@ def real(value, name, owner, *, minimum=None, above=None, maximum=None, none=Fal
         what = "a finite number"
     if maximum is not None:
         what += f" and <= {maximum:g}"
-    ok = _is_real(value) and np.isfinite(float(value))
+    ok = _is_real(value) and math.isfinite(float(value))
     if ok:
         v = float(value)
         ok = ((minimum is None or v >= minimum) and (above is None or v > above)
@@ -58,7 +61,7 @@ def real(value, name, owner, *, minimum=None, above=None, maximum=None, none=Fal
 
 def count(value, name, owner, *, minimum=1, maximum=MAX_COUNT):
     """``value`` as an int in ``[minimum, maximum]`` (integral floats accepted)."""
-    ok = _is_real(value) and np.isfinite(float(value)) and float(value) == int(value)
+    ok = _is_real(value) and math.isfinite(float(value)) and float(value) == int(value)
     if not ok or int(value) < minimum:
         kind = "a positive integer" if minimum == 1 else f"an integer >= {minimum}"
         raise InputError(f"{owner}: {name} must be {kind}, got {value!r}")
@@ -146,7 +149,7 @@ class CheckedScalar:
 def scalar_of(fn, t, where):
     """``fn(t)`` as a finite float; ``where`` names the callable (e.g. ``add_load(4): scale``)."""
     v = fn(t)
-    if not _is_real(v) or not np.isfinite(float(v)):
+    if not _is_real(v) or not math.isfinite(float(v)):
         kind = f"an array of shape {np.shape(v)}" if isinstance(v, np.ndarray) else repr(v)
         raise InputError(f"{where}({t:.6g}) must return a finite number, got {kind}")
     return float(v)

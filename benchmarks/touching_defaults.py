@@ -12,6 +12,15 @@ converges without cut-backs.
 
 Writes the ``touching_defaults`` section of ``docs/benchmarks.md`` with the full-size default
 arguments (``--elements 24 --turns 1 --steps 8 --length 0.03``).
+
+``--start`` measures instead the first state of touching wires with the example's options
+(``examples/twisted_pair.py``: two wires, smoothing ``1e-3 (R1 + R2)``; ``examples/three_wires.py``:
+the default), a 5 N pull on from t = 0, for lengths up to 0.2 m: Newton iterations of step 0
+(budget ``stepping.STEP_ZERO_ITERATIONS`` x 30), the contact force and the largest gap between
+the wires there (the smoothed law pushes touching points apart), then half a turn in 4 steps
+(``--no-twist``: step 0 only).  Writes the ``touching_start`` section.
+
+    python benchmarks/touching_defaults.py --start [--no-twist] [--no-write]
 """
 import argparse
 import sys
@@ -26,8 +35,12 @@ from _report import single_thread  # noqa: E402
 
 single_thread()
 
+import numpy as np  # noqa: E402
+
 import beamsolver as bs  # noqa: E402
 import three_wires  # noqa: E402
+import twisted_pair  # noqa: E402
+from beamsolver.stepping import STEP_ZERO_ITERATIONS  # noqa: E402
 
 R = 0.5e-3
 SMOOTHING = (0.0, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2)      # x (R1 + R2)
@@ -74,6 +87,63 @@ open and closed.
 """)
 
 
+START = [("pair", 0.06, 24, 0.0), ("pair", 0.06, 24, 0.3), ("pair", 0.1, 24, 0.0), ("pair", 0.1, 24, 0.3),
+         ("pair", 0.1, 40, 0.0), ("pair", 0.1, 40, 0.3), ("pair", 0.2, 48, 0.0), ("pair", 0.2, 48, 0.3),
+         ("pair", 0.2, 80, 0.0), ("pair", 0.2, 80, 0.3), ("three", 0.1, 24, 0.0), ("three", 0.1, 24, 0.3)]
+
+
+def widest_gap(sol, wires, k=0):
+    """Largest gap [m] between the centre lines of two wires at equal node numbers, step ``k``."""
+    x = [sol.poses[k][w.nodes][:, :3, 3] for w in wires]
+    return max(float((np.linalg.norm(x[i] - x[j], axis=1) - 2 * R).max())
+               for i in range(len(x)) for j in range(i + 1, len(x)))
+
+
+def start_row(scene, length, elements, mu, twist=True):
+    build = twisted_pair.build if scene == "pair" else three_wires.build
+    model, plate, wires = build(length=length, n_elements=elements, turns=0.5, mu=mu)
+    t0 = time.perf_counter()
+    try:
+        sol = bs.solve(model, steps=4, t_end=1.0 if twist else 1e-9)
+        outcome = "converged"
+    except bs.ConvergenceError as e:
+        sol, outcome = e.solution, "stopped"
+    wall = time.perf_counter() - t0
+    if len(sol.times) == 0:
+        return (scene, length, elements, mu, "stopped at t = 0", "-", "-", "-", "-", "-", "-", f"{wall:.1f}")
+    c = sol.contact(0)
+    return (scene, length, elements, mu, outcome, sol.stats[0]["iterations"], f"{c['normal_force'].sum():.3g}",
+            f"{widest_gap(sol, wires):.3g}", f"{0.5 * sol.times[-1]:.3f}" if twist else "-",
+            sum(st["iterations"] for st in sol.stats), sum(st.get("cutbacks", 0) for st in sol.stats), f"{wall:.1f}")
+
+
+def start(twist=True, write=True):
+    """Table of the first state of touching wires (``START`` scenes) and, with ``twist``, half a turn."""
+    from _report import machine, table, write_section
+    rows = []
+    for scene in START:
+        rows.append(start_row(*scene, twist=twist))
+        print(rows[-1], flush=True)
+    head = ["scene", "length [m]", "elements", "mu", "outcome", "step-0 Newton it.", "step-0 contact force [N]",
+            "step-0 widest gap [m]", "twist reached [turns]", "Newton it.", "cut-backs", "wall [s]"]
+    md = table(head, rows)
+    print(md)
+    if write:
+        write_section("touching_start", f"""## Touching wires at t_start (issue 14 item 1)
+
+`python benchmarks/touching_defaults.py --start{'' if twist else ' --no-twist'}` ({machine()}).  Straight
+steel wires (R = 0.5 mm) touching along their length with the examples' contact options
+(`pair`: `examples/twisted_pair.py`, smoothing `1e-3 (R1 + R2)`; `three`: `examples/three_wires.py`,
+the default), clamped below, rigidly joined to a plate under a 5 N pull from t = 0; then half a turn
+in 4 steps.  Step 0 has {STEP_ZERO_ITERATIONS} x `max_iter` Newton iterations (no cut-back there).
+The smoothed law pushes touching points apart (`eps_N w / 4` per unit length at gap 0), so the first
+state is not the reference one: the contact force and the widest gap of step 0 measure that
+(docs/theory.md section 17).
+
+{md}
+""")
+
+
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--elements", type=int, default=24)
@@ -81,5 +151,10 @@ if __name__ == "__main__":
     ap.add_argument("--steps", type=int, default=8)
     ap.add_argument("--length", type=float, default=0.03)
     ap.add_argument("--no-write", action="store_true")
+    ap.add_argument("--start", action="store_true", help="the first state of touching wires (touching_start)")
+    ap.add_argument("--no-twist", action="store_true", help="with --start: step 0 only")
     a = ap.parse_args()
-    main(a.elements, a.turns, a.steps, a.length, write=not a.no_write)
+    if a.start:
+        start(twist=not a.no_twist, write=not a.no_write)
+    else:
+        main(a.elements, a.turns, a.steps, a.length, write=not a.no_write)

@@ -48,11 +48,37 @@ scaled residual of 2e-3, also without friction or imperfection; 0.06 m is fine).
 The writhing torque with friction lies above Greenhill's ``8.99 B / L`` for ``B = 2 E I``: the
 sticking wires bend stiffer than two free ones, and the damping delays the snap.
 
+Extension control (``--approach s``: the plate's height prescribed as ``L (1 - s t)`` together
+with its turns, so the plate cannot fall; the axial force, the pull plus the support's reaction in
+``z``, tension positive, is then an output) removes the dead-load snap of the plate but not the
+pop of the loop.  ``--length 0.06 --pull 50 --elements 24 --steps 50 --stabilize 2e-3
+--approach 0.3`` (``mu = 0.3``): the shortened pair first buckles in the plane of the imperfection
+at its Euler load (-211 N; ``4 pi^2 B / L^2 = 215 N``) and twists bent (``Wr / Lk <= 0.06`` to
+1.5 turns); from 1.8 turns the twisted pair takes up more length than the plate gives and the
+axial force turns tensile (298 N at 3 turns, 5.5 N m); a loop grows at mid-height from about 3.5
+turns and the solve stops at 3.972 turns, ``Wr = 0.55``, ``Wr / Lk = 0.14``, 990 N, where the
+loop pops (a limit point: 3 negative eigenvalues), ``|Lk - Tw - Wr| / Lk <= 3.2e-3``, dissipated
+at most 1.4e-2 of the strain energy (the first steps; 2.6e-4 at the end), 519 s on a loaded
+machine.  It stops at the same pop with ``--mu 0`` (3.952 turns), ``--pieces 4`` (each wire four
+beams in self-contact: 3.972; a self-contact of point kind only, ``line_angle = 0``: 3.972),
+``--elements 32`` (3.943) and ``--stabilize 5e-2`` (3.978); ``--approach 0.5`` pops earlier
+(3.116 turns, ``Wr = 0.57``).  More damping and shorter steps carry the pop in pseudo-time but
+not past it: ``--mu 0 --stabilize 0.2 --min-step-ratio 1.5e-5`` completes the loop at 3.972
+turns (``Wr = 0.94``, ``Wr / Lk = 0.24``, 1809 N, dissipated 5.2e-2, warned) and stops there
+(with ``--approach 0.5``: at 3.122 turns, ``Wr = 0.89``, 964 N, dissipated 5.0e-2; with
+``--elements 32``: at 3.945 turns, ``Wr = 0.96``, 1838 N, dissipated 5.8e-2);
+with ``mu = 0.3``, ``--stabilize 5e-2 --min-step-ratio 1e-7`` creeps to 4.07 turns and
+``--stabilize 0.2 --min-step-ratio 1e-7`` to 4.02 turns in steps of 1e-9 (both stopped by hand).
+None reaches the 5 turns: the tight, tensioned loop (its radius about two wire diameters) is
+where every run stalls.
+
     python examples/plectoneme.py [--output plectoneme_output] [--turns 5] [--steps 40] [--mu 0.3] [--stabilize 2e-2]
-        [--elements 16] [--imperfection 1e-2] [--length 0.02] [--pull 5]
+        [--elements 16] [--imperfection 1e-2] [--length 0.02] [--pull 5] [--approach s] [--pieces 2]
+        [--min-step-ratio 2**-12]
 """
 import argparse
 import time
+from collections import namedtuple
 
 import numpy as np
 
@@ -65,38 +91,49 @@ LK_MIN = 0.1                 # Lk = Tw + Wr is checked (relative error) from thi
 solve_options = dict(steps=40, stabilize=2e-2)   # for `beamsolver run examples/plectoneme.py`
 
 
-def build(turns=5.0, n_elements=16, mu=0.3, imperfection=1e-2, pull=PULL, E=200e9, nu=0.3, length=LENGTH):
-    """Returns ``(model, plate node, (wire a, wire b))``, each wire a pair ``(lower, upper)`` of
-    beams of ``n_elements // 2`` elements."""
+def build(turns=5.0, n_elements=16, mu=0.3, imperfection=1e-2, pull=PULL, E=200e9, nu=0.3, length=LENGTH,
+          approach=None, pieces=2):
+    """Returns ``(model, plate node, (wire a, wire b))``, each wire a tuple of ``pieces`` beams
+    (bottom to top) of ``n_elements // pieces`` elements joined rigidly.  ``approach=None``: a
+    dead ``pull`` on the plate (free in ``z``); a number ``s``: extension control, the plate's
+    height prescribed as ``length (1 - s t)`` together with its turns (``pull`` then only scales
+    the imperfection)."""
     sec = bs.Section.circular(radius=R, E=E, nu=nu)
     model = bs.Model()
-    half = n_elements // 2
+    if pieces < 2 or n_elements % pieces:
+        raise bs.InputError(f"build: pieces must be >= 2 and divide n_elements = {n_elements}, got {pieces}")
+    cuts = np.linspace(0.0, length, pieces + 1)
     wires = []
     for x, name in ((R, "wire a"), (-R, "wire b")):
-        lo = model.add_beam(bs.geometry.straight((x, 0, 0), (x, 0, length / 2), half), sec, name=name + " lower")
-        up = model.add_beam(bs.geometry.straight((x, 0, length / 2), (x, 0, length), half), sec,
-                            name=name + " upper")
-        model.join(lo.last, up.first, rigid=True)
-        model.clamp(lo.first)
-        model.add_load(lo.last, force=(0.0, imperfection * pull, 0.0), scale=lambda t: 1.0)
-        wires.append((lo, up))
+        wire = tuple(model.add_beam(bs.geometry.straight((x, 0, z0), (x, 0, z1), n_elements // pieces), sec,
+                                    name=f"{name} piece {k}") for k, (z0, z1) in enumerate(zip(cuts, cuts[1:])))
+        for lo, up in zip(wire, wire[1:]):
+            model.join(lo.last, up.first, rigid=True)
+        model.clamp(wire[0].first)
+        mid = wire_nodes(wire)[n_elements // 2]
+        model.add_load(int(mid), force=(0.0, imperfection * pull, 0.0), scale=lambda t: 1.0)
+        wires.append(wire)
     plate = model.add_node((0.0, 0.0, length), name="plate")
-    for lo, up in wires:
-        model.join(plate, up.last, rigid=True)
-    model.fix(plate, ("ux", "uy", "rx", "ry", "rz"), values={"rz": lambda t: 2.0 * np.pi * turns * t})
-    model.add_load(plate, force=(0.0, 0.0, pull), scale=lambda t: 1.0)
-    (a_lo, a_up), (b_lo, b_up) = wires
+    for wire in wires:
+        model.join(plate, wire[-1].last, rigid=True)
+    if approach is None:
+        model.fix(plate, ("ux", "uy", "rx", "ry", "rz"), values={"rz": lambda t: 2.0 * np.pi * turns * t})
+        model.add_load(plate, force=(0.0, 0.0, pull), scale=lambda t: 1.0)
+    else:
+        model.prescribe(plate, bs.motion.compose(
+            bs.motion.translation(lambda t: (0.0, 0.0, -approach * length * t)),
+            bs.motion.rotation((0.0, 0.0, 1.0), lambda t: 2.0 * np.pi * turns * t)))
     opts = dict(mu=mu, smoothing=2e-3 * R)
-    model.add_contact([a_lo, a_up], [b_lo, b_up], **opts)
-    model.add_contact(a_lo, a_up, **opts)
-    model.add_contact(b_lo, b_up, **opts)
+    model.add_contact(list(wires[0]), list(wires[1]), **opts)
+    for wire in wires:
+        for i, j in zip(*np.triu_indices(pieces, 1)):
+            model.add_contact(wire[i], wire[j], **opts)
     return model, plate, tuple(wires)
 
 
 def wire_nodes(wire):
-    """Node numbers along a wire (lower beam, then upper beam without the joined node)."""
-    lo, up = wire
-    return np.concatenate([lo.nodes, up.nodes[1:]])
+    """Node numbers along a wire (its beams in order, each joined node once)."""
+    return np.concatenate([wire[0].nodes] + [b.nodes[1:] for b in wire[1:]])
 
 
 def ribbon_measures(sol, wires, step):
@@ -109,11 +146,16 @@ def ribbon_measures(sol, wires, step):
     return tw, topology.writhe_open(axis)
 
 
-COLUMNS = ("turns = Lk", "torque [N m]", "plate z [mm]", "Tw", "Wr", "|Lk-Tw-Wr|/Lk", "Wr/Lk",
+COLUMNS = ("turns = Lk", "torque [N m]", "axial force [N]", "plate z [mm]", "Tw", "Wr", "|Lk-Tw-Wr|/Lk", "Wr/Lk",
            "dissipated / strain energy", "contacts", "Newton it.")
 
 
-def table(sol, plate, wires, turns):
+Row = namedtuple("Row", "lk torque axial z tw wr error writhe_fraction dissipated contacts iterations")
+
+
+def table(sol, plate, wires, turns, pull=0.0):
+    """One row of ``COLUMNS`` per step; ``pull`` the dead pull on the plate (the axial force is
+    the pull plus the support's reaction in ``z``: tension positive)."""
     rows = []
     for k in range(len(sol.times)):
         lk = turns * sol.times[k]
@@ -122,7 +164,8 @@ def table(sol, plate, wires, turns):
         c = sol.contact(k) or {}
         active = int((np.asarray(c.get("normal_force", np.zeros(0))) > 0).sum())
         err = abs(lk - tw - wr) / lk if lk > 0 else abs(tw + wr)
-        rows.append((lk, sol.reaction(plate, k)[5], 1e3 * sol.position(plate, k)[2], tw, wr, err,
+        react = sol.reaction(plate, k)
+        rows.append(Row(lk, react[5], pull + react[2], 1e3 * sol.position(plate, k)[2], tw, wr, err,
                      wr / lk if lk > 0 else 0.0, st.get("fraction", 0.0), active, sol.stats[k]["iterations"]))
     return rows
 
@@ -130,39 +173,43 @@ def table(sol, plate, wires, turns):
 def onset(rows):
     """Twist [turns] and torque [N m] at the onset of writhing: the largest torque before the
     writhe exceeds 5 % of the linking number."""
-    lk, torque, frac = (np.array([r[i] for r in rows]) for i in (0, 1, 6))
+    lk, torque, frac = (np.array([getattr(r, f) for r in rows]) for f in ("lk", "torque", "writhe_fraction"))
     before = frac < 0.05
     k = int(np.argmax(np.where(before, torque, -np.inf)))
     return lk[k], torque[k]
 
 
 def main(output=None, turns=5.0, steps=40, n_elements=16, mu=0.3, stabilize=2e-2, imperfection=1e-2,
-         verbose=False, length=LENGTH, pull=PULL):
+         verbose=False, length=LENGTH, pull=PULL, approach=None, pieces=2, min_step_ratio=2.0**-12):
     """Solve, print the table and the checks; returns ``(solution, rows, wall time, checks)``."""
     model, plate, wires = build(turns=turns, n_elements=n_elements, mu=mu, imperfection=imperfection,
-                                 length=length, pull=pull)
+                                 length=length, pull=pull, approach=approach,
+                                 pieces=pieces)
     t0 = time.perf_counter()
     try:
-        sol = bs.solve(model, steps=steps, output=output, verbose=verbose, stabilize=stabilize)
+        sol = bs.solve(model, steps=steps, output=output, verbose=verbose, stabilize=stabilize,
+                       min_step_ratio=min_step_ratio)
     except bs.ConvergenceError as e:
         print(f"stopped: {e}")
         sol = e.solution
     wall = time.perf_counter() - t0
-    rows = table(sol, plate, wires, turns)
-    print(f"plectoneme: 2 wires R = {R * 1e3:g} mm, L = {length * 1e3:g} mm, pull {pull:g} N, "
-          f"{n_elements} elements each, mu = {mu}, {turns:g} turns in {steps} steps, stabilize = {stabilize}, imperfection {imperfection:g} x pull")
+    rows = table(sol, plate, wires, turns, pull=pull if approach is None else 0.0)
+    control = f"pull {pull:g} N" if approach is None else f"extension control, approach {approach:g}"
+    print(f"plectoneme: 2 wires R = {R * 1e3:g} mm, L = {length * 1e3:g} mm, {control}, {n_elements} elements "
+          f"each in {pieces} pieces, mu = {mu}, {turns:g} turns in {steps} steps, stabilize = {stabilize}, "
+          f"imperfection {imperfection * pull:g} N")
     print("| " + " | ".join(COLUMNS) + " |")
     print("|" + "---:|" * len(COLUMNS))
-    for lk, tq, z, tw, wr, err, fw, fd, nc, it in rows:
-        print(f"| {lk:.4f} | {tq:.4g} | {z:.3f} | {tw:.4f} | {wr:.4f} | {err:.2e} | {fw:.3f} | {fd:.2e} | {nc} "
-              f"| {it} |")
+    for lk, tq, fz, z, tw, wr, err, fw, fd, nc, it in rows:
+        print(f"| {lk:.4f} | {tq:.4g} | {fz:.4g} | {z:.3f} | {tw:.4f} | {wr:.4f} | {err:.2e} | {fw:.3f} "
+              f"| {fd:.2e} | {nc} | {it} |")
     B = 2.0 * model.beams[0].section.C[4, 4]
-    worst = max((r[5] for r in rows if r[0] >= LK_MIN), default=np.nan)     # relative error: Lk not near 0
+    worst = max((r.error for r in rows if r.lk >= LK_MIN), default=np.nan)     # relative error: Lk not near 0
     tw_c, m_c = onset(rows)
     checks = dict(reached=turns * sol.times[-1], lk_error=worst, onset_turns=tw_c, onset_torque=m_c,
-                  onset_ratio=m_c * length / B, wall=wall, writhe=rows[-1][6])
+                  onset_ratio=m_c * length / B, wall=wall, writhe=rows[-1].writhe_fraction)
     print(f"reached {checks['reached']:.3f} of {turns:g} turns in {wall:.1f} s; Newton iterations "
-          f"{int(sol.iterations.sum())}; writhe at the end {rows[-1][6]:.1%} of Lk")
+          f"{int(sol.iterations.sum())}; writhe at the end {rows[-1].writhe_fraction:.1%} of Lk")
     print(f"Lk = Tw + Wr: largest |Lk - Tw - Wr| / Lk {worst:.2e} ({'within' if worst <= 0.02 else 'NOT within'} 2 %)")
     print(f"onset of writhing at {tw_c:.3f} turns, torque {m_c:.4g} N m: M L / B = {checks['onset_ratio']:.2f} "
           f"(B = 2 E I; Greenhill clamped-clamped {GREENHILL}, the pair's frictionless tangent 8.36)")
@@ -191,6 +238,11 @@ if __name__ == "__main__":
     ap.add_argument("--imperfection", type=float, default=1e-2)
     ap.add_argument("--length", type=float, default=LENGTH, help="wire length [m]")
     ap.add_argument("--pull", type=float, default=PULL, help="dead pull on the plate [N]")
+    ap.add_argument("--min-step-ratio", type=float, default=2.0**-12, help="solve(min_step_ratio=)")
+    ap.add_argument("--pieces", type=int, default=2, help="beams per wire (self-contact between them)")
+    ap.add_argument("--approach", type=float, default=None,
+                    help="extension control: the plate's height prescribed as length (1 - approach t)")
     a = ap.parse_args()
     main(output=a.output, turns=a.turns, steps=a.steps, n_elements=a.elements, mu=a.mu, stabilize=a.stabilize,
-         imperfection=a.imperfection, verbose=True, length=a.length, pull=a.pull)
+         imperfection=a.imperfection, verbose=True, length=a.length, pull=a.pull,
+         approach=a.approach, pieces=a.pieces, min_step_ratio=a.min_step_ratio)

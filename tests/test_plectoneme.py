@@ -19,7 +19,7 @@ def run():
 def test_reduced_run_reaches_its_turns_with_lk_equal_tw_plus_wr(run):
     sol, rows, _, checks = run
     assert checks["reached"] == pytest.approx(0.5)
-    lk, tw, wr = (np.array([r[i] for r in rows]) for i in (0, 3, 4))
+    lk, tw, wr = (np.array([getattr(r, f) for r in rows]) for f in ("lk", "tw", "wr"))
     assert np.allclose(tw + wr, lk, atol=1e-6)           # straight two-ply: all twist, no writhe
     assert np.abs(wr).max() < 1e-4 and checks["lk_error"] < 0.02
 
@@ -27,7 +27,7 @@ def test_reduced_run_reaches_its_turns_with_lk_equal_tw_plus_wr(run):
 def test_torque_and_stabilisation_are_reported(run):
     sol, rows, _, _ = run
     G, J = 200e9 / 2.6, np.pi * plectoneme.R**4 / 2
-    assert rows[-1][1] == pytest.approx(2 * G * J * np.pi / plectoneme.LENGTH, rel=0.1)
+    assert rows[-1].torque == pytest.approx(2 * G * J * np.pi / plectoneme.LENGTH, rel=0.1)
     st = [s["stabilization"] for s in sol.stats[1:]]
     assert st[0]["factor"] > 0 and all(s["fraction"] < 0.05 for s in st)
     assert all(s["dissipated"] > 0 for s in st[1:])
@@ -47,3 +47,51 @@ def test_length_and_pull_are_build_arguments():
     assert z[-1] == pytest.approx(0.06) and z[4] == pytest.approx(0.03)
     pulls = [ld.force[2] for ld in model.loads if ld.node == plate]
     assert pulls == [pytest.approx(50.0)]
+
+
+def test_extension_control_prescribes_the_plate_height_with_its_turns():
+    model, plate, wires = plectoneme.build(n_elements=8, length=0.06, approach=0.25, turns=2.0)
+    kind, motion = model.constraints[plate]
+    assert kind == "prescribe" and not [ld for ld in model.loads if ld.node == plate]
+    G, angle = motion(0.3), 2 * np.pi * 2.0 * 0.3
+    assert np.allclose(G[:3, :3] @ [1.0, 0.0, 0.0], [np.cos(angle), np.sin(angle), 0.0], atol=1e-12)
+    assert np.allclose((G @ model.poses0[plate])[:3, 3], [0.0, 0.0, 0.06 * (1 - 0.25 * 0.3)])
+
+
+def test_wires_in_pieces_have_self_contact_between_every_two_pieces():
+    model, plate, wires = plectoneme.build(n_elements=12, pieces=3)
+    pairs = {(d.slave[0].id, d.master[0].id) for d in model.contacts if len(d.slave) == 1}
+    for wire in wires:
+        ids = [b.id for b in wire]
+        assert len(ids) == 3 and {(ids[0], ids[1]), (ids[0], ids[2]), (ids[1], ids[2])} <= pairs
+    nodes = plectoneme.wire_nodes(wires[0])
+    assert len(nodes) == 13 and np.allclose(np.diff(model.poses0[nodes, 2, 3]), 0.02 / 12)
+    mid = [ld.node for ld in model.loads if ld.force[1] != 0.0]
+    assert np.allclose(model.poses0[mid, 2, 3], 0.01)
+    with pytest.raises(plectoneme.bs.InputError, match="pieces"):
+        plectoneme.build(n_elements=8, pieces=3)
+
+
+def test_extension_control_buckles_the_pair_at_its_euler_load():
+    """Shortened by 1.2 mm of 60 mm with a tenth of a turn, the clamped-clamped pair buckles: the
+    axial force (the support's reaction, tension positive) sits on the Euler load
+    ``4 pi^2 B / L^2`` of the pair (``B = 2 E I``; 8 coarse elements per wire: a few % stiff)."""
+    sol, rows, _, checks = plectoneme.main(turns=0.1, steps=4, n_elements=8, stabilize=None, length=0.06,
+                                           approach=0.02, pull=50.0)
+    assert checks["reached"] == pytest.approx(0.1) and checks["lk_error"] < 0.02
+    B = 2 * 200e9 * np.pi * plectoneme.R**4 / 4
+    euler = 4 * np.pi**2 * B / 0.06**2
+    assert rows[-1].axial == pytest.approx(-euler, rel=0.06)
+    assert rows[-1].z == pytest.approx(60.0 * (1 - 0.02))
+
+
+@pytest.mark.slow
+def test_frictionless_pair_writhes_at_greenhills_torque():
+    """Frictionless, with a small imperfection, the pair leaves the straight two-ply at the torque
+    where its tangent turns indefinite (``M L / B = 8.36``, ``B = 2 E I``; Greenhill's single
+    clamped rod 8.99) and converts a large part of the twist to writhe, Lk = Tw + Wr holding."""
+    sol, rows, _, checks = plectoneme.main(turns=2.0, steps=20, n_elements=8, mu=0.0, stabilize=2e-3,
+                                           imperfection=1e-3)
+    assert checks["onset_ratio"] == pytest.approx(8.36, rel=0.03)
+    assert checks["onset_ratio"] == pytest.approx(plectoneme.GREENHILL, rel=0.1)
+    assert checks["writhe"] > 0.3 and checks["lk_error"] < 0.02
