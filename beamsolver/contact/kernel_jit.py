@@ -472,18 +472,19 @@ def _compose(RA, xA, RB, xB):
 
 @jit
 def _slip_rows(Tdy, Ad, JA, JB, sign, D, c0, tmp):
-    """``D[:, c0:c0+12] = sign (Tdy[1:3] Ad) [J_A, J_B]`` (``Tdy``, ``Ad``, ``J`` ``(6, 6)``; ``tmp`` ``(6, 6)``)."""
+    """``D[:, c0:c0+12] = sign (Tdy[1:3] Ad) [J_A, J_B]`` (``Tdy``, ``Ad``, ``J`` ``(6, 6)``; ``tmp`` ``(6, 6)``);
+    ``Ad`` and ``J`` block upper triangular: the terms of their zero blocks skipped (``_mm_ut``)."""
     for i in range(2):
         for j in range(6):
             acc = 0.0
-            for l in range(6):
+            for l in range(3 if j < 3 else 6):
                 acc += Tdy[1 + i, l] * Ad[l, j]
             tmp[i, j] = acc
     for i in range(2):
         for j in range(6):
             a = 0.0
             b = 0.0
-            for l in range(6):
+            for l in range(3 if j < 3 else 6):
                 a += tmp[i, l] * JA[l, j]
                 b += tmp[i, l] * JB[l, j]
             D[i, c0 + j] = -a if sign < 0.0 else a
