@@ -13,22 +13,14 @@ unknowns; ``lam`` crosses zero exactly where ``K`` becomes singular, and
 ``definiteness.DENSE_MAX`` unknowns LAPACK gives the exact lowest pairs;
 above, a shifted Lanczos (``eigsh``, shift ``-definiteness.SHIFT``) gives the
 pairs *nearest zero*, which are the lowest ones when the negative eigenvalues
-are few and small (near a crossing, where modes are wanted).
+are few and small (near a crossing, where modes are wanted); its shifted
+solves use a banded LU where the tangent is banded (``bandfactor``).
 """
 import numpy as np
-import scipy.sparse as sp
 
-from .definiteness import DENSE_MAX, SHIFT
+from .definiteness import DENSE_MAX, nearest_zero, scaled_symmetric
 
 __all__ = ["lowest_modes"]
-
-
-def _scaling(K):
-    K = sp.csr_matrix(K)
-    K = 0.5 * (K + K.T)
-    d = np.abs(K.diagonal())
-    d[d == 0.0] = 1.0
-    return K, 1.0 / np.sqrt(d)
 
 
 def lowest_modes(K, k):
@@ -39,14 +31,13 @@ def lowest_modes(K, k):
     k = int(min(k, n))
     if k <= 0:
         return np.zeros(0), np.zeros((n, 0))
-    Ks, d = _scaling(K)
-    A = sp.diags(d) @ Ks @ sp.diags(d)
     if n <= DENSE_MAX or k >= n - 1:
         from scipy.linalg import eigh
-        lam, Y = eigh(A.toarray(), subset_by_index=(0, k - 1), driver="evr")
+        A, d = scaled_symmetric(K, dense=True)
+        lam, Y = eigh(A, subset_by_index=(0, k - 1), driver="evr")
     else:
-        from scipy.sparse.linalg import eigsh
-        lam, Y = eigsh(A.tocsc(), k=k, sigma=-SHIFT, which="LM")
+        A, d = scaled_symmetric(K)
+        lam, Y = nearest_zero(A, k, vectors=True)
         order = np.argsort(lam)
         lam, Y = lam[order], Y[:, order]
     return lam, d[:, None] * Y

@@ -6,6 +6,9 @@
   load ``P_CR_DADEPPO = 8.97 EI / R^2`` (DaDeppo, D.A. and Schmidt, R., 1975, "Instability of
   clamped-hinged circular arches subjected to a point load", J. Appl. Mech. 42, 894-896).
 - ``lee_frame``: Lee's right-angle frame, a snap-back (the deflection turns back as well).
+- ``shallow_arch``: a pinned-pinned shallow sinusoidal arch under a sinusoidal dead load, whose
+  shallow-arch (Marguerre) closed form ``shallow_arch_load`` has an upper and a lower limit point
+  ``shallow_arch_limits`` (docs/theory.md, "The shallow sinusoidal arch"); snaps through and back up.
 
 ``first_peak`` and ``peak`` find the limit point on a traced path.  Run
 ``python examples/limit_points.py`` to print the limit loads; ``beamsolver run`` solves the truss.
@@ -18,6 +21,8 @@ A_HALF, RISE, EA = 1.0, 0.1, 1e4               # truss: half span, rise, axial s
 R_ARCH, EI_ARCH = 100.0, 1e6                   # deep arch: radius, bending stiffness
 P_CR_DADEPPO = 8.97 * EI_ARCH / R_ARCH**2      # 897
 LEE_L, LEE_E, LEE_A, LEE_I = 120.0, 720.0, 6.0, 2.0    # Lee's frame: member length, E, A, I
+
+ARCH_SPAN, ARCH_EI = 1.0, 1.0                   # shallow arch: span, in-plane bending stiffness
 
 solve_options = dict(steps=10, t_end=1.5, path="arc-length")   # for `beamsolver run`: the truss
 
@@ -116,6 +121,66 @@ def argyris_frame(F, imperfection=1e-4, n=10):
     return m, b
 
 
+def shallow_arch_load(a, rise, r, span=ARCH_SPAN, EI=ARCH_EI):
+    """Amplitude ``q`` of the load ``q sin(pi x / L)`` holding the shallow pinned arch
+    ``e sin(pi x / L)`` (``e = rise``, radius of gyration ``r``) at midspan height ``a``:
+    ``q = EI (pi / L)^4 [(e - a) + a (e^2 - a^2) / (4 r^2)]`` (docs/theory.md, shallow arch)."""
+    return EI * (np.pi / span) ** 4 * ((rise - a) + a * (rise**2 - a**2) / (4.0 * r**2))
+
+
+def shallow_arch_limits(rise, r, span=ARCH_SPAN, EI=ARCH_EI):
+    """``(q_max, a_star, q_min)``: the upper limit at ``a = a_star = sqrt((e^2 - 4 r^2) / 3)``, the
+    lower at ``a = -a_star``; there are limit points only for ``e > 2 r``."""
+    if rise <= 2.0 * r:
+        raise bs.InputError(f"shallow_arch_limits: rise {rise!r} <= 2 r = {2.0 * r!r}: no limit point")
+    a = np.sqrt((rise**2 - 4.0 * r**2) / 3.0)
+    return shallow_arch_load(a, rise, r, span, EI), a, shallow_arch_load(-a, rise, r, span, EI)
+
+
+def shallow_arch(n_elements=32, rise=0.01, rise_over_r=3.5, load=None):
+    """Pinned-pinned shallow arch ``y = e sin(pi x / L)``, ``0 <= x <= L = 1`` (``e = rise * L``),
+    in the x-y plane, under the dead load ``q sin(pi x / L) t`` downwards as consistent nodal forces
+    (``load``: ``q``, default the closed-form upper limit, so it is at ``t = 1``).
+
+    ``EI = 1`` in plane (``EI3``), ``EA = EI / r^2`` with ``r = e / rise_over_r`` (below 4: limit points,
+    no bifurcation), ``GA = EA``; out of plane 100 times stiffer (``EI2``, ``GJ``) so the arch stays in
+    its plane.  Supports fixed in ``ux, uy, uz, rx, ry`` (``rz`` free).  ``n_elements`` even.
+    Returns ``(model, midspan node, r)``."""
+    if n_elements % 2:
+        raise bs.InputError(f"shallow_arch: n_elements must be even (a node at midspan), got {n_elements!r}")
+    L, e = ARCH_SPAN, rise * ARCH_SPAN
+    r = e / rise_over_r
+    q = shallow_arch_limits(e, r)[0] if load is None else load
+    EA = ARCH_EI / r**2
+    sec = bs.Section(EA=EA, GA2=EA, GA3=EA, GJ=100 * ARCH_EI, EI2=100 * ARCH_EI, EI3=ARCH_EI, radius=r)
+    x = np.linspace(0.0, L, n_elements + 1)
+    k = np.pi / L
+    points = np.stack([x, e * np.sin(k * x), 0 * x], axis=-1)
+    tangents = np.stack([np.ones_like(x), e * k * np.cos(k * x), 0 * x], axis=-1)
+    m = bs.Model()
+    b = m.add_beam(bs.geometry.frames_from_tangents(points, tangents, e2=(0, 1, 0)), sec)
+    for end in (b.first, b.last):
+        m.fix(end, dofs=("ux", "uy", "uz", "rx", "ry"))
+    for node, f in zip(b.nodes, _sine_nodal_forces(x, q * L / np.pi)):
+        m.add_load(int(node), force=(0.0, -f, 0.0))
+    return m, int(b.nodes[n_elements // 2]), r
+
+
+def _sine_nodal_forces(x, scale):
+    """Consistent nodal forces ``int q(x) N_i(x) dx`` of ``q sin(pi x / L)`` on the hat functions of the
+    nodes ``x`` (``0 .. L``), exactly: ``scale = q L / pi``, element by element."""
+    k = np.pi / x[-1]
+    a, b = k * x[:-1], k * x[1:]
+    h = b - a
+    # int_a^b sin(s) (b - s) / h ds  and  int_a^b sin(s) (s - a) / h ds
+    left = (np.cos(a) * h - np.sin(b) + np.sin(a)) / h
+    right = (-np.cos(b) * h + np.sin(b) - np.sin(a)) / h
+    f = np.zeros_like(x)
+    f[:-1] += left
+    f[1:] += right
+    return scale * f
+
+
 def first_peak(t):
     """Index of the first local maximum of ``t`` along a path (the limit point)."""
     down = np.flatnonzero(np.diff(t) < 0)
@@ -131,6 +196,27 @@ def peak(t, y):
         if c[0] < 0:
             return float(np.polyval(c, -c[1] / (2 * c[0])))
     return float(t[k])
+
+
+def turning_point(t, y, k):
+    """``t`` at the turning point of the path near step ``k`` (a local maximum or minimum of ``t``):
+    the extremum of the cubic in ``y`` fitted to the steps ``k - 2 .. k + 2`` nearest ``y[k]`` (the
+    shallow arch's ``q(a)`` is a cubic, so the fit adds no error of its own there)."""
+    s = slice(max(k - 2, 0), min(k + 3, len(t)))
+    c = np.polyfit(y[s], t[s], 3)
+    roots = np.roots(np.polyder(c))
+    roots = roots[np.isreal(roots)].real
+    if not len(roots):
+        return float(t[k])
+    return float(np.polyval(c, roots[np.argmin(np.abs(roots - y[k]))]))
+
+
+def limits(t, y):
+    """``(upper, lower)``: ``t`` at the first local maximum of the path and at the lowest point after
+    it, each refined by ``turning_point``."""
+    k = first_peak(t)
+    j = k + int(np.argmin(t[k:]))
+    return turning_point(t, y, k), turning_point(t, y, j)
 
 
 def heights(sol, node):

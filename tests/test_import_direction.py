@@ -19,6 +19,7 @@ LAYER = {
     "failures": 0,
     # 1: maths and geometry (Lie groups, sections, node poses, motions)
     "se3": 1, "se3_jit": 1, "section": 1, "geometry": 1, "motion": 1, "motion_path": 1, "definiteness": 1,
+    "bandfactor": 1,
     "modes": 1,
     # 2: element and contact kernels
     "element": 2, "element_jit": 2, "elements": 2, "elements.base": 2, "elements.se3_2": 2, "elements.se3_3": 2,
