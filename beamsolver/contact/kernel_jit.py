@@ -45,7 +45,7 @@ import types
 
 import numpy as np
 
-from .._jit import jit
+from .._jit import jit, jit_inline
 from ..errors import InputError
 from ..element_jit import _geometric
 from ..se3_jit import (A_, B_, C_, CP_, D_, DP_, Q2P_, Q2_, Q3P_, Q3_, add, add_outer, coefficient, cross, dot,
@@ -89,21 +89,21 @@ def _pose_of(X, j):
     return R, (X[j, 0, 3], X[j, 1, 3], X[j, 2, 3])
 
 
-@jit
+@jit_inline
 def _put3(A, r0, c0, M):
     for i in range(3):
         for j in range(3):
             A[r0 + i, c0 + j] = M[i][j]
 
 
-@jit
+@jit_inline
 def _zero3(A, r0, c0):
     for i in range(3):
         for j in range(3):
             A[r0 + i, c0 + j] = 0.0
 
 
-@jit
+@jit_inline
 def _zero(A):
     for i in range(A.shape[0]):
         for j in range(A.shape[1]):
@@ -115,7 +115,7 @@ def _col(R, j):
     return (R[0][j], R[1][j], R[2][j])
 
 
-@jit
+@jit_inline
 def _mm_ut(A, B, out):
     """``out = A @ B`` for block upper-triangular ``(6, 6)`` arrays (``A[3:, :3] == B[3:, :3] == 0``, as
     ``T(h)``, ``T(h)^-1``, ``Ad(H)``): ``_mm`` without the terms of the zero blocks.  The same floats:
@@ -128,7 +128,7 @@ def _mm_ut(A, B, out):
             out[i, j] = acc
 
 
-@jit
+@jit_inline
 def _mtm_ut_g(A, B, out):
     """``out = A^T @ B`` for a block upper-triangular ``A`` and a ``B`` with ``B[:3, :3] == 0`` (as
     ``G(h, v)``): ``_mtm`` without the terms of the zero blocks (the same floats, see ``_mm_ut``);
@@ -141,7 +141,7 @@ def _mtm_ut_g(A, B, out):
             out[i, j] = acc
 
 
-@jit
+@jit_inline
 def _mtv_ut(A, v, out):
     """``out = A^T v`` for a block upper-triangular ``(6, 6)`` array and a 6-vector, without the terms
     of the zero block (the same floats, see ``_mm_ut``)."""
@@ -209,7 +209,7 @@ def _geo(u, w, v, G):
     _put3(G, 3, 3, G22)
 
 
-@jit
+@jit_inline
 def _m_times(z, A, out):
     """``out = M(z) A`` with ``M(z) = [[0, hat(z_f)], [hat(z_f), hat(z_m)]]``, column by column."""
     zf, zm = (z[0], z[1], z[2]), (z[3], z[4], z[5])
@@ -351,7 +351,7 @@ def _project(kind, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations=2):
     return xi1, xi2
 
 
-@jit
+@jit_inline
 def _rot_col(R, V, k):
     """``R @ V[0:3, k]``, ``R`` a 3x3 tuple."""
     return (R[0][0] * V[0, k] + R[0][1] * V[1, k] + R[0][2] * V[2, k],
@@ -359,7 +359,7 @@ def _rot_col(R, V, k):
             R[2][0] * V[0, k] + R[2][1] * V[1, k] + R[2][2] * V[2, k])
 
 
-@jit
+@jit_inline
 def _col_dot(a, M, r0, k):
     """``a . M[r0:r0+3, k]``."""
     return a[0] * M[r0, k] + a[1] * M[r0 + 1, k] + a[2] * M[r0 + 2, k]
@@ -611,7 +611,7 @@ def _nodal(u, w, xi, S, v, Dw, Dh, dxi, c0, f, K, j0):
                          D[i, 4], D[i, 5], dd[i], dxi, Dw, Dh, c0, i < 3, K[r0 + i])
 
 
-@jit
+@jit_inline
 def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, dxi, Dw, Dh, c0, force, out):
     """One row of the tangent: ``out[c] = di dxi[c] + sum_l (j_l Dw[l, c] + d_l Dh[l, c])``, the ``Dh``
     terms only on the columns ``c0:c0+12`` of the side's nodes (summed in this order).  ``force``: a
