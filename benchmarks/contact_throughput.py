@@ -68,7 +68,8 @@ def measure(n_points, oracle_max=10_000):
     t_search = _best(lambda: c.pairs(H), repeat)
     X, p = c.kernel_inputs(H)
     kernel_jit.kernel_and_tangent(X[:2], {k: (v[:2] if np.ndim(v) else v) for k, v in p.items()})   # compiled
-    t_jit = _best(lambda: kernel_jit.kernel_and_tangent(X, p, friction=True), repeat)
+    K = np.empty((len(X), 24, 24))      # the tangent buffer a caller keeps (ContactSystem does)
+    t_jit = _best(lambda: kernel_jit.kernel_and_tangent(X, p, friction=True, K=K), repeat)
     t_np = _best(lambda: pairs.kernel_and_tangent(X, p, friction=True), 1) if n_points <= oracle_max else np.nan
     use_numpy_kernel(False)
     # a new step before each evaluation: the contact system keeps its last evaluation for the same poses
@@ -160,7 +161,8 @@ Two parallel beams in line contact, 5 Gauss points per slave element, all points
 on.  Search = broad phase (bounding spheres, scipy cKDTree) + pair rules + SE(3) projections
 (compiled, `contact/projection.py`; `ContactSystem.pairs`); kernel + tangent compiled = `contact.kernel_jit.kernel_and_tangent`
 (numba, forward-mode exact tangent: gradients with respect to the 24 node increments carried
-through the projection, the frames, the laws and the node Jacobians); numpy oracle =
+through the projection, the frames, the laws and the node Jacobians; the tangent written to a
+buffer kept between calls, as `ContactSystem` does); numpy oracle =
 `contact.pairs.kernel_and_tangent` (24 complex-step kernel evaluations per point, measured up
 to 1e4 points); evaluate = `ContactSystem.evaluate` (search + compiled kernel + tangent, the
 local blocks handed to the assembler; after `begin_step`: the contact system keeps its last

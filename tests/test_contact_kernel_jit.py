@@ -195,3 +195,17 @@ def test_projection_stopping_at_a_fixed_point_gives_every_iteration_s_result():
             a_n, b_n = kernel_jit.project(kinds, X[:, 0], h1, xi1, X[:, 2], h2, xi2, iterations=n)
             np.testing.assert_array_equal(a_n, a)
             np.testing.assert_array_equal(b_n, b)
+
+
+def test_tangent_written_to_a_given_array_equals_a_fresh_one_and_checks_the_array():
+    X, p = _scene(5, True, 0.0, 0.0, True, 0.005)
+    f0, K0, o0 = kernel_jit.kernel_and_tangent(X, p)
+    K = np.full((len(X), 24, 24), np.nan)
+    f1, K1, o1 = kernel_jit.kernel_and_tangent(X, p, K=K)
+    assert K1 is K
+    np.testing.assert_array_equal(K, K0)
+    np.testing.assert_array_equal(f1, f0)
+    with pytest.raises(bs.InputError, match="K must be"):
+        kernel_jit.kernel_and_tangent(X, p, K=np.empty((len(X) + 1, 24, 24)))
+    with pytest.raises(bs.InputError, match="K must be"):
+        kernel_jit.kernel_and_tangent(X, p, K=np.empty((24, 24, len(X))).T)

@@ -132,3 +132,36 @@ def test_material_frames_from_the_kept_twists_are_bit_identical():
                                  h[A1[pick] // 2], h[A2[pick] // 2])
     for a, b in zip(own, kept):
         np.testing.assert_array_equal(a, b)
+
+
+def test_tangent_buffer_is_reused_only_when_no_earlier_blocks_hold_it():
+    """The compiled kernel writes the tangent into a buffer the contact system keeps: blocks still
+    referenced (the solver's last evaluation during a line search) are never overwritten, and a
+    buffer nobody holds is reused (same memory, same values as a fresh evaluation)."""
+    model, slave, _ = rolling.build(mu=0.5, n_elements=3)
+    sol = bs.solve(model, steps=2)
+    H1 = sol.poses[-1].copy()
+    H2 = H1.copy()
+    H2[slave.nodes, 0, 3] += 1e-4
+    state = {k[len("contact/"):]: v for k, v in sol.contact_state.items()}
+
+    def system():
+        c = Problem.from_model(model).contact
+        c.set_state(state)
+        c.begin_step(sol.poses[-1], 1.0)
+        return c
+
+    c = system()
+    b1, _ = c.evaluate(H1, tangent=True)
+    K1 = b1.K.copy()
+    b2, _ = c.evaluate(H2, tangent=True)            # b1 still held: another buffer
+    assert not np.shares_memory(b1.K, b2.K)
+    np.testing.assert_array_equal(b1.K, K1)
+    np.testing.assert_array_equal(b2.K, system().evaluate(H2, tangent=True)[0].K)
+    kept = [id(b) for b in c._K_pool]
+    assert len(kept) == 2
+    del b1, b2
+    c.begin_step(sol.poses[-1], 1.0)
+    b3, _ = c.evaluate(H1, tangent=True)            # nothing holds the buffers: one is reused
+    assert [id(b) for b in c._K_pool] == kept
+    np.testing.assert_array_equal(b3.K, K1)

@@ -35,14 +35,18 @@ Nothing is allocated per point: small algebra stays in tuples, and the 6x6 matri
 (``_scratch``; named slots ``S_*``, ``V_*``, ``G*_*``, ``R_*``) and written in place.
 Every sum keeps its terms and their order (the Newton iteration counts of the contact
 examples are round-off sensitive); values that are needed twice are computed once only
-where the two computations are the same operations on the same inputs.
+where the two computations are the same operations on the same inputs.  Terms that are
+structural zeros (the zero blocks of ``T``, ``T^-1``, ``Ad``, ``G`` and the node Jacobians)
+are skipped: a sum started at ``+0.0`` is unchanged by an exact zero term, so the results
+are the same floats (``_mm_ut``; in a tangent row up to the sign of a zero entry).
 """
 import hashlib
 import types
 
 import numpy as np
 
-from .._jit import jit
+from .._jit import jit, jit_inline
+from ..errors import InputError
 from ..element_jit import _geometric
 from ..se3_jit import (A_, B_, C_, CP_, D_, DP_, Q2P_, Q2_, Q3P_, Q3_, add, add_outer, coefficient, cross, dot,
                        log_relative, mat, mm, mv, q_matrix, scale, ti_matrix, transpose)
@@ -85,21 +89,21 @@ def _pose_of(X, j):
     return R, (X[j, 0, 3], X[j, 1, 3], X[j, 2, 3])
 
 
-@jit
+@jit_inline
 def _put3(A, r0, c0, M):
     for i in range(3):
         for j in range(3):
             A[r0 + i, c0 + j] = M[i][j]
 
 
-@jit
+@jit_inline
 def _zero3(A, r0, c0):
     for i in range(3):
         for j in range(3):
             A[r0 + i, c0 + j] = 0.0
 
 
-@jit
+@jit_inline
 def _zero(A):
     for i in range(A.shape[0]):
         for j in range(A.shape[1]):
@@ -111,34 +115,39 @@ def _col(R, j):
     return (R[0][j], R[1][j], R[2][j])
 
 
-@jit
-def _mm(A, B, out):
-    """``out = A @ B`` for ``(6, 6)`` arrays (each sum from 0 over the inner index in order)."""
+@jit_inline
+def _mm_ut(A, B, out):
+    """``out = A @ B`` for block upper-triangular ``(6, 6)`` arrays (``A[3:, :3] == B[3:, :3] == 0``, as
+    ``T(h)``, ``T(h)^-1``, ``Ad(H)``): ``_mm`` without the terms of the zero blocks.  The same floats:
+    a sum started at ``+0.0`` never becomes ``-0.0``, so adding an exact zero changes nothing."""
     for i in range(6):
         for j in range(6):
             acc = 0.0
-            for l in range(6):
+            for l in range(3 if i >= 3 else 0, 3 if j < 3 else 6):
                 acc += A[i, l] * B[l, j]
             out[i, j] = acc
 
 
-@jit
-def _mtm(A, B, out):
-    """``out = A^T @ B`` for ``(6, 6)`` arrays."""
+@jit_inline
+def _mtm_ut_g(A, B, out):
+    """``out = A^T @ B`` for a block upper-triangular ``A`` and a ``B`` with ``B[:3, :3] == 0`` (as
+    ``G(h, v)``): ``_mtm`` without the terms of the zero blocks (the same floats, see ``_mm_ut``);
+    ``out[:3, :3] == 0`` again."""
     for i in range(6):
         for j in range(6):
             acc = 0.0
-            for l in range(6):
+            for l in range(3 if j < 3 else 0, 3 if i < 3 else 6):
                 acc += A[l, i] * B[l, j]
             out[i, j] = acc
 
 
-@jit
-def _mtv(A, v, out):
-    """``out = A^T v`` for a ``(6, 6)`` array and a 6-vector."""
+@jit_inline
+def _mtv_ut(A, v, out):
+    """``out = A^T v`` for a block upper-triangular ``(6, 6)`` array and a 6-vector, without the terms
+    of the zero block (the same floats, see ``_mm_ut``)."""
     for j in range(6):
         acc = 0.0
-        for i in range(6):
+        for i in range(3 if j < 3 else 6):
             acc += A[i, j] * v[i]
         out[j] = acc
 
@@ -200,7 +209,7 @@ def _geo(u, w, v, G):
     _put3(G, 3, 3, G22)
 
 
-@jit
+@jit_inline
 def _m_times(z, A, out):
     """``out = M(z) A`` with ``M(z) = [[0, hat(z_f)], [hat(z_f), hat(z_m)]]``, column by column."""
     zf, zm = (z[0], z[1], z[2]), (z[3], z[4], z[5])
@@ -240,13 +249,13 @@ def _jacobians(u, w, xi, Ti, Ah, Ts, As, JA, JB, tmp):
     ``Ah = Ad(exp(-h))``; also ``Ts = T(xi h)`` and ``As = Ad(exp(-xi h))``."""
     su, sw = scale(xi, u), scale(xi, w)
     _tangent(su, sw, Ts)
-    _mm(Ts, Ti, JB)
+    _mm_ut(Ts, Ti, JB)
     for i in range(6):
         for j in range(6):
             JB[i, j] *= xi
     Rs, xs = _exp(su, sw)
     _adjoint_inv(Rs, xs, As)
-    _mm(JB, Ah, tmp)
+    _mm_ut(JB, Ah, tmp)
     for i in range(6):
         for j in range(6):
             JA[i, j] = As[i, j] - tmp[i, j]
@@ -264,14 +273,14 @@ def _jacobian_derivatives(u, w, xi, S, v):
     Ti, Ah, As, DA, DB, P = S[S_TI], S[S_AH], S[S_AS], S[S_DA], S[S_DB], S[S_P]
     wr, y, xy, dB, b, zs, dA = v[V_WR], v[V_Y], v[V_XY], v[V_DB], v[V_B], v[V_ZS], v[V_DA]
     su, sw = scale(xi, u), scale(xi, w)
-    _mtv(S[S_TS], wr, y)
+    _mtv_ut(S[S_TS], wr, y)
     _geo(su, sw, y, S[S_GS])
-    _mtm(S[S_TS], S[S_GS], S[S_M1])
-    _mtm(Ti, S[S_M1], P)                                  # T(h)^-T T(s)^T G(s, y)
+    _mtm_ut_g(S[S_TS], S[S_GS], S[S_M1])
+    _mtm_ut_g(Ti, S[S_M1], P)                                # T(h)^-T T(s)^T G(s, y)
     for i in range(6):
         xy[i] = xi * y[i]
     _geo(u, w, xy, DB)
-    _mtv(Ti, y, dB)
+    _mtv_ut(Ti, y, dB)
     h = (u[0], u[1], u[2], w[0], w[1], w[2])
     for i in range(6):
         acc = 0.0
@@ -279,18 +288,18 @@ def _jacobian_derivatives(u, w, xi, S, v):
             DB[i, j] -= xi * xi * P[i, j]
             acc += P[i, j] * h[j]
         dB[i] -= xi * acc
-    _mtv(Ti, xy, b)
-    _mtv(As, wr, zs)
-    _mtv(Ah, b, v[V_ZH])
+    _mtv_ut(Ti, xy, b)
+    _mtv_ut(As, wr, zs)
+    _mtv_ut(Ah, b, v[V_ZH])
     _tangent(scale(-1.0, u), scale(-1.0, w), S[S_TMH])
     _m_times(v[V_ZH], S[S_TMH], DA)
     _tangent(scale(-xi, u), scale(-xi, w), S[S_TMS])
     _m_times(zs, S[S_TMS], S[S_MS])
-    _mtm(Ah, DB, S[S_AHDB])
+    _mtm_ut_g(Ah, DB, S[S_AHDB])
     zf, zm = (zs[0], zs[1], zs[2]), (zs[3], zs[4], zs[5])
     top, bot = cross(zf, (h[3], h[4], h[5])), add(cross(zf, (h[0], h[1], h[2])), cross(zm, (h[3], h[4], h[5])))
     AhdB = v[V_AHDB]
-    _mtv(Ah, dB, AhdB)
+    _mtv_ut(Ah, dB, AhdB)
     Ms, AhDB = S[S_MS], S[S_AHDB]
     for i in range(6):
         dA[i] = -(top[i] if i < 3 else bot[i - 3]) - AhdB[i]
@@ -342,7 +351,7 @@ def _project(kind, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations=2):
     return xi1, xi2
 
 
-@jit
+@jit_inline
 def _rot_col(R, V, k):
     """``R @ V[0:3, k]``, ``R`` a 3x3 tuple."""
     return (R[0][0] * V[0, k] + R[0][1] * V[1, k] + R[0][2] * V[2, k],
@@ -350,7 +359,7 @@ def _rot_col(R, V, k):
             R[2][0] * V[0, k] + R[2][1] * V[1, k] + R[2][2] * V[2, k])
 
 
-@jit
+@jit_inline
 def _col_dot(a, M, r0, k):
     """``a . M[r0:r0+3, k]``."""
     return a[0] * M[r0, k] + a[1] * M[r0 + 1, k] + a[2] * M[r0 + 2, k]
@@ -408,7 +417,7 @@ def _variations(S, c0, Dh, V, tmp):
     ``xi`` ``(J_A dq_A + J_B dq_B)``, both ``(6, 24)``, node A at column ``c0``."""
     _zero(Dh)
     _zero(V)
-    _mm(S[S_TI], S[S_AH], tmp)
+    _mm_ut(S[S_TI], S[S_AH], tmp)
     Ti, JA, JB = S[S_TI], S[S_JA], S[S_JB]
     for i in range(6):
         for j in range(6):
@@ -463,18 +472,19 @@ def _compose(RA, xA, RB, xB):
 
 @jit
 def _slip_rows(Tdy, Ad, JA, JB, sign, D, c0, tmp):
-    """``D[:, c0:c0+12] = sign (Tdy[1:3] Ad) [J_A, J_B]`` (``Tdy``, ``Ad``, ``J`` ``(6, 6)``; ``tmp`` ``(6, 6)``)."""
+    """``D[:, c0:c0+12] = sign (Tdy[1:3] Ad) [J_A, J_B]`` (``Tdy``, ``Ad``, ``J`` ``(6, 6)``; ``tmp`` ``(6, 6)``);
+    ``Ad`` and ``J`` block upper triangular: the terms of their zero blocks skipped (``_mm_ut``)."""
     for i in range(2):
         for j in range(6):
             acc = 0.0
-            for l in range(6):
+            for l in range(3 if j < 3 else 6):
                 acc += Tdy[1 + i, l] * Ad[l, j]
             tmp[i, j] = acc
     for i in range(2):
         for j in range(6):
             a = 0.0
             b = 0.0
-            for l in range(6):
+            for l in range(3 if j < 3 else 6):
                 a += tmp[i, l] * JA[l, j]
                 b += tmp[i, l] * JB[l, j]
             D[i, c0 + j] = -a if sign < 0.0 else a
@@ -594,17 +604,19 @@ def _nodal(u, w, xi, S, v, Dw, Dh, dxi, c0, f, K, j0):
         r0 = 6 * (j0 + s)
         for i in range(6):
             acc = 0.0
-            for l in range(6):
+            for l in range(3 if i < 3 else 6):        # J[3:, :3] == 0 (block upper triangular)
                 acc += J[l, i] * wr[l]
             f[j0 + s, i] = acc
             _tangent_row(J[0, i], J[1, i], J[2, i], J[3, i], J[4, i], J[5, i], D[i, 0], D[i, 1], D[i, 2], D[i, 3],
-                         D[i, 4], D[i, 5], dd[i], dxi, Dw, Dh, c0, K[r0 + i])
+                         D[i, 4], D[i, 5], dd[i], dxi, Dw, Dh, c0, i < 3, K[r0 + i])
 
 
-@jit
-def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, dxi, Dw, Dh, c0, out):
+@jit_inline
+def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, dxi, Dw, Dh, c0, force, out):
     """One row of the tangent: ``out[c] = di dxi[c] + sum_l (j_l Dw[l, c] + d_l Dh[l, c])``, the ``Dh``
-    terms only on the columns ``c0:c0+12`` of the side's nodes (summed in this order)."""
+    terms only on the columns ``c0:c0+12`` of the side's nodes (summed in this order).  ``force``: a
+    force row, whose ``j3, j4, j5`` are structural zeros (``J[3:, :3] == 0``): their terms, exact
+    zeros, are skipped (the same sums up to the sign of a zero result)."""
     for c in range(24):
         own = c0 <= c < c0 + 12
         acc = di * dxi[c]
@@ -617,13 +629,16 @@ def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, dxi, Dw, Dh
         acc += j2 * Dw[2, c]
         if own:
             acc += d2 * Dh[2, c]
-        acc += j3 * Dw[3, c]
+        if not force:
+            acc += j3 * Dw[3, c]
         if own:
             acc += d3 * Dh[3, c]
-        acc += j4 * Dw[4, c]
+        if not force:
+            acc += j4 * Dw[4, c]
         if own:
             acc += d4 * Dh[4, c]
-        acc += j5 * Dw[5, c]
+        if not force:
+            acc += j5 * Dw[5, c]
         if own:
             acc += d5 * Dh[5, c]
         out[c] = acc
@@ -838,17 +853,24 @@ def _table(X, p):
     return kind, par, has, frames, lamp
 
 
-def kernel_and_tangent(X, p, friction=True, law=None):
+def kernel_and_tangent(X, p, friction=True, law=None, K=None):
     """Wrenches ``(P, 4, 6)``, exact tangent ``(P, 24, 24)`` and point data (``pairs.kernel_and_tangent``).
 
     ``X``: ``(P, 4, 4, 4)`` node poses ``A1, B1, A2, B2``; ``p``: the per-pair parameters of
     ``pairs.contact_kernel``.  Column ``6 j + k`` of the tangent is the body increment ``k``
     of node ``j``.  ``law``: a ``law.ContactLaw`` (default ``PENALTY_COULOMB``, the law of ``pairs.py``).
+    ``K``: optional C-contiguous float array ``(P, 24, 24)`` the tangent is written to (a buffer the
+    caller keeps: no fresh 4.6 kB per point, whose page faults cost ~1 us per point at 1e4 points).
     """
     X = np.ascontiguousarray(X, dtype=float)
     P = X.shape[0]
     kind, par, has, (HCL, HFK, HLKp), lamp = _table(X, p)
-    f, K = np.empty((P, 4, 6)), np.empty((P, 24, 24))
+    if K is None:
+        K = np.empty((P, 24, 24))
+    elif K.shape != (P, 24, 24) or K.dtype != np.float64 or not K.flags.c_contiguous:
+        raise InputError(f"kernel_and_tangent: K must be a C-contiguous float array {(P, 24, 24)}, "
+                         f"got {K.dtype} {K.shape}")
+    f = np.empty((P, 4, 6))
     sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
     flags, frames = np.empty((P, 2), dtype=np.bool_), np.empty((P, 4, 4, 4))
     kern = evaluate if law is None else make_kernel(law)

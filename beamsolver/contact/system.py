@@ -36,6 +36,7 @@ at the onset of sliding is ``slip_tolerance`` times the slave element length
 ``pairs.stick_penalty``).
 """
 
+import sys
 import time
 
 import numpy as np
@@ -130,6 +131,7 @@ class ContactSystem(Contribution):
         self._H_prev = None        # last converged poses (start of the step)
         self._geo = self._geo_prev = None    # (poses, element twists) of the last evaluation / of H_prev
         self._blocks = None        # (poses, local blocks) of the last evaluation, for the same state
+        self._K_pool = []          # tangent buffers of the compiled kernel (``_tangent_out``)
         self.timings = dict.fromkeys(TIMED, 0.0)
         self._clock = time.process_time()
 
@@ -509,6 +511,7 @@ class ContactSystem(Contribution):
         self._check_normals(P, sel, H, centres)
         p = self._params(P, sel, H)
         self._lap("params")
+        self._blocks = None        # its tangent buffer may be reused (``_tangent_out``)
         f, K, out = self._kernels(H[P.nodes[sel]], p, P.decl[sel], tangent)
         np.negative(f, out=f)
         if K is not None:
@@ -542,7 +545,9 @@ class ContactSystem(Contribution):
         group = np.unique([id(law) for law in laws], return_inverse=True)[1][decl] * 2 + fric
         kinds = np.unique(group)
         if len(kinds) == 1:                     # one kind: no masked copies of the (m, 24, 24) blocks
-            return _kernel(X, p, bool(kinds[0] % 2), laws[decl[0]], tangent)
+            compiled = kernel_and_tangent is kernel_jit.kernel_and_tangent
+            out = self._tangent_out(len(X)) if tangent and compiled else None
+            return _kernel(X, p, bool(kinds[0] % 2), laws[decl[0]], tangent, out)
         f = np.zeros((len(X), 4, 6))
         K = np.zeros((len(X), 24, 24)) if tangent else None
         out = {}
@@ -558,6 +563,18 @@ class ContactSystem(Contribution):
                     out[k] = np.zeros((len(X),) + np.shape(v)[1:], dtype=np.asarray(v).dtype)
                 out[k][mask] = v
         return f, K, out
+
+    def _tangent_out(self, m):
+        """An ``(m, 24, 24)`` array for the compiled kernel's tangent: a view of a kept buffer that
+        nothing else references (blocks of an earlier evaluation may still be in use, e.g. the
+        solver's last evaluation during a line search), else of a new buffer; at most two kept.
+        Reusing memory avoids the page faults of a fresh ``(m, 24, 24)`` array per evaluation."""
+        for b in self._K_pool:
+            if len(b) >= m and sys.getrefcount(b) <= 3:      # the pool, ``b`` and the call's argument
+                return b[:m]
+        b = np.empty((m, 24, 24))
+        self._K_pool = [b] + self._K_pool[:1]
+        return b[:m]
 
     def evaluate(self, H, tangent=True):
         """Local blocks of the active pairs and point data: ``(blocks.Blocks, info)``.
@@ -712,10 +729,12 @@ def _frames(out):
     return HL, HK
 
 
-def _kernel(X, p, friction, law, tangent):
-    """``f``, ``K`` (None without ``tangent`` on the numpy path) and point data of one kernel call."""
+def _kernel(X, p, friction, law, tangent, K=None):
+    """``f``, ``K`` (None without ``tangent`` on the numpy path) and point data of one kernel call;
+    ``K``: the compiled kernel's output array for the tangent (None: a new one)."""
     if tangent:
-        return kernel_and_tangent(X, p, friction=friction, **({} if law is None else dict(law=law)))
+        kw = ({} if law is None else dict(law=law)) | ({} if K is None else dict(K=K))
+        return kernel_and_tangent(X, p, friction=friction, **kw)
     f, out = contact_kernel(X, p, friction=friction, **({} if law is None else dict(law=law)))
     return f, None, out
 
