@@ -56,6 +56,11 @@ from .projection import closest_points, element_twists, project_points, section_
 from .search import broad_phase, element_spheres
 from . import rules
 
+# ``_tangent_out`` tells a buffer nobody holds by ``sys.getrefcount``, whose count of the caller's
+# own references is an implementation detail (CPython 3.14 borrows references on the stack):
+# buffers are reused only on the CPython versions where that count was checked, else made anew.
+REUSE_BUFFERS = sys.implementation.name == "cpython" and sys.version_info < (3, 14)
+
 MAX_AUGMENT = 30
 TIMED = ("search", "rules", "projection", "params", "kernel", "blocks")   # parts of ``ContactSystem.timings``
 
@@ -569,7 +574,7 @@ class ContactSystem(Contribution):
         nothing else references (blocks of an earlier evaluation may still be in use, e.g. the
         solver's last evaluation during a line search), else of a new buffer; at most two kept.
         Reusing memory avoids the page faults of a fresh ``(m, 24, 24)`` array per evaluation."""
-        for b in self._K_pool:
+        for b in self._K_pool if REUSE_BUFFERS else ():
             if len(b) >= m and sys.getrefcount(b) <= 3:      # the pool, ``b`` and the call's argument
                 return b[:m]
         b = np.empty((m, 24, 24))
