@@ -23,8 +23,9 @@ OWNER_TIE = 1e-9          # distances equal within this fraction of R1 + R2 tie 
 
 
 def apart(enodes, e, m):
-    """Mask of the element pairs ``(e, m)`` that share no node."""
-    return ~np.isin(enodes[e], enodes[m]).any(axis=1)
+    """Mask ``(n,)`` of the element pairs ``(e[k], m[k])`` that share no node, each pair compared
+    with its own two elements' nodes (``enodes`` ``(n_el, k)``)."""
+    return ~(enodes[e][:, :, None] == enodes[m][:, None, :]).any(axis=(1, 2))
 
 
 def point_or_orthogonal(ratio, point_ratio):
