@@ -92,16 +92,27 @@ solve_options = dict(steps=40, stabilize=2e-2)   # for `beamsolver run examples/
 
 
 def build(turns=5.0, n_elements=16, mu=0.3, imperfection=1e-2, pull=PULL, E=200e9, nu=0.3, length=LENGTH,
-          approach=None, pieces=2):
+          approach=None, pieces=2, twist_until=1.0, relax=None):
     """Returns ``(model, plate node, (wire a, wire b))``, each wire a tuple of ``pieces`` beams
     (bottom to top) of ``n_elements // pieces`` elements joined rigidly.  ``approach=None``: a
     dead ``pull`` on the plate (free in ``z``); a number ``s``: extension control, the plate's
     height prescribed as ``length (1 - s t)`` together with its turns (``pull`` then only scales
-    the imperfection)."""
+    the imperfection).  ``twist_until = t1 < 1``: a two-stage path, the turns reached at ``t1``
+    and then held; over ``[t1, 1]`` the dead pull goes linearly from ``pull`` to ``relax`` (``relax``
+    also scales the imperfection), or with ``approach`` the plate's height from ``length`` to
+    ``length (1 - s)``."""
     sec = bs.Section.circular(radius=R, E=E, nu=nu)
     model = bs.Model()
     if pieces < 2 or n_elements % pieces:
         raise bs.InputError(f"build: pieces must be >= 2 and divide n_elements = {n_elements}, got {pieces}")
+    if not 0.0 < twist_until <= 1.0:
+        raise bs.InputError(f"build: twist_until must be in (0, 1], got {twist_until}")
+    if relax is not None and (approach is not None or twist_until == 1.0):
+        raise bs.InputError(f"build: relax = {relax} needs a dead pull (approach None) and twist_until < 1")
+    t1 = twist_until
+    stage2 = lambda t: max(0.0, t - t1) / (1.0 - t1) if t1 < 1.0 else t  # noqa: E731
+    angle = lambda t: 2.0 * np.pi * turns * min(t / t1, 1.0)  # noqa: E731
+    lateral = imperfection * (pull if relax is None else relax)
     cuts = np.linspace(0.0, length, pieces + 1)
     wires = []
     for x, name in ((R, "wire a"), (-R, "wire b")):
@@ -111,18 +122,21 @@ def build(turns=5.0, n_elements=16, mu=0.3, imperfection=1e-2, pull=PULL, E=200e
             model.join(lo.last, up.first, rigid=True)
         model.clamp(wire[0].first)
         mid = wire_nodes(wire)[n_elements // 2]
-        model.add_load(int(mid), force=(0.0, imperfection * pull, 0.0), scale=lambda t: 1.0)
+        model.add_load(int(mid), force=(0.0, lateral, 0.0), scale=lambda t: 1.0)
         wires.append(wire)
     plate = model.add_node((0.0, 0.0, length), name="plate")
     for wire in wires:
         model.join(plate, wire[-1].last, rigid=True)
     if approach is None:
-        model.fix(plate, ("ux", "uy", "rx", "ry", "rz"), values={"rz": lambda t: 2.0 * np.pi * turns * t})
-        model.add_load(plate, force=(0.0, 0.0, pull), scale=lambda t: 1.0)
+        model.fix(plate, ("ux", "uy", "rx", "ry", "rz"), values={"rz": angle})
+        if relax is None:
+            model.add_load(plate, force=(0.0, 0.0, pull), scale=lambda t: 1.0)
+        else:
+            model.add_load(plate, force=(0.0, 0.0, pull), scale=lambda t: 1.0 + (relax / pull - 1.0) * stage2(t))
     else:
         model.prescribe(plate, bs.motion.compose(
-            bs.motion.translation(lambda t: (0.0, 0.0, -approach * length * t)),
-            bs.motion.rotation((0.0, 0.0, 1.0), lambda t: 2.0 * np.pi * turns * t)))
+            bs.motion.translation(lambda t: (0.0, 0.0, -approach * length * stage2(t))),
+            bs.motion.rotation((0.0, 0.0, 1.0), angle)))
     opts = dict(mu=mu, smoothing=2e-3 * R)
     model.add_contact(list(wires[0]), list(wires[1]), **opts)
     for wire in wires:
@@ -146,26 +160,61 @@ def ribbon_measures(sol, wires, step):
     return tw, topology.writhe_open(axis)
 
 
-COLUMNS = ("turns = Lk", "torque [N m]", "axial force [N]", "plate z [mm]", "Tw", "Wr", "|Lk-Tw-Wr|/Lk", "Wr/Lk",
+def picture(sol, wires, path, step=-1, title=""):
+    """Side and top views of the two wires' centre lines at ``step`` (matplotlib), drawn with
+    their thickness to scale (lines of the wire diameter in data units, on the side view)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig = plt.figure(figsize=(6.4, 4.8), dpi=80)
+    ax3 = fig.add_subplot(1, 2, 1, projection="3d")
+    ax2 = fig.add_subplot(1, 2, 2)
+    lines = []
+    for wire, color in zip(wires, ("tab:blue", "tab:orange")):
+        nodes = wire_nodes(wire)
+        x = np.array([sol.position(int(i), step) for i in nodes]) * 1e3
+        lines.append(x)
+        ax3.plot(x[:, 0], x[:, 1], x[:, 2], color=color, lw=3)
+        ax2.plot(x[:, 1], x[:, 2], color=color, lw=2, marker=".", ms=3)
+    allx = np.concatenate(lines)
+    mid, half = 0.5 * (allx.max(0) + allx.min(0)), 0.5 * (allx.max(0) - allx.min(0)).max()
+    for set_lim, c in zip((ax3.set_xlim, ax3.set_ylim, ax3.set_zlim), mid):
+        set_lim(c - half, c + half)
+    ax3.set_box_aspect((1, 1, 1))
+    ax3.set_xlabel("x [mm]"), ax3.set_ylabel("y [mm]"), ax3.set_zlabel("z [mm]")
+    ax2.set_aspect("equal"), ax2.set_xlabel("y [mm]"), ax2.set_ylabel("z [mm]"), ax2.set_title("side view")
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+COLUMNS = ("t", "turns = Lk", "torque [N m]", "axial force [N]", "plate z [mm]", "Tw", "Wr", "|Lk-Tw-Wr|/Lk", "Wr/Lk",
            "dissipated / strain energy", "contacts", "Newton it.")
 
 
-Row = namedtuple("Row", "lk torque axial z tw wr error writhe_fraction dissipated contacts iterations")
+Row = namedtuple("Row", "t lk torque axial z tw wr error writhe_fraction dissipated contacts iterations")
 
 
-def table(sol, plate, wires, turns, pull=0.0):
+def table(sol, plate, wires, turns, pull=0.0, twist_until=1.0, relax=None):
     """One row of ``COLUMNS`` per step; ``pull`` the dead pull on the plate (the axial force is
-    the pull plus the support's reaction in ``z``: tension positive)."""
+    the pull plus the support's reaction in ``z``: tension positive), going to ``relax`` over
+    ``[twist_until, 1]`` if given; the turns are reached at ``twist_until``."""
     rows = []
     for k in range(len(sol.times)):
-        lk = turns * sol.times[k]
+        t = sol.times[k]
+        lk = turns * min(t / twist_until, 1.0)
+        if relax is not None:
+            pull_t = pull + (relax - pull) * max(0.0, t - twist_until) / (1.0 - twist_until)
+        else:
+            pull_t = pull
         tw, wr = ribbon_measures(sol, wires, k)
         st = sol.stats[k].get("stabilization", {})
         c = sol.contact(k) or {}
         active = int((np.asarray(c.get("normal_force", np.zeros(0))) > 0).sum())
         err = abs(lk - tw - wr) / lk if lk > 0 else abs(tw + wr)
         react = sol.reaction(plate, k)
-        rows.append(Row(lk, react[5], pull + react[2], 1e3 * sol.position(plate, k)[2], tw, wr, err,
+        rows.append(Row(t, lk, react[5], pull_t + react[2], 1e3 * sol.position(plate, k)[2], tw, wr, err,
                      wr / lk if lk > 0 else 0.0, st.get("fraction", 0.0), active, sol.stats[k]["iterations"]))
     return rows
 
@@ -180,35 +229,40 @@ def onset(rows):
 
 
 def main(output=None, turns=5.0, steps=40, n_elements=16, mu=0.3, stabilize=2e-2, imperfection=1e-2,
-         verbose=False, length=LENGTH, pull=PULL, approach=None, pieces=2, min_step_ratio=2.0**-12):
+         verbose=False, length=LENGTH, pull=PULL, approach=None, pieces=2, min_step_ratio=2.0**-12,
+         twist_until=1.0, relax=None, path="load"):
     """Solve, print the table and the checks; returns ``(solution, rows, wall time, checks)``."""
     model, plate, wires = build(turns=turns, n_elements=n_elements, mu=mu, imperfection=imperfection,
                                  length=length, pull=pull, approach=approach,
-                                 pieces=pieces)
+                                 pieces=pieces, twist_until=twist_until, relax=relax)
     t0 = time.perf_counter()
     try:
         sol = bs.solve(model, steps=steps, output=output, verbose=verbose, stabilize=stabilize,
-                       min_step_ratio=min_step_ratio)
+                       min_step_ratio=min_step_ratio, path=path)
     except bs.ConvergenceError as e:
         print(f"stopped: {e}")
         sol = e.solution
     wall = time.perf_counter() - t0
-    rows = table(sol, plate, wires, turns, pull=pull if approach is None else 0.0)
+    rows = table(sol, plate, wires, turns, pull=pull if approach is None else 0.0, twist_until=twist_until,
+                 relax=relax)
     control = f"pull {pull:g} N" if approach is None else f"extension control, approach {approach:g}"
+    if twist_until < 1.0:
+        control += f", turns reached at t = {twist_until:g} then held" + (f", pull relaxed to {relax:g} N"
+                                                                         if relax is not None else "")
     print(f"plectoneme: 2 wires R = {R * 1e3:g} mm, L = {length * 1e3:g} mm, {control}, {n_elements} elements "
           f"each in {pieces} pieces, mu = {mu}, {turns:g} turns in {steps} steps, stabilize = {stabilize}, "
-          f"imperfection {imperfection * pull:g} N")
+          f"imperfection {imperfection * (pull if relax is None else relax):g} N")
     print("| " + " | ".join(COLUMNS) + " |")
     print("|" + "---:|" * len(COLUMNS))
-    for lk, tq, fz, z, tw, wr, err, fw, fd, nc, it in rows:
-        print(f"| {lk:.4f} | {tq:.4g} | {fz:.4g} | {z:.3f} | {tw:.4f} | {wr:.4f} | {err:.2e} | {fw:.3f} "
+    for t, lk, tq, fz, z, tw, wr, err, fw, fd, nc, it in rows:
+        print(f"| {t:.4f} | {lk:.4f} | {tq:.4g} | {fz:.4g} | {z:.3f} | {tw:.4f} | {wr:.4f} | {err:.2e} | {fw:.3f} "
               f"| {fd:.2e} | {nc} | {it} |")
     B = 2.0 * model.beams[0].section.C[4, 4]
     worst = max((r.error for r in rows if r.lk >= LK_MIN), default=np.nan)     # relative error: Lk not near 0
     tw_c, m_c = onset(rows)
-    checks = dict(reached=turns * sol.times[-1], lk_error=worst, onset_turns=tw_c, onset_torque=m_c,
+    checks = dict(reached=rows[-1].lk, t_end=float(sol.times[-1]), lk_error=worst, onset_turns=tw_c, onset_torque=m_c,
                   onset_ratio=m_c * length / B, wall=wall, writhe=rows[-1].writhe_fraction)
-    print(f"reached {checks['reached']:.3f} of {turns:g} turns in {wall:.1f} s; Newton iterations "
+    print(f"reached {checks['reached']:.3f} of {turns:g} turns, t = {checks['t_end']:.4f}, in {wall:.1f} s; Newton iterations "
           f"{int(sol.iterations.sum())}; writhe at the end {rows[-1].writhe_fraction:.1%} of Lk")
     print(f"Lk = Tw + Wr: largest |Lk - Tw - Wr| / Lk {worst:.2e} ({'within' if worst <= 0.02 else 'NOT within'} 2 %)")
     print(f"onset of writhing at {tw_c:.3f} turns, torque {m_c:.4g} N m: M L / B = {checks['onset_ratio']:.2f} "
@@ -242,7 +296,13 @@ if __name__ == "__main__":
     ap.add_argument("--pieces", type=int, default=2, help="beams per wire (self-contact between them)")
     ap.add_argument("--approach", type=float, default=None,
                     help="extension control: the plate's height prescribed as length (1 - approach t)")
+    ap.add_argument("--twist-until", type=float, default=1.0,
+                    help="two-stage path: the turns reached at this t, then held while the pull relaxes "
+                         "(--relax) or the plate approaches (--approach)")
+    ap.add_argument("--relax", type=float, default=None, help="dead pull [N] at t = 1 (with --twist-until)")
+    ap.add_argument("--path", default="load", help="solve(path=): load or arc-length")
     a = ap.parse_args()
     main(output=a.output, turns=a.turns, steps=a.steps, n_elements=a.elements, mu=a.mu, stabilize=a.stabilize,
          imperfection=a.imperfection, verbose=True, length=a.length, pull=a.pull,
-         approach=a.approach, pieces=a.pieces, min_step_ratio=a.min_step_ratio)
+         approach=a.approach, pieces=a.pieces, min_step_ratio=a.min_step_ratio, twist_until=a.twist_until,
+         relax=a.relax, path=a.path)

@@ -95,3 +95,19 @@ def test_frictionless_pair_writhes_at_greenhills_torque():
     assert checks["onset_ratio"] == pytest.approx(8.36, rel=0.03)
     assert checks["onset_ratio"] == pytest.approx(plectoneme.GREENHILL, rel=0.1)
     assert checks["writhe"] > 0.3 and checks["lk_error"] < 0.02
+
+
+def test_two_stage_path_holds_the_turns_while_the_pull_relaxes():
+    """``twist_until``: the turns reached at ``t1`` and held; the dead pull then goes linearly to
+    ``relax`` (which also scales the imperfection)."""
+    model, plate, wires = plectoneme.build(n_elements=8, turns=5.5, pull=2000.0, relax=300.0, twist_until=0.5)
+    angle = model.fix_values[plate][5]
+    assert angle(0.25) == pytest.approx(2 * np.pi * 2.75) and angle(0.5) == angle(0.8) == pytest.approx(11 * np.pi)
+    pull, = [ld for ld in model.loads if ld.node == plate]
+    assert [pull.force[2] * pull.scale(t) for t in (0.0, 0.5, 0.75, 1.0)] == pytest.approx([2000, 2000, 1150, 300])
+    lateral = [ld.force[1] for ld in model.loads if ld.force[1] != 0.0]
+    assert lateral == pytest.approx([3.0, 3.0])
+    with pytest.raises(plectoneme.bs.InputError, match="relax"):
+        plectoneme.build(n_elements=8, relax=300.0)
+    with pytest.raises(plectoneme.bs.InputError, match="twist_until"):
+        plectoneme.build(n_elements=8, twist_until=0.0)
