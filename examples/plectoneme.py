@@ -72,9 +72,36 @@ with ``mu = 0.3``, ``--stabilize 5e-2 --min-step-ratio 1e-7`` creeps to 4.07 tur
 None reaches the 5 turns: the tight, tensioned loop (its radius about two wire diameters) is
 where every run stalls.
 
+Two-stage path, the magnetic-tweezers protocol (``--twist-until t1 --relax F``): the turns are
+reached at ``t1`` under a dead pull high enough to keep the two-ply straight (Greenhill with
+tension, ``M_c = 2 B sqrt((4.49 / L)^2 + F / B)``), then held, ``Lk`` fixed, while the pull falls
+linearly to ``F`` until the pair writhes.  So the run passes 5 turns before any instability;
+``--length 0.06 --mu 0 --pull 2000 --relax 300 --twist-until 0.5 --turns 5.5 --steps 40
+--stabilize 2e-2``: the straight two-ply twists to 5.5 turns (9.55 N m, plate 60.38 -> 57.84 mm,
+``Wr = 0``, ``Lk = Tw`` to 3e-8); with ``--elements 24`` it writhes as the pull falls to 1180 N at
+9.43 N m (``M_c = 10.1``; ``--mu 0.3``: 778 N), a loop grows near the plate and the plate falls
+under the dead pull; the run stops at ``t = 0.796``, 993 N, plate 42.5 mm, ``Wr = 1.55``,
+``Wr / Lk = 0.28``, ``|Lk - Tw - Wr| / Lk <= 1.4e-2``, dissipated 0.32 (polluted, warned), 190 s,
+Newton failing in the tight loop (``--pieces 4``: "elements turn by up to 2.04 rad within one
+element").  ``--mu 0.3`` stops alike at 5.5 turns, ``Wr / Lk = 0.28``, 678 N; with two pieces
+the loop near the plate lies in one beam (no self-contact): for one step the pair passes through
+itself, ``Wr`` jumps by about 2 and ``|Lk - Tw - Wr| / Lk = 0.35``.  ``--elements 48 --pieces 4``
+(and ``--pieces 8``): onset at 1250 N, stops at ``t = 0.762``, 1110 N, plate 46.8 mm, ``Wr = 0.98``,
+``Wr / Lk = 0.18``, ``|Lk - Tw - Wr| / Lk <= 7.9e-4``, dissipated 0.098, 785 s (1218 s): steps of
+6e-6 with damping do not converge (scaled residual 0.024, positive definite tangent) as the loop
+closes, its arms in contact (centre distance 0.93 mm of 1 mm: self-contact active).
+``--stabilize 0.2`` (48 elements, 4 pieces) carries the snap further in pseudo-time and stops
+alike once the loop has closed: ``t = 0.879``, 712 N, plate 44.5 mm, ``Wr = 1.08``,
+``Wr / Lk = 0.20``, dissipated 0.18, 569 s (scaled residual 0.76 at steps of 6e-6).  A longer pair
+writhes at a lower pull (a wider loop, ``sqrt(B / F)``): ``--length 0.09 --elements 64
+--pieces 4 --relax 100`` twists straight to 5.5 turns at 6.16 N m (``Lk = Tw`` to 1e-11) and
+writhes from 385 N (``M_c = 6.4`` N m), reaching ``t = 1`` at 100 N mid-snap: ``Wr = 0.52``,
+``Wr / Lk = 0.094``, plate 88.9 -> 72.9 mm, ``|Lk - Tw - Wr| / Lk <= 4.5e-5``, dissipated 0.07,
+770 s.
+
     python examples/plectoneme.py [--output plectoneme_output] [--turns 5] [--steps 40] [--mu 0.3] [--stabilize 2e-2]
         [--elements 16] [--imperfection 1e-2] [--length 0.02] [--pull 5] [--approach s] [--pieces 2]
-        [--min-step-ratio 2**-12]
+        [--min-step-ratio 2**-12] [--twist-until 1] [--relax F] [--path load]
 """
 import argparse
 import time
@@ -158,35 +185,6 @@ def ribbon_measures(sol, wires, step):
     axis, u = topology.ribbon(pa[:, :3, 3], pb[:, :3, 3])
     tw = topology.twist(axis, u, tangents=pa[:, :3, 0] + pb[:, :3, 0])
     return tw, topology.writhe_open(axis)
-
-
-def picture(sol, wires, path, step=-1, title=""):
-    """Side and top views of the two wires' centre lines at ``step`` (matplotlib), drawn with
-    their thickness to scale (lines of the wire diameter in data units, on the side view)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig = plt.figure(figsize=(6.4, 4.8), dpi=80)
-    ax3 = fig.add_subplot(1, 2, 1, projection="3d")
-    ax2 = fig.add_subplot(1, 2, 2)
-    lines = []
-    for wire, color in zip(wires, ("tab:blue", "tab:orange")):
-        nodes = wire_nodes(wire)
-        x = np.array([sol.position(int(i), step) for i in nodes]) * 1e3
-        lines.append(x)
-        ax3.plot(x[:, 0], x[:, 1], x[:, 2], color=color, lw=3)
-        ax2.plot(x[:, 1], x[:, 2], color=color, lw=2, marker=".", ms=3)
-    allx = np.concatenate(lines)
-    mid, half = 0.5 * (allx.max(0) + allx.min(0)), 0.5 * (allx.max(0) - allx.min(0)).max()
-    for set_lim, c in zip((ax3.set_xlim, ax3.set_ylim, ax3.set_zlim), mid):
-        set_lim(c - half, c + half)
-    ax3.set_box_aspect((1, 1, 1))
-    ax3.set_xlabel("x [mm]"), ax3.set_ylabel("y [mm]"), ax3.set_zlabel("z [mm]")
-    ax2.set_aspect("equal"), ax2.set_xlabel("y [mm]"), ax2.set_ylabel("z [mm]"), ax2.set_title("side view")
-    fig.suptitle(title, fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
 
 
 COLUMNS = ("t", "turns = Lk", "torque [N m]", "axial force [N]", "plate z [mm]", "Tw", "Wr", "|Lk-Tw-Wr|/Lk", "Wr/Lk",
