@@ -21,7 +21,7 @@ import scipy.sparse as sp
 from . import assembly_jit, contributions, se3
 from . import blocks as _blocks
 from .errors import InputError
-from .extra_pattern import ExtraPattern
+from .extra_pattern import BlockPattern, ExtraPattern, whole_nodes
 from .se3 import skew
 from .validation import check_pose
 
@@ -431,7 +431,7 @@ class System:
             c = (d.copy(), np.repeat(d32, k, axis=1).ravel(), np.tile(d32, (1, k)).ravel())
             for a in c:
                 a.flags.writeable = False
-            self._coo_index = c
+            self._coo_index = c + (whole_nodes(d),)
         return c[1], c[2]
 
     def _concat_coo(self, a, b):
@@ -566,12 +566,19 @@ class System:
         return canonical_csc(data[:self.nnz], self.indices, self.indptr, self.n_free)
 
     def _extra_pattern(self, extra):
-        """The ``extra_pattern.ExtraPattern`` of the COO entries ``extra`` (kept while their pattern
-        stays: the same active contact pairs)."""
+        """The pattern of the COO entries ``extra`` (kept while it stays: the same active contact
+        pairs): ``extra_pattern.BlockPattern`` of the block dofs when they are the index arrays of
+        ``_block_coo`` over whole nodes, else ``extra_pattern.ExtraPattern``."""
         p = getattr(self, "_extra_cache", None)
-        if p is None or not p.same(extra[0], extra[1], (self.red, self.indptr, self.indices)):
+        base = (self.red, self.indptr, self.indices)
+        c = getattr(self, "_coo_index", None)
+        if c is not None and extra[0] is c[1] and extra[1] is c[2] and c[3]:
+            if not isinstance(p, BlockPattern) or not p.same(c[0], base):
+                p = self._extra_cache = BlockPattern(c[0], self.red, self.n_free, self.indptr, self.indices,
+                                                     spare=p if isinstance(p, BlockPattern) else None)
+        elif not isinstance(p, ExtraPattern) or not p.same(extra[0], extra[1], base):
             p = self._extra_cache = ExtraPattern(extra[0], extra[1], self.red, self.n_free, self.indptr,
-                                                 self.indices, spare=p)
+                                                 self.indices, spare=p if isinstance(p, ExtraPattern) else None)
         return p
 
     def full_matrix(self, kvals, extra=None):

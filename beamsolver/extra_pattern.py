@@ -20,13 +20,22 @@ bit for bit (the same values summed in the same order, the same stored entries):
   order of the entries in each run; an evaluation (``matrix``) sums the runs in that order
   and adds them to the element values on the union of both patterns (compiled, no sort),
   then drops the exact zeros as scipy does.
+
+``BlockPattern`` gives the same matrix for the entries of dense blocks over whole nodes (what
+``System.assemble_blocks`` makes of contact blocks: ``rows = repeat(d, b)``, ``cols = tile(d, b)``
+with ``d[:, 6 s + q] = 6 node + q``), built from ``d`` alone, six times less work: the 6
+columns of a node hold the same rows in the same order (one row of ``d`` per block), so
+scipy's sort, which compares rows only, moves their entries alike; the build buckets and
+sorts one column per node (entry numbers of its ``q = 0`` column) and an evaluation reads
+column ``q`` at number ``+ q``.  A new active set costs a new pattern; ``BlockPattern`` needs
+no ``(rows, cols)`` arrays of the entries.
 """
 import numpy as np
 import scipy.sparse as sp
 
 from ._jit import jit
 
-__all__ = ["ExtraPattern"]
+__all__ = ["ExtraPattern", "BlockPattern"]
 
 
 @jit
@@ -187,11 +196,205 @@ class ExtraPattern:
         extra values ``vals`` (aligned with ``rows``, ``cols``); exact zeros dropped."""
         data = np.empty(len(self.indices))
         zeros = _values(el_data, self.el_pos, vals, self.order, self.start, self.c_pos, data)
-        indices, indptr = self.indices, self.indptr
-        if zeros:
-            nz = data != 0.0
-            data, indices = data[nz], indices[nz]
-            indptr = np.concatenate([[0], np.cumsum(np.bincount(self.col[nz], minlength=self.n_free))]).astype(np.int32)
+        return _csc(data, zeros, self.indices, self.indptr, self.col, self.n_free)
+
+
+@jit
+def _count_nodes(node, drow, kept, ptr):
+    """Entries per node column (``ptr[b + 1]``): the kept rows ``drow >= 0`` of every block holding
+    node ``b`` (once per slot) in a kept column (``kept[b]``); returns their number."""
+    ptr[:] = 0
+    n = 0
+    for blk in range(len(node)):
+        rows = 0
+        for i in range(drow.shape[1]):
+            if drow[blk, i] >= 0:
+                rows += 1
+        for s in range(node.shape[1]):
+            b = node[blk, s]
+            if kept[b]:
+                ptr[b + 1] += rows
+                n += rows
+    for j in range(len(ptr) - 1):
+        ptr[j + 1] += ptr[j]
+    return n
+
+
+@jit
+def _bucket_nodes(node, drow, kept, ptr, number, row):
+    """Stable bucketing by node column in the order of the entries of its ``q = 0`` dof column
+    (``coo_tocsr``): block, then row ``i``, then slot ``s``; entry number ``blk b^2 + i b + 6 s``."""
+    nxt = ptr[:-1].copy()
+    nb = drow.shape[1]
+    for blk in range(len(node)):
+        for i in range(nb):
+            r = drow[blk, i]
+            if r < 0:
+                continue
+            for s in range(node.shape[1]):
+                b = node[blk, s]
+                if kept[b]:
+                    number[nxt[b]] = blk * nb * nb + i * nb + 6 * s
+                    row[nxt[b]] = r
+                    nxt[b] += 1
+
+
+@jit
+def _merge_nodes(el_ptr, el_row, col_node, run_ptr, c_row, c_start, u_ptr, u_row, u_col, el_pos, c_pos):
+    """``_merge`` with the runs of node column ``col_node[j]`` (``run_ptr``) in dof column ``j``;
+    ``c_pos`` in the order column, run."""
+    n = 0
+    p = 0
+    u_ptr[0] = 0
+    for j in range(len(el_ptr) - 1):
+        a, a_end = el_ptr[j], el_ptr[j + 1]
+        b = col_node[j]
+        r, r_end = run_ptr[b], run_ptr[b + 1]
+        while True:
+            ra = el_row[a] if a < a_end else -1
+            rb = c_row[c_start[r]] if r < r_end else -1
+            if ra < 0 and rb < 0:
+                break
+            if rb < 0 or (0 <= ra < rb):
+                el_pos[a] = n
+                u_row[n] = ra
+                a += 1
+            elif ra < 0 or rb < ra:
+                c_pos[p] = n
+                p += 1
+                u_row[n] = rb
+                r += 1
+            else:
+                el_pos[a] = n
+                c_pos[p] = n
+                p += 1
+                u_row[n] = ra
+                a += 1
+                r += 1
+            u_col[n] = j
+            n += 1
+        u_ptr[j + 1] = n
+    return n
+
+
+@jit
+def _values_nodes(el_data, el_pos, vals, order, start, col_node, col_q, run_ptr, c_pos, out):
+    """``_values`` of ``BlockPattern``: dof column ``j`` sums the runs of its node column at the
+    entry numbers ``order + col_q[j]``, left to right; returns whether some value is exactly zero."""
+    out[:] = 0.0
+    for k in range(len(el_pos)):
+        out[el_pos[k]] = el_data[k]
+    p = 0
+    for j in range(len(col_node)):
+        b, q = col_node[j], col_q[j]
+        for u in range(run_ptr[b], run_ptr[b + 1]):
+            x = vals[order[start[u]] + q]
+            for s in range(start[u] + 1, start[u + 1]):
+                x += vals[order[s] + q]
+            out[c_pos[p]] += x
+            p += 1
+    for k in range(len(out)):
+        if out[k] == 0.0:
+            return True
+    return False
+
+
+@jit
+def _node_runs(row, ptr, start, run_ptr):
+    """``_runs`` per node column, with the first run of each column ``run_ptr[b]``."""
+    n = 0
+    for j in range(len(ptr) - 1):
+        run_ptr[j] = n
+        for s in range(ptr[j], ptr[j + 1]):
+            if s == ptr[j] or row[s] != row[s - 1]:
+                start[n] = s
+                n += 1
+    run_ptr[len(ptr) - 1] = n
+    start[n] = ptr[-1]
+    return n
+
+
+def whole_nodes(d):
+    """Whether the block dofs ``d`` ``(m, 6 k)`` come in whole nodes: ``d[:, 6 s + q] = 6 node + q``."""
+    d = np.asarray(d)
+    if d.ndim != 2 or d.shape[1] % 6 or not np.issubdtype(d.dtype, np.integer):
+        return False
+    first = d[:, 0::6]
+    return bool((first % 6 == 0).all() and (d.reshape(len(d), -1, 6) == first[:, :, None] + np.arange(6)).all())
+
+
+class BlockPattern:
+    """``ExtraPattern`` of the COO entries of dense blocks over the dofs ``d`` ``(m, 6 k)`` (whole
+    nodes: ``whole_nodes(d)``), ``rows = repeat(d, 6 k)``, ``cols = tile(d, 6 k)``: ``matrix``
+    gives ``K_el + csc_matrix((vals, (red[rows], red[cols])))`` of scipy bit for bit, ``vals``
+    the blocks ``(m, 6 k, 6 k)`` raveled.  ``spare``: the ``BlockPattern`` it replaces, whose
+    buffers (12 bytes per entry of a node column) are reused when large enough.
+    """
+
+    def __init__(self, d, red, n_free, el_indptr, el_indices, spare=None):
+        self.d, self.n_free = d, n_free
+        self.base = (red, el_indptr, el_indices)
+        red = np.ascontiguousarray(red, dtype=np.int64)
+        n_nodes = len(red) // 6
+        node = np.ascontiguousarray(d[:, 0::6] // 6, dtype=np.int64)
+        drow = red[d]
+        free_dofs = np.flatnonzero(red >= 0)
+        self.col_node, self.col_q = free_dofs // 6, free_dofs % 6
+        kept = np.zeros(n_nodes, dtype=bool)
+        kept[self.col_node] = True
+        ptr = np.empty(n_nodes + 1, dtype=np.int64)
+        n_kept = _count_nodes(node, drow, kept, ptr)
+        if spare is None or spare.buffers is None or len(spare.buffers[0]) < n_kept:
+            extra = n_kept + n_kept // 8           # room for a few more pairs next time
+            self.buffers = np.empty(extra, dtype=np.int64), np.empty(extra, dtype=np.int32)
         else:
-            indices, indptr = indices.copy(), indptr.copy()
-        return sp.csc_matrix((data, indices, indptr), shape=(self.n_free, self.n_free))
+            self.buffers = spare.buffers
+            spare.order = spare.buffers = None     # the old pattern is not used any more
+        number, row = self.buffers[0][:n_kept], self.buffers[1][:n_kept]
+        _bucket_nodes(node, drow, kept, ptr, number, row)
+        # scipy's own column sort (the one of ``coo.tocsc``), on the entry numbers
+        tmp = sp.csc_matrix((number, row, ptr.astype(np.int32)), shape=(max(n_free, 1), n_nodes), copy=False)
+        tmp.sort_indices()
+        c_row = tmp.indices
+        self.order = tmp.data
+        start = np.empty(n_kept + 1, dtype=np.int64)
+        self.run_ptr = np.empty(n_nodes + 1, dtype=np.int64)
+        n_runs = _node_runs(c_row, ptr, start, self.run_ptr)
+        self.start = start[:n_runs + 1].copy()
+        runs_per_col = np.diff(self.run_ptr)[self.col_node]
+        size = len(el_indices) + int(runs_per_col.sum())
+        u_ptr = np.empty(n_free + 1, dtype=np.int64)
+        u_row = np.empty(size, dtype=np.int32)
+        u_col = np.empty(size, dtype=np.int32)
+        self.el_pos = np.empty(len(el_indices), dtype=np.int64)
+        self.c_pos = np.empty(int(runs_per_col.sum()), dtype=np.int64)
+        n = _merge_nodes(np.asarray(el_indptr, dtype=np.int64), el_indices, self.col_node, self.run_ptr, c_row,
+                         self.start, u_ptr, u_row, u_col, self.el_pos, self.c_pos)
+        self.indices, self.col = u_row[:n].copy(), u_col[:n].copy()
+        self.indptr = u_ptr.astype(np.int32)
+
+    def same(self, d, base=None):
+        """Whether ``d`` is this pattern's block dofs (the same array, or an equal one), on the same
+        ``base = (red, el_indptr, el_indices)`` (the same arrays)."""
+        if base is not None and any(a is not b for a, b in zip(base, self.base)):
+            return False
+        return d is self.d or (d.shape == self.d.shape and np.array_equal(d, self.d))
+
+    def matrix(self, el_data, vals):
+        """CSC matrix from the element values ``el_data`` and the block values ``vals`` (the blocks
+        raveled, ``(m (6 k)^2,)``); exact zeros dropped."""
+        data = np.empty(len(self.indices))
+        zeros = _values_nodes(el_data, self.el_pos, vals, self.order, self.start, self.col_node, self.col_q,
+                              self.run_ptr, self.c_pos, data)
+        return _csc(data, zeros, self.indices, self.indptr, self.col, self.n_free)
+
+
+def _csc(data, zeros, indices, indptr, col, n_free):
+    """The union-pattern CSC matrix of ``data``, without its exact zeros (``zeros``: some are)."""
+    if zeros:
+        nz = data != 0.0
+        data, indices = data[nz], indices[nz]
+        indptr = np.concatenate([[0], np.cumsum(np.bincount(col[nz], minlength=n_free))]).astype(np.int32)
+    else:
+        indices, indptr = indices.copy(), indptr.copy()
+    return sp.csc_matrix((data, indices, indptr), shape=(n_free, n_free))

@@ -172,3 +172,104 @@ def test_pattern_built_on_the_buffers_of_the_last_one():
     assert _identical(fresh.matrix(el.data, vals), _scipy(el, *small, vals, red))
     vals = rng.standard_normal(len(big[0]))
     assert _identical(third.matrix(el.data, vals), _scipy(el, *big, vals, red))
+
+
+def _node_blocks(rng, n_nodes, m, k):
+    """Block dofs ``(m, 6 k)`` over ``k`` random nodes each (whole nodes, some repeated within a
+    block, as joined nodes share a representative)."""
+    nodes = rng.integers(0, n_nodes, size=(m, k))
+    nodes[::7, 1] = nodes[::7, 0]
+    return ((6 * nodes)[:, :, None] + np.arange(6)).reshape(m, 6 * k)
+
+
+def _coo_of(d):
+    b = d.shape[1]
+    return np.repeat(d, b, axis=1).ravel(), np.tile(d, (1, b)).ravel()
+
+
+def _reduction(rng, n_nodes, clamped, partial):
+    """``red`` over ``6 n_nodes`` unknowns: ``clamped`` nodes fully, ``partial`` nodes on some dofs fixed."""
+    free = np.ones(6 * n_nodes, dtype=bool)
+    for b in rng.choice(n_nodes, clamped, replace=False):
+        free[6 * b:6 * b + 6] = False
+    for b in rng.choice(n_nodes, partial, replace=False):
+        free[6 * b + rng.choice(6, 3, replace=False)] = False
+    red = np.full(6 * n_nodes, -1)
+    red[free] = np.arange(free.sum())
+    return red, int(free.sum())
+
+
+def test_block_pattern_is_scipys_matrix_bit_for_bit():
+    """``BlockPattern`` (built from the block dofs alone) gives scipy's ``K_el + csc_matrix`` of the
+    blocks' COO entries, on long columns (> 16 entries: std::sort's partitions, not an insertion
+    sort), clamped and partly fixed nodes, repeated nodes in a block, and for new values."""
+    from beamsolver.extra_pattern import BlockPattern, whole_nodes
+    rng = np.random.default_rng(11)
+    for trial in range(5):
+        n_nodes = 60 + 40 * trial
+        red, n = _reduction(rng, n_nodes, 5, 4)
+        el = _element_matrix(rng, n, 0.02)
+        d = _node_blocks(rng, n_nodes, 150 + 50 * trial, 4)
+        assert whole_nodes(d)
+        rows, cols = _coo_of(d)
+        pat = BlockPattern(d, red, n, el.indptr, el.indices)
+        for _ in range(3):
+            vals = rng.standard_normal(len(rows)) * 10.0 ** rng.integers(-8, 8, size=len(rows))
+            assert _identical(pat.matrix(el.data, vals), _scipy(el, rows, cols, vals, red))
+        # scipy sorts no column when all are sorted: nor does the pattern
+        one = d[:1]
+        vals = rng.standard_normal(24 * 24)
+        assert _identical(BlockPattern(one, red, n, el.indptr, el.indices).matrix(el.data, vals),
+                          _scipy(el, *_coo_of(one), vals, red))
+
+
+def test_whole_nodes_recognised():
+    from beamsolver.extra_pattern import whole_nodes
+    d = ((6 * np.array([[3, 1], [0, 2]]))[:, :, None] + np.arange(6)).reshape(2, 12)
+    assert whole_nodes(d)
+    bad = d.copy()
+    bad[1, 7] += 1
+    assert not whole_nodes(bad) and not whole_nodes(d + 1) and not whole_nodes(d[:, :10])
+
+
+def _system_matrices(s, d, K):
+    """``System.matrix`` of element values plus blocks ``K`` over dofs ``d`` handed over as
+    ``assemble_blocks`` does (``_block_coo``), and scipy's matrix of the same COO data."""
+    from beamsolver import assembly_jit
+    kvals = np.random.default_rng(len(d)).standard_normal(s.group_kslices[-1] + 36 * len(s.block_nodes))
+    extra = s._block_coo(d) + (K.ravel(),)
+    data = np.empty(s.nnz + 1)
+    assembly_jit.scatter(s.pos, kvals, data)
+    el = sp.csc_matrix((data[:s.nnz], s.indices, s.indptr), shape=(s.n_free, s.n_free))
+    return s.matrix(kvals, extra), _scipy(el, *_coo_of(d), K.ravel(), s.red)
+
+
+def test_system_matrix_as_the_active_set_changes():
+    """Through ``System.matrix``: contact-like blocks of a changing active set (pairs added,
+    dropped, the same set again, a set seen before) give scipy's matrix of the same COO data each
+    time; the pattern is rebuilt only when the set changes, on the buffers of the last one."""
+    import sys
+    from pathlib import Path
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+    import twisted_pair
+    from beamsolver.assembly import System
+    from beamsolver.extra_pattern import BlockPattern
+
+    model, _, _ = twisted_pair.build(n_elements=12, turns=0.5)
+    s = System(model)
+    rng = np.random.default_rng(2)
+    n_nodes = s.n_nodes
+    pairs = rng.integers(0, n_nodes, size=(400, 4))
+    sets = [np.arange(300), np.arange(300), np.arange(20, 330), np.arange(0, 400, 2), np.arange(300),
+            np.arange(5)]
+    built = []
+    for sel in sets:
+        d = ((6 * s.rep[pairs[sel]])[:, :, None] + np.arange(6)).reshape(len(sel), 24)
+        K = rng.standard_normal((len(sel), 24, 24))
+        K[:, ::5] = 0.0                          # exact zeros on the way
+        ours, ref = _system_matrices(s, d, K)
+        assert _identical(ours, ref)
+        assert isinstance(s._extra_cache, BlockPattern)
+        built.append((s._extra_cache, s._extra_cache.buffers[0]))
+    assert built[0][0] is built[1][0] and built[1][0] is not built[2][0] and built[4][0] is not built[0][0]
+    assert all(b[1] is built[0][1] for b in built)       # every set fits the first one's buffers
