@@ -568,13 +568,21 @@ class System:
     def _extra_pattern(self, extra):
         """The pattern of the COO entries ``extra`` (kept while it stays: the same active contact
         pairs): ``extra_pattern.BlockPattern`` of the block dofs when they are the index arrays of
-        ``_block_coo`` over whole nodes, else ``extra_pattern.ExtraPattern``."""
+        ``_block_coo`` over whole nodes (possibly followed by ``_concat_coo``'s), else
+        ``extra_pattern.ExtraPattern``."""
         p = getattr(self, "_extra_cache", None)
         base = (self.red, self.indptr, self.indices)
-        c = getattr(self, "_coo_index", None)
-        if c is not None and extra[0] is c[1] and extra[1] is c[2] and c[3]:
-            if not isinstance(p, BlockPattern) or not p.same(c[0], base):
-                p = self._extra_cache = BlockPattern(c[0], self.red, self.n_free, self.indptr, self.indices,
+        c, cc = getattr(self, "_coo_index", None), getattr(self, "_coo_concat", None)
+        blocks = c is not None and c[3]
+        if blocks and extra[0] is c[1] and extra[1] is c[2]:
+            tail = None
+        elif blocks and cc is not None and extra[0] is cc[4] and extra[1] is cc[5] and cc[0] is c[1] and cc[1] is c[2]:
+            tail = cc[2], cc[3]
+        else:
+            blocks = False
+        if blocks:
+            if not isinstance(p, BlockPattern) or not p.same(c[0], tail, base):
+                p = self._extra_cache = BlockPattern(c[0], self.red, self.n_free, self.indptr, self.indices, tail,
                                                      spare=p if isinstance(p, BlockPattern) else None)
         elif not isinstance(p, ExtraPattern) or not p.same(extra[0], extra[1], base):
             p = self._extra_cache = ExtraPattern(extra[0], extra[1], self.red, self.n_free, self.indptr,

@@ -273,3 +273,50 @@ def test_system_matrix_as_the_active_set_changes():
         built.append((s._extra_cache, s._extra_cache.buffers[0]))
     assert built[0][0] is built[1][0] and built[1][0] is not built[2][0] and built[4][0] is not built[0][0]
     assert all(b[1] is built[0][1] for b in built)       # every set fits the first one's buffers
+
+
+def test_block_pattern_with_a_tail_of_entries():
+    """Blocks followed by other COO entries (``assemble_blocks``' terms of global-type nodes, any
+    entries): the columns they reach are sorted on their own, with scipy's result bit for bit."""
+    from beamsolver.extra_pattern import BlockPattern
+    rng = np.random.default_rng(17)
+    for trial in range(4):
+        n_nodes = 80 + 30 * trial
+        red, n = _reduction(rng, n_nodes, 4, 6)
+        el = _element_matrix(rng, n, 0.03)
+        d = _node_blocks(rng, n_nodes, 200, 4)
+        g = rng.choice(n_nodes, 5, replace=False)          # global-node-like terms, then random entries
+        t_rows = np.concatenate([np.repeat(6 * g, 18) + np.tile(np.repeat(np.arange(6), 3), len(g)),
+                                 rng.integers(0, 6 * n_nodes, 40)])
+        t_cols = np.concatenate([np.repeat(6 * g, 18) + 3 + np.tile(np.arange(3), 6 * len(g)),
+                                 rng.integers(0, 6 * n_nodes, 40)])
+        rows, cols = (np.concatenate([a, b]) for a, b in zip(_coo_of(d), (t_rows, t_cols)))
+        pat = BlockPattern(d, red, n, el.indptr, el.indices, (t_rows, t_cols))
+        for _ in range(2):
+            vals = rng.standard_normal(len(rows)) * 10.0 ** rng.integers(-8, 8, size=len(rows))
+            assert _identical(pat.matrix(el.data, vals), _scipy(el, rows, cols, vals, red))
+        assert not pat.same(d, None) and pat.same(d.copy(), (t_rows.copy(), t_cols.copy()))
+
+
+def test_contact_scene_with_global_nodes_takes_the_block_path():
+    """The twisted pair's contact reaches global-type nodes (partly fixed ends): its tangent is
+    built by ``BlockPattern`` with the global-node terms as a tail, equal to scipy's."""
+    import sys
+    from pathlib import Path
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+    import twisted_pair
+    from beamsolver import assembly_jit
+    from beamsolver.extra_pattern import BlockPattern
+    from beamsolver.problem import Problem
+
+    model, _, _ = twisted_pair.build(n_elements=8, turns=0.5)
+    problem = Problem.from_model(model)
+    s = problem.system
+    H = s.poses0.copy()
+    problem.begin_step(H, 0.0)
+    ev = problem.evaluate(H, 0.0, tangent=True)
+    data = np.empty(s.nnz + 1)
+    assembly_jit.scatter(s.pos, ev.kvals, data)
+    el = sp.csc_matrix((data[:s.nnz], s.indices, s.indptr), shape=(s.n_free, s.n_free))
+    assert _identical(problem.tangent(ev), _scipy(el, *ev.extra, s.red))
+    assert isinstance(s._extra_cache, BlockPattern) and s._extra_cache.tail is not None
