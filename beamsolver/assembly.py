@@ -15,6 +15,8 @@ global-type nodes the term ``[[0, -hat(r_u)], [0, -hat(r_w)]]`` from the
 dependence of ``M`` on ``R`` (``r`` in global components), which keeps Newton
 quadratic.
 """
+import sys
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -31,6 +33,9 @@ FREE, GLOBAL, CLAMPED, PRESCRIBED = 0, 1, 2, 3
 # rank tolerance of the rigid-mode check: the constraint rows mix unit rotations with lever arms
 # in units of the group's size (``_rigid_mode_rank``), so entries are O(1)
 RIGID_MODE_TOL = 1e-9
+# buffers are reused when ``sys.getrefcount`` shows nothing else holds them, a count that is an
+# implementation detail (CPython 3.14 borrows references on the stack): only where it was checked
+REUSE_BUFFERS = sys.implementation.name == "cpython" and sys.version_info < (3, 14)
 
 
 def _rigid_mode_rank(x, fixed):
@@ -427,12 +432,28 @@ class System:
         same (read-only) arrays while ``d`` stays the same, which ``matrix`` recognises at once."""
         c = getattr(self, "_coo_index", None)
         if c is None or c[0].shape != d.shape or not np.array_equal(c[0], d):
-            k, d32 = d.shape[1], d.astype(np.int32)      # int32: half the memory of a fresh pattern
-            c = (d.copy(), np.repeat(d32, k, axis=1).ravel(), np.tile(d32, (1, k)).ravel())
-            for a in c:
-                a.flags.writeable = False
-            self._coo_index = c + (whole_nodes(d),)
+            self._coo_index = c = None           # its arrays may be reused once nothing else holds them
+            m, k = d.shape
+            buf = self._coo_buffer(m * k * k)
+            rows, cols = buf[0, :m * k * k], buf[1, :m * k * k]     # int32: half the memory of int64
+            rows.reshape(m, k, k)[...] = d[:, :, None]
+            cols.reshape(m, k, k)[...] = d[:, None, :]
+            rows.flags.writeable = cols.flags.writeable = False
+            c = self._coo_index = (d.copy(), rows, cols, whole_nodes(d))
         return c[1], c[2]
+
+    def _coo_buffer(self, n):
+        """A ``(2, >= n)`` int32 buffer for ``_block_coo``'s index arrays: a kept one that no array
+        handed out any more is a view of (an evaluation's ``extra`` may outlive the pattern), else a
+        new one with room for a few more blocks; at most two kept.  Fresh memory costs page faults
+        (66 MB for the 19-wire bundle's contact)."""
+        pool = getattr(self, "_coo_pool", [])
+        for b in pool if REUSE_BUFFERS else ():
+            if b.shape[1] >= n and sys.getrefcount(b) <= 3:      # the pool, ``b`` and the call's argument
+                return b
+        b = np.empty((2, n + n // 8 if REUSE_BUFFERS else n), dtype=np.int32)
+        self._coo_pool = [b] + pool[:1]
+        return b
 
     def _concat_coo(self, a, b):
         """``_concat(a, b)`` whose index arrays are kept (the same read-only arrays) while ``a``'s are the

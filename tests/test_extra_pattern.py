@@ -320,3 +320,34 @@ def test_contact_scene_with_global_nodes_takes_the_block_path():
     el = sp.csc_matrix((data[:s.nnz], s.indices, s.indptr), shape=(s.n_free, s.n_free))
     assert _identical(problem.tangent(ev), _scipy(el, *ev.extra, s.red))
     assert isinstance(s._extra_cache, BlockPattern) and s._extra_cache.tail is not None
+
+
+def test_block_coo_buffers_reused_only_when_free():
+    """``_block_coo``'s index arrays of a new block set reuse the memory of earlier ones only once no
+    array handed out is a view of it: arrays still held (an evaluation's ``extra``) keep their values."""
+    import sys
+    from pathlib import Path
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+    import twisted_pair
+    from beamsolver.assembly import REUSE_BUFFERS, System
+
+    model, _, _ = twisted_pair.build(n_elements=12, turns=0.5)
+    s = System(model)
+    rng = np.random.default_rng(4)
+    sets = [((6 * rng.integers(0, s.n_nodes, size=(m, 4)))[:, :, None] + np.arange(6)).reshape(m, 24)
+            for m in (50, 40, 45, 30)]
+    held = [s._block_coo(d) for d in sets[:3]]          # all three held: three buffers
+    for d, (rows, cols) in zip(sets, held):
+        assert np.array_equal(rows, np.repeat(d, 24, axis=1).ravel())
+        assert np.array_equal(cols, np.tile(d, (1, 24)).ravel())
+        assert not rows.flags.writeable
+    assert not np.shares_memory(held[0][0], held[1][0]) and not np.shares_memory(held[1][0], held[2][0])
+    kept = held[2]
+    del held, rows, cols
+    pool = [id(b) for b in s._coo_pool]
+    new = s._block_coo(sets[3])
+    assert np.array_equal(kept[0], np.repeat(sets[2], 24, axis=1).ravel())
+    assert np.array_equal(new[0], np.repeat(sets[3], 24, axis=1).ravel())
+    if REUSE_BUFFERS:                    # the pool's other buffer (the second set's) is free again
+        assert not np.shares_memory(new[0], kept[0]) and np.shares_memory(new[0], s._coo_pool[1])
+        assert [id(b) for b in s._coo_pool] == pool

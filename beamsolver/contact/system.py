@@ -577,7 +577,8 @@ class ContactSystem(Contribution):
         for b in self._K_pool if REUSE_BUFFERS else ():
             if len(b) >= m and sys.getrefcount(b) <= 3:      # the pool, ``b`` and the call's argument
                 return b[:m]
-        b = np.empty((m, 24, 24))
+        # room for a few more pairs: an active set growing by one pair does not need fresh memory
+        b = np.empty((m + m // 8 if REUSE_BUFFERS else m, 24, 24))
         self._K_pool = [b] + self._K_pool[:1]
         return b[:m]
 
