@@ -307,15 +307,52 @@ def _values_nodes(el_data, el_pos, vals, order, start, col_src, col_off, run_ptr
     out[:] = 0.0
     for k in range(len(el_pos)):
         out[el_pos[k]] = el_data[k]
+    # the consecutive columns of one source column together (a node's: one pass over its entries,
+    # whose values sit side by side); each column's sums in its own order
+    x = np.empty(6)
     p = 0
-    for j in range(len(col_src)):
-        b, q = col_src[j], col_off[j]
-        for u in range(run_ptr[b], run_ptr[b + 1]):
-            x = vals[order[start[u]] + q]
+    j = 0
+    while j < len(col_src):
+        b = col_src[j]
+        nq = 1
+        while nq < 6 and j + nq < len(col_src) and col_src[j + nq] == b:
+            nq += 1
+        r0, r1 = run_ptr[b], run_ptr[b + 1]
+        nr = r1 - r0
+        if nq == 6:                          # a free node: its six columns, offsets 0..5
+            for u in range(r0, r1):
+                o = order[start[u]]
+                x0, x1, x2, x3, x4, x5 = vals[o], vals[o + 1], vals[o + 2], vals[o + 3], vals[o + 4], vals[o + 5]
+                for s in range(start[u] + 1, start[u + 1]):
+                    o = order[s]
+                    x0 += vals[o]
+                    x1 += vals[o + 1]
+                    x2 += vals[o + 2]
+                    x3 += vals[o + 3]
+                    x4 += vals[o + 4]
+                    x5 += vals[o + 5]
+                k = p + u - r0
+                out[c_pos[k]] += x0
+                out[c_pos[k + nr]] += x1
+                out[c_pos[k + 2 * nr]] += x2
+                out[c_pos[k + 3 * nr]] += x3
+                out[c_pos[k + 4 * nr]] += x4
+                out[c_pos[k + 5 * nr]] += x5
+            p += 6 * nr
+            j += 6
+            continue
+        for u in range(r0, r1):
+            o = order[start[u]]
+            for g in range(nq):
+                x[g] = vals[o + col_off[j + g]]
             for s in range(start[u] + 1, start[u + 1]):
-                x += vals[order[s] + q]
-            out[c_pos[p]] += x
-            p += 1
+                o = order[s]
+                for g in range(nq):
+                    x[g] += vals[o + col_off[j + g]]
+            for g in range(nq):
+                out[c_pos[p + g * (r1 - r0) + u - r0]] += x[g]
+        p += nq * (r1 - r0)
+        j += nq
     for k in range(len(out)):
         if out[k] == 0.0:
             return True
