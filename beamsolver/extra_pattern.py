@@ -26,9 +26,15 @@ bit for bit (the same values summed in the same order, the same stored entries):
 with ``d[:, 6 s + q] = 6 node + q``), built from ``d`` alone, six times less work: the 6
 columns of a node hold the same rows in the same order (one row of ``d`` per block), so
 scipy's sort, which compares rows only, moves their entries alike; the build buckets and
-sorts one column per node (entry numbers of its ``q = 0`` column) and an evaluation reads
-column ``q`` at number ``+ q``.  A new active set costs a new pattern; ``BlockPattern`` needs
-no ``(rows, cols)`` arrays of the entries.
+sorts one column per node (entry numbers of its ``q = 0`` column) in one scipy sort, and an
+evaluation reads column ``q`` at number ``+ q`` (a free node's six columns in one pass).  The
+only caveat is scipy's "skip the sort when every column is sorted": the node columns are those
+of the kept dof columns, so the test sees the same columns.  Entries after the blocks (a
+``tail``: ``assemble_blocks``' terms of global-type nodes) make the dof columns they reach
+special: those are bucketed (block entries, then tail entries) and sorted on their own, in
+the same scipy sort.  A new active set costs a new pattern (about half of the Newton
+iterations of the example solves meet one): 19-wire bundle, 3002 elements, 8.2e6 contact
+entries, 1.4e6 node-column entries, build 30-70 ms against 280-540 ms for ``ExtraPattern``.
 """
 import numpy as np
 import scipy.sparse as sp
