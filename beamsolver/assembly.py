@@ -586,6 +586,13 @@ class System:
             return self._extra_pattern(extra).matrix(data[:self.nnz], extra[2])
         return canonical_csc(data[:self.nnz], self.indices, self.indptr, self.n_free)
 
+    @property
+    def extra_pattern(self):
+        """The cached pattern of the contributions' COO entries of the last ``matrix`` call
+        (``extra_pattern.BlockPattern`` or ``ExtraPattern``; ``None`` before): a new object
+        whenever the entries' pattern changed (a new active contact set)."""
+        return getattr(self, "_extra_cache", None)
+
     def _extra_pattern(self, extra):
         """The pattern of the COO entries ``extra`` (kept while it stays: the same active contact
         pairs): ``extra_pattern.BlockPattern`` of the block dofs when they are the index arrays of

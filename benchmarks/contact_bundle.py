@@ -58,14 +58,15 @@ _COUNTER = """
 import json, runpy, sys
 from beamsolver import assembly
 n = dict(tangents=0, new=0)
-build = assembly.System._extra_pattern
-def counted(self, extra):
-    before = getattr(self, "_extra_cache", None)
-    p = build(self, extra)
-    n["tangents"] += 1
-    n["new"] += p is not before
-    return p
-assembly.System._extra_pattern = counted
+matrix = assembly.System.matrix
+def counted(self, kvals, extra=None):
+    before = self.extra_pattern
+    K = matrix(self, kvals, extra)
+    if extra is not None and len(extra[2]):
+        n["tangents"] += 1
+        n["new"] += self.extra_pattern is not before
+    return K
+assembly.System.matrix = counted
 sys.argv = [sys.argv[1]]
 runpy.run_path(sys.argv[0], run_name="__main__")
 print("COUNTS", json.dumps(n))

@@ -232,16 +232,17 @@ def test_whole_nodes_recognised():
     assert not whole_nodes(bad) and not whole_nodes(d + 1) and not whole_nodes(d[:, :10])
 
 
-def _system_matrices(s, d, K):
-    """``System.matrix`` of element values plus blocks ``K`` over dofs ``d`` handed over as
-    ``assemble_blocks`` does (``_block_coo``), and scipy's matrix of the same COO data."""
+def _system_matrices(s, nodes, K):
+    """``System.matrix`` of element values plus blocks ``K`` over ``nodes`` ``(m, 4)`` handed over by
+    ``assemble_blocks`` (as contact's), and scipy's matrix of the same COO data."""
     from beamsolver import assembly_jit
-    kvals = np.random.default_rng(len(d)).standard_normal(s.group_kslices[-1] + 36 * len(s.block_nodes))
-    extra = s._block_coo(d) + (K.ravel(),)
+    from beamsolver.blocks import Blocks
+    kvals = np.random.default_rng(len(nodes)).standard_normal(s.group_kslices[-1] + 36 * len(s.block_nodes))
+    _, extra, _, _ = s.assemble_blocks(s.poses0, Blocks(nodes, np.zeros((len(nodes), 24)), K))
     data = np.empty(s.nnz + 1)
     assembly_jit.scatter(s.pos, kvals, data)
     el = sp.csc_matrix((data[:s.nnz], s.indices, s.indptr), shape=(s.n_free, s.n_free))
-    return s.matrix(kvals, extra), _scipy(el, *_coo_of(d), K.ravel(), s.red)
+    return s.matrix(kvals, extra), _scipy(el, *extra, s.red)
 
 
 def test_system_matrix_as_the_active_set_changes():
@@ -264,13 +265,12 @@ def test_system_matrix_as_the_active_set_changes():
             np.arange(5)]
     built = []
     for sel in sets:
-        d = ((6 * s.rep[pairs[sel]])[:, :, None] + np.arange(6)).reshape(len(sel), 24)
         K = rng.standard_normal((len(sel), 24, 24))
         K[:, ::5] = 0.0                          # exact zeros on the way
-        ours, ref = _system_matrices(s, d, K)
+        ours, ref = _system_matrices(s, pairs[sel], K)
         assert _identical(ours, ref)
-        assert isinstance(s._extra_cache, BlockPattern)
-        built.append((s._extra_cache, s._extra_cache.buffers[0]))
+        assert isinstance(s.extra_pattern, BlockPattern)
+        built.append((s.extra_pattern, s.extra_pattern.buffers[0]))
     assert built[0][0] is built[1][0] and built[1][0] is not built[2][0] and built[4][0] is not built[0][0]
     assert all(b[1] is built[0][1] for b in built)       # every set fits the first one's buffers
 
@@ -319,35 +319,45 @@ def test_contact_scene_with_global_nodes_takes_the_block_path():
     assembly_jit.scatter(s.pos, ev.kvals, data)
     el = sp.csc_matrix((data[:s.nnz], s.indices, s.indptr), shape=(s.n_free, s.n_free))
     assert _identical(problem.tangent(ev), _scipy(el, *ev.extra, s.red))
-    assert isinstance(s._extra_cache, BlockPattern) and s._extra_cache.tail is not None
+    assert isinstance(s.extra_pattern, BlockPattern) and s.extra_pattern.tail is not None
 
 
-def test_block_coo_buffers_reused_only_when_free():
-    """``_block_coo``'s index arrays of a new block set reuse the memory of earlier ones only once no
-    array handed out is a view of it: arrays still held (an evaluation's ``extra``) keep their values."""
+def test_block_index_arrays_reused_only_when_free():
+    """The COO index arrays of a new block set reuse the memory of earlier ones only once no array
+    handed out is a view of it: arrays still held (an evaluation's ``extra``) keep their values."""
     import sys
     from pathlib import Path
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
     import twisted_pair
     from beamsolver.assembly import REUSE_BUFFERS, System
+    from beamsolver.blocks import Blocks
 
     model, _, _ = twisted_pair.build(n_elements=12, turns=0.5)
     s = System(model)
     rng = np.random.default_rng(4)
-    sets = [((6 * rng.integers(0, s.n_nodes, size=(m, 4)))[:, :, None] + np.arange(6)).reshape(m, 24)
-            for m in (50, 40, 45, 30)]
-    held = [s._block_coo(d) for d in sets[:3]]          # all three held: three buffers
-    for d, (rows, cols) in zip(sets, held):
+    plain = np.flatnonzero(~s.transformed & s.is_rep)     # no transform, no global-node terms
+    sets = [rng.choice(plain, size=(m, 4)) for m in (50, 40, 45, 30)]
+
+    def index(nodes):
+        d = ((6 * s.rep[nodes])[:, :, None] + np.arange(6)).reshape(len(nodes), 24)
+        blocks = Blocks(nodes, np.zeros((len(nodes), 24)), np.zeros((len(nodes), 24, 24)))
+        return d, s.assemble_blocks(s.poses0, blocks)[1][:2]
+
+    def address(a):
+        return a.__array_interface__["data"][0]
+
+    held = [index(nodes) for nodes in sets[:3]]          # all three held: three buffers
+    for d, (rows, cols) in held:
         assert np.array_equal(rows, np.repeat(d, 24, axis=1).ravel())
         assert np.array_equal(cols, np.tile(d, (1, 24)).ravel())
         assert not rows.flags.writeable
-    assert not np.shares_memory(held[0][0], held[1][0]) and not np.shares_memory(held[1][0], held[2][0])
-    kept = held[2]
-    del held, rows, cols
-    pool = [id(b) for b in s._coo_pool]
-    new = s._block_coo(sets[3])
-    assert np.array_equal(kept[0], np.repeat(sets[2], 24, axis=1).ravel())
-    assert np.array_equal(new[0], np.repeat(sets[3], 24, axis=1).ravel())
-    if REUSE_BUFFERS:                    # the pool's other buffer (the second set's) is free again
-        assert not np.shares_memory(new[0], kept[0]) and np.shares_memory(new[0], s._coo_pool[1])
-        assert [id(b) for b in s._coo_pool] == pool
+    assert len({address(h[1][0]) for h in held}) == 3
+    second = address(held[1][1][0])
+    d_kept, kept = held[2]
+    del held, d, rows, cols
+    d_new, new = index(sets[3])
+    assert np.array_equal(kept[0], np.repeat(d_kept, 24, axis=1).ravel())
+    assert np.array_equal(new[0], np.repeat(d_new, 24, axis=1).ravel())
+    assert np.array_equal(new[1], np.tile(d_new, (1, 24)).ravel())
+    if REUSE_BUFFERS:                    # the second set's buffer is free again: reused
+        assert address(new[0]) == second
