@@ -43,7 +43,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .. import se3
-from ..blocks import Blocks, Contribution
+from ..blocks import REUSE_BUFFERS, Blocks, Contribution
 from ..errors import InputError
 from ..failures import ContactTunnelling, NoContactNormal
 from ..model import JOIN_TOL
@@ -57,10 +57,6 @@ from .projection import closest_points, element_twists, project_points, section_
 from .search import broad_phase, element_spheres
 from . import rules
 
-# ``_tangent_out`` tells a buffer nobody holds by ``sys.getrefcount``, whose count of the caller's
-# own references is an implementation detail (CPython 3.14 borrows references on the stack):
-# buffers are reused only on the CPython versions where that count was checked, else made anew.
-REUSE_BUFFERS = sys.implementation.name == "cpython" and sys.version_info < (3, 14)
 
 MAX_AUGMENT = 30
 TIMED = ("search", "rules", "projection", "params", "kernel", "blocks")   # parts of ``ContactSystem.timings``
