@@ -119,7 +119,7 @@ solve_options = dict(steps=40, stabilize=2e-2)   # for `beamsolver run examples/
 
 
 def build(turns=5.0, n_elements=16, mu=0.3, imperfection=1e-2, pull=PULL, E=200e9, nu=0.3, length=LENGTH,
-          approach=None, pieces=2, twist_until=1.0, relax=None, smoothing=2e-3):
+          approach=None, pieces=2, twist_until=1.0, relax=None, smoothing=2e-3, line_angle=None):
     """Returns ``(model, plate node, (wire a, wire b))``, each wire a tuple of ``pieces`` beams
     (bottom to top) of ``n_elements // pieces`` elements joined rigidly.  ``approach=None``: a
     dead ``pull`` on the plate (free in ``z``); a number ``s``: extension control, the plate's
@@ -165,6 +165,8 @@ def build(turns=5.0, n_elements=16, mu=0.3, imperfection=1e-2, pull=PULL, E=200e
             bs.motion.translation(lambda t: (0.0, 0.0, -approach * length * stage2(t))),
             bs.motion.rotation((0.0, 0.0, 1.0), angle)))
     opts = dict(mu=mu, smoothing=smoothing * R)
+    if line_angle is not None:
+        opts["line_angle"] = np.radians(line_angle)
     model.add_contact(list(wires[0]), list(wires[1]), **opts)
     for wire in wires:
         for i, j in zip(*np.triu_indices(pieces, 1)):
@@ -228,12 +230,12 @@ def onset(rows):
 
 def main(output=None, turns=5.0, steps=40, n_elements=16, mu=0.3, stabilize=2e-2, imperfection=1e-2,
          verbose=False, length=LENGTH, pull=PULL, approach=None, pieces=2, min_step_ratio=2.0**-12,
-         twist_until=1.0, relax=None, path="load", smoothing=2e-3):
+         twist_until=1.0, relax=None, path="load", smoothing=2e-3, line_angle=None):
     """Solve, print the table and the checks; returns ``(solution, rows, wall time, checks)``."""
     model, plate, wires = build(turns=turns, n_elements=n_elements, mu=mu, imperfection=imperfection,
                                  length=length, pull=pull, approach=approach,
                                  pieces=pieces, twist_until=twist_until, relax=relax,
-                                 smoothing=smoothing)
+                                 smoothing=smoothing, line_angle=line_angle)
     t0 = time.perf_counter()
     try:
         sol = bs.solve(model, steps=steps, output=output, verbose=verbose, stabilize=stabilize,
@@ -301,8 +303,9 @@ if __name__ == "__main__":
     ap.add_argument("--relax", type=float, default=None, help="dead pull [N] at t = 1 (with --twist-until)")
     ap.add_argument("--path", default="load", help="solve(path=): load or arc-length")
     ap.add_argument("--smoothing", type=float, default=2e-3, help="contact smoothing gap / wire radius")
+    ap.add_argument("--line-angle", type=float, default=None, help="add_contact(line_angle=) in degrees")
     a = ap.parse_args()
     main(output=a.output, turns=a.turns, steps=a.steps, n_elements=a.elements, mu=a.mu, stabilize=a.stabilize,
          imperfection=a.imperfection, verbose=True, length=a.length, pull=a.pull,
          approach=a.approach, pieces=a.pieces, min_step_ratio=a.min_step_ratio, twist_until=a.twist_until,
-         relax=a.relax, path=a.path, smoothing=a.smoothing)
+         relax=a.relax, path=a.path, smoothing=a.smoothing, line_angle=a.line_angle)
