@@ -111,3 +111,16 @@ def test_two_stage_path_holds_the_turns_while_the_pull_relaxes():
         plectoneme.build(n_elements=8, relax=300.0)
     with pytest.raises(plectoneme.bs.InputError, match="twist_until"):
         plectoneme.build(n_elements=8, twist_until=0.0)
+
+
+def test_two_stage_run_holds_lk_while_the_pull_relaxes():
+    """A reduced two-stage run: the straight two-ply twisted 1 turn under 2000 N, the pull then
+    lowered to 300 N (still far above the critical pull of 1 turn): ``Lk`` stays 1, all twist."""
+    sol, rows, _, checks = plectoneme.main(turns=1.0, steps=4, n_elements=8, mu=0.0, stabilize=None, length=0.06,
+                                           pull=2000.0, relax=300.0, twist_until=0.5)
+    t = np.array([r.t for r in rows])
+    assert t[-1] == pytest.approx(1.0) and checks["reached"] == pytest.approx(1.0)
+    lk, tw, wr, axial = (np.array([getattr(r, f) for r in rows]) for f in ("lk", "tw", "wr", "axial"))
+    assert np.allclose(lk, np.minimum(t / 0.5, 1.0))
+    assert np.allclose(axial, 2000.0 - 1700.0 * np.clip((t - 0.5) / 0.5, 0, 1), rtol=1e-6)
+    assert np.abs(wr).max() < 1e-3 and np.allclose(tw + wr, lk, atol=1e-6)
