@@ -75,33 +75,36 @@ where every run stalls.
 Two-stage path, the magnetic-tweezers protocol (``--twist-until t1 --relax F``): the turns are
 reached at ``t1`` under a dead pull high enough to keep the two-ply straight (Greenhill with
 tension, ``M_c = 2 B sqrt((4.49 / L)^2 + F / B)``), then held, ``Lk`` fixed, while the pull falls
-linearly to ``F`` until the pair writhes.  So the run passes 5 turns before any instability;
-``--length 0.06 --mu 0 --pull 2000 --relax 300 --twist-until 0.5 --turns 5.5 --steps 40
---stabilize 2e-2``: the straight two-ply twists to 5.5 turns (9.55 N m, plate 60.38 -> 57.84 mm,
-``Wr = 0``, ``Lk = Tw`` to 3e-8); with ``--elements 24`` it writhes as the pull falls to 1180 N at
-9.43 N m (``M_c = 10.1``; ``--mu 0.3``: 778 N), a loop grows near the plate and the plate falls
-under the dead pull; the run stops at ``t = 0.796``, 993 N, plate 42.5 mm, ``Wr = 1.55``,
-``Wr / Lk = 0.28``, ``|Lk - Tw - Wr| / Lk <= 1.4e-2``, dissipated 0.32 (polluted, warned), 190 s,
-Newton failing in the tight loop (``--pieces 4``: "elements turn by up to 2.04 rad within one
-element").  ``--mu 0.3`` stops alike at 5.5 turns, ``Wr / Lk = 0.28``, 678 N; with two pieces
-the loop near the plate lies in one beam (no self-contact): for one step the pair passes through
-itself, ``Wr`` jumps by about 2 and ``|Lk - Tw - Wr| / Lk = 0.35``.  ``--elements 48 --pieces 4``
-(and ``--pieces 8``): onset at 1250 N, stops at ``t = 0.762``, 1110 N, plate 46.8 mm, ``Wr = 0.98``,
-``Wr / Lk = 0.18``, ``|Lk - Tw - Wr| / Lk <= 7.9e-4``, dissipated 0.098, 785 s (1218 s): steps of
-6e-6 with damping do not converge (scaled residual 0.024, positive definite tangent) as the loop
-closes, its arms in contact (centre distance 0.93 mm of 1 mm: self-contact active).
-``--stabilize 0.2`` (48 elements, 4 pieces) carries the snap further in pseudo-time and stops
-alike once the loop has closed: ``t = 0.879``, 712 N, plate 44.5 mm, ``Wr = 1.08``,
-``Wr / Lk = 0.20``, dissipated 0.18, 569 s (scaled residual 0.76 at steps of 6e-6).  A longer pair
-writhes at a lower pull (a wider loop, ``sqrt(B / F)``): ``--length 0.09 --elements 64
---pieces 4 --relax 100`` twists straight to 5.5 turns at 6.16 N m (``Lk = Tw`` to 1e-11) and
-writhes from 385 N (``M_c = 6.4`` N m), reaching ``t = 1`` at 100 N mid-snap: ``Wr = 0.52``,
-``Wr / Lk = 0.094``, plate 88.9 -> 72.9 mm, ``|Lk - Tw - Wr| / Lk <= 4.5e-5``, dissipated 0.07,
-770 s.
+linearly to ``F``, so the pair writhes at ``Lk`` = 5.5 turns:
+
+    python examples/plectoneme.py --length 0.06 --elements 48 --pieces 4 --mu 0 --pull 2000 --relax 300
+        --twist-until 0.5 --turns 5.5 --steps 40 --stabilize 0.2
+
+The straight two-ply twists to 5.5 turns (9.55 N m, plate 60.38 -> 57.84 mm, ``Wr = 0``,
+``Lk = Tw`` to 3e-8), writhes from 1250 N (9.41 N m; ``M_c = 10.1``), a loop grows near the plate
+and the plate falls under the dead pull (``docs/plectoneme.png``: the last step); the run stops
+at ``t = 0.879``, 712 N, plate 44.5 mm, ``Wr = 1.08``, ``Wr / Lk = 0.20``,
+``|Lk - Tw - Wr| / Lk <= 7.8e-4``, dissipated 0.18 of the strain energy (warned), 446-569 s: steps
+of 6e-6 do not converge (scaled residual 0.76, positive definite tangent) once the loop has
+closed, its arms crossing at 57-85 deg with contact forces about 1.2 kN, every contact of kind
+orthogonal projection (Gauss points), none of kind point.  Every variant stops there, at
+``Wr`` = 1.0-1.1 (one loop, no plectoneme yet), with ``|Lk - Tw - Wr| / Lk < 1e-3``:
+``--stabilize 2e-2`` at ``t = 0.762`` (1110 N, ``Wr / Lk = 0.18``, dissipated 0.098), ``--pieces 8``
+the same, contact ``--smoothing 0.1`` (gap / R) at ``t = 0.846`` (``Wr = 1.01``), ``--line-angle 50``
+at ``t = 0.873`` (``Wr = 0.99``; crossing pairs still orthogonal, 1.4 kN).  With 24 elements
+(``--stabilize 2e-2``, ``mu = 0`` / ``0.3``: writhing from 1180 / 778 N) the loop goes on to
+``Wr = 1.55``, ``Wr / Lk = 0.28``, then "elements turn by up to 2.04 rad within one element" (the
+loop is 5 elements); with two pieces the loop near the plate lies in one beam (no self-contact)
+and for one step the pair passes through itself (``|Lk - Tw - Wr| / Lk = 0.35``).  A longer pair
+writhes at a lower pull (a wider loop, ``sqrt(B / F)``): ``--length 0.09 --elements 64 --relax
+100 --stabilize 2e-2`` twists straight to 5.5 turns at 6.16 N m and writhes from 385 N
+(``M_c = 6.4`` N m), reaching ``t = 1`` at 100 N mid-snap (``Wr = 0.52``, ``Wr / Lk = 0.094``,
+plate 88.9 -> 72.9 mm, ``|Lk - Tw - Wr| / Lk <= 4.5e-5``, 770 s).
 
     python examples/plectoneme.py [--output plectoneme_output] [--turns 5] [--steps 40] [--mu 0.3] [--stabilize 2e-2]
         [--elements 16] [--imperfection 1e-2] [--length 0.02] [--pull 5] [--approach s] [--pieces 2]
-        [--min-step-ratio 2**-12] [--twist-until 1] [--relax F] [--path load]
+        [--min-step-ratio 2**-12] [--twist-until 1] [--relax F] [--path load] [--smoothing 2e-3]
+        [--line-angle deg] [--point-ratio r]
 """
 import argparse
 import time
@@ -119,7 +122,8 @@ solve_options = dict(steps=40, stabilize=2e-2)   # for `beamsolver run examples/
 
 
 def build(turns=5.0, n_elements=16, mu=0.3, imperfection=1e-2, pull=PULL, E=200e9, nu=0.3, length=LENGTH,
-          approach=None, pieces=2, twist_until=1.0, relax=None, smoothing=2e-3, line_angle=None):
+          approach=None, pieces=2, twist_until=1.0, relax=None, smoothing=2e-3, line_angle=None,
+          point_ratio=None):
     """Returns ``(model, plate node, (wire a, wire b))``, each wire a tuple of ``pieces`` beams
     (bottom to top) of ``n_elements // pieces`` elements joined rigidly.  ``approach=None``: a
     dead ``pull`` on the plate (free in ``z``); a number ``s``: extension control, the plate's
@@ -167,6 +171,8 @@ def build(turns=5.0, n_elements=16, mu=0.3, imperfection=1e-2, pull=PULL, E=200e
     opts = dict(mu=mu, smoothing=smoothing * R)
     if line_angle is not None:
         opts["line_angle"] = np.radians(line_angle)
+    if point_ratio is not None:
+        opts["point_ratio"] = point_ratio
     model.add_contact(list(wires[0]), list(wires[1]), **opts)
     for wire in wires:
         for i, j in zip(*np.triu_indices(pieces, 1)):
@@ -230,12 +236,14 @@ def onset(rows):
 
 def main(output=None, turns=5.0, steps=40, n_elements=16, mu=0.3, stabilize=2e-2, imperfection=1e-2,
          verbose=False, length=LENGTH, pull=PULL, approach=None, pieces=2, min_step_ratio=2.0**-12,
-         twist_until=1.0, relax=None, path="load", smoothing=2e-3, line_angle=None):
+         twist_until=1.0, relax=None, path="load", smoothing=2e-3, line_angle=None,
+         point_ratio=None):
     """Solve, print the table and the checks; returns ``(solution, rows, wall time, checks)``."""
     model, plate, wires = build(turns=turns, n_elements=n_elements, mu=mu, imperfection=imperfection,
                                  length=length, pull=pull, approach=approach,
                                  pieces=pieces, twist_until=twist_until, relax=relax,
-                                 smoothing=smoothing, line_angle=line_angle)
+                                 smoothing=smoothing, line_angle=line_angle,
+                                 point_ratio=point_ratio)
     t0 = time.perf_counter()
     try:
         sol = bs.solve(model, steps=steps, output=output, verbose=verbose, stabilize=stabilize,
@@ -304,8 +312,10 @@ if __name__ == "__main__":
     ap.add_argument("--path", default="load", help="solve(path=): load or arc-length")
     ap.add_argument("--smoothing", type=float, default=2e-3, help="contact smoothing gap / wire radius")
     ap.add_argument("--line-angle", type=float, default=None, help="add_contact(line_angle=) in degrees")
+    ap.add_argument("--point-ratio", type=float, default=None, help="add_contact(point_ratio=)")
     a = ap.parse_args()
     main(output=a.output, turns=a.turns, steps=a.steps, n_elements=a.elements, mu=a.mu, stabilize=a.stabilize,
          imperfection=a.imperfection, verbose=True, length=a.length, pull=a.pull,
          approach=a.approach, pieces=a.pieces, min_step_ratio=a.min_step_ratio, twist_until=a.twist_until,
-         relax=a.relax, path=a.path, smoothing=a.smoothing, line_angle=a.line_angle)
+         relax=a.relax, path=a.path, smoothing=a.smoothing, line_angle=a.line_angle,
+         point_ratio=a.point_ratio)
