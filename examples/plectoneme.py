@@ -91,7 +91,9 @@ orthogonal projection (Gauss points), none of kind point.  Every variant stops t
 ``Wr`` = 1.0-1.1 (one loop, no plectoneme yet), with ``|Lk - Tw - Wr| / Lk < 1e-3``:
 ``--stabilize 2e-2`` at ``t = 0.762`` (1110 N, ``Wr / Lk = 0.18``, dissipated 0.098), ``--pieces 8``
 the same, contact ``--smoothing 0.1`` (gap / R) at ``t = 0.846`` (``Wr = 1.01``), ``--line-angle 50``
-at ``t = 0.873`` (``Wr = 0.99``; crossing pairs still orthogonal, 1.4 kN).  With 24 elements
+at ``t = 0.873`` (``Wr = 0.99``; crossing pairs still orthogonal, 1.4 kN), and with
+``--point-ratio 0.05`` too at ``t = 0.872`` (``Wr = 0.95``; the crossing now one point pair,
+2.1 kN; scaled residual 2e-5 at steps of 6e-6): not the contact kind then.  With 24 elements
 (``--stabilize 2e-2``, ``mu = 0`` / ``0.3``: writhing from 1180 / 778 N) the loop goes on to
 ``Wr = 1.55``, ``Wr / Lk = 0.28``, then "elements turn by up to 2.04 rad within one element" (the
 loop is 5 elements); with two pieces the loop near the plate lies in one beam (no self-contact)
