@@ -60,3 +60,24 @@ def test_kind_decided_anew_after_restore():
     assert _kinds(contact, problem.system.poses0) == {POINT}
     contact.set_state(contact.get_state())
     assert _kinds(contact, H44) == {ORTHOGONAL}
+
+
+def test_wrap_extends_only_to_point_pairs_at_the_slave_end():
+    """``rules.extend_wrap`` (search.py, rule 3) turns a point pair orthogonal when its slave element
+    shares a node with an orthogonal pair against the same master beam *and* its closest point
+    sits at the slave's end; a crossing inside the slave element stays a point pair.  In the
+    plectoneme a neighbour's orthogonal kind, decided at closest points far outside its elements
+    (xi = 4.16 / 2.87, ratio -32), took the point pair from the crossing of the loop's arms
+    (xi1 = 0.63): at the converged state of a step the point pair held 1000 N, decided afresh at
+    the start of the next step the pair was five Gauss points 31 um or more apart, without force."""
+    from beamsolver.contact import rules
+    enodes = np.array([[0, 1], [1, 2], [2, 3], [10, 11]])
+    master_beam = np.array([1, 1, 1])
+    e, m = np.array([1, 0, 2]), np.array([3, 3, 3])
+    kind = np.array([ORTHOGONAL, POINT, POINT])
+    xi1 = np.array([0.5, 0.63, 0.01])
+    assert rules.extend_wrap(enodes, master_beam, 2, e, m, kind, xi1).tolist() == [ORTHOGONAL, POINT, ORTHOGONAL]
+    assert rules.extend_wrap(enodes, master_beam, 2, e, m, kind, np.array([0.5, 0.97, 1.2])).tolist() == \
+        [ORTHOGONAL, ORTHOGONAL, ORTHOGONAL]
+    # against another master beam, or without an orthogonal neighbour: unchanged
+    assert rules.extend_wrap(enodes, np.array([1, 2, 2]), 3, e, m, kind, xi1).tolist() == [ORTHOGONAL, POINT, POINT]

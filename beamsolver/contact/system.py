@@ -303,7 +303,7 @@ class ContactSystem(Contribution):
             self._lap("projection")
             kinds[b] = rules.point_or_orthogonal(ratio, d.point_ratio)
             xi1[b], xi2[b] = x1, x2
-            kinds = rules.extend_wrap(en, self.el_beam[m], self.n_beams, e, m, kinds)
+            kinds = rules.extend_wrap(en, self.el_beam[m], self.n_beams, e, m, kinds, xi1)
             kinds = self._step_kinds(d, e, m, kinds)
         self._lap("rules")
         return Candidates(e=e, m=m, kind=kinds, xi1=xi1, xi2=xi2, h1=hs[i], h2=hm[j], c2=cm[j], r2=rm[j])
