@@ -90,7 +90,7 @@ linearly to ``F``, so the pair writhes at ``Lk`` = 5.5 turns:
 
 (Measured before section 20; with it, below.)  The straight two-ply twists to 5.5 turns (9.55 N m, plate 60.38 -> 57.84 mm, ``Wr = 0``,
 ``Lk = Tw`` to 3e-8), writhes from 1250 N (9.41 N m; ``M_c = 10.1``), a loop grows near the plate
-and the plate falls under the dead pull (``docs/plectoneme.png``: the last step); the run stops
+and the plate falls under the dead pull; the run stops
 at ``t = 0.879``, 712 N, plate 44.5 mm, ``Wr = 1.08``, ``Wr / Lk = 0.20``,
 ``|Lk - Tw - Wr| / Lk <= 7.8e-4``, dissipated 0.18 of the strain energy (warned), 446-569 s: steps
 of 6e-6 do not converge (scaled residual 0.76, positive definite tangent) once the loop has
