@@ -88,10 +88,10 @@ linearly to ``F``, so the pair writhes at ``Lk`` = 5.5 turns:
     python examples/plectoneme.py --length 0.06 --elements 48 --pieces 4 --mu 0 --pull 2000 --relax 300
         --twist-until 0.5 --turns 5.5 --steps 40 --stabilize 0.2
 
-(Measured before section 20; with it, below.)  The straight two-ply twists to 5.5 turns (9.55 N m, plate 60.38 -> 57.84 mm, ``Wr = 0``,
-``Lk = Tw`` to 3e-8), writhes from 1250 N (9.41 N m; ``M_c = 10.1``), a loop grows near the plate
-and the plate falls under the dead pull; the run stops
-at ``t = 0.879``, 712 N, plate 44.5 mm, ``Wr = 1.08``, ``Wr / Lk = 0.20``,
+(Measured before section 20; with it, below.)  The straight two-ply twists to 5.5 turns
+(9.55 N m, plate 60.38 -> 57.84 mm, ``Wr = 0``, ``Lk = Tw`` to 3e-8), writhes from 1250 N
+(9.41 N m; ``M_c = 10.1``), a loop grows near the plate and the plate falls under the dead pull;
+the run stops at ``t = 0.879``, 712 N, plate 44.5 mm, ``Wr = 1.08``, ``Wr / Lk = 0.20``,
 ``|Lk - Tw - Wr| / Lk <= 7.8e-4``, dissipated 0.18 of the strain energy (warned), 446-569 s: steps
 of 6e-6 do not converge (scaled residual 0.76, positive definite tangent) once the loop has
 closed, its arms crossing at 57-85 deg with contact forces about 1.2 kN, every contact of kind
@@ -109,7 +109,14 @@ and for one step the pair passes through itself (``|Lk - Tw - Wr| / Lk = 0.35``)
 writhes at a lower pull (a wider loop, ``sqrt(B / F)``): ``--length 0.09 --elements 64 --relax
 100 --stabilize 2e-2`` twists straight to 5.5 turns at 6.16 N m and writhes from 385 N
 (``M_c = 6.4`` N m), reaching ``t = 1`` at 100 N mid-snap (``Wr = 0.52``, ``Wr / Lk = 0.094``,
-plate 88.9 -> 72.9 mm, ``|Lk - Tw - Wr| / Lk <= 4.5e-5``, 770 s).
+plate 88.9 -> 72.9 mm, ``|Lk - Tw - Wr| / Lk <= 4.5e-5``, 770 s).  With section 20's crossing
+kinds (48 elements, 4 pieces, ``mu = 0``) the loop closes and the two-ply starts to wrap round
+itself near the plate: ``--stabilize 0.2`` to ``Wr = 1.20`` (``t = 0.885``), ``--stabilize 2e-2`` to
+``Wr = 1.52``, ``Wr / Lk = 0.28`` (``t = 0.765``, 1100 N, plate 39.7 mm; also with
+``--min-step-ratio 1e-7``), ``--stabilize 5e-2 --min-step-ratio 1e-7`` to ``Wr = 2.00``,
+``Wr / Lk = 0.36`` (``t = 0.803``, 971 N, plate 33.1 mm, ``|Lk - Tw - Wr| / Lk <= 1.3e-3``,
+dissipated 0.35: polluted, warned; 435 s), each stopping at steps of 6e-6 / 2.5e-9 with a scaled
+residual of 3e-3 to 0.16 and a positive definite tangent.
 
     python examples/plectoneme.py [--output plectoneme_output] [--turns 5] [--steps 40] [--mu 0.3] [--stabilize 2e-2]
         [--elements 16] [--imperfection 1e-2] [--length 0.02] [--pull 5] [--approach s] [--pieces 2]
