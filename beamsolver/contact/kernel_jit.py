@@ -230,6 +230,17 @@ def _geo(u, w, v, G):
     _put3(G, 3, 3, G22)
 
 
+@jit
+def _geo_cached(u, w, v, G, c):
+    """``_geo`` at the element twist, with the coefficients kept in ``c`` by ``_element_side``."""
+    G12, G21, G22 = _geometric(u, w, (v[0], v[1], v[2]), (v[3], v[4], v[5]), c[C_D], c[C_T2],
+                               (c[C_CO], c[C_CO + 1], c[C_CO + 2], c[C_CO + 3], c[C_CO + 4], c[C_CO + 5], c[C_CO + 6]))
+    _zero3(G, 0, 0)
+    _put3(G, 0, 3, G12)
+    _put3(G, 3, 0, G21)
+    _put3(G, 3, 3, G22)
+
+
 @jit_inline
 def _m_times(z, A, out):
     """``out = M(z) A`` with ``M(z) = [[0, hat(z_f)], [hat(z_f), hat(z_m)]]``, column by column."""
@@ -283,9 +294,10 @@ def _jacobians(u, w, xi, Ti, Ah, Ts, As, JA, JB, tmp):
 
 
 @jit
-def _jacobian_derivatives(u, w, xi, S, v):
+def _jacobian_derivatives(u, w, xi, S, v, c):
     """``d(J_A^T wr)/dh, d(J_B^T wr)/dh`` into ``S[S_DA], S[S_DB]`` and ``d/dxi`` into ``v[V_DA], v[V_DB]``
-    at fixed ``wr = v[V_WR]``; ``S`` holds ``TI, AH, TS, AS`` at this ``xi``.
+    at fixed ``wr = v[V_WR]``; ``S`` holds ``TI, AH, TMH`` of the element and ``TS, AS`` at this ``xi``;
+    ``c``: the element's cached coefficients (``_element_side``).
 
     With ``s = xi h``, ``y = T(s)^T wr``, ``b = J_B^T wr = xi T(h)^-T y`` and ``T(-s) h = h``:
     ``dB/dh = G(h, xi y) - xi^2 T(h)^-T T(s)^T G(s, y)``, ``dB/dxi = T(h)^-T y - xi T(h)^-T T(s)^T G(s, y) h``,
@@ -300,7 +312,7 @@ def _jacobian_derivatives(u, w, xi, S, v):
     _mtm_ut_g(Ti, S[S_M1], P)                                # T(h)^-T T(s)^T G(s, y)
     for i in range(6):
         xy[i] = xi * y[i]
-    _geo(u, w, xy, DB)
+    _geo_cached(u, w, xy, DB, c)
     _mtv_ut(Ti, y, dB)
     h = (u[0], u[1], u[2], w[0], w[1], w[2])
     for i in range(6):
@@ -312,7 +324,6 @@ def _jacobian_derivatives(u, w, xi, S, v):
     _mtv_ut(Ti, xy, b)
     _mtv_ut(As, wr, zs)
     _mtv_ut(Ah, b, v[V_ZH])
-    _tangent(scale(-1.0, u), scale(-1.0, w), S[S_TMH])
     _m_times(v[V_ZH], S[S_TMH], DA)
     _tangent(scale(-xi, u), scale(-xi, w), S[S_TMS])
     _m_times(zs, S[S_TMS], S[S_MS])
@@ -423,12 +434,42 @@ def _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, VC0, VF0, Dh1, Dh2, dx
 
 
 # ---------------------------------------------------------------- one side of a pair: element, section, Jacobians
+# per-side element cache ``c`` (2, N_CACHE): the node poses (rows 0-2 of nodes j0, j0 + 1), the twist and the
+# coefficients of ``G(h, .)`` of the last element seen on that side
+C_POSE, C_U, C_W, C_T2, C_D, C_CO, N_CACHE = 0, 24, 27, 30, 31, 32, 39
+
+
 @jit
-def _element_side(Xp, j0, xi):
-    """Twist, section pose and Jacobians of the element of nodes ``j0, j0 + 1`` at ``xi``."""
+def _element_side(Xp, j0, S, c):
+    """Twist ``h = log(H_A^-1 H_B)`` of the element of nodes ``j0, j0 + 1`` and the element's quantities:
+    ``T(h)^-1``, ``Ad(exp(-h))``, ``T(-h)`` into ``S[S_TI], S[S_AH], S[S_TMH]`` and the coefficients of
+    ``G(h, .)`` into ``c``.  Kept while the node poses are those of the last point on this side, bit for
+    bit (the Gauss points of a slave element, consecutive points on one master element): the same floats."""
+    hit = True
+    for a in range(2):
+        for i in range(3):
+            for k in range(4):
+                x = Xp[j0 + a, i, k]
+                m = C_POSE + 12 * a + 4 * i + k
+                if not _same(x, c[m]):
+                    hit = False
+                    c[m] = x
     RA, xA = _pose_of(Xp, j0)
+    if hit:
+        return RA, xA, (c[C_U], c[C_U + 1], c[C_U + 2]), (c[C_W], c[C_W + 1], c[C_W + 2])
     RB, xB = _pose_of(Xp, j0 + 1)
-    u, w, t, d = log_relative(RA, xA, RB, xB)
+    u, w, _, _ = log_relative(RA, xA, RB, xB)
+    _side(u, w, S)
+    _tangent(scale(-1.0, u), scale(-1.0, w), S[S_TMH])
+    t2 = dot(w, w)
+    t = np.sqrt(t2)
+    co = (coefficient(C_, t), coefficient(Q2_, t), coefficient(Q3_, t), coefficient(DP_, t), coefficient(CP_, t),
+          coefficient(Q2P_, t), coefficient(Q3P_, t))
+    for i in range(3):
+        c[C_U + i], c[C_W + i] = u[i], w[i]
+    c[C_T2], c[C_D] = t2, coefficient(D_, t)
+    for i in range(7):
+        c[C_CO + i] = co[i]
     return RA, xA, u, w
 
 
@@ -615,10 +656,10 @@ def _wrench(R, F, DF, neg, m, DmF, sm, V, w, D):
 
 
 @jit
-def _nodal(u, w, xi, S, v, Dw, Dh, dxi, c0, f, K, j0):
+def _nodal(u, w, xi, S, v, c, Dw, Dh, dxi, c0, f, K, j0):
     """``f_j = J_j^T wr`` (``wr = v[V_WR]``) for the two nodes of one side and their rows of the tangent:
     ``J^T dwr + d(J^T wr)/dh dh + d(J^T wr)/dxi dxi`` (``dh`` lives in columns ``c0:c0+12``)."""
-    _jacobian_derivatives(u, w, xi, S, v)
+    _jacobian_derivatives(u, w, xi, S, v, c)
     wr = v[V_WR]
     for s in range(2):
         J, D, dd = (S[S_JA], S[S_DA], v[V_DA]) if s == 0 else (S[S_JB], S[S_DB], v[V_DB])
@@ -684,9 +725,8 @@ def _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2):
 @jit
 def _frame_variations(u1, w1, xi1, u2, w2, xi2, kind, RC, RF, d, S1, S2, g6, r):
     """Node Jacobians of both sides, twist variations ``g6[G6_DH1], g6[G6_DH2]``, projection gradients
-    ``r[R_DXI1], r[R_DXI2]`` and the section-frame variations ``g6[G6_VC], g6[G6_VF]`` ``(6, 24)``."""
-    _side(u1, w1, S1)
-    _side(u2, w2, S2)
+    ``r[R_DXI1], r[R_DXI2]`` and the section-frame variations ``g6[G6_VC], g6[G6_VF]`` ``(6, 24)``;
+    ``S1``, ``S2`` hold the elements' ``T(h)^-1``, ``Ad(exp(-h))`` (``_element_side``)."""
     _jacobians(u1, w1, xi1, S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB], S1[S_TMP])
     _jacobians(u2, w2, xi2, S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB], S2[S_TMP])
     VC, VF, dxi1, dxi2 = g6[G6_VC], g6[G6_VF], r[R_DXI1], r[R_DXI2]
@@ -722,8 +762,8 @@ def _moment_gradient(n, F, DF, Dn, DmF):
 def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames, ws):
     """Forces ``f (4, 6)``, tangent ``K (24, 24)`` and point data of one contact point; ``ws``: the
     scratch arrays of ``_scratch``."""
-    S, v, g6, g3, g2, r = ws
-    side1, side2 = _element_side(Xp, 0, 0.0), _element_side(Xp, 2, 0.0)
+    S, v, g6, g3, g2, r, cache = ws
+    side1, side2 = _element_side(Xp, 0, S[0], cache[0]), _element_side(Xp, 2, S[1], cache[1])
     RA1, xA1, u1, w1 = side1
     RA2, xA2, u2, w2 = side2
     xi1, xi2 = _project(kind, RA1, xA1, u1, w1, par[XI1], RA2, xA2, u2, w2, par[XI2])
@@ -759,8 +799,8 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
     _moment_gradient(n, F, DF, Dn, DmF)
     _wrench(RC, F, DF, False, scale(R1, mF), DmF, R1, VC, v[0, V_WR], g6[G6_DWC])
     _wrench(RF, scale(-1.0, F), DF, True, scale(R2, mF), DmF, R2, VF, v[1, V_WR], g6[G6_DWF])
-    _nodal(u1, w1, xi1, S1, v[0], g6[G6_DWC], g6[G6_DH1], r[R_DXI1], 0, f, K, 0)
-    _nodal(u2, w2, xi2, S2, v[1], g6[G6_DWF], g6[G6_DH2], r[R_DXI2], 12, f, K, 2)
+    _nodal(u1, w1, xi1, S1, v[0], cache[0], g6[G6_DWC], g6[G6_DH1], r[R_DXI1], 0, f, K, 0)
+    _nodal(u2, w2, xi2, S2, v[1], cache[1], g6[G6_DWF], g6[G6_DH2], r[R_DXI2], 12, f, K, 2)
     sc[0], sc[1], sc[2], sc[3] = gap, lam, xi1, xi2
     for i in range(3):
         vec[0, i], vec[1, i], vec[2, i], vec[3, i], vec[4, i], vec[5, i] = n[i], t1[i], t2[i], xC[i], xF[i], F[i]
@@ -772,7 +812,7 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
 def _scratch():
     """Scratch arrays of one evaluation, reused by every point (the kernel allocates nothing per point)."""
     return (np.empty((2, N_SIDE, 6, 6)), np.empty((2, N_VEC, 6)), np.empty((N_G6, 6, 24)), np.empty((N_G3, 3, 24)),
-            np.empty((N_G2, 2, 24)), np.empty((N_R, 24)))
+            np.empty((N_G2, 2, 24)), np.empty((N_R, 24)), np.full((2, N_CACHE), np.nan))
 
 
 def _evaluate(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames):
@@ -781,7 +821,7 @@ def _evaluate(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, 
     compiles it per contact law; the module's ``evaluate`` is the default law's."""
     own = _scratch()
     ws = (_borrowed(own[0]), _borrowed(own[1]), _borrowed(own[2]), _borrowed(own[3]), _borrowed(own[4]),
-          _borrowed(own[5]))
+          _borrowed(own[5]), _borrowed(own[6]))
     X, par, HCL, HFK, HLKp, lamp = _borrowed(X), _borrowed(par), _borrowed(HCL), _borrowed(HFK), _borrowed(HLKp), \
         _borrowed(lamp)
     kind, has, f, K, sc = _borrowed(kind), _borrowed(has), _borrowed(f), _borrowed(K), _borrowed(sc)
