@@ -104,6 +104,34 @@ def _section(RA, xA, u, w, xi):
 
 
 @jit
+def _coefficients(w):
+    """``t^2 = |w|^2`` and the coefficients ``a, b, c, d, q2, q3, cp, dp, q2p, q3p`` at ``t`` (``coefficient``,
+    each once): the sections, node Jacobians and their derivatives at one ``xi h`` share them."""
+    t2 = dot(w, w)
+    t = np.sqrt(t2)
+    return t2, (coefficient(A_, t), coefficient(B_, t), coefficient(C_, t), coefficient(D_, t), coefficient(Q2_, t),
+                coefficient(Q3_, t), coefficient(CP_, t), coefficient(DP_, t), coefficient(Q2P_, t),
+                coefficient(Q3P_, t))
+
+
+@jit
+def _exp_co(u, w, t2, co):
+    """``_exp`` with the coefficients of ``_coefficients(w)``."""
+    a, b, c = co[0], co[1], co[2]
+    R = add_outer(mat(scale(a, w), 1.0 - b * t2), scale(b, w), w)
+    wxu = cross(w, u)
+    return R, add(add(u, scale(b, wxu)), scale(c, cross(w, wxu)))
+
+
+@jit
+def _section_co(RA, xA, u, w, xi, t2, co):
+    """``_section`` with the coefficients of ``_coefficients(xi w)``."""
+    Rs, xs = _exp_co(scale(xi, u), scale(xi, w), t2, co)
+    R = mm(RA, Rs)
+    return R, add(mv(RA, xs), xA), mv(R, u), mv(R, cross(w, u))
+
+
+@jit
 def _pose_of(X, j):
     R = ((X[j, 0, 0], X[j, 0, 1], X[j, 0, 2]), (X[j, 1, 0], X[j, 1, 1], X[j, 1, 2]),
          (X[j, 2, 0], X[j, 2, 1], X[j, 2, 2]))
@@ -189,6 +217,18 @@ def _tangent(u, w, T):
 
 
 @jit
+def _tangent_co(u, w, T, t2, co):
+    """``_tangent`` with the coefficients of ``_coefficients(w)`` (or of ``-w``: the same)."""
+    b, c = co[1], co[2]
+    T3 = add_outer(mat(scale(-b, w), 1.0 - c * t2), scale(c, w), w)
+    Q = q_matrix(scale(-1.0, u), scale(-1.0, w), dot(w, u), cross(w, u), t2, c, co[4], co[5])
+    _put3(T, 0, 0, T3)
+    _put3(T, 3, 3, T3)
+    _put3(T, 0, 3, Q)
+    _zero3(T, 3, 0)
+
+
+@jit
 def _tangent_inv(u, w, T):
     """``T = T(h)^-1 = [[Ti, -Ti Q(-u, -w) Ti], [0, Ti]]`` (``se3.tangent_inv``), ``(6, 6)``."""
     t2 = dot(w, w)
@@ -224,6 +264,17 @@ def _geo(u, w, v, G):
     co = (coefficient(C_, t), coefficient(Q2_, t), coefficient(Q3_, t), coefficient(DP_, t), coefficient(CP_, t),
           coefficient(Q2P_, t), coefficient(Q3P_, t))
     G12, G21, G22 = _geometric(u, w, (v[0], v[1], v[2]), (v[3], v[4], v[5]), coefficient(D_, t), t2, co)
+    _zero3(G, 0, 0)
+    _put3(G, 0, 3, G12)
+    _put3(G, 3, 0, G21)
+    _put3(G, 3, 3, G22)
+
+
+@jit
+def _geo_co(u, w, v, G, t2, co):
+    """``_geo`` with the coefficients of ``_coefficients(w)``."""
+    G12, G21, G22 = _geometric(u, w, (v[0], v[1], v[2]), (v[3], v[4], v[5]), co[3], t2,
+                               (co[2], co[4], co[5], co[7], co[6], co[8], co[9]))
     _zero3(G, 0, 0)
     _put3(G, 0, 3, G12)
     _put3(G, 3, 0, G21)
@@ -276,16 +327,16 @@ def _side(u, w, S):
 
 
 @jit
-def _jacobians(u, w, xi, Ti, Ah, Ts, As, JA, JB, tmp):
+def _jacobians(u, w, xi, t2, co, Ti, Ah, Ts, As, JA, JB, tmp):
     """``J_A, J_B`` of ``H_C = H_A exp(xi h)`` (``pairs._node_jacobians``); ``Ti = T(h)^-1``,
-    ``Ah = Ad(exp(-h))``; also ``Ts = T(xi h)`` and ``As = Ad(exp(-xi h))``."""
+    ``Ah = Ad(exp(-h))``; also ``Ts = T(xi h)`` and ``As = Ad(exp(-xi h))``; ``t2, co = _coefficients(xi w)``."""
     su, sw = scale(xi, u), scale(xi, w)
-    _tangent(su, sw, Ts)
+    _tangent_co(su, sw, Ts, t2, co)
     _mm_ut(Ts, Ti, JB)
     for i in range(6):
         for j in range(6):
             JB[i, j] *= xi
-    Rs, xs = _exp(su, sw)
+    Rs, xs = _exp_co(su, sw, t2, co)
     _adjoint_inv(Rs, xs, As)
     _mm_ut(JB, Ah, tmp)
     for i in range(6):
@@ -294,10 +345,10 @@ def _jacobians(u, w, xi, Ti, Ah, Ts, As, JA, JB, tmp):
 
 
 @jit
-def _jacobian_derivatives(u, w, xi, S, v, c):
+def _jacobian_derivatives(u, w, xi, t2, co, S, v, c):
     """``d(J_A^T wr)/dh, d(J_B^T wr)/dh`` into ``S[S_DA], S[S_DB]`` and ``d/dxi`` into ``v[V_DA], v[V_DB]``
     at fixed ``wr = v[V_WR]``; ``S`` holds ``TI, AH, TMH`` of the element and ``TS, AS`` at this ``xi``;
-    ``c``: the element's cached coefficients (``_element_side``).
+    ``c``: the element's cached coefficients (``_element_side``); ``t2, co = _coefficients(xi w)``.
 
     With ``s = xi h``, ``y = T(s)^T wr``, ``b = J_B^T wr = xi T(h)^-T y`` and ``T(-s) h = h``:
     ``dB/dh = G(h, xi y) - xi^2 T(h)^-T T(s)^T G(s, y)``, ``dB/dxi = T(h)^-T y - xi T(h)^-T T(s)^T G(s, y) h``,
@@ -307,7 +358,7 @@ def _jacobian_derivatives(u, w, xi, S, v, c):
     wr, y, xy, dB, b, zs, dA = v[V_WR], v[V_Y], v[V_XY], v[V_DB], v[V_B], v[V_ZS], v[V_DA]
     su, sw = scale(xi, u), scale(xi, w)
     _mtv_ut(S[S_TS], wr, y)
-    _geo(su, sw, y, S[S_GS])
+    _geo_co(su, sw, y, S[S_GS], t2, co)
     _mtm_ut_g(S[S_TS], S[S_GS], S[S_M1])
     _mtm_ut_g(Ti, S[S_M1], P)                                # T(h)^-T T(s)^T G(s, y)
     for i in range(6):
@@ -325,7 +376,7 @@ def _jacobian_derivatives(u, w, xi, S, v, c):
     _mtv_ut(As, wr, zs)
     _mtv_ut(Ah, b, v[V_ZH])
     _m_times(v[V_ZH], S[S_TMH], DA)
-    _tangent(scale(-xi, u), scale(-xi, w), S[S_TMS])
+    _tangent_co(scale(-xi, u), scale(-xi, w), S[S_TMS], t2, co)
     _m_times(zs, S[S_TMS], S[S_MS])
     _mtm_ut_g(Ah, DB, S[S_AHDB])
     zf, zm = (zs[0], zs[1], zs[2]), (zs[3], zs[4], zs[5])
@@ -594,7 +645,8 @@ def _jacobians_at(u, w, xi, xip, S):
             for j in range(6):
                 JAP[i, j], JBP[i, j] = JA[i, j], JB[i, j]
     else:
-        _jacobians(u, w, xip, S[S_TI], S[S_AH], S[S_TSP], S[S_ASP], S[S_JAP], S[S_JBP], S[S_TMP])
+        t2, co = _coefficients(scale(xip, w))
+        _jacobians(u, w, xip, t2, co, S[S_TI], S[S_AH], S[S_TSP], S[S_ASP], S[S_JAP], S[S_JBP], S[S_TMP])
 
 
 def _friction(slip, Dslip, lamp, t1, t2, Dt1, Dt2, lam, Dlam, par, g2, Dpt):
@@ -656,10 +708,10 @@ def _wrench(R, F, DF, neg, m, DmF, sm, V, w, D):
 
 
 @jit
-def _nodal(u, w, xi, S, v, c, Dw, Dh, dxi, c0, f, K, j0):
+def _nodal(u, w, xi, t2, co, S, v, c, Dw, Dh, dxi, c0, f, K, j0):
     """``f_j = J_j^T wr`` (``wr = v[V_WR]``) for the two nodes of one side and their rows of the tangent:
     ``J^T dwr + d(J^T wr)/dh dh + d(J^T wr)/dxi dxi`` (``dh`` lives in columns ``c0:c0+12``)."""
-    _jacobian_derivatives(u, w, xi, S, v, c)
+    _jacobian_derivatives(u, w, xi, t2, co, S, v, c)
     wr = v[V_WR]
     for s in range(2):
         J, D, dd = (S[S_JA], S[S_DA], v[V_DA]) if s == 0 else (S[S_JB], S[S_DB], v[V_DB])
@@ -723,12 +775,13 @@ def _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2):
 
 
 @jit
-def _frame_variations(u1, w1, xi1, u2, w2, xi2, kind, RC, RF, d, S1, S2, g6, r):
+def _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, d, S1, S2, g6, r):
     """Node Jacobians of both sides, twist variations ``g6[G6_DH1], g6[G6_DH2]``, projection gradients
     ``r[R_DXI1], r[R_DXI2]`` and the section-frame variations ``g6[G6_VC], g6[G6_VF]`` ``(6, 24)``;
-    ``S1``, ``S2`` hold the elements' ``T(h)^-1``, ``Ad(exp(-h))`` (``_element_side``)."""
-    _jacobians(u1, w1, xi1, S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB], S1[S_TMP])
-    _jacobians(u2, w2, xi2, S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB], S2[S_TMP])
+    ``S1``, ``S2`` hold the elements' ``T(h)^-1``, ``Ad(exp(-h))`` (``_element_side``); ``co1``, ``co2``:
+    ``_coefficients(xi w)`` of the sides."""
+    _jacobians(u1, w1, xi1, co1[0], co1[1], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB], S1[S_TMP])
+    _jacobians(u2, w2, xi2, co2[0], co2[1], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB], S2[S_TMP])
     VC, VF, dxi1, dxi2 = g6[G6_VC], g6[G6_VF], r[R_DXI1], r[R_DXI2]
     _variations(S1, 0, g6[G6_DH1], VC, S1[S_TMP])
     _variations(S2, 12, g6[G6_DH2], VF, S2[S_TMP])
@@ -767,10 +820,11 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
     RA1, xA1, u1, w1 = side1
     RA2, xA2, u2, w2 = side2
     xi1, xi2 = _project(kind, RA1, xA1, u1, w1, par[XI1], RA2, xA2, u2, w2, par[XI2])
-    RC, xC, _, _ = _section(RA1, xA1, u1, w1, xi1)
-    RF, xF, _, _ = _section(RA2, xA2, u2, w2, xi2)
+    co1, co2 = _coefficients(scale(xi1, w1)), _coefficients(scale(xi2, w2))
+    RC, xC, _, _ = _section_co(RA1, xA1, u1, w1, xi1, co1[0], co1[1])
+    RF, xF, _, _ = _section_co(RA2, xA2, u2, w2, xi2, co2[0], co2[1])
     S1, S2, VC, VF = S[0], S[1], g6[G6_VC], g6[G6_VF]
-    _frame_variations(u1, w1, xi1, u2, w2, xi2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, g6, r)
+    _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, g6, r)
     Dn, Dt1, Dt2, DF, DmF, Ddist, Dlam = g3[G3_DN], g3[G3_DT1], g3[G3_DT2], g3[G3_DF], g3[G3_DMF], r[R_DDIST], r[R_DLAM]
     n, t1, t2, dist = _axes(RC, xC, RF, xF, VC, VF, Dn, Dt1, Dt2, Ddist)
     R1, R2, wgt = par[R1_], par[R2_], par[WEIGHT]
@@ -799,8 +853,8 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
     _moment_gradient(n, F, DF, Dn, DmF)
     _wrench(RC, F, DF, False, scale(R1, mF), DmF, R1, VC, v[0, V_WR], g6[G6_DWC])
     _wrench(RF, scale(-1.0, F), DF, True, scale(R2, mF), DmF, R2, VF, v[1, V_WR], g6[G6_DWF])
-    _nodal(u1, w1, xi1, S1, v[0], cache[0], g6[G6_DWC], g6[G6_DH1], r[R_DXI1], 0, f, K, 0)
-    _nodal(u2, w2, xi2, S2, v[1], cache[1], g6[G6_DWF], g6[G6_DH2], r[R_DXI2], 12, f, K, 2)
+    _nodal(u1, w1, xi1, co1[0], co1[1], S1, v[0], cache[0], g6[G6_DWC], g6[G6_DH1], r[R_DXI1], 0, f, K, 0)
+    _nodal(u2, w2, xi2, co2[0], co2[1], S2, v[1], cache[1], g6[G6_DWF], g6[G6_DH2], r[R_DXI2], 12, f, K, 2)
     sc[0], sc[1], sc[2], sc[3] = gap, lam, xi1, xi2
     for i in range(3):
         vec[0, i], vec[1, i], vec[2, i], vec[3, i], vec[4, i], vec[5, i] = n[i], t1[i], t2[i], xC[i], xF[i], F[i]
