@@ -103,6 +103,26 @@ def _section(RA, xA, u, w, xi):
     return R, add(mv(RA, xs), xA), mv(R, u), mv(R, cross(w, u))
 
 
+@jit_inline
+def _exp_inline(u, w):
+    """``_exp`` inlined into its caller (the same operations; ``_project``'s iterations)."""
+    t2 = dot(w, w)
+    t = np.sqrt(t2)
+    a, b, c = coefficient(A_, t), coefficient(B_, t), coefficient(C_, t)
+    R = add_outer(mat(scale(a, w), 1.0 - b * t2), scale(b, w), w)
+    wxu = cross(w, u)
+    return R, add(add(u, scale(b, wxu)), scale(c, cross(w, wxu)))
+
+
+@jit_inline
+def _section_inline(RA, xA, u, w, xi):
+    """``_section`` inlined into its caller (the same operations; ``_project``'s iterations: the parts a
+    projection kind does not use are dropped by the compiler)."""
+    Rs, xs = _exp_inline(scale(xi, u), scale(xi, w))
+    R = mm(RA, Rs)
+    return R, add(mv(RA, xs), xA), mv(R, u), mv(R, cross(w, u))
+
+
 @jit
 def _coefficients(w):
     """``t^2 = |w|^2`` and the coefficients ``a, b, c, d, q2, q3, cp, dp, q2p, q3p`` at ``t`` (``coefficient``,
@@ -405,11 +425,11 @@ def _project(kind, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations=2):
     stop at an exact fixed point (an iterate equal to the last, bit for bit, fixes all later ones), so
     the result is that of all ``iterations``."""
     moving = kind != LINE and kind != ORTHOGONAL
-    R1, x1, x1p, x1pp = _section(RA1, xA1, u1, w1, xi1)
+    R1, x1, x1p, x1pp = _section_inline(RA1, xA1, u1, w1, xi1)
     for it in range(iterations):
         if moving and it > 0:
-            R1, x1, x1p, x1pp = _section(RA1, xA1, u1, w1, xi1)
-        R2, x2, x2p, x2pp = _section(RA2, xA2, u2, w2, xi2)
+            R1, x1, x1p, x1pp = _section_inline(RA1, xA1, u1, w1, xi1)
+        R2, x2, x2p, x2pp = _section_inline(RA2, xA2, u2, w2, xi2)
         d = add(x2, scale(-1.0, x1))
         e1 = _col(R1, 0)
         xi1_new, xi2_new = xi1, xi2
