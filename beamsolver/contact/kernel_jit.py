@@ -424,8 +424,15 @@ def _project(kind, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations=2):
     The slave section is computed once where ``xi1`` is fixed (line, orthogonal), and the iterations
     stop at an exact fixed point (an iterate equal to the last, bit for bit, fixes all later ones), so
     the result is that of all ``iterations``."""
+    return _project_from(kind, _section_inline(RA1, xA1, u1, w1, xi1), RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2,
+                         iterations)
+
+
+@jit
+def _project_from(kind, sec1, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations):
+    """``_project`` given the slave section ``sec1 = _section(RA1, xA1, u1, w1, xi1)`` (a caller that has it)."""
     moving = kind != LINE and kind != ORTHOGONAL
-    R1, x1, x1p, x1pp = _section_inline(RA1, xA1, u1, w1, xi1)
+    R1, x1, x1p, x1pp = sec1
     for it in range(iterations):
         if moving and it > 0:
             R1, x1, x1p, x1pp = _section_inline(RA1, xA1, u1, w1, xi1)

@@ -21,7 +21,7 @@ import numpy as np
 from .. import se3
 from .._jit import jit
 from ..se3_jit import dot
-from .kernel_jit import _pose_of, _project, _section
+from .kernel_jit import _pose_of, _project, _project_from, _section
 from .pairs import POINT
 
 __all__ = ["element_twists", "section_points", "closest_points", "project_points"]
@@ -89,12 +89,13 @@ def _project_points(H, kind, A1, h1, xi1, A2, B2, h2, iterations, out2, dist):
         _, xB2 = _pose_of(H, B2[k])
         u1, w1 = (h1[k, 0], h1[k, 1], h1[k, 2]), (h1[k, 3], h1[k, 4], h1[k, 5])
         u2, w2 = (h2[k, 0], h2[k, 1], h2[k, 2]), (h2[k, 3], h2[k, 4], h2[k, 5])
-        _, xc, _, _ = _section(RA1, xA1, u1, w1, xi1[k])
+        sec1 = _section(RA1, xA1, u1, w1, xi1[k])
+        xc = sec1[1]
         chord = (xB2[0] - xA2[0], xB2[1] - xA2[1], xB2[2] - xA2[2])
         rel = (xc[0] - xA2[0], xc[1] - xA2[1], xc[2] - xA2[2])
         s = dot(rel, chord) / max(dot(chord, chord), 1e-300)
         s = min(max(s, 0.0), 1.0)
-        _, xi2 = _project(kind[k], RA1, xA1, u1, w1, xi1[k], RA2, xA2, u2, w2, s, iterations)
+        _, xi2 = _project_from(kind[k], sec1, RA1, xA1, u1, w1, xi1[k], RA2, xA2, u2, w2, s, iterations)
         _, xf, _, _ = _section(RA2, xA2, u2, w2, xi2)
         out2[k] = xi2
         dist[k] = np.sqrt((xf[0] - xc[0]) ** 2 + (xf[1] - xc[1]) ** 2 + (xf[2] - xc[2]) ** 2)
