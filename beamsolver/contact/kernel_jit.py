@@ -44,7 +44,7 @@ import hashlib
 import types
 
 import numpy as np
-from numba import types as nb_types
+from numba import config as numba_config, types as nb_types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
@@ -67,10 +67,10 @@ _normal_law = _tangential_law = None
 
 # ---------------------------------------------------------------- borrowed arrays
 @intrinsic
-def _borrowed(typingctx, a):
+def _borrowed_intrinsic(typingctx, a):
     """A view of the array ``a`` without its memory owner (meminfo): numba's reference counting
-    (an atomic increment and decrement per array passed to a function or sliced, ~10 % of the
-    kernel's time) skips it.  The caller keeps ``a`` alive while the view is in use."""
+    (an atomic increment and decrement per array passed to a function or sliced: ~10 % of the
+    kernel's perf samples) skips it.  The caller keeps ``a`` alive while the view is in use."""
     if not isinstance(a, nb_types.Array):
         return None
 
@@ -81,6 +81,14 @@ def _borrowed(typingctx, a):
         return ary._getvalue()
 
     return a(a), codegen
+
+
+def _borrowed_python(a):
+    """``_borrowed`` as plain Python (``NUMBA_DISABLE_JIT=1``): the array itself."""
+    return a
+
+
+_borrowed = _borrowed_python if numba_config.DISABLE_JIT else _borrowed_intrinsic
 
 
 # ---------------------------------------------------------------- small algebra (tuples; small arrays written in place)
