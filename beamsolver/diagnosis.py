@@ -9,7 +9,7 @@ import numpy as np
 from .definiteness import negative_eigenvalues
 from .failures import DampingStalled, NotConverged, SingularTangent
 
-__all__ = ["nonfinite_source", "advice", "stiffness_spread", "ILL_CONDITIONED"]
+__all__ = ["nonfinite_source", "advice", "stiffness_spread", "pushing_point", "ILL_CONDITIONED"]
 
 ILL_CONDITIONED = 1e10     # ratio of scaled diagonal stiffnesses called ill-conditioned
 
@@ -57,6 +57,38 @@ def _contact_declaration(model, nodes):
             return (f"add_contact no. {i} (slave beams {[b.id for b in d.slave]}, "
                     f"master beams {[b.id for b in d.master]})")
     return "a contact declaration"
+
+
+def _element_label(model, e):
+    """``Beam b 'name' element j`` for a global element id ``e``."""
+    for b in model.beams:
+        if b.elements[0] <= e <= b.elements[-1]:
+            return f"Beam {b.id}" + (f" {b.name!r}" if b.name else "") + f" element {e - b.elements[0]}"
+    return f"element {e}"
+
+
+def pushing_point(problem, H):
+    """Where contact pushes the poses ``H`` hardest: ``add_contact no. k: <slave element> against
+    <master element> (normal force, gap; points in contact)``.  Commits ``H`` to the contact
+    contribution to read its point table: for a run that stops there."""
+    cs = problem.contact
+    if cs is None:
+        return "no contact declared"
+    try:
+        cs.commit(H)
+        c = cs.results(H)
+    except Exception:           # advice only: never hide the failure being reported
+        return "the contact points could not be evaluated"
+    on = np.flatnonzero(c["normal_force"] > 0)
+    if not len(on):
+        return "no contact point carries force"
+    k = on[np.argmax(c["normal_force"][on])]
+    e, m = int(c["slave_element"][k]), int(c["master_element"][k])
+    decl = next((d.index for d in cs.decls if e in d.slave_el and m in d.master_el), "?")
+    model = problem.system.model
+    return (f"the largest push: add_contact no. {decl}: {_element_label(model, e)} against "
+            f"{_element_label(model, m)}, normal force {c['normal_force'][k]:.3g} at gap {c['gap'][k]:.3g}; "
+            f"{len(on)} points in contact")
 
 
 def stiffness_spread(system, K):

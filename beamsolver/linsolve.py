@@ -42,6 +42,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ._jit import jit
 from .errors import InputError
 
 __all__ = ["factorize", "Solver", "SingularMatrixError", "available", "BACKENDS", "DEFAULT"]
@@ -213,22 +214,117 @@ _RCM_LAST = []      # the last (pattern, ordering) of ``_rcm``
 def _rcm(K):
     """RCM ordering of ``K``'s pattern and the symmetrically permuted CSC pattern:
     ``(perm, where, indices, indptr)`` with ``K_p.data = K.data[where]``.  Kept for the last
-    pattern (Newton iterations with the same active contact pairs)."""
-    from scipy.sparse.csgraph import reverse_cuthill_mckee
+    pattern (Newton iterations with the same active contact pairs).  A CSC ``K`` (what
+    ``System.matrix`` gives) takes the compiled ``_rcm_csc``, others scipy's ``_rcm_scipy``:
+    the same arrays (both canonical, the same graph for the ordering)."""
     key = (K.format, K.shape)
     if _RCM_LAST:
         k, ptr, ind, out = _RCM_LAST[0]
         if k == key and np.array_equal(ptr, K.indptr) and np.array_equal(ind, K.indices):
             return out
-    # the entry numbers (1..nnz, exact as floats) travel through the same permutation as the values
+    fast = K.format == "csc" and K.nnz < np.iinfo(np.int32).max and K.has_canonical_format
+    out = _rcm_csc(K) if fast else _rcm_scipy(K)
+    _RCM_LAST[:] = [(key, K.indptr.copy(), K.indices.copy(), out)]
+    return out
+
+
+def _rcm_scipy(K):
+    """``_rcm`` by scipy: the entry numbers (1..nnz, exact as floats) travel through the same
+    permutation as the values."""
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
     numbers = K.__class__((np.arange(1.0, K.nnz + 1.0), K.indices, K.indptr), shape=K.shape)
     A = sp.csr_matrix(numbers)
     pattern = sp.csr_matrix((np.ones(A.nnz), A.indices, A.indptr), shape=A.shape)
     perm = reverse_cuthill_mckee((pattern + pattern.T).tocsr(), symmetric_mode=True)
     Ap = A[perm][:, perm].tocsc()
-    out = (perm, Ap.data.astype(np.int64) - 1, Ap.indices, Ap.indptr)
-    _RCM_LAST[:] = [(key, K.indptr.copy(), K.indices.copy(), out)]
-    return out
+    return perm, Ap.data.astype(np.int64) - 1, Ap.indices, Ap.indptr
+
+
+def _rcm_csc(K):
+    """``_rcm_scipy`` of a canonical CSC ``K`` in compiled passes, no sparse temporaries: the
+    transposed pattern (``_transpose``), the graph ``pattern + pattern^T`` (``_union``) and the
+    permuted pattern (``_permuted``), the canonical arrays scipy builds."""
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
+    n = K.shape[0]
+    ptr, ind = np.asarray(K.indptr, dtype=np.int64), np.asarray(K.indices, dtype=np.int32)
+    t_ptr = np.empty(n + 1, dtype=np.int64)
+    t_ind = np.empty(len(ind), dtype=np.int32)
+    t_pos = np.empty(len(ind), dtype=np.int64)
+    _transpose(ptr, ind, t_ptr, t_ind, t_pos)
+    s_ptr = np.empty(n + 1, dtype=np.int32)
+    s_ind = np.empty(2 * len(ind), dtype=np.int32)
+    m = _union(ptr, ind, t_ptr, t_ind, s_ptr, s_ind)
+    perm = reverse_cuthill_mckee(sp.csr_matrix((np.ones(m), s_ind[:m], s_ptr), shape=K.shape), symmetric_mode=True)
+    where = np.empty(len(ind), dtype=np.int64)
+    indices = np.empty(len(ind), dtype=np.int32)
+    indptr = np.empty(n + 1, dtype=np.int32)
+    _permuted(ptr, t_ptr, t_ind, t_pos, perm, where, indices, indptr)
+    return perm, where, indices, indptr
+
+
+@jit
+def _transpose(ptr, ind, t_ptr, t_ind, t_pos):
+    """The transpose of the compressed pattern ``(ptr, ind)`` (square): sorted, with each entry's
+    position ``t_pos`` in the input (a stable counting sort)."""
+    n = len(ptr) - 1
+    t_ptr[:] = 0
+    for p in range(len(ind)):
+        t_ptr[ind[p] + 1] += 1
+    for i in range(n):
+        t_ptr[i + 1] += t_ptr[i]
+    nxt = t_ptr[:-1].copy()
+    for j in range(n):
+        for p in range(ptr[j], ptr[j + 1]):
+            i = ind[p]
+            t_ind[nxt[i]] = j
+            t_pos[nxt[i]] = p
+            nxt[i] += 1
+
+
+@jit
+def _union(ptr, ind, t_ptr, t_ind, s_ptr, s_ind):
+    """The union of two sorted patterns (a pattern and its transpose), sorted; returns its size."""
+    m = 0
+    s_ptr[0] = 0
+    for j in range(len(ptr) - 1):
+        a, a_end, b, b_end = ptr[j], ptr[j + 1], t_ptr[j], t_ptr[j + 1]
+        while a < a_end or b < b_end:
+            if b >= b_end or (a < a_end and ind[a] < t_ind[b]):
+                s_ind[m] = ind[a]
+                a += 1
+            elif a >= a_end or t_ind[b] < ind[a]:
+                s_ind[m] = t_ind[b]
+                b += 1
+            else:
+                s_ind[m] = ind[a]
+                a += 1
+                b += 1
+            m += 1
+        s_ptr[j + 1] = m
+    return m
+
+
+@jit
+def _permuted(ptr, t_ptr, t_ind, t_pos, perm, where, indices, indptr):
+    """CSC pattern of ``K[perm][:, perm]`` and the position in ``K`` of each entry (``where``), from
+    ``K``'s column starts ``ptr`` and its transpose ``(t_ptr, t_ind, t_pos)``: the rows taken in the
+    new order fill each new column in ascending row order."""
+    n = len(ptr) - 1
+    inv = np.empty(n, dtype=np.int64)
+    indptr[0] = 0
+    for j in range(n):
+        inv[perm[j]] = j
+        indptr[j + 1] = indptr[j] + (ptr[perm[j] + 1] - ptr[perm[j]])
+    nxt = np.empty(n, dtype=np.int64)
+    for j in range(n):
+        nxt[j] = indptr[j]
+    for i in range(n):
+        r = perm[i]
+        for q in range(t_ptr[r], t_ptr[r + 1]):
+            j = inv[t_ind[q]]
+            indices[nxt[j]] = i
+            where[nxt[j]] = t_pos[q]
+            nxt[j] += 1
 
 
 def _backward_error(K, x, b):

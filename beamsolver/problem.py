@@ -82,6 +82,13 @@ class Problem:
 
     # ------------------------------------------------------------ properties
     @property
+    def solves_start(self):
+        """Whether forces of the contributions on the load-free given poses make step 0 an
+        equilibrium to solve (``Newton.at_rest`` decides): contact, whose smoothed law pushes
+        touching wires apart (docs/theory.md 19.2); user contributions keep the given state."""
+        return self.contact is not None
+
+    @property
     def smooth(self):
         return all(c.smooth for c in self.contributions)
 

@@ -190,6 +190,19 @@ class Newton:
     def _ratio(self, r, scales):
         return self.conv.residual_ratio(r[self._dofs_u], r[self._dofs_w], *scales)
 
+    def at_rest(self, ev, H, t):
+        """Whether the given poses ``H`` (evaluated in ``ev`` at ``t``) are an equilibrium by
+        Newton's tests (``Convergence.decide``): the scaled residual, else the Newton correction
+        one iteration would make, against its round-off floor.  A state Newton could not start
+        from (a singular tangent, a refused contact) counts as at rest: it is kept as given."""
+        if not np.all(np.isfinite(ev.r)) or self._ratio(ev.r, self.conv.scales(ev, self.L_ref)) <= self.conv.rtol:
+            return True
+        try:
+            _, dzf = self._direction(self.problem.evaluate(H, t, tangent=True))
+        except StepFailed:
+            return True
+        return self._inc(dzf) <= max(self.conv.dtol, self.conv.floor(H, self.L_ref))
+
     def _merit(self, r, scales):
         rf = r[self.sys.free_dofs]
         F, M = scales

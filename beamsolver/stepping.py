@@ -119,7 +119,8 @@ class Run:
 
     def _step_zero(self, H0, t_start):
         """Step 0: the state ``H0`` at ``t_start`` (prescribed nodes on their motion) or, when loads,
-        motions or ``fix`` values act there, the equilibrium solved there from ``H0`` with
+        motions or ``fix`` values act there or contact pushes ``H0`` off balance
+        (``Newton.at_rest``), the equilibrium solved there from ``H0`` with
         ``STEP_ZERO_ITERATIONS`` times the Newton budget ``max_iter``: no step can be cut back
         there, and the first state of touching wires converges only linearly (docs/theory.md
         section 17, touching wires at t_start)."""
@@ -129,7 +130,14 @@ class Run:
             H[sys.prescribed_nodes] = sys.prescribed_poses(t_start)
             sys.sync_members(H)
         stats, record = dict(iterations=0, residuals=[], wall_time=0.0, dt=0.0, cutbacks=0), None
-        if _acts_at(sys, H0, t_start):
+        acts = _acts_at(sys, H0, t_start)
+        pushed = False
+        if not acts:
+            ev0 = problem.evaluate(H, t_start, tangent=False)
+            # contact alone may push the given poses (touching wires under the smoothed law,
+            # docs/theory.md 19.2); round-off contact forces ask for a correction at round-off
+            pushed = problem.solves_start and not self.newton.at_rest(ev0, H, t_start)
+        if acts or pushed:
             t0 = time.perf_counter()
             self.H, self.t = H0, None
             conv = self.newton.conv
@@ -138,8 +146,12 @@ class Run:
                 H, ev0, stats = self.newton_step(t_start)
             except StepFailed as e:
                 self.sol.converged, self.sol.message = False, str(e)
-                err = ConvergenceError(f"solve: no equilibrium at t_start = {t_start:.6g}, where loads or motions "
-                                       f"already act: {e}; start the loads from zero or use more steps", self.sol)
+                if pushed:
+                    why = (f"contact forces already act ({diagnosis.pushing_point(problem, H)}): {e}; "
+                           "separate the beams by a small gap or raise max_iter")
+                else:
+                    why = f"loads or motions already act: {e}; start the loads from zero or use more steps"
+                err = ConvergenceError(f"solve: no equilibrium at t_start = {t_start:.6g}, where {why}", self.sol)
                 err.failure = e
                 raise err from None
             finally:
@@ -148,8 +160,6 @@ class Run:
             record = problem.commit(H)
             if problem.contributions:
                 self.sol.contact_state = problem.get_state()
-        else:
-            ev0 = problem.evaluate(H, t_start, tangent=False)
         self._check_finite(H, ev0.r, ev0.state, t_start)
         self.sol.append(t_start, H, sys.reactions(H, ev0.r), ev0.state.sigma, ev0.state.strain, stats, record)
         self.H = H

@@ -172,3 +172,192 @@ def test_pattern_built_on_the_buffers_of_the_last_one():
     assert _identical(fresh.matrix(el.data, vals), _scipy(el, *small, vals, red))
     vals = rng.standard_normal(len(big[0]))
     assert _identical(third.matrix(el.data, vals), _scipy(el, *big, vals, red))
+
+
+def _node_blocks(rng, n_nodes, m, k):
+    """Block dofs ``(m, 6 k)`` over ``k`` random nodes each (whole nodes, some repeated within a
+    block, as joined nodes share a representative)."""
+    nodes = rng.integers(0, n_nodes, size=(m, k))
+    nodes[::7, 1] = nodes[::7, 0]
+    return ((6 * nodes)[:, :, None] + np.arange(6)).reshape(m, 6 * k)
+
+
+def _coo_of(d):
+    b = d.shape[1]
+    return np.repeat(d, b, axis=1).ravel(), np.tile(d, (1, b)).ravel()
+
+
+def _reduction(rng, n_nodes, clamped, partial):
+    """``red`` over ``6 n_nodes`` unknowns: ``clamped`` nodes fully, ``partial`` nodes on some dofs fixed."""
+    free = np.ones(6 * n_nodes, dtype=bool)
+    for b in rng.choice(n_nodes, clamped, replace=False):
+        free[6 * b:6 * b + 6] = False
+    for b in rng.choice(n_nodes, partial, replace=False):
+        free[6 * b + rng.choice(6, 3, replace=False)] = False
+    red = np.full(6 * n_nodes, -1)
+    red[free] = np.arange(free.sum())
+    return red, int(free.sum())
+
+
+def test_block_pattern_is_scipys_matrix_bit_for_bit():
+    """``BlockPattern`` (built from the block dofs alone) gives scipy's ``K_el + csc_matrix`` of the
+    blocks' COO entries, on long columns (> 16 entries: std::sort's partitions, not an insertion
+    sort), clamped and partly fixed nodes, repeated nodes in a block, and for new values."""
+    from beamsolver.extra_pattern import BlockPattern, whole_nodes
+    rng = np.random.default_rng(11)
+    for trial in range(5):
+        n_nodes = 60 + 40 * trial
+        red, n = _reduction(rng, n_nodes, 5, 4)
+        el = _element_matrix(rng, n, 0.02)
+        d = _node_blocks(rng, n_nodes, 150 + 50 * trial, 4)
+        assert whole_nodes(d)
+        rows, cols = _coo_of(d)
+        pat = BlockPattern(d, red, n, el.indptr, el.indices)
+        for _ in range(3):
+            vals = rng.standard_normal(len(rows)) * 10.0 ** rng.integers(-8, 8, size=len(rows))
+            assert _identical(pat.matrix(el.data, vals), _scipy(el, rows, cols, vals, red))
+        # scipy sorts no column when all are sorted: nor does the pattern
+        one = d[:1]
+        vals = rng.standard_normal(24 * 24)
+        assert _identical(BlockPattern(one, red, n, el.indptr, el.indices).matrix(el.data, vals),
+                          _scipy(el, *_coo_of(one), vals, red))
+
+
+def test_whole_nodes_recognised():
+    from beamsolver.extra_pattern import whole_nodes
+    d = ((6 * np.array([[3, 1], [0, 2]]))[:, :, None] + np.arange(6)).reshape(2, 12)
+    assert whole_nodes(d)
+    bad = d.copy()
+    bad[1, 7] += 1
+    assert not whole_nodes(bad) and not whole_nodes(d + 1) and not whole_nodes(d[:, :10])
+
+
+def _system_matrices(s, nodes, K):
+    """``System.matrix`` of element values plus blocks ``K`` over ``nodes`` ``(m, 4)`` handed over by
+    ``assemble_blocks`` (as contact's), and scipy's matrix of the same COO data."""
+    from beamsolver import assembly_jit
+    from beamsolver.blocks import Blocks
+    kvals = np.random.default_rng(len(nodes)).standard_normal(s.group_kslices[-1] + 36 * len(s.block_nodes))
+    _, extra, _, _ = s.assemble_blocks(s.poses0, Blocks(nodes, np.zeros((len(nodes), 24)), K))
+    data = np.empty(s.nnz + 1)
+    assembly_jit.scatter(s.pos, kvals, data)
+    el = sp.csc_matrix((data[:s.nnz], s.indices, s.indptr), shape=(s.n_free, s.n_free))
+    return s.matrix(kvals, extra), _scipy(el, *extra, s.red)
+
+
+def test_system_matrix_as_the_active_set_changes():
+    """Through ``System.matrix``: contact-like blocks of a changing active set (pairs added,
+    dropped, the same set again, a set seen before) give scipy's matrix of the same COO data each
+    time; the pattern is rebuilt only when the set changes, on the buffers of the last one."""
+    import sys
+    from pathlib import Path
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+    import twisted_pair
+    from beamsolver.assembly import System
+    from beamsolver.extra_pattern import BlockPattern
+
+    model, _, _ = twisted_pair.build(n_elements=12, turns=0.5)
+    s = System(model)
+    rng = np.random.default_rng(2)
+    n_nodes = s.n_nodes
+    pairs = rng.integers(0, n_nodes, size=(400, 4))
+    sets = [np.arange(300), np.arange(300), np.arange(20, 330), np.arange(0, 400, 2), np.arange(300),
+            np.arange(5)]
+    built = []
+    for sel in sets:
+        K = rng.standard_normal((len(sel), 24, 24))
+        K[:, ::5] = 0.0                          # exact zeros on the way
+        ours, ref = _system_matrices(s, pairs[sel], K)
+        assert _identical(ours, ref)
+        assert isinstance(s.extra_pattern, BlockPattern)
+        built.append((s.extra_pattern, s.extra_pattern.buffers[0]))
+    assert built[0][0] is built[1][0] and built[1][0] is not built[2][0] and built[4][0] is not built[0][0]
+    assert all(b[1] is built[0][1] for b in built)       # every set fits the first one's buffers
+
+
+def test_block_pattern_with_a_tail_of_entries():
+    """Blocks followed by other COO entries (``assemble_blocks``' terms of global-type nodes, any
+    entries): the columns they reach are sorted on their own, with scipy's result bit for bit."""
+    from beamsolver.extra_pattern import BlockPattern
+    rng = np.random.default_rng(17)
+    for trial in range(4):
+        n_nodes = 80 + 30 * trial
+        red, n = _reduction(rng, n_nodes, 4, 6)
+        el = _element_matrix(rng, n, 0.03)
+        d = _node_blocks(rng, n_nodes, 200, 4)
+        g = rng.choice(n_nodes, 5, replace=False)          # global-node-like terms, then random entries
+        t_rows = np.concatenate([np.repeat(6 * g, 18) + np.tile(np.repeat(np.arange(6), 3), len(g)),
+                                 rng.integers(0, 6 * n_nodes, 40)])
+        t_cols = np.concatenate([np.repeat(6 * g, 18) + 3 + np.tile(np.arange(3), 6 * len(g)),
+                                 rng.integers(0, 6 * n_nodes, 40)])
+        rows, cols = (np.concatenate([a, b]) for a, b in zip(_coo_of(d), (t_rows, t_cols)))
+        pat = BlockPattern(d, red, n, el.indptr, el.indices, (t_rows, t_cols))
+        for _ in range(2):
+            vals = rng.standard_normal(len(rows)) * 10.0 ** rng.integers(-8, 8, size=len(rows))
+            assert _identical(pat.matrix(el.data, vals), _scipy(el, rows, cols, vals, red))
+        assert not pat.same(d, None) and pat.same(d.copy(), (t_rows.copy(), t_cols.copy()))
+
+
+def test_contact_scene_with_global_nodes_takes_the_block_path():
+    """The twisted pair's contact reaches global-type nodes (partly fixed ends): its tangent is
+    built by ``BlockPattern`` with the global-node terms as a tail, equal to scipy's."""
+    import sys
+    from pathlib import Path
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+    import twisted_pair
+    from beamsolver import assembly_jit
+    from beamsolver.extra_pattern import BlockPattern
+    from beamsolver.problem import Problem
+
+    model, _, _ = twisted_pair.build(n_elements=8, turns=0.5)
+    problem = Problem.from_model(model)
+    s = problem.system
+    H = s.poses0.copy()
+    problem.begin_step(H, 0.0)
+    ev = problem.evaluate(H, 0.0, tangent=True)
+    data = np.empty(s.nnz + 1)
+    assembly_jit.scatter(s.pos, ev.kvals, data)
+    el = sp.csc_matrix((data[:s.nnz], s.indices, s.indptr), shape=(s.n_free, s.n_free))
+    assert _identical(problem.tangent(ev), _scipy(el, *ev.extra, s.red))
+    assert isinstance(s.extra_pattern, BlockPattern) and s.extra_pattern.tail is not None
+
+
+def test_block_index_arrays_reused_only_when_free():
+    """The COO index arrays of a new block set reuse the memory of earlier ones only once no array
+    handed out is a view of it: arrays still held (an evaluation's ``extra``) keep their values."""
+    import sys
+    from pathlib import Path
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+    import twisted_pair
+    from beamsolver.assembly import REUSE_BUFFERS, System
+    from beamsolver.blocks import Blocks
+
+    model, _, _ = twisted_pair.build(n_elements=12, turns=0.5)
+    s = System(model)
+    rng = np.random.default_rng(4)
+    plain = np.flatnonzero(~s.transformed & s.is_rep)     # no transform, no global-node terms
+    sets = [rng.choice(plain, size=(m, 4)) for m in (50, 40, 45, 30)]
+
+    def index(nodes):
+        d = ((6 * s.rep[nodes])[:, :, None] + np.arange(6)).reshape(len(nodes), 24)
+        blocks = Blocks(nodes, np.zeros((len(nodes), 24)), np.zeros((len(nodes), 24, 24)))
+        return d, s.assemble_blocks(s.poses0, blocks)[1][:2]
+
+    def address(a):
+        return a.__array_interface__["data"][0]
+
+    held = [index(nodes) for nodes in sets[:3]]          # all three held: three buffers
+    for d, (rows, cols) in held:
+        assert np.array_equal(rows, np.repeat(d, 24, axis=1).ravel())
+        assert np.array_equal(cols, np.tile(d, (1, 24)).ravel())
+        assert not rows.flags.writeable
+    assert len({address(h[1][0]) for h in held}) == 3
+    second = address(held[1][1][0])
+    d_kept, kept = held[2]
+    del held, d, rows, cols
+    d_new, new = index(sets[3])
+    assert np.array_equal(kept[0], np.repeat(d_kept, 24, axis=1).ravel())
+    assert np.array_equal(new[0], np.repeat(d_new, 24, axis=1).ravel())
+    assert np.array_equal(new[1], np.tile(d_new, (1, 24)).ravel())
+    if REUSE_BUFFERS:                    # the second set's buffer is free again: reused
+        assert address(new[0]) == second

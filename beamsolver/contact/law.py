@@ -104,15 +104,24 @@ def coulomb(trial0, trial1, Dtrial, mu, lam, Dlam):
     """``coulomb_return_mapping`` for one point in forward mode (``ContactLaw.tangential``): stick
     inside the disk ``|trial| <= mu lam``, else ``mu lam trial / |trial|``.  ``Dtrial`` ``(2, k)``,
     ``Dlam`` ``(k,)``: gradients of the trial traction and of ``lam``; returns ``(lt0, lt1, D, stick)``
-    with ``D`` ``(2, k)`` the gradient of the traction."""
+    with ``D`` ``(2, k)`` the gradient of the traction.  In slip
+    ``D = tt (mu Dlam)^T + (limit / norm) (Dtrial - tt proj^T)``, ``tt = trial / norm``,
+    ``proj = tt^T Dtrial``: written column by column into ``D``, its only allocation (the
+    operations and their order those of the array form, so the same bits)."""
     norm = np.sqrt(trial0 * trial0 + trial1 * trial1)
     limit = mu * lam
     if norm <= limit:
         return trial0, trial1, Dtrial, True
-    tt = np.array([trial0 / norm, trial1 / norm])
-    proj = tt[0] * Dtrial[0] + tt[1] * Dtrial[1]
-    D = np.outer(tt, mu * Dlam) + (limit / norm) * (Dtrial - np.outer(tt, proj))
-    return limit * tt[0], limit * tt[1], D, False
+    t0, t1 = trial0 / norm, trial1 / norm
+    s = limit / norm
+    k = Dtrial.shape[1]
+    D = np.empty((2, k))
+    for j in range(k):
+        proj = t0 * Dtrial[0, j] + t1 * Dtrial[1, j]
+        dl = mu * Dlam[j]
+        D[0, j] = t0 * dl + s * (Dtrial[0, j] - t0 * proj)
+        D[1, j] = t1 * dl + s * (Dtrial[1, j] - t1 * proj)
+    return limit * t0, limit * t1, D, False
 
 
 PENALTY_COULOMB = ContactLaw("penalty_coulomb", penalty_normal, coulomb)

@@ -3,7 +3,8 @@
 Pure functions over arrays (no state: the hysteresis inputs, the owners chosen at the
 last evaluation, are arguments).  The stages, in the order ``ContactSystem.pairs`` runs them:
 
-1. ``apart``: elements sharing a node (a beam joined to another) never pair;
+1. ``apart``: elements sharing a node never pair, nor elements meeting at a joint (their
+   nodes merged by ``joint_nodes``);
 2. ``crossing``: line contact below ``line_angle``, else ``point_or_orthogonal`` by the
    reduced-Hessian ratio (search.py, rules 1-2), and ``extend_wrap`` (rule 3);
 3. ``xi_range``: accepted projection parameters on an element;
@@ -11,20 +12,46 @@ last evaluation, are arguments).  The stages, in the order ``ContactSystem.pairs
    ``dedupe_points`` (one point pair per crossing).
 """
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from .pairs import ORTHOGONAL, POINT
 from .search import XI_TOL
 
-__all__ = ["apart", "crossing", "point_or_orthogonal", "extend_wrap", "xi_range", "owners", "dedupe_points", "XI_OVERHANG", "OWNER_TIE"]
+__all__ = ["joint_nodes", "apart", "crossing", "point_or_orthogonal", "extend_wrap", "xi_range", "owners", "dedupe_points", "XI_OVERHANG", "OWNER_TIE"]
 
 XI_OVERHANG = 0.05        # accepted projection past an inner node, in element lengths (kinks of the C0 line)
 OWNER_TIE = 1e-9          # distances equal within this fraction of R1 + R2 tie (a point on a shared node)
 
 
+def joint_nodes(group, x, tol):
+    """Node ids ``(n_nodes,)`` for ``apart`` in which the nodes of a joint are one node.
+
+    ``group`` ``(n_nodes,)``: the join group of each node (``assembly.System.rep``, union-find
+    over every ``Model.join``); ``x`` ``(n_nodes, 3)``: reference positions.  Nodes of one
+    group within ``tol`` of each other are merged, whichever kind of ``join`` tied them: a
+    joint (``join(a, b)``, or ``rigid=True`` on coincident nodes, as the halves of a wire in
+    ``examples/plectoneme.py``) makes the elements on either side neighbours, as if they
+    shared the node.  A rigid link between nodes apart (wire ends on a plate node) does not:
+    the elements it ties are apart at the link, and wires touching along their length up to
+    a plate are in contact there too.
+    """
+    n = len(group)
+    ij = cKDTree(x).query_pairs(tol, output_type="ndarray")
+    ij = ij[group[ij[:, 0]] == group[ij[:, 1]]]
+    if len(ij) == 0:
+        return np.arange(n)
+    tie = coo_matrix((np.ones(len(ij)), (ij[:, 0], ij[:, 1])), shape=(n, n))
+    return connected_components(tie, directed=False)[1]
+
+
 def apart(enodes, e, m):
     """Mask ``(n,)`` of the element pairs ``(e[k], m[k])`` that share no node, each pair compared
-    with its own two elements' nodes (``enodes`` ``(n_el, k)``)."""
+    with its own two elements' nodes (``enodes`` ``(n_el, k)``; pass the table mapped by
+    ``joint_nodes`` so that elements meeting at a joint never pair: their centre lines meet
+    there, a contact pair between them would find no normal or the full overlap
+    ``R1 + R2``)."""
     return ~(enodes[e][:, :, None] == enodes[m][:, None, :]).any(axis=(1, 2))
 
 

@@ -5,8 +5,8 @@ contact declarations.  It orchestrates pure stages kept in their own modules:
 
 1. broad phase (``search.py``: element spheres, ``scipy.spatial.cKDTree``) on the element
    twists computed once per evaluation (``projection.element_twists``);
-2. pair rules (``rules.py``: no pair between elements sharing a node, the kind of each
-   element pair, closest points of crossings from ``projection.closest_points``);
+2. pair rules (``rules.py``: no pair between elements sharing a node or meeting at a joint,
+   the kind of each element pair, closest points of crossings from ``projection.closest_points``);
 3. projection of the slave Gauss points (``projection.project_points``, compiled) and
    ownership (``rules.owners``, ``rules.dedupe_points``: one owner per slave point, stable
    at shared nodes), giving one typed ``record.PairSet``;
@@ -46,6 +46,7 @@ from .. import se3
 from ..blocks import Blocks, Contribution
 from ..errors import InputError
 from ..failures import ContactTunnelling, NoContactNormal
+from ..model import JOIN_TOL
 from .law import default_penalty
 from . import kernel_jit, pairs
 from .kernel_jit import contact_kernel, kernel_and_tangent      # compiled; pairs.py's are the oracle
@@ -117,6 +118,9 @@ class ContactSystem(Contribution):
             self.el_last[b.elements[-1]] = True
             self.el_first[b.elements[0]] = True
         self.n_beams = len(model.beams)
+        # element end nodes with the nodes of a joint merged: elements meeting there never pair
+        self._joint_enodes = rules.joint_nodes(system.rep, system.poses0[:, :3, 3],
+                                               JOIN_TOL * system.length_scale)[system.enodes]
         self.decls = [_Decl(k, d, model) for k, d in enumerate(model.contacts)]
         # per-declaration parameters as arrays, indexed by a pair's ``decl`` (no loop over pairs)
         self._decl_penalty = np.array([d.penalty for d in self.decls])
@@ -262,7 +266,7 @@ class ContactSystem(Contribution):
         i, j = broad_phase(cs, rs, cm, rm)
         self._lap("search")
         e, m = d.slave_el[i], d.master_el[j]
-        keep = rules.apart(en, e, m)
+        keep = rules.apart(self._joint_enodes, e, m)
         i, j, e, m = i[keep], j[keep], e[keep], m[keep]
         kinds = np.full(len(i), LINE)
         xi1, xi2 = np.zeros(len(i)), np.zeros(len(i))
@@ -577,7 +581,8 @@ class ContactSystem(Contribution):
         for b in self._K_pool if REUSE_BUFFERS else ():
             if len(b) >= m and sys.getrefcount(b) <= 3:      # the pool, ``b`` and the call's argument
                 return b[:m]
-        b = np.empty((m, 24, 24))
+        # room for a few more pairs: an active set growing by one pair does not need fresh memory
+        b = np.empty((m + m // 8 if REUSE_BUFFERS else m, 24, 24))
         self._K_pool = [b] + self._K_pool[:1]
         return b[:m]
 
