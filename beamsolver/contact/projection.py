@@ -12,9 +12,11 @@ follow the constant-strain interpolation ``H_A exp(xi h)`` with the element twis
   ``ORTHOGONAL``), started from the projection on the master chord.
 
 ``_project`` computes a fixed slave section once and stops at an exact fixed point of
-the iteration, with the result of all the iterations asked for.  (Numba's disk cache
-keys a function on its own source file only: after editing ``kernel_jit._project``,
-delete the ``__pycache__`` numba files of this module too, or it keeps the old copy.)
+the iteration, with the result of all the iterations asked for; ``project_points`` hands
+it the slave section it already has (``kernel_jit._project_from``).  (Numba's disk cache
+keys a function on its own source file only: after editing ``kernel_jit._project`` or the
+functions it calls, delete the ``__pycache__`` numba files of this module too, or it keeps
+the old copy.)
 """
 import numpy as np
 
