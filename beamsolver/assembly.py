@@ -22,6 +22,7 @@ import scipy.sparse as sp
 
 from . import assembly_jit, contributions, se3
 from . import blocks as _blocks
+from .blocks import REUSE_BUFFERS
 from .errors import InputError
 from .extra_pattern import BlockPattern, ExtraPattern, whole_nodes
 from .se3 import skew
@@ -33,9 +34,6 @@ FREE, GLOBAL, CLAMPED, PRESCRIBED = 0, 1, 2, 3
 # rank tolerance of the rigid-mode check: the constraint rows mix unit rotations with lever arms
 # in units of the group's size (``_rigid_mode_rank``), so entries are O(1)
 RIGID_MODE_TOL = 1e-9
-# buffers are reused when ``sys.getrefcount`` shows nothing else holds them, a count that is an
-# implementation detail (CPython 3.14 borrows references on the stack): only where it was checked
-REUSE_BUFFERS = sys.implementation.name == "cpython" and sys.version_info < (3, 14)
 
 
 def _rigid_mode_rank(x, fixed):

@@ -613,6 +613,8 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     newton.linsolver = linsolve.Solver(linear_solver)
     options = _run_options(problem, t_start, t_end, allow_unmet_tolerance, check_stability, modes,
                            branch_switching, stabilize)
+    if sol is not None and options["stabilizer"] is not None:
+        options["stabilizer"].resume(sol)
     run = None
     try:
         args = (problem, newton, _writer(output, system, checkpoint), grid, dt_min, verbose, options)

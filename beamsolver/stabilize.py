@@ -17,8 +17,8 @@ carries an artificial viscous force, body frame, translation first:
 The factor ``c`` follows from a dissipated-energy fraction ``fraction`` (Abaqus' default 2e-4):
 the first step with a positive strain energy ``E_1`` and motion is solved without damping, then
 ``c = fraction E_1 dt_1 / (h_1^T M* h_1)``, so that the same step would have dissipated
-``fraction E_1``; ``c`` is then kept for the whole solve (a restarted solve calibrates it
-again from its first step, and its dissipated total starts from zero).  Each stabilised step is a step of
+``fraction E_1``; ``c`` is then kept for the whole solve (a restarted solve continues with the factor and the
+dissipated total recorded in the solution it restarts from, ``Stabilization.resume``).  Each stabilised step is a step of
 implicit Euler on the viscous flow ``c M* v = -r``, i.e. a minimiser of the potential plus
 ``(c / 2 dt) h^T M* h``: a converged step whose stabilised tangent ``K + (c / dt) M*`` is not
 positive definite overshot an unstable mode (it lands on the far side of the unstable
@@ -150,6 +150,17 @@ class Stabilization(Contribution):
             raise StabilizedSaddle(f"t = {t:.6g}: the stabilised tangent has {neg} negative eigenvalue(s): "
                                    f"the viscous damping (c / dt = {self.c / self.dt:.3g}) is too weak for this "
                                    "step")
+
+    def resume(self, solution):
+        """Continue the damping of the run ``solution`` (a restart): its last recorded factor ``c``
+        (unless ``factor=`` was given) and dissipated total, so that the continued run damps as
+        the uninterrupted one (a factor calibrated again would leave the first step undamped)."""
+        rec = next((s["stabilization"] for s in reversed(solution.stats) if "stabilization" in s), None)
+        if rec is None:
+            return
+        if self.c == 0.0:
+            self.c = float(rec.get("factor", 0.0))
+        self.total = float(rec.get("dissipated_total", 0.0))
 
     def strain_energy(self, H):
         s = self.sys

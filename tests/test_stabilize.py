@@ -149,3 +149,30 @@ def test_stabilisation_of_three_node_elements_is_refused_naming_the_type():
     m.add_load(b.last, force=(0, 0, 1.0))
     with pytest.raises(bs.InputError, match="se3-3"):
         bs.solve(m, steps=2, stabilize=1e-3, verbose=False)
+
+
+def test_restart_continues_with_the_same_damping():
+    """A stabilised run interrupted and restarted with the same arguments ends where the
+    uninterrupted one does: the restart keeps the damping factor ``c`` and the dissipated total
+    (it used to calibrate ``c`` again, its first step undamped: near a snap, the wrong moment)."""
+    m, b, sec = _cantilever(8)
+    EI = sec.C[4, 4]
+    m.add_load(b.last, force=(0, 3 * EI, 0.5 * EI))
+    args = dict(steps=10, stabilize=1e-2, verbose=False)
+    ref = bs.solve(m, **args)
+
+    def stop(info):
+        if info["t"] > 0.55:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt) as e:
+        bs.solve(m, callback=stop, **args)
+    first = e.value.solution
+    assert first.times[-1] == pytest.approx(0.5)
+    sol = bs.solve(m, restart=first, **args)
+    assert np.array_equal(sol.times, ref.times)
+    for k in range(1, len(ref.times)):
+        assert sol.stats[k]["stabilization"]["factor"] == ref.stats[k]["stabilization"]["factor"]
+    st, st_ref = sol.stats[-1]["stabilization"], ref.stats[-1]["stabilization"]
+    assert st["dissipated_total"] == pytest.approx(st_ref["dissipated_total"], rel=1e-9)
+    assert np.abs(sol.poses[-1] - ref.poses[-1]).max() < 1e-12

@@ -22,6 +22,7 @@ from .search import XI_TOL
 __all__ = ["joint_nodes", "apart", "crossing", "point_or_orthogonal", "extend_wrap", "xi_range", "owners", "dedupe_points", "XI_OVERHANG", "OWNER_TIE"]
 
 XI_OVERHANG = 0.05        # accepted projection past an inner node, in element lengths (kinks of the C0 line)
+WRAP_END = 0.05          # extend_wrap: a slave closest point this close to an element end counts as at the end
 OWNER_TIE = 1e-9          # distances equal within this fraction of R1 + R2 tie (a point on a shared node)
 
 
@@ -66,16 +67,22 @@ def crossing(t_slave, t_master, line_angle):
     return np.arccos(np.clip(np.abs(np.sum(t_slave * t_master, axis=1)), 0.0, 1.0)) >= line_angle
 
 
-def extend_wrap(enodes, master_beam, n_beams, e, m, kind):
+def extend_wrap(enodes, master_beam, n_beams, e, m, kind, xi1=None):
     """A straight slave element leaving a wrap tangentially (it shares a node with an
     ``ORTHOGONAL`` element against the same master beam, ``master_beam[k]`` the beam of ``m[k]``)
     is projected orthogonally too: its closest point to the master sits at its end, where a
-    point pair would switch on and off as the tangent point moves (search.py, rule 3)."""
+    point pair would switch on and off as the tangent point moves (search.py, rule 3).
+    ``xi1``: the slave's closest points; given, only point pairs whose closest point lies
+    outside ``[WRAP_END, 1 - WRAP_END]`` are extended: a crossing inside the slave element is an
+    isolated crossing whatever its neighbours are (a neighbour's kind, decided at closest points
+    far outside its elements, must not take the point pair from a crossing of the loop's arms)."""
     orth = kind == ORTHOGONAL
     if not orth.any() or orth.all():
         return kind
     wrap = np.unique((enodes[e[orth]] * n_beams + master_beam[orth, None]).ravel())
     pt = np.flatnonzero(kind == POINT)
+    if xi1 is not None:
+        pt = pt[(xi1[pt] < WRAP_END) | (xi1[pt] > 1.0 - WRAP_END)]
     near = np.isin(enodes[e[pt]] * n_beams + master_beam[pt, None], wrap).any(axis=1)
     kind = kind.copy()
     kind[pt[near]] = ORTHOGONAL

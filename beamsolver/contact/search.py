@@ -22,7 +22,9 @@ the README, tested on both sides of each switch):
    shares a node with an orthogonal one against the same master beam (a
    straight rope leaving a wrap tangentially) is projected orthogonally too:
    its closest point sits at its end, and a point pair there would switch on
-   and off as the tangent point moves (``rules.extend_wrap``).
+   and off as the tangent point moves (``rules.extend_wrap``; only point pairs
+   whose slave closest point lies within ``rules.WRAP_END`` of an end or past it:
+   a crossing inside the slave element stays a point pair).
 
 Projections are accepted on ``[0, 1]`` of the master element (so they continue
 across element boundaries along the whole master beam); per slave Gauss point

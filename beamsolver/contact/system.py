@@ -43,7 +43,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .. import se3
-from ..blocks import Blocks, Contribution
+from ..blocks import REUSE_BUFFERS, Blocks, Contribution
 from ..errors import InputError
 from ..failures import ContactTunnelling, NoContactNormal
 from ..model import JOIN_TOL
@@ -57,10 +57,6 @@ from .projection import closest_points, element_twists, project_points, section_
 from .search import broad_phase, element_spheres
 from . import rules
 
-# ``_tangent_out`` tells a buffer nobody holds by ``sys.getrefcount``, whose count of the caller's
-# own references is an implementation detail (CPython 3.14 borrows references on the stack):
-# buffers are reused only on the CPython versions where that count was checked, else made anew.
-REUSE_BUFFERS = sys.implementation.name == "cpython" and sys.version_info < (3, 14)
 
 MAX_AUGMENT = 30
 TIMED = ("search", "rules", "projection", "params", "kernel", "blocks")   # parts of ``ContactSystem.timings``
@@ -137,6 +133,7 @@ class ContactSystem(Contribution):
         self._augments = 0
         self._prev_points = np.zeros(0, dtype=np.int64)
         self._prev_owners = np.zeros(0, dtype=np.int64)   # Gauss-point key * n_elements + master element
+        self._forget_kinds()
         self._H_prev = None        # last converged poses (start of the step)
         self._geo = self._geo_prev = None    # (poses, element twists) of the last evaluation / of H_prev
         self._blocks = None        # (poses, local blocks) of the last evaluation, for the same state
@@ -174,6 +171,35 @@ class ContactSystem(Contribution):
         for name in ("prev_points", "prev_owners"):
             if name in state:
                 setattr(self, f"_{name}", np.sort(np.asarray(state[name], dtype=np.int64)))
+        self._forget_kinds()
+
+    def _forget_kinds(self):
+        """Empty the kinds of the step (``_step_kinds``): the next evaluation decides them."""
+        self._kind_keys, self._kind_values = np.zeros(0, dtype=np.int64), np.zeros(0, dtype=int)
+
+    def _step_kinds(self, d, e, m, kinds):
+        """Kinds of crossing element pairs kept within a step: a pair (declaration ``d``, slave
+        ``e``, master ``m``) that was a point or orthogonal pair at an earlier evaluation of the
+        step keeps that kind while it is a crossing; the others are remembered as decided now.
+
+        The choice (the reduced-Hessian ratio of the closest points, ``rules.extend_wrap``) is
+        not continuous: decided afresh at every iterate it may flip between two iterates, and
+        the contact force with it (a point pair at the crossing against Gauss points around
+        it), so that Newton cycles (docs/theory.md, kind of a crossing within a step)."""
+        n_el = np.int64(self.sys.n_elements)
+        cross = np.flatnonzero(kinds != LINE)
+        if not len(cross):
+            return kinds
+        keys = (np.int64(d.index) * n_el + e[cross]) * n_el + m[cross]
+        idx, found = self._lookup(self._kind_keys, keys)
+        kinds = kinds.copy()
+        kinds[cross[found]] = self._kind_values[idx[found]]
+        if not found.all():
+            k = np.concatenate([self._kind_keys, keys[~found]])
+            v = np.concatenate([self._kind_values, kinds[cross[~found]]])
+            order = np.argsort(k, kind="stable")
+            self._kind_keys, self._kind_values = k[order], v[order]
+        return kinds
 
     @staticmethod
     def _empty_history():
@@ -277,7 +303,8 @@ class ContactSystem(Contribution):
             self._lap("projection")
             kinds[b] = rules.point_or_orthogonal(ratio, d.point_ratio)
             xi1[b], xi2[b] = x1, x2
-            kinds = rules.extend_wrap(en, self.el_beam[m], self.n_beams, e, m, kinds)
+            kinds = rules.extend_wrap(en, self.el_beam[m], self.n_beams, e, m, kinds, xi1)
+            kinds = self._step_kinds(d, e, m, kinds)
         self._lap("rules")
         return Candidates(e=e, m=m, kind=kinds, xi1=xi1, xi2=xi2, h1=hs[i], h2=hm[j], c2=cm[j], r2=rm[j])
 
@@ -607,6 +634,7 @@ class ContactSystem(Contribution):
     # ------------------------------------------------------------ per step
     def begin_step(self, H, t):
         self._blocks = None
+        self._forget_kinds()
         self._H_prev = np.array(H, dtype=float)
         self._geo_prev = None
         self._mult = self._mult_committed
