@@ -92,28 +92,9 @@ _borrowed = _borrowed_python if numba_config.DISABLE_JIT else _borrowed_intrinsi
 
 
 # ---------------------------------------------------------------- small algebra (tuples; small arrays written in place)
-@jit
-def _exp(u, w):
-    """``exp(hat(u, w))`` as rotation and position tuples (``se3.exp``)."""
-    t2 = dot(w, w)
-    t = np.sqrt(t2)
-    a, b, c = coefficient(A_, t), coefficient(B_, t), coefficient(C_, t)
-    R = add_outer(mat(scale(a, w), 1.0 - b * t2), scale(b, w), w)
-    wxu = cross(w, u)
-    return R, add(add(u, scale(b, wxu)), scale(c, cross(w, wxu)))
-
-
-@jit
-def _section(RA, xA, u, w, xi):
-    """Pose of ``H_A exp(xi h)``, ``x' = R u`` and ``x'' = R (w x u)`` (``pairs._section``)."""
-    Rs, xs = _exp(scale(xi, u), scale(xi, w))
-    R = mm(RA, Rs)
-    return R, add(mv(RA, xs), xA), mv(R, u), mv(R, cross(w, u))
-
-
 @jit_inline
 def _exp_inline(u, w):
-    """``_exp`` inlined into its caller (the same operations; ``_project``'s iterations)."""
+    """``exp(hat(u, w))`` as rotation and position tuples (``se3.exp``), inlined into its caller."""
     t2 = dot(w, w)
     t = np.sqrt(t2)
     a, b, c = coefficient(A_, t), coefficient(B_, t), coefficient(C_, t)
@@ -129,6 +110,18 @@ def _section_inline(RA, xA, u, w, xi):
     Rs, xs = _exp_inline(scale(xi, u), scale(xi, w))
     R = mm(RA, Rs)
     return R, add(mv(RA, xs), xA), mv(R, u), mv(R, cross(w, u))
+
+
+@jit
+def _exp(u, w):
+    """``_exp_inline`` as a function of its own (one copy of the maths, called where not inlined)."""
+    return _exp_inline(u, w)
+
+
+@jit
+def _section(RA, xA, u, w, xi):
+    """Pose of ``H_A exp(xi h)``, ``x' = R u`` and ``x'' = R (w x u)`` (``pairs._section``)."""
+    return _section_inline(RA, xA, u, w, xi)
 
 
 @jit
