@@ -4,8 +4,16 @@
 ``error_model="numpy"``: a division by zero gives inf/nan as in numpy (no
 per-division check); no ``fastmath``, so results stay those of the numpy
 oracle to round-off.
+
+Numba checks a cached function against its own source file only; ``jit_cache.drop_stale``
+deletes the package's cache files when any compiled module changed (run here, once per process,
+before anything compiled is loaded).
 """
 from numba import njit
+
+from .jit_cache import drop_stale
+
+drop_stale()
 
 jit = njit(cache=True, error_model="numpy")
 # functions taking arrays are inlined into their caller: a call passing arrays costs a reference

@@ -209,3 +209,40 @@ def test_tangent_written_to_a_given_array_equals_a_fresh_one_and_checks_the_arra
         kernel_jit.kernel_and_tangent(X, p, K=np.empty((len(X) + 1, 24, 24)))
     with pytest.raises(bs.InputError, match="K must be"):
         kernel_jit.kernel_and_tangent(X, p, K=np.empty((24, 24, len(X))).T)
+
+
+def test_points_sharing_elements_equal_each_point_alone_and_the_oracle():
+    """Consecutive points on the same elements (Gauss points of one slave element against one master
+    element, as in a bundle) reuse the elements' twists and operators (``kernel_jit._element_side``): the
+    results are those of each point evaluated alone, bit for bit, and those of the oracle."""
+    rng = np.random.default_rng(21)
+    A1, B1 = _element(rng, [0, 0, 0], 0.0, 0.4)
+    masters = [_element(rng, [0.0, -0.02, 0.19], 0.05, 0.4), _element(rng, [0.3, 0.2, 0.19], 0.6, 0.4)]
+    P = 12
+    X = np.array([[A1, B1, *masters[q // 6]] for q in range(P)])
+    X[9:, 0, 0, 3] += 1e-9                                   # a slave element that moved: recomputed
+    kinds = np.where(np.arange(P) < 6, pairs.LINE, pairs.ORTHOGONAL)
+    h1 = se3.log(se3.relative(X[:, 0], X[:, 1]))
+    h2 = se3.log(se3.relative(X[:, 2], X[:, 3]))
+    xi1, xi2 = pairs._project(kinds, X[:, 0], h1, np.tile(np.linspace(0.1, 0.9, 6), 2), X[:, 2], h2,
+                              np.full(P, 0.5), iterations=30)
+    p = dict(kind=kinds, xi1=xi1, xi2=xi2, R1=np.full(P, 0.25), R2=np.full(P, 0.25), weight=np.full(P, 0.2),
+             penalty=np.full(P, 100.0), multiplier=np.zeros(P), mu=np.full(P, 0.3), penalty_t=np.full(P, np.nan),
+             elastic_slip=np.full(P, 0.005))
+    Xo = X.copy()
+    for j in range(4):
+        Xo[:, j] = se3.compose(X[:, j], se3.exp(rng.normal(size=(P, 6)) * 0.003))
+    H_CL, H_FK, H_LK = pairs.material_frames(Xo, kinds, xi1, xi2, p["R1"], p["R2"])
+    p.update(H_CL=H_CL, H_FK=H_FK, H_LK_prev=H_LK, xi1_prev=xi1, xi2_prev=xi2 - 0.01,
+             lam_t_prev=rng.normal(size=(P, 3)) * 0.5, has_history=np.full(P, True))
+    f, K, o = kernel_jit.kernel_and_tangent(X, p)
+    for q in range(P):
+        fq, Kq, oq = kernel_jit.kernel_and_tangent(X[q:q + 1], {k: v[q:q + 1] for k, v in p.items()})
+        np.testing.assert_array_equal(fq[0], f[q])
+        np.testing.assert_array_equal(Kq[0], K[q])
+        for k in FIELDS:
+            np.testing.assert_array_equal(oq[k][0], o[k][q])
+    f0, K0, _ = pairs.kernel_and_tangent(X, p)
+    assert np.abs(f - f0).max() <= 1e-8 * np.abs(f0).max()
+    assert np.abs(K - K0).max() <= 1e-8 * np.abs(K0).max()
+    assert o["active"].sum() >= P // 2 and not o["stick"][o["active"]].all()      # forces, friction, slip

@@ -9,7 +9,7 @@ import numpy as np
 import beamsolver as bs
 from beamsolver import se3
 from beamsolver.problem import Problem
-from beamsolver.contact import pairs, projection
+from beamsolver.contact import kernel_jit, pairs, projection
 from beamsolver.contact.system import TIMED
 from beamsolver.contact import system as cs
 
@@ -69,6 +69,22 @@ def test_gauss_point_projection_equals_the_numpy_projection_from_the_chord():
     y2, ydist = projection.project_points(H, kinds, A1, h1, xi1, A2, A2 + 1, h2)
     np.testing.assert_allclose(y2, x2, atol=1e-12)
     np.testing.assert_allclose(ydist, dist, rtol=1e-12)
+
+
+def test_gauss_point_projection_equals_the_compiled_projection_bit_for_bit():
+    """``project_points`` hands its slave section to the Newton iterations (``kernel_jit._project_from``):
+    the same floats as ``kernel_jit.project`` from the same chord start."""
+    rng, H, kinds, A1, A2, h1, h2 = _poses(4)
+    kinds = np.where(kinds == pairs.POINT, pairs.ORTHOGONAL, kinds)
+    xi1 = rng.uniform(0.1, 0.9, len(A1))
+    xc, _ = projection.section_points(H, A1, h1, xi1)
+    xa, xb = H[A2, :3, 3], H[A2 + 1, :3, 3]
+    rel, chord = xc - xa, xb - xa
+    start = np.clip((rel[:, 0] * chord[:, 0] + rel[:, 1] * chord[:, 1] + rel[:, 2] * chord[:, 2])
+                    / (chord[:, 0] ** 2 + chord[:, 1] ** 2 + chord[:, 2] ** 2), 0.0, 1.0)
+    _, x2 = kernel_jit.project(kinds, H[A1], h1, xi1, H[A2], h2, start, 8)
+    y2, _ = projection.project_points(H, kinds, A1, h1, xi1, A2, A2 + 1, h2)
+    np.testing.assert_array_equal(y2, x2)
 
 
 def _residual(contact, H, tangent):

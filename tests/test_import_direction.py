@@ -15,7 +15,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "beamsolver"
 
 LAYER = {
     # 0: no physics (errors, argument checks, the numpy file format of saved solutions)
-    "errors": 0, "version": 0, "_jit": 0, "progress": 0, "validation": 0, "solution_file": 0, "files": 0,
+    "errors": 0, "version": 0, "_jit": 0, "jit_cache": 0, "progress": 0, "validation": 0, "solution_file": 0, "files": 0,
     "failures": 0,
     # 1: maths and geometry (Lie groups, sections, node poses, motions)
     "se3": 1, "se3_jit": 1, "section": 1, "geometry": 1, "motion": 1, "motion_path": 1, "definiteness": 1,

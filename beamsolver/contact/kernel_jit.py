@@ -44,6 +44,9 @@ import hashlib
 import types
 
 import numpy as np
+from numba import config as numba_config, types as nb_types
+from numba.core import cgutils
+from numba.extending import intrinsic
 
 from .._jit import jit, jit_inline
 from ..errors import InputError
@@ -62,10 +65,36 @@ N_PAR = 13
 _normal_law = _tangential_law = None
 
 
+# ---------------------------------------------------------------- borrowed arrays
+@intrinsic
+def _borrowed_intrinsic(typingctx, a):
+    """A view of the array ``a`` without its memory owner (meminfo): numba's reference counting
+    (an atomic increment and decrement per array passed to a function or sliced: ~10 % of the
+    kernel's perf samples) skips it.  The caller keeps ``a`` alive while the view is in use."""
+    if not isinstance(a, nb_types.Array):
+        return None
+
+    def codegen(context, builder, sig, args):
+        ary = cgutils.create_struct_proxy(sig.args[0])(context, builder, value=args[0])
+        ary.meminfo = cgutils.get_null_value(ary.meminfo.type)
+        ary.parent = cgutils.get_null_value(ary.parent.type)
+        return ary._getvalue()
+
+    return a(a), codegen
+
+
+def _borrowed_python(a):
+    """``_borrowed`` as plain Python (``NUMBA_DISABLE_JIT=1``): the array itself."""
+    return a
+
+
+_borrowed = _borrowed_python if numba_config.DISABLE_JIT else _borrowed_intrinsic
+
+
 # ---------------------------------------------------------------- small algebra (tuples; small arrays written in place)
-@jit
-def _exp(u, w):
-    """``exp(hat(u, w))`` as rotation and position tuples (``se3.exp``)."""
+@jit_inline
+def _exp_inline(u, w):
+    """``exp(hat(u, w))`` as rotation and position tuples (``se3.exp``), inlined into its caller."""
     t2 = dot(w, w)
     t = np.sqrt(t2)
     a, b, c = coefficient(A_, t), coefficient(B_, t), coefficient(C_, t)
@@ -74,10 +103,51 @@ def _exp(u, w):
     return R, add(add(u, scale(b, wxu)), scale(c, cross(w, wxu)))
 
 
+@jit_inline
+def _section_inline(RA, xA, u, w, xi):
+    """``_section`` inlined into its caller (the same operations; ``_project``'s iterations: the parts a
+    projection kind does not use are dropped by the compiler)."""
+    Rs, xs = _exp_inline(scale(xi, u), scale(xi, w))
+    R = mm(RA, Rs)
+    return R, add(mv(RA, xs), xA), mv(R, u), mv(R, cross(w, u))
+
+
+@jit
+def _exp(u, w):
+    """``_exp_inline`` as a function of its own (one copy of the maths, called where not inlined)."""
+    return _exp_inline(u, w)
+
+
 @jit
 def _section(RA, xA, u, w, xi):
     """Pose of ``H_A exp(xi h)``, ``x' = R u`` and ``x'' = R (w x u)`` (``pairs._section``)."""
-    Rs, xs = _exp(scale(xi, u), scale(xi, w))
+    return _section_inline(RA, xA, u, w, xi)
+
+
+@jit
+def _coefficients(w):
+    """``t^2 = |w|^2`` and the coefficients ``a, b, c, d, q2, q3, cp, dp, q2p, q3p`` at ``t`` (``coefficient``,
+    each once): the sections, node Jacobians and their derivatives at one ``xi h`` share them."""
+    t2 = dot(w, w)
+    t = np.sqrt(t2)
+    return t2, (coefficient(A_, t), coefficient(B_, t), coefficient(C_, t), coefficient(D_, t), coefficient(Q2_, t),
+                coefficient(Q3_, t), coefficient(CP_, t), coefficient(DP_, t), coefficient(Q2P_, t),
+                coefficient(Q3P_, t))
+
+
+@jit
+def _exp_co(u, w, t2, co):
+    """``_exp`` with the coefficients of ``_coefficients(w)``."""
+    a, b, c = co[0], co[1], co[2]
+    R = add_outer(mat(scale(a, w), 1.0 - b * t2), scale(b, w), w)
+    wxu = cross(w, u)
+    return R, add(add(u, scale(b, wxu)), scale(c, cross(w, wxu)))
+
+
+@jit
+def _section_co(RA, xA, u, w, xi, t2, co):
+    """``_section`` with the coefficients of ``_coefficients(xi w)``."""
+    Rs, xs = _exp_co(scale(xi, u), scale(xi, w), t2, co)
     R = mm(RA, Rs)
     return R, add(mv(RA, xs), xA), mv(R, u), mv(R, cross(w, u))
 
@@ -168,6 +238,18 @@ def _tangent(u, w, T):
 
 
 @jit
+def _tangent_co(u, w, T, t2, co):
+    """``_tangent`` with the coefficients of ``_coefficients(w)`` (or of ``-w``: the same)."""
+    b, c = co[1], co[2]
+    T3 = add_outer(mat(scale(-b, w), 1.0 - c * t2), scale(c, w), w)
+    Q = q_matrix(scale(-1.0, u), scale(-1.0, w), dot(w, u), cross(w, u), t2, c, co[4], co[5])
+    _put3(T, 0, 0, T3)
+    _put3(T, 3, 3, T3)
+    _put3(T, 0, 3, Q)
+    _zero3(T, 3, 0)
+
+
+@jit
 def _tangent_inv(u, w, T):
     """``T = T(h)^-1 = [[Ti, -Ti Q(-u, -w) Ti], [0, Ti]]`` (``se3.tangent_inv``), ``(6, 6)``."""
     t2 = dot(w, w)
@@ -209,6 +291,28 @@ def _geo(u, w, v, G):
     _put3(G, 3, 3, G22)
 
 
+@jit
+def _geo_co(u, w, v, G, t2, co):
+    """``_geo`` with the coefficients of ``_coefficients(w)``."""
+    G12, G21, G22 = _geometric(u, w, (v[0], v[1], v[2]), (v[3], v[4], v[5]), co[3], t2,
+                               (co[2], co[4], co[5], co[7], co[6], co[8], co[9]))
+    _zero3(G, 0, 0)
+    _put3(G, 0, 3, G12)
+    _put3(G, 3, 0, G21)
+    _put3(G, 3, 3, G22)
+
+
+@jit
+def _geo_cached(u, w, v, G, c):
+    """``_geo`` at the element twist, with the coefficients kept in ``c`` by ``_element_side``."""
+    G12, G21, G22 = _geometric(u, w, (v[0], v[1], v[2]), (v[3], v[4], v[5]), c[C_D], c[C_T2],
+                               (c[C_CO], c[C_CO + 1], c[C_CO + 2], c[C_CO + 3], c[C_CO + 4], c[C_CO + 5], c[C_CO + 6]))
+    _zero3(G, 0, 0)
+    _put3(G, 0, 3, G12)
+    _put3(G, 3, 0, G21)
+    _put3(G, 3, 3, G22)
+
+
 @jit_inline
 def _m_times(z, A, out):
     """``out = M(z) A`` with ``M(z) = [[0, hat(z_f)], [hat(z_f), hat(z_m)]]``, column by column."""
@@ -244,16 +348,16 @@ def _side(u, w, S):
 
 
 @jit
-def _jacobians(u, w, xi, Ti, Ah, Ts, As, JA, JB, tmp):
+def _jacobians(u, w, xi, t2, co, Ti, Ah, Ts, As, JA, JB, tmp):
     """``J_A, J_B`` of ``H_C = H_A exp(xi h)`` (``pairs._node_jacobians``); ``Ti = T(h)^-1``,
-    ``Ah = Ad(exp(-h))``; also ``Ts = T(xi h)`` and ``As = Ad(exp(-xi h))``."""
+    ``Ah = Ad(exp(-h))``; also ``Ts = T(xi h)`` and ``As = Ad(exp(-xi h))``; ``t2, co = _coefficients(xi w)``."""
     su, sw = scale(xi, u), scale(xi, w)
-    _tangent(su, sw, Ts)
+    _tangent_co(su, sw, Ts, t2, co)
     _mm_ut(Ts, Ti, JB)
     for i in range(6):
         for j in range(6):
             JB[i, j] *= xi
-    Rs, xs = _exp(su, sw)
+    Rs, xs = _exp_co(su, sw, t2, co)
     _adjoint_inv(Rs, xs, As)
     _mm_ut(JB, Ah, tmp)
     for i in range(6):
@@ -262,9 +366,10 @@ def _jacobians(u, w, xi, Ti, Ah, Ts, As, JA, JB, tmp):
 
 
 @jit
-def _jacobian_derivatives(u, w, xi, S, v):
+def _jacobian_derivatives(u, w, xi, t2, co, S, v, c):
     """``d(J_A^T wr)/dh, d(J_B^T wr)/dh`` into ``S[S_DA], S[S_DB]`` and ``d/dxi`` into ``v[V_DA], v[V_DB]``
-    at fixed ``wr = v[V_WR]``; ``S`` holds ``TI, AH, TS, AS`` at this ``xi``.
+    at fixed ``wr = v[V_WR]``; ``S`` holds ``TI, AH, TMH`` of the element and ``TS, AS`` at this ``xi``;
+    ``c``: the element's cached coefficients (``_element_side``); ``t2, co = _coefficients(xi w)``.
 
     With ``s = xi h``, ``y = T(s)^T wr``, ``b = J_B^T wr = xi T(h)^-T y`` and ``T(-s) h = h``:
     ``dB/dh = G(h, xi y) - xi^2 T(h)^-T T(s)^T G(s, y)``, ``dB/dxi = T(h)^-T y - xi T(h)^-T T(s)^T G(s, y) h``,
@@ -274,12 +379,12 @@ def _jacobian_derivatives(u, w, xi, S, v):
     wr, y, xy, dB, b, zs, dA = v[V_WR], v[V_Y], v[V_XY], v[V_DB], v[V_B], v[V_ZS], v[V_DA]
     su, sw = scale(xi, u), scale(xi, w)
     _mtv_ut(S[S_TS], wr, y)
-    _geo(su, sw, y, S[S_GS])
+    _geo_co(su, sw, y, S[S_GS], t2, co)
     _mtm_ut_g(S[S_TS], S[S_GS], S[S_M1])
     _mtm_ut_g(Ti, S[S_M1], P)                                # T(h)^-T T(s)^T G(s, y)
     for i in range(6):
         xy[i] = xi * y[i]
-    _geo(u, w, xy, DB)
+    _geo_cached(u, w, xy, DB, c)
     _mtv_ut(Ti, y, dB)
     h = (u[0], u[1], u[2], w[0], w[1], w[2])
     for i in range(6):
@@ -291,9 +396,8 @@ def _jacobian_derivatives(u, w, xi, S, v):
     _mtv_ut(Ti, xy, b)
     _mtv_ut(As, wr, zs)
     _mtv_ut(Ah, b, v[V_ZH])
-    _tangent(scale(-1.0, u), scale(-1.0, w), S[S_TMH])
     _m_times(v[V_ZH], S[S_TMH], DA)
-    _tangent(scale(-xi, u), scale(-xi, w), S[S_TMS])
+    _tangent_co(scale(-xi, u), scale(-xi, w), S[S_TMS], t2, co)
     _m_times(zs, S[S_TMS], S[S_MS])
     _mtm_ut_g(Ah, DB, S[S_AHDB])
     zf, zm = (zs[0], zs[1], zs[2]), (zs[3], zs[4], zs[5])
@@ -321,12 +425,19 @@ def _project(kind, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations=2):
     The slave section is computed once where ``xi1`` is fixed (line, orthogonal), and the iterations
     stop at an exact fixed point (an iterate equal to the last, bit for bit, fixes all later ones), so
     the result is that of all ``iterations``."""
+    return _project_from(kind, _section_inline(RA1, xA1, u1, w1, xi1), RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2,
+                         iterations)
+
+
+@jit
+def _project_from(kind, sec1, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations):
+    """``_project`` given the slave section ``sec1 = _section(RA1, xA1, u1, w1, xi1)`` (a caller that has it)."""
     moving = kind != LINE and kind != ORTHOGONAL
-    R1, x1, x1p, x1pp = _section(RA1, xA1, u1, w1, xi1)
+    R1, x1, x1p, x1pp = sec1
     for it in range(iterations):
         if moving and it > 0:
-            R1, x1, x1p, x1pp = _section(RA1, xA1, u1, w1, xi1)
-        R2, x2, x2p, x2pp = _section(RA2, xA2, u2, w2, xi2)
+            R1, x1, x1p, x1pp = _section_inline(RA1, xA1, u1, w1, xi1)
+        R2, x2, x2p, x2pp = _section_inline(RA2, xA2, u2, w2, xi2)
         d = add(x2, scale(-1.0, x1))
         e1 = _col(R1, 0)
         xi1_new, xi2_new = xi1, xi2
@@ -402,12 +513,42 @@ def _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, VC0, VF0, Dh1, Dh2, dx
 
 
 # ---------------------------------------------------------------- one side of a pair: element, section, Jacobians
+# per-side element cache ``c`` (2, N_CACHE): the node poses (rows 0-2 of nodes j0, j0 + 1), the twist and the
+# coefficients of ``G(h, .)`` of the last element seen on that side
+C_POSE, C_U, C_W, C_T2, C_D, C_CO, N_CACHE = 0, 24, 27, 30, 31, 32, 39
+
+
 @jit
-def _element_side(Xp, j0, xi):
-    """Twist, section pose and Jacobians of the element of nodes ``j0, j0 + 1`` at ``xi``."""
+def _element_side(Xp, j0, S, c):
+    """Twist ``h = log(H_A^-1 H_B)`` of the element of nodes ``j0, j0 + 1`` and the element's quantities:
+    ``T(h)^-1``, ``Ad(exp(-h))``, ``T(-h)`` into ``S[S_TI], S[S_AH], S[S_TMH]`` and the coefficients of
+    ``G(h, .)`` into ``c``.  Kept while the node poses are those of the last point on this side, bit for
+    bit (the Gauss points of a slave element, consecutive points on one master element): the same floats."""
+    hit = True
+    for a in range(2):
+        for i in range(3):
+            for k in range(4):
+                x = Xp[j0 + a, i, k]
+                m = C_POSE + 12 * a + 4 * i + k
+                if not _same(x, c[m]):
+                    hit = False
+                    c[m] = x
     RA, xA = _pose_of(Xp, j0)
+    if hit:
+        return RA, xA, (c[C_U], c[C_U + 1], c[C_U + 2]), (c[C_W], c[C_W + 1], c[C_W + 2])
     RB, xB = _pose_of(Xp, j0 + 1)
-    u, w, t, d = log_relative(RA, xA, RB, xB)
+    u, w, _, _ = log_relative(RA, xA, RB, xB)
+    _side(u, w, S)
+    _tangent(scale(-1.0, u), scale(-1.0, w), S[S_TMH])
+    t2 = dot(w, w)
+    t = np.sqrt(t2)
+    co = (coefficient(C_, t), coefficient(Q2_, t), coefficient(Q3_, t), coefficient(DP_, t), coefficient(CP_, t),
+          coefficient(Q2P_, t), coefficient(Q3P_, t))
+    for i in range(3):
+        c[C_U + i], c[C_W + i] = u[i], w[i]
+    c[C_T2], c[C_D] = t2, coefficient(D_, t)
+    for i in range(7):
+        c[C_CO + i] = co[i]
     return RA, xA, u, w
 
 
@@ -532,7 +673,8 @@ def _jacobians_at(u, w, xi, xip, S):
             for j in range(6):
                 JAP[i, j], JBP[i, j] = JA[i, j], JB[i, j]
     else:
-        _jacobians(u, w, xip, S[S_TI], S[S_AH], S[S_TSP], S[S_ASP], S[S_JAP], S[S_JBP], S[S_TMP])
+        t2, co = _coefficients(scale(xip, w))
+        _jacobians(u, w, xip, t2, co, S[S_TI], S[S_AH], S[S_TSP], S[S_ASP], S[S_JAP], S[S_JBP], S[S_TMP])
 
 
 def _friction(slip, Dslip, lamp, t1, t2, Dt1, Dt2, lam, Dlam, par, g2, Dpt):
@@ -594,10 +736,10 @@ def _wrench(R, F, DF, neg, m, DmF, sm, V, w, D):
 
 
 @jit
-def _nodal(u, w, xi, S, v, Dw, Dh, dxi, c0, f, K, j0):
+def _nodal(u, w, xi, t2, co, S, v, c, Dw, Dh, dxi, c0, f, K, j0):
     """``f_j = J_j^T wr`` (``wr = v[V_WR]``) for the two nodes of one side and their rows of the tangent:
     ``J^T dwr + d(J^T wr)/dh dh + d(J^T wr)/dxi dxi`` (``dh`` lives in columns ``c0:c0+12``)."""
-    _jacobian_derivatives(u, w, xi, S, v)
+    _jacobian_derivatives(u, w, xi, t2, co, S, v, c)
     wr = v[V_WR]
     for s in range(2):
         J, D, dd = (S[S_JA], S[S_DA], v[V_DA]) if s == 0 else (S[S_JB], S[S_DB], v[V_DB])
@@ -661,13 +803,13 @@ def _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2):
 
 
 @jit
-def _frame_variations(u1, w1, xi1, u2, w2, xi2, kind, RC, RF, d, S1, S2, g6, r):
+def _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, d, S1, S2, g6, r):
     """Node Jacobians of both sides, twist variations ``g6[G6_DH1], g6[G6_DH2]``, projection gradients
-    ``r[R_DXI1], r[R_DXI2]`` and the section-frame variations ``g6[G6_VC], g6[G6_VF]`` ``(6, 24)``."""
-    _side(u1, w1, S1)
-    _side(u2, w2, S2)
-    _jacobians(u1, w1, xi1, S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB], S1[S_TMP])
-    _jacobians(u2, w2, xi2, S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB], S2[S_TMP])
+    ``r[R_DXI1], r[R_DXI2]`` and the section-frame variations ``g6[G6_VC], g6[G6_VF]`` ``(6, 24)``;
+    ``S1``, ``S2`` hold the elements' ``T(h)^-1``, ``Ad(exp(-h))`` (``_element_side``); ``co1``, ``co2``:
+    ``_coefficients(xi w)`` of the sides."""
+    _jacobians(u1, w1, xi1, co1[0], co1[1], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB], S1[S_TMP])
+    _jacobians(u2, w2, xi2, co2[0], co2[1], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB], S2[S_TMP])
     VC, VF, dxi1, dxi2 = g6[G6_VC], g6[G6_VF], r[R_DXI1], r[R_DXI2]
     _variations(S1, 0, g6[G6_DH1], VC, S1[S_TMP])
     _variations(S2, 12, g6[G6_DH2], VF, S2[S_TMP])
@@ -701,15 +843,16 @@ def _moment_gradient(n, F, DF, Dn, DmF):
 def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames, ws):
     """Forces ``f (4, 6)``, tangent ``K (24, 24)`` and point data of one contact point; ``ws``: the
     scratch arrays of ``_scratch``."""
-    S, v, g6, g3, g2, r = ws
-    side1, side2 = _element_side(Xp, 0, 0.0), _element_side(Xp, 2, 0.0)
+    S, v, g6, g3, g2, r, cache = ws
+    side1, side2 = _element_side(Xp, 0, S[0], cache[0]), _element_side(Xp, 2, S[1], cache[1])
     RA1, xA1, u1, w1 = side1
     RA2, xA2, u2, w2 = side2
     xi1, xi2 = _project(kind, RA1, xA1, u1, w1, par[XI1], RA2, xA2, u2, w2, par[XI2])
-    RC, xC, _, _ = _section(RA1, xA1, u1, w1, xi1)
-    RF, xF, _, _ = _section(RA2, xA2, u2, w2, xi2)
+    co1, co2 = _coefficients(scale(xi1, w1)), _coefficients(scale(xi2, w2))
+    RC, xC, _, _ = _section_co(RA1, xA1, u1, w1, xi1, co1[0], co1[1])
+    RF, xF, _, _ = _section_co(RA2, xA2, u2, w2, xi2, co2[0], co2[1])
     S1, S2, VC, VF = S[0], S[1], g6[G6_VC], g6[G6_VF]
-    _frame_variations(u1, w1, xi1, u2, w2, xi2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, g6, r)
+    _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, g6, r)
     Dn, Dt1, Dt2, DF, DmF, Ddist, Dlam = g3[G3_DN], g3[G3_DT1], g3[G3_DT2], g3[G3_DF], g3[G3_DMF], r[R_DDIST], r[R_DLAM]
     n, t1, t2, dist = _axes(RC, xC, RF, xF, VC, VF, Dn, Dt1, Dt2, Ddist)
     R1, R2, wgt = par[R1_], par[R2_], par[WEIGHT]
@@ -738,8 +881,8 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
     _moment_gradient(n, F, DF, Dn, DmF)
     _wrench(RC, F, DF, False, scale(R1, mF), DmF, R1, VC, v[0, V_WR], g6[G6_DWC])
     _wrench(RF, scale(-1.0, F), DF, True, scale(R2, mF), DmF, R2, VF, v[1, V_WR], g6[G6_DWF])
-    _nodal(u1, w1, xi1, S1, v[0], g6[G6_DWC], g6[G6_DH1], r[R_DXI1], 0, f, K, 0)
-    _nodal(u2, w2, xi2, S2, v[1], g6[G6_DWF], g6[G6_DH2], r[R_DXI2], 12, f, K, 2)
+    _nodal(u1, w1, xi1, co1[0], co1[1], S1, v[0], cache[0], g6[G6_DWC], g6[G6_DH1], r[R_DXI1], 0, f, K, 0)
+    _nodal(u2, w2, xi2, co2[0], co2[1], S2, v[1], cache[1], g6[G6_DWF], g6[G6_DH2], r[R_DXI2], 12, f, K, 2)
     sc[0], sc[1], sc[2], sc[3] = gap, lam, xi1, xi2
     for i in range(3):
         vec[0, i], vec[1, i], vec[2, i], vec[3, i], vec[4, i], vec[5, i] = n[i], t1[i], t2[i], xC[i], xF[i], F[i]
@@ -751,16 +894,24 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
 def _scratch():
     """Scratch arrays of one evaluation, reused by every point (the kernel allocates nothing per point)."""
     return (np.empty((2, N_SIDE, 6, 6)), np.empty((2, N_VEC, 6)), np.empty((N_G6, 6, 24)), np.empty((N_G3, 3, 24)),
-            np.empty((N_G2, 2, 24)), np.empty((N_R, 24)))
+            np.empty((N_G2, 2, 24)), np.empty((N_R, 24)), np.full((2, N_CACHE), np.nan))
 
 
 def _evaluate(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames):
-    """Batch driver: ``_point`` over all pairs (a plain loop; one core).  A template: ``make_kernel``
+    """Batch driver: ``_point`` over all pairs (a plain loop; one core), on borrowed views of the arguments
+    and the scratch (no reference counting per point; the arguments are held by the caller).  A template: ``make_kernel``
     compiles it per contact law; the module's ``evaluate`` is the default law's."""
-    ws = _scratch()
+    own = _scratch()
+    ws = (_borrowed(own[0]), _borrowed(own[1]), _borrowed(own[2]), _borrowed(own[3]), _borrowed(own[4]),
+          _borrowed(own[5]), _borrowed(own[6]))
+    X, par, HCL, HFK, HLKp, lamp = _borrowed(X), _borrowed(par), _borrowed(HCL), _borrowed(HFK), _borrowed(HLKp), \
+        _borrowed(lamp)
+    kind, has, f, K, sc = _borrowed(kind), _borrowed(has), _borrowed(f), _borrowed(K), _borrowed(sc)
+    vec, two, flags, frames = _borrowed(vec), _borrowed(two), _borrowed(flags), _borrowed(frames)
     for p in range(X.shape[0]):
         _point(X[p], kind[p], par[p], has[p], HCL[p], HFK[p], HLKp[p], lamp[p], friction, f[p], K[p], sc[p],
                vec[p], two[p], flags[p], frames[p], ws)
+    own[0][0, 0, 0, 0] = 0.0           # the scratch arrays' owners live until here
 
 
 # ---------------------------------------------------------------- the kernel of a contact law

@@ -12,16 +12,19 @@ follow the constant-strain interpolation ``H_A exp(xi h)`` with the element twis
   ``ORTHOGONAL``), started from the projection on the master chord.
 
 ``_project`` computes a fixed slave section once and stops at an exact fixed point of
-the iteration, with the result of all the iterations asked for.  (Numba's disk cache
-keys a function on its own source file only: after editing ``kernel_jit._project``,
-delete the ``__pycache__`` numba files of this module too, or it keeps the old copy.)
+the iteration, with the result of all the iterations asked for; ``project_points`` hands
+it the slave section it already has (``kernel_jit._project_from``).  (Numba's disk cache
+keys a function on its own source file only: after editing ``kernel_jit._project`` or the
+functions it calls, delete the ``__pycache__`` numba files of this module too, or it keeps
+the old copy.)  The sections are inlined (``kernel_jit._section_inline``, the same operations):
+what a loop does not use of them (``x'``, ``x''``, the rotation) is not computed.
 """
 import numpy as np
 
 from .. import se3
 from .._jit import jit
 from ..se3_jit import dot
-from .kernel_jit import _pose_of, _project, _section
+from .kernel_jit import _pose_of, _project, _project_from, _section_inline
 from .pairs import POINT
 
 __all__ = ["element_twists", "section_points", "closest_points", "project_points"]
@@ -38,7 +41,7 @@ def element_twists(H, enodes):
 def _sections(H, A, h, xi, x, e1):
     for k in range(len(A)):
         RA, xA = _pose_of(H, A[k])
-        R, xc, _, _ = _section(RA, xA, (h[k, 0], h[k, 1], h[k, 2]), (h[k, 3], h[k, 4], h[k, 5]), xi[k])
+        R, xc, _, _ = _section_inline(RA, xA, (h[k, 0], h[k, 1], h[k, 2]), (h[k, 3], h[k, 4], h[k, 5]), xi[k])
         for i in range(3):
             x[k, i], e1[k, i] = xc[i], R[i][0]
 
@@ -61,8 +64,8 @@ def _closest(H, A1, h1, A2, h2, iterations, out1, out2, ratio):
         u1, w1 = (h1[k, 0], h1[k, 1], h1[k, 2]), (h1[k, 3], h1[k, 4], h1[k, 5])
         u2, w2 = (h2[k, 0], h2[k, 1], h2[k, 2]), (h2[k, 3], h2[k, 4], h2[k, 5])
         xi1, xi2 = _project(POINT, RA1, xA1, u1, w1, 0.5, RA2, xA2, u2, w2, 0.5, iterations)
-        _, x1, x1p, x1pp = _section(RA1, xA1, u1, w1, xi1)
-        _, x2, x2p, x2pp = _section(RA2, xA2, u2, w2, xi2)
+        _, x1, x1p, x1pp = _section_inline(RA1, xA1, u1, w1, xi1)
+        _, x2, x2p, x2pp = _section_inline(RA2, xA2, u2, w2, xi2)
         d = (x2[0] - x1[0], x2[1] - x1[1], x2[2] - x1[2])
         h11 = dot(x1p, x1p) - dot(d, x1pp)
         h12 = -dot(x1p, x2p)
@@ -89,13 +92,14 @@ def _project_points(H, kind, A1, h1, xi1, A2, B2, h2, iterations, out2, dist):
         _, xB2 = _pose_of(H, B2[k])
         u1, w1 = (h1[k, 0], h1[k, 1], h1[k, 2]), (h1[k, 3], h1[k, 4], h1[k, 5])
         u2, w2 = (h2[k, 0], h2[k, 1], h2[k, 2]), (h2[k, 3], h2[k, 4], h2[k, 5])
-        _, xc, _, _ = _section(RA1, xA1, u1, w1, xi1[k])
+        sec1 = _section_inline(RA1, xA1, u1, w1, xi1[k])
+        xc = sec1[1]
         chord = (xB2[0] - xA2[0], xB2[1] - xA2[1], xB2[2] - xA2[2])
         rel = (xc[0] - xA2[0], xc[1] - xA2[1], xc[2] - xA2[2])
         s = dot(rel, chord) / max(dot(chord, chord), 1e-300)
         s = min(max(s, 0.0), 1.0)
-        _, xi2 = _project(kind[k], RA1, xA1, u1, w1, xi1[k], RA2, xA2, u2, w2, s, iterations)
-        _, xf, _, _ = _section(RA2, xA2, u2, w2, xi2)
+        _, xi2 = _project_from(kind[k], sec1, RA1, xA1, u1, w1, xi1[k], RA2, xA2, u2, w2, s, iterations)
+        _, xf, _, _ = _section_inline(RA2, xA2, u2, w2, xi2)
         out2[k] = xi2
         dist[k] = np.sqrt((xf[0] - xc[0]) ** 2 + (xf[1] - xc[1]) ** 2 + (xf[2] - xc[2]) ** 2)
 
