@@ -288,7 +288,8 @@ def main(output=None, turns=5.0, steps=40, n_elements=16, mu=0.3, stabilize=2e-2
     tw_c, m_c = onset(rows)
     checks = dict(reached=rows[-1].lk, t_end=float(sol.times[-1]), lk_error=worst, onset_turns=tw_c, onset_torque=m_c,
                   onset_ratio=m_c * length / B, wall=wall, writhe=rows[-1].writhe_fraction)
-    print(f"reached {checks['reached']:.3f} of {turns:g} turns, t = {checks['t_end']:.4f}, in {wall:.1f} s; Newton iterations "
+    print(f"reached {checks['reached']:.3f} of {turns:g} turns, t = {checks['t_end']:.4f}, in {wall:.1f} s; "
+          f"Newton iterations "
           f"{int(sol.iterations.sum())}; writhe at the end {rows[-1].writhe_fraction:.1%} of Lk")
     print(f"Lk = Tw + Wr: largest |Lk - Tw - Wr| / Lk {worst:.2e} ({'within' if worst <= 0.02 else 'NOT within'} 2 %)")
     print(f"onset of writhing at {tw_c:.3f} turns, torque {m_c:.4g} N m: M L / B = {checks['onset_ratio']:.2f} "
