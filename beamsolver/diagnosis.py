@@ -59,14 +59,6 @@ def _contact_declaration(model, nodes):
     return "a contact declaration"
 
 
-def _element_label(model, e):
-    """``Beam b 'name' element j`` for a global element id ``e``."""
-    for b in model.beams:
-        if b.elements[0] <= e <= b.elements[-1]:
-            return f"Beam {b.id}" + (f" {b.name!r}" if b.name else "") + f" element {e - b.elements[0]}"
-    return f"element {e}"
-
-
 def pushing_point(problem, H):
     """Where contact pushes the poses ``H`` hardest: ``add_contact no. k: <slave element> against
     <master element> (normal force, gap; points in contact)``.  Commits ``H`` to the contact
@@ -85,9 +77,8 @@ def pushing_point(problem, H):
     k = on[np.argmax(c["normal_force"][on])]
     e, m = int(c["slave_element"][k]), int(c["master_element"][k])
     decl = next((d.index for d in cs.decls if e in d.slave_el and m in d.master_el), "?")
-    model = problem.system.model
-    return (f"the largest push: add_contact no. {decl}: {_element_label(model, e)} against "
-            f"{_element_label(model, m)}, normal force {c['normal_force'][k]:.3g} at gap {c['gap'][k]:.3g}; "
+    return (f"the largest push: add_contact no. {decl}: {cs.element_label(e)} against "
+            f"{cs.element_label(m)}, normal force {c['normal_force'][k]:.3g} at gap {c['gap'][k]:.3g}; "
             f"{len(on)} points in contact")
 
 

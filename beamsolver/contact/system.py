@@ -471,12 +471,13 @@ class ContactSystem(Contribution):
         return np.flatnonzero(mult - pen * gap > -pen * band)
 
     # ------------------------------------------------------------ refusals
+    def element_label(self, e):
+        """``Beam b 'name' element j`` for the global element id ``e``."""
+        b = self.sys.model.beams[self.el_beam[e]]
+        return f"Beam {b.id}" + (f" {b.name!r}" if b.name else "") + f" element {e - b.elements[0]}"
+
     def _pair_label(self, e, m):
-        beams = self.sys.model.beams
-        be, bm = beams[self.el_beam[e]], beams[self.el_beam[m]]
-        name = lambda b: f"Beam {b.id}" + (f" {b.name!r}" if b.name else "")   # noqa: E731
-        return (f"{name(be)} element {e - be.elements[0]} (global {e}) against "
-                f"{name(bm)} element {m - bm.elements[0]} (global {m})")
+        return f"{self.element_label(e)} (global {e}) against {self.element_label(m)} (global {m})"
 
     def _check_normals(self, P, sel, H, centres):
         """Refuse (a step failure: cut back) pairs whose centre lines intersect: no normal
