@@ -84,12 +84,14 @@ def test_sorted_columns_keep_their_order():
     assert _identical(pat.matrix(el.data, vals), _scipy(el, rows, cols, vals, red))
 
 
-def test_contact_scene_tangent_bit_identical():
-    """The twisted pair's tangent with its contact blocks, through ``System.matrix``."""
+def _twisted_pair_tangent():
+    """The twisted pair (8 elements, half a turn) evaluated with its tangent at the reference poses:
+    ``(problem, system, evaluation, element part of the tangent as a CSC matrix)``."""
     import sys
     from pathlib import Path
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
     import twisted_pair
+    from beamsolver import assembly_jit
     from beamsolver.problem import Problem
 
     model, _, _ = twisted_pair.build(n_elements=8, turns=0.5)
@@ -98,11 +100,16 @@ def test_contact_scene_tangent_bit_identical():
     H = s.poses0.copy()
     problem.begin_step(H, 0.0)
     ev = problem.evaluate(H, 0.0, tangent=True)
-    assert len(ev.extra[2])
     data = np.empty(s.nnz + 1)
-    from beamsolver import assembly_jit
     assembly_jit.scatter(s.pos, ev.kvals, data)
     el = sp.csc_matrix((data[:s.nnz], s.indices, s.indptr), shape=(s.n_free, s.n_free))
+    return problem, s, ev, el
+
+
+def test_contact_scene_tangent_bit_identical():
+    """The twisted pair's tangent with its contact blocks, through ``System.matrix``."""
+    problem, s, ev, el = _twisted_pair_tangent()
+    assert len(ev.extra[2])
     for _ in range(2):                       # built, then reused
         assert _identical(problem.tangent(ev), _scipy(el, *ev.extra, s.red))
 
@@ -301,23 +308,9 @@ def test_block_pattern_with_a_tail_of_entries():
 def test_contact_scene_with_global_nodes_takes_the_block_path():
     """The twisted pair's contact reaches global-type nodes (partly fixed ends): its tangent is
     built by ``BlockPattern`` with the global-node terms as a tail, equal to scipy's."""
-    import sys
-    from pathlib import Path
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
-    import twisted_pair
-    from beamsolver import assembly_jit
     from beamsolver.extra_pattern import BlockPattern
-    from beamsolver.problem import Problem
 
-    model, _, _ = twisted_pair.build(n_elements=8, turns=0.5)
-    problem = Problem.from_model(model)
-    s = problem.system
-    H = s.poses0.copy()
-    problem.begin_step(H, 0.0)
-    ev = problem.evaluate(H, 0.0, tangent=True)
-    data = np.empty(s.nnz + 1)
-    assembly_jit.scatter(s.pos, ev.kvals, data)
-    el = sp.csc_matrix((data[:s.nnz], s.indices, s.indptr), shape=(s.n_free, s.n_free))
+    problem, s, ev, el = _twisted_pair_tangent()
     assert _identical(problem.tangent(ev), _scipy(el, *ev.extra, s.red))
     assert isinstance(s.extra_pattern, BlockPattern) and s.extra_pattern.tail is not None
 
