@@ -93,14 +93,20 @@ _borrowed = _borrowed_python if numba_config.DISABLE_JIT else _borrowed_intrinsi
 
 # ---------------------------------------------------------------- small algebra (tuples; small arrays written in place)
 @jit_inline
+def _exp_abc(u, w, t2, a, b, c):
+    """``exp(hat(u, w))`` as rotation and position tuples (``se3.exp``) from ``t2 = |w|^2`` and the
+    coefficients ``a, b, c`` at ``|w|``."""
+    R = add_outer(mat(scale(a, w), 1.0 - b * t2), scale(b, w), w)
+    wxu = cross(w, u)
+    return R, add(add(u, scale(b, wxu)), scale(c, cross(w, wxu)))
+
+
+@jit_inline
 def _exp_inline(u, w):
     """``exp(hat(u, w))`` as rotation and position tuples (``se3.exp``), inlined into its caller."""
     t2 = dot(w, w)
     t = np.sqrt(t2)
-    a, b, c = coefficient(A_, t), coefficient(B_, t), coefficient(C_, t)
-    R = add_outer(mat(scale(a, w), 1.0 - b * t2), scale(b, w), w)
-    wxu = cross(w, u)
-    return R, add(add(u, scale(b, wxu)), scale(c, cross(w, wxu)))
+    return _exp_abc(u, w, t2, coefficient(A_, t), coefficient(B_, t), coefficient(C_, t))
 
 
 @jit_inline
@@ -138,10 +144,7 @@ def _coefficients(w):
 @jit
 def _exp_co(u, w, t2, co):
     """``_exp`` with the coefficients of ``_coefficients(w)``."""
-    a, b, c = co[0], co[1], co[2]
-    R = add_outer(mat(scale(a, w), 1.0 - b * t2), scale(b, w), w)
-    wxu = cross(w, u)
-    return R, add(add(u, scale(b, wxu)), scale(c, cross(w, wxu)))
+    return _exp_abc(u, w, t2, co[0], co[1], co[2])
 
 
 @jit
@@ -284,7 +287,13 @@ def _geo(u, w, v, G):
     t = np.sqrt(t2)
     co = (coefficient(C_, t), coefficient(Q2_, t), coefficient(Q3_, t), coefficient(DP_, t), coefficient(CP_, t),
           coefficient(Q2P_, t), coefficient(Q3P_, t))
-    G12, G21, G22 = _geometric(u, w, (v[0], v[1], v[2]), (v[3], v[4], v[5]), coefficient(D_, t), t2, co)
+    _put_geo(G, _geometric(u, w, (v[0], v[1], v[2]), (v[3], v[4], v[5]), coefficient(D_, t), t2, co))
+
+
+@jit_inline
+def _put_geo(G, blocks):
+    """``G`` ``(6, 6)`` = ``[[0, G12], [G21, G22]]`` from ``blocks = (G12, G21, G22)``."""
+    G12, G21, G22 = blocks
     _zero3(G, 0, 0)
     _put3(G, 0, 3, G12)
     _put3(G, 3, 0, G21)
@@ -294,23 +303,15 @@ def _geo(u, w, v, G):
 @jit
 def _geo_co(u, w, v, G, t2, co):
     """``_geo`` with the coefficients of ``_coefficients(w)``."""
-    G12, G21, G22 = _geometric(u, w, (v[0], v[1], v[2]), (v[3], v[4], v[5]), co[3], t2,
-                               (co[2], co[4], co[5], co[7], co[6], co[8], co[9]))
-    _zero3(G, 0, 0)
-    _put3(G, 0, 3, G12)
-    _put3(G, 3, 0, G21)
-    _put3(G, 3, 3, G22)
+    _put_geo(G, _geometric(u, w, (v[0], v[1], v[2]), (v[3], v[4], v[5]), co[3], t2,
+                           (co[2], co[4], co[5], co[7], co[6], co[8], co[9])))
 
 
 @jit
 def _geo_cached(u, w, v, G, c):
     """``_geo`` at the element twist, with the coefficients kept in ``c`` by ``_element_side``."""
-    G12, G21, G22 = _geometric(u, w, (v[0], v[1], v[2]), (v[3], v[4], v[5]), c[C_D], c[C_T2],
-                               (c[C_CO], c[C_CO + 1], c[C_CO + 2], c[C_CO + 3], c[C_CO + 4], c[C_CO + 5], c[C_CO + 6]))
-    _zero3(G, 0, 0)
-    _put3(G, 0, 3, G12)
-    _put3(G, 3, 0, G21)
-    _put3(G, 3, 3, G22)
+    _put_geo(G, _geometric(u, w, (v[0], v[1], v[2]), (v[3], v[4], v[5]), c[C_D], c[C_T2],
+                           (c[C_CO], c[C_CO + 1], c[C_CO + 2], c[C_CO + 3], c[C_CO + 4], c[C_CO + 5], c[C_CO + 6])))
 
 
 @jit_inline
