@@ -333,11 +333,15 @@ N_SIDE = 22
 # 6-vector slots of a side's ``v`` (N_VEC, 6)
 (V_WR, V_Y, V_XY, V_DB, V_B, V_ZS, V_ZH, V_AHDB, V_DA) = range(9)
 N_VEC = 9
-# gradient slots: ``g6`` (N_G6, 6, 24), ``g3`` (N_G3, 3, 24), ``g2`` (N_G2, 2, 24), ``r`` (N_R, 24)
-(G6_VC, G6_VF, G6_DH1, G6_DH2, G6_DWC, G6_DWF), N_G6 = range(6), 6
-(G3_DN, G3_DT1, G3_DT2, G3_DF, G3_DMF), N_G3 = range(5), 5
-(G2_DSLIP, G2_DLP, G2_DPREV, G2_DTR), N_G2 = range(4), 4
-(R_DXI1, R_DXI2, R_DDIST, R_DLAM, R_DPT), N_R = range(5), 5
+# the gradients ``(k, 24)`` of one point: rows of one array ``G`` (N_G, 24); a quantity's rows start at its
+# offset.  One array and constant rows let the compiler see which accesses overlap (none), so the loops
+# over the 24 columns vectorise without runtime alias checks.
+_SIZES = dict(VC=6, VF=6, DH1=6, DH2=6, DWC=6, DWF=6, DN=3, DT1=3, DT2=3, DF=3, DMF=3, DSLIP=2, DLP=2, DPREV=2,
+              DTR=2, DXI1=1, DXI2=1, DDIST=1, DLAM=1, DPT=1)
+_OFFSETS = dict(zip(_SIZES, np.cumsum([0] + list(_SIZES.values()))[:-1].tolist()))
+(G_VC, G_VF, G_DH1, G_DH2, G_DWC, G_DWF, G_DN, G_DT1, G_DT2, G_DF, G_DMF, G_DSLIP, G_DLP, G_DPREV, G_DTR, G_DXI1,
+ G_DXI2, G_DDIST, G_DLAM, G_DPT) = _OFFSETS.values()
+N_G = sum(_SIZES.values())
 
 
 @jit
@@ -464,11 +468,11 @@ def _project_from(kind, sec1, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iter
 
 
 @jit_inline
-def _rot_col(R, V, k):
-    """``R @ V[0:3, k]``, ``R`` a 3x3 tuple."""
-    return (R[0][0] * V[0, k] + R[0][1] * V[1, k] + R[0][2] * V[2, k],
-            R[1][0] * V[0, k] + R[1][1] * V[1, k] + R[1][2] * V[2, k],
-            R[2][0] * V[0, k] + R[2][1] * V[1, k] + R[2][2] * V[2, k])
+def _rot_col(R, G, r0, k):
+    """``R @ G[r0:r0+3, k]``, ``R`` a 3x3 tuple."""
+    return (R[0][0] * G[r0, k] + R[0][1] * G[r0 + 1, k] + R[0][2] * G[r0 + 2, k],
+            R[1][0] * G[r0, k] + R[1][1] * G[r0 + 1, k] + R[1][2] * G[r0 + 2, k],
+            R[2][0] * G[r0, k] + R[2][1] * G[r0 + 1, k] + R[2][2] * G[r0 + 2, k])
 
 
 @jit_inline
@@ -478,11 +482,10 @@ def _col_dot(a, M, r0, k):
 
 
 @jit
-def _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, VC0, VF0, Dh1, Dh2, dxi1, dxi2):
-    """``dxi1, dxi2`` ``(24,)`` by the implicit-function theorem at the converged projection.
-
-    ``VC0``, ``VF0``: section-frame variations at fixed ``xi`` ``(6, 24)``; ``Dh1``, ``Dh2``:
-    twist variations.  The Jacobians (and their zero guards) are those of ``_project``.
+def _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, G):
+    """``dxi1, dxi2`` (rows ``G_DXI1``, ``G_DXI2`` of ``G``) by the implicit-function theorem at the converged
+    projection, from the section-frame variations at fixed ``xi`` (rows ``G_VC``, ``G_VF``) and the twist
+    variations (``G_DH1``, ``G_DH2``).  The Jacobians (and their zero guards) are those of ``_project``.
     """
     x1p, x2p = mv(RC, u1), mv(RF, u2)
     x1pp, x2pp = mv(RC, cross(w1, u1)), mv(RF, cross(w2, u2))
@@ -499,18 +502,18 @@ def _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, VC0, VF0, Dh1, Dh2, dx
     det = a11 * a22 - a12 * a21
     det = det if det != 0.0 else 1.0
     for k in range(24):
-        dxC, dxF = _rot_col(RC, VC0, k), _rot_col(RF, VF0, k)     # position variations
+        dxC, dxF = _rot_col(RC, G, G_VC, k), _rot_col(RF, G, G_VF, k)     # position variations
         rel = (dxF[0] - dxC[0], dxF[1] - dxC[1], dxF[2] - dxC[2])
         # g2 = d . x2' (orthogonal / point), at fixed xi
-        g2 = dot(x2p, rel) + _col_dot(c2, VF0, 3, k) + _col_dot(dF, Dh2, 0, k)
+        g2 = dot(x2p, rel) + _col_dot(c2, G, G_VF + 3, k) + _col_dot(dF, G, G_DH2, k)
         if kind == LINE:
-            g = dot(e1, rel) - dC[2] * VC0[4, k] + dC[1] * VC0[5, k]
-            dxi1[k], dxi2[k] = 0.0, -g / jl
+            g = dot(e1, rel) - dC[2] * G[G_VC + 4, k] + dC[1] * G[G_VC + 5, k]
+            G[G_DXI1, k], G[G_DXI2, k] = 0.0, -g / jl
         elif kind == ORTHOGONAL:
-            dxi1[k], dxi2[k] = 0.0, -g2 / jo
+            G[G_DXI1, k], G[G_DXI2, k] = 0.0, -g2 / jo
         else:
-            g1 = dot(x1p, rel) + _col_dot(c1, VC0, 3, k) + _col_dot(dC, Dh1, 0, k)
-            dxi1[k], dxi2[k] = -(a22 * g1 - a12 * g2) / det, -(-a21 * g1 + a11 * g2) / det
+            g1 = dot(x1p, rel) + _col_dot(c1, G, G_VC + 3, k) + _col_dot(dC, G, G_DH1, k)
+            G[G_DXI1, k], G[G_DXI2, k] = -(a22 * g1 - a12 * g2) / det, -(-a21 * g1 + a11 * g2) / det
 
 
 # ---------------------------------------------------------------- one side of a pair: element, section, Jacobians
@@ -554,26 +557,28 @@ def _element_side(Xp, j0, S, c):
 
 
 @jit
-def _variations(S, c0, Dh, V, tmp):
+def _variations(S, c0, G, DH, V, tmp):
     """Twist variation ``dh = T(h)^-1 (dq_B - Ad(exp(-h)) dq_A)`` and section-frame variation at fixed
-    ``xi`` ``(J_A dq_A + J_B dq_B)``, both ``(6, 24)``, node A at column ``c0``."""
-    _zero(Dh)
-    _zero(V)
+    ``xi`` ``(J_A dq_A + J_B dq_B)`` into the rows ``DH``, ``V`` of ``G`` (6 each), node A at column ``c0``."""
+    for i in range(6):
+        for k in range(24):
+            G[DH + i, k] = 0.0
+            G[V + i, k] = 0.0
     _mm_ut(S[S_TI], S[S_AH], tmp)
     Ti, JA, JB = S[S_TI], S[S_JA], S[S_JB]
     for i in range(6):
         for j in range(6):
-            Dh[i, c0 + j] = -tmp[i, j]
-            Dh[i, c0 + 6 + j] = Ti[i, j]
-            V[i, c0 + j] = JA[i, j]
-            V[i, c0 + 6 + j] = JB[i, j]
+            G[DH + i, c0 + j] = -tmp[i, j]
+            G[DH + i, c0 + 6 + j] = Ti[i, j]
+            G[V + i, c0 + j] = JA[i, j]
+            G[V + i, c0 + 6 + j] = JB[i, j]
 
 
 # ---------------------------------------------------------------- 3-vectors with gradients (3, 24)
 @jit
-def _axes(RC, xC, RF, xF, VC, VF, Dn, Dt1, Dt2, Ddist):
+def _axes(RC, xC, RF, xF, G):
     """``n, t1, t2`` (``pairs._axes``), centre distance, and the gradients of ``n, t1, t2, dist``
-    (one pass over the 24 columns)."""
+    into ``G`` (rows ``G_DN``, ``G_DT1``, ``G_DT2``, ``G_DDIST``; one pass over the 24 columns)."""
     d = add(xF, scale(-1.0, xC))
     dist = np.sqrt(dot(d, d))
     n = scale(1.0 / dist, d)
@@ -584,19 +589,19 @@ def _axes(RC, xC, RF, xF, VC, VF, Dn, Dt1, Dt2, Ddist):
     t1 = scale(1.0 / lt, t1r)
     t2 = cross(n, t1)
     for k in range(24):
-        dF = mv(RF, (VF[0, k], VF[1, k], VF[2, k]))
-        dC = mv(RC, (VC[0, k], VC[1, k], VC[2, k]))
+        dF = mv(RF, (G[G_VF, k], G[G_VF + 1, k], G[G_VF + 2, k]))
+        dC = mv(RC, (G[G_VC, k], G[G_VC + 1, k], G[G_VC + 2, k]))
         dd = add(dF, scale(-1.0, dC))
         nd = dot(n, dd)
         dn = scale(1.0 / dist, add(dd, scale(-nd, n)))
-        de1 = add(scale(VC[5, k], e2), scale(-VC[4, k], e3))
+        de1 = add(scale(G[G_VC + 5, k], e2), scale(-G[G_VC + 4, k], e3))
         dc = dot(n, de1) + dot(e1, dn)
         dt1r = add(add(de1, scale(-dc, n)), scale(-c, dn))
         dt1 = scale(1.0 / lt, add(dt1r, scale(-dot(t1, dt1r), t1)))
         dt2 = add(cross(n, dt1), scale(-1.0, cross(t1, dn)))
         for i in range(3):
-            Dn[i, k], Dt1[i, k], Dt2[i, k] = dn[i], dt1[i], dt2[i]
-        Ddist[k] = nd
+            G[G_DN + i, k], G[G_DT1 + i, k], G[G_DT2 + i, k] = dn[i], dt1[i], dt2[i]
+        G[G_DDIST, k] = nd
     return n, t1, t2, dist
 
 
@@ -678,112 +683,116 @@ def _jacobians_at(u, w, xi, xip, S):
         _jacobians(u, w, xip, t2, co, S[S_TI], S[S_AH], S[S_TSP], S[S_ASP], S[S_JAP], S[S_JBP], S[S_TMP])
 
 
-def _friction(slip, Dslip, lamp, t1, t2, Dt1, Dt2, lam, Dlam, par, g2, Dpt):
+def _friction(slip, lamp, t1, t2, lam, par, G):
     """Transported stored traction, tangential penalty, trial traction and the law's tangential part
-    (``_tangential_law``, bound by ``make_kernel``); ``lam_t``, its gradient ``(2, 24)``, ``stick``."""
+    (``_tangential_law``, bound by ``make_kernel``); ``lam_t``, its gradient ``(2, 24)``, ``stick``.
+    Reads the rows ``G_DSLIP``, ``G_DT1``, ``G_DT2``, ``G_DLAM`` of ``G``; writes ``G_DLP``, ``G_DPREV``,
+    ``G_DPT``, ``G_DTR``."""
     lp = (dot(lamp, t1), dot(lamp, t2))
-    Dlp, Dprev, Dtr = g2[G2_DLP], g2[G2_DPREV], g2[G2_DTR]
     for k in range(24):
-        Dlp[0, k] = lamp[0] * Dt1[0, k] + lamp[1] * Dt1[1, k] + lamp[2] * Dt1[2, k]
-        Dlp[1, k] = lamp[0] * Dt2[0, k] + lamp[1] * Dt2[1, k] + lamp[2] * Dt2[2, k]
+        G[G_DLP, k] = lamp[0] * G[G_DT1, k] + lamp[1] * G[G_DT1 + 1, k] + lamp[2] * G[G_DT1 + 2, k]
+        G[G_DLP + 1, k] = lamp[0] * G[G_DT2, k] + lamp[1] * G[G_DT2 + 1, k] + lamp[2] * G[G_DT2 + 2, k]
     npv = np.sqrt(dot(lamp, lamp))
     nl = np.sqrt(lp[0] * lp[0] + lp[1] * lp[1])
     if nl > 1e-300 * (1.0 + npv):
         s = npv / nl
         l0, l1 = lp[0] / nl, lp[1] / nl
         for k in range(24):
-            proj = l0 * Dlp[0, k] + l1 * Dlp[1, k]
-            Dprev[0, k] = s * (Dlp[0, k] - l0 * proj)
-            Dprev[1, k] = s * (Dlp[1, k] - l1 * proj)
+            proj = l0 * G[G_DLP, k] + l1 * G[G_DLP + 1, k]
+            G[G_DPREV, k] = s * (G[G_DLP, k] - l0 * proj)
+            G[G_DPREV + 1, k] = s * (G[G_DLP + 1, k] - l1 * proj)
         lam_prev = (lp[0] * s, lp[1] * s)
     else:
-        _zero(Dprev)
+        for k in range(24):
+            G[G_DPREV, k] = 0.0
+            G[G_DPREV + 1, k] = 0.0
         lam_prev = (0.0, 0.0)
     pen_t, mu = par[PEN_T], par[MU]
     for k in range(24):
-        Dpt[k] = 0.0
+        G[G_DPT, k] = 0.0
     if np.isnan(pen_t) and not np.isnan(par[ESLIP]):
         lam_min = PENALTY_T_MIN * par[PENALTY] * par[ESLIP]      # pairs.stick_penalty
         if lam >= lam_min:
             pen_t = mu * lam / par[ESLIP]
             for k in range(24):
-                Dpt[k] = (mu / par[ESLIP]) * Dlam[k]
+                G[G_DPT, k] = (mu / par[ESLIP]) * G[G_DLAM, k]
         else:
             pen_t = mu * lam_min / par[ESLIP]
     tr0, tr1 = lam_prev[0] + pen_t * slip[0], lam_prev[1] + pen_t * slip[1]
     for a in range(2):
         for k in range(24):
-            Dtr[a, k] = Dprev[a, k] + slip[a] * Dpt[k] + pen_t * Dslip[a, k]
-    lt0, lt1, D, stick = _tangential_law(tr0, tr1, Dtr, mu, lam, Dlam)
+            G[G_DTR + a, k] = G[G_DPREV + a, k] + slip[a] * G[G_DPT, k] + pen_t * G[G_DSLIP + a, k]
+    lt0, lt1, D, stick = _tangential_law(tr0, tr1, G[G_DTR:G_DTR + 2], mu, lam, G[G_DLAM])
     return (lt0, lt1), D, stick
 
 
 # ---------------------------------------------------------------- one contact point
 @jit
-def _wrench(R, F, DF, neg, m, DmF, sm, V, w, D):
-    """Body wrench ``w = (R^T F, R^T m)`` and its gradient ``D`` ``(6, 24)`` from ``dF = -DF`` if ``neg``
-    (else ``DF``) and ``dm = sm DmF``; ``V``: the frame's variation ``(6, 24)``; ``d(R^T F)/dtheta = hat(R^T F)``."""
+def _wrench(R, F, neg, m, sm, G, V, DW, w):
+    """Body wrench ``w = (R^T F, R^T m)`` and its gradient (rows ``DW`` of ``G``, 6) from ``dF = -dF_slave``
+    if ``neg`` (else ``dF_slave``; rows ``G_DF``) and ``dm = sm d(n x F)`` (rows ``G_DMF``); ``V``: the rows
+    of the frame's variation; ``d(R^T F)/dtheta = hat(R^T F)``."""
     Rt = transpose(R)
     bF, bm = mv(Rt, F), mv(Rt, m)
     for i in range(3):
         w[i], w[3 + i] = bF[i], bm[i]
     for k in range(24):
-        th = (V[3, k], V[4, k], V[5, k])
-        dF = (-DF[0, k], -DF[1, k], -DF[2, k]) if neg else (DF[0, k], DF[1, k], DF[2, k])
+        th = (G[V + 3, k], G[V + 4, k], G[V + 5, k])
+        dF = (-G[G_DF, k], -G[G_DF + 1, k], -G[G_DF + 2, k]) if neg else (G[G_DF, k], G[G_DF + 1, k], G[G_DF + 2, k])
         a = add(mv(Rt, dF), cross(bF, th))
-        b = add(mv(Rt, (sm * DmF[0, k], sm * DmF[1, k], sm * DmF[2, k])), cross(bm, th))
+        b = add(mv(Rt, (sm * G[G_DMF, k], sm * G[G_DMF + 1, k], sm * G[G_DMF + 2, k])), cross(bm, th))
         for i in range(3):
-            D[i, k], D[3 + i, k] = a[i], b[i]
+            G[DW + i, k], G[DW + 3 + i, k] = a[i], b[i]
 
 
 @jit
-def _nodal(u, w, xi, t2, co, S, v, c, Dw, Dh, dxi, c0, f, K, j0):
+def _nodal(u, w, xi, t2, co, S, v, c, G, DW, DH, DXI, f, K, j0):
     """``f_j = J_j^T wr`` (``wr = v[V_WR]``) for the two nodes of one side and their rows of the tangent:
-    ``J^T dwr + d(J^T wr)/dh dh + d(J^T wr)/dxi dxi`` (``dh`` lives in columns ``c0:c0+12``)."""
+    ``J^T dwr + d(J^T wr)/dh dh + d(J^T wr)/dxi dxi`` (rows ``DW``, ``DH``, ``DXI`` of ``G``; ``dh`` is zero
+    outside the side's columns)."""
     _jacobian_derivatives(u, w, xi, t2, co, S, v, c)
     wr = v[V_WR]
     for s in range(2):
         J, D, dd = (S[S_JA], S[S_DA], v[V_DA]) if s == 0 else (S[S_JB], S[S_DB], v[V_DB])
         r0 = 6 * (j0 + s)
-        for i in range(6):
+        for i in range(3):                      # force rows: J[3:, :3] == 0 (block upper triangular)
+            f[j0 + s, i] = J[0, i] * wr[0] + J[1, i] * wr[1] + J[2, i] * wr[2]
+            _tangent_row(J[0, i], J[1, i], J[2, i], 0.0, 0.0, 0.0, D[i, 0], D[i, 1], D[i, 2], D[i, 3], D[i, 4],
+                         D[i, 5], dd[i], G, DXI, DW, DH, True, K[r0 + i])
+        for i in range(3, 6):                   # moment rows
             acc = 0.0
-            for l in range(3 if i < 3 else 6):        # J[3:, :3] == 0 (block upper triangular)
+            for l in range(6):
                 acc += J[l, i] * wr[l]
             f[j0 + s, i] = acc
             _tangent_row(J[0, i], J[1, i], J[2, i], J[3, i], J[4, i], J[5, i], D[i, 0], D[i, 1], D[i, 2], D[i, 3],
-                         D[i, 4], D[i, 5], dd[i], dxi, Dw, Dh, c0, i < 3, K[r0 + i])
+                         D[i, 4], D[i, 5], dd[i], G, DXI, DW, DH, False, K[r0 + i])
 
 
 @jit_inline
-def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, dxi, Dw, Dh, c0, force, out):
-    """One row of the tangent: ``out[c] = di dxi[c] + sum_l (j_l Dw[l, c] + d_l Dh[l, c])``, the ``Dh``
-    terms only on the columns ``c0:c0+12`` of the side's nodes (summed in this order).  ``force``: a
-    force row, whose ``j3, j4, j5`` are structural zeros (``J[3:, :3] == 0``): their terms, exact
-    zeros, are skipped (the same sums up to the sign of a zero result)."""
+def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, G, DXI, DW, DH, force, out):
+    """One row of the tangent: ``out[c] = di dxi[c] + sum_l (j_l Dw[l, c] + d_l Dh[l, c])``, summed in this
+    order (``dxi``, ``Dw``, ``Dh``: the rows ``DXI``, ``DW``, ``DH`` of ``G``).  ``force`` (a constant at each call): a force row, whose ``j3, j4, j5`` are structural zeros
+    (``J[3:, :3] == 0``): their terms, exact zeros, are skipped.  ``Dh`` is zero outside the side's columns:
+    its terms there, exact zeros, change a sum only in the sign of a zero result (``_mm_ut``), and keep
+    the loop branch-free over all 24 columns, which the compiler vectorises (a loop of fewer than 16
+    iterations is not: its arrays' runtime alias checks are refused as too costly)."""
     for c in range(24):
-        own = c0 <= c < c0 + 12
-        acc = di * dxi[c]
-        acc += j0 * Dw[0, c]
-        if own:
-            acc += d0 * Dh[0, c]
-        acc += j1 * Dw[1, c]
-        if own:
-            acc += d1 * Dh[1, c]
-        acc += j2 * Dw[2, c]
-        if own:
-            acc += d2 * Dh[2, c]
+        acc = di * G[DXI, c]
+        acc += j0 * G[DW + 0, c]
+        acc += d0 * G[DH + 0, c]
+        acc += j1 * G[DW + 1, c]
+        acc += d1 * G[DH + 1, c]
+        acc += j2 * G[DW + 2, c]
+        acc += d2 * G[DH + 2, c]
         if not force:
-            acc += j3 * Dw[3, c]
-        if own:
-            acc += d3 * Dh[3, c]
+            acc += j3 * G[DW + 3, c]
+        acc += d3 * G[DH + 3, c]
         if not force:
-            acc += j4 * Dw[4, c]
-        if own:
-            acc += d4 * Dh[4, c]
+            acc += j4 * G[DW + 4, c]
+        acc += d4 * G[DH + 4, c]
         if not force:
-            acc += j5 * Dw[5, c]
-        if own:
-            acc += d5 * Dh[5, c]
+            acc += j5 * G[DW + 5, c]
+        acc += d5 * G[DH + 5, c]
         out[c] = acc
 
 
@@ -804,47 +813,47 @@ def _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2):
 
 
 @jit
-def _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, d, S1, S2, g6, r):
-    """Node Jacobians of both sides, twist variations ``g6[G6_DH1], g6[G6_DH2]``, projection gradients
-    ``r[R_DXI1], r[R_DXI2]`` and the section-frame variations ``g6[G6_VC], g6[G6_VF]`` ``(6, 24)``;
+def _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, d, S1, S2, G):
+    """Node Jacobians of both sides, twist variations (rows ``G_DH1``, ``G_DH2`` of ``G``), projection
+    gradients (``G_DXI1``, ``G_DXI2``) and the section-frame variations (``G_VC``, ``G_VF``, 6 rows each);
     ``S1``, ``S2`` hold the elements' ``T(h)^-1``, ``Ad(exp(-h))`` (``_element_side``); ``co1``, ``co2``:
     ``_coefficients(xi w)`` of the sides."""
     _jacobians(u1, w1, xi1, co1[0], co1[1], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB], S1[S_TMP])
     _jacobians(u2, w2, xi2, co2[0], co2[1], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB], S2[S_TMP])
-    VC, VF, dxi1, dxi2 = g6[G6_VC], g6[G6_VF], r[R_DXI1], r[R_DXI2]
-    _variations(S1, 0, g6[G6_DH1], VC, S1[S_TMP])
-    _variations(S2, 12, g6[G6_DH2], VF, S2[S_TMP])
-    _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, VC, VF, g6[G6_DH1], g6[G6_DH2], dxi1, dxi2)
+    _variations(S1, 0, G, G_DH1, G_VC, S1[S_TMP])
+    _variations(S2, 12, G, G_DH2, G_VF, S2[S_TMP])
+    _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, G)
     h1 = (u1[0], u1[1], u1[2], w1[0], w1[1], w1[2])
     h2 = (u2[0], u2[1], u2[2], w2[0], w2[1], w2[2])
     for i in range(6):
         for k in range(24):
-            VC[i, k] += h1[i] * dxi1[k]
-            VF[i, k] += h2[i] * dxi2[k]
+            G[G_VC + i, k] += h1[i] * G[G_DXI1, k]
+            G[G_VF + i, k] += h2[i] * G[G_DXI2, k]
 
 
 @jit
-def _add_friction_force(F, DF, wgt, lt, Dlt, t1, t2, Dt1, Dt2):
-    """``F + wgt (lt0 t1 + lt1 t2)`` and its gradient added to ``DF`` ``(3, 24)``."""
+def _add_friction_force(F, G, wgt, lt, Dlt, t1, t2):
+    """``F + wgt (lt0 t1 + lt1 t2)`` and its gradient added to the rows ``G_DF`` of ``G`` (``Dlt`` ``(2, 24)``)."""
     for i in range(3):
         for k in range(24):
-            DF[i, k] += wgt * (t1[i] * Dlt[0, k] + lt[0] * Dt1[i, k] + t2[i] * Dlt[1, k] + lt[1] * Dt2[i, k])
+            G[G_DF + i, k] += wgt * (t1[i] * Dlt[0, k] + lt[0] * G[G_DT1 + i, k] + t2[i] * Dlt[1, k]
+                                     + lt[1] * G[G_DT2 + i, k])
     return add(F, add(scale(wgt * lt[0], t1), scale(wgt * lt[1], t2)))
 
 
 @jit
-def _moment_gradient(n, F, DF, Dn, DmF):
-    """``d(n x F)`` ``(3, 24)`` into ``DmF``."""
+def _moment_gradient(n, F, G):
+    """``d(n x F)`` into the rows ``G_DMF`` of ``G`` from ``dF`` (``G_DF``) and ``dn`` (``G_DN``)."""
     for k in range(24):
-        DmF[0, k] = (n[1] * DF[2, k] - n[2] * DF[1, k]) - (F[1] * Dn[2, k] - F[2] * Dn[1, k])
-        DmF[1, k] = (n[2] * DF[0, k] - n[0] * DF[2, k]) - (F[2] * Dn[0, k] - F[0] * Dn[2, k])
-        DmF[2, k] = (n[0] * DF[1, k] - n[1] * DF[0, k]) - (F[0] * Dn[1, k] - F[1] * Dn[0, k])
+        G[G_DMF, k] = (n[1] * G[G_DF + 2, k] - n[2] * G[G_DF + 1, k]) - (F[1] * G[G_DN + 2, k] - F[2] * G[G_DN + 1, k])
+        G[G_DMF + 1, k] = (n[2] * G[G_DF, k] - n[0] * G[G_DF + 2, k]) - (F[2] * G[G_DN, k] - F[0] * G[G_DN + 2, k])
+        G[G_DMF + 2, k] = (n[0] * G[G_DF + 1, k] - n[1] * G[G_DF, k]) - (F[0] * G[G_DN + 1, k] - F[1] * G[G_DN, k])
 
 
 def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames, ws):
     """Forces ``f (4, 6)``, tangent ``K (24, 24)`` and point data of one contact point; ``ws``: the
     scratch arrays of ``_scratch``."""
-    S, v, g6, g3, g2, r, cache = ws
+    S, v, G, cache = ws
     side1, side2 = _element_side(Xp, 0, S[0], cache[0]), _element_side(Xp, 2, S[1], cache[1])
     RA1, xA1, u1, w1 = side1
     RA2, xA2, u2, w2 = side2
@@ -852,38 +861,38 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
     co1, co2 = _coefficients(scale(xi1, w1)), _coefficients(scale(xi2, w2))
     RC, xC, _, _ = _section_co(RA1, xA1, u1, w1, xi1, co1[0], co1[1])
     RF, xF, _, _ = _section_co(RA2, xA2, u2, w2, xi2, co2[0], co2[1])
-    S1, S2, VC, VF = S[0], S[1], g6[G6_VC], g6[G6_VF]
-    _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, g6, r)
-    Dn, Dt1, Dt2, DF, DmF, Ddist, Dlam = g3[G3_DN], g3[G3_DT1], g3[G3_DT2], g3[G3_DF], g3[G3_DMF], r[R_DDIST], r[R_DLAM]
-    n, t1, t2, dist = _axes(RC, xC, RF, xF, VC, VF, Dn, Dt1, Dt2, Ddist)
+    S1, S2 = S[0], S[1]
+    _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, G)
+    n, t1, t2, dist = _axes(RC, xC, RF, xF, G)
     R1, R2, wgt = par[R1_], par[R2_], par[WEIGHT]
     gap = dist - R1 - R2
     lam, dlam, active = _normal_law(gap, par[PENALTY], par[MULT], par[SMOOTH])      # bound by make_kernel
     for k in range(24):
-        Dlam[k] = dlam * Ddist[k]
+        G[G_DLAM, k] = dlam * G[G_DDIST, k]
     F = scale(-wgt * lam, n)
     for i in range(3):
         for k in range(24):
-            DF[i, k] = -wgt * (n[i] * Dlam[k] + lam * Dn[i, k])
+            G[G_DF + i, k] = -wgt * (n[i] * G[G_DLAM, k] + lam * G[G_DN + i, k])
     lt, stick, slip = (0.0, 0.0), True, (0.0, 0.0)
     if friction:
-        Dslip = g2[G2_DSLIP]
-        _zero(Dslip)
+        for a in range(2):
+            for k in range(24):
+                G[G_DSLIP + a, k] = 0.0
         if has:
             slip = _slip(side1, side2, S1, S2, (xi1, RC, xC), (xi2, RF, xF), par[XI1P], par[XI2P], HCL, HFK, HLKp,
-                         Dslip)
-        lt, Dlt, stick = _friction(slip, Dslip, lamp, t1, t2, Dt1, Dt2, lam, Dlam, par, g2, r[R_DPT])
+                         G[G_DSLIP:G_DSLIP + 2])
+        lt, Dlt, stick = _friction(slip, lamp, t1, t2, lam, par, G)
         if active:
-            F = _add_friction_force(F, DF, wgt, lt, Dlt, t1, t2, Dt1, Dt2)
+            F = _add_friction_force(F, G, wgt, lt, Dlt, t1, t2)
         else:
             lt = (0.0, 0.0)
         _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2)
     mF = cross(n, F)
-    _moment_gradient(n, F, DF, Dn, DmF)
-    _wrench(RC, F, DF, False, scale(R1, mF), DmF, R1, VC, v[0, V_WR], g6[G6_DWC])
-    _wrench(RF, scale(-1.0, F), DF, True, scale(R2, mF), DmF, R2, VF, v[1, V_WR], g6[G6_DWF])
-    _nodal(u1, w1, xi1, co1[0], co1[1], S1, v[0], cache[0], g6[G6_DWC], g6[G6_DH1], r[R_DXI1], 0, f, K, 0)
-    _nodal(u2, w2, xi2, co2[0], co2[1], S2, v[1], cache[1], g6[G6_DWF], g6[G6_DH2], r[R_DXI2], 12, f, K, 2)
+    _moment_gradient(n, F, G)
+    _wrench(RC, F, False, scale(R1, mF), R1, G, G_VC, G_DWC, v[0, V_WR])
+    _wrench(RF, scale(-1.0, F), True, scale(R2, mF), R2, G, G_VF, G_DWF, v[1, V_WR])
+    _nodal(u1, w1, xi1, co1[0], co1[1], S1, v[0], cache[0], G, G_DWC, G_DH1, G_DXI1, f, K, 0)
+    _nodal(u2, w2, xi2, co2[0], co2[1], S2, v[1], cache[1], G, G_DWF, G_DH2, G_DXI2, f, K, 2)
     sc[0], sc[1], sc[2], sc[3] = gap, lam, xi1, xi2
     for i in range(3):
         vec[0, i], vec[1, i], vec[2, i], vec[3, i], vec[4, i], vec[5, i] = n[i], t1[i], t2[i], xC[i], xF[i], F[i]
@@ -894,8 +903,7 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
 @jit
 def _scratch():
     """Scratch arrays of one evaluation, reused by every point (the kernel allocates nothing per point)."""
-    return (np.empty((2, N_SIDE, 6, 6)), np.empty((2, N_VEC, 6)), np.empty((N_G6, 6, 24)), np.empty((N_G3, 3, 24)),
-            np.empty((N_G2, 2, 24)), np.empty((N_R, 24)), np.full((2, N_CACHE), np.nan))
+    return np.empty((2, N_SIDE, 6, 6)), np.empty((2, N_VEC, 6)), np.empty((N_G, 24)), np.full((2, N_CACHE), np.nan)
 
 
 def _evaluate(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames):
@@ -903,8 +911,7 @@ def _evaluate(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, 
     and the scratch (no reference counting per point; the arguments are held by the caller).  A template: ``make_kernel``
     compiles it per contact law; the module's ``evaluate`` is the default law's."""
     own = _scratch()
-    ws = (_borrowed(own[0]), _borrowed(own[1]), _borrowed(own[2]), _borrowed(own[3]), _borrowed(own[4]),
-          _borrowed(own[5]), _borrowed(own[6]))
+    ws = (_borrowed(own[0]), _borrowed(own[1]), _borrowed(own[2]), _borrowed(own[3]))
     X, par, HCL, HFK, HLKp, lamp = _borrowed(X), _borrowed(par), _borrowed(HCL), _borrowed(HFK), _borrowed(HLKp), \
         _borrowed(lamp)
     kind, has, f, K, sc = _borrowed(kind), _borrowed(has), _borrowed(f), _borrowed(K), _borrowed(sc)
