@@ -559,10 +559,10 @@ def _element_side(Xp, j0, S, c):
 @jit
 def _variations(S, c0, G, DH, V, tmp):
     """Twist variation ``dh = T(h)^-1 (dq_B - Ad(exp(-h)) dq_A)`` and section-frame variation at fixed
-    ``xi`` ``(J_A dq_A + J_B dq_B)`` into the rows ``DH``, ``V`` of ``G`` (6 each), node A at column ``c0``."""
+    ``xi`` ``(J_A dq_A + J_B dq_B)`` into the rows ``DH``, ``V`` of ``G`` (6 each), node A at column ``c0``
+    (``c0`` 0 or 12).  The other side's columns of ``DH`` are zero from ``_scratch`` on (never written)."""
     for i in range(6):
-        for k in range(24):
-            G[DH + i, k] = 0.0
+        for k in range(12 - c0, 24 - c0):
             G[V + i, k] = 0.0
     _mm_ut(S[S_TI], S[S_AH], tmp)
     Ti, JA, JB = S[S_TI], S[S_JA], S[S_JB]
@@ -902,8 +902,9 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
 
 @jit
 def _scratch():
-    """Scratch arrays of one evaluation, reused by every point (the kernel allocates nothing per point)."""
-    return np.empty((2, N_SIDE, 6, 6)), np.empty((2, N_VEC, 6)), np.empty((N_G, 24)), np.full((2, N_CACHE), np.nan)
+    """Scratch arrays of one evaluation, reused by every point (the kernel allocates nothing per point); the
+    gradients ``G`` start at zero (``_variations`` relies on it)."""
+    return np.empty((2, N_SIDE, 6, 6)), np.empty((2, N_VEC, 6)), np.zeros((N_G, 24)), np.full((2, N_CACHE), np.nan)
 
 
 def _evaluate(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames):
