@@ -32,13 +32,19 @@ scalar functions (default ``law.PENALTY_COULOMB``, tested equal to the numpy for
 
 Nothing is allocated per point: small algebra stays in tuples, and the 6x6 matrices,
 6-vectors and ``(k, 24)`` gradients live in scratch arrays made once per batch
-(``_scratch``; named slots ``S_*``, ``V_*``, ``G*_*``, ``R_*``) and written in place.
+(``_scratch``; named slots ``S_*``, ``V_*``; the gradients are rows of one array ``G`` at
+the named row offsets ``G_*``) and written in place.  The loops over the 24 columns are
+branch-free and read and write ``G`` at constant rows, so the compiler vectorises them
+(AVX2, four columns per instruction; nothing proves that two separate arrays do not overlap,
+and runtime overlap checks are refused in loops of fewer than 16 iterations): each column's
+sum keeps its terms and their order, so vectorising changes no result.
 Every sum keeps its terms and their order (the Newton iteration counts of the contact
 examples are round-off sensitive); values that are needed twice are computed once only
 where the two computations are the same operations on the same inputs.  Terms that are
 structural zeros (the zero blocks of ``T``, ``T^-1``, ``Ad``, ``G`` and the node Jacobians)
 are skipped: a sum started at ``+0.0`` is unchanged by an exact zero term, so the results
-are the same floats (``_mm_ut``; in a tangent row up to the sign of a zero entry).
+are the same floats (``_mm_ut``; in a tangent row, which also adds the exact zeros of the
+twist variation on the other side's columns, up to the sign of a zero entry).
 """
 import hashlib
 import types
@@ -658,29 +664,27 @@ def _slip(side1, side2, S1, S2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp, D):
     RLK, xLK = mm(RLt, RK), mv(RLt, add(xK, scale(-1.0, xL)))
     RP, xP = _pose4(HLKp)
     dyu, dyw, _, _ = log_relative(RP, xP, RLK, xLK)
-    _jacobians_at(u1, w1, xi1, xi1p, S1)
-    _jacobians_at(u2, w2, xi2, xi2p, S2)
+    a1, b1 = _jacobians_at(u1, w1, xi1, xi1p, S1)
+    a2, b2 = _jacobians_at(u2, w2, xi2, xi2p, S2)
     Tdy, Ad, tmp = S1[S_TDY], S1[S_AD], S1[S_TMP]
     _tangent_inv(dyu, dyw, Tdy)
     Rs, xs = _compose(RCL, xCL, RLK, xLK)
     _adjoint_inv(Rs, xs, Ad)
-    _slip_rows(Tdy, Ad, S1[S_JAP], S1[S_JBP], -1.0, D, 0, tmp)
+    _slip_rows(Tdy, Ad, S1[a1], S1[b1], -1.0, D, 0, tmp)
     _adjoint_inv(RFK, xFK, Ad)
-    _slip_rows(Tdy, Ad, S2[S_JAP], S2[S_JBP], 1.0, D, 12, tmp)
+    _slip_rows(Tdy, Ad, S2[a2], S2[b2], 1.0, D, 12, tmp)
     return (dyu[1], dyu[2])
 
 
 @jit
 def _jacobians_at(u, w, xi, xip, S):
-    """Node Jacobians at ``xip`` into ``S[S_JAP], S[S_JBP]``; copied from those at ``xi`` if ``xip`` is ``xi``."""
+    """Slots of ``S`` with the node Jacobians at ``xip``: ``S_JA, S_JB`` (those at ``xi``) if ``xip`` is ``xi``,
+    else ``S_JAP, S_JBP``, computed."""
     if _same(xip, xi):
-        JA, JB, JAP, JBP = S[S_JA], S[S_JB], S[S_JAP], S[S_JBP]
-        for i in range(6):
-            for j in range(6):
-                JAP[i, j], JBP[i, j] = JA[i, j], JB[i, j]
-    else:
-        t2, co = _coefficients(scale(xip, w))
-        _jacobians(u, w, xip, t2, co, S[S_TI], S[S_AH], S[S_TSP], S[S_ASP], S[S_JAP], S[S_JBP], S[S_TMP])
+        return S_JA, S_JB
+    t2, co = _coefficients(scale(xip, w))
+    _jacobians(u, w, xip, t2, co, S[S_TI], S[S_AH], S[S_TSP], S[S_ASP], S[S_JAP], S[S_JBP], S[S_TMP])
+    return S_JAP, S_JBP
 
 
 def _friction(slip, lamp, t1, t2, lam, par, G):
@@ -875,12 +879,13 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
             G[G_DF + i, k] = -wgt * (n[i] * G[G_DLAM, k] + lam * G[G_DN + i, k])
     lt, stick, slip = (0.0, 0.0), True, (0.0, 0.0)
     if friction:
-        for a in range(2):
-            for k in range(24):
-                G[G_DSLIP + a, k] = 0.0
-        if has:
+        if has:         # writes all 24 columns of the slip gradient
             slip = _slip(side1, side2, S1, S2, (xi1, RC, xC), (xi2, RF, xF), par[XI1P], par[XI2P], HCL, HFK, HLKp,
                          G[G_DSLIP:G_DSLIP + 2])
+        else:
+            for a in range(2):
+                for k in range(24):
+                    G[G_DSLIP + a, k] = 0.0
         lt, Dlt, stick = _friction(slip, lamp, t1, t2, lam, par, G)
         if active:
             F = _add_friction_force(F, G, wgt, lt, Dlt, t1, t2)
