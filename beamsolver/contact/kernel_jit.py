@@ -339,9 +339,13 @@ N_SIDE = 22
 # 6-vector slots of a side's ``v`` (N_VEC, 6)
 (V_WR, V_Y, V_XY, V_DB, V_B, V_ZS, V_ZH, V_AHDB, V_DA) = range(9)
 N_VEC = 9
-# the gradients ``(k, 24)`` of one point: rows of one array ``G`` (N_G, 24); a quantity's rows start at its
-# offset.  One array and constant rows let the compiler see which accesses overlap (none), so the loops
-# over the 24 columns vectorise without runtime alias checks.
+# the gradients ``(k, 24)`` of one point: rows of one flat array ``G`` (N_G * W,), row ``r``, column ``k`` at
+# ``G[r * W + k]``; a quantity's rows start at its row offset ``G_*``.  One array and constant offsets let the
+# compiler see that the accesses of a loop do not overlap, so the loops over the columns vectorise
+# without runtime overlap checks (it refuses more than 8 of them per loop, and any in loops of fewer than
+# 16 iterations).  Loops over rows go inside the loop over the columns (unrolled there, a tuple's index
+# is a constant; a variable index is a branch that stops the vectorisation).
+W = 24
 _SIZES = dict(VC=6, VF=6, DH1=6, DH2=6, DWC=6, DWF=6, DN=3, DT1=3, DT2=3, DF=3, DMF=3, DSLIP=2, DLP=2, DPREV=2,
               DTR=2, DXI1=1, DXI2=1, DDIST=1, DLAM=1, DPT=1)
 _OFFSETS = dict(zip(_SIZES, np.cumsum([0] + list(_SIZES.values()))[:-1].tolist()))
@@ -476,15 +480,15 @@ def _project_from(kind, sec1, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iter
 @jit_inline
 def _rot_col(R, G, r0, k):
     """``R @ G[r0:r0+3, k]``, ``R`` a 3x3 tuple."""
-    return (R[0][0] * G[r0, k] + R[0][1] * G[r0 + 1, k] + R[0][2] * G[r0 + 2, k],
-            R[1][0] * G[r0, k] + R[1][1] * G[r0 + 1, k] + R[1][2] * G[r0 + 2, k],
-            R[2][0] * G[r0, k] + R[2][1] * G[r0 + 1, k] + R[2][2] * G[r0 + 2, k])
+    return (R[0][0] * G[r0 * W + k] + R[0][1] * G[(r0 + 1) * W + k] + R[0][2] * G[(r0 + 2) * W + k],
+            R[1][0] * G[r0 * W + k] + R[1][1] * G[(r0 + 1) * W + k] + R[1][2] * G[(r0 + 2) * W + k],
+            R[2][0] * G[r0 * W + k] + R[2][1] * G[(r0 + 1) * W + k] + R[2][2] * G[(r0 + 2) * W + k])
 
 
 @jit_inline
-def _col_dot(a, M, r0, k):
-    """``a . M[r0:r0+3, k]``."""
-    return a[0] * M[r0, k] + a[1] * M[r0 + 1, k] + a[2] * M[r0 + 2, k]
+def _col_dot(a, G, r0, k):
+    """``a . G[r0:r0+3, k]`` (rows of ``G``)."""
+    return a[0] * G[r0 * W + k] + a[1] * G[(r0 + 1) * W + k] + a[2] * G[(r0 + 2) * W + k]
 
 
 @jit
@@ -513,13 +517,13 @@ def _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, G):
         # g2 = d . x2' (orthogonal / point), at fixed xi
         g2 = dot(x2p, rel) + _col_dot(c2, G, G_VF + 3, k) + _col_dot(dF, G, G_DH2, k)
         if kind == LINE:
-            g = dot(e1, rel) - dC[2] * G[G_VC + 4, k] + dC[1] * G[G_VC + 5, k]
-            G[G_DXI1, k], G[G_DXI2, k] = 0.0, -g / jl
+            g = dot(e1, rel) - dC[2] * G[(G_VC + 4) * W + k] + dC[1] * G[(G_VC + 5) * W + k]
+            G[G_DXI1 * W + k], G[G_DXI2 * W + k] = 0.0, -g / jl
         elif kind == ORTHOGONAL:
-            G[G_DXI1, k], G[G_DXI2, k] = 0.0, -g2 / jo
+            G[G_DXI1 * W + k], G[G_DXI2 * W + k] = 0.0, -g2 / jo
         else:
             g1 = dot(x1p, rel) + _col_dot(c1, G, G_VC + 3, k) + _col_dot(dC, G, G_DH1, k)
-            G[G_DXI1, k], G[G_DXI2, k] = -(a22 * g1 - a12 * g2) / det, -(-a21 * g1 + a11 * g2) / det
+            G[G_DXI1 * W + k], G[G_DXI2 * W + k] = -(a22 * g1 - a12 * g2) / det, -(-a21 * g1 + a11 * g2) / det
 
 
 # ---------------------------------------------------------------- one side of a pair: element, section, Jacobians
@@ -569,15 +573,15 @@ def _variations(S, c0, G, DH, V, tmp):
     (``c0`` 0 or 12).  The other side's columns of ``DH`` are zero from ``_scratch`` on (never written)."""
     for i in range(6):
         for k in range(12 - c0, 24 - c0):
-            G[V + i, k] = 0.0
+            G[(V + i) * W + k] = 0.0
     _mm_ut(S[S_TI], S[S_AH], tmp)
     Ti, JA, JB = S[S_TI], S[S_JA], S[S_JB]
     for i in range(6):
         for j in range(6):
-            G[DH + i, c0 + j] = -tmp[i, j]
-            G[DH + i, c0 + 6 + j] = Ti[i, j]
-            G[V + i, c0 + j] = JA[i, j]
-            G[V + i, c0 + 6 + j] = JB[i, j]
+            G[(DH + i) * W + c0 + j] = -tmp[i, j]
+            G[(DH + i) * W + c0 + 6 + j] = Ti[i, j]
+            G[(V + i) * W + c0 + j] = JA[i, j]
+            G[(V + i) * W + c0 + 6 + j] = JB[i, j]
 
 
 # ---------------------------------------------------------------- 3-vectors with gradients (3, 24)
@@ -595,19 +599,19 @@ def _axes(RC, xC, RF, xF, G):
     t1 = scale(1.0 / lt, t1r)
     t2 = cross(n, t1)
     for k in range(24):
-        dF = mv(RF, (G[G_VF, k], G[G_VF + 1, k], G[G_VF + 2, k]))
-        dC = mv(RC, (G[G_VC, k], G[G_VC + 1, k], G[G_VC + 2, k]))
+        dF = mv(RF, (G[G_VF * W + k], G[(G_VF + 1) * W + k], G[(G_VF + 2) * W + k]))
+        dC = mv(RC, (G[G_VC * W + k], G[(G_VC + 1) * W + k], G[(G_VC + 2) * W + k]))
         dd = add(dF, scale(-1.0, dC))
         nd = dot(n, dd)
         dn = scale(1.0 / dist, add(dd, scale(-nd, n)))
-        de1 = add(scale(G[G_VC + 5, k], e2), scale(-G[G_VC + 4, k], e3))
+        de1 = add(scale(G[(G_VC + 5) * W + k], e2), scale(-G[(G_VC + 4) * W + k], e3))
         dc = dot(n, de1) + dot(e1, dn)
         dt1r = add(add(de1, scale(-dc, n)), scale(-c, dn))
         dt1 = scale(1.0 / lt, add(dt1r, scale(-dot(t1, dt1r), t1)))
         dt2 = add(cross(n, dt1), scale(-1.0, cross(t1, dn)))
         for i in range(3):
-            G[G_DN + i, k], G[G_DT1 + i, k], G[G_DT2 + i, k] = dn[i], dt1[i], dt2[i]
-        G[G_DDIST, k] = nd
+            G[(G_DN + i) * W + k], G[(G_DT1 + i) * W + k], G[(G_DT2 + i) * W + k] = dn[i], dt1[i], dt2[i]
+        G[G_DDIST * W + k] = nd
     return n, t1, t2, dist
 
 
@@ -693,40 +697,43 @@ def _friction(slip, lamp, t1, t2, lam, par, G):
     Reads the rows ``G_DSLIP``, ``G_DT1``, ``G_DT2``, ``G_DLAM`` of ``G``; writes ``G_DLP``, ``G_DPREV``,
     ``G_DPT``, ``G_DTR``."""
     lp = (dot(lamp, t1), dot(lamp, t2))
+    dt1, dt2, dlp = G_DT1 * W, G_DT2 * W, G_DLP * W          # first entries of the rows
     for k in range(24):
-        G[G_DLP, k] = lamp[0] * G[G_DT1, k] + lamp[1] * G[G_DT1 + 1, k] + lamp[2] * G[G_DT1 + 2, k]
-        G[G_DLP + 1, k] = lamp[0] * G[G_DT2, k] + lamp[1] * G[G_DT2 + 1, k] + lamp[2] * G[G_DT2 + 2, k]
+        G[dlp + k] = lamp[0] * G[dt1 + k] + lamp[1] * G[dt1 + W + k] + lamp[2] * G[dt1 + 2 * W + k]
+        G[dlp + W + k] = lamp[0] * G[dt2 + k] + lamp[1] * G[dt2 + W + k] + lamp[2] * G[dt2 + 2 * W + k]
     npv = np.sqrt(dot(lamp, lamp))
     nl = np.sqrt(lp[0] * lp[0] + lp[1] * lp[1])
     if nl > 1e-300 * (1.0 + npv):
         s = npv / nl
         l0, l1 = lp[0] / nl, lp[1] / nl
         for k in range(24):
-            proj = l0 * G[G_DLP, k] + l1 * G[G_DLP + 1, k]
-            G[G_DPREV, k] = s * (G[G_DLP, k] - l0 * proj)
-            G[G_DPREV + 1, k] = s * (G[G_DLP + 1, k] - l1 * proj)
+            proj = l0 * G[G_DLP * W + k] + l1 * G[(G_DLP + 1) * W + k]
+            G[G_DPREV * W + k] = s * (G[G_DLP * W + k] - l0 * proj)
+            G[(G_DPREV + 1) * W + k] = s * (G[(G_DLP + 1) * W + k] - l1 * proj)
         lam_prev = (lp[0] * s, lp[1] * s)
     else:
         for k in range(24):
-            G[G_DPREV, k] = 0.0
-            G[G_DPREV + 1, k] = 0.0
+            G[G_DPREV * W + k] = 0.0
+            G[(G_DPREV + 1) * W + k] = 0.0
         lam_prev = (0.0, 0.0)
     pen_t, mu = par[PEN_T], par[MU]
     for k in range(24):
-        G[G_DPT, k] = 0.0
+        G[G_DPT * W + k] = 0.0
     if np.isnan(pen_t) and not np.isnan(par[ESLIP]):
         lam_min = PENALTY_T_MIN * par[PENALTY] * par[ESLIP]      # pairs.stick_penalty
         if lam >= lam_min:
             pen_t = mu * lam / par[ESLIP]
             for k in range(24):
-                G[G_DPT, k] = (mu / par[ESLIP]) * G[G_DLAM, k]
+                G[G_DPT * W + k] = (mu / par[ESLIP]) * G[G_DLAM * W + k]
         else:
             pen_t = mu * lam_min / par[ESLIP]
     tr0, tr1 = lam_prev[0] + pen_t * slip[0], lam_prev[1] + pen_t * slip[1]
-    for a in range(2):
-        for k in range(24):
-            G[G_DTR + a, k] = G[G_DPREV + a, k] + slip[a] * G[G_DPT, k] + pen_t * G[G_DSLIP + a, k]
-    lt0, lt1, D, stick = _tangential_law(tr0, tr1, G[G_DTR:G_DTR + 2], mu, lam, G[G_DLAM])
+    for k in range(24):
+        for a in range(2):
+            G[(G_DTR + a) * W + k] = (G[(G_DPREV + a) * W + k] + slip[a] * G[G_DPT * W + k]
+                                      + pen_t * G[(G_DSLIP + a) * W + k])
+    Dtr, Dlam = G[G_DTR * W:(G_DTR + 2) * W].reshape((2, W)), G[G_DLAM * W:(G_DLAM + 1) * W]
+    lt0, lt1, D, stick = _tangential_law(tr0, tr1, Dtr, mu, lam, Dlam)
     return (lt0, lt1), D, stick
 
 
@@ -740,13 +747,14 @@ def _wrench(R, F, neg, m, sm, G, V, DW, w):
     bF, bm = mv(Rt, F), mv(Rt, m)
     for i in range(3):
         w[i], w[3 + i] = bF[i], bm[i]
+    df, dm, dv = G_DF * W, G_DMF * W, (V + 3) * W        # first entries of the rows
     for k in range(24):
-        th = (G[V + 3, k], G[V + 4, k], G[V + 5, k])
-        dF = (-G[G_DF, k], -G[G_DF + 1, k], -G[G_DF + 2, k]) if neg else (G[G_DF, k], G[G_DF + 1, k], G[G_DF + 2, k])
+        th = (G[dv + k], G[dv + W + k], G[dv + 2 * W + k])
+        dF = (-G[df + k], -G[df + W + k], -G[df + 2 * W + k]) if neg else (G[df + k], G[df + W + k], G[df + 2 * W + k])
         a = add(mv(Rt, dF), cross(bF, th))
-        b = add(mv(Rt, (sm * G[G_DMF, k], sm * G[G_DMF + 1, k], sm * G[G_DMF + 2, k])), cross(bm, th))
+        b = add(mv(Rt, (sm * G[dm + k], sm * G[dm + W + k], sm * G[dm + 2 * W + k])), cross(bm, th))
         for i in range(3):
-            G[DW + i, k], G[DW + 3 + i, k] = a[i], b[i]
+            G[(DW + i) * W + k], G[(DW + 3 + i) * W + k] = a[i], b[i]
 
 
 @jit
@@ -775,28 +783,30 @@ def _nodal(u, w, xi, t2, co, S, v, c, G, DW, DH, DXI, f, K, j0):
 @jit_inline
 def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, G, DXI, DW, DH, force, out):
     """One row of the tangent: ``out[c] = di dxi[c] + sum_l (j_l Dw[l, c] + d_l Dh[l, c])``, summed in this
-    order (``dxi``, ``Dw``, ``Dh``: the rows ``DXI``, ``DW``, ``DH`` of ``G``).  ``force`` (a constant at each call): a force row, whose ``j3, j4, j5`` are structural zeros
-    (``J[3:, :3] == 0``): their terms, exact zeros, are skipped.  ``Dh`` is zero outside the side's columns:
-    its terms there, exact zeros, change a sum only in the sign of a zero result (``_mm_ut``), and keep
-    the loop branch-free over all 24 columns, which the compiler vectorises (a loop of fewer than 16
-    iterations is not: its arrays' runtime alias checks are refused as too costly)."""
+    order (``dxi``, ``Dw``, ``Dh``: the rows ``DXI``, ``DW``, ``DH`` of ``G``).  ``force`` (a constant at each
+    call): a force row, whose ``j3, j4, j5`` are structural zeros (``J[3:, :3] == 0``): their terms, exact
+    zeros, are skipped.  ``Dh`` is zero outside the side's columns: its terms there, exact zeros, change a
+    sum only in the sign of a zero result (``_mm_ut``), and keep the loop branch-free over all 24 columns,
+    which the compiler vectorises (with a runtime check that ``out`` and ``G`` do not overlap, refused in
+    loops of fewer than 16 iterations)."""
+    x, w, h = DXI * W, DW * W, DH * W           # first entries of the rows
     for c in range(24):
-        acc = di * G[DXI, c]
-        acc += j0 * G[DW + 0, c]
-        acc += d0 * G[DH + 0, c]
-        acc += j1 * G[DW + 1, c]
-        acc += d1 * G[DH + 1, c]
-        acc += j2 * G[DW + 2, c]
-        acc += d2 * G[DH + 2, c]
+        acc = di * G[x + c]
+        acc += j0 * G[w + c]
+        acc += d0 * G[h + c]
+        acc += j1 * G[w + W + c]
+        acc += d1 * G[h + W + c]
+        acc += j2 * G[w + 2 * W + c]
+        acc += d2 * G[h + 2 * W + c]
         if not force:
-            acc += j3 * G[DW + 3, c]
-        acc += d3 * G[DH + 3, c]
+            acc += j3 * G[w + 3 * W + c]
+        acc += d3 * G[h + 3 * W + c]
         if not force:
-            acc += j4 * G[DW + 4, c]
-        acc += d4 * G[DH + 4, c]
+            acc += j4 * G[w + 4 * W + c]
+        acc += d4 * G[h + 4 * W + c]
         if not force:
-            acc += j5 * G[DW + 5, c]
-        acc += d5 * G[DH + 5, c]
+            acc += j5 * G[w + 5 * W + c]
+        acc += d5 * G[h + 5 * W + c]
         out[c] = acc
 
 
@@ -829,29 +839,31 @@ def _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, d, S1, S
     _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, G)
     h1 = (u1[0], u1[1], u1[2], w1[0], w1[1], w1[2])
     h2 = (u2[0], u2[1], u2[2], w2[0], w2[1], w2[2])
-    for i in range(6):
-        for k in range(24):
-            G[G_VC + i, k] += h1[i] * G[G_DXI1, k]
-            G[G_VF + i, k] += h2[i] * G[G_DXI2, k]
+    for k in range(24):
+        for i in range(6):
+            G[(G_VC + i) * W + k] += h1[i] * G[G_DXI1 * W + k]
+            G[(G_VF + i) * W + k] += h2[i] * G[G_DXI2 * W + k]
 
 
 @jit
 def _add_friction_force(F, G, wgt, lt, Dlt, t1, t2):
     """``F + wgt (lt0 t1 + lt1 t2)`` and its gradient added to the rows ``G_DF`` of ``G`` (``Dlt`` ``(2, 24)``)."""
-    for i in range(3):
-        for k in range(24):
-            G[G_DF + i, k] += wgt * (t1[i] * Dlt[0, k] + lt[0] * G[G_DT1 + i, k] + t2[i] * Dlt[1, k]
-                                     + lt[1] * G[G_DT2 + i, k])
+    for k in range(24):
+        for i in range(3):
+            G[(G_DF + i) * W + k] += wgt * (t1[i] * Dlt[0, k] + lt[0] * G[(G_DT1 + i) * W + k] + t2[i] * Dlt[1, k]
+                                     + lt[1] * G[(G_DT2 + i) * W + k])
     return add(F, add(scale(wgt * lt[0], t1), scale(wgt * lt[1], t2)))
 
 
 @jit
 def _moment_gradient(n, F, G):
     """``d(n x F)`` into the rows ``G_DMF`` of ``G`` from ``dF`` (``G_DF``) and ``dn`` (``G_DN``)."""
+    f0, f1, f2, n0, n1, n2 = G_DF * W, (G_DF + 1) * W, (G_DF + 2) * W, G_DN * W, (G_DN + 1) * W, (G_DN + 2) * W
+    m0, m1, m2 = G_DMF * W, (G_DMF + 1) * W, (G_DMF + 2) * W
     for k in range(24):
-        G[G_DMF, k] = (n[1] * G[G_DF + 2, k] - n[2] * G[G_DF + 1, k]) - (F[1] * G[G_DN + 2, k] - F[2] * G[G_DN + 1, k])
-        G[G_DMF + 1, k] = (n[2] * G[G_DF, k] - n[0] * G[G_DF + 2, k]) - (F[2] * G[G_DN, k] - F[0] * G[G_DN + 2, k])
-        G[G_DMF + 2, k] = (n[0] * G[G_DF + 1, k] - n[1] * G[G_DF, k]) - (F[0] * G[G_DN + 1, k] - F[1] * G[G_DN, k])
+        G[m0 + k] = (n[1] * G[f2 + k] - n[2] * G[f1 + k]) - (F[1] * G[n2 + k] - F[2] * G[n1 + k])
+        G[m1 + k] = (n[2] * G[f0 + k] - n[0] * G[f2 + k]) - (F[2] * G[n0 + k] - F[0] * G[n2 + k])
+        G[m2 + k] = (n[0] * G[f1 + k] - n[1] * G[f0 + k]) - (F[0] * G[n1 + k] - F[1] * G[n0 + k])
 
 
 def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames, ws):
@@ -872,20 +884,20 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
     gap = dist - R1 - R2
     lam, dlam, active = _normal_law(gap, par[PENALTY], par[MULT], par[SMOOTH])      # bound by make_kernel
     for k in range(24):
-        G[G_DLAM, k] = dlam * G[G_DDIST, k]
+        G[G_DLAM * W + k] = dlam * G[G_DDIST * W + k]
     F = scale(-wgt * lam, n)
-    for i in range(3):
-        for k in range(24):
-            G[G_DF + i, k] = -wgt * (n[i] * G[G_DLAM, k] + lam * G[G_DN + i, k])
+    for k in range(24):
+        for i in range(3):
+            G[(G_DF + i) * W + k] = -wgt * (n[i] * G[G_DLAM * W + k] + lam * G[(G_DN + i) * W + k])
     lt, stick, slip = (0.0, 0.0), True, (0.0, 0.0)
     if friction:
         if has:         # writes all 24 columns of the slip gradient
             slip = _slip(side1, side2, S1, S2, (xi1, RC, xC), (xi2, RF, xF), par[XI1P], par[XI2P], HCL, HFK, HLKp,
-                         G[G_DSLIP:G_DSLIP + 2])
+                         G[G_DSLIP * W:(G_DSLIP + 2) * W].reshape((2, W)))
         else:
             for a in range(2):
                 for k in range(24):
-                    G[G_DSLIP + a, k] = 0.0
+                    G[(G_DSLIP + a) * W + k] = 0.0
         lt, Dlt, stick = _friction(slip, lamp, t1, t2, lam, par, G)
         if active:
             F = _add_friction_force(F, G, wgt, lt, Dlt, t1, t2)
@@ -909,7 +921,7 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
 def _scratch():
     """Scratch arrays of one evaluation, reused by every point (the kernel allocates nothing per point); the
     gradients ``G`` start at zero (``_variations`` relies on it)."""
-    return np.empty((2, N_SIDE, 6, 6)), np.empty((2, N_VEC, 6)), np.zeros((N_G, 24)), np.full((2, N_CACHE), np.nan)
+    return np.empty((2, N_SIDE, 6, 6)), np.empty((2, N_VEC, 6)), np.zeros(N_G * W), np.full((2, N_CACHE), np.nan)
 
 
 def _evaluate(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames):
