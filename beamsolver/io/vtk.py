@@ -1,4 +1,4 @@
-"""ParaView output through meshio: one ``.vtu`` per converged step and ``.pvd`` collections.
+"""ParaView output: one ``.vtu`` per converged step and ``.pvd`` collections.
 
 Files in the output folder (``solve(model, output=folder)``, or
 ``write_vtk(solution, folder)`` for a saved solution):
@@ -32,9 +32,10 @@ complete files, and ``.pvd`` files that list exactly the steps written.
 A writer first removes the numbered files its folder's ``beams.pvd`` and
 ``contact.pvd`` list (the previous run's series; nothing else), so ParaView
 never groups two runs.
-meshio can neither write nor read VTK poly-lines (type 4), hence two-point
-``line`` cells; for smooth tubes ParaView joins them into poly-lines with
-*Triangle Strips* before the Tube filter (README, "ParaView").
+The VTU files are written by ``io.vtu`` (numpy and zlib; meshio's binary layout, read
+by meshio, pyvista and ParaView) with two-point ``line`` cells, which meshio reads (it
+cannot read VTK poly-lines, type 4); for smooth tubes ParaView joins them into
+poly-lines with *Triangle Strips* before the Tube filter (README, "ParaView").
 """
 import os
 import tempfile
@@ -47,6 +48,7 @@ import numpy as np
 from ..errors import InputError
 from ..files import follow_umask, previous_series
 from .lines import LineLayout
+from .vtu import write_vtu
 
 __all__ = ["StepWriter", "write_vtk", "write_pvd"]
 
@@ -125,8 +127,6 @@ class StepWriter:
     """
 
     def __init__(self, folder, system=None, refine=8, compression="zlib", contact=None, checkpoint=60.0):
-        import meshio   # imported here: scenes without output never pay for it
-        self._meshio = meshio
         self.folder = _output_folder(folder)
         for old in previous_series(self.folder, (f"{BEAMS}.pvd", f"{CONTACT}.pvd"), SERIES):
             old.unlink()
@@ -149,7 +149,6 @@ class StepWriter:
 
     def write(self, solution, step):
         """Write step ``step`` of ``solution`` and rewrite the collections."""
-        meshio = self._meshio
         if self.layout is None:
             self.layout = LineLayout(solution.description, self.refine)
             if self.contact is None:
@@ -160,14 +159,13 @@ class StepWriter:
         pdata, points = lay.point_data(rec.poses)
         pdata.update(mode_fields(lay, rec.stats))
         cdata = lay.cell_data(rec.section_forces, rec.strains)
-        mesh = meshio.Mesh(points, [("line", lay.segments)], point_data=pdata,
-                           cell_data={k: [v] for k, v in cdata.items()})
-        self._write_mesh(self.folder / self._name(BEAMS, step), mesh)
+        self._write_vtu(self.folder / self._name(BEAMS, step), points, "line", lay.segments, pdata, cdata)
         if self.contact:
             path = self.folder / self._name(CONTACT, step)
             table = rec.contact
             if len(active_points(table)):
-                self._write_mesh(path, contact_mesh(table))
+                pos, pdata = contact_points(table)
+                self._write_vtu(path, pos, "vertex", np.arange(len(pos)).reshape(-1, 1), pdata)
             else:
                 _atomic(path, _write_empty_points)
         # the archive first, then the collections: a run killed in between never has a .pvd that
@@ -184,9 +182,8 @@ class StepWriter:
             self._solution.save(self.folder / ARCHIVE)
             self._saved_at = time.perf_counter()
 
-    def _write_mesh(self, path, mesh):
-        meshio = self._meshio
-        _atomic(path, lambda tmp: meshio.vtu.write(tmp, mesh, binary=True, compression=self.compression))
+    def _write_vtu(self, path, points, cell_type, cells, point_data, cell_data=None):
+        _atomic(path, lambda tmp: write_vtu(tmp, points, cell_type, cells, point_data, cell_data, self.compression))
 
     def _write_collections(self):
         steps = sorted(self.entries)
@@ -218,9 +215,9 @@ def active_points(table):
     return np.flatnonzero(np.asarray(table.get("normal_force", np.zeros(0)), dtype=float) > 0)
 
 
-def contact_mesh(table):
-    """The active contact points of one step (``active_points``) as a meshio vertex mesh."""
-    import meshio
+def contact_points(table):
+    """The active contact points of one step (``active_points``): positions ``(k, 3)`` and point
+    data (``CONTACT_FIELDS``), for a VTU of vertex cells."""
     pos = np.asarray(table.get("position", np.zeros((0, 3))), dtype=float).reshape(-1, 3)
     n = len(pos)
     on = active_points(table) if "normal_force" in table else np.arange(n)
@@ -234,8 +231,7 @@ def contact_mesh(table):
         else:
             v = v.astype(float)
         pdata[name] = v.reshape((k,) + shape)
-    cells = [("vertex", np.arange(k, dtype=np.int64).reshape(-1, 1))]
-    return meshio.Mesh(pos, cells, point_data=pdata)
+    return pos, pdata
 
 
 def _write_empty_points(path):
