@@ -635,11 +635,11 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
         run = Run(*args) if arc is None else ArcLengthRun(*args, arc)
         run.start(sol, initial_poses)
         run.loop()
+        return run.finish()         # inside: a failure of the output's last files carries .solution too
     except BaseException as e:
         if run is not None:
             run.abort(e)
         raise
-    return run.finish()
 
 
 def _run_options(problem, t_start, t_end, allow_unmet_tolerance, check_stability, modes, branch_switching,

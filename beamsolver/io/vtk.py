@@ -124,6 +124,13 @@ class StepWriter:
     element; ``compression``: ``"zlib"``, ``"lzma"`` or ``None``;
     ``checkpoint``: seconds between saves of ``solution.npz`` (``None``: never
     save it, as for exporting a loaded solution).
+
+    ``write`` takes what it needs from the solution at once and leaves the files (encoding,
+    compression, file system) to one background thread, which writes the steps in order, each
+    step's VTU files before the collections that list it, so the solver goes on meanwhile (the
+    metadata operations of a busy disk cost milliseconds a file).  ``close`` waits for them.  A
+    failure there (``InputError``: full disk, permissions) stops the writing of later steps and
+    is raised by the next ``write`` or by ``close``.
     """
 
     def __init__(self, folder, system=None, refine=8, compression="zlib", contact=None, checkpoint=60.0):
@@ -143,12 +150,17 @@ class StepWriter:
         self.checkpoint = checkpoint
         self._solution = None
         self._saved_at = time.perf_counter()
+        self._pool = None          # the writing thread (started by the first write)
+        self._jobs = []            # futures of the steps not yet known to be written
+        self._failure = None       # the first error of the writing thread: nothing is written after it
+        self._reported = False     # whether ``write`` or ``close`` raised it
 
     def _name(self, kind, step):
         return f"{kind}_{step:0{self.width}d}.vtu"
 
     def write(self, solution, step):
-        """Write step ``step`` of ``solution`` and rewrite the collections."""
+        """Write step ``step`` of ``solution`` and rewrite the collections (in the background)."""
+        self._raise_failure()
         if self.layout is None:
             self.layout = LineLayout(solution.description, self.refine)
             if self.contact is None:
@@ -159,22 +171,47 @@ class StepWriter:
         pdata, points = lay.point_data(rec.poses)
         pdata.update(mode_fields(lay, rec.stats))
         cdata = lay.cell_data(rec.section_forces, rec.strains)
-        self._write_vtu(self.folder / self._name(BEAMS, step), points, "line", lay.segments, pdata, cdata)
+        files = [(self.folder / self._name(BEAMS, step), (points, "line", lay.segments, pdata, cdata))]
         if self.contact:
-            path = self.folder / self._name(CONTACT, step)
             table = rec.contact
-            if len(active_points(table)):
-                pos, pdata = contact_points(table)
-                self._write_vtu(path, pos, "vertex", np.arange(len(pos)).reshape(-1, 1), pdata)
-            else:
-                _atomic(path, _write_empty_points)
+            pos, cpdata = contact_points(table) if len(active_points(table)) else (None, None)
+            files.append((self.folder / self._name(CONTACT, step),
+                          None if pos is None else (pos, "vertex", np.arange(len(pos)).reshape(-1, 1), cpdata, None)))
         # the archive first, then the collections: a run killed in between never has a .pvd that
         # lists a step its solution.npz lacks (with checkpoint=0 both list the same steps)
         self._solution = solution
         if self.checkpoint is not None and time.perf_counter() - self._saved_at >= self.checkpoint:
             self.save()
         self.entries[step] = t
-        self._write_collections()
+        self._submit(files, self._collections())
+
+    def _submit(self, files, collections):
+        if self._pool is None:
+            from concurrent.futures import ThreadPoolExecutor
+            self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="beamsolver-output")
+        self._jobs = [j for j in self._jobs if not j.done()]
+        self._jobs.append(self._pool.submit(self._write_step, files, collections))
+
+    def _write_step(self, files, collections):
+        """The files of one step, then its collections (in the writing thread; after a failure, nothing)."""
+        if self._failure is not None:
+            return
+        try:
+            for path, mesh in files:
+                if mesh is None:
+                    _atomic(path, _write_empty_points)
+                else:
+                    _atomic(path, lambda tmp, m=mesh: write_vtu(tmp, *m, self.compression))
+            for path, entries in collections:
+                write_pvd(path, entries)
+        except BaseException as e:
+            self._failure = e
+
+    def _raise_failure(self):
+        """Raise the writing thread's failure, if any (every call: nothing more is written)."""
+        if self._failure is not None:
+            self._reported = True
+            raise self._failure
 
     def save(self):
         """Save the solution written so far to ``solution.npz`` (atomically)."""
@@ -182,21 +219,30 @@ class StepWriter:
             self._solution.save(self.folder / ARCHIVE)
             self._saved_at = time.perf_counter()
 
-    def _write_vtu(self, path, points, cell_type, cells, point_data, cell_data=None):
-        _atomic(path, lambda tmp: write_vtu(tmp, points, cell_type, cells, point_data, cell_data, self.compression))
-
-    def _write_collections(self):
+    def _collections(self):
+        """``[(path, entries)]`` of the ``.pvd`` files listing the steps written so far."""
         steps = sorted(self.entries)
         times = [self.entries[k] for k in steps]
         if np.any(np.diff(times) <= 0.0):       # not increasing: ParaView would reorder; step numbers
             times = [float(k) for k in steps]
-        write_pvd(self.folder / f"{BEAMS}.pvd", [(t, self._name(BEAMS, k)) for t, k in zip(times, steps)])
-        if self.contact:
-            write_pvd(self.folder / f"{CONTACT}.pvd", [(t, self._name(CONTACT, k)) for t, k in zip(times, steps)])
+        kinds = (BEAMS, CONTACT) if self.contact else (BEAMS,)
+        return [(self.folder / f"{kind}.pvd", [(t, self._name(kind, k)) for t, k in zip(times, steps)])
+                for kind in kinds]
 
     def close(self):
-        """Save ``solution.npz`` (every VTU/PVD file is already complete when ``write`` returns)."""
-        self.save()
+        """Wait for the files of every step, save ``solution.npz``, then raise the writing thread's
+        failure if no ``write`` has raised it yet."""
+        for j in self._jobs:
+            j.result()
+        self._jobs = []
+        if self._pool is not None:
+            self._pool.shutdown(wait=True)
+            self._pool = None
+        try:
+            self.save()
+        finally:
+            if self._failure is not None and not self._reported:
+                self._raise_failure()
 
 
 def mode_fields(layout, stats):
