@@ -30,7 +30,8 @@ mode ``open()`` would give it (``0666 & ~umask``), and then renamed
 rewritten after every step: a run that stops at any moment leaves only
 complete files, and ``.pvd`` files that list exactly the steps written.
 A writer first removes the numbered files its folder's ``beams.pvd`` and
-``contact.pvd`` list (the previous run's series; nothing else), so ParaView
+``contact.pvd`` list (the previous run's series; nothing else; the collections at
+once, the files they listed in the writing thread before any new file), so ParaView
 never groups two runs.
 The VTU files are written by ``io.vtu`` (numpy and zlib; meshio's binary layout, read
 by meshio, pyvista and ParaView) with two-point ``line`` cells, which meshio reads (it
@@ -135,8 +136,7 @@ class StepWriter:
 
     def __init__(self, folder, system=None, refine=8, compression="zlib", contact=None, checkpoint=60.0):
         self.folder = _output_folder(folder)
-        for old in previous_series(self.folder, (f"{BEAMS}.pvd", f"{CONTACT}.pvd"), SERIES):
-            old.unlink()
+        stale = previous_series(self.folder, (f"{BEAMS}.pvd", f"{CONTACT}.pvd"), SERIES)
         for name in (f"{BEAMS}.pvd", f"{CONTACT}.pvd"):
             (self.folder / name).unlink(missing_ok=True)
         self.refine = refine
@@ -154,6 +154,8 @@ class StepWriter:
         self._jobs = []            # futures of the steps not yet known to be written
         self._failure = None       # the first error of the writing thread: nothing is written after it
         self._reported = False     # whether ``write`` or ``close`` raised it
+        if stale:                  # the previous run's files, unlisted now: removed before any new one is written
+            self._enqueue(_remove, stale)
 
     def _name(self, kind, step):
         return f"{kind}_{step:0{self.width}d}.vtu"
@@ -186,26 +188,33 @@ class StepWriter:
         self._submit(files, self._collections())
 
     def _submit(self, files, collections):
+        self._enqueue(self._write_step, files, collections)
+
+    def _enqueue(self, job, *args):
+        """Run ``job(*args)`` in the writing thread after the jobs before it (none after a failure)."""
         if self._pool is None:
             from concurrent.futures import ThreadPoolExecutor
             self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="beamsolver-output")
         self._jobs = [j for j in self._jobs if not j.done()]
-        self._jobs.append(self._pool.submit(self._write_step, files, collections))
+        self._jobs.append(self._pool.submit(self._guarded, job, *args))
 
-    def _write_step(self, files, collections):
-        """The files of one step, then its collections (in the writing thread; after a failure, nothing)."""
+    def _guarded(self, job, *args):
         if self._failure is not None:
             return
         try:
-            for path, mesh in files:
-                if mesh is None:
-                    _atomic(path, _write_empty_points)
-                else:
-                    _atomic(path, lambda tmp, m=mesh: write_vtu(tmp, *m, self.compression))
-            for path, entries in collections:
-                write_pvd(path, entries)
+            job(*args)
         except BaseException as e:
             self._failure = e
+
+    def _write_step(self, files, collections):
+        """The files of one step, then its collections (in the writing thread)."""
+        for path, mesh in files:
+            if mesh is None:
+                _atomic(path, _write_empty_points)
+            else:
+                _atomic(path, lambda tmp, m=mesh: write_vtu(tmp, *m, self.compression))
+        for path, entries in collections:
+            write_pvd(path, entries)
 
     def _raise_failure(self):
         """Raise the writing thread's failure, if any (every call: nothing more is written)."""
@@ -243,6 +252,11 @@ class StepWriter:
         finally:
             if self._failure is not None and not self._reported:
                 self._raise_failure()
+
+
+def _remove(paths):
+    for p in paths:
+        p.unlink(missing_ok=True)
 
 
 def mode_fields(layout, stats):
