@@ -53,7 +53,7 @@ from .kernel_jit import contact_kernel, kernel_and_tangent      # compiled; pair
 from .options import SMOOTHING, ContactOptions
 from .pairs import LINE, NORMAL_TOL, POINT, material_frames, no_normal
 from .record import Candidates, PairSet
-from .projection import closest_points, element_twists, project_points, section_points
+from .projection import closest_points, element_twists, gauss_projections, section_points
 from .search import broad_phase, element_spheres
 from . import rules
 
@@ -340,20 +340,17 @@ class ContactSystem(Contribution):
         en = self.sys.enodes
         gp = np.flatnonzero(c.kind != POINT)
         xg, wg = d.gauss
-        rep = np.repeat(gp, d.n_gp)
-        g = np.tile(np.arange(d.n_gp), len(gp))
-        e, m, h1, h2 = c.e[rep], c.m[rep], c.h1[rep], c.h2[rep]
-        xi1 = xg[g]
+        e, m = c.e[gp], c.m[gp]
         H, _ = self._twists(H)
-        xc, _ = section_points(H, en[e, 0], h1, xi1)
-        # a slave Gauss point outside the master element's sphere (grown by R1) cannot
-        # touch that element: no projection for it
-        near = np.sum((xc - c.c2[rep]) ** 2, axis=1) <= (c.r2[rep] + self.el_radius[e]) ** 2
-        rep, g, e, m, h1, h2, xi1 = rep[near], g[near], e[near], m[near], h1[near], h2[near], xi1[near]
+        # a slave Gauss point outside the master element's sphere (grown by R1) cannot touch that
+        # element: no projection for it; the others from the projection on the master chord, 8 Newton
+        # iterations (compiled, projection.py; the kernel polishes the point with 2 more and needs it
+        # converged for an exact tangent)
+        r, g, xi2, dist = gauss_projections(H, en[e, 0], c.h1[gp], xg, c.kind[gp], en[m, 0], en[m, 1], c.h2[gp],
+                                            c.c2[gp], c.r2[gp] + self.el_radius[e], iterations=8)
+        rep, e, m = gp[r], e[r], m[r]
+        xi1 = xg[g]
         kind = c.kind[rep]
-        # from the projection on the master chord, 8 Newton iterations (compiled, projection.py; the
-        # kernel polishes the point with 2 more and needs it converged for an exact tangent)
-        xi2, dist = project_points(H, kind, en[e, 0], h1, xi1, en[m, 0], en[m, 1], h2, iterations=8)
         self._lap("projection")
         lo, hi = self._xi_range(m)
         ok = (xi2 >= lo) & (xi2 <= hi) & np.isfinite(dist)
