@@ -27,7 +27,7 @@ from ..se3_jit import _SERIES_TABLE, _SWITCH, A_, B_, C_, add, add_outer, cross,
 from .kernel_jit import _pose_of, _project, _section_inline
 from .pairs import LINE, POINT
 
-__all__ = ["element_twists", "section_points", "closest_points", "project_points", "gauss_projections"]
+__all__ = ["element_twists", "section_points", "spheres", "closest_points", "project_points", "gauss_projections"]
 
 
 def element_twists(H, enodes):
@@ -54,6 +54,20 @@ def section_points(H, A, h, xi):
     _sections(H, np.ascontiguousarray(A), np.ascontiguousarray(h, dtype=float),
               np.ascontiguousarray(np.broadcast_to(xi, (n,)), dtype=float), x, e1)
     return x, e1
+
+
+@jit
+def spheres(H, enodes, h, radii, margin, el, mid, radius, tangent):
+    """Bounding spheres of the elements ``el`` into ``mid`` ``(n, 3)``, ``radius`` ``(n,)``
+    (``|u| / 2 + r + margin``, ``|u|`` the arc length) and the mid-point tangents ``(n, 3)``."""
+    for k in range(len(el)):
+        j = el[k]
+        RA, xA = _pose_of(H, enodes[j, 0])
+        u = (h[j, 0], h[j, 1], h[j, 2])
+        R, xc, _, _ = _section_inline(RA, xA, u, (h[j, 3], h[j, 4], h[j, 5]), 0.5)
+        for i in range(3):
+            mid[k, i], tangent[k, i] = xc[i], R[i][0]
+        radius[k] = 0.5 * np.sqrt((u[0] * u[0] + u[1] * u[1]) + u[2] * u[2]) + radii[j] + margin
 
 
 @jit
