@@ -24,7 +24,7 @@ import numpy as np
 from .. import se3
 from .._jit import jit, jit_inline
 from ..se3_jit import _SERIES_TABLE, _SWITCH, A_, B_, C_, add, add_outer, cross, dot, mat, mm, mv, scale
-from .kernel_jit import _pose_of, _project, _section_inline
+from .kernel_jit import _pose_of, _project, _section, _section_inline
 from .pairs import LINE, POINT
 
 __all__ = ["element_twists", "section_points", "spheres", "closest_points", "project_points", "gauss_projections"]
@@ -170,8 +170,8 @@ def _step_series(line, x1, e1, RA, xA, u, w, xi2):
 
 @jit_inline
 def _step(line, x1, e1, RA, xA, u, w, xi2):
-    """``_update`` at the section ``kernel_jit._section_inline`` (any angle; scalar)."""
-    _, x2, x2p, x2pp = _section_inline(RA, xA, u, w, xi2)
+    """``_update`` at the section ``kernel_jit._section`` (any angle; scalar, a rare lane: not inlined)."""
+    _, x2, x2p, x2pp = _section(RA, xA, u, w, xi2)
     return _update(line, x1, e1, x2, x2p, x2pp, xi2)
 
 
