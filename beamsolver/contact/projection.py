@@ -191,7 +191,7 @@ def _iterate(S, line, xi, nxt, ang, n, iterations):
 
 
 @jit_inline
-def _fill(S, l, RA2, xA2, h2, k, xc, R1):
+def _fill(S, l, RA2, xA2, h2, k, xc, e1):
     for i in range(3):
         for j in range(3):
             S[_RA + 3 * i + j, l] = RA2[i][j]
@@ -199,7 +199,7 @@ def _fill(S, l, RA2, xA2, h2, k, xc, R1):
         S[_U + i, l] = h2[k, i]
         S[_W + i, l] = h2[k, 3 + i]
         S[_X1 + i, l] = xc[i]
-        S[_E1 + i, l] = R1[i][0]
+        S[_E1 + i, l] = e1[i]
 
 
 @jit_inline
@@ -221,27 +221,38 @@ def _finish(H, A2, h2, k, S, l, xi2, out2, dist, r):
 
 
 @jit
-def _gauss_project(H, A1, h1, xg, line, A2, B2, h2, c2, reach, iterations, row, gp, out2, dist):
-    """Slave Gauss points ``xg`` of element pairs ``k`` (slave first node ``A1``, twist ``h1``; master
-    ``A2``, ``B2``, ``h2``) within ``reach[k]`` of ``c2[k]``, projected on the master; rows in the
-    order ``(k, g)``, returns their number."""
+def _gauss_project(H, e, n_el, A1, h1, xg, line, A2, B2, h2, c2, reach, iterations, row, gp, out2, dist):
+    """Slave Gauss points ``xg`` of element pairs ``k`` (slave element ``e``, first node ``A1``, twist ``h1``;
+    master ``A2``, ``B2``, ``h2``) within ``reach[k]`` of ``c2[k]``, projected on the master; rows in the
+    order ``(k, g)``, returns their number.  A slave element's sections are computed once."""
     S = np.empty((N_FIELDS, LANES))
     xi, nxt, ang = np.empty(LANES), np.empty(LANES), np.empty(LANES)
     ln = np.empty(LANES, dtype=np.bool_)
     lane_row = np.empty(LANES, dtype=np.int64)
+    slot = np.full(n_el, -1, dtype=np.int64)
+    sec = np.empty((len(A1), len(xg), 6))       # per slave element: centre and first axis of each Gauss point
+    n_sec = 0
     n, l = 0, 0
     for k in range(len(A1)):
-        RA1, xA1 = _pose_of(H, A1[k])
+        s = slot[e[k]]
+        if s < 0:
+            s = slot[e[k]] = n_sec
+            n_sec += 1
+            RA1, xA1 = _pose_of(H, A1[k])
+            u1, w1 = (h1[k, 0], h1[k, 1], h1[k, 2]), (h1[k, 3], h1[k, 4], h1[k, 5])
+            for g in range(len(xg)):
+                R1, xc, _, _ = _section_inline(RA1, xA1, u1, w1, xg[g])
+                for i in range(3):
+                    sec[s, g, i], sec[s, g, 3 + i] = xc[i], R1[i][0]
         RA2, xA2 = _pose_of(H, A2[k])
         _, xB2 = _pose_of(H, B2[k])
-        u1, w1 = (h1[k, 0], h1[k, 1], h1[k, 2]), (h1[k, 3], h1[k, 4], h1[k, 5])
         r2 = reach[k] * reach[k]
         for g in range(len(xg)):
-            R1, xc, _, _ = _section_inline(RA1, xA1, u1, w1, xg[g])
+            xc = (sec[s, g, 0], sec[s, g, 1], sec[s, g, 2])
             d0, d1, d2 = xc[0] - c2[k, 0], xc[1] - c2[k, 1], xc[2] - c2[k, 2]
             if not (d0 * d0 + d1 * d1) + d2 * d2 <= r2:
                 continue
-            _fill(S, l, RA2, xA2, h2, k, xc, R1)
+            _fill(S, l, RA2, xA2, h2, k, xc, (sec[s, g, 3], sec[s, g, 4], sec[s, g, 5]))
             xi[l] = _chord_start(xc, xA2, xB2)
             ln[l] = line[k]
             row[n], gp[n], lane_row[l] = k, g, n
@@ -258,22 +269,24 @@ def _gauss_project(H, A1, h1, xg, line, A2, B2, h2, c2, reach, iterations, row, 
     return n
 
 
-def gauss_projections(H, A1, h1, xg, kind, A2, B2, h2, c2, reach, iterations=8):
+def gauss_projections(H, e, n_el, A1, h1, xg, kind, A2, B2, h2, c2, reach, iterations=8):
     """Slave Gauss points ``xg`` ``(g,)`` of element pairs ``(n,)`` projected on their master elements.
 
-    Pair ``k``: slave first node ``A1[k]`` and twist ``h1[k]``, ``kind[k]`` (``LINE`` or
-    ``ORTHOGONAL``), master nodes ``A2[k]``, ``B2[k]`` and twist ``h2[k]``.  A Gauss point whose centre
-    lies farther than ``reach[k]`` from ``c2[k]`` ``(n, 3)`` (the master's bounding sphere grown by the
-    slave radius) cannot touch the master and is skipped.  The others are projected as
-    ``project_points`` does (from the master chord, ``iterations`` Newton iterations).  Returns, over
-    the rows kept in the order ``(k, g)``: pair ``row``, Gauss point ``gp``, ``xi2`` and centre distance.
+    Pair ``k``: slave element ``e[k]`` (of ``n_el``; its sections are computed once), its first node
+    ``A1[k]`` and twist ``h1[k]``, ``kind[k]`` (``LINE`` or ``ORTHOGONAL``), master nodes ``A2[k]``,
+    ``B2[k]`` and twist ``h2[k]``.  A Gauss point whose centre lies farther than ``reach[k]`` from
+    ``c2[k]`` ``(n, 3)`` (the master's bounding sphere grown by the slave radius) cannot touch the
+    master and is skipped.  The others are projected as ``project_points`` does (from the master
+    chord, ``iterations`` Newton iterations).  Returns, over the rows kept in the order ``(k, g)``:
+    pair ``row``, Gauss point ``gp``, ``xi2`` and centre distance.
     """
     c = np.ascontiguousarray
     n = len(A1) * len(xg)
     row, gp = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
     out2, dist = np.empty(n), np.empty(n)
-    m = _gauss_project(H, c(A1), c(h1, dtype=float), c(xg, dtype=float), c(np.asarray(kind) == LINE), c(A2), c(B2),
-                       c(h2, dtype=float), c(c2, dtype=float), c(reach, dtype=float), int(iterations), row, gp, out2, dist)
+    m = _gauss_project(H, c(e), int(n_el), c(A1), c(h1, dtype=float), c(xg, dtype=float), c(np.asarray(kind) == LINE),
+                       c(A2), c(B2), c(h2, dtype=float), c(c2, dtype=float), c(reach, dtype=float), int(iterations), row,
+                       gp, out2, dist)
     return row[:m], gp[:m], out2[:m], dist[:m]
 
 
@@ -292,7 +305,7 @@ def _project_points(H, line, A1, h1, xi1, A2, B2, h2, iterations, out2, dist):
             _, xB2 = _pose_of(H, B2[k])
             R1, xc, _, _ = _section_inline(RA1, xA1, (h1[k, 0], h1[k, 1], h1[k, 2]), (h1[k, 3], h1[k, 4], h1[k, 5]),
                                            xi1[k])
-            _fill(S, l, RA2, xA2, h2, k, xc, R1)
+            _fill(S, l, RA2, xA2, h2, k, xc, (R1[0][0], R1[1][0], R1[2][0]))
             xi[l] = _chord_start(xc, xA2, xB2)
             ln[l] = line[k]
         _iterate(S, ln, xi, nxt, ang, m, iterations)

@@ -349,7 +349,7 @@ class ContactSystem(Contribution):
         # element: no projection for it; the others from the projection on the master chord, 8 Newton
         # iterations (compiled, projection.py; the kernel polishes the point with 2 more and needs it
         # converged for an exact tangent)
-        r, g, xi2, dist = gauss_projections(H, en[e, 0], c.h1[gp], xg, c.kind[gp], en[m, 0], en[m, 1], c.h2[gp],
+        r, g, xi2, dist = gauss_projections(H, e, len(en), en[e, 0], c.h1[gp], xg, c.kind[gp], en[m, 0], en[m, 1], c.h2[gp],
                                             c.c2[gp], c.r2[gp] + self.el_radius[e], iterations=8)
         rep, e, m = gp[r], e[r], m[r]
         self._lap("projection")
