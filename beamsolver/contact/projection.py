@@ -6,18 +6,20 @@ follow the constant-strain interpolation ``H_A exp(xi h)`` with the element twis
 ``h = log(H_A^-1 H_B)``; the projections are the Newton iterations of
 ``kernel_jit._project`` (``pairs._project`` is their numpy oracle):
 
+- ``spheres``: the broad phase's element bounding spheres and mid-point tangents;
 - ``closest_points``: closest points of two centre lines (kind ``POINT``) and the
   reduced-Hessian ratio ``(H11 - H12^2 / H22) / |x1'|^2`` of the search's rule 2;
-- ``project_points``: a slave section ``xi1`` onto a master element (``LINE`` or
-  ``ORTHOGONAL``), started from the projection on the master chord.
+- ``gauss_projections``: the slave Gauss points of element pairs, their sphere filter and
+  their projections onto the master element (``LINE`` or ``ORTHOGONAL``), started from the
+  projection on the master chord, in one pass; ``project_points``: the same projections of
+  given slave sections.
 
-``_project`` computes a fixed slave section once and stops at an exact fixed point of
-the iteration, with the result of all the iterations asked for; ``project_points`` hands
-it the slave section it already has (``kernel_jit._project_from``).  (Numba's disk cache
-keys a function on its own source file only: after editing ``kernel_jit._project`` or the
-functions it calls, delete the ``__pycache__`` numba files of this module too, or it keeps
-the old copy.)  The sections are inlined (``kernel_jit._section_inline``, the same operations):
-what a loop does not use of them (``x'``, ``x''``, the rotation) is not computed.
+The Gauss-point projections run in lockstep over blocks of ``LANES`` (SIMD; the same
+operations as ``kernel_jit._project_from``, bit for bit: see the comment above ``LANES``).
+(Numba's disk cache keys a function on its own source file only; ``jit_cache.drop_stale``
+deletes the package's cache files when any compiled module changed.)  The sections are inlined
+(``kernel_jit._section_inline``, the same operations): what a loop does not use of them
+(``x'``, ``x''``, the rotation) is not computed.
 """
 import numpy as np
 

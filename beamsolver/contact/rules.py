@@ -105,6 +105,7 @@ def owners(cand, key, xi2, dist, rsum, known):
     (a point projecting on a node shared by two elements, to round-off); among equals
     the owner of the last evaluation (``known``, over all rows: no flip-flop inside
     Newton), then the element on which the point lies at its start (smaller ``xi2``).
+    The search runs its compiled twin ``ownership.gauss_owners`` (tested equal).
     """
     if len(cand) == 0:
         return cand

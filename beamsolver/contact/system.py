@@ -7,9 +7,9 @@ contact declarations.  It orchestrates pure stages kept in their own modules:
    twists computed once per evaluation (``projection.element_twists``);
 2. pair rules (``rules.py``: no pair between elements sharing a node or meeting at a joint,
    the kind of each element pair, closest points of crossings from ``projection.closest_points``);
-3. projection of the slave Gauss points (``projection.project_points``, compiled) and
-   ownership (``rules.owners``, ``rules.dedupe_points``: one owner per slave point, stable
-   at shared nodes), giving one typed ``record.PairSet``;
+3. projection of the slave Gauss points (``projection.gauss_projections``, compiled) and
+   ownership (``ownership.gauss_owners``, the compiled ``rules.owners``; ``rules.dedupe_points``:
+   one owner per slave point, stable at shared nodes), giving one typed ``record.PairSet``;
 4. refusals (``_check_sides``: tunnelling; ``_check_normals``: no normal);
 5. kernel parameters and history look-up (``_params``), then the compiled kernel of the
    contact law (``kernel_jit``, ``law.ContactLaw``) on the active pairs (``_local_blocks``,
@@ -339,7 +339,8 @@ class ContactSystem(Contribution):
 
     def _gauss_pairs(self, d, H, c):
         """Line and orthogonal projections of the slave Gauss points; one owner per slave
-        point and master beam (``rules.owners``).  Returns the record and the owner ids."""
+        point and master beam (``ownership.gauss_owners``, the compiled ``rules.owners``).  Returns
+        the record and the owner ids."""
         en = self.sys.enodes
         gp = np.flatnonzero(c.kind != POINT)
         xg, wg = d.gauss
