@@ -72,7 +72,7 @@ def test_gauss_projections_equal_the_kernel_projection_bit_for_bit():
     c2, _ = projection.section_points(H, A2, h2, np.full(len(A2), 0.5))
     reach = rng.uniform(0.05, 0.4, len(A1))              # some Gauss points filtered out, some kept
     ref = _gauss_reference(H, A1, h1, xg, kind, A2, A2 + 1, h2, c2, reach)
-    got = projection.gauss_projections(H, A1 // 2, len(enodes), A1, h1, xg, kind, A2, A2 + 1, h2, c2, reach)
+    got = projection.gauss_projections(H, enodes, h, A1 // 2, A2 // 2, xg, kind, c2, reach)
     assert 0 < len(got[0]) < len(A1) * len(xg)
     for a, b in zip(got, ref[:4]):
         np.testing.assert_array_equal(a, b)

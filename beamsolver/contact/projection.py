@@ -29,7 +29,7 @@ from ..se3_jit import _SERIES_TABLE, _SWITCH, A_, B_, C_, add, add_outer, cross,
 from .kernel_jit import _pose_of, _project, _section, _section_inline
 from .pairs import LINE, POINT
 
-__all__ = ["element_twists", "section_points", "spheres", "closest_points", "project_points", "gauss_projections"]
+__all__ = ["element_twists", "section_points", "spheres", "overlap", "closest_points", "project_points", "gauss_projections"]
 
 
 def element_twists(H, enodes):
@@ -70,6 +70,16 @@ def spheres(H, enodes, h, radii, margin, el, mid, radius, tangent):
         for i in range(3):
             mid[k, i], tangent[k, i] = xc[i], R[i][0]
         radius[k] = 0.5 * np.sqrt((u[0] * u[0] + u[1] * u[1]) + u[2] * u[2]) + radii[j] + margin
+
+
+@jit
+def overlap(c_s, r_s, c_m, r_m, i, j, keep):
+    """``keep[k]``: spheres ``i[k]`` (centres ``c_s``, radii ``r_s``) and ``j[k]`` (``c_m``, ``r_m``) overlap
+    (``|c_s[i] - c_m[j]| <= r_s[i] + r_m[j]``, the operations of ``np.linalg.norm``)."""
+    for k in range(len(i)):
+        a, b = i[k], j[k]
+        d0, d1, d2 = c_s[a, 0] - c_m[b, 0], c_s[a, 1] - c_m[b, 1], c_s[a, 2] - c_m[b, 2]
+        keep[k] = np.sqrt((d0 * d0 + d1 * d1) + d2 * d2) <= r_s[a] + r_m[b]
 
 
 @jit
@@ -214,47 +224,48 @@ def _chord_start(xc, xA2, xB2):
 
 
 @jit_inline
-def _finish(H, A2, h2, k, S, l, xi2, out2, dist, r):
-    """Master parameter and centre distance of lane ``l`` (pair ``k``) into row ``r``."""
-    RA2, xA2 = _pose_of(H, A2[k])
+def _finish(H, a2, h2, k, S, l, xi2, out2, dist, r):
+    """Master parameter and centre distance of lane ``l`` (master first node ``a2``, twist ``h2[k]``)
+    into row ``r``."""
+    RA2, xA2 = _pose_of(H, a2)
     _, xf, _, _ = _section_inline(RA2, xA2, (h2[k, 0], h2[k, 1], h2[k, 2]), (h2[k, 3], h2[k, 4], h2[k, 5]), xi2)
     out2[r] = xi2
     dist[r] = np.sqrt((xf[0] - S[_X1, l]) ** 2 + (xf[1] - S[_X1 + 1, l]) ** 2 + (xf[2] - S[_X1 + 2, l]) ** 2)
 
 
 @jit
-def _gauss_project(H, e, n_el, A1, h1, xg, line, A2, B2, h2, c2, reach, iterations, row, gp, out2, dist):
-    """Slave Gauss points ``xg`` of element pairs ``k`` (slave element ``e``, first node ``A1``, twist ``h1``;
-    master ``A2``, ``B2``, ``h2``) within ``reach[k]`` of ``c2[k]``, projected on the master; rows in the
-    order ``(k, g)``, returns their number.  A slave element's sections are computed once."""
+def _gauss_project(H, enodes, h, e, m, xg, line, c2, reach, iterations, row, gp, out2, dist):
+    """Slave Gauss points ``xg`` of element pairs ``k`` (slave ``e[k]``, master ``m[k]``) within ``reach[k]``
+    of ``c2[k]``, projected on the master; rows in the order ``(k, g)``, returns their number.  A slave
+    element's sections are computed once."""
     S = np.empty((N_FIELDS, LANES))
     xi, nxt, ang = np.empty(LANES), np.empty(LANES), np.empty(LANES)
     ln = np.empty(LANES, dtype=np.bool_)
     lane_row = np.empty(LANES, dtype=np.int64)
-    slot = np.full(n_el, -1, dtype=np.int64)
-    sec = np.empty((len(A1), len(xg), 6))       # per slave element: centre and first axis of each Gauss point
+    slot = np.full(len(enodes), -1, dtype=np.int64)
+    sec = np.empty((len(e), len(xg), 6))       # per slave element: centre and first axis of each Gauss point
     n_sec = 0
     n, l = 0, 0
-    for k in range(len(A1)):
+    for k in range(len(e)):
         s = slot[e[k]]
         if s < 0:
             s = slot[e[k]] = n_sec
             n_sec += 1
-            RA1, xA1 = _pose_of(H, A1[k])
-            u1, w1 = (h1[k, 0], h1[k, 1], h1[k, 2]), (h1[k, 3], h1[k, 4], h1[k, 5])
+            RA1, xA1 = _pose_of(H, enodes[e[k], 0])
+            u1, w1 = (h[e[k], 0], h[e[k], 1], h[e[k], 2]), (h[e[k], 3], h[e[k], 4], h[e[k], 5])
             for g in range(len(xg)):
                 R1, xc, _, _ = _section_inline(RA1, xA1, u1, w1, xg[g])
                 for i in range(3):
                     sec[s, g, i], sec[s, g, 3 + i] = xc[i], R1[i][0]
-        RA2, xA2 = _pose_of(H, A2[k])
-        _, xB2 = _pose_of(H, B2[k])
+        RA2, xA2 = _pose_of(H, enodes[m[k], 0])
+        _, xB2 = _pose_of(H, enodes[m[k], 1])
         r2 = reach[k] * reach[k]
         for g in range(len(xg)):
             xc = (sec[s, g, 0], sec[s, g, 1], sec[s, g, 2])
             d0, d1, d2 = xc[0] - c2[k, 0], xc[1] - c2[k, 1], xc[2] - c2[k, 2]
             if not (d0 * d0 + d1 * d1) + d2 * d2 <= r2:
                 continue
-            _fill(S, l, RA2, xA2, h2, k, xc, (sec[s, g, 3], sec[s, g, 4], sec[s, g, 5]))
+            _fill(S, l, RA2, xA2, h, m[k], xc, (sec[s, g, 3], sec[s, g, 4], sec[s, g, 5]))
             xi[l] = _chord_start(xc, xA2, xB2)
             ln[l] = line[k]
             row[n], gp[n], lane_row[l] = k, g, n
@@ -263,33 +274,34 @@ def _gauss_project(H, e, n_el, A1, h1, xg, line, A2, B2, h2, c2, reach, iteratio
             if l == LANES:
                 _iterate(S, ln, xi, nxt, ang, l, iterations)
                 for j in range(l):
-                    _finish(H, A2, h2, row[lane_row[j]], S, j, xi[j], out2, dist, lane_row[j])
+                    mj = m[row[lane_row[j]]]
+                    _finish(H, enodes[mj, 0], h, mj, S, j, xi[j], out2, dist, lane_row[j])
                 l = 0
     _iterate(S, ln, xi, nxt, ang, l, iterations)
     for j in range(l):
-        _finish(H, A2, h2, row[lane_row[j]], S, j, xi[j], out2, dist, lane_row[j])
+        mj = m[row[lane_row[j]]]
+        _finish(H, enodes[mj, 0], h, mj, S, j, xi[j], out2, dist, lane_row[j])
     return n
 
 
-def gauss_projections(H, e, n_el, A1, h1, xg, kind, A2, B2, h2, c2, reach, iterations=8):
+def gauss_projections(H, enodes, h, e, m, xg, kind, c2, reach, iterations=8):
     """Slave Gauss points ``xg`` ``(g,)`` of element pairs ``(n,)`` projected on their master elements.
 
-    Pair ``k``: slave element ``e[k]`` (of ``n_el``; its sections are computed once), its first node
-    ``A1[k]`` and twist ``h1[k]``, ``kind[k]`` (``LINE`` or ``ORTHOGONAL``), master nodes ``A2[k]``,
-    ``B2[k]`` and twist ``h2[k]``.  A Gauss point whose centre lies farther than ``reach[k]`` from
+    Pair ``k``: slave element ``e[k]`` (its sections are computed once), master element ``m[k]``,
+    ``kind[k]`` (``LINE`` or ``ORTHOGONAL``); ``enodes``, twists ``h`` ``(n_el, 6)``: all elements'.
+    A Gauss point whose centre lies farther than ``reach[k]`` from
     ``c2[k]`` ``(n, 3)`` (the master's bounding sphere grown by the slave radius) cannot touch the
     master and is skipped.  The others are projected as ``project_points`` does (from the master
     chord, ``iterations`` Newton iterations).  Returns, over the rows kept in the order ``(k, g)``:
     pair ``row``, Gauss point ``gp``, ``xi2`` and centre distance.
     """
     c = np.ascontiguousarray
-    n = len(A1) * len(xg)
+    n = len(e) * len(xg)
     row, gp = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
     out2, dist = np.empty(n), np.empty(n)
-    m = _gauss_project(H, c(e), int(n_el), c(A1), c(h1, dtype=float), c(xg, dtype=float), c(np.asarray(kind) == LINE),
-                       c(A2), c(B2), c(h2, dtype=float), c(c2, dtype=float), c(reach, dtype=float), int(iterations), row,
-                       gp, out2, dist)
-    return row[:m], gp[:m], out2[:m], dist[:m]
+    k = _gauss_project(H, enodes, c(h, dtype=float), c(e), c(m), c(xg, dtype=float), c(np.asarray(kind) == LINE),
+                       c(c2, dtype=float), c(reach, dtype=float), int(iterations), row, gp, out2, dist)
+    return row[:k], gp[:k], out2[:k], dist[:k]
 
 
 @jit
@@ -312,7 +324,7 @@ def _project_points(H, line, A1, h1, xi1, A2, B2, h2, iterations, out2, dist):
             ln[l] = line[k]
         _iterate(S, ln, xi, nxt, ang, m, iterations)
         for l in range(m):
-            _finish(H, A2, h2, lo + l, S, l, xi[l], out2, dist, lo + l)
+            _finish(H, A2[lo + l], h2, lo + l, S, l, xi[l], out2, dist, lo + l)
 
 
 def project_points(H, kind, A1, h1, xi1, A2, B2, h2, iterations=8):

@@ -53,7 +53,12 @@ def apart(enodes, e, m):
     ``joint_nodes`` so that elements meeting at a joint never pair: their centre lines meet
     there, a contact pair between them would find no normal or the full overlap
     ``R1 + R2``)."""
-    return ~(enodes[e][:, :, None] == enodes[m][:, None, :]).any(axis=(1, 2))
+    A, B = enodes[e], enodes[m]
+    shared = np.zeros(len(A), dtype=bool)
+    for a in range(A.shape[1]):            # node columns: no (n, k, k) table
+        for b in range(B.shape[1]):
+            shared |= A[:, a] == B[:, b]
+    return ~shared
 
 
 def point_or_orthogonal(ratio, point_ratio):
@@ -63,8 +68,10 @@ def point_or_orthogonal(ratio, point_ratio):
 
 
 def crossing(t_slave, t_master, line_angle):
-    """Mask of the element pairs at or above ``line_angle`` (those needing their closest points)."""
-    return np.arccos(np.clip(np.abs(np.sum(t_slave * t_master, axis=1)), 0.0, 1.0)) >= line_angle
+    """Mask of the element pairs at or above ``line_angle`` (those needing their closest points);
+    tangents ``(n, 3)``."""
+    cos = t_slave[:, 0] * t_master[:, 0] + t_slave[:, 1] * t_master[:, 1] + t_slave[:, 2] * t_master[:, 2]
+    return np.arccos(np.clip(np.abs(cos), 0.0, 1.0)) >= line_angle
 
 
 def extend_wrap(enodes, master_beam, n_beams, e, m, kind, xi1=None):

@@ -33,7 +33,7 @@ and master beam the closest accepted projection is kept.
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .projection import spheres
+from .projection import overlap, spheres
 
 XI_TOL = 1e-9
 
@@ -57,6 +57,6 @@ def broad_phase(c_s, r_s, c_m, r_m):
     # (half the broad phase's time on small scenes)
     D = ts.sparse_distance_matrix(tm, float(r_s.max() + r_m.max()), output_type="ndarray")
     i, j = D["i"], D["j"]
-    d = np.linalg.norm(c_s[i] - c_m[j], axis=1)
-    keep = d <= r_s[i] + r_m[j]
+    keep = np.empty(len(i), dtype=bool)
+    overlap(c_s, r_s, c_m, r_m, i, j, keep)
     return i[keep], j[keep]

@@ -307,7 +307,7 @@ class ContactSystem(Contribution):
             kinds = rules.extend_wrap(en, self.el_beam[m], self.n_beams, e, m, kinds, xi1)
             kinds = self._step_kinds(d, e, m, kinds)
         self._lap("rules")
-        return Candidates(e=e, m=m, kind=kinds, xi1=xi1, xi2=xi2, h1=h[e], h2=h[m], c2=cm[j], r2=rm[j])
+        return Candidates(e=e, m=m, kind=kinds, xi1=xi1, xi2=xi2, c2=cm[j], r2=rm[j])
 
     def _record(self, d, kind, e, m, xi1, xi2, weight, key, gp):
         en = self.sys.enodes
@@ -345,13 +345,13 @@ class ContactSystem(Contribution):
         gp = np.flatnonzero(c.kind != POINT)
         xg, wg = d.gauss
         e, m = c.e[gp], c.m[gp]
-        H, _ = self._twists(H)
+        H, h = self._twists(H)
         # a slave Gauss point outside the master element's sphere (grown by R1) cannot touch that
         # element: no projection for it; the others from the projection on the master chord, 8 Newton
         # iterations (compiled, projection.py; the kernel polishes the point with 2 more and needs it
         # converged for an exact tangent)
-        r, g, xi2, dist = gauss_projections(H, e, len(en), en[e, 0], c.h1[gp], xg, c.kind[gp], en[m, 0], en[m, 1], c.h2[gp],
-                                            c.c2[gp], c.r2[gp] + self.el_radius[e], iterations=8)
+        r, g, xi2, dist = gauss_projections(H, en, h, e, m, xg, c.kind[gp], c.c2[gp], c.r2[gp] + self.el_radius[e],
+                                            iterations=8)
         rep, e, m = gp[r], e[r], m[r]
         self._lap("projection")
         s, key = gauss_owners(d.index, len(en), self.max_gp, self.n_beams, e, m, g, xi2, dist, self.el_first,
