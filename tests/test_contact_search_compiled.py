@@ -130,3 +130,30 @@ def test_broad_phase_keeps_the_pairs_and_order_of_the_distance_matrix():
     np.testing.assert_array_equal(j, D.col[keep])
     d = np.linalg.norm(cs[:, None] - cm[None], axis=2) <= rs[:, None] + rm[None]
     assert set(zip(i.tolist(), j.tolist())) == set(zip(*np.nonzero(d)))
+
+
+def _extend_wrap_isin(enodes, master_beam, n_beams, e, m, kind, xi1):
+    """``rules.extend_wrap`` as written with ``np.isin`` (the reference of its binary search)."""
+    orth = kind == pairs.ORTHOGONAL
+    if not orth.any() or orth.all():
+        return kind
+    wrap = np.unique((enodes[e[orth]] * n_beams + master_beam[orth, None]).ravel())
+    pt = np.flatnonzero(kind == pairs.POINT)
+    pt = pt[(xi1[pt] < rules.WRAP_END) | (xi1[pt] > 1.0 - rules.WRAP_END)]
+    near = np.isin(enodes[e[pt]] * n_beams + master_beam[pt, None], wrap).any(axis=1)
+    kind = kind.copy()
+    kind[pt[near]] = pairs.ORTHOGONAL
+    return kind
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_extend_wrap_equals_its_isin_form(seed):
+    rng = np.random.default_rng(seed)
+    n_el, n = 12, 40
+    enodes = np.stack([np.arange(n_el), np.arange(n_el) + 1], axis=1)
+    e, m = rng.integers(0, n_el, n), rng.integers(0, n_el, n)
+    kind = rng.choice([pairs.LINE, pairs.ORTHOGONAL, pairs.POINT], n, p=[0.2, 0.2 + 0.1 * (seed % 3), 0.6 - 0.1 * (seed % 3)])
+    xi1 = rng.choice([-0.1, 0.02, 0.5, 0.97, 1.1], n)
+    master_beam = rng.integers(0, 3, n)
+    want = _extend_wrap_isin(enodes, master_beam, 3, e, m, kind, xi1)
+    np.testing.assert_array_equal(rules.extend_wrap(enodes, master_beam, 3, e, m, kind, xi1), want)

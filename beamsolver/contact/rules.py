@@ -90,7 +90,10 @@ def extend_wrap(enodes, master_beam, n_beams, e, m, kind, xi1=None):
     pt = np.flatnonzero(kind == POINT)
     if xi1 is not None:
         pt = pt[(xi1[pt] < WRAP_END) | (xi1[pt] > 1.0 - WRAP_END)]
-    near = np.isin(enodes[e[pt]] * n_beams + master_beam[pt, None], wrap).any(axis=1)
+    if not len(pt):
+        return kind
+    ids = enodes[e[pt]] * n_beams + master_beam[pt, None]
+    near = (wrap[np.minimum(np.searchsorted(wrap, ids), len(wrap) - 1)] == ids).any(axis=1)    # np.isin, wrap sorted
     kind = kind.copy()
     kind[pt[near]] = ORTHOGONAL
     return kind
