@@ -321,6 +321,10 @@ class ContactSystem(Contribution):
         n_el = len(self.sys.enodes)
         pt = np.flatnonzero(c.kind == POINT)
         e, m, x1, x2 = c.e[pt], c.m[pt], c.xi1[pt], c.xi2[pt]
+        if not len(pt):             # no point pairs: an empty record
+            rec = self._record(d, pt, e, m, x1, x2, x1, pt, pt)
+            self._lap("rules")
+            return rec, e * n_el + m
         lo1, hi1 = self._xi_range(e)
         lo2, hi2 = self._xi_range(m)
         pt = pt[(x1 >= lo1) & (x1 <= hi1) & (x2 >= lo2) & (x2 <= hi2)]
