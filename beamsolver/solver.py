@@ -373,7 +373,13 @@ class Newton:
                 continue
             if not damping:
                 last_inc = conv.increment_ratio(dz, self.L_ref)
-                H = self._line_search(H, dz, ev.r, scales, t) if self.line_search else problem.update(H, dz)
+                if not self.line_search:
+                    H = problem.update(H, dz)
+                    continue
+                H, ev1 = self._line_search(H, dz, ev.r, scales, t)
+                if ev1 is not None:        # the accepted full step's evaluation is the next iteration's
+                    scales1 = conv.scales(ev1, self.L_ref)
+                    ahead = (ev1, None, None, scales1, self._ratio(ev1.r, scales1), None)
                 continue
             lam0 = min(1.0, 2.0 * lam)          # after a damped iteration, try twice its length
             inc = conv.increment_ratio(dz, self.L_ref)
@@ -470,17 +476,25 @@ class Newton:
     def _line_search(self, H, dz, r0, scales, t):
         """Backtracking on the scaled residual (problems that are not smooth; the others use the
         damped Newton of ``_damped``: a piecewise smooth residual made its natural-monotonicity
-        test accept steps that later stalled, e.g. in the twisted pair)."""
+        test accept steps that later stalled, e.g. in the twisted pair).
+
+        Returns ``(H1, ev1)``: the accepted poses and, when the full step is accepted, its
+        evaluation (with tangent: the next iteration's, computed once; ``None`` otherwise).
+        The residual does not depend on whether the tangent is computed."""
         problem = self.problem
         phi0 = self._merit(r0, scales)
         H1 = problem.update(H, dz)
         if phi0 <= (10.0 * self.conv.rtol) ** 2 * len(self.sys.free_dofs):
-            return H1
+            return H1, None
         alpha = 1.0
         best = (np.inf, H1)
         for _ in range(8):
+            ev1 = None
             try:
-                phi = self._merit(self.evaluate(H1, t, tangent=False).r, scales)
+                # the full step is nearly always accepted: evaluated with the tangent the next
+                # iteration needs; the backtracked trials need the residual only
+                ev1 = self.evaluate(H1, t, tangent=alpha == 1.0)
+                phi = self._merit(ev1.r, scales)
             except StepFailed:
                 phi = np.inf
             if phi < best[0]:
@@ -488,7 +502,7 @@ class Newton:
             # Newton may raise the residual for a while: only a blow-up (factor
             # LS_GROWTH) triggers backtracking, which then asks for a decrease
             if phi <= (LS_GROWTH * phi0 if alpha == 1.0 else (1.0 - 1e-4 * alpha) * phi0):
-                return H1
+                return H1, (ev1 if alpha == 1.0 else None)
             # minimiser of the quadratic through phi(0), phi'(0) = -2 phi0, phi(alpha)
             if np.isfinite(phi):
                 a_new = phi0 * alpha**2 / (phi - phi0 + 2.0 * alpha * phi0)
@@ -498,7 +512,7 @@ class Newton:
             H1 = problem.update(H, alpha * dz)
         if not np.isfinite(best[0]):
             raise NonFinite("line search found no finite residual along the Newton direction")
-        return best[1]
+        return best[1], None
 
 
 def _starting_point(restart, model, problem, t_start, t_end):
@@ -621,11 +635,11 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
         run = Run(*args) if arc is None else ArcLengthRun(*args, arc)
         run.start(sol, initial_poses)
         run.loop()
+        return run.finish()         # inside: a failure of the output's last files carries .solution too
     except BaseException as e:
         if run is not None:
             run.abort(e)
         raise
-    return run.finish()
 
 
 def _run_options(problem, t_start, t_end, allow_unmet_tolerance, check_stability, modes, branch_switching,

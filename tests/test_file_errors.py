@@ -5,6 +5,7 @@ traceback from zipfile/json/pathlib."""
 import errno
 import json
 import os
+import re
 import struct
 import subprocess
 import sys
@@ -115,6 +116,26 @@ def test_output_on_a_full_disk_at_start_and_during_the_run(tmp_path, monkeypatch
     with pytest.raises(InputError, match=r"output folder .*full1.*: cannot write \S+ \(No space left on device\)"):
         bs.solve(_cantilever(), steps=3, output=tmp_path / "full1", verbose=False)
     assert not [p for p in (tmp_path / "full1").iterdir() if p.name.endswith(".tmp")]   # no temp files left
+
+
+def test_a_step_file_that_fails_stops_the_output_and_no_collection_lists_a_missing_file(tmp_path, monkeypatch):
+    # the files are written by a background thread (io.vtk.StepWriter): its failure reaches solve,
+    # which keeps the converged steps (.solution), and no later step's files or collections follow
+    real_replace = os.replace
+
+    def full(src, dst):
+        if Path(dst).name == "beams_0002.vtu":
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real_replace(src, dst)
+    monkeypatch.setattr(os, "replace", full)
+    folder = tmp_path / "out"
+    with pytest.raises(InputError, match=r"cannot write beams_0002\.vtu \(No space left on device\)") as err:
+        bs.solve(_cantilever(), steps=6, output=folder, verbose=False)
+    assert err.value.solution is not None and err.value.solution.n_steps >= 2
+    listed = re.findall(r'file="([^"]+)"', (folder / "beams.pvd").read_text())
+    assert listed == ["beams_0000.vtu", "beams_0001.vtu"]
+    assert sorted(p.name for p in folder.glob("*.vtu")) == listed
+    assert not [p for p in folder.iterdir() if p.name.endswith(".tmp")]
 
 
 def test_save_into_a_file_path(tmp_path, saved):

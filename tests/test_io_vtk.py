@@ -128,3 +128,33 @@ def test_custom_writer_object(tmp_path):
     mesh = meshio.read(tmp_path / entries[-1][1])
     assert mesh.points.shape == (4 * 2 + 1, 3)
     np.testing.assert_allclose(mesh.points[::2], sol.poses[-1][:, :3, 3], atol=1e-12 * L)
+
+
+@pytest.mark.parametrize("compression", ["zlib", "lzma", None])
+def test_write_vtu_arrays_read_back_exactly_by_meshio_and_pyvista(tmp_path, compression):
+    from beamsolver.io.vtu import BLOCK, write_vtu
+    rng = np.random.default_rng(1)
+    n = BLOCK // 8 + 5                     # the points span two compressed blocks
+    pts = rng.standard_normal((n, 3))
+    seg = np.stack([np.arange(n - 1), np.arange(1, n)], axis=1)
+    pdata = dict(u=rng.standard_normal((n, 3)), r=rng.random(n), id=np.arange(n, dtype=np.int32))
+    cdata = dict(N=rng.standard_normal(n - 1), strain=rng.standard_normal((n - 1, 6)),
+                 element=np.arange(n - 1, dtype=np.int32))
+    path = tmp_path / "a.vtu"
+    write_vtu(path, pts, "line", seg, pdata, cdata, compression)
+    mesh = meshio.read(path)
+    assert mesh.points.dtype == np.float64 and np.array_equal(mesh.points, pts)
+    assert mesh.cells[0].type == "line" and np.array_equal(mesh.cells[0].data, seg)
+    for k, v in pdata.items():
+        assert mesh.point_data[k].dtype == v.dtype and np.array_equal(mesh.point_data[k], v), k
+    for k, v in cdata.items():
+        assert mesh.cell_data[k][0].dtype == v.dtype and np.array_equal(mesh.cell_data[k][0], v), k
+    write_vtu(tmp_path / "v.vtu", pts[:3], "vertex", np.arange(3).reshape(-1, 1), dict(g=np.ones(3)))
+    v = meshio.read(tmp_path / "v.vtu")
+    assert v.cells[0].type == "vertex" and np.array_equal(v.point_data["g"], np.ones(3))
+    pv = pytest.importorskip("pyvista")
+    grid = pv.read(path)
+    np.testing.assert_array_equal(grid.points, pts)
+    np.testing.assert_array_equal(grid.cell_data["strain"], cdata["strain"])
+    with pytest.raises(ValueError, match="compression"):
+        write_vtu(path, pts, "line", seg, compression="gzip")

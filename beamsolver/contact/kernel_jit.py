@@ -983,25 +983,37 @@ def project(kind, HA1, h1, xi1, HA2, h2, xi2, iterations=3):
 
 
 # ---------------------------------------------------------------- the signatures of pairs.py
+_PAR_COLUMNS = ((XI1, "xi1", np.nan), (XI2, "xi2", np.nan), (R1_, "R1", np.nan), (R2_, "R2", np.nan),
+                (WEIGHT, "weight", np.nan), (PENALTY, "penalty", np.nan), (MULT, "multiplier", 0.0),
+                (MU, "mu", np.nan), (PEN_T, "penalty_t", np.nan), (SMOOTH, "smoothing", 0.0),
+                (ESLIP, "elastic_slip", np.nan))
+
+
+def _readonly(v, shape, dtype):
+    """``np.ascontiguousarray(np.broadcast_to(v, shape), dtype=dtype)``: for an array ``v`` already of
+    that shape, dtype and layout the same read-only view without the broadcasting machinery (the
+    kernel's argument types, hence its cached compilation, stay those of that expression)."""
+    if isinstance(v, np.ndarray) and v.shape == shape and v.dtype == dtype and v.flags.c_contiguous:
+        out = v.view()
+        out.flags.writeable = False
+        return out
+    return np.ascontiguousarray(np.broadcast_to(v, shape), dtype=dtype)
+
+
 def _table(X, p):
     P = X.shape[0]
-
-    def col(name, default=np.nan):
-        return np.broadcast_to(np.asarray(p.get(name, default), dtype=float), (P,))
-
     par = np.empty((P, N_PAR))
-    for k, name in ((XI1, "xi1"), (XI2, "xi2"), (R1_, "R1"), (R2_, "R2"), (WEIGHT, "weight"),
-                    (PENALTY, "penalty"), (MULT, "multiplier"), (MU, "mu"), (PEN_T, "penalty_t"),
-                    (SMOOTH, "smoothing"), (ESLIP, "elastic_slip")):
-        par[:, k] = col(name, 0.0 if name in ("smoothing", "multiplier") else np.nan)
-    par[:, XI1P] = col("xi1_prev", 0.0) if "xi1_prev" in p else par[:, XI1]
-    par[:, XI2P] = col("xi2_prev", 0.0) if "xi2_prev" in p else par[:, XI2]
-    eye = np.broadcast_to(np.eye(4), (P, 4, 4))
-    frames = [np.ascontiguousarray(np.broadcast_to(p.get(k, eye), (P, 4, 4)), dtype=float)
-              for k in ("H_CL", "H_FK", "H_LK_prev")]
-    lamp = np.ascontiguousarray(np.broadcast_to(p.get("lam_t_prev", np.zeros(3)), (P, 3)), dtype=float)
-    has = np.ascontiguousarray(np.broadcast_to(p.get("has_history", False), (P,)), dtype=np.bool_)
-    kind = np.ascontiguousarray(np.broadcast_to(p["kind"], (P,)), dtype=np.int64)
+    for k, name, default in _PAR_COLUMNS:
+        v = p.get(name, default)
+        par[:, k] = v if isinstance(v, np.ndarray) and v.shape == (P,) else \
+            np.broadcast_to(np.asarray(v, dtype=float), (P,))
+    par[:, XI1P] = p["xi1_prev"] if "xi1_prev" in p else par[:, XI1]
+    par[:, XI2P] = p["xi2_prev"] if "xi2_prev" in p else par[:, XI2]
+    eye = np.eye(4)
+    frames = [_readonly(p.get(k, eye), (P, 4, 4), np.float64) for k in ("H_CL", "H_FK", "H_LK_prev")]
+    lamp = _readonly(p.get("lam_t_prev", np.zeros(3)), (P, 3), np.float64)
+    has = _readonly(p.get("has_history", False), (P,), np.bool_)
+    kind = _readonly(p["kind"], (P,), np.int64)
     return kind, par, has, frames, lamp
 
 

@@ -722,7 +722,7 @@ class ContactSystem(Contribution):
                              H_FK=se3.relative(HF, HK)[order], H_LK=se3.relative(HL, HK)[order],
                              e=P.e[sel][order], m=P.m[sel][order], xi1=out["xi1"][order],
                              xi2=out["xi2"][order], lam_t=lam_vec[order])
-        self._last = (P, sel, p, out)
+        self._last = (P, sel, p, out, (np.array(H), HC, HF))
 
     def results(self, H):
         """Contact point table of the committed state (dict of arrays).
@@ -741,12 +741,13 @@ class ContactSystem(Contribution):
                         angle=np.zeros(0), slave_element=np.zeros(0, dtype=int),
                         master_element=np.zeros(0, dtype=int), xi1=np.zeros(0), xi2=np.zeros(0),
                         weight=np.zeros(0))
-        P, sel, p, out = last
+        P, sel, p, out, (H_c, HC, HF) = last
         w = p["weight"]
         lam_t = out["lam_t"]
         ft = (w * lam_t[:, 0])[:, None] * out["t1"] + (w * lam_t[:, 1])[:, None] * out["t2"]
-        e1s = self._pose_at(H, P.e[sel], out["xi1"])[:, :3, 0]
-        e1m = self._pose_at(H, P.m[sel], out["xi2"])[:, :3, 0]
+        if not np.array_equal(H_c, H):        # the section poses of commit are those at its poses
+            HC, HF = self._pose_at(H, P.e[sel], out["xi1"]), self._pose_at(H, P.m[sel], out["xi2"])
+        e1s, e1m = HC[:, :3, 0], HF[:, :3, 0]
         ang = np.degrees(np.arccos(np.clip(np.abs(np.sum(e1s * e1m, axis=1)), 0.0, 1.0)))
         active = out["lam_n"] > 0
         return dict(position=0.5 * (out["xC"] + out["xF"]) + 0.5 * (p["R1"] - p["R2"])[:, None] * out["n"],

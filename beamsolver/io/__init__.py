@@ -1,8 +1,8 @@
-"""Files: saved solutions (``archive``, numpy only) and ParaView output (``vtk``, needs meshio).
+"""Files: saved solutions (``archive``, numpy only) and ParaView output (``vtk``, numpy and zlib: ``vtu``).
 
 ``vtk`` is imported only when output is asked for (``solve(output=)``,
 ``write_vtk``) or the submodule is first used (``bs.io.vtk.StepWriter``), so
-``import beamsolver`` never imports meshio.
+``import beamsolver`` never imports it.
 """
 import importlib
 
@@ -18,7 +18,7 @@ def write_vtk(solution, folder, steps=None, refine=8, compression="zlib"):
 
 
 def __getattr__(name):
-    """``bs.io.vtk`` without an explicit import, loaded (with meshio) on first use."""
+    """``bs.io.vtk`` without an explicit import, loaded on first use."""
     if name == "vtk":
         return importlib.import_module(".vtk", __name__)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

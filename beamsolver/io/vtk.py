@@ -1,4 +1,4 @@
-"""ParaView output through meshio: one ``.vtu`` per converged step and ``.pvd`` collections.
+"""ParaView output: one ``.vtu`` per converged step and ``.pvd`` collections.
 
 Files in the output folder (``solve(model, output=folder)``, or
 ``write_vtk(solution, folder)`` for a saved solution):
@@ -30,11 +30,13 @@ mode ``open()`` would give it (``0666 & ~umask``), and then renamed
 rewritten after every step: a run that stops at any moment leaves only
 complete files, and ``.pvd`` files that list exactly the steps written.
 A writer first removes the numbered files its folder's ``beams.pvd`` and
-``contact.pvd`` list (the previous run's series; nothing else), so ParaView
+``contact.pvd`` list (the previous run's series; nothing else; the collections at
+once, the files they listed in the writing thread before any new file), so ParaView
 never groups two runs.
-meshio can neither write nor read VTK poly-lines (type 4), hence two-point
-``line`` cells; for smooth tubes ParaView joins them into poly-lines with
-*Triangle Strips* before the Tube filter (README, "ParaView").
+The VTU files are written by ``io.vtu`` (numpy and zlib; meshio's binary layout, read
+by meshio, pyvista and ParaView) with two-point ``line`` cells, which meshio reads (it
+cannot read VTK poly-lines, type 4); for smooth tubes ParaView joins them into
+poly-lines with *Triangle Strips* before the Tube filter (README, "ParaView").
 """
 import os
 import tempfile
@@ -47,6 +49,7 @@ import numpy as np
 from ..errors import InputError
 from ..files import follow_umask, previous_series
 from .lines import LineLayout
+from .vtu import write_vtu
 
 __all__ = ["StepWriter", "write_vtk", "write_pvd"]
 
@@ -122,14 +125,18 @@ class StepWriter:
     element; ``compression``: ``"zlib"``, ``"lzma"`` or ``None``;
     ``checkpoint``: seconds between saves of ``solution.npz`` (``None``: never
     save it, as for exporting a loaded solution).
+
+    ``write`` takes what it needs from the solution at once and leaves the files (encoding,
+    compression, file system) to one background thread, which writes the steps in order, each
+    step's VTU files before the collections that list it, so the solver goes on meanwhile (the
+    metadata operations of a busy disk cost milliseconds a file).  ``close`` waits for them.  A
+    failure there (``InputError``: full disk, permissions) stops the writing of later steps and
+    is raised by the next ``write`` or by ``close``.
     """
 
     def __init__(self, folder, system=None, refine=8, compression="zlib", contact=None, checkpoint=60.0):
-        import meshio   # imported here: scenes without output never pay for it
-        self._meshio = meshio
         self.folder = _output_folder(folder)
-        for old in previous_series(self.folder, (f"{BEAMS}.pvd", f"{CONTACT}.pvd"), SERIES):
-            old.unlink()
+        stale = previous_series(self.folder, (f"{BEAMS}.pvd", f"{CONTACT}.pvd"), SERIES)
         for name in (f"{BEAMS}.pvd", f"{CONTACT}.pvd"):
             (self.folder / name).unlink(missing_ok=True)
         self.refine = refine
@@ -143,13 +150,19 @@ class StepWriter:
         self.checkpoint = checkpoint
         self._solution = None
         self._saved_at = time.perf_counter()
+        self._pool = None          # the writing thread (started by the first write)
+        self._jobs = []            # futures of the steps not yet known to be written
+        self._failure = None       # the first error of the writing thread: nothing is written after it
+        self._reported = False     # whether ``write`` or ``close`` raised it
+        if stale:                  # the previous run's files, unlisted now: removed before any new one is written
+            self._enqueue(_remove, stale)
 
     def _name(self, kind, step):
         return f"{kind}_{step:0{self.width}d}.vtu"
 
     def write(self, solution, step):
-        """Write step ``step`` of ``solution`` and rewrite the collections."""
-        meshio = self._meshio
+        """Write step ``step`` of ``solution`` and rewrite the collections (in the background)."""
+        self._raise_failure()
         if self.layout is None:
             self.layout = LineLayout(solution.description, self.refine)
             if self.contact is None:
@@ -160,23 +173,54 @@ class StepWriter:
         pdata, points = lay.point_data(rec.poses)
         pdata.update(mode_fields(lay, rec.stats))
         cdata = lay.cell_data(rec.section_forces, rec.strains)
-        mesh = meshio.Mesh(points, [("line", lay.segments)], point_data=pdata,
-                           cell_data={k: [v] for k, v in cdata.items()})
-        self._write_mesh(self.folder / self._name(BEAMS, step), mesh)
+        files = [(self.folder / self._name(BEAMS, step), (points, "line", lay.segments, pdata, cdata))]
         if self.contact:
-            path = self.folder / self._name(CONTACT, step)
             table = rec.contact
-            if len(active_points(table)):
-                self._write_mesh(path, contact_mesh(table))
-            else:
-                _atomic(path, _write_empty_points)
+            pos, cpdata = contact_points(table) if len(active_points(table)) else (None, None)
+            files.append((self.folder / self._name(CONTACT, step),
+                          None if pos is None else (pos, "vertex", np.arange(len(pos)).reshape(-1, 1), cpdata, None)))
         # the archive first, then the collections: a run killed in between never has a .pvd that
         # lists a step its solution.npz lacks (with checkpoint=0 both list the same steps)
         self._solution = solution
         if self.checkpoint is not None and time.perf_counter() - self._saved_at >= self.checkpoint:
             self.save()
         self.entries[step] = t
-        self._write_collections()
+        self._submit(files, self._collections())
+
+    def _submit(self, files, collections):
+        self._enqueue(self._write_step, files, collections)
+
+    def _enqueue(self, job, *args):
+        """Run ``job(*args)`` in the writing thread after the jobs before it (none after a failure)."""
+        if self._pool is None:
+            from concurrent.futures import ThreadPoolExecutor
+            self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="beamsolver-output")
+        self._jobs = [j for j in self._jobs if not j.done()]
+        self._jobs.append(self._pool.submit(self._guarded, job, *args))
+
+    def _guarded(self, job, *args):
+        if self._failure is not None:
+            return
+        try:
+            job(*args)
+        except BaseException as e:
+            self._failure = e
+
+    def _write_step(self, files, collections):
+        """The files of one step, then its collections (in the writing thread)."""
+        for path, mesh in files:
+            if mesh is None:
+                _atomic(path, _write_empty_points)
+            else:
+                _atomic(path, lambda tmp, m=mesh: write_vtu(tmp, *m, self.compression))
+        for path, entries in collections:
+            write_pvd(path, entries)
+
+    def _raise_failure(self):
+        """Raise the writing thread's failure, if any (every call: nothing more is written)."""
+        if self._failure is not None:
+            self._reported = True
+            raise self._failure
 
     def save(self):
         """Save the solution written so far to ``solution.npz`` (atomically)."""
@@ -184,22 +228,35 @@ class StepWriter:
             self._solution.save(self.folder / ARCHIVE)
             self._saved_at = time.perf_counter()
 
-    def _write_mesh(self, path, mesh):
-        meshio = self._meshio
-        _atomic(path, lambda tmp: meshio.vtu.write(tmp, mesh, binary=True, compression=self.compression))
-
-    def _write_collections(self):
+    def _collections(self):
+        """``[(path, entries)]`` of the ``.pvd`` files listing the steps written so far."""
         steps = sorted(self.entries)
         times = [self.entries[k] for k in steps]
         if np.any(np.diff(times) <= 0.0):       # not increasing: ParaView would reorder; step numbers
             times = [float(k) for k in steps]
-        write_pvd(self.folder / f"{BEAMS}.pvd", [(t, self._name(BEAMS, k)) for t, k in zip(times, steps)])
-        if self.contact:
-            write_pvd(self.folder / f"{CONTACT}.pvd", [(t, self._name(CONTACT, k)) for t, k in zip(times, steps)])
+        kinds = (BEAMS, CONTACT) if self.contact else (BEAMS,)
+        return [(self.folder / f"{kind}.pvd", [(t, self._name(kind, k)) for t, k in zip(times, steps)])
+                for kind in kinds]
 
     def close(self):
-        """Save ``solution.npz`` (every VTU/PVD file is already complete when ``write`` returns)."""
-        self.save()
+        """Wait for the files of every step, save ``solution.npz``, then raise the writing thread's
+        failure if no ``write`` has raised it yet."""
+        for j in self._jobs:
+            j.result()
+        self._jobs = []
+        if self._pool is not None:
+            self._pool.shutdown(wait=True)
+            self._pool = None
+        try:
+            self.save()
+        finally:
+            if self._failure is not None and not self._reported:
+                self._raise_failure()
+
+
+def _remove(paths):
+    for p in paths:
+        p.unlink(missing_ok=True)
 
 
 def mode_fields(layout, stats):
@@ -218,9 +275,9 @@ def active_points(table):
     return np.flatnonzero(np.asarray(table.get("normal_force", np.zeros(0)), dtype=float) > 0)
 
 
-def contact_mesh(table):
-    """The active contact points of one step (``active_points``) as a meshio vertex mesh."""
-    import meshio
+def contact_points(table):
+    """The active contact points of one step (``active_points``): positions ``(k, 3)`` and point
+    data (``CONTACT_FIELDS``), for a VTU of vertex cells."""
     pos = np.asarray(table.get("position", np.zeros((0, 3))), dtype=float).reshape(-1, 3)
     n = len(pos)
     on = active_points(table) if "normal_force" in table else np.arange(n)
@@ -234,8 +291,7 @@ def contact_mesh(table):
         else:
             v = v.astype(float)
         pdata[name] = v.reshape((k,) + shape)
-    cells = [("vertex", np.arange(k, dtype=np.int64).reshape(-1, 1))]
-    return meshio.Mesh(pos, cells, point_data=pdata)
+    return pos, pdata
 
 
 def _write_empty_points(path):
