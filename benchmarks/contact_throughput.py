@@ -64,7 +64,8 @@ def _best(fn, repeat):
 
 def _projection_time(c, H, repeat):
     """Least CPU time of the search's projection part (``ContactSystem.timings['projection']``: the
-    Gauss points' sections and ``projection.project_points``, with their numpy glue) over ``repeat`` searches."""
+    Gauss points' sections, sphere filter and projections, ``projection.gauss_projections``, one
+    compiled pass) over ``repeat`` searches."""
     best = np.inf
     for _ in range(repeat):
         c.timings = dict.fromkeys(c.timings, 0.0)
@@ -172,7 +173,7 @@ if __name__ == "__main__":
 Two parallel beams in line contact, 5 Gauss points per slave element, all points active, friction
 on.  Search = broad phase (bounding spheres, scipy cKDTree) + pair rules + SE(3) projections
 (compiled, `contact/projection.py`; `ContactSystem.pairs`; its projection part: the Gauss points'
-sections and projections with their numpy glue); kernel + tangent compiled = `contact.kernel_jit.kernel_and_tangent`
+sections, sphere filter and projections in one compiled pass); kernel + tangent compiled = `contact.kernel_jit.kernel_and_tangent`
 (numba, forward-mode exact tangent: gradients with respect to the 24 node increments carried
 through the projection, the frames, the laws and the node Jacobians; an element's twist and
 operators computed once for consecutive points on it; the tangent written to a

@@ -6,28 +6,30 @@ follow the constant-strain interpolation ``H_A exp(xi h)`` with the element twis
 ``h = log(H_A^-1 H_B)``; the projections are the Newton iterations of
 ``kernel_jit._project`` (``pairs._project`` is their numpy oracle):
 
+- ``spheres``: the broad phase's element bounding spheres and mid-point tangents;
 - ``closest_points``: closest points of two centre lines (kind ``POINT``) and the
   reduced-Hessian ratio ``(H11 - H12^2 / H22) / |x1'|^2`` of the search's rule 2;
-- ``project_points``: a slave section ``xi1`` onto a master element (``LINE`` or
-  ``ORTHOGONAL``), started from the projection on the master chord.
+- ``gauss_projections``: the slave Gauss points of element pairs, their sphere filter and
+  their projections onto the master element (``LINE`` or ``ORTHOGONAL``), started from the
+  projection on the master chord, in one pass; ``project_points``: the same projections of
+  given slave sections.
 
-``_project`` computes a fixed slave section once and stops at an exact fixed point of
-the iteration, with the result of all the iterations asked for; ``project_points`` hands
-it the slave section it already has (``kernel_jit._project_from``).  (Numba's disk cache
-keys a function on its own source file only: after editing ``kernel_jit._project`` or the
-functions it calls, delete the ``__pycache__`` numba files of this module too, or it keeps
-the old copy.)  The sections are inlined (``kernel_jit._section_inline``, the same operations):
-what a loop does not use of them (``x'``, ``x''``, the rotation) is not computed.
+The Gauss-point projections run in lockstep over blocks of ``LANES`` (SIMD; the same
+operations as ``kernel_jit._project_from``, bit for bit: see the comment above ``LANES``).
+(Numba's disk cache keys a function on its own source file only; ``jit_cache.drop_stale``
+deletes the package's cache files when any compiled module changed.)  The sections are inlined
+(``kernel_jit._section_inline``, the same operations): what a loop does not use of them
+(``x'``, ``x''``, the rotation) is not computed.
 """
 import numpy as np
 
 from .. import se3
-from .._jit import jit
-from ..se3_jit import dot
-from .kernel_jit import _pose_of, _project, _project_from, _section_inline
-from .pairs import POINT
+from .._jit import jit, jit_inline
+from ..se3_jit import _SERIES_TABLE, _SWITCH, A_, B_, C_, add, add_outer, cross, dot, mat, mm, mv, scale
+from .kernel_jit import _pose_of, _project, _section, _section_inline
+from .pairs import LINE, POINT
 
-__all__ = ["element_twists", "section_points", "closest_points", "project_points"]
+__all__ = ["element_twists", "section_points", "spheres", "overlap", "closest_points", "project_points", "gauss_projections"]
 
 
 def element_twists(H, enodes):
@@ -54,6 +56,30 @@ def section_points(H, A, h, xi):
     _sections(H, np.ascontiguousarray(A), np.ascontiguousarray(h, dtype=float),
               np.ascontiguousarray(np.broadcast_to(xi, (n,)), dtype=float), x, e1)
     return x, e1
+
+
+@jit
+def spheres(H, enodes, h, radii, margin, el, mid, radius, tangent):
+    """Bounding spheres of the elements ``el`` into ``mid`` ``(n, 3)``, ``radius`` ``(n,)``
+    (``|u| / 2 + r + margin``, ``|u|`` the arc length) and the mid-point tangents ``(n, 3)``."""
+    for k in range(len(el)):
+        j = el[k]
+        RA, xA = _pose_of(H, enodes[j, 0])
+        u = (h[j, 0], h[j, 1], h[j, 2])
+        R, xc, _, _ = _section_inline(RA, xA, u, (h[j, 3], h[j, 4], h[j, 5]), 0.5)
+        for i in range(3):
+            mid[k, i], tangent[k, i] = xc[i], R[i][0]
+        radius[k] = 0.5 * np.sqrt((u[0] * u[0] + u[1] * u[1]) + u[2] * u[2]) + radii[j] + margin
+
+
+@jit
+def overlap(c_s, r_s, c_m, r_m, i, j, keep):
+    """``keep[k]``: spheres ``i[k]`` (centres ``c_s``, radii ``r_s``) and ``j[k]`` (``c_m``, ``r_m``) overlap
+    (``|c_s[i] - c_m[j]| <= r_s[i] + r_m[j]``, the operations of ``np.linalg.norm``)."""
+    for k in range(len(i)):
+        a, b = i[k], j[k]
+        d0, d1, d2 = c_s[a, 0] - c_m[b, 0], c_s[a, 1] - c_m[b, 1], c_s[a, 2] - c_m[b, 2]
+        keep[k] = np.sqrt((d0 * d0 + d1 * d1) + d2 * d2) <= r_s[a] + r_m[b]
 
 
 @jit
@@ -84,32 +110,230 @@ def closest_points(H, A1, h1, A2, h2, iterations=8):
     return out1, out2, ratio
 
 
+# ---------------------------------------------------------------- Gauss-point projections, lanes in lockstep
+# The Newton iterations of a Gauss-point projection are one serial chain of dependent operations
+# (~50 ns an iteration, latency-bound); iterated in lockstep over a block of ``LANES`` projections
+# stored field by field (``S[f, lane]``), the loop over lanes has no branch and no call and the
+# compiler runs it in SIMD registers (measured 3x faster).  The lanes compute the same operations
+# as ``kernel_jit._project_from``'s ``LINE`` / ``ORTHOGONAL`` iterations, bit for bit: the
+# exponential's coefficients by their series (``se3_jit.coefficient`` below its switch; a lane at or
+# above it is redone by the scalar iteration), both kinds' updates computed and one selected, all
+# iterations done (``_project_from`` stops at an exact fixed point, which fixes all later iterates).
+LANES = 64
+_SA, _SB, _SC = (tuple(float(v) for v in _SERIES_TABLE[k]) for k in (A_, B_, C_))
+_SWITCH_ABC = float(min(_SWITCH[A_], _SWITCH[B_], _SWITCH[C_]))
+# fields of a lane: master node pose RA2 (row-major), xA2, twist u2, w2, slave centre x1, axis e1
+_RA, _XA, _U, _W, _X1, _E1, N_FIELDS = 0, 9, 12, 15, 18, 21, 24
+
+
+@jit_inline
+def _series(row, t):
+    """``se3_jit.coefficient`` of the series ``row`` below its switch (the same operations)."""
+    t2 = t * t
+    v = row[8]
+    v = v * t2 + row[7]
+    v = v * t2 + row[6]
+    v = v * t2 + row[5]
+    v = v * t2 + row[4]
+    v = v * t2 + row[3]
+    v = v * t2 + row[2]
+    v = v * t2 + row[1]
+    return v * t2 + row[0]
+
+
+@jit_inline
+def _vec(S, f, l):
+    return (S[f, l], S[f + 1, l], S[f + 2, l])
+
+
+@jit_inline
+def _lane(S, l):
+    """Master node pose, twist, slave centre and axis of lane ``l``."""
+    RA = (_vec(S, _RA, l), _vec(S, _RA + 3, l), _vec(S, _RA + 6, l))
+    return RA, _vec(S, _XA, l), _vec(S, _U, l), _vec(S, _W, l), _vec(S, _X1, l), _vec(S, _E1, l)
+
+
+@jit_inline
+def _update(line, x1, e1, x2, x2p, x2pp, xi2):
+    """One Newton update of ``xi2`` (``kernel_jit._project_from``, ``LINE`` or ``ORTHOGONAL``) from the master
+    section at ``xi2``; both kinds computed, one selected (no branch)."""
+    d = add(x2, scale(-1.0, x1))
+    jl = dot(x2p, e1)
+    jo = dot(x2p, x2p) + dot(d, x2pp)
+    j = jl if line else jo
+    g = dot(d, e1) if line else dot(d, x2p)
+    return xi2 - g / (j if j != 0.0 else 1.0)
+
+
+@jit_inline
+def _step_series(line, x1, e1, RA, xA, u, w, xi2):
+    """``_update`` at the section ``kernel_jit._section_inline(RA, xA, u, w, xi2)`` computed with the
+    coefficients' series; also the angle ``t`` (the series hold below ``_SWITCH_ABC``)."""
+    us, ws = scale(xi2, u), scale(xi2, w)
+    t2 = dot(ws, ws)
+    t = np.sqrt(t2)
+    a, b, c = _series(_SA, t), _series(_SB, t), _series(_SC, t)
+    Rs = add_outer(mat(scale(a, ws), 1.0 - b * t2), scale(b, ws), ws)
+    wxu = cross(ws, us)
+    xs = add(add(us, scale(b, wxu)), scale(c, cross(ws, wxu)))
+    R = mm(RA, Rs)
+    return _update(line, x1, e1, add(mv(RA, xs), xA), mv(R, u), mv(R, cross(w, u)), xi2), t
+
+
+@jit_inline
+def _step(line, x1, e1, RA, xA, u, w, xi2):
+    """``_update`` at the section ``kernel_jit._section`` (any angle; scalar, a rare lane: not inlined)."""
+    _, x2, x2p, x2pp = _section(RA, xA, u, w, xi2)
+    return _update(line, x1, e1, x2, x2p, x2pp, xi2)
+
+
 @jit
-def _project_points(H, kind, A1, h1, xi1, A2, B2, h2, iterations, out2, dist):
-    for k in range(len(A1)):
-        RA1, xA1 = _pose_of(H, A1[k])
-        RA2, xA2 = _pose_of(H, A2[k])
-        _, xB2 = _pose_of(H, B2[k])
-        u1, w1 = (h1[k, 0], h1[k, 1], h1[k, 2]), (h1[k, 3], h1[k, 4], h1[k, 5])
-        u2, w2 = (h2[k, 0], h2[k, 1], h2[k, 2]), (h2[k, 3], h2[k, 4], h2[k, 5])
-        sec1 = _section_inline(RA1, xA1, u1, w1, xi1[k])
-        xc = sec1[1]
-        chord = (xB2[0] - xA2[0], xB2[1] - xA2[1], xB2[2] - xA2[2])
-        rel = (xc[0] - xA2[0], xc[1] - xA2[1], xc[2] - xA2[2])
-        s = dot(rel, chord) / max(dot(chord, chord), 1e-300)
-        s = min(max(s, 0.0), 1.0)
-        _, xi2 = _project_from(kind[k], sec1, RA1, xA1, u1, w1, xi1[k], RA2, xA2, u2, w2, s, iterations)
-        _, xf, _, _ = _section_inline(RA2, xA2, u2, w2, xi2)
-        out2[k] = xi2
-        dist[k] = np.sqrt((xf[0] - xc[0]) ** 2 + (xf[1] - xc[1]) ** 2 + (xf[2] - xc[2]) ** 2)
+def _iterate(S, line, xi, nxt, ang, n, iterations):
+    """``iterations`` Newton updates of ``xi[:n]`` for the lanes ``S[:, :n]`` (``line[l]``: kind ``LINE``,
+    else ``ORTHOGONAL``); ``nxt``, ``ang`` scratch ``(LANES,)``."""
+    for _ in range(iterations):
+        for l in range(n):
+            RA, xA, u, w, x1, e1 = _lane(S, l)
+            nxt[l], ang[l] = _step_series(line[l], x1, e1, RA, xA, u, w, xi[l])
+        for l in range(n):
+            if ang[l] >= _SWITCH_ABC:
+                RA, xA, u, w, x1, e1 = _lane(S, l)
+                nxt[l] = _step(line[l], x1, e1, RA, xA, u, w, xi[l])
+            xi[l] = nxt[l]
+
+
+@jit_inline
+def _fill(S, l, RA2, xA2, h2, k, xc, e1):
+    for i in range(3):
+        for j in range(3):
+            S[_RA + 3 * i + j, l] = RA2[i][j]
+        S[_XA + i, l] = xA2[i]
+        S[_U + i, l] = h2[k, i]
+        S[_W + i, l] = h2[k, 3 + i]
+        S[_X1 + i, l] = xc[i]
+        S[_E1 + i, l] = e1[i]
+
+
+@jit_inline
+def _chord_start(xc, xA2, xB2):
+    """Projection of ``xc`` on the master chord ``xA2 xB2``, clipped to ``[0, 1]``."""
+    chord = (xB2[0] - xA2[0], xB2[1] - xA2[1], xB2[2] - xA2[2])
+    rel = (xc[0] - xA2[0], xc[1] - xA2[1], xc[2] - xA2[2])
+    s = dot(rel, chord) / max(dot(chord, chord), 1e-300)
+    return min(max(s, 0.0), 1.0)
+
+
+@jit_inline
+def _finish(H, a2, h2, k, S, l, xi2, out2, dist, r):
+    """Master parameter and centre distance of lane ``l`` (master first node ``a2``, twist ``h2[k]``)
+    into row ``r``."""
+    RA2, xA2 = _pose_of(H, a2)
+    _, xf, _, _ = _section_inline(RA2, xA2, (h2[k, 0], h2[k, 1], h2[k, 2]), (h2[k, 3], h2[k, 4], h2[k, 5]), xi2)
+    out2[r] = xi2
+    dist[r] = np.sqrt((xf[0] - S[_X1, l]) ** 2 + (xf[1] - S[_X1 + 1, l]) ** 2 + (xf[2] - S[_X1 + 2, l]) ** 2)
+
+
+@jit
+def _gauss_project(H, enodes, h, e, m, xg, line, c2, reach, iterations, row, gp, out2, dist):
+    """Slave Gauss points ``xg`` of element pairs ``k`` (slave ``e[k]``, master ``m[k]``) within ``reach[k]``
+    of ``c2[k]``, projected on the master; rows in the order ``(k, g)``, returns their number.  A slave
+    element's sections are computed once."""
+    S = np.empty((N_FIELDS, LANES))
+    xi, nxt, ang = np.empty(LANES), np.empty(LANES), np.empty(LANES)
+    ln = np.empty(LANES, dtype=np.bool_)
+    lane_row = np.empty(LANES, dtype=np.int64)
+    slot = np.full(len(enodes), -1, dtype=np.int64)
+    sec = np.empty((len(e), len(xg), 6))       # per slave element: centre and first axis of each Gauss point
+    n_sec = 0
+    n, l = 0, 0
+    for k in range(len(e)):
+        s = slot[e[k]]
+        if s < 0:
+            s = slot[e[k]] = n_sec
+            n_sec += 1
+            RA1, xA1 = _pose_of(H, enodes[e[k], 0])
+            u1, w1 = (h[e[k], 0], h[e[k], 1], h[e[k], 2]), (h[e[k], 3], h[e[k], 4], h[e[k], 5])
+            for g in range(len(xg)):
+                R1, xc, _, _ = _section_inline(RA1, xA1, u1, w1, xg[g])
+                for i in range(3):
+                    sec[s, g, i], sec[s, g, 3 + i] = xc[i], R1[i][0]
+        RA2, xA2 = _pose_of(H, enodes[m[k], 0])
+        _, xB2 = _pose_of(H, enodes[m[k], 1])
+        r2 = reach[k] * reach[k]
+        for g in range(len(xg)):
+            xc = (sec[s, g, 0], sec[s, g, 1], sec[s, g, 2])
+            d0, d1, d2 = xc[0] - c2[k, 0], xc[1] - c2[k, 1], xc[2] - c2[k, 2]
+            if not (d0 * d0 + d1 * d1) + d2 * d2 <= r2:
+                continue
+            _fill(S, l, RA2, xA2, h, m[k], xc, (sec[s, g, 3], sec[s, g, 4], sec[s, g, 5]))
+            xi[l] = _chord_start(xc, xA2, xB2)
+            ln[l] = line[k]
+            row[n], gp[n], lane_row[l] = k, g, n
+            n += 1
+            l += 1
+            if l == LANES:
+                _iterate(S, ln, xi, nxt, ang, l, iterations)
+                for j in range(l):
+                    mj = m[row[lane_row[j]]]
+                    _finish(H, enodes[mj, 0], h, mj, S, j, xi[j], out2, dist, lane_row[j])
+                l = 0
+    _iterate(S, ln, xi, nxt, ang, l, iterations)
+    for j in range(l):
+        mj = m[row[lane_row[j]]]
+        _finish(H, enodes[mj, 0], h, mj, S, j, xi[j], out2, dist, lane_row[j])
+    return n
+
+
+def gauss_projections(H, enodes, h, e, m, xg, kind, c2, reach, iterations=8):
+    """Slave Gauss points ``xg`` ``(g,)`` of element pairs ``(n,)`` projected on their master elements.
+
+    Pair ``k``: slave element ``e[k]`` (its sections are computed once), master element ``m[k]``,
+    ``kind[k]`` (``LINE`` or ``ORTHOGONAL``); ``enodes``, twists ``h`` ``(n_el, 6)``: all elements'.
+    A Gauss point whose centre lies farther than ``reach[k]`` from
+    ``c2[k]`` ``(n, 3)`` (the master's bounding sphere grown by the slave radius) cannot touch the
+    master and is skipped.  The others are projected as ``project_points`` does (from the master
+    chord, ``iterations`` Newton iterations).  Returns, over the rows kept in the order ``(k, g)``:
+    pair ``row``, Gauss point ``gp``, ``xi2`` and centre distance.
+    """
+    c = np.ascontiguousarray
+    n = len(e) * len(xg)
+    row, gp = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
+    out2, dist = np.empty(n), np.empty(n)
+    k = _gauss_project(H, enodes, c(h, dtype=float), c(e), c(m), c(xg, dtype=float), c(np.asarray(kind) == LINE),
+                       c(c2, dtype=float), c(reach, dtype=float), int(iterations), row, gp, out2, dist)
+    return row[:k], gp[:k], out2[:k], dist[:k]
+
+
+@jit
+def _project_points(H, line, A1, h1, xi1, A2, B2, h2, iterations, out2, dist):
+    S = np.empty((N_FIELDS, LANES))
+    xi, nxt, ang = np.empty(LANES), np.empty(LANES), np.empty(LANES)
+    ln = np.empty(LANES, dtype=np.bool_)
+    n = len(A1)
+    for lo in range(0, n, LANES):
+        m = min(LANES, n - lo)
+        for l in range(m):
+            k = lo + l
+            RA1, xA1 = _pose_of(H, A1[k])
+            RA2, xA2 = _pose_of(H, A2[k])
+            _, xB2 = _pose_of(H, B2[k])
+            R1, xc, _, _ = _section_inline(RA1, xA1, (h1[k, 0], h1[k, 1], h1[k, 2]), (h1[k, 3], h1[k, 4], h1[k, 5]),
+                                           xi1[k])
+            _fill(S, l, RA2, xA2, h2, k, xc, (R1[0][0], R1[1][0], R1[2][0]))
+            xi[l] = _chord_start(xc, xA2, xB2)
+            ln[l] = line[k]
+        _iterate(S, ln, xi, nxt, ang, m, iterations)
+        for l in range(m):
+            _finish(H, A2[lo + l], h2, lo + l, S, l, xi[l], out2, dist, lo + l)
 
 
 def project_points(H, kind, A1, h1, xi1, A2, B2, h2, iterations=8):
     """Master parameter ``xi2`` and centre distance of slave sections ``xi1`` projected onto master
-    elements (nodes ``A2``, ``B2``; ``kind`` ``LINE`` or ``ORTHOGONAL``), started on the master chord."""
+    elements (nodes ``A2``, ``B2``; ``kind`` ``LINE`` or ``ORTHOGONAL``), started on the master chord
+    (the iterations of ``kernel_jit._project_from``, lanes in lockstep)."""
     n = len(A1)
     out2, dist = np.empty(n), np.empty(n)
     c = np.ascontiguousarray
-    _project_points(H, c(kind, dtype=np.int64), c(A1), c(h1, dtype=float), c(xi1, dtype=float), c(A2), c(B2),
-                    c(h2, dtype=float), int(iterations), out2, dist)
+    _project_points(H, c(np.asarray(kind) == LINE), c(A1), c(h1, dtype=float), c(np.broadcast_to(xi1, (n,)), dtype=float),
+                    c(A2), c(B2), c(h2, dtype=float), int(iterations), out2, dist)
     return out2, dist

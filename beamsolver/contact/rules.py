@@ -53,7 +53,12 @@ def apart(enodes, e, m):
     ``joint_nodes`` so that elements meeting at a joint never pair: their centre lines meet
     there, a contact pair between them would find no normal or the full overlap
     ``R1 + R2``)."""
-    return ~(enodes[e][:, :, None] == enodes[m][:, None, :]).any(axis=(1, 2))
+    A, B = enodes[e], enodes[m]
+    shared = np.zeros(len(A), dtype=bool)
+    for a in range(A.shape[1]):            # node columns: no (n, k, k) table
+        for b in range(B.shape[1]):
+            shared |= A[:, a] == B[:, b]
+    return ~shared
 
 
 def point_or_orthogonal(ratio, point_ratio):
@@ -63,8 +68,10 @@ def point_or_orthogonal(ratio, point_ratio):
 
 
 def crossing(t_slave, t_master, line_angle):
-    """Mask of the element pairs at or above ``line_angle`` (those needing their closest points)."""
-    return np.arccos(np.clip(np.abs(np.sum(t_slave * t_master, axis=1)), 0.0, 1.0)) >= line_angle
+    """Mask of the element pairs at or above ``line_angle`` (those needing their closest points);
+    tangents ``(n, 3)``."""
+    cos = t_slave[:, 0] * t_master[:, 0] + t_slave[:, 1] * t_master[:, 1] + t_slave[:, 2] * t_master[:, 2]
+    return np.arccos(np.clip(np.abs(cos), 0.0, 1.0)) >= line_angle
 
 
 def extend_wrap(enodes, master_beam, n_beams, e, m, kind, xi1=None):
@@ -83,7 +90,10 @@ def extend_wrap(enodes, master_beam, n_beams, e, m, kind, xi1=None):
     pt = np.flatnonzero(kind == POINT)
     if xi1 is not None:
         pt = pt[(xi1[pt] < WRAP_END) | (xi1[pt] > 1.0 - WRAP_END)]
-    near = np.isin(enodes[e[pt]] * n_beams + master_beam[pt, None], wrap).any(axis=1)
+    if not len(pt):
+        return kind
+    ids = enodes[e[pt]] * n_beams + master_beam[pt, None]
+    near = (wrap[np.minimum(np.searchsorted(wrap, ids), len(wrap) - 1)] == ids).any(axis=1)    # np.isin, wrap sorted
     kind = kind.copy()
     kind[pt[near]] = ORTHOGONAL
     return kind
@@ -105,6 +115,7 @@ def owners(cand, key, xi2, dist, rsum, known):
     (a point projecting on a node shared by two elements, to round-off); among equals
     the owner of the last evaluation (``known``, over all rows: no flip-flop inside
     Newton), then the element on which the point lies at its start (smaller ``xi2``).
+    The search runs its compiled twin ``ownership.gauss_owners`` (tested equal).
     """
     if len(cand) == 0:
         return cand

@@ -33,17 +33,19 @@ and master beam the closest accepted projection is kept.
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .projection import section_points
+from .projection import overlap, spheres
 
 XI_TOL = 1e-9
 
 
-def element_spheres(H, enodes, h, radii, margin):
-    """Mid-points ``(n, 3)``, bounding radii ``(n,)``, twists ``h`` ``(n, 6)`` (given) and mid-point
-    tangents ``(n, 3)`` of elements ``enodes`` at poses ``H`` (compiled, ``projection.section_points``)."""
-    mid, tangent = section_points(H, enodes[:, 0], h, np.full(len(h), 0.5))
-    arc = np.sqrt(np.sum(h[:, :3] ** 2, axis=1))
-    return mid, 0.5 * arc + radii + margin, h, tangent
+def element_spheres(H, enodes, h, radii, margin, el):
+    """Mid-points ``(n, 3)``, bounding radii ``(n,)`` and mid-point tangents ``(n, 3)`` of the elements
+    ``el`` ``(n,)`` at poses ``H`` (``enodes``, twists ``h`` ``(n_el, 6)``, section ``radii``: all elements'),
+    compiled (``projection.sphere_points``)."""
+    mid, radius, tangent = np.empty((len(el), 3)), np.empty(len(el)), np.empty((len(el), 3))
+    spheres(H, enodes, np.ascontiguousarray(h, dtype=float), radii, float(margin), np.ascontiguousarray(el), mid,
+            radius, tangent)
+    return mid, radius, tangent
 
 
 def broad_phase(c_s, r_s, c_m, r_m):
@@ -51,8 +53,10 @@ def broad_phase(c_s, r_s, c_m, r_m):
     if len(c_s) == 0 or len(c_m) == 0:
         return np.zeros(0, dtype=int), np.zeros(0, dtype=int)
     ts, tm = cKDTree(c_s), cKDTree(c_m)
-    D = ts.sparse_distance_matrix(tm, float(r_s.max() + r_m.max()), output_type="coo_matrix")
-    i, j = D.row, D.col
-    d = np.linalg.norm(c_s[i] - c_m[j], axis=1)
-    keep = d <= r_s[i] + r_m[j]
+    # "ndarray": the pairs of the "coo_matrix" output, in the same order, without building a matrix
+    # (half the broad phase's time on small scenes)
+    D = ts.sparse_distance_matrix(tm, float(r_s.max() + r_m.max()), output_type="ndarray")
+    i, j = D["i"], D["j"]
+    keep = np.empty(len(i), dtype=bool)
+    overlap(c_s, r_s, c_m, r_m, i, j, keep)
     return i[keep], j[keep]

@@ -7,9 +7,9 @@ contact declarations.  It orchestrates pure stages kept in their own modules:
    twists computed once per evaluation (``projection.element_twists``);
 2. pair rules (``rules.py``: no pair between elements sharing a node or meeting at a joint,
    the kind of each element pair, closest points of crossings from ``projection.closest_points``);
-3. projection of the slave Gauss points (``projection.project_points``, compiled) and
-   ownership (``rules.owners``, ``rules.dedupe_points``: one owner per slave point, stable
-   at shared nodes), giving one typed ``record.PairSet``;
+3. projection of the slave Gauss points (``projection.gauss_projections``, compiled) and
+   ownership (``ownership.gauss_owners``, the compiled ``rules.owners``; ``rules.dedupe_points``:
+   one owner per slave point, stable at shared nodes), giving one typed ``record.PairSet``;
 4. refusals (``_check_sides``: tunnelling; ``_check_normals``: no normal);
 5. kernel parameters and history look-up (``_params``), then the compiled kernel of the
    contact law (``kernel_jit``, ``law.ContactLaw``) on the active pairs (``_local_blocks``,
@@ -53,7 +53,8 @@ from .kernel_jit import contact_kernel, kernel_and_tangent      # compiled; pair
 from .options import SMOOTHING, ContactOptions
 from .pairs import LINE, NORMAL_TOL, POINT, material_frames, no_normal
 from .record import Candidates, PairSet
-from .projection import closest_points, element_twists, project_points, section_points
+from .ownership import gauss_owners
+from .projection import closest_points, element_twists, gauss_projections, section_points
 from .search import broad_phase, element_spheres
 from . import rules
 
@@ -287,8 +288,8 @@ class ContactSystem(Contribution):
         ratio; search.py) and the closest points of non-line pairs."""
         en = self.sys.enodes
         H, h = self._twists(H)
-        cs, rs, hs, ts = element_spheres(H, en[d.slave_el], h[d.slave_el], self.el_radius[d.slave_el], d.margin)
-        cm, rm, hm, tm = element_spheres(H, en[d.master_el], h[d.master_el], self.el_radius[d.master_el], d.margin)
+        cs, rs, ts = element_spheres(H, en, h, self.el_radius, d.margin, d.slave_el)
+        cm, rm, tm = element_spheres(H, en, h, self.el_radius, d.margin, d.master_el)
         i, j = broad_phase(cs, rs, cm, rm)
         self._lap("search")
         e, m = d.slave_el[i], d.master_el[j]
@@ -299,14 +300,14 @@ class ContactSystem(Contribution):
         b = np.flatnonzero(rules.crossing(ts[i], tm[j], d.line_angle))
         if len(b):
             self._lap("rules")
-            x1, x2, ratio = closest_points(H, en[e[b], 0], hs[i[b]], en[m[b], 0], hm[j[b]])
+            x1, x2, ratio = closest_points(H, en[e[b], 0], h[e[b]], en[m[b], 0], h[m[b]])
             self._lap("projection")
             kinds[b] = rules.point_or_orthogonal(ratio, d.point_ratio)
             xi1[b], xi2[b] = x1, x2
             kinds = rules.extend_wrap(en, self.el_beam[m], self.n_beams, e, m, kinds, xi1)
             kinds = self._step_kinds(d, e, m, kinds)
         self._lap("rules")
-        return Candidates(e=e, m=m, kind=kinds, xi1=xi1, xi2=xi2, h1=hs[i], h2=hm[j], c2=cm[j], r2=rm[j])
+        return Candidates(e=e, m=m, kind=kinds, xi1=xi1, xi2=xi2, c2=cm[j], r2=rm[j])
 
     def _record(self, d, kind, e, m, xi1, xi2, weight, key, gp):
         en = self.sys.enodes
@@ -320,13 +321,19 @@ class ContactSystem(Contribution):
         n_el = len(self.sys.enodes)
         pt = np.flatnonzero(c.kind == POINT)
         e, m, x1, x2 = c.e[pt], c.m[pt], c.xi1[pt], c.xi2[pt]
+        if not len(pt):             # no point pairs: an empty record
+            rec = self._record(d, pt, e, m, x1, x2, x1, pt, pt)
+            self._lap("rules")
+            return rec, e * n_el + m
         lo1, hi1 = self._xi_range(e)
         lo2, hi2 = self._xi_range(m)
         pt = pt[(x1 >= lo1) & (x1 <= hi1) & (x2 >= lo2) & (x2 <= hi2)]
         e, m, x1, x2 = c.e[pt], c.m[pt], c.xi1[pt], c.xi2[pt]
-        keep = rules.dedupe_points(self._points(H, e, x1), self._points(H, m, x2), x1, x2,
-                                   self.el_radius[e] + self.el_radius[m], self.el_beam[e] * self.n_beams + self.el_beam[m],
-                                   _member(e * n_el + m, self._prev_points))
+        keep = np.arange(len(pt))       # rules.dedupe_points of fewer than two pairs
+        if len(pt) > 1:
+            keep = rules.dedupe_points(self._points(H, e, x1), self._points(H, m, x2), x1, x2,
+                                       self.el_radius[e] + self.el_radius[m], self.el_beam[e] * self.n_beams + self.el_beam[m],
+                                       _member(e * n_el + m, self._prev_points))
         pt, e, m = pt[keep], e[keep], m[keep]
         key = self.point_offset + (np.int64(d.index) * n_el + e) * n_el + m
         rec = self._record(d, np.full(len(pt), POINT), e, m, c.xi1[pt], c.xi2[pt], self.sys.L[e], key,
@@ -336,33 +343,27 @@ class ContactSystem(Contribution):
 
     def _gauss_pairs(self, d, H, c):
         """Line and orthogonal projections of the slave Gauss points; one owner per slave
-        point and master beam (``rules.owners``).  Returns the record and the owner ids."""
+        point and master beam (``ownership.gauss_owners``, the compiled ``rules.owners``).  Returns
+        the record and the owner ids."""
         en = self.sys.enodes
         gp = np.flatnonzero(c.kind != POINT)
         xg, wg = d.gauss
-        rep = np.repeat(gp, d.n_gp)
-        g = np.tile(np.arange(d.n_gp), len(gp))
-        e, m, h1, h2 = c.e[rep], c.m[rep], c.h1[rep], c.h2[rep]
-        xi1 = xg[g]
-        H, _ = self._twists(H)
-        xc, _ = section_points(H, en[e, 0], h1, xi1)
-        # a slave Gauss point outside the master element's sphere (grown by R1) cannot
-        # touch that element: no projection for it
-        near = np.sum((xc - c.c2[rep]) ** 2, axis=1) <= (c.r2[rep] + self.el_radius[e]) ** 2
-        rep, g, e, m, h1, h2, xi1 = rep[near], g[near], e[near], m[near], h1[near], h2[near], xi1[near]
-        kind = c.kind[rep]
-        # from the projection on the master chord, 8 Newton iterations (compiled, projection.py; the
-        # kernel polishes the point with 2 more and needs it converged for an exact tangent)
-        xi2, dist = project_points(H, kind, en[e, 0], h1, xi1, en[m, 0], en[m, 1], h2, iterations=8)
+        e, m = c.e[gp], c.m[gp]
+        H, h = self._twists(H)
+        # a slave Gauss point outside the master element's sphere (grown by R1) cannot touch that
+        # element: no projection for it; the others from the projection on the master chord, 8 Newton
+        # iterations (compiled, projection.py; the kernel polishes the point with 2 more and needs it
+        # converged for an exact tangent)
+        r, g, xi2, dist = gauss_projections(H, en, h, e, m, xg, c.kind[gp], c.c2[gp], c.r2[gp] + self.el_radius[e],
+                                            iterations=8)
+        rep, e, m = gp[r], e[r], m[r]
         self._lap("projection")
-        lo, hi = self._xi_range(m)
-        ok = (xi2 >= lo) & (xi2 <= hi) & np.isfinite(dist)
-        key = ((np.int64(d.index) * len(en) + e) * self.max_gp + g) * self.n_beams + self.el_beam[m]
-        known = _member(key * len(en) + m, self._prev_owners)
-        s = rules.owners(np.flatnonzero(ok), key, xi2, dist, self.el_radius[e] + self.el_radius[m], known)
-        rec = self._record(d, kind[s], e[s], m[s], xi1[s], xi2[s], wg[g[s]] * self.sys.L[e[s]], key[s], g[s])
+        s, key = gauss_owners(d.index, len(en), self.max_gp, self.n_beams, e, m, g, xi2, dist, self.el_first,
+                              self.el_last, self.el_beam, self.el_radius, self._prev_owners)
+        e, m, g = e[s], m[s], g[s]
+        rec = self._record(d, c.kind[rep[s]], e, m, xg[g], xi2[s], wg[g] * self.sys.L[e], key, g)
         self._lap("rules")
-        return rec, key[s] * len(en) + m[s]
+        return rec, key * len(en) + m
 
     def _xi_range(self, el):
         """Accepted projections ``[lo, hi]`` on elements ``el`` (``rules.xi_range``)."""

@@ -1,0 +1,119 @@
+"""Compiled ownership of the slave Gauss points: ``rules.owners`` in one pass (no sorts of all rows).
+
+``gauss_owners`` takes the projected rows of ``projection.gauss_projections`` and returns the
+rows ``rules.owners`` chooses among the accepted ones (``rules.xi_range``, finite distance), in
+the same order (by key).  The rows are bucketed by slave element (a counting sort, stable), each
+bucket's few rows sorted by key in place; per key the owner is the least of ``(not tie, not known,
+xi2, dist, row)`` among the rows inside their element, else among those on an extension, where
+``tie`` compares the distance with the least of that level (``rules.OWNER_TIE``) and ``known``
+(the owner of the last evaluation, a binary search) is looked up only where two rows tie.
+"""
+import numpy as np
+
+from .._jit import jit
+from .rules import OWNER_TIE, XI_OVERHANG
+from .search import XI_TOL
+
+__all__ = ["gauss_owners"]
+
+
+@jit
+def _known(sorted_ids, x):
+    """``x`` in the sorted array ``sorted_ids`` (binary search)."""
+    lo, hi = 0, len(sorted_ids)
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if sorted_ids[mid] < x:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo < len(sorted_ids) and sorted_ids[lo] == x
+
+
+@jit
+def _owners(base, n_el, max_gp, n_beams, e, m, g, xi2, dist, first, last, beam, radius, prev, out, out_key):
+    n = len(e)
+    key = np.empty(n, dtype=np.int64)
+    start = np.zeros(n_el + 1, dtype=np.int64)
+    n_ok = 0
+    for r in range(n):
+        lo = -XI_TOL if first[m[r]] else -XI_OVERHANG
+        hi = 1.0 + XI_TOL if last[m[r]] else 1.0 + XI_OVERHANG
+        if xi2[r] >= lo and xi2[r] <= hi and np.isfinite(dist[r]):
+            key[r] = ((base + e[r]) * max_gp + g[r]) * n_beams + beam[m[r]]
+            start[e[r] + 1] += 1
+            n_ok += 1
+        else:
+            key[r] = -1
+    for j in range(n_el):
+        start[j + 1] += start[j]
+    rows = np.empty(n_ok, dtype=np.int64)
+    fill = start[:-1].copy()
+    for r in range(n):
+        if key[r] >= 0:
+            rows[fill[e[r]]] = r
+            fill[e[r]] += 1
+    n_out = 0
+    for j in range(n_el):
+        a, b = start[j], start[j + 1]
+        for i in range(a + 1, b):          # insertion sort by key, stable
+            r = rows[i]
+            p = i
+            while p > a and key[rows[p - 1]] > key[r]:
+                rows[p] = rows[p - 1]
+                p -= 1
+            rows[p] = r
+        i = a
+        while i < b:
+            q = i
+            inside = False
+            while q < b and key[rows[q]] == key[rows[i]]:
+                x = xi2[rows[q]]
+                inside = inside or not (x < -XI_TOL or x > 1.0 + XI_TOL)
+                q += 1
+            # the level chosen (inside over an extension), its least distance and ties
+            least = np.inf
+            for p in range(i, q):
+                r = rows[p]
+                if (not (xi2[r] < -XI_TOL or xi2[r] > 1.0 + XI_TOL)) == inside:
+                    least = min(least, dist[r])
+            n_tie = 0
+            best = -1
+            for p in range(i, q):
+                r = rows[p]
+                if (not (xi2[r] < -XI_TOL or xi2[r] > 1.0 + XI_TOL)) == inside:
+                    if dist[r] <= least + OWNER_TIE * (radius[e[r]] + radius[m[r]]):
+                        n_tie += 1
+                        if best < 0:
+                            best = r
+            if n_tie > 1:
+                best = -1
+                best_known = False
+                for p in range(i, q):
+                    r = rows[p]
+                    if (not (xi2[r] < -XI_TOL or xi2[r] > 1.0 + XI_TOL)) != inside:
+                        continue
+                    if not dist[r] <= least + OWNER_TIE * (radius[e[r]] + radius[m[r]]):
+                        continue
+                    kn = _known(prev, key[r] * n_el + m[r])
+                    if best < 0 or (kn and not best_known) or (kn == best_known and (
+                            xi2[r] < xi2[best] or (xi2[r] == xi2[best] and dist[r] < dist[best]))):
+                        best, best_known = r, kn
+            out[n_out] = best
+            out_key[n_out] = key[best]
+            n_out += 1
+            i = q
+    return n_out
+
+
+def gauss_owners(decl, n_el, max_gp, n_beams, e, m, g, xi2, dist, first, last, beam, radius, prev):
+    """Owners (``rules.owners``) among the projected Gauss-point rows ``e``, ``m``, ``g``, ``xi2``, ``dist``
+    ``(n,)`` of declaration ``decl``: accepted rows only (``rules.xi_range`` of the master: ``first``,
+    ``last`` per element; finite distance), key ``((decl n_el + e) max_gp + g) n_beams + beam[m]``,
+    section ``radius`` per element, ``prev``: sorted ``key * n_el + m`` of the last owners.  Returns the
+    rows chosen, in key order, and their keys."""
+    n = len(e)
+    out, out_key = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
+    k = _owners(np.int64(decl) * n_el, int(n_el), int(max_gp), int(n_beams), e, m, g, xi2, dist, first, last, beam,
+                radius, prev, out, out_key)
+    return out[:k], out_key[:k]
