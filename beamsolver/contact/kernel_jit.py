@@ -334,8 +334,8 @@ def _m_times(z, A, out):
 # ---------------------------------------------------------------- one side of a pair: scratch slots
 # 6x6 slots of a side's scratch ``S`` (N_SIDE, 6, 6)
 (S_TI, S_AH, S_TS, S_AS, S_JA, S_JB, S_TSP, S_ASP, S_JAP, S_JBP, S_TMP, S_GS, S_M1, S_P, S_DA, S_DB, S_TMH, S_TMS, S_MS,
- S_AHDB, S_TDY, S_AD) = range(22)
-N_SIDE = 22
+ S_AHDB, S_TDY, S_AD, S_TIAH) = range(23)
+N_SIDE = 23
 # 6-vector slots of a side's ``v`` (N_VEC, 6)
 (V_WR, V_Y, V_XY, V_DB, V_B, V_ZS, V_ZH, V_AHDB, V_DA) = range(9)
 N_VEC = 9
@@ -535,9 +535,10 @@ C_POSE, C_U, C_W, C_T2, C_D, C_CO, N_CACHE = 0, 24, 27, 30, 31, 32, 39
 @jit
 def _element_side(Xp, j0, S, c):
     """Twist ``h = log(H_A^-1 H_B)`` of the element of nodes ``j0, j0 + 1`` and the element's quantities:
-    ``T(h)^-1``, ``Ad(exp(-h))``, ``T(-h)`` into ``S[S_TI], S[S_AH], S[S_TMH]`` and the coefficients of
-    ``G(h, .)`` into ``c``.  Kept while the node poses are those of the last point on this side, bit for
-    bit (the Gauss points of a slave element, consecutive points on one master element): the same floats."""
+    ``T(h)^-1``, ``Ad(exp(-h))``, ``T(h)^-1 Ad(exp(-h))``, ``T(-h)`` into ``S[S_TI], S[S_AH], S[S_TIAH],
+    S[S_TMH]`` and the coefficients of ``G(h, .)`` into ``c``.  Kept while the node poses are those of the last
+    point on this side, bit for bit (the Gauss points of a slave element, consecutive points on one master
+    element): the same floats."""
     hit = True
     for a in range(2):
         for i in range(3):
@@ -553,6 +554,7 @@ def _element_side(Xp, j0, S, c):
     RB, xB = _pose_of(Xp, j0 + 1)
     u, w, _, _ = log_relative(RA, xA, RB, xB)
     _side(u, w, S)
+    _mm_ut(S[S_TI], S[S_AH], S[S_TIAH])
     _tangent(scale(-1.0, u), scale(-1.0, w), S[S_TMH])
     t2 = dot(w, w)
     t = np.sqrt(t2)
@@ -567,18 +569,17 @@ def _element_side(Xp, j0, S, c):
 
 
 @jit
-def _variations(S, c0, G, DH, V, tmp):
+def _variations(S, c0, G, DH, V):
     """Twist variation ``dh = T(h)^-1 (dq_B - Ad(exp(-h)) dq_A)`` and section-frame variation at fixed
     ``xi`` ``(J_A dq_A + J_B dq_B)`` into the rows ``DH``, ``V`` of ``G`` (6 each), node A at column ``c0``
     (``c0`` 0 or 12).  The other side's columns of ``DH`` are zero from ``_scratch`` on (never written)."""
     for i in range(6):
         for k in range(12 - c0, 24 - c0):
             G[(V + i) * W + k] = 0.0
-    _mm_ut(S[S_TI], S[S_AH], tmp)
-    Ti, JA, JB = S[S_TI], S[S_JA], S[S_JB]
+    Ti, TiAh, JA, JB = S[S_TI], S[S_TIAH], S[S_JA], S[S_JB]
     for i in range(6):
         for j in range(6):
-            G[(DH + i) * W + c0 + j] = -tmp[i, j]
+            G[(DH + i) * W + c0 + j] = -TiAh[i, j]
             G[(DH + i) * W + c0 + 6 + j] = Ti[i, j]
             G[(V + i) * W + c0 + j] = JA[i, j]
             G[(V + i) * W + c0 + 6 + j] = JB[i, j]
@@ -834,8 +835,8 @@ def _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, d, S1, S
     ``_coefficients(xi w)`` of the sides."""
     _jacobians(u1, w1, xi1, co1[0], co1[1], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB], S1[S_TMP])
     _jacobians(u2, w2, xi2, co2[0], co2[1], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB], S2[S_TMP])
-    _variations(S1, 0, G, G_DH1, G_VC, S1[S_TMP])
-    _variations(S2, 12, G, G_DH2, G_VF, S2[S_TMP])
+    _variations(S1, 0, G, G_DH1, G_VC)
+    _variations(S2, 12, G, G_DH2, G_VF)
     _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, G)
     h1 = (u1[0], u1[1], u1[2], w1[0], w1[1], w1[2])
     h2 = (u2[0], u2[1], u2[2], w2[0], w2[1], w2[2])
