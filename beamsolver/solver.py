@@ -17,6 +17,7 @@ the user's grid, keeping what converged when a run stops) is ``stepping.Run``.
 import logging
 import time
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -157,6 +158,18 @@ def _refine_advice(system, H, t, t_start, t_end):
     return "".join("; " + p for p in parts)
 
 
+class _Measured(NamedTuple):
+    """An evaluation (``problem.Evaluation``) with its residual scales and scaled residual, and,
+    once computed, its factorised tangent ``lu``, Newton correction ``dzf`` of the free unknowns
+    and that correction's norm."""
+    ev: object
+    scales: tuple
+    ratio: float
+    lu: object = None
+    dzf: object = None
+    norm: float = None
+
+
 class Newton:
     """Newton iterations of one step (``step``) on a ``problem.Problem`` with the ``Convergence``
     ``conv``; ``evaluate`` is the checked, timed evaluation it uses (also for branch switching),
@@ -189,6 +202,11 @@ class Newton:
 
     def _ratio(self, r, scales):
         return self.conv.residual_ratio(r[self._dofs_u], r[self._dofs_w], *scales)
+
+    def _measured(self, ev):
+        """``ev`` with its residual scales and scaled residual (``_Measured``; no direction yet)."""
+        scales = self.conv.scales(ev, self.L_ref)
+        return _Measured(ev, scales, self._ratio(ev.r, scales))
 
     def at_rest(self, ev, H, t):
         """Whether the given poses ``H`` (evaluated in ``ev`` at ``t``) are an equilibrium by
@@ -337,19 +355,13 @@ class Newton:
         floor = conv.floor(H, self.L_ref)
         damping = self.line_search and problem.smooth
         last_inc = np.inf
-        ahead = None                 # (ev, lu, dzf, scales, ratio, norm) of an accepted damped trial
+        ahead = None                 # the ``_Measured`` evaluation of an accepted trial (line search, damping)
         lam = 1.0
         rotation_streak = 0
         stats_extra = {}
         for it in range(conv.max_iter + 1):
-            if ahead is None:
-                ev = self.evaluate(H, t)
-                lu = dzf = nrm = None
-                scales = conv.scales(ev, self.L_ref)
-                ratio = self._ratio(ev.r, scales)
-            else:
-                ev, lu, dzf, scales, ratio, nrm = ahead     # the damped trial's, already measured
-                ahead = None
+            ev, scales, ratio, lu, dzf, nrm = self._measured(self.evaluate(H, t)) if ahead is None else ahead
+            ahead = None
             residuals.append(ratio)
             log.debug("t = %.6g  iteration %d  scaled residual %.3e", t, it, ratio)
             if self.callback is not None:
@@ -376,10 +388,7 @@ class Newton:
                 if not self.line_search:
                     H = problem.update(H, dz)
                     continue
-                H, ev1 = self._line_search(H, dz, ev.r, scales, t)
-                if ev1 is not None:        # the accepted full step's evaluation is the next iteration's
-                    scales1 = conv.scales(ev1, self.L_ref)
-                    ahead = (ev1, None, None, scales1, self._ratio(ev1.r, scales1), None)
+                H, ahead = self._line_search(H, dz, ev.r, scales, t)
                 continue
             lam0 = min(1.0, 2.0 * lam)          # after a damped iteration, try twice its length
             inc = conv.increment_ratio(dz, self.L_ref)
@@ -434,7 +443,7 @@ class Newton:
         rejected too) down to ``DAMPING_MIN``.
 
         ``nrm``, ``inc``: ``_norm(dzf)`` and ``_inc(dzf)`` if known.  Returns ``(H, lam, ahead,
-        rotation)``: ``ahead`` the trial's ``(ev, lu, dzf, scales, ratio, norm)`` (``lu``, ``dzf``,
+        rotation)``: ``ahead`` the trial's ``_Measured`` evaluation (its ``lu``, ``dzf``,
         ``norm`` ``None`` if it converged), ``rotation`` the rotation-limit failure of the full first
         trial, if that is what rejected it.
         """
@@ -451,16 +460,14 @@ class Newton:
             self.stall_ratio = np.inf
             H1 = problem.update(H, dz if lam == 1.0 else lam * dz)
             try:
-                ev1 = self.evaluate(H1, t)
-                scales1 = conv.scales(ev1, self.L_ref)
-                ratio1 = self._ratio(ev1.r, scales1)
-                if ratio1 <= conv.rtol:
-                    return H1, lam, (ev1, None, None, scales1, ratio1, None), None
-                lu1, d1 = self._direction(ev1)
+                m = self._measured(self.evaluate(H1, t))
+                if m.ratio <= conv.rtol:
+                    return H1, lam, m, None
+                lu1, d1 = self._direction(m.ev)
                 nrm1 = self._norm(d1)
                 self.stall_ratio = nrm1 / nrm
                 if nrm1 < nrm or self._inc(d1) <= conv.dtol:
-                    return H1, lam, (ev1, lu1, d1, scales1, ratio1, nrm1), rotation
+                    return H1, lam, m._replace(lu=lu1, dzf=d1, norm=nrm1), rotation
             except StepFailed as e:
                 failure = e
                 if first and e.rotation:
@@ -478,8 +485,8 @@ class Newton:
         damped Newton of ``_damped``: a piecewise smooth residual made its natural-monotonicity
         test accept steps that later stalled, e.g. in the twisted pair).
 
-        Returns ``(H1, ev1)``: the accepted poses and, when the full step is accepted, its
-        evaluation (with tangent: the next iteration's, computed once; ``None`` otherwise).
+        Returns ``(H1, ahead)``: the accepted poses and, when the full step is accepted, its
+        ``_Measured`` evaluation (with tangent: the next iteration's, computed once; ``None`` otherwise).
         The residual does not depend on whether the tangent is computed."""
         problem = self.problem
         phi0 = self._merit(r0, scales)
@@ -502,7 +509,7 @@ class Newton:
             # Newton may raise the residual for a while: only a blow-up (factor
             # LS_GROWTH) triggers backtracking, which then asks for a decrease
             if phi <= (LS_GROWTH * phi0 if alpha == 1.0 else (1.0 - 1e-4 * alpha) * phi0):
-                return H1, (ev1 if alpha == 1.0 else None)
+                return H1, (self._measured(ev1) if alpha == 1.0 else None)
             # minimiser of the quadratic through phi(0), phi'(0) = -2 phi0, phi(alpha)
             if np.isfinite(phi):
                 a_new = phi0 * alpha**2 / (phi - phi0 + 2.0 * alpha * phi0)
