@@ -187,16 +187,10 @@ class ExtraPattern:
         start = np.empty(n_kept + 1, dtype=np.int64)
         n_runs = _runs(c_row, ptr, start)
         self.start = start[:n_runs + 1].copy()
-        size = len(el_indices) + n_runs
-        u_ptr = np.empty(n_free + 1, dtype=np.int64)
-        u_row = np.empty(size, dtype=np.int32)
-        u_col = np.empty(size, dtype=np.int32)
-        self.el_pos = np.empty(len(el_indices), dtype=np.int64)
-        self.c_pos = np.empty(n_runs, dtype=np.int64)
+        u_ptr, u_row, u_col, self.el_pos, self.c_pos = _union_buffers(n_free, len(el_indices), n_runs)
         n = _merge(np.asarray(el_indptr, dtype=np.int64), el_indices, ptr, c_row, self.start, n_runs,
                    u_ptr, u_row, u_col, self.el_pos, self.c_pos)
-        self.indices, self.col = u_row[:n].copy(), u_col[:n].copy()
-        self.indptr = u_ptr.astype(np.int32)
+        self.indices, self.col, self.indptr = u_row[:n].copy(), u_col[:n].copy(), u_ptr.astype(np.int32)
 
     def same(self, rows, cols, base=None):
         """Whether ``(rows, cols)`` is this pattern (the same arrays, or equal ones), on the same
@@ -436,16 +430,10 @@ class BlockPattern:
         n_runs = _node_runs(c_row, ptr, start, self.run_ptr)
         self.start = start[:n_runs + 1].copy()
         n_c = int((self.run_ptr[src + 1] - self.run_ptr[src]).sum())
-        size = len(el_indices) + n_c
-        u_ptr = np.empty(n_free + 1, dtype=np.int64)
-        u_row = np.empty(size, dtype=np.int32)
-        u_col = np.empty(size, dtype=np.int32)
-        self.el_pos = np.empty(len(el_indices), dtype=np.int64)
-        self.c_pos = np.empty(n_c, dtype=np.int64)
+        u_ptr, u_row, u_col, self.el_pos, self.c_pos = _union_buffers(n_free, len(el_indices), n_c)
         n = _merge_nodes(np.asarray(el_indptr, dtype=np.int64), el_indices, src, self.run_ptr, c_row,
                          self.start, u_ptr, u_row, u_col, self.el_pos, self.c_pos)
-        self.indices, self.col = u_row[:n].copy(), u_col[:n].copy()
-        self.indptr = u_ptr.astype(np.int32)
+        self.indices, self.col, self.indptr = u_row[:n].copy(), u_col[:n].copy(), u_ptr.astype(np.int32)
 
     def same(self, d, tail=None, base=None):
         """Whether ``d`` and ``tail`` are this pattern's (the same ``d`` array, or equal ones), on the
@@ -475,3 +463,12 @@ def _csc(data, zeros, indices, indptr, col, n_free):
     else:
         indices, indptr = indices.copy(), indptr.copy()
     return sp.csc_matrix((data, indices, indptr), shape=(n_free, n_free))
+
+
+def _union_buffers(n_free, n_el, n_c):
+    """Output buffers of a union-pattern merge (``_merge``, ``_merge_nodes``): column pointers
+    ``(n_free + 1,)``, rows and columns ``(n_el + n_c,)`` (room for no overlap) and the union
+    positions of the ``n_el`` element entries and of the ``n_c`` contact runs."""
+    size = n_el + n_c
+    return (np.empty(n_free + 1, dtype=np.int64), np.empty(size, dtype=np.int32), np.empty(size, dtype=np.int32),
+            np.empty(n_el, dtype=np.int64), np.empty(n_c, dtype=np.int64))
