@@ -16,14 +16,15 @@ __all__ = ["PairSet", "Candidates"]
 class Candidates(NamedTuple):
     """Element pairs from the broad phase and pair rules, arrays over ``n`` element pairs:
     slave and master elements ``e``, ``m``, their ``kind``, closest points ``xi1``, ``xi2`` (non-line
-    pairs), master bounding-sphere centres ``c2`` ``(n, 3)`` and radii ``r2``."""
+    pairs), master bounding-sphere centres ``c2`` ``(n, 3)`` and their radii plus the slave's section
+    radius ``reach`` (``projection.gauss_projections``' filter of the Gauss points)."""
     e: np.ndarray
     m: np.ndarray
     kind: np.ndarray
     xi1: np.ndarray
     xi2: np.ndarray
     c2: np.ndarray
-    r2: np.ndarray
+    reach: np.ndarray
 
 
 @dataclass

@@ -67,10 +67,9 @@ def point_or_orthogonal(ratio, point_ratio):
     return np.where(ratio >= point_ratio, POINT, ORTHOGONAL)
 
 
-def crossing(t_slave, t_master, line_angle):
+def crossing(cos, line_angle):
     """Mask of the element pairs at or above ``line_angle`` (those needing their closest points);
-    tangents ``(n, 3)``."""
-    cos = t_slave[:, 0] * t_master[:, 0] + t_slave[:, 1] * t_master[:, 1] + t_slave[:, 2] * t_master[:, 2]
+    ``cos`` ``(n,)``: cosines of the angles between their mid-point tangents (``search.broad_pairs``)."""
     return np.arccos(np.clip(np.abs(cos), 0.0, 1.0)) >= line_angle
 
 

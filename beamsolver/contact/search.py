@@ -33,6 +33,7 @@ and master beam the closest accepted projection is kept.
 import numpy as np
 from scipy.spatial import cKDTree
 
+from .._jit import jit
 from .projection import overlap, spheres
 
 XI_TOL = 1e-9
@@ -60,3 +61,49 @@ def broad_phase(c_s, r_s, c_m, r_m):
     keep = np.empty(len(i), dtype=bool)
     overlap(c_s, r_s, c_m, r_m, i, j, keep)
     return i[keep], j[keep]
+
+
+@jit
+def _pairs_apart(i, j, c_s, r_s, c_m, r_m, t_s, t_m, slave_el, master_el, enodes, radius, e, m, cos, c2, reach):
+    n = 0
+    for k in range(len(i)):
+        a, b = i[k], j[k]
+        d0, d1, d2 = c_s[a, 0] - c_m[b, 0], c_s[a, 1] - c_m[b, 1], c_s[a, 2] - c_m[b, 2]
+        if not np.sqrt((d0 * d0 + d1 * d1) + d2 * d2) <= r_s[a] + r_m[b]:       # ``overlap``
+            continue
+        ea, mb = slave_el[a], master_el[b]
+        shared = False
+        for x in range(enodes.shape[1]):                                       # ``rules.apart``
+            for y in range(enodes.shape[1]):
+                shared = shared or enodes[ea, x] == enodes[mb, y]
+        if shared:
+            continue
+        e[n], m[n] = ea, mb
+        cos[n] = t_s[a, 0] * t_m[b, 0] + t_s[a, 1] * t_m[b, 1] + t_s[a, 2] * t_m[b, 2]
+        for x in range(3):
+            c2[n, x] = c_m[b, x]
+        reach[n] = r_m[b] + radius[ea]
+        n += 1
+    return n
+
+
+def broad_pairs(c_s, r_s, t_s, c_m, r_m, t_m, slave_el, master_el, enodes, radius):
+    """``broad_phase`` and the pair rule ``rules.apart`` in one compiled pass over the distance
+    matrix's pairs (in its order), with the data the later stages read of each pair kept.
+
+    Spheres ``c_s``, ``r_s``, mid-point tangents ``t_s`` of the slave elements ``slave_el`` (``c_m``,
+    ``r_m``, ``t_m``, ``master_el``: the masters'); ``enodes``: the end nodes ``rules.apart`` compares
+    (joints merged), ``radius``: section radii, both ``(n_el, ...)``.  Returns, per element pair kept:
+    slave and master elements ``e``, ``m``, the cosine of their mid-point tangents (``rules.crossing``),
+    the master's sphere centre ``c2`` ``(n, 3)`` and ``reach``: its radius plus the slave's section
+    radius (``projection.gauss_projections``' filter)."""
+    if len(c_s) == 0 or len(c_m) == 0:
+        i = j = np.zeros(0, dtype=np.intp)
+    else:
+        D = cKDTree(c_s).sparse_distance_matrix(cKDTree(c_m), float(r_s.max() + r_m.max()), output_type="ndarray")
+        i, j = D["i"], D["j"]
+    n = len(i)
+    e, m, cos, c2, reach = (np.empty(n, dtype=slave_el.dtype), np.empty(n, dtype=master_el.dtype), np.empty(n),
+                            np.empty((n, 3)), np.empty(n))
+    k = _pairs_apart(i, j, c_s, r_s, c_m, r_m, t_s, t_m, slave_el, master_el, enodes, radius, e, m, cos, c2, reach)
+    return e[:k], m[:k], cos[:k], c2[:k], reach[:k]

@@ -53,9 +53,9 @@ from .kernel_jit import contact_kernel, kernel_and_tangent      # compiled; pair
 from .options import SMOOTHING, ContactOptions
 from .pairs import LINE, NORMAL_TOL, POINT, material_frames, no_normal
 from .record import Candidates, PairSet
-from .ownership import gauss_owners
+from .ownership import gauss_owners, gauss_record
 from .projection import closest_points, element_twists, gauss_projections, section_points
-from .search import broad_phase, element_spheres
+from .search import broad_pairs, element_spheres
 from . import rules
 
 
@@ -290,14 +290,12 @@ class ContactSystem(Contribution):
         H, h = self._twists(H)
         cs, rs, ts = element_spheres(H, en, h, self.el_radius, d.margin, d.slave_el)
         cm, rm, tm = element_spheres(H, en, h, self.el_radius, d.margin, d.master_el)
-        i, j = broad_phase(cs, rs, cm, rm)
+        e, m, cos, c2, reach = broad_pairs(cs, rs, ts, cm, rm, tm, d.slave_el, d.master_el, self._joint_enodes,
+                                           self.el_radius)
         self._lap("search")
-        e, m = d.slave_el[i], d.master_el[j]
-        keep = rules.apart(self._joint_enodes, e, m)
-        i, j, e, m = i[keep], j[keep], e[keep], m[keep]
-        kinds = np.full(len(i), LINE)
-        xi1, xi2 = np.zeros(len(i)), np.zeros(len(i))
-        b = np.flatnonzero(rules.crossing(ts[i], tm[j], d.line_angle))
+        kinds = np.full(len(e), LINE)
+        xi1, xi2 = np.zeros(len(e)), np.zeros(len(e))
+        b = np.flatnonzero(rules.crossing(cos, d.line_angle))
         if len(b):
             self._lap("rules")
             x1, x2, ratio = closest_points(H, en[e[b], 0], h[e[b]], en[m[b], 0], h[m[b]])
@@ -307,7 +305,7 @@ class ContactSystem(Contribution):
             kinds = rules.extend_wrap(en, self.el_beam[m], self.n_beams, e, m, kinds, xi1)
             kinds = self._step_kinds(d, e, m, kinds)
         self._lap("rules")
-        return Candidates(e=e, m=m, kind=kinds, xi1=xi1, xi2=xi2, c2=cm[j], r2=rm[j])
+        return Candidates(e=e, m=m, kind=kinds, xi1=xi1, xi2=xi2, c2=c2, reach=reach)
 
     def _record(self, d, kind, e, m, xi1, xi2, weight, key, gp):
         en = self.sys.enodes
@@ -346,24 +344,24 @@ class ContactSystem(Contribution):
         point and master beam (``ownership.gauss_owners``, the compiled ``rules.owners``).  Returns
         the record and the owner ids."""
         en = self.sys.enodes
-        gp = np.flatnonzero(c.kind != POINT)
         xg, wg = d.gauss
-        e, m = c.e[gp], c.m[gp]
+        e, m, kind, c2, reach = c.e, c.m, c.kind, c.c2, c.reach
+        if (kind == POINT).any():
+            gp = np.flatnonzero(kind != POINT)
+            e, m, kind, c2, reach = e[gp], m[gp], kind[gp], c2[gp], reach[gp]
         H, h = self._twists(H)
         # a slave Gauss point outside the master element's sphere (grown by R1) cannot touch that
         # element: no projection for it; the others from the projection on the master chord, 8 Newton
         # iterations (compiled, projection.py; the kernel polishes the point with 2 more and needs it
         # converged for an exact tangent)
-        r, g, xi2, dist = gauss_projections(H, en, h, e, m, xg, c.kind[gp], c.c2[gp], c.r2[gp] + self.el_radius[e],
-                                            iterations=8)
-        rep, e, m = gp[r], e[r], m[r]
+        r, g, xi2, dist = gauss_projections(H, en, h, e, m, xg, kind, c2, reach, iterations=8)
         self._lap("projection")
-        s, key = gauss_owners(d.index, len(en), self.max_gp, self.n_beams, e, m, g, xi2, dist, self.el_first,
+        s, key = gauss_owners(d.index, len(en), self.max_gp, self.n_beams, e[r], m[r], g, xi2, dist, self.el_first,
                               self.el_last, self.el_beam, self.el_radius, self._prev_owners)
-        e, m, g = e[s], m[s], g[s]
-        rec = self._record(d, c.kind[rep[s]], e, m, xg[g], xi2[s], wg[g] * self.sys.L[e], key, g)
+        f, ids = gauss_record(s, key, r, g, xi2, e, m, kind, xg, wg, self.sys.L, en, self.el_radius)
+        rec = PairSet(key=key, decl=np.full(len(s), d.index), **f)
         self._lap("rules")
-        return rec, key * len(en) + m
+        return rec, ids
 
     def _xi_range(self, el):
         """Accepted projections ``[lo, hi]`` on elements ``el`` (``rules.xi_range``)."""
