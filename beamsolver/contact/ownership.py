@@ -31,10 +31,14 @@ def _known(sorted_ids, x):
 
 
 @jit
-def _owners(base, n_el, max_gp, n_beams, e, m, g, xi2, dist, first, last, beam, radius, prev, out, out_key):
-    n = len(e)
+def _owners(base, n_el, max_gp, n_beams, pair, e_pair, m_pair, g, xi2, dist, first, last, beam, radius, prev, out,
+            out_key):
+    n = len(g)
     key = np.empty(n, dtype=np.int64)
     start = np.zeros(n_el + 1, dtype=np.int64)
+    e, m = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
+    for r in range(n):
+        e[r], m[r] = e_pair[pair[r]], m_pair[pair[r]]
     n_ok = 0
     for r in range(n):
         lo = -XI_TOL if first[m[r]] else -XI_OVERHANG
@@ -106,16 +110,18 @@ def _owners(base, n_el, max_gp, n_beams, e, m, g, xi2, dist, first, last, beam, 
     return n_out
 
 
-def gauss_owners(decl, n_el, max_gp, n_beams, e, m, g, xi2, dist, first, last, beam, radius, prev):
+def gauss_owners(decl, n_el, max_gp, n_beams, e, m, g, xi2, dist, first, last, beam, radius, prev, pair=None):
     """Owners (``rules.owners``) among the projected Gauss-point rows ``e``, ``m``, ``g``, ``xi2``, ``dist``
     ``(n,)`` of declaration ``decl``: accepted rows only (``rules.xi_range`` of the master: ``first``,
     ``last`` per element; finite distance), key ``((decl n_el + e) max_gp + g) n_beams + beam[m]``,
-    section ``radius`` per element, ``prev``: sorted ``key * n_el + m`` of the last owners.  Returns the
-    rows chosen, in key order, and their keys."""
-    n = len(e)
+    section ``radius`` per element, ``prev``: sorted ``key * n_el + m`` of the last owners.  ``pair``
+    ``(n,)``: if given, row ``r``'s elements are ``e[pair[r]]``, ``m[pair[r]]`` (of element pairs).
+    Returns the rows chosen, in key order, and their keys."""
+    n = len(g)
+    pair = np.arange(n) if pair is None else pair
     out, out_key = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
-    k = _owners(np.int64(decl) * n_el, int(n_el), int(max_gp), int(n_beams), e, m, g, xi2, dist, first, last, beam,
-                radius, prev, out, out_key)
+    k = _owners(np.int64(decl) * n_el, int(n_el), int(max_gp), int(n_beams), pair, e, m, g, xi2, dist, first, last,
+                beam, radius, prev, out, out_key)
     return out[:k], out_key[:k]
 
 

@@ -23,6 +23,7 @@ __all__ = ["joint_nodes", "apart", "crossing", "point_or_orthogonal", "extend_wr
 
 XI_OVERHANG = 0.05        # accepted projection past an inner node, in element lengths (kinks of the C0 line)
 WRAP_END = 0.05          # extend_wrap: a slave closest point this close to an element end counts as at the end
+CROSSING_MARGIN = 1e-9    # crossing: far above the round-off of arccos and cos (1e-16)
 OWNER_TIE = 1e-9          # distances equal within this fraction of R1 + R2 tie (a point on a shared node)
 
 
@@ -67,9 +68,14 @@ def point_or_orthogonal(ratio, point_ratio):
     return np.where(ratio >= point_ratio, POINT, ORTHOGONAL)
 
 
-def crossing(cos, line_angle):
+def crossing(cos, line_angle, least=None):
     """Mask of the element pairs at or above ``line_angle`` (those needing their closest points);
-    ``cos`` ``(n,)``: cosines of the angles between their mid-point tangents (``search.broad_pairs``)."""
+    ``cos`` ``(n,)``: cosines of the angles between their mid-point tangents (``search.broad_pairs``).
+    ``least``: the least ``|cos|`` if known; above ``cos(line_angle) + CROSSING_MARGIN`` no pair crosses
+    (every angle is below ``line_angle - CROSSING_MARGIN``: ``|d arccos / dc| >= 1``) and no ``arccos``
+    is evaluated (nearly parallel wires)."""
+    if least is not None and least > np.cos(line_angle) + CROSSING_MARGIN:
+        return np.zeros(len(cos), dtype=bool)
     return np.arccos(np.clip(np.abs(cos), 0.0, 1.0)) >= line_angle
 
 

@@ -66,6 +66,7 @@ def broad_phase(c_s, r_s, c_m, r_m):
 @jit
 def _pairs_apart(i, j, c_s, r_s, c_m, r_m, t_s, t_m, slave_el, master_el, enodes, radius, e, m, cos, c2, reach):
     n = 0
+    least = np.inf
     for k in range(len(i)):
         a, b = i[k], j[k]
         d0, d1, d2 = c_s[a, 0] - c_m[b, 0], c_s[a, 1] - c_m[b, 1], c_s[a, 2] - c_m[b, 2]
@@ -80,11 +81,12 @@ def _pairs_apart(i, j, c_s, r_s, c_m, r_m, t_s, t_m, slave_el, master_el, enodes
             continue
         e[n], m[n] = ea, mb
         cos[n] = t_s[a, 0] * t_m[b, 0] + t_s[a, 1] * t_m[b, 1] + t_s[a, 2] * t_m[b, 2]
+        least = min(least, abs(cos[n])) if not np.isnan(cos[n]) else least
         for x in range(3):
             c2[n, x] = c_m[b, x]
         reach[n] = r_m[b] + radius[ea]
         n += 1
-    return n
+    return n, least
 
 
 def broad_pairs(c_s, r_s, t_s, c_m, r_m, t_m, slave_el, master_el, enodes, radius):
@@ -96,7 +98,8 @@ def broad_pairs(c_s, r_s, t_s, c_m, r_m, t_m, slave_el, master_el, enodes, radiu
     (joints merged), ``radius``: section radii, both ``(n_el, ...)``.  Returns, per element pair kept:
     slave and master elements ``e``, ``m``, the cosine of their mid-point tangents (``rules.crossing``),
     the master's sphere centre ``c2`` ``(n, 3)`` and ``reach``: its radius plus the slave's section
-    radius (``projection.gauss_projections``' filter)."""
+    radius (``projection.gauss_projections``' filter); and the least ``|cos|`` (inf without pairs; nan
+    cosines left out), for ``rules.crossing``."""
     if len(c_s) == 0 or len(c_m) == 0:
         i = j = np.zeros(0, dtype=np.intp)
     else:
@@ -105,5 +108,6 @@ def broad_pairs(c_s, r_s, t_s, c_m, r_m, t_m, slave_el, master_el, enodes, radiu
     n = len(i)
     e, m, cos, c2, reach = (np.empty(n, dtype=slave_el.dtype), np.empty(n, dtype=master_el.dtype), np.empty(n),
                             np.empty((n, 3)), np.empty(n))
-    k = _pairs_apart(i, j, c_s, r_s, c_m, r_m, t_s, t_m, slave_el, master_el, enodes, radius, e, m, cos, c2, reach)
-    return e[:k], m[:k], cos[:k], c2[:k], reach[:k]
+    k, least = _pairs_apart(i, j, c_s, r_s, c_m, r_m, t_s, t_m, slave_el, master_el, enodes, radius, e, m, cos, c2,
+                            reach)
+    return e[:k], m[:k], cos[:k], c2[:k], reach[:k], least

@@ -267,35 +267,40 @@ class ContactSystem(Contribution):
         """
         out, chosen, owners = [], [], []
         self._lap()
+        geo = self._twists(H)
         for d in self.decls:
-            c = self._candidates(d, H)
+            c = self._candidates(d, geo)
             part, ids = self._point_pairs(d, H, c)
             out.append(part)
             chosen.append(ids)
-            part, ids = self._gauss_pairs(d, H, c)
+            part, ids = self._gauss_pairs(d, geo, c)
             out.append(part)
             owners.append(ids)
         self._prev_points = np.sort(np.concatenate(chosen)) if chosen else np.zeros(0, dtype=np.int64)
-        self._prev_owners = np.sort(np.concatenate(owners)) if owners else np.zeros(0, dtype=np.int64)
-        out = [p for p in out if len(p)]
+        # sorted as made: a declaration's owner ids are ascending (``gauss_owners``' key order, one
+        # owner per key, ``key * n_el + m``, ``m < n_el``) and above the last declaration's (``key``
+        # grows with ``decl``)
+        self._prev_owners = np.concatenate(owners) if owners else np.zeros(0, dtype=np.int64)
+        out = [p for p in out if p is not None and len(p)]
         if len(out) == 1:
             return out[0]
         return PairSet.concatenate(out) if out else None
 
-    def _candidates(self, d, H):
+    def _candidates(self, d, geo):
         """Broad phase and pair rules of declaration ``d``: element pairs not sharing a node,
         their kind (line below ``line_angle``, else point or orthogonal by the reduced-Hessian
-        ratio; search.py) and the closest points of non-line pairs."""
+        ratio; search.py) and the closest points of non-line pairs; ``geo``: poses and element
+        twists (``_twists``)."""
         en = self.sys.enodes
-        H, h = self._twists(H)
+        H, h = geo
         cs, rs, ts = element_spheres(H, en, h, self.el_radius, d.margin, d.slave_el)
         cm, rm, tm = element_spheres(H, en, h, self.el_radius, d.margin, d.master_el)
-        e, m, cos, c2, reach = broad_pairs(cs, rs, ts, cm, rm, tm, d.slave_el, d.master_el, self._joint_enodes,
+        e, m, cos, c2, reach, least = broad_pairs(cs, rs, ts, cm, rm, tm, d.slave_el, d.master_el, self._joint_enodes,
                                            self.el_radius)
         self._lap("search")
         kinds = np.full(len(e), LINE)
         xi1, xi2 = np.zeros(len(e)), np.zeros(len(e))
-        b = np.flatnonzero(rules.crossing(cos, d.line_angle))
+        b = np.flatnonzero(rules.crossing(cos, d.line_angle, least))
         if len(b):
             self._lap("rules")
             x1, x2, ratio = closest_points(H, en[e[b], 0], h[e[b]], en[m[b], 0], h[m[b]])
@@ -318,11 +323,10 @@ class ContactSystem(Contribution):
         ``rules.XI_OVERHANG`` past an inner node.  Returns the record and the chosen element pairs."""
         n_el = len(self.sys.enodes)
         pt = np.flatnonzero(c.kind == POINT)
-        e, m, x1, x2 = c.e[pt], c.m[pt], c.xi1[pt], c.xi2[pt]
-        if not len(pt):             # no point pairs: an empty record
-            rec = self._record(d, pt, e, m, x1, x2, x1, pt, pt)
+        if not len(pt):             # no point pairs: no record
             self._lap("rules")
-            return rec, e * n_el + m
+            return None, np.zeros(0, dtype=np.int64)
+        e, m, x1, x2 = c.e[pt], c.m[pt], c.xi1[pt], c.xi2[pt]
         lo1, hi1 = self._xi_range(e)
         lo2, hi2 = self._xi_range(m)
         pt = pt[(x1 >= lo1) & (x1 <= hi1) & (x2 >= lo2) & (x2 <= hi2)]
@@ -339,25 +343,25 @@ class ContactSystem(Contribution):
         self._lap("rules")
         return rec, e * n_el + m
 
-    def _gauss_pairs(self, d, H, c):
+    def _gauss_pairs(self, d, geo, c):
         """Line and orthogonal projections of the slave Gauss points; one owner per slave
         point and master beam (``ownership.gauss_owners``, the compiled ``rules.owners``).  Returns
-        the record and the owner ids."""
+        the record and the owner ids; ``geo``: poses and element twists (``_twists``)."""
         en = self.sys.enodes
         xg, wg = d.gauss
         e, m, kind, c2, reach = c.e, c.m, c.kind, c.c2, c.reach
         if (kind == POINT).any():
             gp = np.flatnonzero(kind != POINT)
             e, m, kind, c2, reach = e[gp], m[gp], kind[gp], c2[gp], reach[gp]
-        H, h = self._twists(H)
+        H, h = geo
         # a slave Gauss point outside the master element's sphere (grown by R1) cannot touch that
         # element: no projection for it; the others from the projection on the master chord, 8 Newton
         # iterations (compiled, projection.py; the kernel polishes the point with 2 more and needs it
         # converged for an exact tangent)
         r, g, xi2, dist = gauss_projections(H, en, h, e, m, xg, kind, c2, reach, iterations=8)
         self._lap("projection")
-        s, key = gauss_owners(d.index, len(en), self.max_gp, self.n_beams, e[r], m[r], g, xi2, dist, self.el_first,
-                              self.el_last, self.el_beam, self.el_radius, self._prev_owners)
+        s, key = gauss_owners(d.index, len(en), self.max_gp, self.n_beams, e, m, g, xi2, dist, self.el_first,
+                              self.el_last, self.el_beam, self.el_radius, self._prev_owners, pair=r)
         f, ids = gauss_record(s, key, r, g, xi2, e, m, kind, xg, wg, self.sys.L, en, self.el_radius)
         rec = PairSet(key=key, decl=np.full(len(s), d.index), **f)
         self._lap("rules")
