@@ -10,7 +10,7 @@ import pytest
 from scipy.spatial import cKDTree
 
 from beamsolver import se3
-from beamsolver.contact import kernel_jit, pairs, projection, rules
+from beamsolver.contact import kernel_jit, pairs, projection, rules, search
 from beamsolver.contact.ownership import gauss_owners
 from beamsolver.contact.search import broad_phase, element_spheres
 
@@ -157,3 +157,110 @@ def test_extend_wrap_equals_its_isin_form(seed):
     master_beam = rng.integers(0, 3, n)
     want = _extend_wrap_isin(enodes, master_beam, 3, e, m, kind, xi1)
     np.testing.assert_array_equal(rules.extend_wrap(enodes, master_beam, 3, e, m, kind, xi1), want)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_sweep_phase_finds_the_pairs_of_the_distance_matrix(seed):
+    """The sort and sweep (``search.sweep_phase``) finds the set of ``broad_phase``'s pairs, slave-major,
+    on scenes spread along one axis (a wire) and in a cube, radii uneven."""
+    rng = np.random.default_rng(seed)
+    ns, nm = 300, 250
+    if seed % 2:
+        cs = np.c_[rng.uniform(0, 10, ns), rng.uniform(0, 0.2, (ns, 2))]
+        cm = np.c_[rng.uniform(0, 10, nm), rng.uniform(0, 0.2, (nm, 2))] + [0, 0, 0.1]
+    else:
+        cs, cm = rng.uniform(0, 1, (ns, 3)), rng.uniform(0, 1, (nm, 3))
+    cs += 1e3 * seed          # far from the origin: the windows' round-off
+    cm += 1e3 * seed
+    rs, rm = rng.uniform(0.01, 0.08, ns), rng.uniform(0.01, 0.12, nm)
+    i, j = broad_phase(cs, rs, cm, rm)
+    si, sj, edge = search.sweep_phase(cs, rs, cm, rm)
+    assert not edge and len(i) > 50
+    assert sorted(zip(si.tolist(), sj.tolist())) == sorted(zip(i.tolist(), j.tolist()))
+    assert np.all(np.diff(si) >= 0)
+
+
+def test_sweep_phase_flags_what_the_distance_matrix_may_see_otherwise():
+    cs, cm = np.array([[0.0, 0, 0], [5.0, 0, 0]]), np.array([[0.2, 0, 0], [9.0, 0, 0]])
+    rs, rm = np.array([0.1, 0.1]), np.array([0.2, 0.1])
+    i, j, edge = search.sweep_phase(cs, rs, cm, rm)
+    assert not edge and i.tolist() == [0] and j.tolist() == [0]
+    cm[0, 0] = 0.1 + 0.2         # spheres touching at the distance matrix's radius (max r_s + max r_m)
+    assert search.sweep_phase(cs, rs, cm, rm)[2]
+    cm[0, 0] = 0.2
+    cs[1, 2] = np.nan
+    assert search.sweep_phase(cs, rs, cm, rm)[2]
+
+
+def test_crossing_skips_arccos_only_where_no_pair_can_cross():
+    rng = np.random.default_rng(3)
+    angle = np.radians(20.0)
+    near = np.cos(angle) + np.array([-1e-12, 0.0, 1e-12, 1e-10, 1e-9, 2e-9, 1e-6])
+    for c in near:
+        cos = np.r_[rng.uniform(c, 1.0, 20), c] * rng.choice([-1.0, 1.0], 21)
+        least = np.abs(cos).min()
+        np.testing.assert_array_equal(rules.crossing(cos, angle, least), rules.crossing(cos, angle))
+
+
+def test_gauss_owners_report_a_choice_by_the_order_of_the_rows():
+    """Two rows of a key equal in ``known``, ``xi2`` and ``dist``: the first is chosen, and ``order=True``
+    says so (the search then takes the distance matrix's order); rows differing in ``xi2`` do not."""
+    args = dict(first=np.zeros(4, bool), last=np.zeros(4, bool), beam=np.zeros(4, int), radius=np.ones(4),
+                prev=np.zeros(0, dtype=np.int64))
+    e, m, g = np.array([0, 0]), np.array([2, 3]), np.array([0, 0])
+    for xi2, tied in ((np.array([0.5, 0.5]), True), (np.array([0.5, 0.4]), False)):
+        s, key, got = gauss_owners(0, 4, 1, 1, e, m, g, xi2, np.array([0.1, 0.1]), order=True, **args)
+        assert got is tied
+        np.testing.assert_array_equal(s, [0] if tied else [1])
+
+
+def _line_scene(n_el=40):
+    """Two nearly parallel wires in line contact (``benchmarks/contact_throughput.py``' scene)."""
+    import beamsolver as bs
+    from beamsolver.problem import Problem
+    sec = bs.Section.circular(radius=0.005, E=1e9)
+    m = bs.Model()
+    L = 0.05 * n_el
+    master = m.add_beam(bs.geometry.straight((0, 0, 0), (L, 0, 0), n_el), sec)
+    slave = m.add_beam(bs.geometry.straight((0.01 * L, 0.001, 0.0099), (0.99 * L, -0.001, 0.0099), n_el), sec)
+    m.clamp(master.first)
+    m.clamp(slave.first)
+    m.add_contact(slave, master, mu=0.3)
+    return lambda: Problem.from_model(m, check_rigid_modes=False).contact
+
+
+def _same_pairs(P, Q):
+    from dataclasses import fields
+    for f in fields(P):
+        a, b = getattr(P, f.name), getattr(Q, f.name)
+        assert a.dtype == b.dtype and a.tobytes() == b.tobytes(), f.name
+
+
+def test_the_swept_search_gives_the_pairs_in_the_distance_matrix_order(monkeypatch):
+    """Without crossings the search takes the sweep's pairs (``_candidates``): the pair record and the
+    owners remembered are those of the distance matrix's order, bit for bit, over two evaluations (the
+    second with the first's owners); with owners depending on the order it takes the distance matrix's."""
+    from beamsolver.contact import system
+    make = _line_scene()
+    swept, tree = make(), make()
+    H = swept.sys.poses0.copy()
+    H[:, :3, 3] += 2e-4 * np.random.default_rng(0).standard_normal((len(H), 3))
+    calls = []
+    candidates = system.ContactSystem._candidates
+
+    def spy(self, d, geo, sweep=True):
+        c = candidates(self, d, geo, sweep=sweep and self is swept)
+        calls.append((self is swept, c.swept))
+        return c
+
+    monkeypatch.setattr(system.ContactSystem, "_candidates", spy)
+    for poses in (H, swept.sys.poses0):
+        _same_pairs(swept.pairs(poses), tree.pairs(poses))
+        np.testing.assert_array_equal(swept._prev_owners, tree._prev_owners)
+    assert calls == [(True, True), (False, False)] * 2
+    # an order-dependent choice of owners: the search is redone in the distance matrix's order
+    owners = system.gauss_owners
+    monkeypatch.setattr(system, "gauss_owners", lambda *a, **k: owners(*a, **k)[:2] + (True,))
+    calls.clear()
+    _same_pairs(swept.pairs(H), tree.pairs(H))
+    assert calls == [(True, True), (True, False), (False, False)]

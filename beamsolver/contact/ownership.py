@@ -32,7 +32,7 @@ def _known(sorted_ids, x):
 
 @jit
 def _owners(base, n_el, max_gp, n_beams, pair, e_pair, m_pair, g, xi2, dist, first, last, beam, radius, prev, out,
-            out_key):
+            out_key, tied):
     n = len(g)
     key = np.empty(n, dtype=np.int64)
     start = np.zeros(n_el + 1, dtype=np.int64)
@@ -100,6 +100,8 @@ def _owners(base, n_el, max_gp, n_beams, pair, e_pair, m_pair, g, xi2, dist, fir
                     if not dist[r] <= least + OWNER_TIE * (radius[e[r]] + radius[m[r]]):
                         continue
                     kn = _known(prev, key[r] * n_el + m[r])
+                    if best >= 0 and kn == best_known and xi2[r] == xi2[best] and dist[r] == dist[best]:
+                        tied[0] = True          # equal rows: the first one is chosen
                     if best < 0 or (kn and not best_known) or (kn == best_known and (
                             xi2[r] < xi2[best] or (xi2[r] == xi2[best] and dist[r] < dist[best]))):
                         best, best_known = r, kn
@@ -110,7 +112,8 @@ def _owners(base, n_el, max_gp, n_beams, pair, e_pair, m_pair, g, xi2, dist, fir
     return n_out
 
 
-def gauss_owners(decl, n_el, max_gp, n_beams, e, m, g, xi2, dist, first, last, beam, radius, prev, pair=None):
+def gauss_owners(decl, n_el, max_gp, n_beams, e, m, g, xi2, dist, first, last, beam, radius, prev, pair=None,
+                 order=False):
     """Owners (``rules.owners``) among the projected Gauss-point rows ``e``, ``m``, ``g``, ``xi2``, ``dist``
     ``(n,)`` of declaration ``decl``: accepted rows only (``rules.xi_range`` of the master: ``first``,
     ``last`` per element; finite distance), key ``((decl n_el + e) max_gp + g) n_beams + beam[m]``,
@@ -120,9 +123,10 @@ def gauss_owners(decl, n_el, max_gp, n_beams, e, m, g, xi2, dist, first, last, b
     n = len(g)
     pair = np.arange(n) if pair is None else pair
     out, out_key = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
+    tied = np.zeros(1, dtype=bool)
     k = _owners(np.int64(decl) * n_el, int(n_el), int(max_gp), int(n_beams), pair, e, m, g, xi2, dist, first, last,
-                beam, radius, prev, out, out_key)
-    return out[:k], out_key[:k]
+                beam, radius, prev, out, out_key, tied)
+    return (out[:k], out_key[:k], bool(tied[0])) if order else (out[:k], out_key[:k])
 
 
 @jit

@@ -17,7 +17,8 @@ class Candidates(NamedTuple):
     """Element pairs from the broad phase and pair rules, arrays over ``n`` element pairs:
     slave and master elements ``e``, ``m``, their ``kind``, closest points ``xi1``, ``xi2`` (non-line
     pairs), master bounding-sphere centres ``c2`` ``(n, 3)`` and their radii plus the slave's section
-    radius ``reach`` (``projection.gauss_projections``' filter of the Gauss points)."""
+    radius ``reach`` (``projection.gauss_projections``' filter of the Gauss points); ``swept``: the pairs
+    are in the order of ``search.sweep_phase``, not of the distance matrix (``ContactSystem._candidates``)."""
     e: np.ndarray
     m: np.ndarray
     kind: np.ndarray
@@ -25,6 +26,7 @@ class Candidates(NamedTuple):
     xi2: np.ndarray
     c2: np.ndarray
     reach: np.ndarray
+    swept: bool
 
 
 @dataclass

@@ -19,7 +19,7 @@ from scipy.spatial import cKDTree
 from .pairs import ORTHOGONAL, POINT
 from .search import XI_TOL
 
-__all__ = ["joint_nodes", "apart", "crossing", "point_or_orthogonal", "extend_wrap", "xi_range", "owners", "dedupe_points", "XI_OVERHANG", "OWNER_TIE"]
+__all__ = ["joint_nodes", "apart", "crossing", "may_cross", "point_or_orthogonal", "extend_wrap", "xi_range", "owners", "dedupe_points", "XI_OVERHANG", "OWNER_TIE"]
 
 XI_OVERHANG = 0.05        # accepted projection past an inner node, in element lengths (kinks of the C0 line)
 WRAP_END = 0.05          # extend_wrap: a slave closest point this close to an element end counts as at the end
@@ -74,9 +74,14 @@ def crossing(cos, line_angle, least=None):
     ``least``: the least ``|cos|`` if known; above ``cos(line_angle) + CROSSING_MARGIN`` no pair crosses
     (every angle is below ``line_angle - CROSSING_MARGIN``: ``|d arccos / dc| >= 1``) and no ``arccos``
     is evaluated (nearly parallel wires)."""
-    if least is not None and least > np.cos(line_angle) + CROSSING_MARGIN:
+    if least is not None and not may_cross(least, line_angle):
         return np.zeros(len(cos), dtype=bool)
     return np.arccos(np.clip(np.abs(cos), 0.0, 1.0)) >= line_angle
+
+
+def may_cross(least, line_angle):
+    """Whether a pair whose least ``|cos|`` is ``least`` may be at or above ``line_angle`` (``crossing``)."""
+    return not least > np.cos(line_angle) + CROSSING_MARGIN
 
 
 def extend_wrap(enodes, master_beam, n_beams, e, m, kind, xi1=None):

@@ -89,7 +89,70 @@ def _pairs_apart(i, j, c_s, r_s, c_m, r_m, t_s, t_m, slave_el, master_el, enodes
     return n, least
 
 
-def broad_pairs(c_s, r_s, t_s, c_m, r_m, t_m, slave_el, master_el, enodes, radius):
+SWEEP_MARGIN = 1e-9     # sweep: relative widening of its windows and of the distance-matrix radius checked
+
+
+@jit
+def _sweep(c_s, r_s, c_m, r_m, R, i, j):
+    """Pairs ``(a, b)`` of overlapping spheres (``overlap``'s test), slave-major, masters by their centre's
+    coordinate along the axis of the largest spread; written to ``i``, ``j`` if they are long enough.
+    Returns their number and whether the distance matrix of ``broad_phase`` could differ: a centre or
+    radius not finite, or an overlapping pair within ``SWEEP_MARGIN`` of its radius ``R``."""
+    edge = False
+    for a in range(len(r_s)):
+        edge = edge or not (np.isfinite(r_s[a]) and np.isfinite(c_s[a, 0]) and np.isfinite(c_s[a, 1])
+                            and np.isfinite(c_s[a, 2]))
+    for b in range(len(r_m)):
+        edge = edge or not (np.isfinite(r_m[b]) and np.isfinite(c_m[b, 0]) and np.isfinite(c_m[b, 1])
+                            and np.isfinite(c_m[b, 2]))
+    if edge:
+        return 0, True
+    ax, spread = 0, -1.0
+    for x in range(3):
+        lo, hi = np.inf, -np.inf
+        for b in range(len(r_m)):
+            lo, hi = min(lo, c_m[b, x]), max(hi, c_m[b, x])
+        if hi - lo > spread:
+            ax, spread = x, hi - lo
+    key = c_m[:, ax].copy()
+    order = np.argsort(key)
+    key = key[order]
+    r_max = 0.0
+    for b in range(len(r_m)):
+        r_max = max(r_max, r_m[b])
+    n = 0
+    for a in range(len(r_s)):
+        # |x_a - x_b| <= |c_a - c_b| <= r_a + r_b: the masters in a window of the sorted coordinate
+        w = (r_s[a] + r_max) * (1.0 + SWEEP_MARGIN) + 1e-12 * abs(c_s[a, ax])     # round-off of x_a -+ w
+        lo = np.searchsorted(key, c_s[a, ax] - w)
+        hi = np.searchsorted(key, c_s[a, ax] + w, side="right")
+        for q in range(lo, hi):
+            b = order[q]
+            d0, d1, d2 = c_s[a, 0] - c_m[b, 0], c_s[a, 1] - c_m[b, 1], c_s[a, 2] - c_m[b, 2]
+            d = np.sqrt((d0 * d0 + d1 * d1) + d2 * d2)
+            if d <= r_s[a] + r_m[b]:
+                edge = edge or d >= R * (1.0 - SWEEP_MARGIN)
+                if n < len(i):
+                    i[n], j[n] = a, b
+                n += 1
+    return n, edge
+
+
+def sweep_phase(c_s, r_s, c_m, r_m):
+    """``broad_phase``'s pairs by a sort and sweep (compiled), in another order (slave-major); and whether
+    they could differ from ``broad_phase``'s set (``_sweep``: not finite, or a pair at its radius)."""
+    i, j = np.empty(4 * len(c_s), dtype=np.intp), np.empty(4 * len(c_s), dtype=np.intp)
+    if len(c_s) == 0 or len(c_m) == 0:
+        return i[:0], j[:0], False
+    R = float(r_s.max() + r_m.max())
+    n, edge = _sweep(c_s, r_s, c_m, r_m, R, i, j)
+    if n > len(i):
+        i, j = np.empty(n, dtype=np.intp), np.empty(n, dtype=np.intp)
+        n, edge = _sweep(c_s, r_s, c_m, r_m, R, i, j)
+    return i[:n], j[:n], edge
+
+
+def broad_pairs(c_s, r_s, t_s, c_m, r_m, t_m, slave_el, master_el, enodes, radius, sweep=False):
     """``broad_phase`` and the pair rule ``rules.apart`` in one compiled pass over the distance
     matrix's pairs (in its order), with the data the later stages read of each pair kept.
 
@@ -99,12 +162,22 @@ def broad_pairs(c_s, r_s, t_s, c_m, r_m, t_m, slave_el, master_el, enodes, radiu
     slave and master elements ``e``, ``m``, the cosine of their mid-point tangents (``rules.crossing``),
     the master's sphere centre ``c2`` ``(n, 3)`` and ``reach``: its radius plus the slave's section
     radius (``projection.gauss_projections``' filter); and the least ``|cos|`` (inf without pairs; nan
-    cosines left out), for ``rules.crossing``."""
+    cosines left out), for ``rules.crossing``.
+
+    ``sweep``: the pairs of ``sweep_phase`` (the same set, another order) instead of the distance
+    matrix's; returns also whether that set could differ (then use the distance matrix)."""
+    if sweep:
+        i, j, edge = sweep_phase(c_s, r_s, c_m, r_m)
+        return _apart(i, j, c_s, r_s, t_s, c_m, r_m, t_m, slave_el, master_el, enodes, radius) + (edge,)
     if len(c_s) == 0 or len(c_m) == 0:
         i = j = np.zeros(0, dtype=np.intp)
     else:
         D = cKDTree(c_s).sparse_distance_matrix(cKDTree(c_m), float(r_s.max() + r_m.max()), output_type="ndarray")
         i, j = D["i"], D["j"]
+    return _apart(i, j, c_s, r_s, t_s, c_m, r_m, t_m, slave_el, master_el, enodes, radius)
+
+
+def _apart(i, j, c_s, r_s, t_s, c_m, r_m, t_m, slave_el, master_el, enodes, radius):
     n = len(i)
     e, m, cos, c2, reach = (np.empty(n, dtype=slave_el.dtype), np.empty(n, dtype=master_el.dtype), np.empty(n),
                             np.empty((n, 3)), np.empty(n))

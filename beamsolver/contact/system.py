@@ -271,11 +271,14 @@ class ContactSystem(Contribution):
         for d in self.decls:
             c = self._candidates(d, geo)
             part, ids = self._point_pairs(d, H, c)
-            out.append(part)
+            rec, own, tied = self._gauss_pairs(d, geo, c)
+            if tied and c.swept:      # owners depending on the pairs' order: the distance matrix's order
+                c = self._candidates(d, geo, sweep=False)
+                part, ids = self._point_pairs(d, H, c)
+                rec, own, _ = self._gauss_pairs(d, geo, c)
+            out += [part, rec]
             chosen.append(ids)
-            part, ids = self._gauss_pairs(d, geo, c)
-            out.append(part)
-            owners.append(ids)
+            owners.append(own)
         self._prev_points = np.sort(np.concatenate(chosen)) if chosen else np.zeros(0, dtype=np.int64)
         # sorted as made: a declaration's owner ids are ascending (``gauss_owners``' key order, one
         # owner per key, ``key * n_el + m``, ``m < n_el``) and above the last declaration's (``key``
@@ -286,17 +289,27 @@ class ContactSystem(Contribution):
             return out[0]
         return PairSet.concatenate(out) if out else None
 
-    def _candidates(self, d, geo):
+    def _candidates(self, d, geo, sweep=True):
         """Broad phase and pair rules of declaration ``d``: element pairs not sharing a node,
         their kind (line below ``line_angle``, else point or orthogonal by the reduced-Hessian
         ratio; search.py) and the closest points of non-line pairs; ``geo``: poses and element
-        twists (``_twists``)."""
+        twists (``_twists``).
+
+        The pairs are those of the distance matrix (``search.broad_phase``), in its order: the
+        order of the point pairs and of equal owners.  With ``sweep``, first the same pairs from a
+        sort and sweep (``search.sweep_phase``, cheaper): kept, in their order, when no pair is a
+        crossing (so no point pairs; ``pairs`` falls back when the owners depend on the order)."""
         en = self.sys.enodes
         H, h = geo
         cs, rs, ts = element_spheres(H, en, h, self.el_radius, d.margin, d.slave_el)
         cm, rm, tm = element_spheres(H, en, h, self.el_radius, d.margin, d.master_el)
-        e, m, cos, c2, reach, least = broad_pairs(cs, rs, ts, cm, rm, tm, d.slave_el, d.master_el, self._joint_enodes,
-                                           self.el_radius)
+        args = (cs, rs, ts, cm, rm, tm, d.slave_el, d.master_el, self._joint_enodes, self.el_radius)
+        swept = sweep
+        if sweep:
+            e, m, cos, c2, reach, least, edge = broad_pairs(*args, sweep=True)
+            swept = not edge and not rules.may_cross(least, d.line_angle)
+        if not swept:
+            e, m, cos, c2, reach, least = broad_pairs(*args)
         self._lap("search")
         kinds = np.full(len(e), LINE)
         xi1, xi2 = np.zeros(len(e)), np.zeros(len(e))
@@ -310,7 +323,7 @@ class ContactSystem(Contribution):
             kinds = rules.extend_wrap(en, self.el_beam[m], self.n_beams, e, m, kinds, xi1)
             kinds = self._step_kinds(d, e, m, kinds)
         self._lap("rules")
-        return Candidates(e=e, m=m, kind=kinds, xi1=xi1, xi2=xi2, c2=c2, reach=reach)
+        return Candidates(e=e, m=m, kind=kinds, xi1=xi1, xi2=xi2, c2=c2, reach=reach, swept=swept)
 
     def _record(self, d, kind, e, m, xi1, xi2, weight, key, gp):
         en = self.sys.enodes
@@ -346,7 +359,8 @@ class ContactSystem(Contribution):
     def _gauss_pairs(self, d, geo, c):
         """Line and orthogonal projections of the slave Gauss points; one owner per slave
         point and master beam (``ownership.gauss_owners``, the compiled ``rules.owners``).  Returns
-        the record and the owner ids; ``geo``: poses and element twists (``_twists``)."""
+        the record, the owner ids and whether the owners depend on the order of the pairs; ``geo``:
+        poses and element twists (``_twists``)."""
         en = self.sys.enodes
         xg, wg = d.gauss
         e, m, kind, c2, reach = c.e, c.m, c.kind, c.c2, c.reach
@@ -360,12 +374,12 @@ class ContactSystem(Contribution):
         # converged for an exact tangent)
         r, g, xi2, dist = gauss_projections(H, en, h, e, m, xg, kind, c2, reach, iterations=8)
         self._lap("projection")
-        s, key = gauss_owners(d.index, len(en), self.max_gp, self.n_beams, e, m, g, xi2, dist, self.el_first,
-                              self.el_last, self.el_beam, self.el_radius, self._prev_owners, pair=r)
+        s, key, tied = gauss_owners(d.index, len(en), self.max_gp, self.n_beams, e, m, g, xi2, dist, self.el_first,
+                                    self.el_last, self.el_beam, self.el_radius, self._prev_owners, pair=r, order=True)
         f, ids = gauss_record(s, key, r, g, xi2, e, m, kind, xg, wg, self.sys.L, en, self.el_radius)
         rec = PairSet(key=key, decl=np.full(len(s), d.index), **f)
         self._lap("rules")
-        return rec, ids
+        return rec, ids, tied
 
     def _xi_range(self, el):
         """Accepted projections ``[lo, hi]`` on elements ``el`` (``rules.xi_range``)."""
