@@ -239,7 +239,11 @@ class ContactSystem(Contribution):
     def _prev_twists(self):
         """Twists ``(n_elements, 6)`` of all elements at the last converged poses (once per step)."""
         if self._geo_prev is None:
-            self._geo_prev = (self._H_prev, element_twists(self._H_prev, self.sys.enodes))
+            g = self._geo       # a step starts at the last iterate's poses, whose twists are kept
+            if g is not None and g[0].shape == self._H_prev.shape and np.array_equal(g[0], self._H_prev):
+                self._geo_prev = (self._H_prev, g[1])
+            else:
+                self._geo_prev = (self._H_prev, element_twists(self._H_prev, self.sys.enodes))
         return self._geo_prev[1]
 
     def _pose_at(self, H, e, xi):
