@@ -3,8 +3,9 @@
 ``ContactSystem`` is created by ``assembly.System`` only when the model has
 contact declarations.  It orchestrates pure stages kept in their own modules:
 
-1. broad phase (``search.py``: element spheres, ``scipy.spatial.cKDTree``) on the element
-   twists computed once per evaluation (``projection.element_twists``);
+1. broad phase (``search.py``: element spheres, ``scipy.spatial.cKDTree``, or a compiled sort
+   and sweep where the pairs' order cannot matter) on the element twists computed once per
+   evaluation (``projection.element_twists``);
 2. pair rules (``rules.py``: no pair between elements sharing a node or meeting at a joint,
    the kind of each element pair, closest points of crossings from ``projection.closest_points``);
 3. projection of the slave Gauss points (``projection.gauss_projections``, compiled) and
@@ -521,8 +522,8 @@ class ContactSystem(Contribution):
         one beam passed through the other within the step, where the penalty, seeing
         the other side, would push them further apart and report a converged state.
         """
-        if self._H_prev is None or self._H_prev.shape != H.shape:
-            return
+        if self._H_prev is None or self._H_prev.shape != H.shape or np.array_equal(self._H_prev, H):
+            return              # (at the step's start, the first iterate: d_prev = d, no pair changed sides)
         d = centres[1] - centres[0]
         x0C, x0F = self._centres(H, P, prev=True)
         d0 = x0F - x0C
