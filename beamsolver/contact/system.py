@@ -406,9 +406,9 @@ class ContactSystem(Contribution):
         hi, hf = self._lookup(hist["key"], key)
         n = len(key)
         if len(hist["key"]):
-            p["H_CL"] = np.where(hf[:, None, None], hist["H_CL"][hi], np.eye(4))
-            p["H_FK"] = np.where(hf[:, None, None], hist["H_FK"][hi], np.eye(4))
-            p["H_LK_prev"] = np.where(hf[:, None, None], hist["H_LK"][hi], np.eye(4))
+            every = hf.all()        # (every pair with history, as in a step's later iterates: no masking)
+            for name, src in (("H_CL", "H_CL"), ("H_FK", "H_FK"), ("H_LK_prev", "H_LK")):
+                p[name] = hist[src][hi] if every else np.where(hf[:, None, None], hist[src][hi], np.eye(4))
             # material points, re-expressed on the current elements (same beam, consecutive ids)
             p["xi1_prev"] = np.where(hf, hist["xi1"][hi] + hist["e"][hi] - P.e[sel], p["xi1"])
             p["xi2_prev"] = np.where(hf, hist["xi2"][hi] + hist["m"][hi] - P.m[sel], p["xi2"])
