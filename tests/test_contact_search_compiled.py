@@ -174,7 +174,8 @@ def test_sweep_phase_finds_the_pairs_of_the_distance_matrix(seed):
     cm += 1e3 * seed
     rs, rm = rng.uniform(0.01, 0.08, ns), rng.uniform(0.01, 0.12, nm)
     i, j = broad_phase(cs, rs, cm, rm)
-    si, sj, edge = search.sweep_phase(cs, rs, cm, rm)
+    # a cube: most masters in every window (past the default budget, which gives up there)
+    si, sj, edge = search.sweep_phase(cs, rs, cm, rm, **({} if seed % 2 else dict(budget=nm)))
     assert not edge and len(i) > 50
     assert sorted(zip(si.tolist(), sj.tolist())) == sorted(zip(i.tolist(), j.tolist()))
     assert np.all(np.diff(si) >= 0)
@@ -264,3 +265,15 @@ def test_the_swept_search_gives_the_pairs_in_the_distance_matrix_order(monkeypat
     calls.clear()
     _same_pairs(swept.pairs(H), tree.pairs(H))
     assert calls == [(True, True), (True, False), (False, False)]
+
+
+def test_sweep_phase_gives_up_on_a_scene_not_spread_along_an_axis():
+    """A ball of spheres: the windows of any axis hold most masters; past the budget the sweep flags
+    (the search then takes the tree), below it finds the pairs."""
+    rng = np.random.default_rng(7)
+    cs, cm = rng.uniform(0, 1, (400, 3)), rng.uniform(0, 1, (400, 3))
+    rs, rm = np.full(400, 0.05), np.full(400, 0.05)
+    assert search.sweep_phase(cs, rs, cm, rm, budget=8)[2]
+    i, j = broad_phase(cs, rs, cm, rm)
+    si, sj, edge = search.sweep_phase(cs, rs, cm, rm, budget=400)
+    assert not edge and sorted(zip(si.tolist(), sj.tolist())) == sorted(zip(i.tolist(), j.tolist()))

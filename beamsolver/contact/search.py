@@ -94,14 +94,17 @@ def _pairs_apart(i, j, c_s, r_s, c_m, r_m, t_s, t_m, slave_el, master_el, enodes
 
 
 SWEEP_MARGIN = 1e-9     # sweep: relative widening of its windows and of the distance-matrix radius checked
+SWEEP_BUDGET = 32       # sweep: masters in the windows per slave element, at most (else the tree)
 
 
 @jit
-def _sweep(c_s, r_s, c_m, r_m, R, i, j):
+def _sweep(c_s, r_s, c_m, r_m, R, budget, i, j):
     """Pairs ``(a, b)`` of overlapping spheres (``overlap``'s test), slave-major, masters by their centre's
     coordinate along the axis of the largest spread; written to ``i``, ``j`` if they are long enough.
     Returns their number and whether the distance matrix of ``broad_phase`` could differ: a centre or
-    radius not finite, or an overlapping pair within ``SWEEP_MARGIN`` of its radius ``R``."""
+    radius not finite, or an overlapping pair within ``SWEEP_MARGIN`` of its radius ``R``; or whether
+    the windows held more than ``budget`` masters in all (a scene not spread along one axis: a sheet,
+    a ball, where the tree is cheaper; the pairs are then incomplete)."""
     edge = False
     for a in range(len(r_s)):
         edge = edge or not (np.isfinite(r_s[a]) and np.isfinite(c_s[a, 0]) and np.isfinite(c_s[a, 1])
@@ -125,11 +128,15 @@ def _sweep(c_s, r_s, c_m, r_m, R, i, j):
     for b in range(len(r_m)):
         r_max = max(r_max, r_m[b])
     n = 0
+    seen = 0
     for a in range(len(r_s)):
         # |x_a - x_b| <= |c_a - c_b| <= r_a + r_b: the masters in a window of the sorted coordinate
         w = (r_s[a] + r_max) * (1.0 + SWEEP_MARGIN) + 1e-12 * abs(c_s[a, ax])     # round-off of x_a -+ w
         lo = np.searchsorted(key, c_s[a, ax] - w)
         hi = np.searchsorted(key, c_s[a, ax] + w, side="right")
+        seen += hi - lo
+        if seen > budget:
+            return n, True
         for q in range(lo, hi):
             b = order[q]
             d0, d1, d2 = c_s[a, 0] - c_m[b, 0], c_s[a, 1] - c_m[b, 1], c_s[a, 2] - c_m[b, 2]
@@ -142,17 +149,19 @@ def _sweep(c_s, r_s, c_m, r_m, R, i, j):
     return n, edge
 
 
-def sweep_phase(c_s, r_s, c_m, r_m):
+def sweep_phase(c_s, r_s, c_m, r_m, budget=SWEEP_BUDGET):
     """``broad_phase``'s pairs by a sort and sweep (compiled), in another order (slave-major); and whether
-    they could differ from ``broad_phase``'s set (``_sweep``: not finite, or a pair at its radius)."""
+    they could differ from ``broad_phase``'s set (``_sweep``: not finite, a pair at its radius, or more
+    than ``budget`` masters per slave element in the windows)."""
     i, j = np.empty(4 * len(c_s), dtype=np.intp), np.empty(4 * len(c_s), dtype=np.intp)
     if len(c_s) == 0 or len(c_m) == 0:
         return i[:0], j[:0], False
     R = float(r_s.max() + r_m.max())
-    n, edge = _sweep(c_s, r_s, c_m, r_m, R, i, j)
-    if n > len(i):
+    cap = int(budget * len(c_s))
+    n, edge = _sweep(c_s, r_s, c_m, r_m, R, cap, i, j)
+    if n > len(i) and not edge:
         i, j = np.empty(n, dtype=np.intp), np.empty(n, dtype=np.intp)
-        n, edge = _sweep(c_s, r_s, c_m, r_m, R, i, j)
+        n, edge = _sweep(c_s, r_s, c_m, r_m, R, cap, i, j)
     return i[:n], j[:n], edge
 
 

@@ -135,6 +135,7 @@ class ContactSystem(Contribution):
         self._augments = 0
         self._prev_points = np.zeros(0, dtype=np.int64)
         self._prev_owners = np.zeros(0, dtype=np.int64)   # Gauss-point key * n_elements + master element
+        self._sweepable = {}       # per declaration: whether the last search found no crossing (``_candidates``)
         self._forget_kinds()
         self._H_prev = None        # last converged poses (start of the step)
         self._geo = self._geo_prev = None    # (poses, element twists) of the last evaluation / of H_prev
@@ -309,12 +310,16 @@ class ContactSystem(Contribution):
         cs, rs, ts = element_spheres(H, en, h, self.el_radius, d.margin, d.slave_el)
         cm, rm, tm = element_spheres(H, en, h, self.el_radius, d.margin, d.master_el)
         args = (cs, rs, ts, cm, rm, tm, d.slave_el, d.master_el, self._joint_enodes, self.el_radius)
-        swept = sweep
-        if sweep:
+        # the sweep is tried unless the last search of the declaration had crossings or the sweep's flag
+        tried = swept = sweep and self._sweepable.get(d.index, True)
+        edge = False
+        if tried:
             e, m, cos, c2, reach, least, edge = broad_pairs(*args, sweep=True)
             swept = not edge and not rules.may_cross(least, d.line_angle)
         if not swept:
             e, m, cos, c2, reach, least = broad_pairs(*args)
+        if sweep:
+            self._sweepable[d.index] = not edge and not rules.may_cross(least, d.line_angle)
         self._lap("search")
         kinds = np.full(len(e), LINE)
         xi1, xi2 = np.zeros(len(e)), np.zeros(len(e))
