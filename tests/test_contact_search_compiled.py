@@ -277,3 +277,36 @@ def test_sweep_phase_gives_up_on_a_scene_not_spread_along_an_axis():
     i, j = broad_phase(cs, rs, cm, rm)
     si, sj, edge = search.sweep_phase(cs, rs, cm, rm, budget=400)
     assert not edge and sorted(zip(si.tolist(), sj.tolist())) == sorted(zip(i.tolist(), j.tolist()))
+
+
+@pytest.mark.parametrize("sweep", [False, True])
+def test_broad_pairs_are_the_broad_phase_and_apart_in_one_pass(sweep):
+    """``search.broad_pairs``: the pairs of ``broad_phase`` (its order; the sweep's: the same set) that
+    ``rules.apart`` keeps, their tangents' cosines, master sphere centres and reach, bit for bit."""
+    rng = np.random.default_rng(11)
+    n_el = 120
+    enodes = np.stack([np.arange(n_el), np.arange(n_el) + 1], 1)
+    enodes[rng.choice(n_el, 30), 1] = rng.integers(0, n_el, 30)       # shared nodes across the sets
+    slave_el, master_el = rng.permutation(n_el)[:70], rng.permutation(n_el)[:80]
+    c = np.c_[np.linspace(0, 3, n_el), rng.uniform(0, 0.05, (n_el, 2))]
+    r = rng.uniform(0.02, 0.06, n_el)
+    t = rng.standard_normal((n_el, 3))
+    t /= np.linalg.norm(t, axis=1)[:, None]
+    radius = rng.uniform(0.001, 0.01, n_el)
+    cs, rs, ts, cm, rm, tm = c[slave_el], r[slave_el], t[slave_el], c[master_el], r[master_el], t[master_el]
+    i, j = broad_phase(cs, rs, cm, rm)
+    e, m = slave_el[i], master_el[j]
+    keep = rules.apart(enodes, e, m)
+    assert 0 < keep.sum() < len(keep)
+    i, j, e, m = i[keep], j[keep], e[keep], m[keep]
+    cos = ts[i, 0] * tm[j, 0] + ts[i, 1] * tm[j, 1] + ts[i, 2] * tm[j, 2]
+    got = search.broad_pairs(cs, rs, ts, cm, rm, tm, slave_el, master_el, enodes, radius, sweep=sweep)
+    if sweep:
+        assert not got[6]
+        order = np.lexsort((m, e))
+        i, j, e, m, cos = i[order], j[order], e[order], m[order], cos[order]
+        s = np.lexsort((got[1], got[0]))
+        got = tuple(a[s] for a in got[:5]) + got[5:]
+    for a, b in zip(got[:5], (e, m, cos, cm[j], rm[j] + radius[e])):
+        assert a.dtype == b.dtype and a.tobytes() == b.tobytes()
+    assert got[5] == np.abs(cos).min()

@@ -53,7 +53,8 @@ def apart(enodes, e, m):
     with its own two elements' nodes (``enodes`` ``(n_el, k)``; pass the table mapped by
     ``joint_nodes`` so that elements meeting at a joint never pair: their centre lines meet
     there, a contact pair between them would find no normal or the full overlap
-    ``R1 + R2``)."""
+    ``R1 + R2``).  The search runs it inside the broad phase's compiled pass (``search.broad_pairs``,
+    tested equal)."""
     A, B = enodes[e], enodes[m]
     shared = np.zeros(len(A), dtype=bool)
     for a in range(A.shape[1]):            # node columns: no (n, k, k) table

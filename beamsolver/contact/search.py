@@ -54,7 +54,8 @@ def element_spheres(H, enodes, h, radii, margin, el):
 
 
 def broad_phase(c_s, r_s, c_m, r_m):
-    """Slave/master element index pairs whose bounding spheres overlap."""
+    """Slave/master element index pairs whose bounding spheres overlap, in the distance matrix's order
+    (the search runs it fused with the pair rule ``rules.apart``: ``broad_pairs``)."""
     if len(c_s) == 0 or len(c_m) == 0:
         return np.zeros(0, dtype=int), np.zeros(0, dtype=int)
     ts, tm = cKDTree(c_s), cKDTree(c_m)
