@@ -1,6 +1,6 @@
 """The contact search (``ContactSystem.pairs``) of this tree against a git revision's, in one process.
 
-The revision's package is exported (``git archive``) under ``benchmarks/results/search_ref/<sha>/`` as
+The revision's package is exported (``git archive``) under ``<tmp>/beamsolver_search_ref/<sha>/`` as
 ``beamsolver_ref`` (its imports are relative; kept, so that numba's cache of it is reused) and both
 searches run interleaved on the scene of ``contact_throughput.py`` (two parallel beams in line
 contact, 5 Gauss points per slave element).  Per size: least CPU time of ``repeat`` searches of
@@ -35,7 +35,7 @@ def reference_package(ref):
     """``beamsolver_ref``: the package of git revision ``ref``, exported once per commit."""
     sha = subprocess.run(["git", "rev-parse", ref], cwd=ROOT, check=True, capture_output=True,
                          text=True).stdout.strip()
-    where = ROOT / "benchmarks" / "results" / "search_ref" / sha[:12]
+    where = Path(tempfile.gettempdir()) / "beamsolver_search_ref" / sha[:12]     # outside the tree (source scans)
     if not (where / "beamsolver_ref").is_dir():
         with tempfile.TemporaryDirectory() as tmp:
             archive = Path(tmp) / "tree.tar"
