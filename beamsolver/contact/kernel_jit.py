@@ -57,6 +57,7 @@ from numba.extending import intrinsic
 from .._jit import jit, jit_inline
 from ..errors import InputError
 from ..element_jit import _geometric
+from ..se3_jit import madd, mscale
 from ..se3_jit import (A_, B_, C_, CP_, D_, DP_, Q2P_, Q2_, Q3P_, Q3_, add, add_outer, coefficient, cross, dot,
                        log_relative, mat, mm, mv, q_matrix, scale, ti_matrix, transpose)
 from .law import PENALTY_COULOMB
@@ -380,50 +381,80 @@ def _jacobians(u, w, xi, t2, co, Ti, Ah, Ts, As, JA, JB, tmp):
             JA[i, j] = As[i, j] - tmp[i, j]
 
 
+@jit_inline
+def _blk(A, r0, c0):
+    """The 3x3 block ``A[r0:r0+3, c0:c0+3]`` of a ``(6, 6)`` array as a tuple."""
+    return ((A[r0, c0], A[r0, c0 + 1], A[r0, c0 + 2]), (A[r0 + 1, c0], A[r0 + 1, c0 + 1], A[r0 + 1, c0 + 2]),
+            (A[r0 + 2, c0], A[r0 + 2, c0 + 1], A[r0 + 2, c0 + 2]))
+
+
+@jit
+def _hat_mm(z, A):
+    """``hat(z) A`` of a 3-vector and a 3x3 tuple: rows ``z1 A_2 - z2 A_1, z2 A_0 - z0 A_2, z0 A_1 - z1 A_0``."""
+    return (add(scale(z[1], A[2]), scale(-z[2], A[1])), add(scale(z[2], A[0]), scale(-z[0], A[2])),
+            add(scale(z[0], A[1]), scale(-z[1], A[0])))
+
+
+@jit
+def _msub(A, s, B):
+    """``A - s B`` of 3x3 tuples."""
+    return madd(A, mscale(-s, B))
+
+
 @jit
 def _jacobian_derivatives(u, w, xi, t2, co, S, v, c):
     """``d(J_A^T wr)/dh, d(J_B^T wr)/dh`` into ``S[S_DA], S[S_DB]`` and ``d/dxi`` into ``v[V_DA], v[V_DB]``
-    at fixed ``wr = v[V_WR]``; ``S`` holds ``TI, AH, TMH`` of the element and ``TS, AS`` at this ``xi``;
+    at fixed ``wr = v[V_WR]``; ``S`` holds ``TI, AH, TMH`` of the element and ``TS, AS, JB`` at this ``xi``;
     ``c``: the element's cached coefficients (``_element_side``); ``t2, co = _coefficients(xi w)``.
 
-    With ``s = xi h``, ``y = T(s)^T wr``, ``b = J_B^T wr = xi T(h)^-T y`` and ``T(-s) h = h``:
-    ``dB/dh = G(h, xi y) - xi^2 T(h)^-T T(s)^T G(s, y)``, ``dB/dxi = T(h)^-T y - xi T(h)^-T T(s)^T G(s, y) h``,
-    ``dA/dh = -xi M(z_s) T(-s) + M(z_h) T(-h) - Ad(exp(-h))^T dB/dh``, ``dA/dxi = -M(z_s) h - Ad(exp(-h))^T dB/dxi``.
+    With ``s = xi h``, ``y = T(s)^T wr``, ``b = J_B^T wr = xi T(h)^-T y``, ``T(-s) h = h`` and
+    ``Q = J_B^T G(s, y) = xi T(h)^-T T(s)^T G(s, y)``:
+    ``dB/dh = G(h, xi y) - xi Q``, ``dB/dxi = T(h)^-T y - Q h``,
+    ``dA/dh = -xi M(z_s) T(-s) + M(z_h) T(-h) - Ad(exp(-h))^T dB/dh``, ``dA/dxi = -M(z_s) h - Ad(exp(-h))^T dB/dxi``
+    (``z_s = Ad(exp(-s))^T wr``, ``z_h = Ad(exp(-h))^T b``).  Done in 3x3 blocks: ``G``, ``Q``, ``M(z) T``, ``dA/dh``,
+    ``dB/dh`` have a zero upper-left block; ``J_B``, ``T``, ``T^-1``, ``Ad`` are ``[[X, Y], [0, X]]``;
+    ``T(-s) = [[T3^T, Q3^T], [0, T3^T]]`` of ``T(s) = [[T3, Q3], [0, T3]]`` (``Q(u, w)^T = Q(-u, -w)``).
     """
-    Ti, Ah, As, DA, DB, P = S[S_TI], S[S_AH], S[S_AS], S[S_DA], S[S_DB], S[S_P]
-    wr, y, xy, dB, b, zs, dA = v[V_WR], v[V_Y], v[V_XY], v[V_DB], v[V_B], v[V_ZS], v[V_DA]
-    su, sw = scale(xi, u), scale(xi, w)
-    _mtv_ut(S[S_TS], wr, y)
-    _geo_co(su, sw, y, S[S_GS], t2, co)
-    _mtm_ut_g(S[S_TS], S[S_GS], S[S_M1])
-    _mtm_ut_g(Ti, S[S_M1], P)                                # T(h)^-T T(s)^T G(s, y)
-    for i in range(6):
-        xy[i] = xi * y[i]
-    _geo_cached(u, w, xy, DB, c)
-    _mtv_ut(Ti, y, dB)
-    h = (u[0], u[1], u[2], w[0], w[1], w[2])
-    for i in range(6):
-        acc = 0.0
-        for j in range(6):
-            DB[i, j] -= xi * xi * P[i, j]
-            acc += P[i, j] * h[j]
-        dB[i] -= xi * acc
-    _mtv_ut(Ti, xy, b)
-    _mtv_ut(As, wr, zs)
-    _mtv_ut(Ah, b, v[V_ZH])
-    _m_times(v[V_ZH], S[S_TMH], DA)
-    _tangent_co(scale(-xi, u), scale(-xi, w), S[S_TMS], t2, co)
-    _m_times(zs, S[S_TMS], S[S_MS])
-    _mtm_ut_g(Ah, DB, S[S_AHDB])
-    zf, zm = (zs[0], zs[1], zs[2]), (zs[3], zs[4], zs[5])
-    top, bot = cross(zf, (h[3], h[4], h[5])), add(cross(zf, (h[0], h[1], h[2])), cross(zm, (h[3], h[4], h[5])))
-    AhdB = v[V_AHDB]
-    _mtv_ut(Ah, dB, AhdB)
-    Ms, AhDB = S[S_MS], S[S_AHDB]
-    for i in range(6):
-        dA[i] = -(top[i] if i < 3 else bot[i - 3]) - AhdB[i]
-        for j in range(6):
-            DA[i, j] -= xi * Ms[i, j] + AhDB[i, j]
+    wr = v[V_WR]
+    a, m = (wr[0], wr[1], wr[2]), (wr[3], wr[4], wr[5])
+    T3t, Q3t = transpose(_blk(S[S_TS], 0, 0)), transpose(_blk(S[S_TS], 0, 3))     # T(-s) blocks
+    yf, ym = mv(T3t, a), add(mv(Q3t, a), mv(T3t, m))                               # y = T(s)^T wr
+    G12, G21, G22 = _geometric(scale(xi, u), scale(xi, w), yf, ym, co[3], t2,
+                               (co[2], co[4], co[5], co[7], co[6], co[8], co[9]))    # G(s, y)
+    J11t, J12t = transpose(_blk(S[S_JB], 0, 0)), transpose(_blk(S[S_JB], 0, 3))
+    Q12, Q21 = mm(J11t, G12), mm(J11t, G21)
+    Q22 = madd(mm(J12t, G12), mm(J11t, G22))
+    H12, H21, H22 = _geometric(u, w, scale(xi, yf), scale(xi, ym), c[C_D], c[C_T2],
+                               (c[C_CO], c[C_CO + 1], c[C_CO + 2], c[C_CO + 3], c[C_CO + 4], c[C_CO + 5],
+                                c[C_CO + 6]))                                         # G(h, xi y)
+    B12, B21, B22 = _msub(H12, xi, Q12), _msub(H21, xi, Q21), _msub(H22, xi, Q22)
+    Ti3t, Xt = transpose(_blk(S[S_TI], 0, 0)), transpose(_blk(S[S_TI], 0, 3))
+    tyf, tym = mv(Ti3t, yf), add(mv(Xt, yf), mv(Ti3t, ym))                          # T(h)^-T y
+    dBf = add(tyf, scale(-1.0, mv(Q12, w)))
+    dBm = add(tym, scale(-1.0, add(mv(Q21, u), mv(Q22, w))))
+    Rst, Yst = transpose(_blk(S[S_AS], 0, 0)), transpose(_blk(S[S_AS], 0, 3))
+    zsf, zsm = mv(Rst, a), add(mv(Yst, a), mv(Rst, m))
+    Rht, Yht = transpose(_blk(S[S_AH], 0, 0)), transpose(_blk(S[S_AH], 0, 3))
+    bf, bm = scale(xi, tyf), scale(xi, tym)
+    zhf, zhm = mv(Rht, bf), add(mv(Yht, bf), mv(Rht, bm))
+    T3h, Q3h = _blk(S[S_TMH], 0, 0), _blk(S[S_TMH], 0, 3)                           # T(-h) blocks
+    Cz = _msub(_hat_mm(zhf, T3h), xi, _hat_mm(zsf, T3t))
+    A22 = _msub(madd(_hat_mm(zhf, Q3h), _hat_mm(zhm, T3h)), xi, madd(_hat_mm(zsf, Q3t), _hat_mm(zsm, T3t)))
+    A22 = _msub(_msub(A22, 1.0, mm(Yht, B12)), 1.0, mm(Rht, B22))
+    DA, DB = S[S_DA], S[S_DB]
+    _zero3(DA, 0, 0)
+    _put3(DA, 0, 3, _msub(Cz, 1.0, mm(Rht, B12)))
+    _put3(DA, 3, 0, _msub(Cz, 1.0, mm(Rht, B21)))
+    _put3(DA, 3, 3, A22)
+    _zero3(DB, 0, 0)
+    _put3(DB, 0, 3, B12)
+    _put3(DB, 3, 0, B21)
+    _put3(DB, 3, 3, B22)
+    dAf = add(cross(zsf, w), mv(Rht, dBf))
+    dAm = add(add(cross(zsf, u), cross(zsm, w)), add(mv(Yht, dBf), mv(Rht, dBm)))
+    dA, dB = v[V_DA], v[V_DB]
+    for i in range(3):
+        dA[i], dA[3 + i], dB[i], dB[3 + i] = -dAf[i], -dAm[i], dBf[i], dBm[i]
 
 
 # ---------------------------------------------------------------- projection and its derivative
