@@ -816,20 +816,23 @@ def _nodal(u, w, xi, t2, co, S, v, c, G, DW, DH, DXI, f, K, j0):
 def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, G, DXI, DW, DH, force, out):
     """One row of the tangent: ``out[c] = di dxi[c] + sum_l (j_l Dw[l, c] + d_l Dh[l, c])``, summed in this
     order (``dxi``, ``Dw``, ``Dh``: the rows ``DXI``, ``DW``, ``DH`` of ``G``).  ``force`` (a constant at each
-    call): a force row, whose ``j3, j4, j5`` are structural zeros (``J[3:, :3] == 0``): their terms, exact
-    zeros, are skipped.  ``Dh`` is zero outside the side's columns: its terms there, exact zeros, change a
-    sum only in the sign of a zero result (``_mm_ut``), and keep the loop branch-free over all 24 columns,
-    which the compiler vectorises (with a runtime check that ``out`` and ``G`` do not overlap, refused in
+    call): a force row, whose ``j3, j4, j5`` (``J[3:, :3] == 0``) and ``d0, d1, d2`` (the zero upper-left block
+    of ``d(J^T wr)/dh``, ``_jacobian_derivatives``) are structural zeros: their terms, exact zeros, are
+    skipped.  ``Dh`` is zero outside the side's columns: its terms there, exact zeros, change a sum only
+    in the sign of a zero result (``_mm_ut``), and keep the loop branch-free over all 24 columns, which the compiler vectorises (with a runtime check that ``out`` and ``G`` do not overlap, refused in
     loops of fewer than 16 iterations)."""
     x, w, h = DXI * W, DW * W, DH * W           # first entries of the rows
     for c in range(24):
         acc = di * G[x + c]
         acc += j0 * G[w + c]
-        acc += d0 * G[h + c]
+        if not force:
+            acc += d0 * G[h + c]
         acc += j1 * G[w + W + c]
-        acc += d1 * G[h + W + c]
+        if not force:
+            acc += d1 * G[h + W + c]
         acc += j2 * G[w + 2 * W + c]
-        acc += d2 * G[h + 2 * W + c]
+        if not force:
+            acc += d2 * G[h + 2 * W + c]
         if not force:
             acc += j3 * G[w + 3 * W + c]
         acc += d3 * G[h + 3 * W + c]
