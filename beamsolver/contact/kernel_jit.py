@@ -819,8 +819,9 @@ def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, G, DXI, DW,
     call): a force row, whose ``j3, j4, j5`` (``J[3:, :3] == 0``) and ``d0, d1, d2`` (the zero upper-left block
     of ``d(J^T wr)/dh``, ``_jacobian_derivatives``) are structural zeros: their terms, exact zeros, are
     skipped.  ``Dh`` is zero outside the side's columns: its terms there, exact zeros, change a sum only
-    in the sign of a zero result (``_mm_ut``), and keep the loop branch-free over all 24 columns, which the compiler vectorises (with a runtime check that ``out`` and ``G`` do not overlap, refused in
-    loops of fewer than 16 iterations)."""
+    in the sign of a zero result (``_mm_ut``), and keep the loop branch-free over all 24 columns, which the
+    compiler vectorises (with a runtime check that ``out`` and ``G`` do not overlap, refused in loops of fewer
+    than 16 iterations)."""
     x, w, h = DXI * W, DW * W, DH * W           # first entries of the rows
     for c in range(24):
         acc = di * G[x + c]
