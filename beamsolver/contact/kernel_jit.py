@@ -56,7 +56,7 @@ from numba.extending import intrinsic
 
 from .._jit import jit, jit_inline
 from ..errors import InputError
-from ..element_jit import _geometric
+from ..element_jit import _dq_du, _dq_dw, _geometric
 from ..se3_jit import madd, mscale
 from ..se3_jit import (A_, B_, C_, CP_, D_, DP_, Q2P_, Q2_, Q3P_, Q3_, add, add_outer, coefficient, cross, dot,
                        log_relative, mat, mm, mv, q_matrix, scale, ti_matrix, transpose)
@@ -402,6 +402,39 @@ def _msub(A, s, B):
 
 
 @jit
+def _d_t3t(w, v, b, c, bp, cp):
+    """``d(T3(w)^T v)/dw`` at fixed ``v``, ``T3(w)^T v = v + b w x v + c w x (w x v)`` (the ``SO(3)`` block of
+    ``T(h)^T``): ``-b hat(v) + bp (w x v) w^T + c ((w.v) I + w v^T - 2 v w^T) + cp (w x (w x v)) w^T`` with
+    ``bp = b'(t)/t = a c - b^2``, ``cp = c'(t)/t``."""
+    wv = cross(w, v)
+    M = add_outer(mat(scale(-b, v), c * dot(w, v)),
+                  add(add(scale(bp, wv), scale(cp, cross(w, wv))), scale(-2.0 * c, v)), w)
+    return add_outer(M, scale(c, w), v)
+
+
+@jit
+def _dt_t(u, w, a, m, t2, co):
+    """``F = d(T(s)^T wr)/ds`` at fixed ``wr = (a, m)``, ``s = (u, w)``, as the blocks ``F12, F21, F22`` of
+    ``[[0, F12], [F21, F22]]``; ``co``: ``_coefficients(w)``.  ``T(s)^T wr = (T3^T a, Q(u, w) a + T3^T m)``
+    (``Q(-u, -w)^T = Q(u, w)``): ``F12 = d(T3^T a)/dw``, ``F21 = dQ/du a``, ``F22 = dQ/dw a + d(T3^T m)/dw``
+    (``element_jit._dq_du``, ``_dq_dw``, ``_d_t3t``).  ``T(s)^T G(s, T(s)^T wr) = -F``."""
+    b, c1, c2, c3, cp, q2p, q3p = co[1], co[2], co[4], co[5], co[6], co[8], co[9]
+    bp = co[0] * c1 - b * b
+    yw = cross(w, a)
+    yww = cross(w, yw)
+    a_, b_, e_ = cross(u, a), cross(u, yw), cross(u, yww)
+    wa_, wb_ = cross(w, a_), cross(w, b_)
+    g1 = add(add(wa_, b_), wb_)
+    g2 = add(add(cross(w, wa_), e_), scale(-3.0, wb_))
+    g3 = add(cross(w, e_), cross(w, wb_))
+    gp = add(add(scale(cp, g1), scale(q2p, g2)), scale(q3p, g3))
+    wy = dot(w, a)
+    F21 = _dq_du(a, yw, yww, w, t2, wy, c1, c2, c3)
+    dQw = _dq_dw(u, w, a, yw, a_, b_, e_, wa_, gp, t2, wy, dot(u, a), dot(w, u), cross(u, w), c1, c2, c3)
+    return _d_t3t(w, a, b, c1, bp, cp), F21, madd(dQw, _d_t3t(w, m, b, c1, bp, cp))
+
+
+@jit
 def _jacobian_derivatives(u, w, xi, t2, co, S, v, c):
     """``d(J_A^T wr)/dh, d(J_B^T wr)/dh`` into ``S[S_DA], S[S_DB]`` and ``d/dxi`` into ``v[V_DA], v[V_DB]``
     at fixed ``wr = v[V_WR]``; ``S`` holds ``TI, AH, TMH`` of the element and ``TS, AS, JB`` at this ``xi``;
@@ -419,16 +452,14 @@ def _jacobian_derivatives(u, w, xi, t2, co, S, v, c):
     a, m = (wr[0], wr[1], wr[2]), (wr[3], wr[4], wr[5])
     T3t, Q3t = transpose(_blk(S[S_TS], 0, 0)), transpose(_blk(S[S_TS], 0, 3))     # T(-s) blocks
     yf, ym = mv(T3t, a), add(mv(Q3t, a), mv(T3t, m))                               # y = T(s)^T wr
-    G12, G21, G22 = _geometric(scale(xi, u), scale(xi, w), yf, ym, co[3], t2,
-                               (co[2], co[4], co[5], co[7], co[6], co[8], co[9]))    # G(s, y)
-    J11t, J12t = transpose(_blk(S[S_JB], 0, 0)), transpose(_blk(S[S_JB], 0, 3))
-    Q12, Q21 = mm(J11t, G12), mm(J11t, G21)
-    Q22 = madd(mm(J12t, G12), mm(J11t, G22))
+    F12, F21, F22 = _dt_t(scale(xi, u), scale(xi, w), a, m, t2, co)                 # -T(s)^T G(s, y)
+    Ti3t, Xt = transpose(_blk(S[S_TI], 0, 0)), transpose(_blk(S[S_TI], 0, 3))
+    Q12, Q21 = mscale(-xi, mm(Ti3t, F12)), mscale(-xi, mm(Ti3t, F21))
+    Q22 = mscale(-xi, madd(mm(Xt, F12), mm(Ti3t, F22)))
     H12, H21, H22 = _geometric(u, w, scale(xi, yf), scale(xi, ym), c[C_D], c[C_T2],
                                (c[C_CO], c[C_CO + 1], c[C_CO + 2], c[C_CO + 3], c[C_CO + 4], c[C_CO + 5],
                                 c[C_CO + 6]))                                         # G(h, xi y)
     B12, B21, B22 = _msub(H12, xi, Q12), _msub(H21, xi, Q21), _msub(H22, xi, Q22)
-    Ti3t, Xt = transpose(_blk(S[S_TI], 0, 0)), transpose(_blk(S[S_TI], 0, 3))
     tyf, tym = mv(Ti3t, yf), add(mv(Xt, yf), mv(Ti3t, ym))                          # T(h)^-T y
     dBf = add(tyf, scale(-1.0, mv(Q12, w)))
     dBm = add(tym, scale(-1.0, add(mv(Q21, u), mv(Q22, w))))
