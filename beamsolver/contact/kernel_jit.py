@@ -15,8 +15,7 @@ The tangent is forward mode done by hand: every quantity carries its gradient
 the projection parameters by the implicit-function theorem at the converged
 projection, and the node Jacobians themselves through
 
-- ``d(T(h)^-T v)/dh = G(h, v)`` (``element_jit._geometric``),
-- ``d(T(s)^T w)/ds = -T(s)^T G(s, T(s)^T w)``,
+- ``d(T(s)^T w)/ds = F(s, w)`` in closed form (``_dt_t``; ``d(T(h)^-T v)/dh = -T(h)^-T F(h, T(h)^-T v)``),
 - ``d(Ad(exp(-s))^T w)/ds = -M(z) T(-s)``, ``z = Ad(exp(-s))^T w``,
   ``M(z) = [[0, hat(z_f)], [hat(z_f), hat(z_m)]]``.
 
@@ -56,7 +55,7 @@ from numba.extending import intrinsic
 
 from .._jit import jit, jit_inline
 from ..errors import InputError
-from ..element_jit import _dq_du, _dq_dw, _geometric
+from ..element_jit import _dq_du, _dq_dw
 from ..se3_jit import madd, mscale
 from ..se3_jit import (A_, B_, C_, CP_, D_, DP_, Q2P_, Q2_, Q3P_, Q3_, add, add_outer, coefficient, cross, dot,
                        log_relative, mat, mm, mv, q_matrix, scale, ti_matrix, transpose)
@@ -209,19 +208,6 @@ def _mm_ut(A, B, out):
 
 
 @jit_inline
-def _mtm_ut_g(A, B, out):
-    """``out = A^T @ B`` for a block upper-triangular ``A`` and a ``B`` with ``B[:3, :3] == 0`` (as
-    ``G(h, v)``): ``_mtm`` without the terms of the zero blocks (the same floats, see ``_mm_ut``);
-    ``out[:3, :3] == 0`` again."""
-    for i in range(6):
-        for j in range(6):
-            acc = 0.0
-            for l in range(3 if j < 3 else 0, 3 if i < 3 else 6):
-                acc += A[l, i] * B[l, j]
-            out[i, j] = acc
-
-
-@jit_inline
 def _mtv_ut(A, v, out):
     """``out = A^T v`` for a block upper-triangular ``(6, 6)`` array and a 6-vector, without the terms
     of the zero block (the same floats, see ``_mm_ut``)."""
@@ -285,51 +271,6 @@ def _adjoint_inv(R, x, A):
     _put3(A, 3, 3, Rt)
     _put3(A, 0, 3, mm(mat(xt, 0.0), Rt))
     _zero3(A, 3, 0)
-
-
-@jit
-def _geo(u, w, v, G):
-    """``G = G(h, v) = d(T(h)^-T v)/dh``, ``(6, 6)`` (``element_jit._geometric``); ``v`` ``(6,)``."""
-    t2 = dot(w, w)
-    t = np.sqrt(t2)
-    co = (coefficient(C_, t), coefficient(Q2_, t), coefficient(Q3_, t), coefficient(DP_, t), coefficient(CP_, t),
-          coefficient(Q2P_, t), coefficient(Q3P_, t))
-    _put_geo(G, _geometric(u, w, (v[0], v[1], v[2]), (v[3], v[4], v[5]), coefficient(D_, t), t2, co))
-
-
-@jit_inline
-def _put_geo(G, blocks):
-    """``G`` ``(6, 6)`` = ``[[0, G12], [G21, G22]]`` from ``blocks = (G12, G21, G22)``."""
-    G12, G21, G22 = blocks
-    _zero3(G, 0, 0)
-    _put3(G, 0, 3, G12)
-    _put3(G, 3, 0, G21)
-    _put3(G, 3, 3, G22)
-
-
-@jit
-def _geo_co(u, w, v, G, t2, co):
-    """``_geo`` with the coefficients of ``_coefficients(w)``."""
-    _put_geo(G, _geometric(u, w, (v[0], v[1], v[2]), (v[3], v[4], v[5]), co[3], t2,
-                           (co[2], co[4], co[5], co[7], co[6], co[8], co[9])))
-
-
-@jit
-def _geo_cached(u, w, v, G, c):
-    """``_geo`` at the element twist, with the coefficients kept in ``c`` by ``_element_side``."""
-    _put_geo(G, _geometric(u, w, (v[0], v[1], v[2]), (v[3], v[4], v[5]), c[C_D], c[C_T2],
-                           (c[C_CO], c[C_CO + 1], c[C_CO + 2], c[C_CO + 3], c[C_CO + 4], c[C_CO + 5], c[C_CO + 6])))
-
-
-@jit_inline
-def _m_times(z, A, out):
-    """``out = M(z) A`` with ``M(z) = [[0, hat(z_f)], [hat(z_f), hat(z_m)]]``, column by column."""
-    zf, zm = (z[0], z[1], z[2]), (z[3], z[4], z[5])
-    for k in range(A.shape[1]):
-        au, aw = (A[0, k], A[1, k], A[2, k]), (A[3, k], A[4, k], A[5, k])
-        top, bot = cross(zf, aw), add(cross(zf, au), cross(zm, aw))
-        for i in range(3):
-            out[i, k], out[3 + i, k] = top[i], bot[i]
 
 
 # ---------------------------------------------------------------- one side of a pair: scratch slots
@@ -413,13 +354,12 @@ def _d_t3t(w, v, b, c, bp, cp):
 
 
 @jit
-def _dt_t(u, w, a, m, t2, co):
+def _dt_t(u, w, a, m, t2, ca, b, c1, c2, c3, cp, q2p, q3p):
     """``F = d(T(s)^T wr)/ds`` at fixed ``wr = (a, m)``, ``s = (u, w)``, as the blocks ``F12, F21, F22`` of
-    ``[[0, F12], [F21, F22]]``; ``co``: ``_coefficients(w)``.  ``T(s)^T wr = (T3^T a, Q(u, w) a + T3^T m)``
+    ``[[0, F12], [F21, F22]]``; ``t2 = |w|^2`` and the coefficients ``a, b, c, q2, q3, cp, q2p, q3p`` at ``|w|``.  ``T(s)^T wr = (T3^T a, Q(u, w) a + T3^T m)``
     (``Q(-u, -w)^T = Q(u, w)``): ``F12 = d(T3^T a)/dw``, ``F21 = dQ/du a``, ``F22 = dQ/dw a + d(T3^T m)/dw``
     (``element_jit._dq_du``, ``_dq_dw``, ``_d_t3t``).  ``T(s)^T G(s, T(s)^T wr) = -F``."""
-    b, c1, c2, c3, cp, q2p, q3p = co[1], co[2], co[4], co[5], co[6], co[8], co[9]
-    bp = co[0] * c1 - b * b
+    bp = ca * c1 - b * b
     yw = cross(w, a)
     yww = cross(w, yw)
     a_, b_, e_ = cross(u, a), cross(u, yw), cross(u, yww)
@@ -441,10 +381,10 @@ def _jacobian_derivatives(u, w, xi, t2, co, S, v, c):
     ``c``: the element's cached coefficients (``_element_side``); ``t2, co = _coefficients(xi w)``.
 
     With ``s = xi h``, ``y = T(s)^T wr``, ``b = J_B^T wr = xi T(h)^-T y``, ``T(-s) h = h`` and
-    ``Q = J_B^T G(s, y) = xi T(h)^-T T(s)^T G(s, y)``:
-    ``dB/dh = G(h, xi y) - xi Q``, ``dB/dxi = T(h)^-T y - Q h``,
+    ``F(s, x) = d(T(s)^T x)/ds`` at fixed ``x`` (``_dt_t``; ``G(h, v) = d(T(h)^-T v)/dh = -T(h)^-T F(h, T(h)^-T v)``):
+    ``dB/dh = -T(h)^-T (F(h, b) - xi^2 F(s, wr))``, ``dB/dxi = T(h)^-T (y + xi F(s, wr) h)``,
     ``dA/dh = -xi M(z_s) T(-s) + M(z_h) T(-h) - Ad(exp(-h))^T dB/dh``, ``dA/dxi = -M(z_s) h - Ad(exp(-h))^T dB/dxi``
-    (``z_s = Ad(exp(-s))^T wr``, ``z_h = Ad(exp(-h))^T b``).  Done in 3x3 blocks: ``G``, ``Q``, ``M(z) T``, ``dA/dh``,
+    (``z_s = Ad(exp(-s))^T wr``, ``z_h = Ad(exp(-h))^T b``).  Done in 3x3 blocks: ``F``, ``M(z) T``, ``dA/dh``,
     ``dB/dh`` have a zero upper-left block; ``J_B``, ``T``, ``T^-1``, ``Ad`` are ``[[X, Y], [0, X]]``;
     ``T(-s) = [[T3^T, Q3^T], [0, T3^T]]`` of ``T(s) = [[T3, Q3], [0, T3]]`` (``Q(u, w)^T = Q(-u, -w)``).
     """
@@ -452,21 +392,23 @@ def _jacobian_derivatives(u, w, xi, t2, co, S, v, c):
     a, m = (wr[0], wr[1], wr[2]), (wr[3], wr[4], wr[5])
     T3t, Q3t = transpose(_blk(S[S_TS], 0, 0)), transpose(_blk(S[S_TS], 0, 3))     # T(-s) blocks
     yf, ym = mv(T3t, a), add(mv(Q3t, a), mv(T3t, m))                               # y = T(s)^T wr
-    F12, F21, F22 = _dt_t(scale(xi, u), scale(xi, w), a, m, t2, co)                 # -T(s)^T G(s, y)
+    F12, F21, F22 = _dt_t(scale(xi, u), scale(xi, w), a, m, t2, co[0], co[1], co[2], co[4], co[5], co[6], co[8],
+                          co[9])                                                     # F(s, wr)
     Ti3t, Xt = transpose(_blk(S[S_TI], 0, 0)), transpose(_blk(S[S_TI], 0, 3))
-    Q12, Q21 = mscale(-xi, mm(Ti3t, F12)), mscale(-xi, mm(Ti3t, F21))
-    Q22 = mscale(-xi, madd(mm(Xt, F12), mm(Ti3t, F22)))
-    H12, H21, H22 = _geometric(u, w, scale(xi, yf), scale(xi, ym), c[C_D], c[C_T2],
-                               (c[C_CO], c[C_CO + 1], c[C_CO + 2], c[C_CO + 3], c[C_CO + 4], c[C_CO + 5],
-                                c[C_CO + 6]))                                         # G(h, xi y)
-    B12, B21, B22 = _msub(H12, xi, Q12), _msub(H21, xi, Q21), _msub(H22, xi, Q22)
     tyf, tym = mv(Ti3t, yf), add(mv(Xt, yf), mv(Ti3t, ym))                          # T(h)^-T y
-    dBf = add(tyf, scale(-1.0, mv(Q12, w)))
-    dBm = add(tym, scale(-1.0, add(mv(Q21, u), mv(Q22, w))))
+    bf, bm = scale(xi, tyf), scale(xi, tym)                                           # b = J_B^T wr
+    H12, H21, H22 = _dt_t(u, w, bf, bm, c[C_T2], c[C_A], c[C_B], c[C_CO], c[C_CO + 1], c[C_CO + 2], c[C_CO + 4],
+                          c[C_CO + 5], c[C_CO + 6])                                 # F(h, b)
+    x2 = xi * xi
+    E12, E21, E22 = _msub(H12, x2, F12), _msub(H21, x2, F21), _msub(H22, x2, F22)
+    B12, B21, B22 = mscale(-1.0, mm(Ti3t, E12)), mscale(-1.0, mm(Ti3t, E21)), \
+        mscale(-1.0, madd(mm(Xt, E12), mm(Ti3t, E22)))                              # dB/dh = -T(h)^-T E
+    ef = add(yf, scale(xi, mv(F12, w)))                                               # y + xi F(s, wr) h
+    em = add(ym, scale(xi, add(mv(F21, u), mv(F22, w))))
+    dBf, dBm = mv(Ti3t, ef), add(mv(Xt, ef), mv(Ti3t, em))
     Rst, Yst = transpose(_blk(S[S_AS], 0, 0)), transpose(_blk(S[S_AS], 0, 3))
     zsf, zsm = mv(Rst, a), add(mv(Yst, a), mv(Rst, m))
     Rht, Yht = transpose(_blk(S[S_AH], 0, 0)), transpose(_blk(S[S_AH], 0, 3))
-    bf, bm = scale(xi, tyf), scale(xi, tym)
     zhf, zhm = mv(Rht, bf), add(mv(Yht, bf), mv(Rht, bm))
     T3h, Q3h = _blk(S[S_TMH], 0, 0), _blk(S[S_TMH], 0, 3)                           # T(-h) blocks
     Cz = _msub(_hat_mm(zhf, T3h), xi, _hat_mm(zsf, T3t))
@@ -591,7 +533,7 @@ def _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, G):
 # ---------------------------------------------------------------- one side of a pair: element, section, Jacobians
 # per-side element cache ``c`` (2, N_CACHE): the node poses (rows 0-2 of nodes j0, j0 + 1), the twist and the
 # coefficients of ``G(h, .)`` of the last element seen on that side
-C_POSE, C_U, C_W, C_T2, C_D, C_CO, N_CACHE = 0, 24, 27, 30, 31, 32, 39
+C_POSE, C_U, C_W, C_T2, C_D, C_CO, C_A, C_B, N_CACHE = 0, 24, 27, 30, 31, 32, 39, 40, 41
 
 
 @jit
@@ -625,6 +567,7 @@ def _element_side(Xp, j0, S, c):
     for i in range(3):
         c[C_U + i], c[C_W + i] = u[i], w[i]
     c[C_T2], c[C_D] = t2, coefficient(D_, t)
+    c[C_A], c[C_B] = coefficient(A_, t), coefficient(B_, t)
     for i in range(7):
         c[C_CO + i] = co[i]
     return RA, xA, u, w
