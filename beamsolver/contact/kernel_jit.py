@@ -343,6 +343,19 @@ def _msub(A, s, B):
 
 
 @jit
+def _mdiff(A, B):
+    """``A - B`` of 3x3 tuples."""
+    return (add(A[0], scale(-1.0, B[0])), add(A[1], scale(-1.0, B[1])), add(A[2], scale(-1.0, B[2])))
+
+
+@jit
+def _axmy(s, A, B):
+    """``s A - B`` of 3x3 tuples."""
+    return (add(scale(s, A[0]), scale(-1.0, B[0])), add(scale(s, A[1]), scale(-1.0, B[1])),
+            add(scale(s, A[2]), scale(-1.0, B[2])))
+
+
+@jit
 def _d_t3t(w, v, b, c, bp, cp):
     """``d(T3(w)^T v)/dw`` at fixed ``v``, ``T3(w)^T v = v + b w x v + c w x (w x v)`` (the ``SO(3)`` block of
     ``T(h)^T``): ``-b hat(v) + bp (w x v) w^T + c ((w.v) I + w v^T - 2 v w^T) + cp (w x (w x v)) w^T`` with
@@ -356,9 +369,10 @@ def _d_t3t(w, v, b, c, bp, cp):
 @jit
 def _dt_t(u, w, a, m, t2, ca, b, c1, c2, c3, cp, q2p, q3p):
     """``F = d(T(s)^T wr)/ds`` at fixed ``wr = (a, m)``, ``s = (u, w)``, as the blocks ``F12, F21, F22`` of
-    ``[[0, F12], [F21, F22]]``; ``t2 = |w|^2`` and the coefficients ``a, b, c, q2, q3, cp, q2p, q3p`` at ``|w|``.  ``T(s)^T wr = (T3^T a, Q(u, w) a + T3^T m)``
-    (``Q(-u, -w)^T = Q(u, w)``): ``F12 = d(T3^T a)/dw``, ``F21 = dQ/du a``, ``F22 = dQ/dw a + d(T3^T m)/dw``
-    (``element_jit._dq_du``, ``_dq_dw``, ``_d_t3t``).  ``T(s)^T G(s, T(s)^T wr) = -F``."""
+    ``[[0, F12], [F21, F22]]``; ``t2 = |w|^2`` and the coefficients ``a, b, c, q2, q3, cp, q2p, q3p`` at ``|w|``.
+    ``T(s)^T wr = (T3^T a, Q(u, w) a + T3^T m)`` (``Q(-u, -w)^T = Q(u, w)``): ``F12 = d(T3^T a)/dw``,
+    ``F21 = dQ/du a``, ``F22 = dQ/dw a + d(T3^T m)/dw`` (``element_jit._dq_du``, ``_dq_dw``, ``_d_t3t``).
+    ``T(s)^T G(s, T(s)^T wr) = -F``."""
     bp = ca * c1 - b * b
     yw = cross(w, a)
     yww = cross(w, yw)
@@ -382,7 +396,7 @@ def _jacobian_derivatives(u, w, xi, t2, co, S, v, c):
 
     With ``s = xi h``, ``y = T(s)^T wr``, ``b = J_B^T wr = xi T(h)^-T y``, ``T(-s) h = h`` and
     ``F(s, x) = d(T(s)^T x)/ds`` at fixed ``x`` (``_dt_t``; ``G(h, v) = d(T(h)^-T v)/dh = -T(h)^-T F(h, T(h)^-T v)``):
-    ``dB/dh = -T(h)^-T (F(h, b) - xi^2 F(s, wr))``, ``dB/dxi = T(h)^-T (y + xi F(s, wr) h)``,
+    ``dB/dh = T(h)^-T N``, ``N = xi^2 F(s, wr) - F(h, b)``, ``dB/dxi = T(h)^-T (y + xi F(s, wr) h)``,
     ``dA/dh = -xi M(z_s) T(-s) + M(z_h) T(-h) - Ad(exp(-h))^T dB/dh``, ``dA/dxi = -M(z_s) h - Ad(exp(-h))^T dB/dxi``
     (``z_s = Ad(exp(-s))^T wr``, ``z_h = Ad(exp(-h))^T b``).  Done in 3x3 blocks: ``F``, ``M(z) T``, ``dA/dh``,
     ``dB/dh`` have a zero upper-left block; ``J_B``, ``T``, ``T^-1``, ``Ad`` are ``[[X, Y], [0, X]]``;
@@ -400,9 +414,8 @@ def _jacobian_derivatives(u, w, xi, t2, co, S, v, c):
     H12, H21, H22 = _dt_t(u, w, bf, bm, c[C_T2], c[C_A], c[C_B], c[C_CO], c[C_CO + 1], c[C_CO + 2], c[C_CO + 4],
                           c[C_CO + 5], c[C_CO + 6])                                 # F(h, b)
     x2 = xi * xi
-    E12, E21, E22 = _msub(H12, x2, F12), _msub(H21, x2, F21), _msub(H22, x2, F22)
-    B12, B21, B22 = mscale(-1.0, mm(Ti3t, E12)), mscale(-1.0, mm(Ti3t, E21)), \
-        mscale(-1.0, madd(mm(Xt, E12), mm(Ti3t, E22)))                              # dB/dh = -T(h)^-T E
+    N12, N21, N22 = _axmy(x2, F12, H12), _axmy(x2, F21, H21), _axmy(x2, F22, H22)
+    B12, B21, B22 = mm(Ti3t, N12), mm(Ti3t, N21), madd(mm(Xt, N12), mm(Ti3t, N22))   # dB/dh = T(h)^-T N
     ef = add(yf, scale(xi, mv(F12, w)))                                               # y + xi F(s, wr) h
     em = add(ym, scale(xi, add(mv(F21, u), mv(F22, w))))
     dBf, dBm = mv(Ti3t, ef), add(mv(Xt, ef), mv(Ti3t, em))
@@ -413,11 +426,11 @@ def _jacobian_derivatives(u, w, xi, t2, co, S, v, c):
     T3h, Q3h = _blk(S[S_TMH], 0, 0), _blk(S[S_TMH], 0, 3)                           # T(-h) blocks
     Cz = _msub(_hat_mm(zhf, T3h), xi, _hat_mm(zsf, T3t))
     A22 = _msub(madd(_hat_mm(zhf, Q3h), _hat_mm(zhm, T3h)), xi, madd(_hat_mm(zsf, Q3t), _hat_mm(zsm, T3t)))
-    A22 = _msub(_msub(A22, 1.0, mm(Yht, B12)), 1.0, mm(Rht, B22))
+    A22 = _mdiff(_mdiff(A22, mm(Yht, B12)), mm(Rht, B22))
     DA, DB = S[S_DA], S[S_DB]
     _zero3(DA, 0, 0)
-    _put3(DA, 0, 3, _msub(Cz, 1.0, mm(Rht, B12)))
-    _put3(DA, 3, 0, _msub(Cz, 1.0, mm(Rht, B21)))
+    _put3(DA, 0, 3, _mdiff(Cz, mm(Rht, B12)))
+    _put3(DA, 3, 0, _mdiff(Cz, mm(Rht, B21)))
     _put3(DA, 3, 3, A22)
     _zero3(DB, 0, 0)
     _put3(DB, 0, 3, B12)
