@@ -388,7 +388,7 @@ def _dt_t(u, w, a, m, t2, ca, b, c1, c2, c3, cp, q2p, q3p):
     return _d_t3t(w, a, b, c1, bp, cp), F21, madd(dQw, _d_t3t(w, m, b, c1, bp, cp))
 
 
-@jit
+@jit_inline
 def _jacobian_derivatives(u, w, xi, t2, co, S, v, c):
     """``d(J_A^T wr)/dh, d(J_B^T wr)/dh`` into ``S[S_DA], S[S_DB]`` and ``d/dxi`` into ``v[V_DA], v[V_DB]``
     at fixed ``wr = v[V_WR]``; ``S`` holds ``TI, AH, TMH`` of the element and ``TS, AS, JB`` at this ``xi``;
@@ -767,11 +767,11 @@ def _wrench(R, F, neg, m, sm, G, V, DW, w):
     for i in range(3):
         w[i], w[3 + i] = bF[i], bm[i]
     df, dm, dv = G_DF * W, G_DMF * W, (V + 3) * W        # first entries of the rows
+    Rf, Rm = mscale(-1.0 if neg else 1.0, Rt), mscale(sm, Rt)
     for k in range(24):
         th = (G[dv + k], G[dv + W + k], G[dv + 2 * W + k])
-        dF = (-G[df + k], -G[df + W + k], -G[df + 2 * W + k]) if neg else (G[df + k], G[df + W + k], G[df + 2 * W + k])
-        a = add(mv(Rt, dF), cross(bF, th))
-        b = add(mv(Rt, (sm * G[dm + k], sm * G[dm + W + k], sm * G[dm + 2 * W + k])), cross(bm, th))
+        a = add(mv(Rf, (G[df + k], G[df + W + k], G[df + 2 * W + k])), cross(bF, th))
+        b = add(mv(Rm, (G[dm + k], G[dm + W + k], G[dm + 2 * W + k])), cross(bm, th))
         for i in range(3):
             G[(DW + i) * W + k], G[(DW + 3 + i) * W + k] = a[i], b[i]
 
