@@ -15,8 +15,7 @@ The tangent is forward mode done by hand: every quantity carries its gradient
 the projection parameters by the implicit-function theorem at the converged
 projection, and the node Jacobians themselves through
 
-- ``d(T(h)^-T v)/dh = G(h, v)`` (``element_jit._geometric``),
-- ``d(T(s)^T w)/ds = -T(s)^T G(s, T(s)^T w)``,
+- ``d(T(s)^T w)/ds = F(s, w)`` in closed form (``_dt_t``; ``d(T(h)^-T v)/dh = -T(h)^-T F(h, T(h)^-T v)``),
 - ``d(Ad(exp(-s))^T w)/ds = -M(z) T(-s)``, ``z = Ad(exp(-s))^T w``,
   ``M(z) = [[0, hat(z_f)], [hat(z_f), hat(z_m)]]``.
 
@@ -56,7 +55,8 @@ from numba.extending import intrinsic
 
 from .._jit import jit, jit_inline
 from ..errors import InputError
-from ..element_jit import _geometric
+from ..element_jit import _dq_du, _dq_dw
+from ..se3_jit import madd, mscale
 from ..se3_jit import (A_, B_, C_, CP_, D_, DP_, Q2P_, Q2_, Q3P_, Q3_, add, add_outer, coefficient, cross, dot,
                        log_relative, mat, mm, mv, q_matrix, scale, ti_matrix, transpose)
 from .law import PENALTY_COULOMB
@@ -208,19 +208,6 @@ def _mm_ut(A, B, out):
 
 
 @jit_inline
-def _mtm_ut_g(A, B, out):
-    """``out = A^T @ B`` for a block upper-triangular ``A`` and a ``B`` with ``B[:3, :3] == 0`` (as
-    ``G(h, v)``): ``_mtm`` without the terms of the zero blocks (the same floats, see ``_mm_ut``);
-    ``out[:3, :3] == 0`` again."""
-    for i in range(6):
-        for j in range(6):
-            acc = 0.0
-            for l in range(3 if j < 3 else 0, 3 if i < 3 else 6):
-                acc += A[l, i] * B[l, j]
-            out[i, j] = acc
-
-
-@jit_inline
 def _mtv_ut(A, v, out):
     """``out = A^T v`` for a block upper-triangular ``(6, 6)`` array and a 6-vector, without the terms
     of the zero block (the same floats, see ``_mm_ut``)."""
@@ -286,51 +273,6 @@ def _adjoint_inv(R, x, A):
     _zero3(A, 3, 0)
 
 
-@jit
-def _geo(u, w, v, G):
-    """``G = G(h, v) = d(T(h)^-T v)/dh``, ``(6, 6)`` (``element_jit._geometric``); ``v`` ``(6,)``."""
-    t2 = dot(w, w)
-    t = np.sqrt(t2)
-    co = (coefficient(C_, t), coefficient(Q2_, t), coefficient(Q3_, t), coefficient(DP_, t), coefficient(CP_, t),
-          coefficient(Q2P_, t), coefficient(Q3P_, t))
-    _put_geo(G, _geometric(u, w, (v[0], v[1], v[2]), (v[3], v[4], v[5]), coefficient(D_, t), t2, co))
-
-
-@jit_inline
-def _put_geo(G, blocks):
-    """``G`` ``(6, 6)`` = ``[[0, G12], [G21, G22]]`` from ``blocks = (G12, G21, G22)``."""
-    G12, G21, G22 = blocks
-    _zero3(G, 0, 0)
-    _put3(G, 0, 3, G12)
-    _put3(G, 3, 0, G21)
-    _put3(G, 3, 3, G22)
-
-
-@jit
-def _geo_co(u, w, v, G, t2, co):
-    """``_geo`` with the coefficients of ``_coefficients(w)``."""
-    _put_geo(G, _geometric(u, w, (v[0], v[1], v[2]), (v[3], v[4], v[5]), co[3], t2,
-                           (co[2], co[4], co[5], co[7], co[6], co[8], co[9])))
-
-
-@jit
-def _geo_cached(u, w, v, G, c):
-    """``_geo`` at the element twist, with the coefficients kept in ``c`` by ``_element_side``."""
-    _put_geo(G, _geometric(u, w, (v[0], v[1], v[2]), (v[3], v[4], v[5]), c[C_D], c[C_T2],
-                           (c[C_CO], c[C_CO + 1], c[C_CO + 2], c[C_CO + 3], c[C_CO + 4], c[C_CO + 5], c[C_CO + 6])))
-
-
-@jit_inline
-def _m_times(z, A, out):
-    """``out = M(z) A`` with ``M(z) = [[0, hat(z_f)], [hat(z_f), hat(z_m)]]``, column by column."""
-    zf, zm = (z[0], z[1], z[2]), (z[3], z[4], z[5])
-    for k in range(A.shape[1]):
-        au, aw = (A[0, k], A[1, k], A[2, k]), (A[3, k], A[4, k], A[5, k])
-        top, bot = cross(zf, aw), add(cross(zf, au), cross(zm, aw))
-        for i in range(3):
-            out[i, k], out[3 + i, k] = top[i], bot[i]
-
-
 # ---------------------------------------------------------------- one side of a pair: scratch slots
 # 6x6 slots of a side's scratch ``S`` (N_SIDE, 6, 6)
 (S_TI, S_AH, S_TS, S_AS, S_JA, S_JB, S_TSP, S_ASP, S_JAP, S_JBP, S_TMP, S_GS, S_M1, S_P, S_DA, S_DB, S_TMH, S_TMS, S_MS,
@@ -380,50 +322,125 @@ def _jacobians(u, w, xi, t2, co, Ti, Ah, Ts, As, JA, JB, tmp):
             JA[i, j] = As[i, j] - tmp[i, j]
 
 
+@jit_inline
+def _blk(A, r0, c0):
+    """The 3x3 block ``A[r0:r0+3, c0:c0+3]`` of a ``(6, 6)`` array as a tuple."""
+    return ((A[r0, c0], A[r0, c0 + 1], A[r0, c0 + 2]), (A[r0 + 1, c0], A[r0 + 1, c0 + 1], A[r0 + 1, c0 + 2]),
+            (A[r0 + 2, c0], A[r0 + 2, c0 + 1], A[r0 + 2, c0 + 2]))
+
+
 @jit
+def _hat_mm(z, A):
+    """``hat(z) A`` of a 3-vector and a 3x3 tuple: rows ``z1 A_2 - z2 A_1, z2 A_0 - z0 A_2, z0 A_1 - z1 A_0``."""
+    return (add(scale(z[1], A[2]), scale(-z[2], A[1])), add(scale(z[2], A[0]), scale(-z[0], A[2])),
+            add(scale(z[0], A[1]), scale(-z[1], A[0])))
+
+
+@jit
+def _msub(A, s, B):
+    """``A - s B`` of 3x3 tuples."""
+    return madd(A, mscale(-s, B))
+
+
+@jit
+def _mdiff(A, B):
+    """``A - B`` of 3x3 tuples."""
+    return (add(A[0], scale(-1.0, B[0])), add(A[1], scale(-1.0, B[1])), add(A[2], scale(-1.0, B[2])))
+
+
+@jit
+def _axmy(s, A, B):
+    """``s A - B`` of 3x3 tuples."""
+    return (add(scale(s, A[0]), scale(-1.0, B[0])), add(scale(s, A[1]), scale(-1.0, B[1])),
+            add(scale(s, A[2]), scale(-1.0, B[2])))
+
+
+@jit
+def _d_t3t(w, v, b, c, bp, cp):
+    """``d(T3(w)^T v)/dw`` at fixed ``v``, ``T3(w)^T v = v + b w x v + c w x (w x v)`` (the ``SO(3)`` block of
+    ``T(h)^T``): ``-b hat(v) + bp (w x v) w^T + c ((w.v) I + w v^T - 2 v w^T) + cp (w x (w x v)) w^T`` with
+    ``bp = b'(t)/t = a c - b^2``, ``cp = c'(t)/t``."""
+    wv = cross(w, v)
+    M = add_outer(mat(scale(-b, v), c * dot(w, v)),
+                  add(add(scale(bp, wv), scale(cp, cross(w, wv))), scale(-2.0 * c, v)), w)
+    return add_outer(M, scale(c, w), v)
+
+
+@jit
+def _dt_t(u, w, a, m, t2, ca, b, c1, c2, c3, cp, q2p, q3p):
+    """``F = d(T(s)^T wr)/ds`` at fixed ``wr = (a, m)``, ``s = (u, w)``, as the blocks ``F12, F21, F22`` of
+    ``[[0, F12], [F21, F22]]``; ``t2 = |w|^2`` and the coefficients ``a, b, c, q2, q3, cp, q2p, q3p`` at ``|w|``.
+    ``T(s)^T wr = (T3^T a, Q(u, w) a + T3^T m)`` (``Q(-u, -w)^T = Q(u, w)``): ``F12 = d(T3^T a)/dw``,
+    ``F21 = dQ/du a``, ``F22 = dQ/dw a + d(T3^T m)/dw`` (``element_jit._dq_du``, ``_dq_dw``, ``_d_t3t``).
+    ``T(s)^T G(s, T(s)^T wr) = -F``."""
+    bp = ca * c1 - b * b
+    yw = cross(w, a)
+    yww = cross(w, yw)
+    a_, b_, e_ = cross(u, a), cross(u, yw), cross(u, yww)
+    wa_, wb_ = cross(w, a_), cross(w, b_)
+    g1 = add(add(wa_, b_), wb_)
+    g2 = add(add(cross(w, wa_), e_), scale(-3.0, wb_))
+    g3 = add(cross(w, e_), cross(w, wb_))
+    gp = add(add(scale(cp, g1), scale(q2p, g2)), scale(q3p, g3))
+    wy = dot(w, a)
+    F21 = _dq_du(a, yw, yww, w, t2, wy, c1, c2, c3)
+    dQw = _dq_dw(u, w, a, yw, a_, b_, e_, wa_, gp, t2, wy, dot(u, a), dot(w, u), cross(u, w), c1, c2, c3)
+    return _d_t3t(w, a, b, c1, bp, cp), F21, madd(dQw, _d_t3t(w, m, b, c1, bp, cp))
+
+
+@jit_inline
 def _jacobian_derivatives(u, w, xi, t2, co, S, v, c):
     """``d(J_A^T wr)/dh, d(J_B^T wr)/dh`` into ``S[S_DA], S[S_DB]`` and ``d/dxi`` into ``v[V_DA], v[V_DB]``
-    at fixed ``wr = v[V_WR]``; ``S`` holds ``TI, AH, TMH`` of the element and ``TS, AS`` at this ``xi``;
+    at fixed ``wr = v[V_WR]``; ``S`` holds ``TI, AH, TMH`` of the element and ``TS, AS, JB`` at this ``xi``;
     ``c``: the element's cached coefficients (``_element_side``); ``t2, co = _coefficients(xi w)``.
 
-    With ``s = xi h``, ``y = T(s)^T wr``, ``b = J_B^T wr = xi T(h)^-T y`` and ``T(-s) h = h``:
-    ``dB/dh = G(h, xi y) - xi^2 T(h)^-T T(s)^T G(s, y)``, ``dB/dxi = T(h)^-T y - xi T(h)^-T T(s)^T G(s, y) h``,
-    ``dA/dh = -xi M(z_s) T(-s) + M(z_h) T(-h) - Ad(exp(-h))^T dB/dh``, ``dA/dxi = -M(z_s) h - Ad(exp(-h))^T dB/dxi``.
+    With ``s = xi h``, ``y = T(s)^T wr``, ``b = J_B^T wr = xi T(h)^-T y``, ``T(-s) h = h`` and
+    ``F(s, x) = d(T(s)^T x)/ds`` at fixed ``x`` (``_dt_t``; ``G(h, v) = d(T(h)^-T v)/dh = -T(h)^-T F(h, T(h)^-T v)``):
+    ``dB/dh = T(h)^-T N``, ``N = xi^2 F(s, wr) - F(h, b)``, ``dB/dxi = T(h)^-T (y + xi F(s, wr) h)``,
+    ``dA/dh = -xi M(z_s) T(-s) + M(z_h) T(-h) - Ad(exp(-h))^T dB/dh``, ``dA/dxi = -M(z_s) h - Ad(exp(-h))^T dB/dxi``
+    (``z_s = Ad(exp(-s))^T wr``, ``z_h = Ad(exp(-h))^T b``).  Done in 3x3 blocks: ``F``, ``M(z) T``, ``dA/dh``,
+    ``dB/dh`` have a zero upper-left block; ``J_B``, ``T``, ``T^-1``, ``Ad`` are ``[[X, Y], [0, X]]``;
+    ``T(-s) = [[T3^T, Q3^T], [0, T3^T]]`` of ``T(s) = [[T3, Q3], [0, T3]]`` (``Q(u, w)^T = Q(-u, -w)``).
     """
-    Ti, Ah, As, DA, DB, P = S[S_TI], S[S_AH], S[S_AS], S[S_DA], S[S_DB], S[S_P]
-    wr, y, xy, dB, b, zs, dA = v[V_WR], v[V_Y], v[V_XY], v[V_DB], v[V_B], v[V_ZS], v[V_DA]
-    su, sw = scale(xi, u), scale(xi, w)
-    _mtv_ut(S[S_TS], wr, y)
-    _geo_co(su, sw, y, S[S_GS], t2, co)
-    _mtm_ut_g(S[S_TS], S[S_GS], S[S_M1])
-    _mtm_ut_g(Ti, S[S_M1], P)                                # T(h)^-T T(s)^T G(s, y)
-    for i in range(6):
-        xy[i] = xi * y[i]
-    _geo_cached(u, w, xy, DB, c)
-    _mtv_ut(Ti, y, dB)
-    h = (u[0], u[1], u[2], w[0], w[1], w[2])
-    for i in range(6):
-        acc = 0.0
-        for j in range(6):
-            DB[i, j] -= xi * xi * P[i, j]
-            acc += P[i, j] * h[j]
-        dB[i] -= xi * acc
-    _mtv_ut(Ti, xy, b)
-    _mtv_ut(As, wr, zs)
-    _mtv_ut(Ah, b, v[V_ZH])
-    _m_times(v[V_ZH], S[S_TMH], DA)
-    _tangent_co(scale(-xi, u), scale(-xi, w), S[S_TMS], t2, co)
-    _m_times(zs, S[S_TMS], S[S_MS])
-    _mtm_ut_g(Ah, DB, S[S_AHDB])
-    zf, zm = (zs[0], zs[1], zs[2]), (zs[3], zs[4], zs[5])
-    top, bot = cross(zf, (h[3], h[4], h[5])), add(cross(zf, (h[0], h[1], h[2])), cross(zm, (h[3], h[4], h[5])))
-    AhdB = v[V_AHDB]
-    _mtv_ut(Ah, dB, AhdB)
-    Ms, AhDB = S[S_MS], S[S_AHDB]
-    for i in range(6):
-        dA[i] = -(top[i] if i < 3 else bot[i - 3]) - AhdB[i]
-        for j in range(6):
-            DA[i, j] -= xi * Ms[i, j] + AhDB[i, j]
+    wr = v[V_WR]
+    a, m = (wr[0], wr[1], wr[2]), (wr[3], wr[4], wr[5])
+    T3t, Q3t = transpose(_blk(S[S_TS], 0, 0)), transpose(_blk(S[S_TS], 0, 3))     # T(-s) blocks
+    yf, ym = mv(T3t, a), add(mv(Q3t, a), mv(T3t, m))                               # y = T(s)^T wr
+    F12, F21, F22 = _dt_t(scale(xi, u), scale(xi, w), a, m, t2, co[0], co[1], co[2], co[4], co[5], co[6], co[8],
+                          co[9])                                                     # F(s, wr)
+    Ti3t, Xt = transpose(_blk(S[S_TI], 0, 0)), transpose(_blk(S[S_TI], 0, 3))
+    tyf, tym = mv(Ti3t, yf), add(mv(Xt, yf), mv(Ti3t, ym))                          # T(h)^-T y
+    bf, bm = scale(xi, tyf), scale(xi, tym)                                           # b = J_B^T wr
+    H12, H21, H22 = _dt_t(u, w, bf, bm, c[C_T2], c[C_A], c[C_B], c[C_CO], c[C_CO + 1], c[C_CO + 2], c[C_CO + 4],
+                          c[C_CO + 5], c[C_CO + 6])                                 # F(h, b)
+    x2 = xi * xi
+    N12, N21, N22 = _axmy(x2, F12, H12), _axmy(x2, F21, H21), _axmy(x2, F22, H22)
+    B12, B21, B22 = mm(Ti3t, N12), mm(Ti3t, N21), madd(mm(Xt, N12), mm(Ti3t, N22))   # dB/dh = T(h)^-T N
+    ef = add(yf, scale(xi, mv(F12, w)))                                               # y + xi F(s, wr) h
+    em = add(ym, scale(xi, add(mv(F21, u), mv(F22, w))))
+    dBf, dBm = mv(Ti3t, ef), add(mv(Xt, ef), mv(Ti3t, em))
+    Rst, Yst = transpose(_blk(S[S_AS], 0, 0)), transpose(_blk(S[S_AS], 0, 3))
+    zsf, zsm = mv(Rst, a), add(mv(Yst, a), mv(Rst, m))
+    Rht, Yht = transpose(_blk(S[S_AH], 0, 0)), transpose(_blk(S[S_AH], 0, 3))
+    zhf, zhm = mv(Rht, bf), add(mv(Yht, bf), mv(Rht, bm))
+    T3h, Q3h = _blk(S[S_TMH], 0, 0), _blk(S[S_TMH], 0, 3)                           # T(-h) blocks
+    Cz = _msub(_hat_mm(zhf, T3h), xi, _hat_mm(zsf, T3t))
+    A22 = _msub(madd(_hat_mm(zhf, Q3h), _hat_mm(zhm, T3h)), xi, madd(_hat_mm(zsf, Q3t), _hat_mm(zsm, T3t)))
+    A22 = _mdiff(_mdiff(A22, mm(Yht, B12)), mm(Rht, B22))
+    DA, DB = S[S_DA], S[S_DB]
+    _zero3(DA, 0, 0)
+    _put3(DA, 0, 3, _mdiff(Cz, mm(Rht, B12)))
+    _put3(DA, 3, 0, _mdiff(Cz, mm(Rht, B21)))
+    _put3(DA, 3, 3, A22)
+    _zero3(DB, 0, 0)
+    _put3(DB, 0, 3, B12)
+    _put3(DB, 3, 0, B21)
+    _put3(DB, 3, 3, B22)
+    dAf = add(cross(zsf, w), mv(Rht, dBf))
+    dAm = add(add(cross(zsf, u), cross(zsm, w)), add(mv(Yht, dBf), mv(Rht, dBm)))
+    dA, dB = v[V_DA], v[V_DB]
+    for i in range(3):
+        dA[i], dA[3 + i], dB[i], dB[3 + i] = -dAf[i], -dAm[i], dBf[i], dBm[i]
 
 
 # ---------------------------------------------------------------- projection and its derivative
@@ -529,7 +546,7 @@ def _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, G):
 # ---------------------------------------------------------------- one side of a pair: element, section, Jacobians
 # per-side element cache ``c`` (2, N_CACHE): the node poses (rows 0-2 of nodes j0, j0 + 1), the twist and the
 # coefficients of ``G(h, .)`` of the last element seen on that side
-C_POSE, C_U, C_W, C_T2, C_D, C_CO, N_CACHE = 0, 24, 27, 30, 31, 32, 39
+C_POSE, C_U, C_W, C_T2, C_D, C_CO, C_A, C_B, N_CACHE = 0, 24, 27, 30, 31, 32, 39, 40, 41
 
 
 @jit
@@ -563,6 +580,7 @@ def _element_side(Xp, j0, S, c):
     for i in range(3):
         c[C_U + i], c[C_W + i] = u[i], w[i]
     c[C_T2], c[C_D] = t2, coefficient(D_, t)
+    c[C_A], c[C_B] = coefficient(A_, t), coefficient(B_, t)
     for i in range(7):
         c[C_CO + i] = co[i]
     return RA, xA, u, w
@@ -749,11 +767,11 @@ def _wrench(R, F, neg, m, sm, G, V, DW, w):
     for i in range(3):
         w[i], w[3 + i] = bF[i], bm[i]
     df, dm, dv = G_DF * W, G_DMF * W, (V + 3) * W        # first entries of the rows
+    Rf, Rm = mscale(-1.0 if neg else 1.0, Rt), mscale(sm, Rt)
     for k in range(24):
         th = (G[dv + k], G[dv + W + k], G[dv + 2 * W + k])
-        dF = (-G[df + k], -G[df + W + k], -G[df + 2 * W + k]) if neg else (G[df + k], G[df + W + k], G[df + 2 * W + k])
-        a = add(mv(Rt, dF), cross(bF, th))
-        b = add(mv(Rt, (sm * G[dm + k], sm * G[dm + W + k], sm * G[dm + 2 * W + k])), cross(bm, th))
+        a = add(mv(Rf, (G[df + k], G[df + W + k], G[df + 2 * W + k])), cross(bF, th))
+        b = add(mv(Rm, (G[dm + k], G[dm + W + k], G[dm + 2 * W + k])), cross(bm, th))
         for i in range(3):
             G[(DW + i) * W + k], G[(DW + 3 + i) * W + k] = a[i], b[i]
 
@@ -785,20 +803,24 @@ def _nodal(u, w, xi, t2, co, S, v, c, G, DW, DH, DXI, f, K, j0):
 def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, G, DXI, DW, DH, force, out):
     """One row of the tangent: ``out[c] = di dxi[c] + sum_l (j_l Dw[l, c] + d_l Dh[l, c])``, summed in this
     order (``dxi``, ``Dw``, ``Dh``: the rows ``DXI``, ``DW``, ``DH`` of ``G``).  ``force`` (a constant at each
-    call): a force row, whose ``j3, j4, j5`` are structural zeros (``J[3:, :3] == 0``): their terms, exact
-    zeros, are skipped.  ``Dh`` is zero outside the side's columns: its terms there, exact zeros, change a
-    sum only in the sign of a zero result (``_mm_ut``), and keep the loop branch-free over all 24 columns,
-    which the compiler vectorises (with a runtime check that ``out`` and ``G`` do not overlap, refused in
-    loops of fewer than 16 iterations)."""
+    call): a force row, whose ``j3, j4, j5`` (``J[3:, :3] == 0``) and ``d0, d1, d2`` (the zero upper-left block
+    of ``d(J^T wr)/dh``, ``_jacobian_derivatives``) are structural zeros: their terms, exact zeros, are
+    skipped.  ``Dh`` is zero outside the side's columns: its terms there, exact zeros, change a sum only
+    in the sign of a zero result (``_mm_ut``), and keep the loop branch-free over all 24 columns, which the
+    compiler vectorises (with a runtime check that ``out`` and ``G`` do not overlap, refused in loops of fewer
+    than 16 iterations)."""
     x, w, h = DXI * W, DW * W, DH * W           # first entries of the rows
     for c in range(24):
         acc = di * G[x + c]
         acc += j0 * G[w + c]
-        acc += d0 * G[h + c]
+        if not force:
+            acc += d0 * G[h + c]
         acc += j1 * G[w + W + c]
-        acc += d1 * G[h + W + c]
+        if not force:
+            acc += d1 * G[h + W + c]
         acc += j2 * G[w + 2 * W + c]
-        acc += d2 * G[h + 2 * W + c]
+        if not force:
+            acc += d2 * G[h + 2 * W + c]
         if not force:
             acc += j3 * G[w + 3 * W + c]
         acc += d3 * G[h + 3 * W + c]
