@@ -628,68 +628,133 @@ def _compose(RA, xA, RB, xB):
     return mm(RA, RB), add(mv(RA, xB), xA)
 
 
+@jit_inline
+def _vm(y, M):
+    """The row ``y^T M`` (``M^T y``) of a 3x3 tuple ``M``."""
+    return (y[0] * M[0][0] + y[1] * M[1][0] + y[2] * M[2][0], y[0] * M[0][1] + y[1] * M[1][1] + y[2] * M[2][1],
+            y[0] * M[0][2] + y[1] * M[1][2] + y[2] * M[2][2])
+
+
+@jit_inline
+def _cdot(y, A, r0, j):
+    """``y . A[r0:r0+3, j]``."""
+    return y[0] * A[r0, j] + y[1] * A[r0 + 1, j] + y[2] * A[r0 + 2, j]
+
+
+@jit_inline
+def _row_ut(yf, ym, A):
+    """The row ``y^T A``, ``y = (yf, ym)``, of a block upper-triangular ``(6, 6)`` array (``A[3:, :3] == 0``),
+    as two 3-tuples."""
+    return ((_cdot(yf, A, 0, 0), _cdot(yf, A, 0, 1), _cdot(yf, A, 0, 2)),
+            (_cdot(yf, A, 0, 3) + _cdot(ym, A, 3, 3), _cdot(yf, A, 0, 4) + _cdot(ym, A, 3, 4),
+             _cdot(yf, A, 0, 5) + _cdot(ym, A, 3, 5)))
+
+
+@jit_inline
+def _row_adjoint_inv(yf, ym, R, xt):
+    """The row ``y^T Ad(H^-1)`` of the pose ``H = (R, x)``, ``xt = -R^T x``: ``(R yf, R (ym + yf x xt))``."""
+    return mv(R, yf), mv(R, add(ym, cross(yf, xt)))
+
+
 @jit
-def _slip_rows(Tdy, Ad, JA, JB, sign, D, c0, tmp):
-    """``D[:, c0:c0+12] = sign (Tdy[1:3] Ad) [J_A, J_B]`` (``Tdy``, ``Ad``, ``J`` ``(6, 6)``; ``tmp`` ``(6, 6)``);
-    ``Ad`` and ``J`` block upper triangular: the terms of their zero blocks skipped (``_mm_ut``)."""
-    for i in range(2):
-        for j in range(6):
-            acc = 0.0
-            for l in range(3 if j < 3 else 6):
-                acc += Tdy[1 + i, l] * Ad[l, j]
-            tmp[i, j] = acc
-    for i in range(2):
-        for j in range(6):
-            a = 0.0
-            b = 0.0
-            for l in range(3 if j < 3 else 6):
-                a += tmp[i, l] * JA[l, j]
-                b += tmp[i, l] * JB[l, j]
-            D[i, c0 + j] = -a if sign < 0.0 else a
-            D[i, c0 + 6 + j] = -b if sign < 0.0 else b
+def _coefficients_exp_tangent(w):
+    """``t^2 = |w|^2`` and the coefficients ``a, b, c, q2, q3`` at ``t``: those of ``exp`` and ``T`` (a
+    section and its node Jacobians, without their derivatives; ``_coefficients`` has all ten)."""
+    t2 = dot(w, w)
+    t = np.sqrt(t2)
+    return t2, (coefficient(A_, t), coefficient(B_, t), coefficient(C_, t), coefficient(Q2_, t), coefficient(Q3_, t))
+
+
+@jit
+def _section_prev(RA, xA, u, w, xi, R, x, xip):
+    """The section at ``xip`` and the factors of its node Jacobians ``J_B = xip T(s) T(h)^-1``,
+    ``J_A = Ad(exp(-s)) - J_B Ad(exp(-h))``, ``s = xip h``: ``(same, R, x, Rs, xt, T3, Q)`` with the section
+    pose ``(R, x)``, ``exp(s) = (Rs, xs)``, ``xt = -Rs^T xs`` and ``T(s) = [[T3, Q], [0, T3]]``.  ``same``:
+    ``xip`` is ``xi`` bit for bit, the section ``(R, x)`` at ``xi`` is returned (the rest unused; the
+    Jacobians at ``xi`` are in ``S_JA``, ``S_JB``).  The section is ``_section``'s operations."""
+    if _same(xip, xi):
+        return True, R, x, R, x, R, R
+    su, sw = scale(xip, u), scale(xip, w)
+    t2, co = _coefficients_exp_tangent(sw)
+    Rs, xs = _exp_abc(su, sw, t2, co[0], co[1], co[2])
+    T3 = add_outer(mat(scale(-co[1], sw), 1.0 - co[2] * t2), scale(co[2], sw), sw)
+    Q = q_matrix(scale(-1.0, su), scale(-1.0, sw), dot(sw, su), cross(sw, su), t2, co[2], co[3], co[4])
+    return False, mm(RA, Rs), add(mv(RA, xs), xA), Rs, scale(-1.0, mv(transpose(Rs), xs)), T3, Q
+
+
+@jit
+def _tangent_inv_rows(u, w):
+    """Rows 1 and 2 of ``T(h)^-1 = [[Ti, -Ti Q Ti], [0, Ti]]`` (``_tangent_inv``) as ``(yf, ym)`` pairs."""
+    t2 = dot(w, w)
+    t = np.sqrt(t2)
+    Ti = ti_matrix(w, coefficient(D_, t), t2)
+    Q = q_matrix(scale(-1.0, u), scale(-1.0, w), dot(w, u), cross(w, u), t2, coefficient(C_, t),
+                 coefficient(Q2_, t), coefficient(Q3_, t))
+    return (Ti[1], scale(-1.0, _vm(_vm(Ti[1], Q), Ti))), (Ti[2], scale(-1.0, _vm(_vm(Ti[2], Q), Ti)))
+
+
+@jit
+def _slip_rows(yf, ym, prev, xip, S, D, a, c0):
+    """``D[a, c0:c0+12] = y [J_A, J_B]`` at ``xip`` for the row ``y = (yf, ym)``; ``prev``: ``_section_prev``.
+    Without forming ``J``: ``y J_B = xip (y T(s)) T(h)^-1``, ``y J_A = y Ad(exp(-s)) - xip (y T(s)) T(h)^-1
+    Ad(exp(-h))`` (``S[S_TI]``, ``S[S_TIAH]``); where ``xip`` is ``xi``, from ``S[S_JA]``, ``S[S_JB]``."""
+    same, _, _, Rs, xt, T3, Q = prev
+    if same:
+        af, am = _row_ut(yf, ym, S[S_JA])
+        bf, bm = _row_ut(yf, ym, S[S_JB])
+    else:
+        zf, zm = _vm(yf, T3), add(_vm(yf, Q), _vm(ym, T3))          # y T(s)
+        bf, bm = _row_ut(zf, zm, S[S_TI])
+        cf, cm = _row_ut(zf, zm, S[S_TIAH])
+        af, am = _row_adjoint_inv(yf, ym, Rs, xt)
+        af, am = add(af, scale(-xip, cf)), add(am, scale(-xip, cm))
+        bf, bm = scale(xip, bf), scale(xip, bm)
+    D[a, c0], D[a, c0 + 1], D[a, c0 + 2], D[a, c0 + 3], D[a, c0 + 4], D[a, c0 + 5] = af[0], af[1], af[2], am[0], \
+        am[1], am[2]
+    D[a, c0 + 6], D[a, c0 + 7], D[a, c0 + 8], D[a, c0 + 9], D[a, c0 + 10], D[a, c0 + 11] = bf[0], bf[1], bf[2], \
+        bm[0], bm[1], bm[2]
 
 
 @jit
 def _slip(side1, side2, S1, S2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp, D):
     """Slip ``log(H_LK_prev^-1 H_LK)[1:3]`` of the material frames (``kinematics.slip_increment``)
     and its gradient into ``D`` ``(2, 24)``; ``sec1``, ``sec2``: ``(xi, R, x)`` of the sections at the
-    point.  The node Jacobians at ``xi_prev`` go to ``S[S_JAP], S[S_JBP]``; where ``xi_prev`` is ``xi``
-    (bit for bit) the section and the Jacobians at ``xi`` are reused."""
+    point.  With ``dy = log(H_LK_prev^-1 H_LK)`` and the section variations ``dq = J_A dq_A + J_B dq_B`` at
+    ``xi_prev`` (fixed): ``d(dy) = T(dy)^-1 (-Ad((H_CL H_LK)^-1) dq_C + Ad(H_FK^-1) dq_F)``; only its rows 1, 2
+    are formed, as rows times the factors of ``J`` (``_slip_rows``).  Where ``xi_prev`` is ``xi`` (bit for
+    bit) the section and the Jacobians at ``xi`` are reused."""
     RA1, xA1, u1, w1 = side1
     RA2, xA2, u2, w2 = side2
     xi1, RC, xC = sec1
     xi2, RF, xF = sec2
-    RCm, xCm = (RC, xC) if _same(xi1p, xi1) else _section(RA1, xA1, u1, w1, xi1p)[:2]
-    RFm, xFm = (RF, xF) if _same(xi2p, xi2) else _section(RA2, xA2, u2, w2, xi2p)[:2]
+    prev1 = _section_prev(RA1, xA1, u1, w1, xi1, RC, xC, xi1p)
+    prev2 = _section_prev(RA2, xA2, u2, w2, xi2, RF, xF, xi2p)
     RCL, xCL = _pose4(HCL)
     RFK, xFK = _pose4(HFK)
-    RL, xL = _compose(RCm, xCm, RCL, xCL)
-    RK, xK = _compose(RFm, xFm, RFK, xFK)
+    RL, xL = _compose(prev1[1], prev1[2], RCL, xCL)
+    RK, xK = _compose(prev2[1], prev2[2], RFK, xFK)
     RLt = transpose(RL)
     RLK, xLK = mm(RLt, RK), mv(RLt, add(xK, scale(-1.0, xL)))
     RP, xP = _pose4(HLKp)
     dyu, dyw, _, _ = log_relative(RP, xP, RLK, xLK)
-    a1, b1 = _jacobians_at(u1, w1, xi1, xi1p, S1)
-    a2, b2 = _jacobians_at(u2, w2, xi2, xi2p, S2)
-    Tdy, Ad, tmp = S1[S_TDY], S1[S_AD], S1[S_TMP]
-    _tangent_inv(dyu, dyw, Tdy)
-    Rs, xs = _compose(RCL, xCL, RLK, xLK)
-    _adjoint_inv(Rs, xs, Ad)
-    _slip_rows(Tdy, Ad, S1[a1], S1[b1], -1.0, D, 0, tmp)
-    _adjoint_inv(RFK, xFK, Ad)
-    _slip_rows(Tdy, Ad, S2[a2], S2[b2], 1.0, D, 12, tmp)
+    row1, row2 = _tangent_inv_rows(dyu, dyw)
+    Rm, xm = _compose(RCL, xCL, RLK, xLK)
+    adm = (Rm, scale(-1.0, mv(transpose(Rm), xm)))
+    adk = (RFK, scale(-1.0, mv(transpose(RFK), xFK)))
+    _slip_row_pair(row1, adm, adk, prev1, prev2, xi1p, xi2p, S1, S2, D, 0)
+    _slip_row_pair(row2, adm, adk, prev1, prev2, xi1p, xi2p, S1, S2, D, 1)
     return (dyu[1], dyu[2])
 
 
-@jit
-def _jacobians_at(u, w, xi, xip, S):
-    """Slots of ``S`` with the node Jacobians at ``xip``: ``S_JA, S_JB`` (those at ``xi``) if ``xip`` is ``xi``,
-    else ``S_JAP, S_JBP``, computed."""
-    if _same(xip, xi):
-        return S_JA, S_JB
-    t2, co = _coefficients(scale(xip, w))
-    _jacobians(u, w, xip, t2, co, S[S_TI], S[S_AH], S[S_TSP], S[S_ASP], S[S_JAP], S[S_JBP], S[S_TMP])
-    return S_JAP, S_JBP
+@jit_inline
+def _slip_row_pair(row, adm, adk, prev1, prev2, xi1p, xi2p, S1, S2, D, a):
+    """Row ``a`` of the slip gradient from the row ``row = (yf, ym)`` of ``T(dy)^-1``: ``-row Ad(H_M^-1)
+    [J_A1, J_B1]``, ``row Ad(H_FK^-1) [J_A2, J_B2]`` (``adm``, ``adk``: ``(R, -R^T x)`` of ``H_M = H_CL H_LK``,
+    ``H_FK``)."""
+    cf, cm = _row_adjoint_inv(row[0], row[1], adm[0], adm[1])
+    _slip_rows(scale(-1.0, cf), scale(-1.0, cm), prev1, xi1p, S1, D, a, 0)
+    kf, km = _row_adjoint_inv(row[0], row[1], adk[0], adk[1])
+    _slip_rows(kf, km, prev2, xi2p, S2, D, a, 12)
 
 
 def _friction(slip, lamp, t1, t2, lam, par, G):
