@@ -433,7 +433,7 @@ def _same(a, b):
     return a == b and np.signbit(a) == np.signbit(b)
 
 
-@jit
+@jit_inline
 def _project(kind, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations=2):
     """Newton iterations of ``pairs._project`` (two in the kernel, from the search's converged point).
 
@@ -444,7 +444,7 @@ def _project(kind, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations=2):
                          iterations)
 
 
-@jit
+@jit_inline
 def _project_from(kind, sec1, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations):
     """``_project`` given the slave section ``sec1 = _section(RA1, xA1, u1, w1, xi1)`` (a caller that has it)."""
     moving = kind != LINE and kind != ORTHOGONAL
@@ -491,7 +491,7 @@ def _col_dot(a, G, r0, k):
     return a[0] * G[r0 * W + k] + a[1] * G[(r0 + 1) * W + k] + a[2] * G[(r0 + 2) * W + k]
 
 
-@jit
+@jit_inline
 def _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, G):
     """``dxi1, dxi2`` (rows ``G_DXI1``, ``G_DXI2`` of ``G``) by the implicit-function theorem at the converged
     projection, from the section-frame variations at fixed ``xi`` (rows ``G_VC``, ``G_VF``) and the twist
@@ -568,7 +568,7 @@ def _element_side(Xp, j0, S, c):
     return RA, xA, u, w
 
 
-@jit
+@jit_inline
 def _variations(S, c0, G, DH, V):
     """Twist variation ``dh = T(h)^-1 (dq_B - Ad(exp(-h)) dq_A)`` and section-frame variation at fixed
     ``xi`` ``(J_A dq_A + J_B dq_B)`` into the rows ``DH``, ``V`` of ``G`` (6 each), node A at column ``c0``
@@ -586,7 +586,7 @@ def _variations(S, c0, G, DH, V):
 
 
 # ---------------------------------------------------------------- 3-vectors with gradients (3, 24)
-@jit
+@jit_inline
 def _axes(RC, xC, RF, xF, G):
     """``n, t1, t2`` (``pairs._axes``), centre distance, and the gradients of ``n, t1, t2, dist``
     into ``G`` (rows ``G_DN``, ``G_DT1``, ``G_DT2``, ``G_DDIST``; one pass over the 24 columns)."""
@@ -617,13 +617,13 @@ def _axes(RC, xC, RF, xF, G):
 
 
 # ---------------------------------------------------------------- friction
-@jit
+@jit_inline
 def _pose4(H):
     R = ((H[0, 0], H[0, 1], H[0, 2]), (H[1, 0], H[1, 1], H[1, 2]), (H[2, 0], H[2, 1], H[2, 2]))
     return R, (H[0, 3], H[1, 3], H[2, 3])
 
 
-@jit
+@jit_inline
 def _compose(RA, xA, RB, xB):
     return mm(RA, RB), add(mv(RA, xB), xA)
 
@@ -636,18 +636,15 @@ def _vm(y, M):
 
 
 @jit_inline
-def _cdot(y, A, r0, j):
-    """``y . A[r0:r0+3, j]``."""
-    return y[0] * A[r0, j] + y[1] * A[r0 + 1, j] + y[2] * A[r0 + 2, j]
-
-
-@jit_inline
 def _row_ut(yf, ym, A):
     """The row ``y^T A``, ``y = (yf, ym)``, of a block upper-triangular ``(6, 6)`` array (``A[3:, :3] == 0``),
-    as two 3-tuples."""
-    return ((_cdot(yf, A, 0, 0), _cdot(yf, A, 0, 1), _cdot(yf, A, 0, 2)),
-            (_cdot(yf, A, 0, 3) + _cdot(ym, A, 3, 3), _cdot(yf, A, 0, 4) + _cdot(ym, A, 3, 4),
-             _cdot(yf, A, 0, 5) + _cdot(ym, A, 3, 5)))
+    as two 3-tuples (written out: nested inlined helpers cost compile time)."""
+    return ((yf[0] * A[0, 0] + yf[1] * A[1, 0] + yf[2] * A[2, 0],
+             yf[0] * A[0, 1] + yf[1] * A[1, 1] + yf[2] * A[2, 1],
+             yf[0] * A[0, 2] + yf[1] * A[1, 2] + yf[2] * A[2, 2]),
+            (yf[0] * A[0, 3] + yf[1] * A[1, 3] + yf[2] * A[2, 3] + ym[0] * A[3, 3] + ym[1] * A[4, 3] + ym[2] * A[5, 3],
+             yf[0] * A[0, 4] + yf[1] * A[1, 4] + yf[2] * A[2, 4] + ym[0] * A[3, 4] + ym[1] * A[4, 4] + ym[2] * A[5, 4],
+             yf[0] * A[0, 5] + yf[1] * A[1, 5] + yf[2] * A[2, 5] + ym[0] * A[3, 5] + ym[1] * A[4, 5] + ym[2] * A[5, 5]))
 
 
 @jit_inline
@@ -656,7 +653,7 @@ def _row_adjoint_inv(yf, ym, R, xt):
     return mv(R, yf), mv(R, add(ym, cross(yf, xt)))
 
 
-@jit
+@jit_inline
 def _coefficients_exp_tangent(w):
     """``t^2 = |w|^2`` and the coefficients ``a, b, c, q2, q3`` at ``t``: those of ``exp`` and ``T`` (a
     section and its node Jacobians, without their derivatives; ``_coefficients`` has all ten)."""
@@ -665,7 +662,7 @@ def _coefficients_exp_tangent(w):
     return t2, (coefficient(A_, t), coefficient(B_, t), coefficient(C_, t), coefficient(Q2_, t), coefficient(Q3_, t))
 
 
-@jit
+@jit_inline
 def _section_prev(RA, xA, u, w, xi, R, x, xip):
     """The section at ``xip`` and the factors of its node Jacobians ``J_B = xip T(s) T(h)^-1``,
     ``J_A = Ad(exp(-s)) - J_B Ad(exp(-h))``, ``s = xip h``: ``(same, R, x, Rs, xt, T3, Q)`` with the section
@@ -682,7 +679,7 @@ def _section_prev(RA, xA, u, w, xi, R, x, xip):
     return False, mm(RA, Rs), add(mv(RA, xs), xA), Rs, scale(-1.0, mv(transpose(Rs), xs)), T3, Q
 
 
-@jit
+@jit_inline
 def _tangent_inv_rows(u, w):
     """Rows 1 and 2 of ``T(h)^-1 = [[Ti, -Ti Q Ti], [0, Ti]]`` (``_tangent_inv``) as ``(yf, ym)`` pairs."""
     t2 = dot(w, w)
@@ -693,8 +690,15 @@ def _tangent_inv_rows(u, w):
     return (Ti[1], scale(-1.0, _vm(_vm(Ti[1], Q), Ti))), (Ti[2], scale(-1.0, _vm(_vm(Ti[2], Q), Ti)))
 
 
-@jit
-def _slip_rows(yf, ym, prev, xip, S, D, a, c0):
+@jit_inline
+def _put_row(D, a, c0, yf, ym):
+    """``D[a, c0:c0+6] = (yf, ym)``."""
+    D[a, c0], D[a, c0 + 1], D[a, c0 + 2], D[a, c0 + 3], D[a, c0 + 4], D[a, c0 + 5] = yf[0], yf[1], yf[2], ym[0], \
+        ym[1], ym[2]
+
+
+@jit_inline
+def _slip_row(yf, ym, prev, xip, S, D, a, c0):
     """``D[a, c0:c0+12] = y [J_A, J_B]`` at ``xip`` for the row ``y = (yf, ym)``; ``prev``: ``_section_prev``.
     Without forming ``J``: ``y J_B = xip (y T(s)) T(h)^-1``, ``y J_A = y Ad(exp(-s)) - xip (y T(s)) T(h)^-1
     Ad(exp(-h))`` (``S[S_TI]``, ``S[S_TIAH]``); where ``xip`` is ``xi``, from ``S[S_JA]``, ``S[S_JB]``."""
@@ -709,13 +713,21 @@ def _slip_rows(yf, ym, prev, xip, S, D, a, c0):
         af, am = _row_adjoint_inv(yf, ym, Rs, xt)
         af, am = add(af, scale(-xip, cf)), add(am, scale(-xip, cm))
         bf, bm = scale(xip, bf), scale(xip, bm)
-    D[a, c0], D[a, c0 + 1], D[a, c0 + 2], D[a, c0 + 3], D[a, c0 + 4], D[a, c0 + 5] = af[0], af[1], af[2], am[0], \
-        am[1], am[2]
-    D[a, c0 + 6], D[a, c0 + 7], D[a, c0 + 8], D[a, c0 + 9], D[a, c0 + 10], D[a, c0 + 11] = bf[0], bf[1], bf[2], \
-        bm[0], bm[1], bm[2]
+    _put_row(D, a, c0, af, am)
+    _put_row(D, a, c0 + 6, bf, bm)
 
 
 @jit
+def _slip_rows(row1, row2, R, xt, sign, prev, xip, S, D, c0):
+    """``D[:, c0:c0+12] = sign (row Ad(H^-1)) [J_A, J_B]`` at ``xip`` for the rows ``row1``, ``row2`` ``(yf, ym)``
+    of ``T(dy)^-1``; ``H = (R, x)``, ``xt = -R^T x``; ``prev``: ``_section_prev``."""
+    for a in range(2):
+        yf, ym = row1 if a == 0 else row2
+        cf, cm = _row_adjoint_inv(yf, ym, R, xt)
+        _slip_row(scale(sign, cf), scale(sign, cm), prev, xip, S, D, a, c0)
+
+
+@jit_inline
 def _slip(side1, side2, S1, S2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp, D):
     """Slip ``log(H_LK_prev^-1 H_LK)[1:3]`` of the material frames (``kinematics.slip_increment``)
     and its gradient into ``D`` ``(2, 24)``; ``sec1``, ``sec2``: ``(xi, R, x)`` of the sections at the
@@ -739,22 +751,9 @@ def _slip(side1, side2, S1, S2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp, D):
     dyu, dyw, _, _ = log_relative(RP, xP, RLK, xLK)
     row1, row2 = _tangent_inv_rows(dyu, dyw)
     Rm, xm = _compose(RCL, xCL, RLK, xLK)
-    adm = (Rm, scale(-1.0, mv(transpose(Rm), xm)))
-    adk = (RFK, scale(-1.0, mv(transpose(RFK), xFK)))
-    _slip_row_pair(row1, adm, adk, prev1, prev2, xi1p, xi2p, S1, S2, D, 0)
-    _slip_row_pair(row2, adm, adk, prev1, prev2, xi1p, xi2p, S1, S2, D, 1)
+    _slip_rows(row1, row2, Rm, scale(-1.0, mv(transpose(Rm), xm)), -1.0, prev1, xi1p, S1, D, 0)
+    _slip_rows(row1, row2, RFK, scale(-1.0, mv(transpose(RFK), xFK)), 1.0, prev2, xi2p, S2, D, 12)
     return (dyu[1], dyu[2])
-
-
-@jit_inline
-def _slip_row_pair(row, adm, adk, prev1, prev2, xi1p, xi2p, S1, S2, D, a):
-    """Row ``a`` of the slip gradient from the row ``row = (yf, ym)`` of ``T(dy)^-1``: ``-row Ad(H_M^-1)
-    [J_A1, J_B1]``, ``row Ad(H_FK^-1) [J_A2, J_B2]`` (``adm``, ``adk``: ``(R, -R^T x)`` of ``H_M = H_CL H_LK``,
-    ``H_FK``)."""
-    cf, cm = _row_adjoint_inv(row[0], row[1], adm[0], adm[1])
-    _slip_rows(scale(-1.0, cf), scale(-1.0, cm), prev1, xi1p, S1, D, a, 0)
-    kf, km = _row_adjoint_inv(row[0], row[1], adk[0], adk[1])
-    _slip_rows(kf, km, prev2, xi2p, S2, D, a, 12)
 
 
 def _friction(slip, lamp, t1, t2, lam, par, G):
@@ -876,7 +875,7 @@ def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, G, DXI, DW,
         out[c] = acc
 
 
-@jit
+@jit_inline
 def _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2):
     """``HL, HK, HC, HF`` (``pairs._contact_frames``)."""
     for k in range(4):
@@ -892,7 +891,7 @@ def _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2):
         frames[2, i, 3], frames[3, i, 3] = xC[i], xF[i]
 
 
-@jit
+@jit_inline
 def _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, d, S1, S2, G):
     """Node Jacobians of both sides, twist variations (rows ``G_DH1``, ``G_DH2`` of ``G``), projection
     gradients (``G_DXI1``, ``G_DXI2``) and the section-frame variations (``G_VC``, ``G_VF``, 6 rows each);
@@ -911,7 +910,7 @@ def _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, d, S1, S
             G[(G_VF + i) * W + k] += h2[i] * G[G_DXI2 * W + k]
 
 
-@jit
+@jit_inline
 def _add_friction_force(F, G, wgt, lt, Dlt, t1, t2):
     """``F + wgt (lt0 t1 + lt1 t2)`` and its gradient added to the rows ``G_DF`` of ``G`` (``Dlt`` ``(2, 24)``)."""
     for k in range(24):
