@@ -153,7 +153,7 @@ def _exp_co(u, w, t2, co):
     return _exp_abc(u, w, t2, co[0], co[1], co[2])
 
 
-@jit
+@jit_inline
 def _section_co(RA, xA, u, w, xi, t2, co):
     """``_section`` with the coefficients of ``_coefficients(xi w)``."""
     Rs, xs = _exp_co(scale(xi, u), scale(xi, w), t2, co)
@@ -362,7 +362,7 @@ def _side(u, w, S):
     _adjoint_inv(Rh, xh, S[S_AH])
 
 
-@jit
+@jit_inline
 def _jacobians(u, w, xi, t2, co, Ti, Ah, Ts, As, JA, JB, tmp):
     """``J_A, J_B`` of ``H_C = H_A exp(xi h)`` (``pairs._node_jacobians``); ``Ti = T(h)^-1``,
     ``Ah = Ad(exp(-h))``; also ``Ts = T(xi h)`` and ``As = Ad(exp(-xi h))``; ``t2, co = _coefficients(xi w)``."""
