@@ -6,7 +6,9 @@ shortened where a prescribed rotation would be ambiguous
 retryable ``failures.StepFailed`` is halved down to ``dt_min`` (compared with a
 relative tolerance ``STEP_TOLERANCE``, and a grown step cut back below
 ``dt_min`` tries ``dt_min`` itself); after two easy steps running the next one
-grows (``growth``), never past the user's step, and not back to the size of the
+grows (``growth``), never past the user's step (easy: no cut-back and at most ``easy_limit``
+Newton iterations, the more of ``EASY_ITERATIONS`` and the iterations of the last step taken at
+the user's size: a contact step that needs 15 iterations at any size regrows too), and not back to the size of the
 last failed step before ``wait`` easy steps running (``next_step``: the wait doubles
 each time that size fails again, up to ``WAIT_MAX``; 2, the fixed rule, until then), and
 lands on the grid (no sliver shorter than ``LANDING`` steps before a grid point).  Every loop is
@@ -29,7 +31,7 @@ from .failures import AugmentationFailed, MotionTooFast, NonFinite, StepFailed
 from .progress import Progress
 from .results import Solution
 
-__all__ = ["Run", "growth", "next_step", "after_failure", "STEP_TOLERANCE", "EASY_ITERATIONS", "WAIT_MAX",
+__all__ = ["Run", "growth", "easy_limit", "next_step", "after_failure", "STEP_TOLERANCE", "EASY_ITERATIONS", "WAIT_MAX",
            "STEP_ZERO_ITERATIONS"]
 
 log = logging.getLogger("beamsolver")
@@ -48,6 +50,13 @@ def growth(iterations, easy):
     at most ``EASY_ITERATIONS`` Newton iterations without cut-back (``easy`` counts them, this
     one included), else 1."""
     return 2.0 if easy >= EASY_RUN else 1.0
+
+
+def easy_limit(reference):
+    """Most Newton iterations of an easy step: ``EASY_ITERATIONS``, or ``reference`` (the iterations
+    of the last step converged at the user's size without cut-back, ``None``: none yet) if more.
+    After a cut-back, a step that converges as fast as the user's steps did counts as easy."""
+    return EASY_ITERATIONS if reference is None else max(EASY_ITERATIONS, int(reference))
 
 
 def next_step(dt, iterations, easy, failed=np.inf, wait=EASY_RUN):
@@ -91,7 +100,7 @@ class Run:
         sys, grid = self.sys, self.grid
         t_start, steps = grid[0], len(grid) - 1
         self.dt, self.t, self.k, self.easy = self.dt_user, t_start, 1, 0
-        self.failed, self.wait = np.inf, EASY_RUN
+        self.failed, self.wait, self.reference = np.inf, EASY_RUN, None
         if restart_solution is None:
             self.sol = Solution(sys.model, sys)
             H0 = sys.poses0.copy() if initial_poses is None else np.array(initial_poses, dtype=float)
@@ -107,6 +116,7 @@ class Run:
                 if np.isfinite(dt) and dt >= self.dt_min * (1.0 - STEP_TOLERANCE):   # else: a bad file
                     self.dt, self.easy = min(dt, self.dt_user), int(rs["easy"])
                     self.failed, self.wait = _memory(rs)
+                    self.reference = _reference(rs)
             if self.writer is not None:
                 for j in range(len(sol)):
                     self.writer.write(sol, j)
@@ -274,7 +284,9 @@ class Run:
         t, k = t_next, self.k
         if t >= self.grid[k] - 1e-12 * self.dt_user:
             t, k = self.grid[k], k + 1
-        easy = self.easy + 1 if stats["iterations"] <= EASY_ITERATIONS and stats["cutbacks"] == 0 else 0
+        if stats["cutbacks"] == 0 and dt >= self.dt_user * (1.0 - STEP_TOLERANCE):
+            self.reference = stats["iterations"]
+        easy = self.easy + 1 if stats["iterations"] <= easy_limit(self.reference) and stats["cutbacks"] == 0 else 0
         dt, self.failed, self.wait = next_step(dt, stats["iterations"], easy, self.failed, self.wait)
         dt = min(dt, self.dt_user)
         if problem.contributions:
@@ -288,8 +300,9 @@ class Run:
         self.progress.step(sol.n_steps, t_next, stats["dt"], stats)
 
     def _memory_state(self):
-        """The failed-size memory of ``next_step`` for ``resume`` (JSON: no inf)."""
-        return dict(failed=None if not np.isfinite(self.failed) else float(self.failed), wait=int(self.wait))
+        """The failed-size memory of ``next_step`` and the ``easy_limit`` reference for ``resume`` (JSON: no inf)."""
+        return dict(failed=None if not np.isfinite(self.failed) else float(self.failed), wait=int(self.wait),
+                    reference=self.reference)
 
     def _stability(self, stats, t, H, ev):
         """Record whether the tangent at the converged state ``H`` (evaluation ``ev``) is positive
@@ -370,6 +383,15 @@ def _memory(resume):
     if not (np.isfinite(failed) and failed > 0):
         return np.inf, EASY_RUN
     return failed, min(max(wait, EASY_RUN), WAIT_MAX)
+
+
+def _reference(resume):
+    """The ``easy_limit`` reference of a ``resume`` dict; missing or damaged: ``None``."""
+    try:
+        ref = int(resume.get("reference"))
+    except (TypeError, ValueError, OverflowError):
+        return None
+    return ref if ref >= 0 else None
 
 
 def _acts_at(system, H, t):

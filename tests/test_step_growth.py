@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
-from beamsolver.stepping import EASY_RUN, WAIT_MAX, after_failure, growth, next_step
+from beamsolver.stepping import EASY_ITERATIONS, EASY_RUN, WAIT_MAX, after_failure, growth, next_step
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 from argyris_frame import frame  # noqa: E402
@@ -95,3 +95,23 @@ def test_a_restart_keeps_the_failed_size_memory(window):
     sol = bs.solve(m, steps=1, t_start=0.975, t_end=0.995, max_iter=12, restart=part, verbose=False)
     np.testing.assert_array_equal(sol.times, full.times)
     np.testing.assert_allclose(sol.poses[-1], full.poses[-1], rtol=0, atol=1e-12)
+
+
+def test_easy_limit_is_the_users_steps_iterations_when_more():
+    from beamsolver.stepping import easy_limit
+    assert easy_limit(None) == EASY_ITERATIONS
+    assert easy_limit(3) == EASY_ITERATIONS
+    assert easy_limit(21) == 21
+
+
+def test_contact_steps_regrow_after_a_cut_back():
+    """Three touching wires (examples/three_wires.py) with E one ulp above its default: step 2
+    (0.25 -> 0.375 turns) fails twice and the rest ran at 1/4 of the user's step (29 steps,
+    343 Newton iterations), since a contact step never took the 6 iterations of an 'easy' one.
+    Steps as easy as the user's steps were (at most the iterations of the last step taken at
+    the user's size) regrow; on a machine where no step is cut back the run has 8 steps."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+    from three_wires import build
+    sol = bs.solve(build(E=float(np.nextafter(200e9, np.inf)))[0], steps=8)
+    assert sol.converged and sol.times[-1] == 1.0
+    assert len(sol.times) <= 16, [s["dt"] for s in sol.stats]
