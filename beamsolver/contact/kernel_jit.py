@@ -153,7 +153,7 @@ def _exp_co(u, w, t2, co):
     return _exp_abc(u, w, t2, co[0], co[1], co[2])
 
 
-@jit
+@jit_inline
 def _section_co(RA, xA, u, w, xi, t2, co):
     """``_section`` with the coefficients of ``_coefficients(xi w)``."""
     Rs, xs = _exp_co(scale(xi, u), scale(xi, w), t2, co)
@@ -304,7 +304,7 @@ def _side(u, w, S):
     _adjoint_inv(Rh, xh, S[S_AH])
 
 
-@jit
+@jit_inline
 def _jacobians(u, w, xi, t2, co, Ti, Ah, Ts, As, JA, JB, tmp):
     """``J_A, J_B`` of ``H_C = H_A exp(xi h)`` (``pairs._node_jacobians``); ``Ti = T(h)^-1``,
     ``Ah = Ad(exp(-h))``; also ``Ts = T(xi h)`` and ``As = Ad(exp(-xi h))``; ``t2, co = _coefficients(xi w)``."""
@@ -450,7 +450,7 @@ def _same(a, b):
     return a == b and np.signbit(a) == np.signbit(b)
 
 
-@jit
+@jit_inline
 def _project(kind, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations=2):
     """Newton iterations of ``pairs._project`` (two in the kernel, from the search's converged point).
 
@@ -461,7 +461,7 @@ def _project(kind, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations=2):
                          iterations)
 
 
-@jit
+@jit_inline
 def _project_from(kind, sec1, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations):
     """``_project`` given the slave section ``sec1 = _section(RA1, xA1, u1, w1, xi1)`` (a caller that has it)."""
     moving = kind != LINE and kind != ORTHOGONAL
@@ -508,7 +508,7 @@ def _col_dot(a, G, r0, k):
     return a[0] * G[r0 * W + k] + a[1] * G[(r0 + 1) * W + k] + a[2] * G[(r0 + 2) * W + k]
 
 
-@jit
+@jit_inline
 def _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, G):
     """``dxi1, dxi2`` (rows ``G_DXI1``, ``G_DXI2`` of ``G``) by the implicit-function theorem at the converged
     projection, from the section-frame variations at fixed ``xi`` (rows ``G_VC``, ``G_VF``) and the twist
@@ -586,7 +586,7 @@ def _element_side(Xp, j0, S, c):
     return RA, xA, u, w
 
 
-@jit
+@jit_inline
 def _variations(S, c0, G, DH, V):
     """Twist variation ``dh = T(h)^-1 (dq_B - Ad(exp(-h)) dq_A)`` and section-frame variation at fixed
     ``xi`` ``(J_A dq_A + J_B dq_B)`` into the rows ``DH``, ``V`` of ``G`` (6 each), node A at column ``c0``
@@ -604,7 +604,7 @@ def _variations(S, c0, G, DH, V):
 
 
 # ---------------------------------------------------------------- 3-vectors with gradients (3, 24)
-@jit
+@jit_inline
 def _axes(RC, xC, RF, xF, G):
     """``n, t1, t2`` (``pairs._axes``), centre distance, and the gradients of ``n, t1, t2, dist``
     into ``G`` (rows ``G_DN``, ``G_DT1``, ``G_DT2``, ``G_DDIST``; one pass over the 24 columns)."""
@@ -635,79 +635,143 @@ def _axes(RC, xC, RF, xF, G):
 
 
 # ---------------------------------------------------------------- friction
-@jit
+@jit_inline
 def _pose4(H):
     R = ((H[0, 0], H[0, 1], H[0, 2]), (H[1, 0], H[1, 1], H[1, 2]), (H[2, 0], H[2, 1], H[2, 2]))
     return R, (H[0, 3], H[1, 3], H[2, 3])
 
 
-@jit
+@jit_inline
 def _compose(RA, xA, RB, xB):
     return mm(RA, RB), add(mv(RA, xB), xA)
 
 
-@jit
-def _slip_rows(Tdy, Ad, JA, JB, sign, D, c0, tmp):
-    """``D[:, c0:c0+12] = sign (Tdy[1:3] Ad) [J_A, J_B]`` (``Tdy``, ``Ad``, ``J`` ``(6, 6)``; ``tmp`` ``(6, 6)``);
-    ``Ad`` and ``J`` block upper triangular: the terms of their zero blocks skipped (``_mm_ut``)."""
-    for i in range(2):
-        for j in range(6):
-            acc = 0.0
-            for l in range(3 if j < 3 else 6):
-                acc += Tdy[1 + i, l] * Ad[l, j]
-            tmp[i, j] = acc
-    for i in range(2):
-        for j in range(6):
-            a = 0.0
-            b = 0.0
-            for l in range(3 if j < 3 else 6):
-                a += tmp[i, l] * JA[l, j]
-                b += tmp[i, l] * JB[l, j]
-            D[i, c0 + j] = -a if sign < 0.0 else a
-            D[i, c0 + 6 + j] = -b if sign < 0.0 else b
+@jit_inline
+def _vm(y, M):
+    """The row ``y^T M`` (``M^T y``) of a 3x3 tuple ``M``."""
+    return (y[0] * M[0][0] + y[1] * M[1][0] + y[2] * M[2][0], y[0] * M[0][1] + y[1] * M[1][1] + y[2] * M[2][1],
+            y[0] * M[0][2] + y[1] * M[1][2] + y[2] * M[2][2])
+
+
+@jit_inline
+def _row_ut(yf, ym, A):
+    """The row ``y^T A``, ``y = (yf, ym)``, of a block upper-triangular ``(6, 6)`` array (``A[3:, :3] == 0``),
+    as two 3-tuples (written out: nested inlined helpers cost compile time)."""
+    return ((yf[0] * A[0, 0] + yf[1] * A[1, 0] + yf[2] * A[2, 0],
+             yf[0] * A[0, 1] + yf[1] * A[1, 1] + yf[2] * A[2, 1],
+             yf[0] * A[0, 2] + yf[1] * A[1, 2] + yf[2] * A[2, 2]),
+            (yf[0] * A[0, 3] + yf[1] * A[1, 3] + yf[2] * A[2, 3] + ym[0] * A[3, 3] + ym[1] * A[4, 3] + ym[2] * A[5, 3],
+             yf[0] * A[0, 4] + yf[1] * A[1, 4] + yf[2] * A[2, 4] + ym[0] * A[3, 4] + ym[1] * A[4, 4] + ym[2] * A[5, 4],
+             yf[0] * A[0, 5] + yf[1] * A[1, 5] + yf[2] * A[2, 5] + ym[0] * A[3, 5] + ym[1] * A[4, 5] + ym[2] * A[5, 5]))
+
+
+@jit_inline
+def _row_adjoint_inv(yf, ym, R, xt):
+    """The row ``y^T Ad(H^-1)`` of the pose ``H = (R, x)``, ``xt = -R^T x``: ``(R yf, R (ym + yf x xt))``."""
+    return mv(R, yf), mv(R, add(ym, cross(yf, xt)))
+
+
+@jit_inline
+def _coefficients_exp_tangent(w):
+    """``t^2 = |w|^2`` and the coefficients ``a, b, c, q2, q3`` at ``t``: those of ``exp`` and ``T`` (a
+    section and its node Jacobians, without their derivatives; ``_coefficients`` has all ten)."""
+    t2 = dot(w, w)
+    t = np.sqrt(t2)
+    return t2, (coefficient(A_, t), coefficient(B_, t), coefficient(C_, t), coefficient(Q2_, t), coefficient(Q3_, t))
+
+
+@jit_inline
+def _section_prev(RA, xA, u, w, xi, R, x, xip):
+    """The section at ``xip`` and the factors of its node Jacobians ``J_B = xip T(s) T(h)^-1``,
+    ``J_A = Ad(exp(-s)) - J_B Ad(exp(-h))``, ``s = xip h``: ``(same, R, x, Rs, xt, T3, Q)`` with the section
+    pose ``(R, x)``, ``exp(s) = (Rs, xs)``, ``xt = -Rs^T xs`` and ``T(s) = [[T3, Q], [0, T3]]``.  ``same``:
+    ``xip`` is ``xi`` bit for bit, the section ``(R, x)`` at ``xi`` is returned (the rest unused; the
+    Jacobians at ``xi`` are in ``S_JA``, ``S_JB``).  The section is ``_section``'s operations."""
+    if _same(xip, xi):
+        return True, R, x, R, x, R, R
+    su, sw = scale(xip, u), scale(xip, w)
+    t2, co = _coefficients_exp_tangent(sw)
+    Rs, xs = _exp_abc(su, sw, t2, co[0], co[1], co[2])
+    T3 = add_outer(mat(scale(-co[1], sw), 1.0 - co[2] * t2), scale(co[2], sw), sw)
+    Q = q_matrix(scale(-1.0, su), scale(-1.0, sw), dot(sw, su), cross(sw, su), t2, co[2], co[3], co[4])
+    return False, mm(RA, Rs), add(mv(RA, xs), xA), Rs, scale(-1.0, mv(transpose(Rs), xs)), T3, Q
+
+
+@jit_inline
+def _tangent_inv_rows(u, w):
+    """Rows 1 and 2 of ``T(h)^-1 = [[Ti, -Ti Q Ti], [0, Ti]]`` (``_tangent_inv``) as ``(yf, ym)`` pairs."""
+    t2 = dot(w, w)
+    t = np.sqrt(t2)
+    Ti = ti_matrix(w, coefficient(D_, t), t2)
+    Q = q_matrix(scale(-1.0, u), scale(-1.0, w), dot(w, u), cross(w, u), t2, coefficient(C_, t),
+                 coefficient(Q2_, t), coefficient(Q3_, t))
+    return (Ti[1], scale(-1.0, _vm(_vm(Ti[1], Q), Ti))), (Ti[2], scale(-1.0, _vm(_vm(Ti[2], Q), Ti)))
+
+
+@jit_inline
+def _put_row(D, a, c0, yf, ym):
+    """``D[a, c0:c0+6] = (yf, ym)``."""
+    D[a, c0], D[a, c0 + 1], D[a, c0 + 2], D[a, c0 + 3], D[a, c0 + 4], D[a, c0 + 5] = yf[0], yf[1], yf[2], ym[0], \
+        ym[1], ym[2]
+
+
+@jit_inline
+def _slip_row(yf, ym, prev, xip, S, D, a, c0):
+    """``D[a, c0:c0+12] = y [J_A, J_B]`` at ``xip`` for the row ``y = (yf, ym)``; ``prev``: ``_section_prev``.
+    Without forming ``J``: ``y J_B = xip (y T(s)) T(h)^-1``, ``y J_A = y Ad(exp(-s)) - xip (y T(s)) T(h)^-1
+    Ad(exp(-h))`` (``S[S_TI]``, ``S[S_TIAH]``); where ``xip`` is ``xi``, from ``S[S_JA]``, ``S[S_JB]``."""
+    same, _, _, Rs, xt, T3, Q = prev
+    if same:
+        af, am = _row_ut(yf, ym, S[S_JA])
+        bf, bm = _row_ut(yf, ym, S[S_JB])
+    else:
+        zf, zm = _vm(yf, T3), add(_vm(yf, Q), _vm(ym, T3))          # y T(s)
+        bf, bm = _row_ut(zf, zm, S[S_TI])
+        cf, cm = _row_ut(zf, zm, S[S_TIAH])
+        af, am = _row_adjoint_inv(yf, ym, Rs, xt)
+        af, am = add(af, scale(-xip, cf)), add(am, scale(-xip, cm))
+        bf, bm = scale(xip, bf), scale(xip, bm)
+    _put_row(D, a, c0, af, am)
+    _put_row(D, a, c0 + 6, bf, bm)
 
 
 @jit
+def _slip_rows(row1, row2, R, xt, sign, prev, xip, S, D, c0):
+    """``D[:, c0:c0+12] = sign (row Ad(H^-1)) [J_A, J_B]`` at ``xip`` for the rows ``row1``, ``row2`` ``(yf, ym)``
+    of ``T(dy)^-1``; ``H = (R, x)``, ``xt = -R^T x``; ``prev``: ``_section_prev``."""
+    for a in range(2):
+        yf, ym = row1 if a == 0 else row2
+        cf, cm = _row_adjoint_inv(yf, ym, R, xt)
+        _slip_row(scale(sign, cf), scale(sign, cm), prev, xip, S, D, a, c0)
+
+
+@jit_inline
 def _slip(side1, side2, S1, S2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp, D):
     """Slip ``log(H_LK_prev^-1 H_LK)[1:3]`` of the material frames (``kinematics.slip_increment``)
     and its gradient into ``D`` ``(2, 24)``; ``sec1``, ``sec2``: ``(xi, R, x)`` of the sections at the
-    point.  The node Jacobians at ``xi_prev`` go to ``S[S_JAP], S[S_JBP]``; where ``xi_prev`` is ``xi``
-    (bit for bit) the section and the Jacobians at ``xi`` are reused."""
+    point.  With ``dy = log(H_LK_prev^-1 H_LK)`` and the section variations ``dq = J_A dq_A + J_B dq_B`` at
+    ``xi_prev`` (fixed): ``d(dy) = T(dy)^-1 (-Ad((H_CL H_LK)^-1) dq_C + Ad(H_FK^-1) dq_F)``; only its rows 1, 2
+    are formed, as rows times the factors of ``J`` (``_slip_rows``).  Where ``xi_prev`` is ``xi`` (bit for
+    bit) the section and the Jacobians at ``xi`` are reused."""
     RA1, xA1, u1, w1 = side1
     RA2, xA2, u2, w2 = side2
     xi1, RC, xC = sec1
     xi2, RF, xF = sec2
-    RCm, xCm = (RC, xC) if _same(xi1p, xi1) else _section(RA1, xA1, u1, w1, xi1p)[:2]
-    RFm, xFm = (RF, xF) if _same(xi2p, xi2) else _section(RA2, xA2, u2, w2, xi2p)[:2]
+    prev1 = _section_prev(RA1, xA1, u1, w1, xi1, RC, xC, xi1p)
+    prev2 = _section_prev(RA2, xA2, u2, w2, xi2, RF, xF, xi2p)
     RCL, xCL = _pose4(HCL)
     RFK, xFK = _pose4(HFK)
-    RL, xL = _compose(RCm, xCm, RCL, xCL)
-    RK, xK = _compose(RFm, xFm, RFK, xFK)
+    RL, xL = _compose(prev1[1], prev1[2], RCL, xCL)
+    RK, xK = _compose(prev2[1], prev2[2], RFK, xFK)
     RLt = transpose(RL)
     RLK, xLK = mm(RLt, RK), mv(RLt, add(xK, scale(-1.0, xL)))
     RP, xP = _pose4(HLKp)
     dyu, dyw, _, _ = log_relative(RP, xP, RLK, xLK)
-    a1, b1 = _jacobians_at(u1, w1, xi1, xi1p, S1)
-    a2, b2 = _jacobians_at(u2, w2, xi2, xi2p, S2)
-    Tdy, Ad, tmp = S1[S_TDY], S1[S_AD], S1[S_TMP]
-    _tangent_inv(dyu, dyw, Tdy)
-    Rs, xs = _compose(RCL, xCL, RLK, xLK)
-    _adjoint_inv(Rs, xs, Ad)
-    _slip_rows(Tdy, Ad, S1[a1], S1[b1], -1.0, D, 0, tmp)
-    _adjoint_inv(RFK, xFK, Ad)
-    _slip_rows(Tdy, Ad, S2[a2], S2[b2], 1.0, D, 12, tmp)
+    row1, row2 = _tangent_inv_rows(dyu, dyw)
+    Rm, xm = _compose(RCL, xCL, RLK, xLK)
+    _slip_rows(row1, row2, Rm, scale(-1.0, mv(transpose(Rm), xm)), -1.0, prev1, xi1p, S1, D, 0)
+    _slip_rows(row1, row2, RFK, scale(-1.0, mv(transpose(RFK), xFK)), 1.0, prev2, xi2p, S2, D, 12)
     return (dyu[1], dyu[2])
-
-
-@jit
-def _jacobians_at(u, w, xi, xip, S):
-    """Slots of ``S`` with the node Jacobians at ``xip``: ``S_JA, S_JB`` (those at ``xi``) if ``xip`` is ``xi``,
-    else ``S_JAP, S_JBP``, computed."""
-    if _same(xip, xi):
-        return S_JA, S_JB
-    t2, co = _coefficients(scale(xip, w))
-    _jacobians(u, w, xip, t2, co, S[S_TI], S[S_AH], S[S_TSP], S[S_ASP], S[S_JAP], S[S_JBP], S[S_TMP])
-    return S_JAP, S_JBP
 
 
 def _friction(slip, lamp, t1, t2, lam, par, G):
@@ -833,7 +897,7 @@ def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, G, DXI, DW,
         out[c] = acc
 
 
-@jit
+@jit_inline
 def _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2):
     """``HL, HK, HC, HF`` (``pairs._contact_frames``)."""
     for k in range(4):
@@ -849,7 +913,7 @@ def _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2):
         frames[2, i, 3], frames[3, i, 3] = xC[i], xF[i]
 
 
-@jit
+@jit_inline
 def _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, d, S1, S2, G):
     """Node Jacobians of both sides, twist variations (rows ``G_DH1``, ``G_DH2`` of ``G``), projection
     gradients (``G_DXI1``, ``G_DXI2``) and the section-frame variations (``G_VC``, ``G_VF``, 6 rows each);
@@ -868,7 +932,7 @@ def _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, d, S1, S
             G[(G_VF + i) * W + k] += h2[i] * G[G_DXI2 * W + k]
 
 
-@jit
+@jit_inline
 def _add_friction_force(F, G, wgt, lt, Dlt, t1, t2):
     """``F + wgt (lt0 t1 + lt1 t2)`` and its gradient added to the rows ``G_DF`` of ``G`` (``Dlt`` ``(2, 24)``)."""
     for k in range(24):
