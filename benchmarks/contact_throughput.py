@@ -35,16 +35,24 @@ from beamsolver.contact.system import use_numpy_kernel  # noqa: E402
 OUT = Path(__file__).resolve().parent / "results"
 
 
-def scene(n_points, gauss_points=5, mu=0.3):
-    n_el = max(1, n_points // gauss_points)
-    sec = bs.Section.circular(radius=0.005, E=1e9)
-    m = bs.Model()
+def line_model(package, n_el, gauss_points=5, mu=0.3):
+    """The scene's model built with the beamsolver package ``package`` (a reference copy may be
+    passed): two nearly parallel beams of ``n_el`` elements each in line contact, both clamped."""
+    sec = package.Section.circular(radius=0.005, E=1e9)
+    m = package.Model()
     L = 0.05 * n_el
-    master = m.add_beam(bs.geometry.straight((0, 0, 0), (L, 0, 0), n_el), sec)
-    slave = m.add_beam(bs.geometry.straight((0.01 * L, 0.001, 0.0099), (0.99 * L, -0.001, 0.0099), n_el), sec)
+    master = m.add_beam(package.geometry.straight((0, 0, 0), (L, 0, 0), n_el), sec)
+    slave = m.add_beam(package.geometry.straight((0.01 * L, 0.001, 0.0099), (0.99 * L, -0.001, 0.0099), n_el), sec)
     m.clamp(master.first)
     m.clamp(slave.first)
     m.add_contact(slave, master, mu=mu, gauss_points=gauss_points)
+    return m
+
+
+def scene(n_points, gauss_points=5, mu=0.3):
+    """The contact system of ``line_model`` with ``n_points`` slave points and its reference poses,
+    friction history committed for every point."""
+    m = line_model(bs, max(1, n_points // gauss_points), gauss_points, mu)
     contact = Problem.from_model(m, check_rigid_modes=False).contact
     H = contact.sys.poses0.copy()
     contact.commit(H)          # friction history for every point

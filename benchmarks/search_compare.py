@@ -50,16 +50,9 @@ def reference_package(ref):
 
 def scene(bs, n_points, gauss_points=5, mu=0.3):
     """``contact_throughput.scene`` built with the package ``bs``: the contact system and poses."""
+    from contact_throughput import line_model
     problem = importlib.import_module(bs.__name__ + ".problem")
-    n_el = max(1, n_points // gauss_points)
-    sec = bs.Section.circular(radius=0.005, E=1e9)
-    m = bs.Model()
-    L = 0.05 * n_el
-    master = m.add_beam(bs.geometry.straight((0, 0, 0), (L, 0, 0), n_el), sec)
-    slave = m.add_beam(bs.geometry.straight((0.01 * L, 0.001, 0.0099), (0.99 * L, -0.001, 0.0099), n_el), sec)
-    m.clamp(master.first)
-    m.clamp(slave.first)
-    m.add_contact(slave, master, mu=mu, gauss_points=gauss_points)
+    m = line_model(bs, max(1, n_points // gauss_points), gauss_points, mu)
     contact = problem.Problem.from_model(m, check_rigid_modes=False).contact
     H = contact.sys.poses0.copy()
     contact.commit(H)

@@ -219,14 +219,9 @@ def _line_scene(n_el=40):
     """Two nearly parallel wires in line contact (``benchmarks/contact_throughput.py``' scene)."""
     import beamsolver as bs
     from beamsolver.problem import Problem
-    sec = bs.Section.circular(radius=0.005, E=1e9)
-    m = bs.Model()
-    L = 0.05 * n_el
-    master = m.add_beam(bs.geometry.straight((0, 0, 0), (L, 0, 0), n_el), sec)
-    slave = m.add_beam(bs.geometry.straight((0.01 * L, 0.001, 0.0099), (0.99 * L, -0.001, 0.0099), n_el), sec)
-    m.clamp(master.first)
-    m.clamp(slave.first)
-    m.add_contact(slave, master, mu=0.3)
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    from contact_throughput import line_model
+    m = line_model(bs, n_el)
     return lambda: Problem.from_model(m, check_rigid_modes=False).contact
 
 
