@@ -57,7 +57,7 @@ from .._jit import jit, jit_inline
 from ..errors import InputError
 from ..element_jit import _dq_du, _dq_dw
 from ..se3_jit import madd, mscale
-from ..se3_jit import (A_, B_, C_, CP_, D_, DP_, Q2P_, Q2_, Q3P_, Q3_, add, add_outer, coefficient, cross, dot,
+from ..se3_jit import (A_, B_, C_, CP_, D_, Q2P_, Q2_, Q3P_, Q3_, add, add_outer, coefficient, cross, dot,
                        log_relative, mat, mm, mv, q_matrix, scale, ti_matrix, transpose)
 from .law import PENALTY_COULOMB
 from .pairs import LINE, ORTHOGONAL, PENALTY_T_MIN
@@ -138,13 +138,12 @@ def _section(RA, xA, u, w, xi):
 
 @jit
 def _coefficients(w):
-    """``t^2 = |w|^2`` and the coefficients ``a, b, c, d, q2, q3, cp, dp, q2p, q3p`` at ``t`` (``coefficient``,
+    """``t^2 = |w|^2`` and the coefficients ``a, b, c, q2, q3, cp, q2p, q3p`` at ``t`` (``coefficient``,
     each once): the sections, node Jacobians and their derivatives at one ``xi h`` share them."""
     t2 = dot(w, w)
     t = np.sqrt(t2)
-    return t2, (coefficient(A_, t), coefficient(B_, t), coefficient(C_, t), coefficient(D_, t), coefficient(Q2_, t),
-                coefficient(Q3_, t), coefficient(CP_, t), coefficient(DP_, t), coefficient(Q2P_, t),
-                coefficient(Q3P_, t))
+    return t2, (coefficient(A_, t), coefficient(B_, t), coefficient(C_, t), coefficient(Q2_, t), coefficient(Q3_, t),
+                coefficient(CP_, t), coefficient(Q2P_, t), coefficient(Q3P_, t))
 
 
 @jit
@@ -182,13 +181,6 @@ def _zero3(A, r0, c0):
             A[r0 + i, c0 + j] = 0.0
 
 
-@jit_inline
-def _zero(A):
-    for i in range(A.shape[0]):
-        for j in range(A.shape[1]):
-            A[i, j] = 0.0
-
-
 @jit
 def _col(R, j):
     return (R[0][j], R[1][j], R[2][j])
@@ -205,17 +197,6 @@ def _mm_ut(A, B, out):
             for l in range(3 if i >= 3 else 0, 3 if j < 3 else 6):
                 acc += A[i, l] * B[l, j]
             out[i, j] = acc
-
-
-@jit_inline
-def _mtv_ut(A, v, out):
-    """``out = A^T v`` for a block upper-triangular ``(6, 6)`` array and a 6-vector, without the terms
-    of the zero block (the same floats, see ``_mm_ut``)."""
-    for j in range(6):
-        acc = 0.0
-        for i in range(3 if j < 3 else 6):
-            acc += A[i, j] * v[i]
-        out[j] = acc
 
 
 @jit
@@ -238,7 +219,7 @@ def _tangent_co(u, w, T, t2, co):
     """``_tangent`` with the coefficients of ``_coefficients(w)`` (or of ``-w``: the same)."""
     b, c = co[1], co[2]
     T3 = add_outer(mat(scale(-b, w), 1.0 - c * t2), scale(c, w), w)
-    Q = q_matrix(scale(-1.0, u), scale(-1.0, w), dot(w, u), cross(w, u), t2, c, co[4], co[5])
+    Q = q_matrix(scale(-1.0, u), scale(-1.0, w), dot(w, u), cross(w, u), t2, c, co[3], co[4])
     _put3(T, 0, 0, T3)
     _put3(T, 3, 3, T3)
     _put3(T, 0, 3, Q)
@@ -275,12 +256,11 @@ def _adjoint_inv(R, x, A):
 
 # ---------------------------------------------------------------- one side of a pair: scratch slots
 # 6x6 slots of a side's scratch ``S`` (N_SIDE, 6, 6)
-(S_TI, S_AH, S_TS, S_AS, S_JA, S_JB, S_TSP, S_ASP, S_JAP, S_JBP, S_TMP, S_GS, S_M1, S_P, S_DA, S_DB, S_TMH, S_TMS, S_MS,
- S_AHDB, S_TDY, S_AD, S_TIAH) = range(23)
-N_SIDE = 23
+(S_TI, S_AH, S_TS, S_AS, S_JA, S_JB, S_TMP, S_DA, S_DB, S_TMH, S_TIAH) = range(11)
+N_SIDE = 11
 # 6-vector slots of a side's ``v`` (N_VEC, 6)
-(V_WR, V_Y, V_XY, V_DB, V_B, V_ZS, V_ZH, V_AHDB, V_DA) = range(9)
-N_VEC = 9
+(V_WR, V_DB, V_DA) = range(3)
+N_VEC = 3
 # the gradients ``(k, 24)`` of one point: rows of one flat array ``G`` (N_G * W,), row ``r``, column ``k`` at
 # ``G[r * W + k]``; a quantity's rows start at its row offset ``G_*``.  One array and constant offsets let the
 # compiler see that the accesses of a loop do not overlap, so the loops over the columns vectorise
@@ -406,13 +386,13 @@ def _jacobian_derivatives(u, w, xi, t2, co, S, v, c):
     a, m = (wr[0], wr[1], wr[2]), (wr[3], wr[4], wr[5])
     T3t, Q3t = transpose(_blk(S[S_TS], 0, 0)), transpose(_blk(S[S_TS], 0, 3))     # T(-s) blocks
     yf, ym = mv(T3t, a), add(mv(Q3t, a), mv(T3t, m))                               # y = T(s)^T wr
-    F12, F21, F22 = _dt_t(scale(xi, u), scale(xi, w), a, m, t2, co[0], co[1], co[2], co[4], co[5], co[6], co[8],
-                          co[9])                                                     # F(s, wr)
+    F12, F21, F22 = _dt_t(scale(xi, u), scale(xi, w), a, m, t2, co[0], co[1], co[2], co[3], co[4], co[5], co[6],
+                          co[7])                                                     # F(s, wr)
     Ti3t, Xt = transpose(_blk(S[S_TI], 0, 0)), transpose(_blk(S[S_TI], 0, 3))
     tyf, tym = mv(Ti3t, yf), add(mv(Xt, yf), mv(Ti3t, ym))                          # T(h)^-T y
     bf, bm = scale(xi, tyf), scale(xi, tym)                                           # b = J_B^T wr
-    H12, H21, H22 = _dt_t(u, w, bf, bm, c[C_T2], c[C_A], c[C_B], c[C_CO], c[C_CO + 1], c[C_CO + 2], c[C_CO + 4],
-                          c[C_CO + 5], c[C_CO + 6])                                 # F(h, b)
+    H12, H21, H22 = _dt_t(u, w, bf, bm, c[C_T2], c[C_A], c[C_B], c[C_CO], c[C_CO + 1], c[C_CO + 2], c[C_CO + 3],
+                          c[C_CO + 4], c[C_CO + 5])                                 # F(h, b)
     x2 = xi * xi
     N12, N21, N22 = _axmy(x2, F12, H12), _axmy(x2, F21, H21), _axmy(x2, F22, H22)
     B12, B21, B22 = mm(Ti3t, N12), mm(Ti3t, N21), madd(mm(Xt, N12), mm(Ti3t, N22))   # dB/dh = T(h)^-T N
@@ -545,15 +525,15 @@ def _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, G):
 
 # ---------------------------------------------------------------- one side of a pair: element, section, Jacobians
 # per-side element cache ``c`` (2, N_CACHE): the node poses (rows 0-2 of nodes j0, j0 + 1), the twist and the
-# coefficients of ``G(h, .)`` of the last element seen on that side
-C_POSE, C_U, C_W, C_T2, C_D, C_CO, C_A, C_B, N_CACHE = 0, 24, 27, 30, 31, 32, 39, 40, 41
+# coefficients ``a, b`` and ``c, q2, q3, cp, q2p, q3p`` of ``F(h, .)`` of the last element seen on that side
+C_POSE, C_U, C_W, C_T2, C_A, C_B, C_CO, N_CACHE = 0, 24, 27, 30, 31, 32, 33, 39
 
 
 @jit
 def _element_side(Xp, j0, S, c):
     """Twist ``h = log(H_A^-1 H_B)`` of the element of nodes ``j0, j0 + 1`` and the element's quantities:
     ``T(h)^-1``, ``Ad(exp(-h))``, ``T(h)^-1 Ad(exp(-h))``, ``T(-h)`` into ``S[S_TI], S[S_AH], S[S_TIAH],
-    S[S_TMH]`` and the coefficients of ``G(h, .)`` into ``c``.  Kept while the node poses are those of the last
+    S[S_TMH]`` and the coefficients of ``F(h, .)`` into ``c``.  Kept while the node poses are those of the last
     point on this side, bit for bit (the Gauss points of a slave element, consecutive points on one master
     element): the same floats."""
     hit = True
@@ -575,13 +555,13 @@ def _element_side(Xp, j0, S, c):
     _tangent(scale(-1.0, u), scale(-1.0, w), S[S_TMH])
     t2 = dot(w, w)
     t = np.sqrt(t2)
-    co = (coefficient(C_, t), coefficient(Q2_, t), coefficient(Q3_, t), coefficient(DP_, t), coefficient(CP_, t),
-          coefficient(Q2P_, t), coefficient(Q3P_, t))
+    co = (coefficient(C_, t), coefficient(Q2_, t), coefficient(Q3_, t), coefficient(CP_, t), coefficient(Q2P_, t),
+          coefficient(Q3P_, t))
     for i in range(3):
         c[C_U + i], c[C_W + i] = u[i], w[i]
-    c[C_T2], c[C_D] = t2, coefficient(D_, t)
+    c[C_T2] = t2
     c[C_A], c[C_B] = coefficient(A_, t), coefficient(B_, t)
-    for i in range(7):
+    for i in range(6):
         c[C_CO + i] = co[i]
     return RA, xA, u, w
 
