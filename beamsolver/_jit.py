@@ -5,15 +5,15 @@
 per-division check); no ``fastmath``, so results stay those of the numpy
 oracle to round-off.
 
-Numba checks a cached function against its own source file only; ``jit_cache.drop_stale``
-deletes the package's cache files when any compiled module changed (run here, once per process,
-before anything compiled is loaded).
+Numba checks a cached function against its own source file only; ``jit_cache.install`` (run
+here, before any function is decorated) stamps the package's cached functions with the digest of
+their module and every package module it imports instead.
 """
 from numba import njit
 
-from .jit_cache import drop_stale
+from .jit_cache import install
 
-drop_stale()
+install()
 
 jit = njit(cache=True, error_model="numpy")
 # functions taking arrays are inlined into their caller: a call passing arrays costs a reference

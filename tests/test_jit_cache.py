@@ -1,8 +1,11 @@
-"""Numba's disk cache and edits of a module a cached function calls (beamsolver.jit_cache)."""
+"""Numba's disk cache and edits of the code a cached function depends on (beamsolver.jit_cache).
+
+Each test builds a small package in a temporary folder whose ``_jit`` installs the package's
+locators (or not: the hazard), and runs it in fresh processes."""
 import os
 import subprocess
 import sys
-import textwrap
+import time
 
 import pytest
 
@@ -12,70 +15,115 @@ JIT = """from numba import njit
 {guard}
 jit = njit(cache=True)
 """
-GUARD = "from pathlib import Path\nfrom beamsolver.jit_cache import drop_stale\ndrop_stale(Path(__file__).parent)"
+GUARD = "from pathlib import Path\nfrom beamsolver.jit_cache import install\ninstall(Path(__file__).parent)"
+CALLER = """from ._jit import jit
+from .callee import f
+from .consts import K
 
 
-def _package(tmp_path, guard, value):
+@jit
+def g():
+    return f() + K
+"""
+
+
+def _write(path, text, tick):
+    """Write ``text`` with a distinct modification time (numba's own stamp is mtime and size)."""
+    path.write_text(text)
+    st = os.stat(path)
+    os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns + 10**9 * tick))
+
+
+def _package(tmp_path, guard, value=1.0, const=0.0):
     pkg = tmp_path / "pkg"
     pkg.mkdir(exist_ok=True)
     (pkg / "__init__.py").write_text("")
     (pkg / "_jit.py").write_text(JIT.format(guard=GUARD if guard else ""))
-    (pkg / "caller.py").write_text("from ._jit import jit\nfrom .callee import f\n\n\n@jit\ndef g():\n    return f()\n")
+    (pkg / "caller.py").write_text(CALLER)
+    (pkg / "other.py").write_text("X = 1\n")                            # not imported by caller
     _callee(pkg, value)
+    _write(pkg / "consts.py", f"K = {const}\n", 1)
     return pkg
 
 
-def _callee(pkg, value):
-    p = pkg / "callee.py"
-    p.write_text(f"from ._jit import jit\n\n\n@jit\ndef f():\n    return {value}\n")
-    st = os.stat(p)
-    os.utime(p, ns=(st.st_atime_ns, st.st_mtime_ns + 10**9 * int(value)))     # a distinct stamp
+def _callee(pkg, value, tick=1):
+    _write(pkg / "callee.py", f"from ._jit import jit\n\n\n@jit\ndef f():\n    return {value}\n", tick)
 
 
-def _run(tmp_path):
+def _run(tmp_path, code="from pkg.caller import g; print(g(), g.stats.cache_hits.get(g.signatures[0], 0) > 0)"):
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tmp_path)] + sys.path), NUMBA_CACHE_DIR="")
-    out = subprocess.run([sys.executable, "-c", "from pkg.caller import g; print(g())"], cwd=tmp_path,
-                         env=env, capture_output=True, text=True, timeout=300)
+    out = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True,
+                         timeout=300)
     assert out.returncode == 0, out.stderr
-    return float(out.stdout)
+    value, hit = out.stdout.split()
+    return float(value), hit == "True"
 
 
+@pytest.mark.slow                      # each test runs numba in 3-4 fresh processes
 @pytest.mark.parametrize("guard", [False, True])
 def test_an_edited_callee_is_compiled_again(tmp_path, guard):
-    """Without the guard numba reloads ``g`` with the old ``f`` inlined (the hazard); with it the
-    edit is seen."""
-    pkg = _package(tmp_path, guard, 1.0)
-    assert _run(tmp_path) == 1.0
-    assert list((pkg / "__pycache__").glob("caller.*.nbi"))         # g was cached
-    _callee(pkg, 2.0)
-    assert _run(tmp_path) == (2.0 if guard else 1.0)
+    """Without the locators numba reloads ``g`` with the old ``f`` inlined (the hazard); with
+    them the edit is seen."""
+    pkg = _package(tmp_path, guard)
+    assert _run(tmp_path) == (1.0, False)
+    assert _run(tmp_path) == (1.0, True)                              # g was cached
+    _callee(pkg, 2.0, tick=2)
+    assert _run(tmp_path)[0] == (2.0 if guard else 1.0)
 
 
-def test_drop_stale_deletes_only_on_a_new_digest(tmp_path):
-    pkg = tmp_path / "p"
-    (pkg / "__pycache__").mkdir(parents=True)
-    (pkg / "a.py").write_text("from ._jit import jit\n")
-    (pkg / "b.py").write_text("import numpy\n")                      # not compiled
-    cached = [pkg / "__pycache__" / n for n in ("a.f-3.py311.nbi", "a.f-3.py311.nbc")]
-    other = pkg / "__pycache__" / "b.cpython-311.pyc"
-
-    def make():
-        for f in cached + [other]:
-            f.write_bytes(b"x")
-
-    make()
-    assert jit_cache.drop_stale(pkg) == 2                             # no stamp yet: stale
-    assert not any(f.exists() for f in cached) and other.exists()
-    assert (pkg / "__pycache__" / jit_cache.STAMP).read_text() == jit_cache.digest([pkg / "a.py"], pkg)
-    make()
-    assert jit_cache.drop_stale(pkg) == 0 and all(f.exists() for f in cached)
-    (pkg / "b.py").write_text("import scipy\n")                      # a module without compiled code
-    assert jit_cache.drop_stale(pkg) == 0
-    (pkg / "a.py").write_text("from ._jit import jit\nX = 1\n")
-    assert jit_cache.drop_stale(pkg) == 2
+@pytest.mark.slow
+@pytest.mark.parametrize("guard", [False, True])
+def test_a_frozen_constant_of_a_plain_module_is_seen(tmp_path, guard):
+    """``consts`` has no compiled code; ``g`` freezes its ``K`` (as the contact kernel freezes
+    ``contact.pairs``' constants)."""
+    pkg = _package(tmp_path, guard)
+    assert _run(tmp_path) == (1.0, False)
+    _write(pkg / "consts.py", "K = 10.0\n", 3)
+    assert _run(tmp_path)[0] == (11.0 if guard else 1.0)
 
 
-def test_the_package_digest_covers_its_compiled_modules():
-    names = {p.name for p in jit_cache.compiled_modules(os.path.dirname(jit_cache.__file__))}
-    assert {"se3_jit.py", "element_jit.py", "kernel_jit.py", "projection.py"} <= names
-    assert "solver.py" not in names
+@pytest.mark.slow
+def test_an_unrelated_edit_keeps_the_cache(tmp_path):
+    pkg = _package(tmp_path, True)
+    assert _run(tmp_path) == (1.0, False)
+    _write(pkg / "other.py", "X = 2\n", 4)
+    assert _run(tmp_path) == (1.0, True)
+
+
+@pytest.mark.slow
+def test_a_process_running_old_code_cannot_stamp_it_new(tmp_path):
+    """A process imports the old code, the files change, another process caches the new code,
+    then the old process compiles and saves: the next process must run the new code."""
+    pkg = _package(tmp_path, True)
+    go = tmp_path / "go"
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tmp_path)] + sys.path), NUMBA_CACHE_DIR="")
+    old = subprocess.Popen([sys.executable, "-c",
+                            "import os, time\nfrom pkg.caller import g\nopen('ready', 'w').close()\n"
+                            "while not os.path.exists('go'): time.sleep(0.05)\nprint(g())"],
+                           cwd=tmp_path, env=env, stdout=subprocess.PIPE, text=True)
+    try:
+        t0 = time.monotonic()
+        while not (tmp_path / "ready").exists():
+            assert time.monotonic() - t0 < 120 and old.poll() is None
+            time.sleep(0.05)
+        _callee(pkg, 2.0, tick=2)
+        assert _run(tmp_path) == (2.0, False)                         # new code compiled and saved
+        go.write_text("")
+        assert float(old.communicate(timeout=300)[0]) == 1.0           # old code saved last
+    finally:
+        old.kill()
+    assert _run(tmp_path)[0] == 2.0
+
+
+def test_dependencies_follow_imports_transitively(tmp_path):
+    pkg = _package(tmp_path, True)
+    deps = {p.name for p in jit_cache.dependencies(pkg / "caller.py", pkg)}
+    assert deps == {"caller.py", "callee.py", "consts.py", "_jit.py"}
+
+
+def test_the_contact_kernel_depends_on_the_constants_it_freezes():
+    root = os.path.dirname(jit_cache.__file__)
+    kernel = os.path.join(root, "contact", "kernel_jit.py")
+    rel = {os.path.relpath(p, root) for p in jit_cache.dependencies(kernel, root)}
+    assert {os.path.join("contact", "pairs.py"), os.path.join("contact", "law.py"), "_jit.py"} <= rel
+    assert not any(os.path.basename(p) in ("solver.py", "driver.py", "linsolve.py") for p in rel)

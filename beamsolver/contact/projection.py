@@ -16,8 +16,8 @@ follow the constant-strain interpolation ``H_A exp(xi h)`` with the element twis
 
 The Gauss-point projections run in lockstep over blocks of ``LANES`` (SIMD; the same
 operations as ``kernel_jit._project_from``, bit for bit: see the comment above ``LANES``).
-(Numba's disk cache keys a function on its own source file only; ``jit_cache.drop_stale``
-deletes the package's cache files when any compiled module changed.)  The sections are inlined
+(Numba's disk cache would key a function on its own source file only; ``jit_cache`` stamps it
+with the digest of every package module it imports.)  The sections are inlined
 (``kernel_jit._section_inline``, the same operations): what a loop does not use of them
 (``x'``, ``x''``, the rotation) is not computed.
 """
