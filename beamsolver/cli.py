@@ -217,6 +217,19 @@ def cmd_export(args):
     return 0
 
 
+def cmd_paraview(args):
+    from .io.paraview import paraview_script, screenshot
+    script = paraview_script(args.folder, color_by=args.color_by)
+    print(f"written: {script}  (open it with: paraview --script={script})")
+    if args.screenshot:
+        try:
+            print(f"written: {screenshot(script, args.screenshot, step=args.step)}")
+        except RuntimeError as exc:                   # ParaView's own failure, its messages inside
+            print(f"beamsolver paraview: {exc}", file=sys.stderr)
+            return 1
+    return 0
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(prog="beamsolver", description="Geometrically exact beams with contact.")
     sub = p.add_subparsers(dest="command", required=True)
@@ -246,6 +259,14 @@ def main(argv=None):
     e.add_argument("result")
     e.add_argument("folder")
     e.set_defaults(func=cmd_export)
+    v = sub.add_parser("paraview", help="write OUT/view.py, a ParaView script: smooth tubes at the real radii, "
+                                        "contact points coloured by stick/slip, a camera across the scene")
+    v.add_argument("folder", help="output folder with beams.pvd")
+    v.add_argument("--color-by", choices=("N", "Q2", "Q3", "T", "M2", "M3"),
+                   help="section force or moment of the tubes (default: the largest moment)")
+    v.add_argument("--screenshot", metavar="PNG", help="also run it in pvbatch and save this picture")
+    v.add_argument("--step", type=int, default=-1, help="step of the screenshot (default: the last)")
+    v.set_defaults(func=cmd_paraview)
     from .sweep_cli import add_parser as add_sweep
     add_sweep(sub)
     args = p.parse_args(argv)
