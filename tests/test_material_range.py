@@ -124,3 +124,16 @@ def test_bad_limits_are_named(kw, word):
 def test_rectangle_keeps_its_moduli():
     s = bs.Section.rectangular(2e-3, 1e-3, E=E, nu=NU, yield_strain=1e-2)
     assert (s.E, s.G, s.yield_strain, s.yield_stress) == (E, G, 1e-2, None)
+
+
+def test_strand_of_a_named_grade_gets_its_proof_stress():
+    from beamsolver import cables
+    st = cables.build_strand([cables.Layer(0.5e-3), cables.Layer(0.5e-3, 6, lay_angle=0.2)], length=0.02,
+                             E=E, grade="1770", contact=False)
+    assert {w.section.yield_stress for w in st.all_wires} == {cables.PROOF_FRACTION * 1770e6}
+    plain = cables.build_strand([cables.Layer(0.5e-3)], length=0.02, E=E, contact=False)
+    assert plain.all_wires[0].section.yield_stress is None
+    with pytest.raises(bs.InputError, match="grade"):
+        cables.build_strand([cables.Layer(0.5)], length=20.0, E=2e5, grade="1770")   # N, mm: no SI
+    with pytest.raises(bs.InputError, match="grade"):
+        cables.build_strand([cables.Layer(0.5e-3)], length=0.02, E=E, grade="steel")
