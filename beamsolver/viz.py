@@ -21,7 +21,8 @@ from .io.lines import FORCE_NAMES, LineLayout
 
 __all__ = ["render", "plot_history", "FIELDS"]
 
-FIELDS = ("displacement", "beam_id", "radius") + FORCE_NAMES + ("strain",)
+CELL_FIELDS = FORCE_NAMES + ("strain", "equivalent_strain", "utilisation")
+FIELDS = ("displacement", "beam_id", "radius") + CELL_FIELDS
 
 
 def _pyvista():
@@ -56,7 +57,7 @@ def _lines(pv, solution, step, refine):
     # segment values onto points: mean of the (one or two) segments meeting at a point
     acc, cnt = {}, np.zeros(lay.n_points)
     np.add.at(cnt, lay.segments.ravel(), 1.0)
-    for name in FORCE_NAMES + ("strain",):
+    for name in CELL_FIELDS:
         v = cdata[name]
         a = np.zeros((lay.n_points,) + v.shape[1:])
         np.add.at(a, lay.segments[:, 0], v)

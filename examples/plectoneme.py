@@ -1,8 +1,10 @@
 """The twisted pair twisted on past Greenhill's torque: the two-ply writhes into a plectoneme loop.
 
-The scene is the main job's (``examples/twisted_pair.py``: two steel wires of radius
-``R = 0.5 mm``, 20 mm long, clamped below, their upper ends rigidly linked to a plate turned
-about ``e_z`` under a 5 N dead pull, Coulomb friction ``mu = 0.3``) with two additions:
+The scene is the 20 mm benchmark's (``examples/twisted_pair_extreme.py``, the main job until
+issue 32; linear elastic, no yield limit: surface strains far beyond steel's range, a
+mathematical benchmark like it): two wires of radius ``R = 0.5 mm``, 20 mm long, clamped
+below, their upper ends rigidly linked to a plate turned about ``e_z`` under a 5 N dead
+pull, Coulomb friction ``mu = 0.3``, with two additions:
 
 - a small imperfection: a dead lateral force of ``imperfection`` times the pull on the
   mid-node of each wire, so that the pair leaves the straight (unstable) two-ply;
