@@ -473,6 +473,28 @@ class Solution:
         return _utilisation(self.strains[self._step(step)], self.description["eps0"],
                             _properties(self.description))[1]
 
+    def material_summary(self):
+        """One line: the largest equivalent surface strain over all steps and elements, where it
+        occurs, and the largest utilisation of the sections given a limit (``material_range``)."""
+        d = self.description
+        props = _properties(d)
+        eq, u = _utilisation(self.strains, d["eps0"], props)
+        if eq.size == 0:
+            return "material range: no elements"
+        k, e = np.unravel_index(int(np.argmax(eq)), eq.shape)
+        b = int(d["element_beam"][e])
+        name = str(d["beam_name"][b]) or f"beam {b}"
+        first = int(np.flatnonzero(np.asarray(d["element_beam"]) == b)[0])
+        text = (f"material range: largest equivalent surface strain {eq[k, e]:.3g} ({name!r} element "
+                f"{e - first}, step {k})")
+        limited = np.isfinite(props[3]) | np.isfinite(props[4])
+        if limited.any():
+            um = float(u[:, limited].max())
+            text += f"; utilisation of the sections' limits up to {um:.3g} ({'within' if um <= 1 else 'BEYOND'} range)"
+        else:
+            text += "; no section has a limit"
+        return text
+
     def modes(self, step=-1):
         """``(eigenvalues (k,), modes (k, n_nodes, 6))`` recorded at ``step`` by ``solve(modes=k)``:
         the lowest eigenvalues of the scaled tangent and each mode's global displacement and

@@ -294,6 +294,7 @@ def main(output=None, turns=5.0, steps=40, n_elements=16, mu=0.3, stabilize=2e-2
           f"Newton iterations "
           f"{int(sol.iterations.sum())}; writhe at the end {rows[-1].writhe_fraction:.1%} of Lk")
     print(f"Lk = Tw + Wr: largest |Lk - Tw - Wr| / Lk {worst:.2e} ({'within' if worst <= 0.02 else 'NOT within'} 2 %)")
+    print(f"{sol.material_summary()} (linear elastic, a mathematical benchmark)")
     print(f"onset of writhing at {tw_c:.3f} turns, torque {m_c:.4g} N m: M L / B = {checks['onset_ratio']:.2f} "
           f"(B = 2 E I; Greenhill clamped-clamped {GREENHILL}, the pair's frictionless tangent 8.36)")
     if output is not None:

@@ -137,3 +137,12 @@ def test_strand_of_a_named_grade_gets_its_proof_stress():
         cables.build_strand([cables.Layer(0.5)], length=20.0, E=2e5, grade="1770")   # N, mm: no SI
     with pytest.raises(bs.InputError, match="grade"):
         cables.build_strand([cables.Layer(0.5e-3)], length=0.02, E=E, grade="steel")
+
+
+def test_material_summary_names_the_worst_element():
+    sol = cantilever(force=(0, 0.5, 0), steps=2, yield_stress=1e9)
+    text = sol.material_summary()
+    eq = sol.equivalent_strain(-1)
+    assert f"{eq.max():.3g} ('arm' element 0, step 2)" in text
+    assert f"up to {sol.utilisation(-1).max():.3g} (within range)" in text
+    assert "no section has a limit" in cantilever(moment=(1.0, 0, 0), steps=1).material_summary()
