@@ -215,8 +215,9 @@ def main(output=None, turns=2.0, steps=16, n_elements=16, mu=0.3, length=1.0, pu
         try:
             from beamsolver import viz
             png = f"{output}/twisted_pair.png"
-            viz.render(sol, step=-1, path=png, color_by="utilisation")
-            print(f"picture: {png}")
+            viz.render(sol, step=-1, path=png, color_by="utilisation", scale=(1, 1, 0.02), view="xz",
+                       window_size=(560, 720))
+            print(f"picture: {png} (the axis squeezed 50 times to show the lay)")
         except ImportError:
             print("picture: install the [viz] extra (pyvista) to render one")
         except Exception as exc:          # a picture must never fail the run
