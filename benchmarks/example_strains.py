@@ -26,7 +26,7 @@ MATERIAL = {        # what each example's docstring states, in a few words
     "twisted_pair": "steel wire grade 1770, yield 1416 MPa",
     "twisted_pair_extreme": "elastic rod, steel moduli, no limit (benchmark)",
     "plectoneme": "elastic rod, steel moduli, no limit (benchmark)",
-    "three_wires": "steel wire grade 1770, yield 1416 MPa",
+    "three_wires": "elastic rod, steel moduli, no limit (contact test)",
     "seven_wire_strand": "steel wire grade 1770, yield 1416 MPa",
     "strand_sweep": "steel wire grade 1770, yield 1416 MPa",
     "bend45": "dimensionless benchmark (E = 1e7), no limit",

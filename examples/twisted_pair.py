@@ -13,7 +13,7 @@ element lengths, Abaqus' default penalty friction).
 
 Material range: a twisted touching wire has a surface shear strain of about
 ``sin(theta) = R Phi / L`` (docs/theory_twoply.md), so a steel two-ply twisted
-elastically needs ``L / R`` above about 2000 for two turns: here the largest
+elastically needs ``L / R`` above about 1300 for two turns; at 2000 here the largest
 von Mises surface stress is 64 % of the yield stress (printed; the sections
 carry ``yield_stress`` and the solver would warn, ``bs.MaterialRangeWarning``).
 Real ropes are preformed (their wires laid plastically into helices); the
