@@ -30,7 +30,7 @@ from .validation import count, real
 __all__ = ["Layer", "Strand", "build_strand", "fibre_stiffness", "rod_stiffness", "steel_yield_stress",
            "PROOF_FRACTION"]
 
-PROOF_FRACTION = 0.8     # 0.2 % proof stress of cold-drawn steel wire / its grade's tensile strength (docs/theory_material_range.md)
+PROOF_FRACTION = 0.8     # 0.2 % proof stress / tensile strength of cold-drawn wire (docs/theory_material_range.md)
 
 
 def steel_yield_stress(grade, E, owner="build_strand"):

@@ -37,8 +37,8 @@ def run(n_elements, mu, turns=2.0, steps=16):
     return (sol.reaction(plate, -1)[5], theta, dz, vm, int(sol.iterations.sum()), wall)
 
 
-def richardson(h, v):
-    """Extrapolated value and observed order from the three finest ``(h, v)`` (h halving)."""
+def richardson(v):
+    """Extrapolated value and observed order from the three finest values ``v`` (element size halving)."""
     d1, d2 = v[-2] - v[-3], v[-1] - v[-2]
     if d1 == 0 or d2 == 0 or d1 / d2 <= 1:
         return v[-1], np.nan
@@ -62,10 +62,9 @@ def main(elements=(8, 16, 32, 64, 128), mus=(0.0, 0.3)):
             rel = [x / r - 1 for x, r in zip(v, ref)]
             print(f"| {mu:g} | {n} | " + " | ".join(f"{e:+.2e}" for e in rel) + f" | {it} | {wall:.2f} |")
         if len(elements) >= 3:
-            h = 1.0 / np.asarray(elements, dtype=float)
-            ext = [richardson(h, np.array(vals)[:, j]) for j in range(len(QUANTITIES))]
-            print(f"| {mu:g} | extrapolated | " + " | ".join(f"{x / r - 1:+.2e} (p {p:.1f})" for (x, p), r in zip(ext, ref))
-                  + " | | |")
+            ext = [richardson(np.array(vals)[:, j]) for j in range(len(QUANTITIES))]
+            cells = [f"{x / r - 1:+.2e} (p {p:.1f})" for (x, p), r in zip(ext, ref)]
+            print(f"| {mu:g} | extrapolated | " + " | ".join(cells) + " | | |")
 
 
 if __name__ == "__main__":

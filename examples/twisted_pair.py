@@ -85,7 +85,8 @@ def closed_form(phi, radius=0.5e-3, length=1.0, pull=500.0, E=200e9, nu=0.3):
         sin = radius * k / (1 + tw / (E * A))
         cos = np.sqrt(1 - sin**2)
     k_t, k_b = k * cos, k * sin                       # twist and curvature per reference length
-    per_wire = tw * radius * sin + C * k_t * cos + B * k_b * sin + (B - C) * radius * k_b * k_t * cos / (1 + tw / (E * A))
+    per_wire = (tw * radius * sin + C * k_t * cos + B * k_b * sin
+                + (B - C) * radius * k_b * k_t * cos / (1 + tw / (E * A)))
     sigma = tw / A + E * radius * k_b
     tau = G * radius * k_t
     return dict(ply_angle=np.arcsin(sin), torque=2 * per_wire, torque_small=(2 * C + pull * radius**2) * k,
@@ -168,7 +169,8 @@ def summary(sol, model, plate, beams, turns, scene):
         f"(closed form {cf['torque']:.5g}, {torque / cf['torque'] - 1:+.2%}; (2 C + T R^2) Phi / L = "
         f"{cf['torque_small']:.5g}); shortening {z * 1e6:.4g} um (closed form L (1 - cos theta) = "
         f"{cf['shortening'] * 1e6:.4g} um, {z / cf['shortening'] - 1:+.1%})",
-        f"material: largest equivalent surface strain {eq.max():.3e}, von Mises stress {eq.max() * sec.E / 1e6:.0f} MPa "
+        f"material: largest equivalent surface strain {eq.max():.3e}, "
+        f"von Mises stress {eq.max() * sec.E / 1e6:.0f} MPa "
         f"(closed form {cf['von_mises'] / 1e6:.0f} MPa) = {u.max():.2f} of the yield stress "
         f"{sec.yield_stress / 1e6:.0f} MPa: {'within' if u.max() <= 1 else 'BEYOND'} the elastic range; "
         f"largest penetration {pen:.2e} m ({pen / sec.radius:.1%} of R)",

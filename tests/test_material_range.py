@@ -112,7 +112,8 @@ def test_archive_without_material_keys_uses_the_radius():
     assert np.all(np.isinf(sy)) and np.all(np.isinf(ey))
 
 
-@pytest.mark.parametrize("kw, word", [(dict(yield_stress=-1.0), "yield_stress"), (dict(yield_strain=0.0), "yield_strain"),
+@pytest.mark.parametrize("kw, word", [(dict(yield_stress=-1.0), "yield_stress"),
+                                      (dict(yield_strain=0.0), "yield_strain"),
                                       (dict(yield_stress=1e9, yield_strain=1e-2), "not both")])
 def test_bad_limits_are_named(kw, word):
     with pytest.raises(bs.InputError, match=word):
