@@ -21,7 +21,7 @@ Real ropes are preformed (their wires laid plastically into helices); the
 mathematical benchmark.
 
 The summary checks the model against the two-ply's closed forms
-(docs/theory_twoply.md; Love 1927 section 270, Costello 1997 ch. 2): ply angle
+(docs/theory_twoply.md, after Love 1927 and Costello 1997): ply angle
 ``sin(theta) = R Phi / (lambda L)``, torque ``2 (C Phi cos(theta) / L + T_w R
 sin(theta)) + O(theta^3)``, about ``(2 C + T R^2) Phi / L``, and shortening
 ``L (1 - cos(theta))``; and the stability of the path with ``bs.linearize``: under
