@@ -147,3 +147,17 @@ def test_material_summary_names_the_worst_element():
     assert f"{eq.max():.3g} ('arm' element 0, step 2)" in text
     assert f"up to {sol.utilisation(-1).max():.3g} (within range)" in text
     assert "no section has a limit" in cantilever(moment=(1.0, 0, 0), steps=1).material_summary()
+
+
+def test_arc_length_and_restart_check_their_steps_too(tmp_path):
+    """Both other ways a step is recorded (arc length, a restarted run) record the utilisation."""
+    model = bs.Model()
+    beam = model.add_beam(bs.geometry.straight((0, 0, 0), (L, 0, 0), 4),
+                          bs.Section.circular(radius=R, E=E, nu=NU, yield_strain=1.0), name="arm")
+    model.clamp(beam.first)
+    model.add_load(beam.last, moment=(2.0, 0, 0))
+    arc = bs.solve(model, steps=2, path="arc-length", verbose=False)
+    assert all("utilisation" in s for s in arc.stats[1:])
+    first = bs.solve(model, steps=4, t_end=0.5, output=tmp_path, verbose=False)
+    again = bs.solve(model, steps=4, t_end=1.0, restart=first, verbose=False)
+    assert again.stats[-1]["utilisation"] == pytest.approx(np.sqrt(3) * G / E * R * 2.0 / (G * J), rel=1e-9)
