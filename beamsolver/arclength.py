@@ -435,6 +435,8 @@ class ArcLengthRun(Run):
         for text in stats.get("warnings", ()):
             sol.message = text if not sol.message else sol.message + "; " + text
         stats["t"] = t
+        if self.range is not None:
+            self.range.check(ev.state.strain, stats, len(sol))
         sol.append(t, H, sys.reactions(H, ev.r), ev.state.sigma, ev.state.strain, stats, record)
         sol.resume = self._resume()
         ds = next_arc_length(self.ds, stats["iterations"], self.arc.target_iterations, stats["cutbacks"] > 0,

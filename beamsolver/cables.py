@@ -27,7 +27,27 @@ from .model import Model
 from .section import Section
 from .validation import count, real
 
-__all__ = ["Layer", "Strand", "build_strand", "fibre_stiffness", "rod_stiffness"]
+__all__ = ["Layer", "Strand", "build_strand", "fibre_stiffness", "rod_stiffness", "steel_yield_stress",
+           "PROOF_FRACTION"]
+
+PROOF_FRACTION = 0.8     # 0.2 % proof stress / tensile strength of cold-drawn wire (docs/theory_material_range.md)
+
+
+def steel_yield_stress(grade, E, owner="build_strand"):
+    """Yield (0.2 % proof) stress [Pa] of steel wire of ``grade`` (its tensile strength in MPa, e.g.
+    ``"1770"``; EN 12385-4 grades 1570, 1770, 1960, 2160): ``PROOF_FRACTION`` times the tensile
+    strength.  SI units only: ``E`` [Pa] must be a steel's (between 1e11 and 3e11)."""
+    try:
+        rm = float(grade)
+    except (TypeError, ValueError):
+        raise InputError(f"{owner}: grade must be a steel wire's tensile strength in MPa such as '1770', "
+                         f"got {grade!r}") from None
+    if not 300.0 <= rm <= 3500.0:
+        raise InputError(f"{owner}: grade {grade!r} is not a steel wire's tensile strength in MPa (300-3500)")
+    if not 1e11 <= float(E) <= 3e11:
+        raise InputError(f"{owner}: grade {grade!r} sets a yield stress in Pa, but E = {E!r} is not a steel's "
+                         f"Young's modulus in Pa; give yield_stress in your units instead")
+    return PROOF_FRACTION * rm * 1e6
 
 
 @dataclass
@@ -100,14 +120,22 @@ def _lay(layer, r):
 
 
 def build_strand(layers, length, E, nu=0.3, elements_per_lay=24, min_elements=8, mu=0.0,
-                 contact=True, touch_tol=0.05, model=None, contact_options=None):
-    """Build the wires of a straight strand into ``model`` (a new one by default); returns a ``Strand``."""
+                 contact=True, touch_tol=0.05, model=None, contact_options=None, grade=None, yield_stress=None):
+    """Build the wires of a straight strand into ``model`` (a new one by default); returns a ``Strand``.
+
+    Material range of the wires' sections (``Section(yield_stress=)``): ``yield_stress`` in the
+    user's units, or ``grade``, a steel wire's tensile strength in MPa (``"1770"``; SI units,
+    ``steel_yield_stress``); neither: no limit."""
     if not layers:
         raise InputError("build_strand: need at least one layer")
     length = real(length, "length", "build_strand", above=0.0)
     elements_per_lay = count(elements_per_lay, "elements_per_lay", "build_strand")
     min_elements = count(min_elements, "min_elements", "build_strand")
     touch_tol = real(touch_tol, "touch_tol", "build_strand")
+    if grade is not None and yield_stress is not None:
+        raise InputError(f"build_strand: give grade or yield_stress, not both (got {grade!r} and {yield_stress!r})")
+    if grade is not None:
+        yield_stress = steel_yield_stress(grade, E)
     model = Model() if model is None else model
     wires, radii, angles, lays = [], [], [], []
     r_prev, R_prev = None, None
@@ -126,7 +154,7 @@ def build_strand(layers, length, E, nu=0.3, elements_per_lay=24, min_elements=8,
         if layer.direction not in ("right", "left"):
             raise InputError(f"build_strand: layer {k} direction must be 'right' or 'left'")
         sign = 1.0 if layer.direction == "right" else -1.0
-        sec = Section.circular(radius=R, E=E, nu=nu, name=f"layer {k}")
+        sec = Section.circular(radius=R, E=E, nu=nu, name=f"layer {k}", yield_stress=yield_stress)
         layer_wires = []
         for i in range(n_wires):
             if r == 0.0:

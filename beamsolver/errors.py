@@ -1,6 +1,6 @@
 """Exceptions raised by beamsolver."""
 
-__all__ = ["InputError", "ConvergenceError", "StabilityWarning", "StabilizationWarning"]
+__all__ = ["InputError", "ConvergenceError", "StabilityWarning", "StabilizationWarning", "MaterialRangeWarning"]
 
 
 class InputError(ValueError):
@@ -23,3 +23,8 @@ class StabilityWarning(RuntimeWarning):
 
 class StabilizationWarning(RuntimeWarning):
     """The viscous stabilisation has dissipated a large part of the strain energy: see ``solve(stabilize=)``."""
+
+
+class MaterialRangeWarning(UserWarning):
+    """A section is used beyond the yield stress or strain it was given (``Section(yield_stress=)``):
+    the linear-elastic answer is no longer the material's (``beamsolver.material_range``)."""

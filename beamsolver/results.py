@@ -12,6 +12,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import InputError
+from .material_range import element_properties as _properties
+from .material_range import utilisation as _utilisation
 from .solution_file import read as _read_file
 from .solution_file import save as _save_file
 
@@ -40,7 +42,9 @@ def describe_model(model, system=None):
     ``poses0`` (n, 4, 4); ``enodes`` (n_el, 2); ``L`` (n_el,); ``eps0`` (n_el, 6);
     ``element_beam`` (n_el,); ``node_beam`` (n,) (-1 for nodes of ``add_node``);
     ``beam_first_node``, ``beam_n_nodes``, ``beam_radius`` (n_beams,); ``beam_C``
-    (n_beams, 6, 6); ``beam_name`` (str); ``constrained_nodes`` and
+    (n_beams, 6, 6); ``beam_E``, ``beam_G`` (moduli), ``beam_yield_stress``,
+    ``beam_yield_strain`` (n_beams,) (inf: no limit; ``material_range``);
+    ``beam_name`` (str); ``constrained_nodes`` and
     ``constraint_kind`` ('clamp', 'fix' or 'prescribe'); ``load_nodes``;
     ``joins`` (k, 2); ``n_contact_declarations``; ``beam_element`` (n_beams,) element type names
     (``elements.TYPES``; element ``j`` of a beam with ``k``-node elements has its nodes
@@ -66,6 +70,10 @@ def describe_model(model, system=None):
         beam_n_nodes=np.array([len(b.nodes) for b in beams], dtype=np.int64),
         beam_radius=np.array([b.section.radius for b in beams], dtype=float),
         beam_C=np.array([b.section.C for b in beams], dtype=float).reshape(-1, 6, 6),
+        beam_E=np.array([b.section.E for b in beams], dtype=float),
+        beam_G=np.array([b.section.G for b in beams], dtype=float),
+        beam_yield_stress=np.array([_limit(b.section.yield_stress) for b in beams], dtype=float),
+        beam_yield_strain=np.array([_limit(b.section.yield_strain) for b in beams], dtype=float),
         beam_name=np.array([b.name or "" for b in beams], dtype=str),
         beam_element=np.array([b.element_type.name for b in beams], dtype=str),
         constrained_nodes=np.array([c[0] for c in cons], dtype=np.int64),
@@ -73,6 +81,10 @@ def describe_model(model, system=None):
         load_nodes=np.array([ld.node for ld in model.loads], dtype=np.int64),
         joins=np.array(model.joins, dtype=np.int64).reshape(-1, 2),
         n_contact_declarations=np.int64(len(model.contacts)))
+
+
+def _limit(value):
+    return np.inf if value is None else value
 
 
 @dataclass(frozen=True)
@@ -447,6 +459,41 @@ class Solution:
     def contact(self, step=-1):
         """Per active contact point: dict of arrays (empty when the scene has no contact)."""
         return self.contacts[self._step(step)]
+
+    def equivalent_strain(self, step=-1):
+        """Largest von Mises equivalent surface strain ``(n_el,)`` of every element at ``step``
+        (axial, bending, torsion and transverse shear; ``beamsolver.material_range``)."""
+        return _utilisation(self.strains[self._step(step)], self.description["eps0"],
+                            _properties(self.description))[0]
+
+    def utilisation(self, step=-1):
+        """Utilisation ``(n_el,)`` of every element at ``step``: von Mises surface stress over the
+        section's ``yield_stress``, or equivalent strain over its ``yield_strain``, or the
+        equivalent strain itself for a section without a limit (``beamsolver.material_range``)."""
+        return _utilisation(self.strains[self._step(step)], self.description["eps0"],
+                            _properties(self.description))[1]
+
+    def material_summary(self):
+        """One line: the largest equivalent surface strain over all steps and elements, where it
+        occurs, and the largest utilisation of the sections given a limit (``material_range``)."""
+        d = self.description
+        props = _properties(d)
+        eq, u = _utilisation(self.strains, d["eps0"], props)
+        if eq.size == 0:
+            return "material range: no elements"
+        k, e = np.unravel_index(int(np.argmax(eq)), eq.shape)
+        b = int(d["element_beam"][e])
+        name = str(d["beam_name"][b]) or f"beam {b}"
+        first = int(np.flatnonzero(np.asarray(d["element_beam"]) == b)[0])
+        text = (f"material range: largest equivalent surface strain {eq[k, e]:.3g} ({name!r} element "
+                f"{e - first}, step {k})")
+        limited = np.isfinite(props[3]) | np.isfinite(props[4])
+        if limited.any():
+            um = float(u[:, limited].max())
+            text += f"; utilisation of the sections' limits up to {um:.3g} ({'within' if um <= 1 else 'BEYOND'} range)"
+        else:
+            text += "; no section has a limit"
+        return text
 
     def modes(self, step=-1):
         """``(eigenvalues (k,), modes (k, n_nodes, 6))`` recorded at ``step`` by ``solve(modes=k)``:

@@ -29,7 +29,8 @@ from .definiteness import negative_eigenvalues
 from .errors import ConvergenceError, InputError, StabilityWarning
 from .failures import AugmentationFailed, MotionTooFast, NonFinite, StepFailed
 from .progress import Progress
-from .results import Solution
+from .material_range import RangeCheck
+from .results import Solution, describe_model
 
 __all__ = ["Run", "growth", "easy_limit", "next_step", "after_failure", "STEP_TOLERANCE", "EASY_ITERATIONS", "WAIT_MAX",
            "STEP_ZERO_ITERATIONS"]
@@ -94,6 +95,7 @@ class Run:
         self.sol = None
         self.progress = None
         self.warned_unstable = False
+        self.range = None             # material_range.RangeCheck: sections with a yield limit only
 
     # ------------------------------------------------------------------ start
     def start(self, restart_solution, initial_poses):
@@ -103,10 +105,12 @@ class Run:
         self.failed, self.wait, self.reference = np.inf, EASY_RUN, None
         if restart_solution is None:
             self.sol = Solution(sys.model, sys)
+            self.range = RangeCheck.of(self.sol.description)
             H0 = sys.poses0.copy() if initial_poses is None else np.array(initial_poses, dtype=float)
             self._step_zero(H0, t_start)
         else:
             self.sol = sol = restart_solution
+            self.range = RangeCheck.of(describe_model(sys.model, sys))
             self.H = sol.poses[-1].copy()
             self.t = float(sol.times[-1])
             self.k = int(np.searchsorted(grid, self.t + 1e-12 * self.dt_user, side="right"))
@@ -171,6 +175,8 @@ class Run:
             if problem.contributions:
                 self.sol.contact_state = problem.get_state()
         self._check_finite(H, ev0.r, ev0.state, t_start)
+        if self.range is not None:
+            self.range.check(ev0.state.strain, stats, 0)
         self.sol.append(t_start, H, sys.reactions(H, ev0.r), ev0.state.sigma, ev0.state.strain, stats, record)
         self.H = H
         if self.writer is not None:
@@ -291,6 +297,8 @@ class Run:
         dt = min(dt, self.dt_user)
         if problem.contributions:
             sol.contact_state = problem.get_state()
+        if self.range is not None:
+            self.range.check(ev.state.strain, stats, len(sol))
         sol.append(t_next, H, sys.reactions(H, ev.r), ev.state.sigma, ev.state.strain, stats, record)
         sol.resume = dict(t0=float(self.grid[0]), t_end=float(self.grid[-1]), steps=len(self.grid) - 1,
                           dt=float(dt), easy=int(easy), **self._memory_state())

@@ -21,7 +21,8 @@ from .io.lines import FORCE_NAMES, LineLayout
 
 __all__ = ["render", "plot_history", "FIELDS"]
 
-FIELDS = ("displacement", "beam_id", "radius") + FORCE_NAMES + ("strain",)
+CELL_FIELDS = FORCE_NAMES + ("strain", "equivalent_strain", "utilisation")
+FIELDS = ("displacement", "beam_id", "radius") + CELL_FIELDS
 
 
 def _pyvista():
@@ -56,7 +57,7 @@ def _lines(pv, solution, step, refine):
     # segment values onto points: mean of the (one or two) segments meeting at a point
     acc, cnt = {}, np.zeros(lay.n_points)
     np.add.at(cnt, lay.segments.ravel(), 1.0)
-    for name in FORCE_NAMES + ("strain",):
+    for name in CELL_FIELDS:
         v = cdata[name]
         a = np.zeros((lay.n_points,) + v.shape[1:])
         np.add.at(a, lay.segments[:, 0], v)
@@ -94,7 +95,7 @@ def _scalars(poly, color_by, component):
 
 def render(solution, step=-1, path=None, color_by="displacement", component=None,
            window_size=(800, 600), refine=8, n_sides=24, view="auto", zoom=1.0, contacts=True,
-           cmap="viridis", background="white", show_edges=False):
+           cmap="viridis", background="white", show_edges=False, scale=None):
     """Draw the beams of ``step`` as tubes of their section radii; returns the image ``(h, w, 3)``.
 
     ``step``: a step index or a list of them (drawn together, one colour
@@ -104,9 +105,15 @@ def render(solution, step=-1, path=None, color_by="displacement", component=None
     vectors are drawn by magnitude unless ``component`` is given.  ``view``:
     ``"auto"`` (looks along the normal of a flat scene, else isometric),
     ``"xy"``, ``"xz"``, ``"yz"`` or ``"iso"``; ``zoom`` > 1 magnifies.
-    ``contacts``: draw the active contact points as red spheres.
+    ``contacts``: draw the active contact points as red spheres.  ``scale``: factors
+    ``(sx, sy, sz)`` stretching the drawing along x, y, z (e.g. ``(1, 1, 0.04)`` to see the lay of a
+    long thin cable; say so in the caption), default none.
     """
     _folder_for(path, "render")
+    if scale is not None:
+        scale = np.asarray(scale, dtype=float)
+        if scale.shape != (3,) or not np.all(np.isfinite(scale) & (scale > 0)):
+            raise ValueError(f"render: scale must be three positive numbers, got {scale.tolist()!r}")
     pv = _pyvista()
     n = len(solution)
     steps = [step] if np.ndim(step) == 0 else list(step)
@@ -130,6 +137,8 @@ def render(solution, step=-1, path=None, color_by="displacement", component=None
         kw.update(scalars=scalars, cmap=cmap, clim=(lo, hi))
     for j, (k, poly) in enumerate(zip(steps, polys)):
         tubes = poly.tube(scalars="radius", absolute=True, n_sides=n_sides, capping=True)
+        if scale is not None:
+            tubes.points = tubes.points * scale
         if scalars is None:
             plotter.add_mesh(tubes, color="lightsteelblue", **kw)
         else:
@@ -141,10 +150,10 @@ def render(solution, step=-1, path=None, color_by="displacement", component=None
         table = solution.contacts[k] if contacts else {}
         active = np.asarray(table.get("normal_force", np.zeros(0))) > 0
         if active.any():
-            pts = pv.PolyData(np.asarray(table["position"])[active])
+            pts = pv.PolyData(np.asarray(table["position"])[active] * (1.0 if scale is None else scale))
             r = float(np.min(solution.description["beam_radius"]))
             plotter.add_mesh(pts.glyph(geom=pv.Sphere(radius=r), scale=False, orient=False), color="red")
-    _set_view(plotter, np.concatenate([p.points for p in polys]), view)
+    _set_view(plotter, np.concatenate([p.points for p in polys]) * (1.0 if scale is None else scale), view)
     if zoom != 1.0:
         plotter.camera.zoom(zoom)
     img = plotter.screenshot(str(path) if path is not None else None, return_img=True)

@@ -6,7 +6,7 @@ contact, friction on, history stored) and prints
 
 - whether the outputs are the same bits (forces, tangent with the signs of its zeros, point data),
 - the largest relative deviation of forces and tangent (max abs difference / max abs value of the
-  batch) on that scene and on the contact points of a short run of ``examples/twisted_pair.py``
+  batch) on that scene and on the contact points of a short run of ``examples/twisted_pair_extreme.py``
   (half a turn in 4 steps: twisted wires, sliding and sticking points, every kernel call of the run),
   and whether it is within ``tol`` (a kernel that may change round-off),
 - the kernel + tangent time per point of each (least CPU time of ``repeats`` alternating calls:
@@ -65,7 +65,7 @@ def twisted_pair_calls(turns=0.5, steps=4):
     sys.path.insert(0, str(ROOT / "examples"))
     import beamsolver as bs
     from beamsolver.contact import system
-    from twisted_pair import build
+    from twisted_pair_extreme import build
     calls, compiled = [], system.kernel_and_tangent
 
     def record(X, p, friction=True, **kw):

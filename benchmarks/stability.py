@@ -461,7 +461,7 @@ def case_long_slide(mu=0.3, U=0.8):
 
 # ----------------------------------------------------------------- cables
 def case_twisted_pair(turns=5.0, steps=40):
-    import twisted_pair as tp
+    import twisted_pair_extreme as tp
     model, plate, _ = tp.build(turns=turns, n_elements=16, mu=0.3)
     t0 = time.perf_counter()
     try:

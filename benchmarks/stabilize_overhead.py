@@ -45,8 +45,8 @@ def joined(n):
 
 
 def pair(n):
-    """The main job's twisted pair (``examples/twisted_pair.py``) to 1 turn, below its instability."""
-    import twisted_pair as tp
+    """The 20 mm twisted pair (``examples/twisted_pair_extreme.py``) to 1 turn, below its instability."""
+    import twisted_pair_extreme as tp
     m, plate, _ = tp.build(n_elements=n, turns=1.0)
     return m, lambda sol: np.array([sol.reaction(plate)[5]])
 

@@ -14,7 +14,7 @@ Writes the ``touching_defaults`` section of ``docs/benchmarks.md`` with the full
 arguments (``--elements 24 --turns 1 --steps 8 --length 0.03``).
 
 ``--start`` measures instead the first state of touching wires with the example's options
-(``examples/twisted_pair.py``: two wires, smoothing ``1e-3 (R1 + R2)``; ``examples/three_wires.py``:
+(``examples/twisted_pair_extreme.py``: two wires, smoothing ``1e-3 (R1 + R2)``; ``examples/three_wires.py``:
 the default), a 5 N pull on from t = 0, for lengths up to 0.2 m: Newton iterations of step 0
 (budget ``stepping.STEP_ZERO_ITERATIONS`` x 30), the contact force and the largest gap between
 the wires there (the smoothed law pushes touching points apart), then half a turn in 4 steps
@@ -39,7 +39,7 @@ import numpy as np  # noqa: E402
 
 import beamsolver as bs  # noqa: E402
 import three_wires  # noqa: E402
-import twisted_pair  # noqa: E402
+import twisted_pair_extreme as twisted_pair  # noqa: E402
 from beamsolver.stepping import STEP_ZERO_ITERATIONS  # noqa: E402
 
 R = 0.5e-3
@@ -133,7 +133,7 @@ def start(twist=True, write=True):
 
 `python benchmarks/touching_defaults.py --start{'' if twist else ' --no-twist'}` ({machine()}).  Straight
 steel wires (R = 0.5 mm) touching along their length with the examples' contact options
-(`pair`: `examples/twisted_pair.py`, smoothing `1e-3 (R1 + R2)`; `three`: `examples/three_wires.py`,
+(`pair`: `examples/twisted_pair_extreme.py`, smoothing `1e-3 (R1 + R2)`; `three`: `examples/three_wires.py`,
 the default), clamped below, rigidly joined to a plate under a 5 N pull from t = 0; then half a turn
 in 4 steps.  Step 0 has {STEP_ZERO_ITERATIONS} x `max_iter` Newton iterations (no cut-back there).
 The smoothed law pushes touching points apart (`eps_N w / 4` per unit length at gap 0), so the first

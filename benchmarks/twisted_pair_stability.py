@@ -1,6 +1,6 @@
 """Where the twisted pair becomes unstable, against Greenhill's limit of a twisted rod.
 
-The main job (``examples/twisted_pair.py``) reports the twist from which the
+The 20 mm pair (``examples/twisted_pair_extreme.py``, the main job until issue 32) reports the twist from which the
 frictionless tangent (``bs.linearize``) has a negative eigenvalue.  This script
 locates that crossing (the lowest eigenvalue interpolated linearly between
 steps) for
@@ -28,7 +28,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 
 import beamsolver as bs  # noqa: E402
-import twisted_pair  # noqa: E402
+import twisted_pair_extreme as twisted_pair  # noqa: E402
 
 R, L, E, NU = 0.5e-3, 0.02, 200e9, 0.3
 GREENHILL = 8.99          # M L / B of a clamped-clamped rod at the onset of buckling, no axial force

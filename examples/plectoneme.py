@@ -1,8 +1,10 @@
 """The twisted pair twisted on past Greenhill's torque: the two-ply writhes into a plectoneme loop.
 
-The scene is the main job's (``examples/twisted_pair.py``: two steel wires of radius
-``R = 0.5 mm``, 20 mm long, clamped below, their upper ends rigidly linked to a plate turned
-about ``e_z`` under a 5 N dead pull, Coulomb friction ``mu = 0.3``) with two additions:
+The scene is the 20 mm benchmark's (``examples/twisted_pair_extreme.py``, the main job until
+issue 32; linear elastic, no yield limit: surface strains far beyond steel's range, a
+mathematical benchmark like it): two wires of radius ``R = 0.5 mm``, 20 mm long, clamped
+below, their upper ends rigidly linked to a plate turned about ``e_z`` under a 5 N dead
+pull, Coulomb friction ``mu = 0.3``, with two additions:
 
 - a small imperfection: a dead lateral force of ``imperfection`` times the pull on the
   mid-node of each wire, so that the pair leaves the straight (unstable) two-ply;
@@ -292,6 +294,7 @@ def main(output=None, turns=5.0, steps=40, n_elements=16, mu=0.3, stabilize=2e-2
           f"Newton iterations "
           f"{int(sol.iterations.sum())}; writhe at the end {rows[-1].writhe_fraction:.1%} of Lk")
     print(f"Lk = Tw + Wr: largest |Lk - Tw - Wr| / Lk {worst:.2e} ({'within' if worst <= 0.02 else 'NOT within'} 2 %)")
+    print(f"{sol.material_summary()} (linear elastic, a mathematical benchmark)")
     print(f"onset of writhing at {tw_c:.3f} turns, torque {m_c:.4g} N m: M L / B = {checks['onset_ratio']:.2f} "
           f"(B = 2 E I; Greenhill clamped-clamped {GREENHILL}, the pair's frictionless tangent 8.36)")
     if output is not None:

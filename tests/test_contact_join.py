@@ -22,7 +22,7 @@ from beamsolver.problem import Problem
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 
-import twisted_pair  # noqa: E402
+import twisted_pair_extreme as twisted_pair  # noqa: E402
 
 R, L = 0.5e-3, 0.05
 

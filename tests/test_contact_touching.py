@@ -21,7 +21,7 @@ import beamsolver as bs
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 
 import three_wires  # noqa: E402
-import twisted_pair  # noqa: E402
+import twisted_pair_extreme as twisted_pair  # noqa: E402
 
 L, PULL = 0.1, 5.0
 

@@ -90,7 +90,7 @@ def _twisted_pair_tangent():
     import sys
     from pathlib import Path
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
-    import twisted_pair
+    import twisted_pair_extreme as twisted_pair
     from beamsolver import assembly_jit
     from beamsolver.problem import Problem
 
@@ -131,7 +131,7 @@ def test_solve_bit_identical_to_the_scipy_assembly(monkeypatch):
     import sys
     from pathlib import Path
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
-    import twisted_pair
+    import twisted_pair_extreme as twisted_pair
     import beamsolver as bs
     from beamsolver import assembly_jit
     from beamsolver.assembly import System
@@ -259,7 +259,7 @@ def test_system_matrix_as_the_active_set_changes():
     import sys
     from pathlib import Path
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
-    import twisted_pair
+    import twisted_pair_extreme as twisted_pair
     from beamsolver.assembly import System
     from beamsolver.extra_pattern import BlockPattern
 
@@ -321,7 +321,7 @@ def test_block_index_arrays_reused_only_when_free():
     import sys
     from pathlib import Path
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
-    import twisted_pair
+    import twisted_pair_extreme as twisted_pair
     from beamsolver.assembly import REUSE_BUFFERS, System
     from beamsolver.blocks import Blocks
 

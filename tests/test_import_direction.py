@@ -20,7 +20,7 @@ LAYER = {
     # 1: maths and geometry (Lie groups, sections, node poses, motions)
     "se3": 1, "se3_jit": 1, "section": 1, "geometry": 1, "motion": 1, "motion_path": 1, "definiteness": 1,
     "bandfactor": 1,
-    "modes": 1,
+    "modes": 1, "material_range": 1,
     # 2: element and contact kernels
     "element": 2, "element_jit": 2, "elements": 2, "elements.base": 2, "elements.se3_2": 2, "elements.se3_3": 2,
     "blocks": 2, "contact": 2, "contact.law": 2, "contact.kinematics": 2,

@@ -193,7 +193,7 @@ def test_compiled_rcm_is_scipys():
     E = sp.csc_matrix(sp.random(40, 40, density=0.05, random_state=rng).toarray() * (np.arange(40) % 5 != 0))
     mats.append(E)
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
-    import twisted_pair
+    import twisted_pair_extreme as twisted_pair
     from beamsolver.problem import Problem
     model, _, _ = twisted_pair.build(n_elements=8, turns=0.5)
     problem = Problem.from_model(model)

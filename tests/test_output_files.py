@@ -14,7 +14,7 @@ meshio = pytest.importorskip("meshio")
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 import crossing_beams  # noqa: E402
-import twisted_pair  # noqa: E402
+import twisted_pair_extreme as twisted_pair  # noqa: E402
 
 L, EI = 10.0, 1e2
 

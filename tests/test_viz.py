@@ -59,3 +59,24 @@ def test_plot_history_png(tmp_path, roll_up):
     np.testing.assert_allclose(line.get_ydata(), [sol.reaction(b.first, k)[5] for k in range(3)])
     fig = viz.plot_history(sol, ["iterations", lambda s, k: s.position(b.last, k)[1]])
     assert [len(a.lines) for a in fig.axes] == [1, 1]           # a count and a length: one axis each
+
+
+def test_render_by_utilisation_with_a_stretched_axis(roll_up):
+    """The material-range field colours the tubes; ``scale`` squeezes the drawing along one axis
+    (the roll-up is a circle in the x-y plane: squeezed along y by 10, its drawn height over its
+    width drops from about 1 to below 0.3)."""
+    pytest.importorskip("pyvista")
+    from beamsolver import viz
+    sol, _ = roll_up
+    img = viz.render(sol, color_by="utilisation", window_size=(160, 160))
+    assert (img != 255).any(axis=-1).mean() > 0.02
+
+    def aspect(im):
+        drawn = (im != 255).any(axis=-1)
+        rows, cols = np.flatnonzero(drawn.any(axis=1)), np.flatnonzero(drawn.any(axis=0))
+        return np.ptp(rows) / np.ptp(cols)
+    kw = dict(color_by=None, window_size=(200, 200), view="xy", contacts=False)
+    assert aspect(viz.render(sol, **kw)) > 0.8
+    assert aspect(viz.render(sol, scale=(1, 0.1, 1), **kw)) < 0.3
+    with pytest.raises(ValueError, match="scale"):
+        viz.render(sol, scale=(1, 0, 1), **kw)

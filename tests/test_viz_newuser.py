@@ -9,7 +9,7 @@ import beamsolver as bs
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 import crossing_beams  # noqa: E402
-import twisted_pair  # noqa: E402
+import twisted_pair_extreme as twisted_pair  # noqa: E402
 
 SIDES = 12
 

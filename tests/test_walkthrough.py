@@ -59,7 +59,8 @@ def test_main_job_script_export_and_render(tmp_path):
     out = run(EXAMPLES / "twisted_pair.py", "--output", "out", "--turns", "0.25", "--steps", "2",
               "--elements", "8", cwd=tmp_path)
     assert out.returncode == 0, out.stderr
-    assert "| 0.000 | 0 | 5 |" in out.stdout               # step 0 carries the constant 5 N pull
+    assert "| 0.000 | 0 | 0 | 500 | 0 |" in out.stdout     # step 0 carries the constant 500 N pull, no twist
+    assert "within the elastic range" in out.stdout and "stays positive definite" in out.stdout
     names = check_folder(tmp_path / "out")
     assert {"beams.pvd", "contact.pvd", "solution.npz", "twisted_pair.png"} <= names
     exp = run("-m", "beamsolver.cli", "export", "out", "again", cwd=tmp_path)

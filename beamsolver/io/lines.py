@@ -16,11 +16,14 @@ the columns of ``R``), ``radius`` (contact radius of the section, for tubes),
 ``N, Q2, Q3, T, M2, M3`` (section frame) and ``strain`` (6: ``Gamma_1..3,
 kappa_1..3`` minus the reference, so ``sigma = C strain`` and a beam at rest
 shows 0; ``Solution.strains`` is the strain itself, reference included:
-``strain = Solution.strains - eps0``), ``element``.
+``strain = Solution.strains - eps0``), ``equivalent_strain`` and ``utilisation``
+(``Solution.equivalent_strain``, ``Solution.utilisation``: the material range,
+``beamsolver.material_range``), ``element``.
 """
 import numpy as np
 
 from .. import elements
+from ..material_range import element_properties, utilisation
 
 __all__ = ["LineLayout", "FORCE_NAMES", "STRAIN_NAMES"]
 
@@ -68,6 +71,7 @@ class LineLayout:
         self.point_beam = pbeam
         self.point_radius = radius[pbeam]
         self.eps0 = np.asarray(d["eps0"], dtype=float)
+        self.material = element_properties(d)
         self.groups = self._groups(d)
         self.reference = self.poses(np.asarray(d["poses0"], dtype=float))[:, :3, 3]
 
@@ -123,5 +127,7 @@ class LineLayout:
         e = self.segment_el
         out = {name: np.ascontiguousarray(sigma[e, i]) for i, name in enumerate(FORCE_NAMES)}
         out["strain"] = np.ascontiguousarray((strain - self.eps0)[e])
+        eq, u = utilisation(strain, self.eps0, self.material)
+        out["equivalent_strain"], out["utilisation"] = eq[e], u[e]
         out["element"] = e.astype(np.int32)
         return out

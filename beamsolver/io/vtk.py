@@ -7,7 +7,8 @@ Files in the output folder (``solve(model, output=folder)``, or
   ``refine`` segments with the SE(3) interpolation (``io.lines``); point
   data ``displacement``, ``e1``, ``e2``, ``e3``, ``radius``, ``beam_id``;
   cell data ``N, Q2, Q3, T, M2, M3``, ``strain`` (6, minus the reference strain:
-  ``Solution.strains - eps0``, zero at rest), ``element``.
+  ``Solution.strains - eps0``, zero at rest), ``equivalent_strain`` and ``utilisation``
+  (the material range: ``Solution.utilisation``), ``element``.
 - ``contact_<k>.vtu`` (scenes with contact only): one vertex per active
   contact point (``normal_force > 0``; the candidates the search found open
   are left out, so a Glyph draws contacts only), with ``gap``,
