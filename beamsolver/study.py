@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import InputError
+from .files import follow_umask
 
 __all__ = ["points", "point_id", "point_ids", "FINAL", "RESERVED", "param_names", "table_columns", "write_json",
            "write_summary", "read_point", "is_complete", "is_study", "load_study", "report"]
@@ -132,6 +133,7 @@ def _atomic_text(path, text):
     path = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
+        follow_umask(fd)
         with os.fdopen(fd, "w", newline="") as f:
             f.write(text)
         os.replace(tmp, path)

@@ -47,12 +47,17 @@ def _model_of(built, where):
     return model, (built if isinstance(built, tuple) else (built,))
 
 
-def _scalars(values):
+def _scalars(values, params):
+    """The summary's ``values`` as table cells; a key named like a grid parameter of ``params`` (which
+    it would overwrite) or a reserved column, or a value that is not a scalar: ``TypeError``."""
     if not isinstance(values, dict):
         raise TypeError(f"summary must return a dict of scalars, got {type(values).__name__}")
     out = {}
     for k, v in values.items():
         v = study.plain(v)
+        if k in params:
+            raise TypeError(f"summary: entry {k!r} would overwrite the grid parameter {k!r} "
+                            "(give the summary entry another name)")
         if not isinstance(k, str) or k in study.RESERVED or not isinstance(v, (int, float, str, bool)):
             raise TypeError(f"summary: entry {k!r}: {v!r} is not a scalar under a free column name")
         out[k] = v
@@ -98,13 +103,13 @@ def run_point(code, params, pid, folder, options, paraview=False):
         row["message"] = str(e)
         if not isinstance(e, InputError):
             record["traceback"] = traceback.format_exc()
-    if sol is not None:
+    if sol is not None and len(sol):       # a point stopped at t_start has no step to count or save
         row["iterations"], row["steps"] = int(sol.iterations.sum()), int(sol.n_steps)
         if point is not None and not paraview:
             sol.save(point / "solution.npz")
     if row["status"] == "converged" and summary is not None:
         try:
-            row.update(_scalars(summary(sol, *built)))
+            row.update(_scalars(summary(sol, *built), params))
         except Exception as e:
             row["status"], row["message"] = type(e).__name__, f"summary: {e}"
             record["traceback"] = traceback.format_exc()
