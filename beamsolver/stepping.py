@@ -360,11 +360,15 @@ class Run:
         if self.writer is not None:
             try:
                 entries = getattr(self.writer, "entries", None)
-                if sol is not None and entries is not None and sol.n_steps not in entries:
+                if sol is not None and len(sol) and entries is not None and sol.n_steps not in entries:
                     self.writer.write(sol, sol.n_steps)
-                self.writer.close()
             except Exception as e:      # never hide the exception that ended the run
                 log.error("could not save the solution after %s: %s", type(exc).__name__, e)
+            finally:
+                try:
+                    self.writer.close()
+                except Exception as e:
+                    log.error("could not close the output after %s: %s", type(exc).__name__, e)
 
     def finish(self):
         self.progress.close()

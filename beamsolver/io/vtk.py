@@ -32,7 +32,9 @@ complete files, and ``.pvd`` files that list exactly the steps written.
 A writer first removes the numbered files its folder's ``beams.pvd`` and
 ``contact.pvd`` list (the previous run's series; nothing else; the collections at
 once, the files they listed in the writing thread before any new file), so ParaView
-never groups two runs.
+never groups two runs; a writer that saves ``solution.npz`` (``checkpoint`` not ``None``)
+also removes the previous one at once, so a run that fails before its first save leaves no
+other run's result behind.
 The VTU files are written by ``io.vtu`` (numpy and zlib; meshio's binary layout, read
 by meshio, pyvista and ParaView) with two-point ``line`` cells, which meshio reads (it
 cannot read VTK poly-lines, type 4); for smooth tubes ParaView joins them into
@@ -139,6 +141,8 @@ class StepWriter:
         stale = previous_series(self.folder, (f"{BEAMS}.pvd", f"{CONTACT}.pvd"), SERIES)
         for name in (f"{BEAMS}.pvd", f"{CONTACT}.pvd"):
             (self.folder / name).unlink(missing_ok=True)
+        if checkpoint is not None:     # this run's archive replaces the last one's, also when it saves nothing
+            (self.folder / ARCHIVE).unlink(missing_ok=True)
         self.refine = refine
         self.compression = compression
         if contact is None and system is not None:
