@@ -319,11 +319,27 @@ def _write_empty_points(path):
         f.write(text)
 
 
+def _steps(steps, n):
+    """The step numbers ``steps`` (a list of integers in ``-n .. n - 1``) as ``0 .. n - 1``; else ``InputError``."""
+    if isinstance(steps, (str, bytes)) or not hasattr(steps, "__iter__"):
+        raise InputError(f"write_vtk: steps must be a list of step numbers or None, got {steps!r}")
+    out = []
+    for k in steps:
+        if isinstance(k, (bool, np.bool_)) or not isinstance(k, (int, np.integer)):
+            raise InputError(f"write_vtk: steps must be integers, got {k!r} in {steps!r}")
+        if not -n <= k < n:
+            raise InputError(f"write_vtk: step {k} out of range (the solution has steps 0..{n - 1})")
+        out.append(int(k) % n)
+    return out
+
+
 def write_vtk(solution, folder, steps=None, refine=8, compression="zlib"):
-    """Write the steps (default all) of a (saved or fresh) ``solution`` to ``folder``; returns the .pvd path."""
-    writer = StepWriter(folder, None, refine=refine, compression=compression, checkpoint=None)
+    """Write the steps (default all; a list of step numbers, negative from the end) of a (saved or
+    fresh) ``solution`` to ``folder``; returns the .pvd path."""
     n = len(solution)
-    for k in (range(n) if steps is None else [s % n for s in steps]):
+    chosen = range(n) if steps is None else _steps(steps, n)
+    writer = StepWriter(folder, None, refine=refine, compression=compression, checkpoint=None)
+    for k in chosen:
         writer.write(solution, k)
     writer.close()
     return writer.folder / f"{BEAMS}.pvd"
