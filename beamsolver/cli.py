@@ -15,13 +15,16 @@
     ``--t-end`` override it.  Output (VTU/PVD and ``solution.npz``) goes to
     ``DIR`` (default: ``<script name>_output`` in the current directory).
     Exit status 0 when every step converged, 2 on ``ConvergenceError`` (the
-    converged steps are written), 1 on bad input, 130 on Ctrl-C (one line; the
-    converged steps are saved, ``--restart DIR`` continues).
+    converged steps are written), 3 when the run reached its end off equilibrium
+    (``Solution.status`` ``"off-equilibrium"``: a stabilised run whose damping still
+    carries load; written, with the reason on stderr), 1 on bad input, 130 on Ctrl-C
+    (one line; the converged steps are saved, ``--restart DIR`` continues).
 ``beamsolver info RESULT [--all]``
     ``RESULT``: a ``.npz`` file or an output folder.  Prints steps, Newton
     iterations, wall time, contact force, smallest gap / largest
     penetration per step and the reactions of the constrained nodes; the
-    status line says ``converged``, ``STOPPED`` (a ``ConvergenceError``) or
+    status line says ``converged``, ``STOPPED`` (a ``ConvergenceError``),
+    ``OFF-EQUILIBRIUM`` (the final state is not an equilibrium: ``Solution.status``) or
     ``stopped at t = ... of ...`` (a checkpoint of a run interrupted).
 ``beamsolver render RESULT [--step K] -o PNG [--color-by FIELD] [--size W H]``
     Draws the beams as tubes (needs ``beamsolver[viz]``).
@@ -117,6 +120,9 @@ def cmd_run(args):
         print(sol.summary())
         pvd = f"{out}/beams.pvd" + (f", {out}/contact.pvd" if model.contacts else "")
         print(f"written: {pvd} (ParaView), {out}/solution.npz")
+    if sol.status == "off-equilibrium":
+        print(f"beamsolver run: not an equilibrium: {sol.message}", file=sys.stderr)
+        return 3
     return 0
 
 
@@ -125,8 +131,10 @@ def _row(cells, widths):
 
 
 def _status(sol):
-    """``converged``, ``STOPPED: <why>`` or, for a run interrupted (Ctrl-C, a kill) after a
+    """``converged``, ``OFF-EQUILIBRIUM: <why>``, ``STOPPED: <why>`` or, for a run interrupted (Ctrl-C, a kill) after a
     checkpoint, ``stopped at t = ... of ...``."""
+    if sol.status == "off-equilibrium":
+        return f"OFF-EQUILIBRIUM: {sol.message}"
     if not sol.converged:
         return f"STOPPED: {sol.message}"
     t, t0, t_end = float(sol.times[-1]), float(sol.times[0]), sol.resume.get("t_end")

@@ -20,6 +20,8 @@ key                    content
 ``strains``            ``(s, n_el, 6)`` ``h / L`` per element
 ``stats``              JSON text: list of per-step dicts (``iterations``, ``residuals``, ...)
 ``converged``          bool; ``message`` the failure message (str)
+``off_equilibrium``    bool (optional: older files have none, read as False): the run reached its
+                       end off equilibrium (``Solution.status`` ``"off-equilibrium"``)
 ``resume``             JSON text: stepping state for ``solve(..., restart=)``
 ``model/<name>``       ``results.describe_model`` arrays (poses0, enodes, radii, ...)
 ``contact/<key>``      per-step contact tables, concatenated along axis 0, with
@@ -150,6 +152,7 @@ def save(solution, path):
                   section_forces=np.array(s.section_forces, dtype=float),
                   strains=np.array(s.strains, dtype=float),
                   stats=_dumps(s.stats), converged=np.bool_(s.converged),
+                  off_equilibrium=np.bool_(s.off_equilibrium),
                   message=np.array(str(s.message)), resume=_dumps(s.resume))
     for k, v in s.description.items():
         arrays[f"model/{k}"] = np.asarray(v)
@@ -247,7 +250,7 @@ def read(path):
     is not such an archive, or is truncated, corrupted or inconsistent, raises ``InputError``
     naming it and what is wrong (``check_archive``).  Keys: the arguments of
     ``Solution.from_steps``: ``description, times, poses, reactions, section_forces, strains,
-    stats, contacts, extra, converged, message, resume, contact_state``.
+    stats, contacts, extra, converged, message, resume, contact_state, off_equilibrium``.
     """
     path = _resolve(path)
     return _guarded(path, _read)
@@ -265,7 +268,7 @@ def _read(path):
     return dict(description=desc, times=times, poses=arrays["poses"], reactions=arrays["reactions"],
                 section_forces=arrays["section_forces"], strains=arrays["strains"], stats=arrays["stats"],
                 contacts=_unpack_tables(arrays, "contact", len(times)), extra=_unpack_values(arrays, len(times)),
-                converged=bool(arrays["converged"]),
+                converged=bool(arrays["converged"]), off_equilibrium=bool(arrays.get("off_equilibrium", False)),
                 message=str(arrays["message"]), resume=arrays["resume"],
                 contact_state={k[14:]: v for k, v in arrays.items() if k.startswith("contact_state/")})
 

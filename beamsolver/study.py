@@ -18,7 +18,8 @@ Study folder (``beamsolver.sweep(..., output=folder)``):
   *complete* when it has one with a final status (``FINAL``), the same
   parameters and solve options (and ParaView files if asked for): reruns skip it.
 
-Row fields: ``id``, the parameters, ``status`` (``"converged"``,
+Row fields: ``id``, the parameters, ``status`` (``"converged"``, ``"off-equilibrium"``
+(the run reached its end, but not in equilibrium: ``Solution.status``),
 ``"ConvergenceError"``, ``"InputError"``, ``"KilledWorker"`` for a worker that
 died twice, or the name of an unexpected exception), ``iterations`` (Newton,
 total), ``steps`` (converged steps), ``wall`` (seconds in the worker: build,
@@ -42,7 +43,7 @@ from .files import follow_umask
 __all__ = ["points", "point_id", "point_ids", "FINAL", "RESERVED", "param_names", "table_columns", "write_json",
            "write_summary", "read_point", "is_complete", "is_study", "load_study", "report"]
 
-FINAL = ("converged", "ConvergenceError", "InputError")
+FINAL = ("converged", "off-equilibrium", "ConvergenceError", "InputError")
 RESERVED = ("id", "status", "iterations", "steps", "wall", "message")
 STUDY, SUMMARY, POINT = "study.json", "summary.csv", "point.json"
 _SAFE = re.compile(r"^[A-Za-z0-9.+-]+$")

@@ -103,11 +103,13 @@ def run_point(code, params, pid, folder, options, paraview=False):
         row["message"] = str(e)
         if not isinstance(e, InputError):
             record["traceback"] = traceback.format_exc()
+    if sol is not None and row["status"] == "converged" and sol.status == "off-equilibrium":
+        row["status"], row["message"] = sol.status, sol.message
     if sol is not None and len(sol):       # a point stopped at t_start has no step to count or save
         row["iterations"], row["steps"] = int(sol.iterations.sum()), int(sol.n_steps)
         if point is not None and not paraview:
             sol.save(point / "solution.npz")
-    if row["status"] == "converged" and summary is not None:
+    if row["status"] in ("converged", "off-equilibrium") and summary is not None:
         try:
             row.update(_scalars(summary(sol, *built), params))
         except Exception as e:
@@ -215,7 +217,7 @@ def sweep(scene, grid, *, summary=None, client=None, output=None, solve_options=
     ``scene(**params)`` returns a ``Model`` or a tuple starting with one (as a
     scene script's ``build()``); ``grid``: a dict of parameter lists (their
     product) or a list of dicts; ``summary(solution, *built)`` (optional,
-    converged points only) returns a dict of scalars to tabulate, ``built`` being
+    converged and off-equilibrium points only) returns a dict of scalars to tabulate, ``built`` being
     what ``scene`` returned (as a tuple).  ``client``: ``None`` (a local cluster,
     ``local_client``), a ``dask.distributed.Client`` or a scheduler address
     (``"tcp://host:8786"``).  ``output``: the study folder (``None``: nothing
