@@ -74,8 +74,22 @@ def _scene(script):
         if not isinstance(model, Model):
             raise SystemExit(f"beamsolver run: build() in {script} returned {type(out).__name__}, "
                              "not a Model (or a tuple starting with one)")
-    opts = dict(ns.get("solve_options") or {})
-    return model, opts
+    return model, _solve_options(ns.get("solve_options"), script)
+
+
+def _solve_options(opts, script):
+    """A script's ``solve_options`` checked: a dict of ``beamsolver.solve``'s keyword arguments."""
+    from .solver import solve
+    if opts is None:
+        return {}
+    if not isinstance(opts, dict):
+        raise SystemExit(f"beamsolver run: solve_options in {script} must be a dict, got {type(opts).__name__}")
+    known = [n for n in inspect.signature(solve).parameters if n != "model"]
+    unknown = [k for k in opts if k not in known]
+    if unknown:
+        raise SystemExit(f"beamsolver run: solve_options in {script} has {', '.join(map(repr, unknown))}, not "
+                         f"an argument of beamsolver.solve (it takes {', '.join(known)})")
+    return dict(opts)
 
 
 def cmd_run(args):

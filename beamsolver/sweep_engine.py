@@ -233,6 +233,7 @@ def sweep(scene, grid, *, summary=None, client=None, output=None, solve_options=
     """
     pts = study.points(grid)
     opts = _check(scene, summary, solve_options)
+    study.check_names(scene, study.param_names(pts), "scene")
     ids = study.point_ids(pts)
     names = study.param_names(pts)
     rows = [None] * len(pts)
