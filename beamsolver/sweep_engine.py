@@ -3,7 +3,9 @@
 The engine is ``dask.distributed`` (extra ``[distributed]``), imported only
 when a sweep runs: ``import beamsolver`` never imports dask.  By default the
 sweep starts a ``LocalCluster`` of one single-threaded worker process per
-core (BLAS/OpenMP pools pinned to one thread in the workers) and closes it
+core (BLAS/OpenMP pools pinned to one thread in the workers), secured by TLS
+with credentials made for it (``local_client``: no other process of a shared
+machine can connect to its scheduler and run code in its workers), and closes it
 at the end; ``client=`` an existing ``Client`` or a scheduler address runs
 the same sweep on any Dask cluster (``dask-jobqueue`` on SLURM/PBS,
 Kubernetes, ``dask scheduler`` + ``dask worker``).  Results go to the study
@@ -132,9 +134,26 @@ def _import_distributed():
     return distributed
 
 
-def local_client(n_workers=None, **cluster_options):
+def _temporary_security(distributed):
+    """Dask's ``Security.temporary()``: a self-signed CA, certificate and key made for this cluster, kept in
+    memory (TLS with mutual authentication: only this process and its workers hold them)."""
+    try:
+        return distributed.security.Security.temporary()
+    except ImportError:
+        raise ImportError('beamsolver.sweep secures its local Dask cluster with TLS, which needs the '
+                          '"cryptography" package: pip install "beamsolver[distributed]" (or local_client(secure='
+                          'False) on a machine no one else uses)') from None
+
+
+def local_client(n_workers=None, secure=True, **cluster_options):
     """A ``Client`` on a new ``LocalCluster``: ``n_workers`` (default: one per core) single-threaded
-    worker processes with one BLAS thread each, on 127.0.0.1; closing the client closes the cluster."""
+    worker processes with one BLAS thread each, on 127.0.0.1; closing the client closes the cluster.
+
+    ``secure``: the scheduler, workers and client talk TLS with credentials made for this cluster
+    (``_temporary_security``): another process of the machine cannot connect and run code in the
+    workers, which a plain ``tcp://`` scheduler on 127.0.0.1 lets any local user do.  ``False``:
+    plain TCP (0.4-0.6 s faster to start, ~20 ms less per task: docs/benchmarks.md, ``dask_tls``), for
+    a machine no one else uses."""
     import multiprocessing
     if multiprocessing.parent_process() is not None:
         raise RuntimeError("beamsolver.sweep: a worker process started a sweep: put the code that calls "
@@ -143,6 +162,8 @@ def local_client(n_workers=None, **cluster_options):
     import dask
     opts = dict(n_workers=n_workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
                 host="127.0.0.1", dashboard_address="127.0.0.1:0", env={v: "1" for v in BLAS_VARS})
+    if secure:
+        opts.update(security=_temporary_security(distributed), protocol="tls://")
     opts.update(cluster_options)
     # a worker holds only the task it runs (saturation 1), so a death marks that task alone: KilledWorker at
     # the first death (allowed-failures 0), and _run submits the point once more
