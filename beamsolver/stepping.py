@@ -273,13 +273,17 @@ class Run:
 
     def _record(self, t_next, H, ev, stats):
         sys, sol, problem = self.sys, self.sol, self.problem
+        stab = self.opt.get("stabilizer")
+        damped = H
+        if stab is not None:
+            balance = self._undamped(stab, H, ev)
+            if stab.settle and not balance["equilibrium"] and t_next >= self.grid[-1] - 1e-12 * self.dt_user:
+                H, ev, balance = self._settle(stab, t_next, H, ev, stats, balance)
         if self.opt.get("check_stability"):
             t_next, H, ev = self._stability(stats, t_next, H, ev)
-        stab = self.opt.get("stabilizer")
-        balance = self._undamped(stab, H, ev) if stab is not None else None
         record = problem.commit(H)
         if stab is not None:
-            stats["stabilization"] = dict(stab.record(H, t_next), **balance)
+            stats["stabilization"] = dict(stab.record(damped, t_next), **balance)
         for w in stats.get("warnings", ()):
             sol.message = w if not sol.message else sol.message + "; " + w
         # the stepping state after this step, set together with the step (restart reads both)
@@ -315,6 +319,24 @@ class Run:
         return dict(undamped_residual=ratio,
                     equilibrium=bool(ratio <= max(self.newton.conv.rtol, UNDAMPED_MARGIN * full)))
 
+    def _settle(self, stab, t, H, ev, stats, balance):
+        """The last step's damped state ``H`` (evaluation ``ev``, ``balance`` of ``_undamped``) solved once
+        more at ``t`` without the viscous forces, from ``H``: ``(H, ev, balance)`` of the equilibrium
+        reached, or the damped ones if Newton fails there; ``stats["settle"]`` records which."""
+        stab.suspended = True
+        try:
+            H1, ev1, more = self.newton_step(t, start=H)
+            self._check_finite(H1, ev1.r, ev1.state, t)
+        except StepFailed as e:
+            stats["settle"] = dict(failed=str(e), from_residual=balance["undamped_residual"])
+            log.warning("t = %.6g: the undamped solve of the last step failed (%s); its damped state is kept", t, e)
+            return H, ev, balance
+        finally:
+            stab.suspended = False
+        stats["settle"] = dict(iterations=more["iterations"], residuals=more["residuals"],
+                               from_residual=balance["undamped_residual"])
+        return H1, ev1, dict(undamped_residual=self.newton.residual_ratio(ev1), equilibrium=True)
+
     def _off_equilibrium(self):
         """A stabilised run whose final state is not an equilibrium of the model (``_undamped``):
         ``Solution.mark_off_equilibrium`` with the reason, and a ``StabilizationWarning``."""
@@ -324,8 +346,9 @@ class Run:
             return
         text = (f"t = {sol.times[-1]:.6g}: the final state is not an equilibrium of the model: without the "
                 f"stabilisation's viscous forces the scaled residual is {rec['undamped_residual']:.3g} (rtol "
-                f"{self.newton.conv.rtol:g}): the damping still carries that share of the largest force; use a "
-                "smaller stabilize fraction or factor, or more steps")
+                f"{self.newton.conv.rtol:g}): the damping still carries that share of the largest force; "
+                "stabilize=dict(..., settle=True) solves the last step once more without damping, or use a "
+                "smaller stabilize fraction or factor")
         log.warning(text)
         warnings.warn(text, StabilizationWarning, stacklevel=4)
         sol.mark_off_equilibrium(text)

@@ -93,3 +93,23 @@ def test_sweep_row_says_off_equilibrium(tmp_path):
     assert plain["status"] == "converged"
     assert study.is_complete(study.read_point(tmp_path, "p"), {"factor": 1.0}, {"steps": 2,
                                                                                 "stabilize": {"factor": 1e3}})
+
+
+@pytest.mark.parametrize("stabilize", [dict(fraction=1e-2, settle=True), dict(factor=1e3, settle=True)])
+def test_settle_ends_on_the_equilibrium_of_the_model(stabilize):
+    m, b = loaded()
+    ref = bs.solve(m, steps=4, verbose=False)
+    sol, warned = _solve(m, steps=4, stabilize=stabilize)
+    assert sol.status == "converged" and not any("not an equilibrium" in str(w.message) for w in warned)
+    assert not sol.stats[2]["stabilization"]["equilibrium"]          # the steps before stay damped
+    last = sol.stats[-1]
+    assert last["stabilization"]["equilibrium"] and last["stabilization"]["undamped_residual"] <= 1e-8
+    assert last["settle"]["iterations"] >= 1 and last["settle"]["from_residual"] > 1e-8
+    assert np.abs(sol.position(b.last) - ref.position(b.last)).max() < 1e-9
+    assert np.abs(bs.linearize(m, sol).r[:3]).max() < 1e-7 * P
+
+
+def test_settle_option_is_checked():
+    m, _ = loaded()
+    with pytest.raises(bs.InputError, match="settle must be True or False"):
+        bs.solve(m, steps=1, stabilize=dict(settle="yes"), verbose=False)
