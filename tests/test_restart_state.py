@@ -74,6 +74,8 @@ def _set(name, value):
     (_set("contact/prev_points", lambda a: np.r_[a, 10**12]), "'prev_points' has ids outside"),
     (_set("contact/mult_values", lambda a: np.r_[a, 1.0]), r"'mult_values' has shape"),
     (lambda s: s.pop("contact/history.H_FK"), "history has"),
+    (lambda s: s.update({"friction/" + k.split("/", 1)[1]: s.pop(k) for k in list(s)}),
+     r"entries of \['friction'\], which this model does not have"),
 ])
 def test_damaged_state_is_refused_naming_the_entry(runs, change, words):
     _, part = runs
