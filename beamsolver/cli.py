@@ -24,7 +24,8 @@
     iterations, wall time, contact force, smallest gap / largest
     penetration per step and the reactions of the constrained nodes; the
     status line says ``converged``, ``STOPPED`` (a ``ConvergenceError``),
-    ``OFF-EQUILIBRIUM`` (the final state is not an equilibrium: ``Solution.status``) or
+    ``OFF-EQUILIBRIUM`` (the final state is not an equilibrium: ``Solution.status``; a stabilised
+    run's table shows each step's undamped residual and whether it is an equilibrium) or
     ``stopped at t = ... of ...`` (a checkpoint of a run interrupted).
 ``beamsolver render RESULT [--step K] -o PNG [--color-by FIELD] [--size W H]``
     Draws the beams as tubes (needs ``beamsolver[viz]``).
@@ -180,6 +181,10 @@ def cmd_info(args):
     if checked:
         head += ["stable", "neg. eig.", "lowest eig.", "switched"]
         widths += [6, 9, 11, 8]
+    damped = any("undamped_residual" in s.get("stabilization", {}) for s in sol.stats)
+    if damped:
+        head += ["undamped", "equilibrium"]
+        widths += [9, 11]
     print(_row(head, widths))
     steps = range(n) if args.all or n <= 22 else list(range(10)) + [None] + list(range(n - 10, n))
     for k in steps:
@@ -197,6 +202,11 @@ def cmd_info(args):
             cells += [int(np.sum(fn > 0)), f"{fn.sum():.4g}", f"{gap.min():.3g}" if len(gap) else "-"]
         if checked:
             cells += _stability_cells(s)
+        if damped:
+            rec = s.get("stabilization", {})
+            ok = rec.get("equilibrium")
+            cells += [f"{rec['undamped_residual']:.1e}" if "undamped_residual" in rec else "-",
+                      "-" if ok is None else ("yes" if ok else "NO") + (" (settled)" if "settle" in s and ok else "")]
         print(_row(cells, widths))
     gaps = [np.min(c["gap"]) for c in sol.contacts if len(c.get("gap", ()))]
     if gaps:

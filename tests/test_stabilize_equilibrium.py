@@ -51,6 +51,11 @@ def test_damping_carrying_the_load_is_not_a_converged_equilibrium(tmp_path):
     out = subprocess.run([sys.executable, "-m", "beamsolver.cli", "info", str(tmp_path / "out")],
                          capture_output=True, text=True, timeout=120)
     assert out.returncode == 0 and "OFF-EQUILIBRIUM" in out.stdout and "; converged" not in out.stdout
+    lines = out.stdout.splitlines()
+    at = next(i for i, line in enumerate(lines) if line.split()[:1] == ["step"])
+    assert lines[at].split()[-2:] == ["undamped", "equilibrium"]
+    row = lines[at + 5]                                    # step 4, the last
+    assert row.split()[-2:] == [f"{rec['undamped_residual']:.1e}", "NO"]
 
 
 def test_stabilised_run_at_rest_is_a_converged_equilibrium():
