@@ -6,6 +6,7 @@ import os
 
 import numpy as np
 import pytest
+from numba.core import config as numba_config
 
 import beamsolver as bs
 from beamsolver import cables, topology
@@ -60,6 +61,7 @@ def test_duplicated_contact_declaration_is_refused_naming_the_pair():
     assert len(m.contacts) == 2
 
 
+@pytest.mark.skipif(numba_config.DISABLE_JIT, reason="NUMBA_DISABLE_JIT=1: every function is plain Python")
 def test_contact_law_of_plain_python_functions_is_refused_at_add_contact():
     m, a, b, _ = _two_beams()
     plain = ContactLaw("plain", PENALTY_COULOMB.normal.py_func, PENALTY_COULOMB.tangential)
