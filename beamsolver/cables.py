@@ -119,9 +119,24 @@ def _lay(layer, r):
     return float(np.arctan(2.0 * np.pi * r / p)), p
 
 
+def _layer(layer, k):
+    """Layer ``k`` of ``build_strand`` as a ``Layer`` (a ``Layer`` or a dict of its fields), else ``InputError``."""
+    if isinstance(layer, Layer):
+        return layer
+    if not isinstance(layer, dict):
+        raise InputError(f"build_strand: layer {k} must be a cables.Layer or a dict of its fields, got {layer!r}")
+    known = set(Layer.__dataclass_fields__)
+    bad = sorted(set(layer) - known, key=str)
+    if bad or "wire_radius" not in layer:
+        what = f"unknown keys {bad}" if bad else "no 'wire_radius'"
+        raise InputError(f"build_strand: layer {k} {layer!r} has {what}; a layer's fields are {sorted(known)}")
+    return Layer(**layer)
+
+
 def build_strand(layers, length, E, nu=0.3, elements_per_lay=24, min_elements=8, mu=0.0,
                  contact=True, touch_tol=0.05, model=None, contact_options=None, grade=None, yield_stress=None):
     """Build the wires of a straight strand into ``model`` (a new one by default); returns a ``Strand``.
+    ``layers``: ``Layer`` objects or dicts of their fields, from the centre out.
 
     Material range of the wires' sections (``Section(yield_stress=)``): ``yield_stress`` in the
     user's units, or ``grade``, a steel wire's tensile strength in MPa (``"1770"``; SI units,
@@ -139,6 +154,7 @@ def build_strand(layers, length, E, nu=0.3, elements_per_lay=24, min_elements=8,
     model = Model() if model is None else model
     wires, radii, angles, lays = [], [], [], []
     r_prev, R_prev = None, None
+    layers = [_layer(layer, k) for k, layer in enumerate(layers)]
     for k, layer in enumerate(layers):
         R = real(layer.wire_radius, f"layer {k} wire_radius", "build_strand", above=0.0)
         n_wires = count(layer.n_wires, f"layer {k} n_wires", "build_strand")

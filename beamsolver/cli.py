@@ -15,13 +15,17 @@
     ``--t-end`` override it.  Output (VTU/PVD and ``solution.npz``) goes to
     ``DIR`` (default: ``<script name>_output`` in the current directory).
     Exit status 0 when every step converged, 2 on ``ConvergenceError`` (the
-    converged steps are written), 1 on bad input, 130 on Ctrl-C (one line; the
-    converged steps are saved, ``--restart DIR`` continues).
+    converged steps are written), 3 when the run reached its end off equilibrium
+    (``Solution.status`` ``"off-equilibrium"``: a stabilised run whose damping still
+    carries load; written, with the reason on stderr), 1 on bad input, 130 on Ctrl-C
+    (one line; the converged steps are saved, ``--restart DIR`` continues).
 ``beamsolver info RESULT [--all]``
     ``RESULT``: a ``.npz`` file or an output folder.  Prints steps, Newton
     iterations, wall time, contact force, smallest gap / largest
     penetration per step and the reactions of the constrained nodes; the
-    status line says ``converged``, ``STOPPED`` (a ``ConvergenceError``) or
+    status line says ``converged``, ``STOPPED`` (a ``ConvergenceError``),
+    ``OFF-EQUILIBRIUM`` (the final state is not an equilibrium: ``Solution.status``; a stabilised
+    run's table shows each step's undamped residual and whether it is an equilibrium) or
     ``stopped at t = ... of ...`` (a checkpoint of a run interrupted).
 ``beamsolver render RESULT [--step K] -o PNG [--color-by FIELD] [--size W H]``
     Draws the beams as tubes (needs ``beamsolver[viz]``).
@@ -71,8 +75,22 @@ def _scene(script):
         if not isinstance(model, Model):
             raise SystemExit(f"beamsolver run: build() in {script} returned {type(out).__name__}, "
                              "not a Model (or a tuple starting with one)")
-    opts = dict(ns.get("solve_options") or {})
-    return model, opts
+    return model, _solve_options(ns.get("solve_options"), script)
+
+
+def _solve_options(opts, script):
+    """A script's ``solve_options`` checked: a dict of ``beamsolver.solve``'s keyword arguments."""
+    from .solver import solve
+    if opts is None:
+        return {}
+    if not isinstance(opts, dict):
+        raise SystemExit(f"beamsolver run: solve_options in {script} must be a dict, got {type(opts).__name__}")
+    known = [n for n in inspect.signature(solve).parameters if n != "model"]
+    unknown = [k for k in opts if k not in known]
+    if unknown:
+        raise SystemExit(f"beamsolver run: solve_options in {script} has {', '.join(map(repr, unknown))}, not "
+                         f"an argument of beamsolver.solve (it takes {', '.join(known)})")
+    return dict(opts)
 
 
 def cmd_run(args):
@@ -117,6 +135,9 @@ def cmd_run(args):
         print(sol.summary())
         pvd = f"{out}/beams.pvd" + (f", {out}/contact.pvd" if model.contacts else "")
         print(f"written: {pvd} (ParaView), {out}/solution.npz")
+    if sol.status == "off-equilibrium":
+        print(f"beamsolver run: not an equilibrium: {sol.message}", file=sys.stderr)
+        return 3
     return 0
 
 
@@ -125,8 +146,10 @@ def _row(cells, widths):
 
 
 def _status(sol):
-    """``converged``, ``STOPPED: <why>`` or, for a run interrupted (Ctrl-C, a kill) after a
+    """``converged``, ``OFF-EQUILIBRIUM: <why>``, ``STOPPED: <why>`` or, for a run interrupted (Ctrl-C, a kill) after a
     checkpoint, ``stopped at t = ... of ...``."""
+    if sol.status == "off-equilibrium":
+        return f"OFF-EQUILIBRIUM: {sol.message}"
     if not sol.converged:
         return f"STOPPED: {sol.message}"
     t, t0, t_end = float(sol.times[-1]), float(sol.times[0]), sol.resume.get("t_end")
@@ -158,6 +181,10 @@ def cmd_info(args):
     if checked:
         head += ["stable", "neg. eig.", "lowest eig.", "switched"]
         widths += [6, 9, 11, 8]
+    damped = any("undamped_residual" in s.get("stabilization", {}) for s in sol.stats)
+    if damped:
+        head += ["undamped", "equilibrium"]
+        widths += [9, 11]
     print(_row(head, widths))
     steps = range(n) if args.all or n <= 22 else list(range(10)) + [None] + list(range(n - 10, n))
     for k in steps:
@@ -175,6 +202,11 @@ def cmd_info(args):
             cells += [int(np.sum(fn > 0)), f"{fn.sum():.4g}", f"{gap.min():.3g}" if len(gap) else "-"]
         if checked:
             cells += _stability_cells(s)
+        if damped:
+            rec = s.get("stabilization", {})
+            ok = rec.get("equilibrium")
+            cells += [f"{rec['undamped_residual']:.1e}" if "undamped_residual" in rec else "-",
+                      "-" if ok is None else ("yes" if ok else "NO") + (" (settled)" if "settle" in s and ok else "")]
         print(_row(cells, widths))
     gaps = [np.min(c["gap"]) for c in sol.contacts if len(c.get("gap", ()))]
     if gaps:

@@ -72,10 +72,11 @@ class Linearization:
 def linearize(model, solution, step=-1):
     """Tangent stiffness and residual of ``model`` at ``step`` of ``solution`` (a fresh or loaded one)."""
     n = len(solution)
-    k = step % n if -n <= step < n else None
-    if k is None:
+    if isinstance(step, (bool, np.bool_)) or not isinstance(step, (int, np.integer)) or not -n <= step < n:
         from .errors import InputError
-        raise InputError(f"linearize: step {step} out of range (the solution has steps 0..{n - 1})")
+        raise InputError(f"linearize: step {step!r} is not a step number of the solution (steps 0..{n - 1}, "
+                         "or negative from the end)")
+    k = int(step) % n
     problem = Problem.from_model(model, check_rigid_modes=False)
     system = problem.system
     H = np.array(solution.poses[k], dtype=float)

@@ -389,6 +389,7 @@ class Model:
         options = check_contact_options(options)
         same = {b.id for b in s} & {b.id for b in m}
         if not same:
+            self._refuse_declared(_distinct_pairs(s, m))
             decl = ContactDeclaration(s, m, mu, penalty, options)
             self.contacts.append(decl)
             return decl
@@ -398,9 +399,22 @@ class Model:
                              + ("" if len(same) == 1 and len(s) == len(m) == 1 else
                                 " (a group in contact within itself is declared with the same beams on "
                                 "both sides)"))
+        self._refuse_declared(pairs)
         decls = [ContactDeclaration([a], [b], mu, penalty, dict(options)) for a, b in pairs]
         self.contacts.extend(decls)
         return decls
+
+    def _refuse_declared(self, pairs):
+        """``InputError`` if a beam pair of ``pairs`` (``(Beam, Beam)``) already has a contact declaration:
+        a second one would add its forces again (twice the penalty)."""
+        for i, d in enumerate(self.contacts):
+            declared = {frozenset((a.id, b.id)) for a, b in _distinct_pairs(d.slave, d.master)}
+            for a, b in pairs:
+                if frozenset((a.id, b.id)) in declared:
+                    lo, hi = sorted((a.id, b.id))
+                    raise InputError(f"add_contact: beams {lo} and {hi} are already in contact by declaration "
+                                     f"{i}; a second declaration would add its contact forces again (twice the "
+                                     "penalty)")
 
     def add_contribution(self, contribution):
         """Add a physics contribution: an object with ``nodes`` (the node ids it acts on) and

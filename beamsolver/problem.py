@@ -35,6 +35,7 @@ import numpy as np
 
 from . import contributions
 from .assembly import System
+from .errors import InputError
 
 __all__ = ["Problem", "Evaluation"]
 
@@ -184,6 +185,11 @@ class Problem:
         ``/`` come from archives written before the keys were namespaced, which held only the contact
         history: they go to the contribution named ``contact``."""
         legacy = {k: v for k, v in state.items() if SEP not in k}
+        names = {c.name for c in self.contributions}
+        foreign = sorted({k.split(SEP, 1)[0] for k in state if SEP in k} - names)
+        if foreign or (legacy and "contact" not in names):
+            raise InputError(f"contact state: entries of {foreign or ['contact']}, which this model does not have "
+                             f"(its contributions: {sorted(names) or 'none'}): the state of another model")
         for c in self.contributions:
             prefix = c.name + SEP
             part = {k[len(prefix):]: v for k, v in state.items() if k.startswith(prefix)}

@@ -41,7 +41,7 @@ def restart_from(restart, model, problem):
         raise InputError(f"solve: the restart solution ({H.shape[0]} nodes) does not belong to this model "
                          f"({model.n_nodes} nodes, or other reference poses)")
     sol = restart.copy_steps(model, system)
-    sol.converged, sol.message = True, ""
+    sol.converged, sol.message, sol.off_equilibrium = True, "", False
     if sol.contact_state:
         contact_restore(problem, sol.contact_state)
     return sol

@@ -219,6 +219,10 @@ class Solution:
                          path-following data) without a new field
     ``description``      arrays describing the model (``describe_model``)
     ``converged``        bool; ``message`` (str) why not, and warnings
+    ``off_equilibrium``  bool: the run reached its end but its final state is not an equilibrium of
+                         the model (``solve(stabilize=)``: the viscous forces still carry load);
+                         ``converged`` is then False.  ``status`` (read-only) says which:
+                         ``"converged"``, ``"off-equilibrium"`` or ``"stopped"``
     ``resume``           stepping state after the last step (``stepping.next_step``), for restart;
                          ``path`` (read-only) is its ``"path"`` entry, ``"load"`` by default
     ``contact_state``    committed history of the contributions (contact, ...) at the last step
@@ -240,6 +244,7 @@ class Solution:
         self._arrays = {}
         self._stats, self._contacts, self._extra = [], [], {}
         self.converged = True
+        self.off_equilibrium = False
         self.message = ""
         self.resume = {}
         self.contact_state = {}
@@ -247,7 +252,7 @@ class Solution:
     @classmethod
     def from_steps(cls, description, times, poses, reactions, section_forces, strains, stats=None,
                    contacts=None, extra=None, converged=True, message="", resume=None, contact_state=None,
-                   model=None, system=None):
+                   model=None, system=None, off_equilibrium=False):
         """A ``Solution`` holding the given steps (arrays with one row per step), each checked as by
         ``append``; ``stats``/``contacts`` lists and ``extra`` lists default to empty entries."""
         where = "Solution.from_steps"
@@ -269,6 +274,7 @@ class Solution:
             sol._append(f"{where} (step {k})", times[k], poses[k], reactions[k], section_forces[k], strains[k],
                         given["stats"][k], given["contacts"][k], ex)
         sol.converged, sol.message = bool(converged), str(message)
+        sol.off_equilibrium = bool(off_equilibrium) and not sol.converged
         sol.contact_state = dict(contact_state or {})
         return sol
 
@@ -296,7 +302,7 @@ class Solution:
         new._extra = {k: list(v) for k, v in self.extra.items()}
         new.resume = dict(self.resume)
         new.contact_state = dict(self.contact_state)
-        new.converged, new.message = self.converged, self.message
+        new.converged, new.message, new.off_equilibrium = self.converged, self.message, self.off_equilibrium
         return new
 
     def append(self, t, H, reactions, sigma, strain, stats, contact=None, extra=None):
@@ -503,6 +509,20 @@ class Solution:
         n = self.poses.shape[1]
         lam = np.asarray(s.get("mode_eigenvalues", ()), dtype=float)
         return lam, np.asarray(s.get("modes", np.zeros((0, n, 6))), dtype=float).reshape(len(lam), n, 6)
+
+    @property
+    def status(self):
+        """``"converged"`` (every step converged, the final state an equilibrium), ``"off-equilibrium"``
+        (the run reached its end off equilibrium: ``off_equilibrium``) or ``"stopped"`` (a
+        ``ConvergenceError`` or an interruption)."""
+        if self.converged:
+            return "converged"
+        return "off-equilibrium" if self.off_equilibrium else "stopped"
+
+    def mark_off_equilibrium(self, text):
+        """Record that the final state is not an equilibrium of the model, ``text`` saying why."""
+        self.converged, self.off_equilibrium = False, True
+        self.message = text if not self.message else self.message + "; " + text
 
     @property
     def iterations(self):

@@ -20,6 +20,8 @@ key                    content
 ``strains``            ``(s, n_el, 6)`` ``h / L`` per element
 ``stats``              JSON text: list of per-step dicts (``iterations``, ``residuals``, ...)
 ``converged``          bool; ``message`` the failure message (str)
+``off_equilibrium``    bool (optional: older files have none, read as False): the run reached its
+                       end off equilibrium (``Solution.status`` ``"off-equilibrium"``)
 ``resume``             JSON text: stepping state for ``solve(..., restart=)``
 ``model/<name>``       ``results.describe_model`` arrays (poses0, enodes, radii, ...)
 ``contact/<key>``      per-step contact tables, concatenated along axis 0, with
@@ -32,8 +34,13 @@ key                    content
                        number) then the shape padded with 0
 =====================  ===============================================================
 
-A reader ignores keys it does not know, so a file with ``extra`` still loads (without
-it) in a reader that predates it; version 1 files without it load here unchanged.
+Before anything is decompressed the archive's members are checked (``check_members``): a
+member whose name is not one of the keys above (or under one of their prefixes) is refused,
+as is a member whose declared size (the zip directory's ``file_size``) disagrees with its
+``.npy`` header, or an archive whose members declare more than ``MAX_PLAIN`` bytes and more
+than ``MAX_EXPANSION`` times the file's size (a crafted 3 MB file declaring gigabytes of
+zeros: an archive bomb).  Older readers ignored keys they did not know (``extra``,
+``off_equilibrium``); version 1 files without them load here unchanged.
 
 Floats are stored in binary (``poses``, ...) or as shortest-repr JSON
 (``stats``): a save -> load round trip is exact.
@@ -52,10 +59,18 @@ import numpy as np
 from .errors import InputError
 from .files import follow_umask
 
-__all__ = ["save", "read", "saved_times", "check_archive", "FORMAT", "FORMAT_VERSION"]
+__all__ = ["save", "read", "saved_times", "check_archive", "check_members", "FORMAT", "FORMAT_VERSION", "MAX_PLAIN",
+           "MAX_EXPANSION"]
 
 FORMAT = "beamsolver-solution"
 FORMAT_VERSION = 1
+NAMES = ("format", "format_version", "beamsolver_version", "times", "poses", "reactions", "section_forces",
+         "strains", "stats", "converged", "off_equilibrium", "message", "resume")
+PREFIXES = ("model/", "contact/", "contact_count/", "contact_state/", "extra/", "extra_shape/")
+MAX_PLAIN = 2**28          # bytes the members may declare in any case (256 MiB)
+MAX_EXPANSION = 250.0      # above MAX_PLAIN: at most this times the file's size (saved results: 1.6 with contact,
+                           # 81 for 400 steps at rest; a deflate bomb ~1000: benchmarks/archive_expansion.py)
+MAX_HEADER = 2**16         # bytes of a member's .npy header (numpy writes 128-4096)
 
 
 def _json_default(x):
@@ -150,6 +165,7 @@ def save(solution, path):
                   section_forces=np.array(s.section_forces, dtype=float),
                   strains=np.array(s.strains, dtype=float),
                   stats=_dumps(s.stats), converged=np.bool_(s.converged),
+                  off_equilibrium=np.bool_(s.off_equilibrium),
                   message=np.array(str(s.message)), resume=_dumps(s.resume))
     for k, v in s.description.items():
         arrays[f"model/{k}"] = np.asarray(v)
@@ -206,15 +222,83 @@ def _open(path):
         if head != b"PK\x03\x04":
             raise InputError(f"{where}: not a beamsolver result (not a .npz archive written by Solution.save)")
         f.seek(0)
+        check_members(f, where)
+        f.seek(0)
         with np.load(f, allow_pickle=False) as data:
-            if "format" not in data.files or str(data["format"]) != FORMAT:
-                raise InputError(f"{where}: not a beamsolver result (an .npz archive, but not a saved "
-                                 "beamsolver Solution)")
-            version = int(data["format_version"])
-            if version > FORMAT_VERSION:
-                raise InputError(f"{where}: format version {version} is newer than this beamsolver reads "
-                                 f"({FORMAT_VERSION}); upgrade beamsolver")
             yield data
+
+
+def _member_bytes(zf, info, where):
+    """Bytes of the array a member's ``.npy`` header declares, checked against the member's declared
+    size (only the header is decompressed)."""
+    with zf.open(info) as fp:
+        try:
+            version = np.lib.format.read_magic(fp)
+            read = {(1, 0): np.lib.format.read_array_header_1_0, (2, 0): np.lib.format.read_array_header_2_0}
+            if version not in read:
+                raise ValueError(f".npy format version {version}")
+            shape, _, dtype = read[version](fp, max_header_size=MAX_HEADER)
+        except ValueError as e:
+            raise InputError(f"{where}: damaged beamsolver result: member {info.filename!r} is not a .npy "
+                             f"array ({e})") from None
+        header = fp.tell()
+    if dtype.hasobject:
+        raise InputError(f"{where}: damaged beamsolver result: member {info.filename!r} holds Python objects")
+    nbytes = int(np.prod(shape, dtype=object)) * dtype.itemsize
+    if info.file_size != header + nbytes:
+        raise InputError(f"{where}: damaged beamsolver result: member {info.filename!r} declares "
+                         f"{info.file_size} bytes, its header {header + nbytes}")
+    return nbytes
+
+
+def _small(zf, name, where):
+    """The small member ``name`` (a format key; ``None`` if absent), read after its size is checked."""
+    try:
+        info = zf.getinfo(name + ".npy")
+    except KeyError:
+        return None
+    if info.file_size > MAX_HEADER:
+        raise InputError(f"{where}: not a beamsolver result: member {info.filename!r} declares {info.file_size} bytes")
+    with zf.open(info) as fp:
+        return np.lib.format.read_array(fp, allow_pickle=False)
+
+
+def _check_format(zf, where):
+    """``format`` and ``format_version`` of an opened zip: a beamsolver result this version reads."""
+    fmt = _small(zf, "format", where)
+    if fmt is None or fmt.dtype.kind != "U" or str(fmt) != FORMAT:
+        raise InputError(f"{where}: not a beamsolver result (an .npz archive, but not a saved "
+                         "beamsolver Solution)")
+    version = _small(zf, "format_version", where)
+    if version is None or version.dtype.kind not in "iu" or version.size != 1:
+        raise InputError(f"{where}: damaged beamsolver result: no integer 'format_version'")
+    if int(version) > FORMAT_VERSION:
+        raise InputError(f"{where}: format version {int(version)} is newer than this beamsolver reads "
+                         f"({FORMAT_VERSION}); upgrade beamsolver")
+
+
+def check_members(f, where):
+    """Refuse (``InputError``) an archive (open binary file ``f``) that is not a beamsolver result of a
+    version this reader knows, with a member that is not a key of the format, whose declared size disagrees with its header, or whose members declare more than
+    ``MAX_PLAIN`` bytes and ``MAX_EXPANSION`` times the file's size; nothing but headers is read."""
+    size = f.seek(0, os.SEEK_END)
+    f.seek(0)
+    with zipfile.ZipFile(f) as zf:
+        infos = zf.infolist()
+        _check_format(zf, where)
+        for info in infos:
+            name = info.filename[:-4] if info.filename.endswith(".npy") else None
+            if name is None or not (name in NAMES or (name.startswith(PREFIXES) and name not in PREFIXES)):
+                raise InputError(f"{where}: not a beamsolver result: unknown member {info.filename!r} (a saved "
+                                 "Solution holds only the keys of beamsolver.solution_file)")
+        declared = sum(info.file_size for info in infos)
+        if declared > max(MAX_PLAIN, MAX_EXPANSION * size):
+            raise InputError(f"{where}: refused: its members declare {declared / 2**20:.1f} MiB uncompressed, "
+                             f"{declared / max(size, 1):.0f} times the file's {size / 2**20:.2f} MiB (limit "
+                             f"solution_file.MAX_EXPANSION = {MAX_EXPANSION:g} above MAX_PLAIN = "
+                             f"{MAX_PLAIN / 2**20:.0f} MiB): an archive bomb, not a saved result")
+        for info in infos:
+            _member_bytes(zf, info, where)
 
 
 def _guarded(path, read):
@@ -247,7 +331,7 @@ def read(path):
     is not such an archive, or is truncated, corrupted or inconsistent, raises ``InputError``
     naming it and what is wrong (``check_archive``).  Keys: the arguments of
     ``Solution.from_steps``: ``description, times, poses, reactions, section_forces, strains,
-    stats, contacts, extra, converged, message, resume, contact_state``.
+    stats, contacts, extra, converged, message, resume, contact_state, off_equilibrium``.
     """
     path = _resolve(path)
     return _guarded(path, _read)
@@ -265,7 +349,7 @@ def _read(path):
     return dict(description=desc, times=times, poses=arrays["poses"], reactions=arrays["reactions"],
                 section_forces=arrays["section_forces"], strains=arrays["strains"], stats=arrays["stats"],
                 contacts=_unpack_tables(arrays, "contact", len(times)), extra=_unpack_values(arrays, len(times)),
-                converged=bool(arrays["converged"]),
+                converged=bool(arrays["converged"]), off_equilibrium=bool(arrays.get("off_equilibrium", False)),
                 message=str(arrays["message"]), resume=arrays["resume"],
                 contact_state={k[14:]: v for k, v in arrays.items() if k.startswith("contact_state/")})
 

@@ -203,6 +203,11 @@ class Newton:
     def _ratio(self, r, scales):
         return self.conv.residual_ratio(r[self._dofs_u], r[self._dofs_w], *scales)
 
+    def residual_ratio(self, ev, r=None):
+        """Scaled residual (``Convergence.residual_ratio``) of the residual ``r`` ``(6 n,)`` (default
+        ``ev.r``) with the force scales of the evaluation ``ev``."""
+        return self._ratio(ev.r if r is None else r, self.conv.scales(ev, self.L_ref))
+
     def _measured(self, ev):
         """``ev`` with its residual scales and scaled residual (``_Measured``; no direction yet)."""
         scales = self.conv.scales(ev, self.L_ref)

@@ -26,7 +26,9 @@ equilibrium) and is refused (``StabilizedSaddle``, retried with a shorter step, 
 raises ``c / dt``).  The check needs a symmetric tangent: ``solve`` makes it only for
 conservative problems (no friction, no follower loads), where the symmetric part of a
 frictional tangent may be indefinite at a stable state.  ``factor=`` sets ``c`` directly
-(active from the first step).  After every step the dissipated energy, its running total and its
+(active from the first step).  ``settle=True``: the last step is solved once more without damping,
+from its damped state, when that state is not an equilibrium of the model
+(docs/theory_stabilized_equilibrium.md).  After every step the dissipated energy, its running total and its
 ratio to the beams' strain energy are recorded; a ratio above ``warn`` (default 0.05) warns
 (``StabilizationWarning``): the answer is then polluted by the damping.
 """
@@ -102,7 +104,7 @@ class Stabilization(Contribution):
     smooth = True
     conservative = False          # viscous: no potential
 
-    def __init__(self, system, fraction=DEFAULT_FRACTION, factor=None, warn=WARN_FRACTION, check=True):
+    def __init__(self, system, fraction=DEFAULT_FRACTION, factor=None, warn=WARN_FRACTION, check=True, settle=False):
         for g in system.groups:
             if g.element_type.n_nodes != 2:
                 # M* lumps each element at its two end nodes and the strain energy is the two-node one
@@ -118,10 +120,12 @@ class Stabilization(Contribution):
         self.H_prev, self.dt, self.t_last, self.t_next = None, None, None, None
         self.total = 0.0
         self.warned = False
+        self.settle = bool(settle)    # solve the last step once more without damping (``stepping.Run``)
+        self.suspended = False        # True while it does: no viscous forces
 
     @property
     def active(self):
-        return self.c > 0.0 and self.H_prev is not None and len(self.nodes) > 0
+        return self.c > 0.0 and self.H_prev is not None and len(self.nodes) > 0 and not self.suspended
 
     def begin_step(self, H, t):
         """Start the step to ``t`` from the converged poses ``H`` (at ``t_last``)."""
@@ -196,17 +200,20 @@ class Stabilization(Contribution):
 
 def from_option(system, stabilize, check=True):
     """The ``Stabilization`` of ``solve(stabilize=...)``: ``None``/``False`` (off), ``True`` (fraction
-    ``DEFAULT_FRACTION``), a fraction ``> 0``, or ``dict(fraction=, factor=, warn=)``; ``check``:
-    refuse saddle steps (``Stabilization.check``)."""
+    ``DEFAULT_FRACTION``), a fraction ``> 0``, or ``dict(fraction=, factor=, warn=, settle=)``; ``check``:
+    refuse saddle steps (``Stabilization.check``); ``settle``: a last step whose state is not an
+    equilibrium of the model is solved once more without damping (docs/theory_stabilized_equilibrium.md)."""
     if stabilize is None or stabilize is False:
         return None
     if stabilize is True:
         return Stabilization(system, check=check)
     if isinstance(stabilize, dict):
-        unknown = set(stabilize) - {"fraction", "factor", "warn"}
+        unknown = set(stabilize) - {"fraction", "factor", "warn", "settle"}
         if unknown:
-            raise InputError(f"solve: stabilize has unknown keys {sorted(unknown)} (fraction, factor, warn)")
+            raise InputError(f"solve: stabilize has unknown keys {sorted(unknown)} (fraction, factor, warn, settle)")
         opts = dict(stabilize)
+        if not isinstance(opts.get("settle", False), bool):
+            raise InputError(f"solve: stabilize settle must be True or False, got {opts['settle']!r}")
     elif isinstance(stabilize, (int, float)) and not isinstance(stabilize, bool):
         opts = dict(fraction=stabilize)
     else:
@@ -216,4 +223,4 @@ def from_option(system, stabilize, check=True):
         if v is not None and not (isinstance(v, (int, float)) and np.isfinite(v) and v > 0):
             raise InputError(f"solve: stabilize {key} must be a positive number, got {v!r}")
     return Stabilization(system, fraction=opts.get("fraction") or DEFAULT_FRACTION, factor=opts.get("factor"),
-                         warn=opts.get("warn") or WARN_FRACTION, check=check)
+                         warn=opts.get("warn") or WARN_FRACTION, check=check, settle=opts.get("settle", False))

@@ -26,7 +26,7 @@ import numpy as np
 
 from . import branching, diagnosis, motion_path
 from .definiteness import negative_eigenvalues
-from .errors import ConvergenceError, InputError, StabilityWarning
+from .errors import ConvergenceError, InputError, StabilityWarning, StabilizationWarning
 from .failures import AugmentationFailed, MotionTooFast, NonFinite, StepFailed
 from .progress import Progress
 from .material_range import RangeCheck
@@ -43,6 +43,7 @@ EASY_ITERATIONS = 6        # a step converging within these iterations is easy (
 EASY_RUN = 2               # easy steps running before the step grows (growth)
 WAIT_MAX = 32              # most easy steps running before a step regrows to a size that failed again
 MAX_OUTER = 100            # outer iterations of a step (Problem.repeat_step) before it fails
+UNDAMPED_MARGIN = 2.0      # an undamped residual up to this times the damped one Newton accepted is equilibrium
 STEP_ZERO_ITERATIONS = 4   # Newton budget at t_start / max_iter (no cut-back there; docs/theory.md section 17)
 
 
@@ -278,11 +279,17 @@ class Run:
 
     def _record(self, t_next, H, ev, stats):
         sys, sol, problem = self.sys, self.sol, self.problem
+        stab = self.opt.get("stabilizer")
+        damped = H
+        if stab is not None:
+            balance = self._undamped(stab, H, ev)
+            if stab.settle and not balance["equilibrium"] and t_next >= self.grid[-1] - 1e-12 * self.dt_user:
+                H, ev, balance = self._settle(stab, t_next, H, ev, stats, balance)
         if self.opt.get("check_stability"):
             t_next, H, ev = self._stability(stats, t_next, H, ev)
         record = problem.commit(H)
-        if self.opt.get("stabilizer") is not None:
-            stats["stabilization"] = self.opt["stabilizer"].record(H, t_next)
+        if stab is not None:
+            stats["stabilization"] = dict(stab.record(damped, t_next), **balance)
         for w in stats.get("warnings", ()):
             sol.message = w if not sol.message else sol.message + "; " + w
         # the stepping state after this step, set together with the step (restart reads both)
@@ -306,6 +313,53 @@ class Run:
         if self.writer is not None:
             self.writer.write(sol, sol.n_steps)
         self.progress.step(sol.n_steps, t_next, stats["dt"], stats)
+
+    def _undamped(self, stab, H, ev):
+        """The balance of the converged state ``H`` (evaluation ``ev``) without the viscous forces of
+        the stabilisation ``stab``: ``undamped_residual`` (scaled as Newton's residual) and
+        ``equilibrium``: at most the solve's ``rtol``, or twice the damped residual Newton accepted
+        (a step converged on its increment), i.e. an equilibrium of the model itself."""
+        full = self.newton.residual_ratio(ev)
+        if not stab.active:
+            return dict(undamped_residual=full, equilibrium=True)
+        blocks, _ = stab.evaluate(H, tangent=False)
+        ratio = self.newton.residual_ratio(ev, ev.r - self.sys.assemble_blocks(H, blocks)[0])
+        return dict(undamped_residual=ratio,
+                    equilibrium=bool(ratio <= max(self.newton.conv.rtol, UNDAMPED_MARGIN * full)))
+
+    def _settle(self, stab, t, H, ev, stats, balance):
+        """The last step's damped state ``H`` (evaluation ``ev``, ``balance`` of ``_undamped``) solved once
+        more at ``t`` without the viscous forces, from ``H``: ``(H, ev, balance)`` of the equilibrium
+        reached, or the damped ones if Newton fails there; ``stats["settle"]`` records which."""
+        stab.suspended = True
+        try:
+            H1, ev1, more = self.newton_step(t, start=H)
+            self._check_finite(H1, ev1.r, ev1.state, t)
+        except StepFailed as e:
+            stats["settle"] = dict(failed=str(e), from_residual=balance["undamped_residual"])
+            log.warning("t = %.6g: the undamped solve of the last step failed (%s); its damped state is kept", t, e)
+            return H, ev, balance
+        finally:
+            stab.suspended = False
+        stats["settle"] = dict(iterations=more["iterations"], residuals=more["residuals"],
+                               from_residual=balance["undamped_residual"])
+        return H1, ev1, dict(undamped_residual=self.newton.residual_ratio(ev1), equilibrium=True)
+
+    def _off_equilibrium(self):
+        """A stabilised run whose final state is not an equilibrium of the model (``_undamped``):
+        ``Solution.mark_off_equilibrium`` with the reason, and a ``StabilizationWarning``."""
+        sol = self.sol
+        rec = sol.stats[-1].get("stabilization", {}) if len(sol) else {}
+        if rec.get("equilibrium", True):
+            return
+        text = (f"t = {sol.times[-1]:.6g}: the final state is not an equilibrium of the model: without the "
+                f"stabilisation's viscous forces the scaled residual is {rec['undamped_residual']:.3g} (rtol "
+                f"{self.newton.conv.rtol:g}): the damping still carries that share of the largest force; "
+                "stabilize=dict(..., settle=True) solves the last step once more without damping, or use a "
+                "smaller stabilize fraction or factor")
+        log.warning(text)
+        warnings.warn(text, StabilizationWarning, stacklevel=4)
+        sol.mark_off_equilibrium(text)
 
     def _memory_state(self):
         """The failed-size memory of ``next_step`` and the ``easy_limit`` reference for ``resume`` (JSON: no inf)."""
@@ -368,14 +422,20 @@ class Run:
         if self.writer is not None:
             try:
                 entries = getattr(self.writer, "entries", None)
-                if sol is not None and entries is not None and sol.n_steps not in entries:
+                if sol is not None and len(sol) and entries is not None and sol.n_steps not in entries:
                     self.writer.write(sol, sol.n_steps)
-                self.writer.close()
             except Exception as e:      # never hide the exception that ended the run
                 log.error("could not save the solution after %s: %s", type(exc).__name__, e)
+            finally:
+                try:
+                    self.writer.close()
+                except Exception as e:
+                    log.error("could not close the output after %s: %s", type(exc).__name__, e)
 
     def finish(self):
         self.progress.close()
+        if self.opt.get("stabilizer") is not None:
+            self._off_equilibrium()
         if self.writer is not None:
             self.writer.close()
         return self.sol

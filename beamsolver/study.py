@@ -18,7 +18,8 @@ Study folder (``beamsolver.sweep(..., output=folder)``):
   *complete* when it has one with a final status (``FINAL``), the same
   parameters and solve options (and ParaView files if asked for): reruns skip it.
 
-Row fields: ``id``, the parameters, ``status`` (``"converged"``,
+Row fields: ``id``, the parameters, ``status`` (``"converged"``, ``"off-equilibrium"``
+(the run reached its end, but not in equilibrium: ``Solution.status``),
 ``"ConvergenceError"``, ``"InputError"``, ``"KilledWorker"`` for a worker that
 died twice, or the name of an unexpected exception), ``iterations`` (Newton,
 total), ``steps`` (converged steps), ``wall`` (seconds in the worker: build,
@@ -37,11 +38,12 @@ from pathlib import Path
 import numpy as np
 
 from .errors import InputError
+from .files import follow_umask
 
 __all__ = ["points", "point_id", "point_ids", "FINAL", "RESERVED", "param_names", "table_columns", "write_json",
-           "write_summary", "read_point", "is_complete", "is_study", "load_study", "report"]
+           "write_summary", "read_point", "is_complete", "is_study", "load_study", "report", "check_names"]
 
-FINAL = ("converged", "ConvergenceError", "InputError")
+FINAL = ("converged", "off-equilibrium", "ConvergenceError", "InputError")
 RESERVED = ("id", "status", "iterations", "steps", "wall", "message")
 STUDY, SUMMARY, POINT = "study.json", "summary.csv", "point.json"
 _SAFE = re.compile(r"^[A-Za-z0-9.+-]+$")
@@ -132,6 +134,7 @@ def _atomic_text(path, text):
     path = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
+        follow_umask(fd)
         with os.fdopen(fd, "w", newline="") as f:
             f.write(text)
         os.replace(tmp, path)
@@ -204,17 +207,50 @@ def is_study(path):
     return Path(path).is_dir() and (Path(path) / STUDY).is_file()
 
 
-def load_study(path):
-    """``(meta, rows)`` of a study folder: ``rows[i]`` is the row of point ``i`` or ``None`` (not run)."""
-    folder = Path(path)
+def check_names(function, names, where):
+    """Refuse (``InputError``) parameter ``names`` that ``function`` (a scene's build) does not take:
+    a misspelled name would fail every point of the grid.  Functions taking ``**kwargs``, or
+    without a signature, pass."""
+    import inspect
+    try:
+        params = inspect.signature(function).parameters
+    except (TypeError, ValueError):
+        return
+    if any(p.kind == p.VAR_KEYWORD for p in params.values()):
+        return
+    takes = [n for n, p in params.items() if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
+    unknown = [n for n in names if n not in takes]
+    if unknown:
+        raise InputError(f"sweep: {where} has no parameter {', '.join(map(repr, unknown))} (it takes "
+                         f"{', '.join(takes) or 'none'})")
+
+
+def _study_meta(folder):
+    """The checked contents of ``folder/study.json`` (``names``, ``options``, ``points`` of ``id``, ``params``)."""
     try:
         meta = json.loads((folder / STUDY).read_text())
     except (OSError, ValueError) as e:
         raise InputError(f"study {str(folder)!r}: no readable {STUDY} ({e})") from None
+    missing = [k for k in ("names", "options", "points") if not isinstance(meta, dict) or k not in meta]
+    if missing:
+        raise InputError(f"study {str(folder)!r}: {STUDY} is incomplete: no {', '.join(map(repr, missing))} "
+                         "(a partial or foreign file; rerun the sweep to rewrite it)")
+    bad = [i for i, p in enumerate(meta["points"]) if not (isinstance(p, dict) and "id" in p and "params" in p)]
+    if not isinstance(meta["points"], list) or not isinstance(meta["names"], list) or bad:
+        raise InputError(f"study {str(folder)!r}: {STUDY} is damaged: 'points' must be a list of "
+                         f"{{id, params}} and 'names' a list" + (f" (point {bad[0]} is not)" if bad else ""))
+    return meta
+
+
+def load_study(path):
+    """``(meta, rows)`` of a study folder: ``rows[i]`` is the row of point ``i`` or ``None`` (not run)."""
+    folder = Path(path)
+    meta = _study_meta(folder)
     rows = []
     for p in meta["points"]:
-        rec = read_point(folder, p["id"])
-        ok = rec is not None and canonical(rec.get("params")) == canonical(p["params"])
+        rec = read_point(folder, str(p["id"]))
+        ok = isinstance(rec, dict) and isinstance(rec.get("row"), dict) and "status" in rec["row"] and \
+            canonical(rec.get("params")) == canonical(p["params"])
         rows.append(rec["row"] if ok else None)
     return meta, rows
 

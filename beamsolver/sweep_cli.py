@@ -103,7 +103,14 @@ def cmd_sweep(args):
     if not callable(scene.namespace().get("build")):
         print(f"beamsolver sweep: {script} defines no function build(**params)", file=sys.stderr)
         return 1
-    grid = dict(parse_param(p) for p in args.param)
+    grid = {}
+    for text in args.param:
+        name, values = parse_param(text)
+        if name in grid:
+            raise InputError(f"beamsolver sweep: --param {name} is given twice ({name}={grid[name]} and "
+                             f"{text!r}); give all its values in one --param {name}=V1,V2,...")
+        grid[name] = values
+    study.check_names(scene.namespace()["build"], list(grid), f"build() in {script}")
     opts = scene.solve_options
     if args.steps is not None:
         opts["steps"] = args.steps

@@ -3,7 +3,9 @@
 The engine is ``dask.distributed`` (extra ``[distributed]``), imported only
 when a sweep runs: ``import beamsolver`` never imports dask.  By default the
 sweep starts a ``LocalCluster`` of one single-threaded worker process per
-core (BLAS/OpenMP pools pinned to one thread in the workers) and closes it
+core (BLAS/OpenMP pools pinned to one thread in the workers), secured by TLS
+with credentials made for it (``local_client``: no other process of a shared
+machine can connect to its scheduler and run code in its workers), and closes it
 at the end; ``client=`` an existing ``Client`` or a scheduler address runs
 the same sweep on any Dask cluster (``dask-jobqueue`` on SLURM/PBS,
 Kubernetes, ``dask scheduler`` + ``dask worker``).  Results go to the study
@@ -47,12 +49,17 @@ def _model_of(built, where):
     return model, (built if isinstance(built, tuple) else (built,))
 
 
-def _scalars(values):
+def _scalars(values, params):
+    """The summary's ``values`` as table cells; a key named like a grid parameter of ``params`` (which
+    it would overwrite) or a reserved column, or a value that is not a scalar: ``TypeError``."""
     if not isinstance(values, dict):
         raise TypeError(f"summary must return a dict of scalars, got {type(values).__name__}")
     out = {}
     for k, v in values.items():
         v = study.plain(v)
+        if k in params:
+            raise TypeError(f"summary: entry {k!r} would overwrite the grid parameter {k!r} "
+                            "(give the summary entry another name)")
         if not isinstance(k, str) or k in study.RESERVED or not isinstance(v, (int, float, str, bool)):
             raise TypeError(f"summary: entry {k!r}: {v!r} is not a scalar under a free column name")
         out[k] = v
@@ -98,13 +105,15 @@ def run_point(code, params, pid, folder, options, paraview=False):
         row["message"] = str(e)
         if not isinstance(e, InputError):
             record["traceback"] = traceback.format_exc()
-    if sol is not None:
+    if sol is not None and row["status"] == "converged" and sol.status == "off-equilibrium":
+        row["status"], row["message"] = sol.status, sol.message
+    if sol is not None and len(sol):       # a point stopped at t_start has no step to count or save
         row["iterations"], row["steps"] = int(sol.iterations.sum()), int(sol.n_steps)
         if point is not None and not paraview:
             sol.save(point / "solution.npz")
-    if row["status"] == "converged" and summary is not None:
+    if row["status"] in ("converged", "off-equilibrium") and summary is not None:
         try:
-            row.update(_scalars(summary(sol, *built)))
+            row.update(_scalars(summary(sol, *built), params))
         except Exception as e:
             row["status"], row["message"] = type(e).__name__, f"summary: {e}"
             record["traceback"] = traceback.format_exc()
@@ -125,9 +134,26 @@ def _import_distributed():
     return distributed
 
 
-def local_client(n_workers=None, **cluster_options):
+def _temporary_security(distributed):
+    """Dask's ``Security.temporary()``: a self-signed CA, certificate and key made for this cluster, kept in
+    memory (TLS with mutual authentication: only this process and its workers hold them)."""
+    try:
+        return distributed.security.Security.temporary()
+    except ImportError:
+        raise ImportError('beamsolver.sweep secures its local Dask cluster with TLS, which needs the '
+                          '"cryptography" package: pip install "beamsolver[distributed]" (or local_client(secure='
+                          'False) on a machine no one else uses)') from None
+
+
+def local_client(n_workers=None, secure=True, **cluster_options):
     """A ``Client`` on a new ``LocalCluster``: ``n_workers`` (default: one per core) single-threaded
-    worker processes with one BLAS thread each, on 127.0.0.1; closing the client closes the cluster."""
+    worker processes with one BLAS thread each, on 127.0.0.1; closing the client closes the cluster.
+
+    ``secure``: the scheduler, workers and client talk TLS with credentials made for this cluster
+    (``_temporary_security``): another process of the machine cannot connect and run code in the
+    workers, which a plain ``tcp://`` scheduler on 127.0.0.1 lets any local user do.  ``False``:
+    plain TCP (0.4-0.6 s faster to start, ~20 ms less per task: docs/benchmarks.md, ``dask_tls``), for
+    a machine no one else uses."""
     import multiprocessing
     if multiprocessing.parent_process() is not None:
         raise RuntimeError("beamsolver.sweep: a worker process started a sweep: put the code that calls "
@@ -136,6 +162,8 @@ def local_client(n_workers=None, **cluster_options):
     import dask
     opts = dict(n_workers=n_workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
                 host="127.0.0.1", dashboard_address="127.0.0.1:0", env={v: "1" for v in BLAS_VARS})
+    if secure:
+        opts.update(security=_temporary_security(distributed), protocol="tls://")
     opts.update(cluster_options)
     # a worker holds only the task it runs (saturation 1), so a death marks that task alone: KilledWorker at
     # the first death (allowed-failures 0), and _run submits the point once more
@@ -210,7 +238,7 @@ def sweep(scene, grid, *, summary=None, client=None, output=None, solve_options=
     ``scene(**params)`` returns a ``Model`` or a tuple starting with one (as a
     scene script's ``build()``); ``grid``: a dict of parameter lists (their
     product) or a list of dicts; ``summary(solution, *built)`` (optional,
-    converged points only) returns a dict of scalars to tabulate, ``built`` being
+    converged and off-equilibrium points only) returns a dict of scalars to tabulate, ``built`` being
     what ``scene`` returned (as a tuple).  ``client``: ``None`` (a local cluster,
     ``local_client``), a ``dask.distributed.Client`` or a scheduler address
     (``"tcp://host:8786"``).  ``output``: the study folder (``None``: nothing
@@ -226,6 +254,7 @@ def sweep(scene, grid, *, summary=None, client=None, output=None, solve_options=
     """
     pts = study.points(grid)
     opts = _check(scene, summary, solve_options)
+    study.check_names(scene, study.param_names(pts), "scene")
     ids = study.point_ids(pts)
     names = study.param_names(pts)
     rows = [None] * len(pts)

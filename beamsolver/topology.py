@@ -40,9 +40,40 @@ def _unit(v):
     return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 
+def _polygon(points, name, owner, n=None, minimum=2):
+    """``points`` as a finite float array ``(n, 3)`` (``n`` given: that many rows; else at least
+    ``minimum``), else ``InputError`` naming ``owner``'s argument ``name``."""
+    try:
+        p = np.asarray(points, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{owner}: {name} must be an array of numbers of shape (n, 3), got {points!r}") from None
+    if p.ndim != 2 or p.shape[1] != 3:
+        raise InputError(f"{owner}: {name} must have shape (n, 3), got {p.shape}")
+    if n is not None and len(p) != n:
+        raise InputError(f"{owner}: {name} must have {n} rows (one per point of the polygon), got {len(p)}")
+    if len(p) < minimum:
+        raise InputError(f"{owner}: {name} needs at least {minimum} points, got {len(p)}")
+    bad = np.flatnonzero(~np.isfinite(p).all(axis=1))
+    if len(bad):
+        raise InputError(f"{owner}: {name} must be finite; row {int(bad[0])} is {p[bad[0]].tolist()}")
+    return p
+
+
+def _axis(axis, owner):
+    """``axis`` as a unit 3-vector (finite, non-zero), else ``InputError``."""
+    try:
+        e = np.asarray(axis, dtype=float)
+    except (TypeError, ValueError):
+        e = None
+    if e is None or e.shape != (3,) or not np.all(np.isfinite(e)) or not np.linalg.norm(e) > 0.0:
+        raise InputError(f"{owner}: axis must be a finite, non-zero 3-vector, got {axis!r}")
+    return e / np.linalg.norm(e)
+
+
 def node_tangents(points):
     """Unit tangents at the nodes of a polygon ``(n, 3)``: the mean of the adjacent segments'
     directions (the end segments' at the ends)."""
+    points = _polygon(points, "points", "node_tangents")
     seg = _unit(np.diff(points, axis=0))
     t = np.empty_like(points)
     t[0], t[-1] = seg[0], seg[-1]
@@ -53,7 +84,8 @@ def node_tangents(points):
 def ribbon(x_a, x_b):
     """Axis (the midline) and ribbon vectors (from wire a to wire b) of two wires' centre lines
     sampled at the same arc lengths, ``(n, 3)`` each."""
-    x_a, x_b = np.asarray(x_a, float), np.asarray(x_b, float)
+    x_a = _polygon(x_a, "x_a", "ribbon", minimum=1)
+    x_b = _polygon(x_b, "x_b", "ribbon", n=len(x_a))
     return 0.5 * (x_a + x_b), x_b - x_a
 
 
@@ -68,7 +100,9 @@ def _transport(u, t0, t1):
 def twist(axis, ribbon_vectors, tangents=None):
     """Twist ``Tw`` (turns) of the ribbon ``ribbon_vectors`` ``(n, 3)`` about the polygon ``axis``
     ``(n, 3)`` (node tangents ``tangents``, default ``node_tangents(axis)``)."""
-    t = node_tangents(axis) if tangents is None else _unit(np.asarray(tangents, float))
+    axis = _polygon(axis, "axis", "twist")
+    ribbon_vectors = _polygon(ribbon_vectors, "ribbon_vectors", "twist", n=len(axis))
+    t = node_tangents(axis) if tangents is None else _unit(_polygon(tangents, "tangents", "twist", n=len(axis)))
     u = ribbon_vectors - np.einsum("ij,ij->i", ribbon_vectors, t)[:, None] * t
     u = _unit(u)
     if np.any(np.einsum("ij,ij->i", t[:-1], t[1:]) <= -1.0 + 1e-12):
@@ -97,7 +131,7 @@ def _solid_angles(p1, p2, p3, p4):
 
 def writhe_closed(points):
     """Writhe of the closed polygon through ``points`` ``(n, 3)`` (the last joined to the first)."""
-    p = np.asarray(points, float)
+    p = _polygon(points, "points", "writhe_closed", minimum=3)
     a, b = p, np.roll(p, -1, axis=0)          # segment i: a[i] -> b[i]
     n = len(p)
     i, j = np.triu_indices(n, k=2)
@@ -108,7 +142,8 @@ def writhe_closed(points):
 
 def linking(points_a, points_b):
     """Gauss linking number of two closed polygons ``(n, 3)``, ``(m, 3)`` (exact for polygons)."""
-    a, b = np.asarray(points_a, float), np.asarray(points_b, float)
+    a = _polygon(points_a, "points_a", "linking", minimum=3)
+    b = _polygon(points_b, "points_b", "linking", minimum=3)
     i, j = np.meshgrid(np.arange(len(a)), np.arange(len(b)), indexing="ij")
     i, j = i.ravel(), j.ravel()
     return float(np.sum(_solid_angles(a[i], np.roll(a, -1, 0)[i], b[j], np.roll(b, -1, 0)[j])) / (4.0 * np.pi))
@@ -129,16 +164,18 @@ def _closure(points, e, extension):
 def writhe_open(points, axis=(0.0, 0.0, 1.0), extension=CLOSURE_EXTENSION):
     """Writhe of an open polygon ``(n, 3)`` clamped along ``axis`` at both ends (start below,
     end above), closed by half-lines along ``axis`` (module docstring)."""
-    e = _unit(np.asarray(axis, float))
-    p = np.asarray(points, float)
+    e = _axis(axis, "writhe_open")
+    p = _polygon(points, "points", "writhe_open")
     return writhe_closed(_closure(p, e, extension))
 
 
 def writhe_fuller(points, axis=(0.0, 0.0, 1.0), tangents=None):
     """Fuller's writhe of an open polygon ``(n, 3)`` relative to the straight curve along ``axis``
     (tangent increments integrated segment by segment between node tangents)."""
-    e = _unit(np.asarray(axis, float))
-    t = node_tangents(np.asarray(points, float)) if tangents is None else _unit(np.asarray(tangents, float))
+    e = _axis(axis, "writhe_fuller")
+    points = _polygon(points, "points", "writhe_fuller")
+    t = node_tangents(points) if tangents is None else \
+        _unit(_polygon(tangents, "tangents", "writhe_fuller", n=len(points)))
     low = 1.0 + t @ e
     if low.min() < FULLER_MIN:
         k = int(np.argmin(low))

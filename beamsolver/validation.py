@@ -183,11 +183,25 @@ CONTACT_OPTIONS = {   # name -> check(value, owner) returning the stored value (
 def _contact_law(v, owner):
     """A ``contact.law.ContactLaw`` (checked by its fields: ``name``, compiled ``normal`` and
     ``tangential``) or None."""
-    if v is None or (isinstance(getattr(v, "name", None), str) and callable(getattr(v, "normal", None))
-                     and callable(getattr(v, "tangential", None))):
+    if v is None:
+        return v
+    if isinstance(getattr(v, "name", None), str) and callable(getattr(v, "normal", None)) \
+            and callable(getattr(v, "tangential", None)):
+        plain = [k for k in ("normal", "tangential") if not _compiled(getattr(v, k))]
+        if plain:
+            raise InputError(f"{owner}: law {v.name!r}: {' and '.join(plain)} must be numba-compiled functions "
+                             "(decorate them with beamsolver._jit.jit, i.e. numba.njit): the compiled contact "
+                             f"kernel cannot call the plain Python function(s) {plain}")
         return v
     raise InputError(f"{owner}: law must be a beamsolver.contact.law.ContactLaw (name, normal, tangential) "
                      f"or None, got {type(v).__name__} {v!r}")
+
+
+def _compiled(f):
+    """Whether ``f`` is a numba dispatcher (anything callable when numba's JIT is disabled)."""
+    from numba.core import config
+    from numba.core.dispatcher import Dispatcher
+    return isinstance(f, Dispatcher) or bool(config.DISABLE_JIT)
 
 
 def check_contact_options(options, owner="add_contact"):
@@ -223,6 +237,9 @@ def check_solve_arguments(model, *, steps, t_end, t_start, rtol, dtol, max_iter,
         raise InputError(f"solve: callback must be callable or None, got {callback!r}")
     if output is not None and not isinstance(output, (str, os.PathLike)) and not hasattr(output, "write"):
         raise InputError(f"solve: output must be a folder (str or Path), a writer or None, got {output!r}")
+    if isinstance(output, (str, os.PathLike)) and not os.fspath(output).strip():
+        raise InputError(f"solve: output {output!r} names no folder (give a folder name, \".\" for the "
+                         "current folder, or None for no output)")
     if restart is not None and not isinstance(restart, (str, os.PathLike)) and \
             not (hasattr(restart, "times") and hasattr(restart, "poses")):
         raise InputError(f"solve: restart must be a Solution or the path of a saved one, got {restart!r}")

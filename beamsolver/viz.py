@@ -192,6 +192,9 @@ def _series(solution, what, node, component):
     if what in ("reaction", "position", "displacement"):
         if node is None:
             raise ValueError(f"plot_history: {what!r} needs node=")
+        nn = solution.poses.shape[1]
+        if isinstance(node, (bool, np.bool_)) or not isinstance(node, (int, np.integer)) or not 0 <= node < nn:
+            raise InputError(f"plot_history: unknown node id {node!r} (nodes 0..{nn - 1})")
         if what == "reaction":
             v = np.array(solution.reactions[:, node])
             unit = "moment" if c is not None and int(c) >= 3 else "force"

@@ -80,7 +80,12 @@ def test_group_contact_declaration_equals_the_pairwise_one():
         st_g.model.add_contact(a, [a])
     with pytest.raises(bs.InputError, match="same beams on both sides"):
         st_g.model.add_contact([a, b], [b, c])                      # only partly overlapping: a mistake
-    more = st_g.model.add_contact([c, a, b], [a, b, c])             # the same group in another order
+    with pytest.raises(bs.InputError, match="already in contact"):
+        st_g.model.add_contact([c, a, b], [a, b, c])                 # declared twice: twice the penalty
+    fresh = cables.build_strand([cables.Layer(1e-3, 3, lay_angle=np.deg2rad(12.0))], 0.02, 200e9,
+                                elements_per_lay=12, contact=False)
+    a, b, c = fresh.wires[0]
+    more = fresh.model.add_contact([c, a, b], [a, b, c])            # the same group in another order
     assert [(d.slave[0].id, d.master[0].id) for d in more] == [(2, 0), (2, 1), (0, 1)]
 
 

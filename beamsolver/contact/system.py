@@ -57,6 +57,7 @@ from .record import Candidates, PairSet
 from .ownership import gauss_owners, gauss_record
 from .projection import closest_points, element_twists, gauss_projections, section_points
 from .search import broad_pairs, element_spheres
+from .state import KeyLayout, check_state
 from . import rules
 
 
@@ -160,20 +161,24 @@ class ContactSystem(Contribution):
         return out
 
     def set_state(self, state):
-        """Restore a state from ``get_state`` (missing parts: empty; older archives lack some)."""
+        """Restore a state from ``get_state`` (missing parts: empty; older archives lack some), checked
+        first (``contact.state.check_state``: ``InputError`` naming a damaged or foreign entry)."""
+        layout = KeyLayout(self.sys.n_elements, self.max_gp, len(self.decls), self.el_beam, self.n_beams)
+        history, mult, prev = check_state(state, layout)
         self._blocks = None
         hist = self._empty_history()
-        for k in hist:
-            if f"history.{k}" in state:
-                hist[k] = np.asarray(state[f"history.{k}"])
+        for k, v in (history or {}).items():
+            hist[k] = v.astype(hist[k].dtype)
+        n = {len(v) for v in hist.values()}
+        if len(n) > 1:
+            raise InputError(f"contact state: the history has {sorted(n)} rows in different entries "
+                             f"(given: {sorted(history or {})}; all of {sorted(hist)} are needed)")
         self._history = hist
-        if "mult_keys" in state:
-            self._mult_committed = (np.asarray(state["mult_keys"], dtype=np.int64),
-                                    np.asarray(state["mult_values"], dtype=float))
+        if mult is not None:
+            self._mult_committed = mult
         self._mult = self._mult_committed
-        for name in ("prev_points", "prev_owners"):
-            if name in state:
-                setattr(self, f"_{name}", np.sort(np.asarray(state[name], dtype=np.int64)))
+        for name, v in prev.items():
+            setattr(self, f"_{name}", np.sort(v))
         self._forget_kinds()
 
     def _forget_kinds(self):

@@ -33,7 +33,9 @@ complete files, and ``.pvd`` files that list exactly the steps written.
 A writer first removes the numbered files its folder's ``beams.pvd`` and
 ``contact.pvd`` list (the previous run's series; nothing else; the collections at
 once, the files they listed in the writing thread before any new file), so ParaView
-never groups two runs.
+never groups two runs; a writer that saves ``solution.npz`` (``checkpoint`` not ``None``)
+also removes the previous one at once, so a run that fails before its first save leaves no
+other run's result behind.
 The VTU files are written by ``io.vtu`` (numpy and zlib; meshio's binary layout, read
 by meshio, pyvista and ParaView) with two-point ``line`` cells, which meshio reads (it
 cannot read VTK poly-lines, type 4); for smooth tubes ParaView joins them into
@@ -140,6 +142,8 @@ class StepWriter:
         stale = previous_series(self.folder, (f"{BEAMS}.pvd", f"{CONTACT}.pvd"), SERIES)
         for name in (f"{BEAMS}.pvd", f"{CONTACT}.pvd"):
             (self.folder / name).unlink(missing_ok=True)
+        if checkpoint is not None:     # this run's archive replaces the last one's, also when it saves nothing
+            (self.folder / ARCHIVE).unlink(missing_ok=True)
         self.refine = refine
         self.compression = compression
         if contact is None and system is not None:
@@ -316,11 +320,27 @@ def _write_empty_points(path):
         f.write(text)
 
 
+def _steps(steps, n):
+    """The step numbers ``steps`` (a list of integers in ``-n .. n - 1``) as ``0 .. n - 1``; else ``InputError``."""
+    if isinstance(steps, (str, bytes)) or not hasattr(steps, "__iter__"):
+        raise InputError(f"write_vtk: steps must be a list of step numbers or None, got {steps!r}")
+    out = []
+    for k in steps:
+        if isinstance(k, (bool, np.bool_)) or not isinstance(k, (int, np.integer)):
+            raise InputError(f"write_vtk: steps must be integers, got {k!r} in {steps!r}")
+        if not -n <= k < n:
+            raise InputError(f"write_vtk: step {k} out of range (the solution has steps 0..{n - 1})")
+        out.append(int(k) % n)
+    return out
+
+
 def write_vtk(solution, folder, steps=None, refine=8, compression="zlib"):
-    """Write the steps (default all) of a (saved or fresh) ``solution`` to ``folder``; returns the .pvd path."""
-    writer = StepWriter(folder, None, refine=refine, compression=compression, checkpoint=None)
+    """Write the steps (default all; a list of step numbers, negative from the end) of a (saved or
+    fresh) ``solution`` to ``folder``; returns the .pvd path."""
     n = len(solution)
-    for k in (range(n) if steps is None else [s % n for s in steps]):
+    chosen = range(n) if steps is None else _steps(steps, n)
+    writer = StepWriter(folder, None, refine=refine, compression=compression, checkpoint=None)
+    for k in chosen:
         writer.write(solution, k)
     writer.close()
     return writer.folder / f"{BEAMS}.pvd"
