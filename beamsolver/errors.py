@@ -1,6 +1,6 @@
 """Exceptions raised by beamsolver."""
 
-__all__ = ["InputError", "ConvergenceError", "StabilityWarning", "StabilizationWarning"]
+__all__ = ["InputError", "ConvergenceError", "StabilityWarning", "StabilizationWarning", "ConditioningWarning"]
 
 
 class InputError(ValueError):
@@ -23,3 +23,8 @@ class StabilityWarning(RuntimeWarning):
 
 class StabilizationWarning(RuntimeWarning):
     """The viscous stabilisation has dissipated a large part of the strain energy: see ``solve(stabilize=)``."""
+
+
+class ConditioningWarning(RuntimeWarning):
+    """A contact penalty far stiffer than the beams it couples leaves the tangent ill-conditioned:
+    see ``beamsolver.contact.conditioning``."""

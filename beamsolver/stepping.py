@@ -177,6 +177,7 @@ class Run:
                            "separate the beams by a small gap or raise max_iter")
                 else:
                     why = f"loads or motions already act: {e}; start the loads from zero or use more steps"
+                why += self.opt.get("penalty_hint", "")
                 err = ConvergenceError(f"solve: no equilibrium at t_start = {t_start:.6g}, where {why}", self.sol)
                 err.failure = e
                 raise err from None
