@@ -128,3 +128,25 @@ def test_kernel_counts_a_round_off_gap_touching_as_the_oracle(where):
     if np.any(o1["gap"] > 0):
         _, K2, o2 = kernel_jit.kernel_and_tangent(X, dict(p, touch=0.0), False)
         assert not np.all(o2["active"]) and np.abs(K2[o1["gap"] > 0]).max() == 0.0
+
+
+def test_line_contact_smoothing_already_covers_round_off_gaps():
+    """Parallel touching wires (line contact, default smoothing 1e-6 (R1 + R2) >> the touching
+    tolerance): no touching band is added, so their results do not move; with ``smoothing=0`` it is."""
+    def inputs(**options):
+        m = bs.Model()
+        sec = bs.Section.circular(radius=0.05, E=1e7, nu=0.3)
+        a = m.add_beam(bs.geometry.straight((0, -1, 0), (0, 1, 0), 4), sec)
+        b = m.add_beam(bs.geometry.straight((0, -1, 0.1), (0, 1, 0.1), 4), sec)
+        for w in (a, b):
+            m.clamp(w.first)
+            m.clamp(w.last)
+        m.add_contact(b, a, **options)
+        problem = Problem.from_model(m)
+        H = problem.system.poses0
+        problem.contact.begin_step(H, 0.0)
+        return problem.contact.kernel_inputs(H)[1]
+    p = inputs()
+    assert np.all(p["kind"] == pairs.LINE) and np.all(p["smoothing"] > 0) and np.all(p["touch"] == 0.0)
+    p = inputs(smoothing=0.0)
+    np.testing.assert_allclose(p["touch"], pairs.touch_tolerance(1.0, 0.05, 0.05), rtol=1e-15)

@@ -404,7 +404,9 @@ class ContactSystem(Contribution):
         # elastic slip at the onset of sliding (used where no penalty_t is given)
         p["elastic_slip"] = self._decl_slip_tol[dec] * self.sys.L[P.e[sel]]
         p["smoothing"] = self._smoothing(P, sel)
-        p["touch"] = touch_tolerance(_extent(H), p["R1"], p["R2"])
+        # round-off gaps touch (pairs.touching_gap) where the law's smoothing gap does not cover them already
+        touch = touch_tolerance(_extent(H), p["R1"], p["R2"])
+        p["touch"] = np.where(p["smoothing"] >= touch, 0.0, touch)
         key = P.key[sel]
         mi, mf = self._lookup(self._mult[0], key)
         p["multiplier"] = np.where(mf, self._mult[1][mi] if len(self._mult[1]) else 0.0, 0.0)
