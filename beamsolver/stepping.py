@@ -9,7 +9,7 @@ relative tolerance ``STEP_TOLERANCE``, and a grown step cut back below
 grows (``growth``), never past the user's step (easy: no cut-back and at most ``easy_limit``
 Newton iterations, the more of ``EASY_ITERATIONS`` and the iterations of the last step taken at
 the user's size: a contact step that needs 15 iterations at any size regrows too; or ``steady``:
-about as many iterations as the step before, within half the Newton budget, as slip steps of 7-12
+about as many iterations as the step before, within 2/3 of the Newton budget, as slip steps of 7-12
 iterations at any size), and not back to the size of the
 last failed step before ``wait`` easy steps running (``next_step``: the wait doubles
 each time that size fails again, up to ``WAIT_MAX``; 2, the fixed rule, until then), and

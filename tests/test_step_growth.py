@@ -153,3 +153,36 @@ def test_slip_steps_regrow_after_a_forced_cut_back():
     first_full = half.index(False)
     assert first_full <= 6, [s["dt"] for s in sol.stats]          # regrew within 6 steps (was 16)
     assert len(sol.times) <= 20
+    # not straight back into the size that failed at nearly the same state: past the failed step's end
+    assert sol.times[first_full] >= 1.0 / 16
+
+
+def test_a_restart_keeps_the_previous_iterations_of_steady():
+    """The forced twisted pair stopped after its third step (half size, one steady step running):
+    the restart needs the previous step's iterations (``resume["previous"]``) to regrow where
+    the whole run did."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+    from twisted_pair import build
+    model = build()[0]
+    calls, force = [], _forced_cut_back()
+
+    def record(info):
+        force(info)
+        calls.append(info["t"])
+    full = bs.solve(model, steps=16, callback=record)
+    j = 3
+    assert full.stats[j]["dt"] < 0.75 / 16 and full.stats[j + 1]["dt"] < 0.75 / 16   # stopped inside the stretch
+    last = max(i for i, t in enumerate(calls) if t == full.times[j])
+    count, force = [0], _forced_cut_back()
+
+    def stop(info):
+        force(info)
+        count[0] += 1
+        if count[0] > last + 1:
+            raise KeyboardInterrupt
+    with pytest.raises(KeyboardInterrupt) as err:
+        bs.solve(model, steps=16, callback=stop)
+    part = err.value.solution
+    assert part.n_steps == j and part.resume["previous"] == full.stats[j]["iterations"]
+    sol = bs.solve(model, steps=16, restart=part)
+    np.testing.assert_array_equal(sol.times, full.times)
