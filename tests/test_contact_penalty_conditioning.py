@@ -105,3 +105,16 @@ def test_a_stiff_but_well_conditioned_penalty_is_named_when_the_solve_fails():
     msg = str(err.value)
     assert "add_contact no. 0 has penalty 1e+09 (100 times its default 1e+07)" in msg
     assert "ill-conditioned" not in msg and "jump with penetrations" in msg
+
+
+def test_a_non_finite_failure_also_names_the_penalty():
+    """The 1e18 report of the issue was "line search found no finite residual": whatever the
+    failure, the error names a stiff penalty (here the failure is raised by the callback)."""
+    from beamsolver.failures import NonFinite
+
+    def callback(info):
+        if info["t"] > 0.0:
+            raise NonFinite("line search found no finite residual along the Newton direction")
+    with pytest.warns(bs.ConditioningWarning):
+        with pytest.raises(bs.ConvergenceError, match=r"no finite residual.*add_contact no\. 0 has penalty 1e\+18"):
+            bs.solve(_pressed(1e18), steps=1, min_step_ratio=0.5, callback=callback)
