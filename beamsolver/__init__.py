@@ -1,7 +1,8 @@
 """beamsolver: quasi-static geometrically exact beams on SE(3) with frictional contact."""
 from . import contact, elements, geometry, motion, se3
 from .arclength import ArcLength
-from .errors import ConvergenceError, InputError, MaterialRangeWarning, StabilityWarning, StabilizationWarning
+from .errors import (ConditioningWarning, ConvergenceError, InputError, MaterialRangeWarning, StabilityWarning,
+                     StabilizationWarning)
 from .io import load
 from .linear import Linearization, linearize
 from .model import Beam, Model
@@ -13,5 +14,6 @@ from .sweep_engine import sweep   # dask is imported when a sweep runs, not here
 
 
 __all__ = ["Model", "Beam", "Section", "Solution", "solve", "Convergence", "InputError",
-           "ConvergenceError", "MaterialRangeWarning", "StabilityWarning", "StabilizationWarning", "load", "linearize", "sweep", "Linearization", "se3", "geometry",
+           "ConvergenceError", "MaterialRangeWarning", "StabilityWarning", "StabilizationWarning", "ConditioningWarning",
+           "load", "linearize", "sweep", "Linearization", "se3", "geometry",
            "motion", "contact", "elements", "ArcLength", "__version__"]

@@ -1,6 +1,7 @@
 """Exceptions raised by beamsolver."""
 
-__all__ = ["InputError", "ConvergenceError", "StabilityWarning", "StabilizationWarning", "MaterialRangeWarning"]
+__all__ = ["InputError", "ConvergenceError", "StabilityWarning", "StabilizationWarning", "MaterialRangeWarning",
+           "ConditioningWarning"]
 
 
 class InputError(ValueError):
@@ -28,3 +29,8 @@ class StabilizationWarning(RuntimeWarning):
 class MaterialRangeWarning(UserWarning):
     """A section is used beyond the yield stress or strain it was given (``Section(yield_stress=)``):
     the linear-elastic answer is no longer the material's (``beamsolver.material_range``)."""
+
+
+class ConditioningWarning(RuntimeWarning):
+    """A contact penalty far stiffer than the beams it couples leaves the tangent ill-conditioned:
+    see ``beamsolver.contact.conditioning``."""

@@ -343,7 +343,8 @@ class Model:
         ``mu``: Coulomb friction coefficient (default 0: frictionless).
         ``penalty``: normal penalty, force / length^2 (contact force per unit length
         per unit penetration; default: the Young's modulus ``EA / (pi r^2)`` of the
-        softer section, ``contact.law.default_penalty``).  Options, lengths in the
+        softer section, ``contact.law.default_penalty``; ``solve`` warns when
+        ``penalty L_e^2 / EA`` passes 1e6, ``contact.conditioning``).  Options, lengths in the
         model's unit:
 
         - ``smoothing``: gap over which the normal law is made C1 (default None:

@@ -23,6 +23,7 @@ import numpy as np
 
 from . import diagnosis, elements, linsolve, se3
 from .arclength import ArcLengthRun, check_arc_length_arguments
+from .contact import conditioning
 from .errors import InputError
 from .failures import DampingStalled, Diverged, NonFinite, NotConverged, RotationLimit, SingularTangent, StepFailed
 from .problem import Problem
@@ -632,13 +633,15 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     arc = check_arc_length_arguments(path, arc_length, restart, branch_switching, stabilize)
     problem = Problem.from_model(model, check_rigid_modes=check_rigid_modes)
     system = problem.system
+    penalties = conditioning.penalty_ratios(model, system)
+    conditioning.warn_ill_conditioned(penalties)
     sol, t_start = _starting_point(restart, model, problem, t_start, t_end)
     grid = np.linspace(t_start, t_end, int(steps) + 1)
     dt_min = _step_floor(min_step_ratio, grid)
     newton = Newton(problem, Convergence(rtol=rtol, dtol=dtol, max_iter=max_iter), line_search, callback)
     newton.linsolver = linsolve.Solver(linear_solver)
     options = _run_options(problem, t_start, t_end, allow_unmet_tolerance, check_stability, modes,
-                           branch_switching, stabilize)
+                           branch_switching, stabilize, conditioning.stiff_penalty_hint(penalties))
     if sol is not None and options["stabilizer"] is not None:
         options["stabilizer"].resume(sol)
     run = None
@@ -655,13 +658,16 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
 
 
 def _run_options(problem, t_start, t_end, allow_unmet_tolerance, check_stability, modes, branch_switching,
-                 stabilize):
-    """The options of ``stepping.Run``; a stabilisation joins ``problem``'s contributions."""
+                 stabilize, penalty_hint=""):
+    """The options of ``stepping.Run``; a stabilisation joins ``problem``'s contributions;
+    ``penalty_hint``: the tail of a ``ConvergenceError`` naming a stiff contact penalty
+    (``contact.conditioning.stiff_penalty_hint``), in place of the generic advice."""
     modes, branch_switching = check_stability_options(modes, branch_switching)
     stabilizer = stabilize_option(problem.system, stabilize, check=problem.conservative)
     if stabilizer is not None:
         problem.contributions.append(stabilizer)
-    return dict(allow_unmet_tolerance=allow_unmet_tolerance, advice=_advice(problem, t_start, t_end),
+    return dict(allow_unmet_tolerance=allow_unmet_tolerance, advice=_advice(problem, t_start, t_end, penalty_hint),
+                penalty_hint=penalty_hint,
                 check_stability=bool(check_stability or modes or branch_switching), modes=modes,
                 branch_switching=branch_switching, stabilizer=stabilizer)
 
@@ -698,8 +704,9 @@ def _writer(output, system, checkpoint):
     return StepWriter(output, system, checkpoint=checkpoint)
 
 
-def _advice(problem, t_start, t_end):
-    """``advice(failure, rotation_limit, H, t)``: the tail of a ``ConvergenceError`` message."""
+def _advice(problem, t_start, t_end, penalty_hint=""):
+    """``advice(failure, rotation_limit, H, t)``: the tail of a ``ConvergenceError`` message
+    (``penalty_hint``, if any, in place of the tangent's diagnosis)."""
     system = problem.system
 
     def advice(failure, rotation_limit, H, t):
@@ -712,6 +719,8 @@ def _advice(problem, t_start, t_end):
                     f"(limit {MAX_ELEMENT_ROTATION:.2f}): refine the mesh")
         if failure.rotation or rotation_limit is not None or turned > 0.75 * MAX_ELEMENT_ROTATION:
             hint += _refine_advice(system, H, t, t_start, t_end)
+        if penalty_hint:
+            return hint + penalty_hint
         if not hint:
             hint = diagnosis.advice(failure, problem, H, t)
         return hint

@@ -8,7 +8,9 @@ relative tolerance ``STEP_TOLERANCE``, and a grown step cut back below
 ``dt_min`` tries ``dt_min`` itself); after two easy steps running the next one
 grows (``growth``), never past the user's step (easy: no cut-back and at most ``easy_limit``
 Newton iterations, the more of ``EASY_ITERATIONS`` and the iterations of the last step taken at
-the user's size: a contact step that needs 15 iterations at any size regrows too), and not back to the size of the
+the user's size: a contact step that needs 15 iterations at any size regrows too; or ``steady``:
+about as many iterations as the step before, within 2/3 of the Newton budget, as slip steps of 7-12
+iterations at any size), and not back to the size of the
 last failed step before ``wait`` easy steps running (``next_step``: the wait doubles
 each time that size fails again, up to ``WAIT_MAX``; 2, the fixed rule, until then), and
 lands on the grid (no sliver shorter than ``LANDING`` steps before a grid point).  Every loop is
@@ -32,8 +34,8 @@ from .progress import Progress
 from .material_range import RangeCheck
 from .results import Solution, describe_model
 
-__all__ = ["Run", "growth", "easy_limit", "next_step", "after_failure", "STEP_TOLERANCE", "EASY_ITERATIONS", "WAIT_MAX",
-           "STEP_ZERO_ITERATIONS"]
+__all__ = ["Run", "growth", "easy_limit", "steady", "next_step", "after_failure", "STEP_TOLERANCE", "EASY_ITERATIONS", "WAIT_MAX",
+           "STEP_ZERO_ITERATIONS", "STEADY_GROWTH", "STEADY_SHARE"]
 
 log = logging.getLogger("beamsolver")
 
@@ -41,6 +43,8 @@ STEP_TOLERANCE = 1e-9      # relative rounding allowed when comparing step sizes
 LANDING = 0.1              # a step ending within this fraction of a step before a grid point lands on it
 EASY_ITERATIONS = 6        # a step converging within these iterations is easy (growth)
 EASY_RUN = 2               # easy steps running before the step grows (growth)
+STEADY_GROWTH = 1.25       # steady: at most this times the previous step's iterations, plus one (steady)
+STEADY_SHARE = 2.0 / 3.0   # steady: at most this share of max_iter (steady)
 WAIT_MAX = 32              # most easy steps running before a step regrows to a size that failed again
 MAX_OUTER = 100            # outer iterations of a step (Problem.repeat_step) before it fails
 UNDAMPED_MARGIN = 2.0      # an undamped residual up to this times the damped one Newton accepted is equilibrium
@@ -59,6 +63,17 @@ def easy_limit(reference):
     of the last step converged at the user's size without cut-back, ``None``: none yet) if more.
     After a cut-back, a step that converges as fast as the user's steps did counts as easy."""
     return EASY_ITERATIONS if reference is None else max(EASY_ITERATIONS, int(reference))
+
+
+def steady(iterations, previous, max_iter):
+    """Whether a step converged in a steady number of Newton ``iterations``: at most
+    ``STEADY_GROWTH * previous + 1`` (``previous``: the iterations of the step before, ``None``:
+    none) and at most ``STEADY_SHARE * max_iter``.  A slip-dominated stretch of contact steps
+    takes 7-12 iterations at every size; such steps count as easy (the failed-size memory of
+    ``next_step`` still holds back a size that failed)."""
+    if previous is None:
+        return False
+    return iterations <= STEADY_GROWTH * previous + 1 and iterations <= STEADY_SHARE * max_iter
 
 
 def next_step(dt, iterations, easy, failed=np.inf, wait=EASY_RUN):
@@ -103,7 +118,7 @@ class Run:
         sys, grid = self.sys, self.grid
         t_start, steps = grid[0], len(grid) - 1
         self.dt, self.t, self.k, self.easy = self.dt_user, t_start, 1, 0
-        self.failed, self.wait, self.reference = np.inf, EASY_RUN, None
+        self.failed, self.wait, self.reference, self.previous = np.inf, EASY_RUN, None, None
         if restart_solution is None:
             self.sol = Solution(sys.model, sys)
             self.range = RangeCheck.of(self.sol.description)
@@ -122,6 +137,7 @@ class Run:
                     self.dt, self.easy = min(dt, self.dt_user), int(rs["easy"])
                     self.failed, self.wait = _memory(rs)
                     self.reference = _reference(rs)
+                    self.previous = _reference(rs, "previous")
             if self.writer is not None:
                 for j in range(len(sol)):
                     self.writer.write(sol, j)
@@ -166,6 +182,7 @@ class Run:
                            "separate the beams by a small gap or raise max_iter")
                 else:
                     why = f"loads or motions already act: {e}; start the loads from zero or use more steps"
+                why += self.opt.get("penalty_hint", "")
                 err = ConvergenceError(f"solve: no equilibrium at t_start = {t_start:.6g}, where {why}", self.sol)
                 err.failure = e
                 raise err from None
@@ -299,7 +316,9 @@ class Run:
             t, k = self.grid[k], k + 1
         if stats["cutbacks"] == 0 and dt >= self.dt_user * (1.0 - STEP_TOLERANCE):
             self.reference = stats["iterations"]
-        easy = self.easy + 1 if stats["iterations"] <= easy_limit(self.reference) and stats["cutbacks"] == 0 else 0
+        its, previous, self.previous = stats["iterations"], self.previous, stats["iterations"]
+        calm = its <= easy_limit(self.reference) or steady(its, previous, self.newton.conv.max_iter)
+        easy = self.easy + 1 if calm and stats["cutbacks"] == 0 else 0
         dt, self.failed, self.wait = next_step(dt, stats["iterations"], easy, self.failed, self.wait)
         dt = min(dt, self.dt_user)
         if problem.contributions:
@@ -362,9 +381,10 @@ class Run:
         sol.mark_off_equilibrium(text)
 
     def _memory_state(self):
-        """The failed-size memory of ``next_step`` and the ``easy_limit`` reference for ``resume`` (JSON: no inf)."""
+        """The failed-size memory of ``next_step``, the ``easy_limit`` reference and the ``steady``
+        previous iterations for ``resume`` (JSON: no inf)."""
         return dict(failed=None if not np.isfinite(self.failed) else float(self.failed), wait=int(self.wait),
-                    reference=self.reference)
+                    reference=self.reference, previous=self.previous)
 
     def _stability(self, stats, t, H, ev):
         """Record whether the tangent at the converged state ``H`` (evaluation ``ev``) is positive
@@ -453,10 +473,11 @@ def _memory(resume):
     return failed, min(max(wait, EASY_RUN), WAIT_MAX)
 
 
-def _reference(resume):
-    """The ``easy_limit`` reference of a ``resume`` dict; missing or damaged: ``None``."""
+def _reference(resume, key="reference"):
+    """The ``easy_limit`` reference (or ``key``: another iteration count) of a ``resume`` dict;
+    missing or damaged: ``None``."""
     try:
-        ref = int(resume.get("reference"))
+        ref = int(resume.get(key))
     except (TypeError, ValueError, OverflowError):
         return None
     return ref if ref >= 0 else None

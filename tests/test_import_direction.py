@@ -29,7 +29,7 @@ LAYER = {
     # 3: model declarations and their assembly
     "model": 3, "contributions": 3, "cables": 3, "assembly": 3, "stabilize": 3, "topology": 1, "assembly_jit": 3,
     "extra_pattern": 3,
-    "contact.system": 3, "linsolve": 3, "bifurcation": 3,
+    "contact.system": 3, "contact.conditioning": 3, "linsolve": 3, "bifurcation": 3,
     # 4: the Problem interface between the solver and the physics
     "problem": 4,
     # 5: results

@@ -115,3 +115,74 @@ def test_contact_steps_regrow_after_a_cut_back():
     sol = bs.solve(build(E=float(np.nextafter(200e9, np.inf)))[0], steps=8)
     assert sol.converged and sol.times[-1] == 1.0
     assert len(sol.times) <= 16, [s["dt"] for s in sol.stats]
+
+
+def test_steady_is_about_the_previous_steps_iterations_within_the_budget():
+    from beamsolver.stepping import STEADY_GROWTH, STEADY_SHARE, steady
+    assert not steady(3, None, 30)                                  # no step before: not steady
+    assert steady(11, 10, 30) and steady(int(STEADY_GROWTH * 8 + 1), 8, 30)
+    assert not steady(12, 8, 30)                                    # rising: 8 -> 12
+    assert steady(20, 22, 30) and not steady(21, 22, 30)            # within STEADY_SHARE of max_iter only
+    assert not steady(9, 9, 12) and steady(8, 9, 12) and STEADY_SHARE * 12 == 8
+
+
+def _forced_cut_back():
+    """A callback that fails the first Newton iteration after ``t_start`` once (a retryable ``NotConverged``)."""
+    from beamsolver.failures import NotConverged
+    done = []
+
+    def callback(info):
+        if not done and info["t"] > 0.0:
+            done.append(info["t"])
+            raise NotConverged("failure forced by the test")
+    return callback
+
+
+def test_slip_steps_regrow_after_a_forced_cut_back():
+    """Issue 27 item 6.  The twisted pair (examples/twisted_pair.py, 16 steps, never cut back:
+    17 states, 135 iterations) with its first step forced to fail: the steps at half size then
+    take a steady 10-14 iterations (slip), never as few as ``EASY_ITERATIONS``, and no step had
+    been taken at the user's size: with ``easy_limit`` alone the step stayed halved until the
+    iterations fell to 6 near the end (25 states, 214 iterations).  Steady steps regrow."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+    from twisted_pair import build
+    sol = bs.solve(build()[0], steps=16, callback=_forced_cut_back())
+    assert sol.converged and sol.times[-1] == 1.0
+    assert sum(s["cutbacks"] for s in sol.stats) == 1 and sol.stats[1]["cutbacks"] == 1
+    half = [s["dt"] < 0.75 / 16 for s in sol.stats[1:]]
+    first_full = half.index(False)
+    assert first_full <= 6, [s["dt"] for s in sol.stats]          # regrew within 6 steps (was 16)
+    assert len(sol.times) <= 20
+    # not straight back into the size that failed at nearly the same state: past the failed step's end
+    assert sol.times[first_full] >= 1.0 / 16
+
+
+def test_a_restart_keeps_the_previous_iterations_of_steady():
+    """The forced twisted pair stopped after its third step (half size, one steady step running):
+    the restart needs the previous step's iterations (``resume["previous"]``) to regrow where
+    the whole run did."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+    from twisted_pair import build
+    model = build()[0]
+    calls, force = [], _forced_cut_back()
+
+    def record(info):
+        force(info)
+        calls.append(info["t"])
+    full = bs.solve(model, steps=16, callback=record)
+    j = 3
+    assert full.stats[j]["dt"] < 0.75 / 16 and full.stats[j + 1]["dt"] < 0.75 / 16   # stopped inside the stretch
+    last = max(i for i, t in enumerate(calls) if t == full.times[j])
+    count, force = [0], _forced_cut_back()
+
+    def stop(info):
+        force(info)
+        count[0] += 1
+        if count[0] > last + 1:
+            raise KeyboardInterrupt
+    with pytest.raises(KeyboardInterrupt) as err:
+        bs.solve(model, steps=16, callback=stop)
+    part = err.value.solution
+    assert part.n_steps == j and part.resume["previous"] == full.stats[j]["iterations"]
+    sol = bs.solve(model, steps=16, restart=part)
+    np.testing.assert_array_equal(sol.times, full.times)

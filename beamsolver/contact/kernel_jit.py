@@ -63,8 +63,8 @@ from .law import PENALTY_COULOMB
 from .pairs import LINE, ORTHOGONAL, PENALTY_T_MIN
 
 # columns of the per-point parameter table ``par``
-XI1, XI2, R1_, R2_, WEIGHT, PENALTY, MULT, MU, PEN_T, SMOOTH, ESLIP, XI1P, XI2P = range(13)
-N_PAR = 13
+XI1, XI2, R1_, R2_, WEIGHT, PENALTY, MULT, MU, PEN_T, SMOOTH, ESLIP, XI1P, XI2P, TOUCH = range(14)
+N_PAR = 14
 
 
 # the law, bound per kernel by ``make_kernel`` (the templates below call these names)
@@ -949,7 +949,8 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
     n, t1, t2, dist = _axes(RC, xC, RF, xF, G)
     R1, R2, wgt = par[R1_], par[R2_], par[WEIGHT]
     gap = dist - R1 - R2
-    lam, dlam, active = _normal_law(gap, par[PENALTY], par[MULT], par[SMOOTH])      # bound by make_kernel
+    touching = 0.0 < gap <= par[TOUCH]          # round-off of a touching pair's gap: touching (pairs.touching_gap)
+    lam, dlam, active = _normal_law(0.0 if touching else gap, par[PENALTY], par[MULT], par[SMOOTH])  # make_kernel
     for k in range(24):
         G[G_DLAM * W + k] = dlam * G[G_DDIST * W + k]
     F = scale(-wgt * lam, n)
@@ -1078,7 +1079,7 @@ def project(kind, HA1, h1, xi1, HA2, h2, xi2, iterations=3):
 _PAR_COLUMNS = ((XI1, "xi1", np.nan), (XI2, "xi2", np.nan), (R1_, "R1", np.nan), (R2_, "R2", np.nan),
                 (WEIGHT, "weight", np.nan), (PENALTY, "penalty", np.nan), (MULT, "multiplier", 0.0),
                 (MU, "mu", np.nan), (PEN_T, "penalty_t", np.nan), (SMOOTH, "smoothing", 0.0),
-                (ESLIP, "elastic_slip", np.nan))
+                (ESLIP, "elastic_slip", np.nan), (TOUCH, "touch", 0.0))
 
 
 def _readonly(v, shape, dtype):

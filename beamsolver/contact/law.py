@@ -72,7 +72,7 @@ class ContactLaw:
 
     ``normal(gap, penalty, multiplier, smoothing) -> (lam, dlam_dgap, active)``: normal traction per
     unit weight, its derivative with respect to the gap and whether the point carries force or
-    stiffness; ``tangential(trial0, trial1, Dtrial, mu, lam, Dlam) -> (lt0, lt1, D, stick)``:
+    stiffness (a gap within round-off above zero arrives as 0: ``pairs.touching_gap``); ``tangential(trial0, trial1, Dtrial, mu, lam, Dlam) -> (lt0, lt1, D, stick)``:
     tangential traction from the trial ``(trial0, trial1)`` (in ``t1, t2``) in forward mode, ``D``
     ``(2, k)`` its gradient from the gradients ``Dtrial`` ``(2, k)`` of the trial and ``Dlam`` ``(k,)``
     of the normal traction.  Both are numba-jitted (``_jit.jit``).  ``name`` names the compiled kernel (and its numba cache entry).

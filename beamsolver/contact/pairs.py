@@ -30,6 +30,22 @@ from .law import coulomb_return_mapping, normal_force
 LINE, ORTHOGONAL, POINT = 0, 1, 2
 NORMAL_TOL = 1e-9        # centre distance / (R1 + R2) below which a pair has no contact normal
 PENALTY_T_MIN = 1e-3     # floor of lam_N in the slip-tolerance stick stiffness, / (normal penalty x elastic slip)
+TOUCH_ROUNDOFF = 32.0    # touching tolerance / (eps (scene extent + R1 + R2)): the gap's round-off is ~1 such unit
+
+
+def touch_tolerance(extent, R1, R2):
+    """Gap below which a pair touches (``touching_gap``): ``TOUCH_ROUNDOFF eps (extent + R1 + R2)``,
+    ``extent`` the largest node coordinate of the scene (its round-off in the centre-line distance),
+    ``R1 + R2`` that of the distance itself (docs/theory_contact_tolerances.md)."""
+    return TOUCH_ROUNDOFF * np.finfo(float).eps * (extent + R1 + R2)
+
+
+def touching_gap(gap, touch):
+    """The gap the normal law sees: a gap in ``(0, touch]`` is round-off of an exactly touching pair,
+    taken as 0 (the law then counts the pair touching, with stiffness and without force); its
+    variation is kept (complex step: the real part is shifted).  The kernel's rule, elementwise."""
+    r = np.real(gap)
+    return gap - np.where((r > 0.0) & (r <= touch), r, 0.0)
 
 
 def stick_penalty(lam_n, mu, penalty, elastic_slip):
@@ -126,7 +142,7 @@ def contact_kernel(X, p, friction=True):
     ``X``: ``(..., 4, 4, 4)`` node poses.  ``p``: dict of per-pair arrays
     (``kind``, ``xi1``, ``xi2``, ``R1``, ``R2``, ``weight``, ``penalty``,
     ``multiplier``, ``mu``, ``penalty_t`` (nan: ``mu lam_N / elastic_slip``), optional ``smoothing``
-    (gap) and ``elastic_slip``, and for friction ``has_history``,
+    (gap), ``touch`` (``touching_gap``) and ``elastic_slip``, and for friction ``has_history``,
     ``H_CL``, ``H_FK``, ``H_LK_prev``, ``xi1_prev``, ``xi2_prev``, ``lam_t_prev``
     (global 3-vector per unit weight)).
     """
@@ -143,7 +159,8 @@ def contact_kernel(X, p, friction=True):
     R1, R2 = p["R1"], p["R2"]
     xC, xF, n, t1, t2, dist = _axes(HC, HF, R1, R2)
     gap = dist - R1 - R2
-    lam_n, active = normal_force(gap, p["penalty"], p["multiplier"], p.get("smoothing", 0.0))
+    lam_n, active = normal_force(touching_gap(gap, p.get("touch", 0.0)), p["penalty"], p["multiplier"],
+                                 p.get("smoothing", 0.0))
     w = p["weight"]
     F_slave = -(w * lam_n)[..., None] * n
     out = dict(gap=gap, lam_n=lam_n, active=active, n=n, t1=t1, t2=t2, xC=xC, xF=xF,

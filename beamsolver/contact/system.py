@@ -52,7 +52,7 @@ from .law import default_penalty
 from . import kernel_jit, pairs
 from .kernel_jit import contact_kernel, kernel_and_tangent      # compiled; pairs.py's are the oracle
 from .options import SMOOTHING, ContactOptions
-from .pairs import LINE, NORMAL_TOL, POINT, material_frames, no_normal
+from .pairs import LINE, NORMAL_TOL, POINT, material_frames, no_normal, touch_tolerance
 from .record import Candidates, PairSet
 from .ownership import gauss_owners, gauss_record
 from .projection import closest_points, element_twists, gauss_projections, section_points
@@ -409,6 +409,9 @@ class ContactSystem(Contribution):
         # elastic slip at the onset of sliding (used where no penalty_t is given)
         p["elastic_slip"] = self._decl_slip_tol[dec] * self.sys.L[P.e[sel]]
         p["smoothing"] = self._smoothing(P, sel)
+        # round-off gaps touch (pairs.touching_gap) where the law's smoothing gap does not cover them already
+        touch = touch_tolerance(_extent(H), p["R1"], p["R2"])
+        p["touch"] = np.where(p["smoothing"] >= touch, 0.0, touch)
         key = P.key[sel]
         mi, mf = self._lookup(self._mult[0], key)
         p["multiplier"] = np.where(mf, self._mult[1][mi] if len(self._mult[1]) else 0.0, 0.0)
@@ -499,7 +502,7 @@ class ContactSystem(Contribution):
         mi, mf = self._lookup(self._mult[0], P.key)
         mult = np.where(mf, self._mult[1][mi] if len(self._mult[1]) else 0.0, 0.0)
         # the smoothing zone plus a small band keeps the projection-updated gap consistent
-        band = self._smoothing(P, slice(None)) + 1e-3 * (P.R1 + P.R2)
+        band = self._smoothing(P, slice(None)) + 1e-3 * (P.R1 + P.R2) + touch_tolerance(_extent(H), P.R1, P.R2)
         return np.flatnonzero(mult - pen * gap > -pen * band)
 
     # ------------------------------------------------------------ refusals
@@ -799,6 +802,11 @@ def _frames(out):
     HL[:, :3, 3] = out["xC"]
     HK[:, :3, 3] = out["xF"]
     return HL, HK
+
+
+def _extent(H):
+    """Largest node coordinate of the poses ``H`` (``pairs.touch_tolerance``)."""
+    return float(np.abs(H[..., :3, 3]).max(initial=0.0))
 
 
 def _kernel(X, p, friction, law, tangent, K=None):
