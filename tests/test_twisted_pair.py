@@ -93,11 +93,12 @@ def test_slave_master_symmetry(runs):
 
 
 def test_halved_steps_agree(runs):
-    """4 steps of a quarter turn are cut into 8 (``motion_path``); 16 halve them: the path's
-    friction history changes torque and shortening by 4e-6 and 4e-5."""
+    """4 steps of a quarter turn are cut (``motion_path``, cut-backs; the steps then regrow,
+    ``stepping.steady``); 16 steps take the user's size: the path's friction history changes
+    torque and shortening by 4e-6 and 4e-5."""
     (sol, rows, _), _ = runs
     sol_h, rows_h, _ = twisted_pair.main(**dict(KW, steps=16))
-    assert len(sol_h.times) == 2 * len(sol.times) - 1
+    assert sol.times[-1] == sol_h.times[-1] == 1.0 and len(sol_h.times) == 17
     assert rows_h[-1][1] == pytest.approx(rows[-1][1], rel=2e-5)
     assert rows_h[-1][4] == pytest.approx(rows[-1][4], rel=2e-4)
 
