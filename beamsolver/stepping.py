@@ -396,10 +396,8 @@ def _reference(resume):
 
 def _acts_at(system, H, t):
     """Whether loads, prescribed motions or ``fix`` values act at ``t`` on the state ``H``."""
-    if len(system.load_scales):
-        lf = system.load_factors(t)
-        if np.any(lf * (np.abs(system.load_F).sum(axis=1) + np.abs(system.load_M).sum(axis=1)) != 0):
-            return True
+    if len(system.load_scales) and system.loads_act(system.load_factors(t)):
+        return True
     if len(system.prescribed_nodes) and np.any(system.prescribed_poses(t) != H[system.prescribed_nodes]):
         return True
     return any(dx != 0 for _, _, dx in system.fixed_value_increments(H, t)) if system.fix_values else False

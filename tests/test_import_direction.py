@@ -23,7 +23,7 @@ LAYER = {
     "modes": 1,
     # 2: element and contact kernels
     "element": 2, "element_jit": 2, "elements": 2, "elements.base": 2, "elements.se3_2": 2, "elements.se3_3": 2,
-    "blocks": 2, "contact": 2, "contact.law": 2, "contact.kinematics": 2,
+    "blocks": 2, "line_load": 2, "contact": 2, "contact.law": 2, "contact.kinematics": 2,
     "contact.pairs": 2, "contact.search": 2, "contact.kernel_jit": 2, "contact.options": 2, "contact.record": 2,
     "contact.projection": 2, "contact.rules": 2, "contact.ownership": 2,
     # 3: model declarations and their assembly
