@@ -200,8 +200,16 @@ class Solution:
     ``stats``            list of ``s`` dicts: ``iterations``, ``residuals``, ``wall_time``, ``dt``,
                          ``cutbacks``, and whatever the solver adds (``failed_dt``, ``warnings``,
                          ``timings``, ``stable``, ``negative_eigenvalues``, ``lowest_eigenvalue``)
-    ``contacts``         list of ``s`` contact point tables (dicts of arrays of equal length; ``{}``
-                         for a step without contact)
+    ``contacts``         list of ``s`` contact point tables (dicts of arrays of equal length ``k``,
+                         one row per contact point the search found; ``{}`` for a step without
+                         contact): ``position`` (k, 3) midway between the contour points, ``gap``,
+                         ``normal_force`` and ``tangential_force`` (k, 3) on the slave (integrated
+                         over the point's ``weight``, a length), ``status`` (``contact.OPEN`` 0: no
+                         normal force, ``STICK`` 1, ``SLIP`` 2: sliding or frictionless), ``stick``
+                         (True for status STICK only), ``slip_increment`` (k, 2) of the step,
+                         ``kind`` (0 line, 1 orthogonal, 2 point), ``angle`` between the tangents
+                         (degrees), ``slave_element``, ``master_element``, ``xi1``, ``xi2``,
+                         ``normal`` (k, 3)
     ``extra``            dict ``name -> list`` of ``s`` per-step values (arrays or numbers; ``None``
                          where a step has none): room for per-step data of any kind (buckling modes,
                          path-following data) without a new field
