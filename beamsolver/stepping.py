@@ -141,12 +141,17 @@ class Run:
             sys.sync_members(H)
         stats, record = dict(iterations=0, residuals=[], wall_time=0.0, dt=0.0, cutbacks=0), None
         acts = _acts_at(sys, H0, t_start)
-        pushed = False
+        pushed, overlap = False, None
         if not acts:
             ev0 = problem.evaluate(H, t_start, tangent=False)
             # contact alone may push the given poses (touching wires under the smoothed law,
             # docs/theory.md 19.2); round-off contact forces ask for a correction at round-off
             pushed = problem.solves_start and not self.newton.at_rest(ev0, H, t_start)
+            overlap = problem.contact.overlap(H) if pushed else None
+            if overlap:                  # e.g. a strand's wires built overlapping (cables.build_strand)
+                self.sol.message = overlap
+                log.warning(overlap)
+                warnings.warn(overlap, RuntimeWarning, stacklevel=4)
         if acts or pushed:
             t0 = time.perf_counter()
             self.H, self.t = H0, None
@@ -167,6 +172,8 @@ class Run:
             finally:
                 self.t, conv.max_iter = t_start, max_iter
             stats.update(wall_time=time.perf_counter() - t0, dt=0.0, cutbacks=0)
+            if overlap:
+                stats.setdefault("warnings", []).append(overlap)
             record = problem.commit(H)
             if problem.contributions:
                 self.sol.contact_state = problem.get_state()

@@ -61,6 +61,7 @@ from . import rules
 
 
 MAX_AUGMENT = 30
+OVERLAP_REPORT = 1e-4    # penetration / (R1 + R2) in the given poses that step 0 reports (100 x the smoothing)
 SWITCH_TOL = 1e-12        # a step ending within this (relative) of active_from / friction_from ends before it
 TIMED = ("search", "rules", "projection", "params", "kernel", "blocks")   # parts of ``ContactSystem.timings``
 
@@ -614,6 +615,25 @@ class ContactSystem(Contribution):
             self._cache = (H.copy(), P, sel, p, out)
         self._blocks = (np.array(H), (P, sel, p, f, K, out))
         return self._blocks[1]
+
+    def overlap(self, H):
+        """Initial overlaps at poses ``H``: ``None`` when no pair penetrates by more than
+        ``OVERLAP_REPORT (R1 + R2)``, else a sentence naming the deepest pair, its penetration and
+        the normal force of the overlapping points (the pre-stress they put into an unloaded model)."""
+        blocks = self._local_blocks(H, False)
+        if blocks is None:
+            return None
+        P, sel, p, f, K, out = blocks
+        depth = -out["gap"] / (p["R1"] + p["R2"])
+        over = depth > OVERLAP_REPORT
+        if not over.any():
+            return None
+        k = int(np.argmax(depth))
+        force = float(np.sum(p["weight"][over] * out["lam_n"][over]))
+        return (f"{int(over.sum())} contact points overlap in the given poses, the deepest by "
+                f"{-out['gap'][k]:.3g} ({depth[k]:.2g} (R1 + R2); {self.element_label(P.e[sel][k])} against "
+                f"{self.element_label(P.m[sel][k])}): their normal force, {force:.4g} in all, pre-stresses "
+                "the model at t_start")
 
     def kernel_inputs(self, H):
         """Node poses ``(m, 4, 4, 4)`` and kernel parameters (dict of arrays) of the pairs active at
