@@ -31,7 +31,9 @@ End conditions: ``Strand.clamp(side)`` clamps every wire end of a side;
 ``Strand.plate(side)`` makes a node on the axis rigidly linked to every wire
 end of that side (a rigid end plate), to be pulled / twisted with
 ``model.prescribe`` or ``model.fix(..., values=...)``; ``Strand.resultant``
-gives the axial force and the torque about the axis from the plate reaction.
+gives the axial force and the torque about the axis from the plate reaction, ``Strand.cut``
+the axial force, torque and bending moments across a cross-section at any height
+(``resultants.cut_resultant``).
 """
 from dataclasses import dataclass, replace
 from typing import Optional
@@ -108,6 +110,12 @@ class Strand:
         """Axial force and torque about ``e_z`` exerted by the support on the strand at ``plate``."""
         r = solution.reaction(plate, step)
         return float(r[2]), float(r[5])
+
+    def cut(self, solution, z, step=-1, bending_axis=(0.0, 1.0, 0.0), point=None):
+        """Resultants across the strand's material cross-section at height ``z`` (reference), all wires
+        with the lever arms of their axial forces: a ``resultants.CutResultant`` (``axial``,
+        ``torque``, ``bending[0]`` about ``bending_axis``, ``bending[1]``; ``step=None``: every step)."""
+        return solution.cut_resultant(self.all_wires, z, (0.0, 0.0, 1.0), (0.0, 0.0, 0.0), point, bending_axis, step)
 
 
 def _lay(layer, r):

@@ -452,6 +452,13 @@ class Solution:
         P = self.poses
         return P[self._step(step)][:, :3, 3] - P[0][:, :3, 3]
 
+    def cut_resultant(self, beams, position, axis=(0.0, 0.0, 1.0), origin=(0.0, 0.0, 0.0), point=None,
+                      bending_axis=(0.0, 1.0, 0.0), step=-1):
+        """Axial force, torque and bending moments across the material cut ``(x_ref - origin) . axis =
+        position`` through ``beams`` at ``step`` (``None``: every step): ``resultants.cut_resultant``."""
+        from .resultants import cut_resultant
+        return cut_resultant(self, beams, position, axis, origin, point, bending_axis, step)
+
     def contact(self, step=-1):
         """Per active contact point: dict of arrays (empty when the scene has no contact)."""
         return self.contacts[self._step(step)]

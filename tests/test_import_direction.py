@@ -33,7 +33,7 @@ LAYER = {
     # 4: the Problem interface between the solver and the physics
     "problem": 4,
     # 5: results
-    "results": 5, "restart": 5, "study": 5,
+    "results": 5, "resultants": 5, "restart": 5, "study": 5,
     # 6: solver, its stepping and failure diagnosis, linearisation
     "solver": 6, "stepping": 6, "arclength": 6, "diagnosis": 6, "linear": 6, "branching": 6,
     # 7: output, pictures, command line, the package's public face
