@@ -42,12 +42,13 @@ import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 from . import geometry
+from .bending import BendingFixture, bending_fixture
 from .errors import InputError
 from .model import Model
 from .section import Section
 from .validation import count, real
 
-__all__ = ["Layer", "Strand", "build_strand", "fibre_stiffness", "rod_stiffness", "layer_clearance",
+__all__ = ["Layer", "Strand", "build_strand", "bending_fixture", "BendingFixture", "fibre_stiffness", "rod_stiffness", "layer_clearance",
            "closing_radius"]
 
 OVERLAP_TOL = 1e-9       # a clearance above -OVERLAP_TOL R is no overlap (a layer closed to round-off)

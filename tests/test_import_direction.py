@@ -27,7 +27,7 @@ LAYER = {
     "contact.pairs": 2, "contact.search": 2, "contact.kernel_jit": 2, "contact.options": 2, "contact.record": 2,
     "contact.projection": 2, "contact.rules": 2, "contact.ownership": 2,
     # 3: model declarations and their assembly
-    "model": 3, "contributions": 3, "cables": 3, "assembly": 3, "stabilize": 3, "topology": 1, "assembly_jit": 3,
+    "model": 3, "contributions": 3, "cables": 3, "bending": 3, "assembly": 3, "stabilize": 3, "topology": 1, "assembly_jit": 3,
     "extra_pattern": 3,
     "contact.system": 3, "linsolve": 3, "bifurcation": 3,
     # 4: the Problem interface between the solver and the physics
