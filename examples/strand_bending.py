@@ -45,7 +45,7 @@ E, NU, MU = 200e9, 0.3, 0.3
 RC, RW, LAY, N = 1.97e-3, 1.865e-3, 114.6e-3, 6
 STRAIN = 1e-3                     # axial strain of the strand under the pull
 
-LAYS, ELEMENTS, AMPLITUDE, STEPS = 1, 16, 5.0, 6  # default size: about 20 s on one core
+LAYS, ELEMENTS, AMPLITUDE, STEPS = 2, 8, 5.0, 4   # default size: about 30 s of CPU (2 lays: the cut in the middle)
 solve_options = dict(steps=6 * STEPS, t_end=6.0)   # for `beamsolver run examples/strand_bending.py`
 
 
