@@ -92,7 +92,13 @@ def cut_resultant(solution, beams, position, axis=(0.0, 0.0, 1.0), origin=(0.0, 
     axis, origin = _unit(axis, "axis"), np.asarray(origin, dtype=float).reshape(3)
     b_given = _unit(bending_axis, "bending_axis")
     el, xi, sign = _crossings(system, beams, origin, axis, float(position))
-    steps = np.arange(solution.n_steps + 1) if step is None else np.array([solution._step(step)])
+    steps = np.arange(len(solution.times))
+    if step is not None:
+        try:
+            steps = steps[[int(step)]]
+        except (IndexError, TypeError, ValueError):
+            raise InputError(f"cut_resultant: step {step!r} is not a step of the solution "
+                             f"({len(steps)} steps)") from None
     H = solution.poses[steps]                                          # (s, n, 4, 4)
     s, k = len(steps), len(el)
     nodes = system.enodes[el]                                          # (k, 2)
