@@ -23,13 +23,14 @@ from typing import Callable
 import numpy as np
 
 from .errors import InputError
-from .model import Beam, JOIN_TOL
+from .model import Beam
 from .motion import rotation
 from .validation import CheckedScalar
 
 __all__ = ["BendingFixture", "bending_fixture"]
 
 AXES = {"x": (np.array([1.0, 0.0, 0.0]), "rx"), "y": (np.array([0.0, 1.0, 0.0]), "ry")}
+PLANE_TOL = 1e-9         # beam ends within this (relative to the model size) of their end plane
 
 
 @dataclass
@@ -90,7 +91,7 @@ def bending_fixture(strand_or_beams, curvature, pull, axis="y", model=None):
         raise InputError("bending_fixture: give a Strand, or Beams with the Model they belong to (model=)")
     P = model.poses0
     zb, zt = P[[b.first for b in beams], 2, 3], P[[b.last for b in beams], 2, 3]
-    tol = JOIN_TOL * model.characteristic_length() * 1e3
+    tol = PLANE_TOL * model.characteristic_length()
     if np.ptp(zb) > tol or np.ptp(zt) > tol or zt.min() <= zb.max():
         raise InputError("bending_fixture: the beams must run along +e_z, their first nodes in one plane "
                          f"z = z0 and their last in z = z0 + L (first at z {zb.min():.6g}..{zb.max():.6g}, "
@@ -102,7 +103,7 @@ def bending_fixture(strand_or_beams, curvature, pull, axis="y", model=None):
         bottom, top = _plate(model, beams, "first"), _plate(model, beams, "last")
     centre = model.poses0[bottom, :3, 3]
     model.prescribe(bottom, rotation(e_b, lambda t: -0.5 * L * kappa(t), centre))
-    model.fix(top, [d for d in ("ux", "uy", "rx", "ry", "rz")], values={dof: lambda t: 0.5 * L * kappa(t)})
+    model.fix(top, ("ux", "uy", "rx", "ry", "rz"), values={dof: lambda t: 0.5 * L * kappa(t)})
     model.add_load(top, force=(0.0, 0.0, 1.0), scale=T)
     # P-delta: w = T kappa per unit length, shared as the beams' axial forces, away from the centre
     c = np.array([np.mean(P[b.nodes, 2, 0]) for b in beams])        # e1 . e_z: cos of the lay angle

@@ -65,3 +65,14 @@ def test_strand_fixture_shares_the_line_load_as_the_axial_forces():
     assert wire / core == pytest.approx(np.cos(beta) ** 3 / 1.1**2, rel=1e-6)   # EA c^3 shares
     with pytest.raises(bs.InputError, match="axis"):
         cables.bending_fixture(st, curvature=1.0, pull=1.0, axis="z")
+
+
+def test_fixture_input_errors():
+    model = bs.Model()
+    along_x = model.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 4), SEC)
+    with pytest.raises(bs.InputError, match=r"run along \+e_z"):
+        cables.bending_fixture([along_x], curvature=1.0, pull=1.0, model=model)
+    with pytest.raises(bs.InputError, match="model="):
+        cables.bending_fixture([along_x], curvature=1.0, pull=1.0)
+    with pytest.raises(bs.InputError, match="curvature"):
+        cables.bending_fixture([along_x], curvature="big", pull=1.0, model=model)
