@@ -24,6 +24,7 @@ def main():
     ap.add_argument("--amplitude", type=float, default=sb.AMPLITUDE)
     ap.add_argument("--steps", type=int, default=sb.STEPS)
     ap.add_argument("--slip-tolerance", type=float, default=sb.SLIP_TOLERANCE)
+    ap.add_argument("--onset-steps", type=int, default=40, help="steps of the ramp to 2 kappa_b for the first slip")
     a = ap.parse_args()
     sb.SLIP_TOLERANCE = a.slip_tolerance
     table, runtime = {}, []
@@ -33,6 +34,8 @@ def main():
         (EI0, F0), (EIt, Ft) = sb.stiffness_checks(a.lays, n, a.steps)
         rows += [("EI frictionless contact", th["EI_min"], EI0, EI0 / sb.theory(F0)["EI_min"] - 1),
                  ("EI wires tied to the core", th["EI_max"], EIt, EIt / sb.theory(Ft)["EI_max"] - 1)]
+        k1, kb = sb.first_slip(a.lays, n, steps=a.onset_steps)
+        rows.append((f"first slip, ramp of {a.onset_steps} steps to 2 kappa_b [1/m]", kb, k1, k1 / kb - 1))
         for name, t, m, e in rows:
             table.setdefault(name, [t]).append((m, e))
         n_el = sum(w.n_elements for w in res["strand"].all_wires)
