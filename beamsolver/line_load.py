@@ -15,9 +15,10 @@ follower load (given in the section frame).  The consistent nodal loads are
 components at each node (translation first), conjugate to ``H <- H exp(hat(dq))``.
 
 Their derivative ``d f_ext / d(dq_A, dq_B)`` (the load stiffness; the residual's is its
-negative) is taken by complex steps on the group: ``H_A exp(i e e_k)`` with
-``h - i e T(-h)^-1 e_k`` for node A, ``h + i e T(h)^-1 e_k`` for node B (exact to first order in
-``e``, so the derivative is exact to round-off; ``se3.exp`` and the tangents are analytic).
+negative): with ``D = d f_ext / d h`` by complex steps in the six directions of ``h`` (exact to
+round-off; ``se3.exp`` and the tangents are analytic), ``K_B = D T(h)^-1`` and
+``K_A = -D T(-h)^-1 + d f_ext / d w_A|_h``, the last the rigid turn of a dead load's element
+(closed form, ``_loads``; zero for a follower load).
 docs/theory_line_loads.md derives it; tests/test_line_load.py checks it by finite differences.
 """
 import numpy as np
@@ -26,31 +27,40 @@ from . import se3
 
 __all__ = ["GAUSS_POINTS", "nodal_loads", "nodal_loads_and_tangent"]
 
-GAUSS_POINTS = 4                 # per element; exact for a straight element, error O((|h_w| L)^8) when curved
+GAUSS_POINTS = 3                 # per element; exact for a straight element, error O(|h_w|^6) when curved
 COMPLEX_STEP = 1e-30             # imaginary step of the complex-step derivative
 _XG, _WG = np.polynomial.legendre.leggauss(GAUSS_POINTS)
 XI, WEIGHTS = 0.5 * (_XG + 1.0), 0.5 * _WG
 
 
-def _loads(H_A, h, L, q, m, follower):
+def _loads(H_A, h, L, q, m, follower, rotation=False):
     """``f_ext`` ``(..., n, 12)`` from poses ``H_A`` ``(..., n, 4, 4)`` and twists ``h`` ``(..., n, 6)``
-    (real or complex); ``q``, ``m`` ``(n, 3)`` per unit length."""
+    (real or complex); ``q``, ``m`` ``(n, 3)`` per unit length.  With ``rotation`` (real arguments,
+    dead loads) also ``d f_ext / d w_A`` at fixed ``h`` ``(n, 12, 3)``: turning ``H_A`` by ``dw`` turns
+    the whole element, ``dp = (E^T hat(R_A^T q), E^T hat(R_A^T m)) dw`` with ``E`` the rotation of
+    ``exp(xi h)``."""
     Tp, Tm = se3.tangent_inv(h), se3.tangent_inv(-h)
     f = np.zeros(h.shape[:-1] + (12,), dtype=np.result_type(H_A, h))
+    G = np.zeros(h.shape[:-1] + (12, 3)) if rotation else None
     pb = np.concatenate([q, m], axis=-1)
+    RAt = np.swapaxes(H_A[..., :3, :3], -1, -2)
+    vq, vm = np.einsum("...ij,...j->...i", RAt, q), np.einsum("...ij,...j->...i", RAt, m)
     for x, w in zip(XI, WEIGHTS):
         E = se3.exp(x * h)
         Tx = x * se3.tangent(x * h)
-        if follower:
-            p = pb
-        else:
-            Rt = np.swapaxes(H_A[..., :3, :3] @ E[..., :3, :3], -1, -2)
-            p = np.concatenate([np.einsum("...ij,...j->...i", Rt, q), np.einsum("...ij,...j->...i", Rt, m)], axis=-1)
+        Et = np.swapaxes(E[..., :3, :3], -1, -2)
+        p = pb if follower else np.concatenate([np.einsum("...ij,...j->...i", Et, vq),
+                                                np.einsum("...ij,...j->...i", Et, vm)], axis=-1)
         PhiA = se3.adjoint(se3.inverse(E)) - Tx @ Tm
         PhiB = Tx @ Tp
         f[..., :6] += w * np.einsum("...ji,...j->...i", PhiA, p)
         f[..., 6:] += w * np.einsum("...ji,...j->...i", PhiB, p)
-    return f * L[:, None]
+        if rotation:
+            dp = np.concatenate([Et @ se3.skew(vq), Et @ se3.skew(vm)], axis=-2)        # (n, 6, 3)
+            G[..., :6, :] += w * np.swapaxes(PhiA, -1, -2) @ dp
+            G[..., 6:, :] += w * np.swapaxes(PhiB, -1, -2) @ dp
+    f *= L[:, None]
+    return (f, G * L[:, None, None]) if rotation else f
 
 
 def nodal_loads(H_A, H_B, L, q, m, follower=False):
@@ -61,18 +71,20 @@ def nodal_loads(H_A, H_B, L, q, m, follower=False):
 
 
 def nodal_loads_and_tangent(H_A, H_B, L, q, m, follower=False):
-    """``(f_ext (n, 12), K (n, 12, 12))`` with ``K = d f_ext / d(dq_A, dq_B)`` (complex steps on the
-    group, see the module docstring); arguments as ``nodal_loads``."""
-    h, Tp, Tm = se3.log_and_tangent_inv(se3.relative(H_A, H_B))
-    f = _loads(H_A, h, L, q, m, follower)
-    n = len(L)
-    eye = np.eye(6)
-    ie = 1j * COMPLEX_STEP
-    HA = np.broadcast_to(H_A, (12, n, 4, 4)).astype(complex)
-    hh = np.broadcast_to(h, (12, n, 6)).astype(complex)
-    HA[:6] = H_A @ se3.exp(ie * eye)[:, None]
-    hh[:6] -= ie * Tm.transpose(2, 0, 1)          # -i e T(-h)^-1 e_k, direction k first
-    hh[6:] += ie * Tp.transpose(2, 0, 1)
-    fc = _loads(HA, hh, L, q, m, follower)        # (12, n, 12)
-    K = np.ascontiguousarray(np.transpose(fc.imag, (1, 2, 0))) / COMPLEX_STEP
+    """``(f_ext (n, 12), K (n, 12, 12))`` with ``K = d f_ext / d(dq_A, dq_B)``; arguments as
+    ``nodal_loads``.  ``D = d f_ext / d h`` by complex steps in ``h`` (6 directions), then
+    ``K_B = D T(h)^-1``, ``K_A = -D T(-h)^-1`` plus, for dead loads, the rigid turn of the element
+    by ``dw_A`` at fixed ``h`` (``_loads(..., rotation=True)``)."""
+    h = se3.log(se3.relative(H_A, H_B))
+    if follower:
+        f, G = _loads(H_A, h, L, q, m, True), None
+    else:
+        f, G = _loads(H_A, h, L, q, m, False, rotation=True)
+    hh = h + 1j * COMPLEX_STEP * np.eye(6)[:, None, :]                        # (6, n, 6), direction first
+    D = np.transpose(_loads(H_A, hh, L, q, m, follower).imag, (1, 2, 0)) / COMPLEX_STEP   # (n, 12, 6)
+    K = np.empty(f.shape + (12,))
+    K[:, :, :6] = -D @ se3.tangent_inv(-h)
+    K[:, :, 6:] = D @ se3.tangent_inv(h)
+    if G is not None:
+        K[:, :, 3:6] += G
     return f, K
