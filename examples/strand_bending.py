@@ -239,6 +239,37 @@ def main(lays=LAYS, elements_per_lay=ELEMENTS, amplitude=AMPLITUDE, steps=STEPS,
     return res, th, rows
 
 
+def stick_slip_map(res, th, path):
+    """PNG at ``path`` of the contact points (stick blue, slip red) on the wires at the first step of the
+    virgin branch where slip has spread part way (needs pyvista, the ``viz`` extra)."""
+    import os
+    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    import pyvista as pv
+    sol, t = res["sol"], res["times"]
+    k = int(np.flatnonzero((t > 1.0) & (res["share"] > 0) & (res["share"] < 1))[0])
+    H = sol.poses[k]
+    pl = pv.Plotter(off_screen=True, window_size=(1600, 360))
+    for w in res["strand"].all_wires:
+        x = H[w.nodes, :3, 3]
+        pl.add_mesh(pv.Spline(x, 4 * len(x)).tube(radius=0.9 * w.section.radius), color="lightgray", opacity=0.35)
+    c = sol.contacts[k]
+    on = c["normal_force"] > 0
+    for code, colour in ((bs.contact.STICK, "royalblue"), (bs.contact.SLIP, "crimson")):
+        pts = c["position"][on & (c["status"] == code)]
+        if len(pts):
+            pl.add_points(pv.PolyData(pts), color=colour, point_size=9, render_points_as_spheres=True,
+                          label=bs.contact.STATUS_NAMES[code])
+    pl.add_legend()
+    pl.view_vector((0.0, -1.0, 0.0), viewup=(1.0, 0.0, 0.0))     # the strand axis e_z across the picture
+    pl.enable_parallel_projection()
+    pl.reset_camera()
+    pl.camera.zoom(3.5)
+    pl.add_text(f"kappa = {res['kappa'][k] / th['kappa_b']:.2f} kappa_b: slipping share {res['share'][k]:.2f} "
+                f"(theory {2 * slip_angle(res['kappa'][k], th)[0] / np.pi:.2f}, middle half)", font_size=10)
+    pl.screenshot(path)
+    pl.close()
+
+
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--lays", type=float, default=LAYS)
@@ -247,27 +278,9 @@ if __name__ == "__main__":
     ap.add_argument("--steps", type=int, default=STEPS)
     ap.add_argument("--mu", type=float, default=MU)
     ap.add_argument("--plot", default=None, help="PNG of the loop against the theory (needs matplotlib)")
+    ap.add_argument("--map", default=None, help="PNG of the stick/slip map where slip spreads (needs pyvista)")
     a = ap.parse_args()
     res, th, rows = main(a.lays, a.elements, a.amplitude, a.steps, a.mu)
-    if a.plot:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-        t, kap, M = res["times"], res["kappa"], res["M"]
-        kb = th["kappa_b"]
-        x = np.linspace(0, res["k"], 200)
-        fig, ax = plt.subplots(figsize=(6, 4.5))
-        ax.plot(kap[t >= 1] / kb, M[t >= 1], "o-", ms=3, label="beamsolver (cut at mid-length)")
-        ax.plot(x / kb, moment(x, th), "k-", lw=1, label="theory, virgin")
-        xr = np.linspace(res["k"], -res["k"], 400)
-        rev = (res["k"], friction_moment(res["k"], th)[0])
-        ax.plot(xr / kb, moment(xr, th, rev), "k--", lw=1, label="theory, Masing")
-        ax.plot(-xr / kb, -moment(xr, th, rev), "k--", lw=1)
-        ax.plot(x / kb, th["EI_max"] * x, ":", c="gray", label="EI_max")
-        ax.plot(x / kb, th["EI_min"] * x, "-.", c="gray", label="EI_min")
-        ax.set_xlabel("curvature / kappa_b")
-        ax.set_ylabel("bending moment [N m]")
-        ax.legend(fontsize=8)
-        fig.tight_layout()
-        fig.savefig(a.plot, dpi=120)
-        print(f"written: {a.plot}")
+    if a.map:
+        stick_slip_map(res, th, a.map)
+        print(f"written: {a.map}")
