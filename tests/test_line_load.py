@@ -133,3 +133,16 @@ def test_line_load_input_errors():
     b3 = quad.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 4), beam.section, element="se3-3")
     with pytest.raises(bs.InputError, match="two-node"):
         quad.add_line_load(b3, force_per_length=(0, 0, 1))
+
+
+def test_line_loads_drive_arc_length_and_step_zero():
+    """The path-following rate and the step-0 check see line loads (System.load_factors, loads_act)."""
+    model, beam = _cantilever(16, 6.0 * EI)
+    ref = bs.solve(model, steps=6).position(beam.last)
+    model, beam = _cantilever(16, 6.0 * EI)
+    arc = bs.solve(model, steps=6, path="arc-length")
+    assert arc.times[-1] == pytest.approx(1.0) and np.allclose(arc.position(beam.last), ref, atol=1e-9)
+    model, beam = _cantilever(4, 1e-4)
+    model.line_loads[0].scale = lambda t: 1.0           # acting already at t_start: step 0 is solved
+    sol = bs.solve(model, steps=1)
+    assert sol.stats[0]["iterations"] > 0 and sol.position(beam.last, step=0)[2] < -1e-6
