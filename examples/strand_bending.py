@@ -3,7 +3,7 @@
 The strand: a straight core (radius 1.97 mm) and six helical wires (1.865 mm) with a lay length of
 114.6 mm (lay angle 11.9 deg): the 1+6 strand tested by Utting & Jones (1987), whose geometry is
 the common test case of strand theories (Costello 1997); steel, E = 200 GPa, nu = 0.3, mu = 0.3.
-With these radii the outer wires do not touch each other (clearance 0.10 mm, ``build_strand``).
+With these radii the outer wires do not touch each other (clearance 42 um, ``cables.layer_clearance``).
 
 History (pseudo-time ``t``): ``[0, 1]`` the pull ``T`` (wire strain about 1e-3) is applied
 frictionless (``friction_from=1``: friction starts from zero traction at the tensioned state);
