@@ -106,9 +106,15 @@ class Strand:
             self.model.join(node, n, rigid=True)
         return node
 
-    @staticmethod
-    def resultant(solution, plate, step=-1):
-        """Axial force and torque about ``e_z`` exerted by the support on the strand at ``plate``."""
+    def resultant(self, solution, plate=None, step=-1, z=None):
+        """Axial force and torque about ``e_z``: exerted by the support on the strand at ``plate``, or,
+        with ``z``, across the strand's cross-section at reference height ``z`` (``cut``: the wires'
+        section forces with their lever arms, the part above on the part below)."""
+        if z is not None:
+            c = self.cut(solution, z, step)
+            return float(c.axial), float(c.torque)
+        if plate is None:
+            raise InputError("Strand.resultant: give the plate node or a height z")
         r = solution.reaction(plate, step)
         return float(r[2]), float(r[5])
 

@@ -71,5 +71,6 @@ def test_strand_in_pure_tension_has_no_bending_moment_and_carries_the_pull():
         assert F > 0 and cut.axial == pytest.approx(F, rel=1e-6)     # the plate pulls the upper part
         assert cut.torque == pytest.approx(T, rel=1e-4)
         assert np.abs(cut.bending).max() < 1e-6 * abs(F) * 2.1e-3
+        assert st.resultant(sol, z=z) == (cut.axial, cut.torque)
     with pytest.raises(bs.InputError, match="crosses"):
         st.cut(sol, 2 * L)
