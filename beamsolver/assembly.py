@@ -16,11 +16,12 @@ dependence of ``M`` on ``R`` (``r`` in global components), which keeps Newton
 quadratic.
 """
 import sys
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
 
-from . import assembly_jit, contributions, se3
+from . import assembly_jit, contributions, line_load, se3
 from . import blocks as _blocks
 from .blocks import REUSE_BUFFERS
 from .errors import InputError
@@ -165,6 +166,7 @@ class System:
         self._build_reps(model)
         self._build_loads(model)
         self._build_pattern()
+        self._place_line_loads()
         self._build_chains(model)
         if check_rigid_modes:
             self._check_rigid_modes(model)
@@ -335,9 +337,20 @@ class System:
         self.load_scales = [ld.scale for ld in loads]
         self.dead = np.flatnonzero(~self.load_follower)
         self.dead_nodes = self.load_nodes[self.dead]
+        self.n_point_loads = len(loads)
+        self.line = _line_table(model, self.enodes, self.L)
+        self.load_scales = self.load_scales + [ld.scale for ld in model.line_loads]
 
     def load_factors(self, t):
+        """Scales at ``t`` of the nodal loads, then of the line loads (``model.line_loads``)."""
         return np.array([float(s(t)) for s in self.load_scales])
+
+    def loads_act(self, lf):
+        """Whether any load is non-zero with the load factors ``lf`` (``load_factors``)."""
+        n = self.n_point_loads
+        point = np.abs(self.load_F).sum(axis=1) + np.abs(self.load_M).sum(axis=1)
+        line = [np.abs(ld.q).sum() + np.abs(ld.m).sum() for ld in self.model.line_loads]
+        return bool(np.any(lf[:n] * point != 0) or np.any(lf[n:] * np.array(line) != 0))
 
     # ------------------------------------------------------------ pattern
     def _build_pattern(self):
@@ -385,6 +398,19 @@ class System:
         for node, comp, _ in self.fix_values:
             presc[6 * node + comp] = True
         self.fc = np.flatnonzero((rr >= 0) & presc[cols])
+
+    def _place_line_loads(self):
+        """Dofs of the line-loaded elements and the positions of their 12 x 12 blocks in the COO values
+        (those of the elements, ``group_kslices``): the load stiffness shares the element pattern."""
+        ln = self.line
+        if ln is None:
+            return
+        start = np.full(self.n_elements, -1)
+        for j, g in enumerate(self.groups):
+            if g.element_type.n_nodes == 2:
+                start[g.elements] = self.group_kslices[j] + 144 * np.arange(len(g.elements))
+        ln.dofs = _blocks.dofs(self.rep, ln.nodes)
+        ln.kpos = (start[ln.element][:, None] + np.arange(144)).ravel()
 
     # ------------------------------------------------------------ transforms
     def node_transforms(self, H):
@@ -495,7 +521,11 @@ class System:
         r = np.bincount(self.edofs_flat, weights=f, minlength=ndof)
         # external loads (body components at their node, then transformed)
         if len(self.load_nodes):
-            r, f_level, m_level = self._add_loads(H, load_factors, M, r, blocks, f_level, m_level)
+            r, f_level, m_level = self._add_loads(H, load_factors[:self.n_point_loads], M, r, blocks,
+                                                  f_level, m_level)
+        if self.line is not None:
+            r, f_level, m_level = self._add_line_loads(H, load_factors[self.n_point_loads:], M, r, kvals,
+                                                       f_level, m_level)
         if tangent and len(self.global_nodes):
             g = self.global_nodes
             rg = r.reshape(-1, 6)[g]
@@ -571,6 +601,30 @@ class System:
             else:
                 np.add.at(blocks, self.dead_where, kb)
         return r, f_level, m_level
+
+    def _add_line_loads(self, H, lf, M, r, kvals, f_level, m_level):
+        """``r - f_ext`` of the line loads and their stiffness added to the element blocks of
+        ``kvals`` (if given; ``line_load``, dead and follower); updated force levels."""
+        ln = self.line
+        f = np.zeros((len(ln.element), 12))
+        K = np.zeros((len(ln.element), 12, 12)) if kvals is not None else None
+        for rows, follower in ((ln.dead, False), (ln.follower, True)):
+            if not len(rows):
+                continue
+            HA, HB = H[ln.nodes[rows, 0]], H[ln.nodes[rows, 1]]
+            fac = lf[ln.load[rows]][:, None]
+            args = (HA, HB, ln.L[rows], fac * ln.q[rows], fac * ln.m[rows], follower)
+            if K is None:
+                f[rows] = line_load.nodal_loads(*args)
+            else:
+                f[rows], K[rows] = line_load.nodal_loads_and_tangent(*args)
+        fl, ml = _blocks.levels(f)
+        if M is not None:
+            f, K = _blocks.transform(M, ln.nodes, f, K)
+        r = r - np.bincount(ln.dofs.ravel(), weights=f.ravel(), minlength=len(r))
+        if K is not None:
+            np.add.at(kvals, ln.kpos, -K.ravel())
+        return r, max(f_level, fl), max(m_level, ml)
 
     def matrix(self, kvals, extra=None):
         """Reduced tangent (free x free) as CSC from the COO values.
@@ -729,6 +783,35 @@ class System:
         out[body, 3:] = np.einsum("nij,nj->ni", R[body], rr[body, 3:])
         out[~body] = rr[~body]
         return out
+
+
+@dataclass
+class _LineTable:
+    """Line loads element by element: ``element`` ids, end ``nodes`` ``(k, 2)``, ``L``, ``q``, ``m``
+    ``(k, 3)``, index ``load`` of the ``LineLoad`` (its scale), ``dead``/``follower`` rows, ``dofs``
+    ``(k, 12)`` and the positions ``kpos`` ``(k 144,)`` of the element blocks in the COO values."""
+    element: np.ndarray
+    nodes: np.ndarray
+    L: np.ndarray
+    q: np.ndarray
+    m: np.ndarray
+    load: np.ndarray
+    dead: np.ndarray
+    follower: np.ndarray
+    dofs: np.ndarray = None
+    kpos: np.ndarray = None
+
+
+def _line_table(model, enodes, L):
+    """The ``_LineTable`` of ``model.line_loads`` (``None`` without line loads)."""
+    lls = model.line_loads
+    if not lls:
+        return None
+    el = np.concatenate([ld.beam.elements for ld in lls])
+    which = np.concatenate([np.full(ld.beam.n_elements, k) for k, ld in enumerate(lls)])
+    fol = np.array([ld.follower for ld in lls])[which]
+    return _LineTable(el, enodes[el], L[el], np.array([ld.q for ld in lls])[which],
+                      np.array([ld.m for ld in lls])[which], which, np.flatnonzero(~fol), np.flatnonzero(fol))
 
 
 def _concat(a, b):

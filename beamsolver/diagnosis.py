@@ -26,8 +26,10 @@ def nonfinite_source(problem, H, t):
         lf = system.load_factors(t)
         j = np.flatnonzero(~np.isfinite(lf))
         if len(j):
-            ld = model.loads[int(j[0])]
-            return True, f"add_load(node {ld.node}): scale({t:.6g}) = {float(lf[j[0]])!r} is not finite"
+            k = int(j[0])
+            what = f"add_load(node {model.loads[k].node})" if k < len(model.loads) else \
+                f"add_line_load({model.line_loads[k - len(model.loads)].beam!r})"
+            return True, f"{what}: scale({t:.6g}) = {float(lf[k])!r} is not finite"
     for node, comp, f in system.fix_values:
         v = float(f(t))
         if not np.isfinite(v):

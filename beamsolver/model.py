@@ -17,7 +17,7 @@ from .section import Section
 from .validation import (MAX_REFERENCE_ELEMENT_ROTATION, ORTHONORMAL_TOL, CheckedScalar, as_array, check_contact_options,
                          check_node_id, check_pose, real)
 
-__all__ = ["Model", "Beam", "Load", "ContactDeclaration", "ElementGroup", "DOF_NAMES"]
+__all__ = ["Model", "Beam", "Load", "LineLoad", "ContactDeclaration", "ElementGroup", "DOF_NAMES"]
 
 DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
 JOIN_TOL = 1e-9                       # coincidence tolerance relative to the model size
@@ -76,12 +76,28 @@ class Load:
 
 
 @dataclass
+class LineLoad:
+    """A load per unit reference length on every element of ``beam``: force ``q``, moment ``m``
+    (global components, or section-frame ones if ``follower``), ramped by ``scale(t)``."""
+    beam: Beam
+    q: np.ndarray
+    m: np.ndarray
+    follower: bool
+    scale: Callable[[float], float]
+
+
+@dataclass
 class ContactDeclaration:
+    """``active_from``: the declaration acts only in steps ending after this time (None: always);
+    ``friction_from``: frictionless in steps ending at or before it, Coulomb friction with
+    ``mu`` after it, from zero tangential traction at the state it starts from."""
     slave: list
     master: list
     mu: float = 0.0
     penalty: Optional[float] = None
     options: dict = field(default_factory=dict)
+    active_from: Optional[float] = None
+    friction_from: Optional[float] = None
 
 
 def _ramp(t):
@@ -125,6 +141,7 @@ class Model:
         self.constraints = {}     # node -> ("clamp",) | ("fix", frozenset) | ("prescribe", motion)
         self.joins = []           # (node_a, node_b)
         self.loads = []
+        self.line_loads = []
         self.contacts = []
         self.contributions = []   # user contributions (blocks.Contribution protocol), checked at solve
         self.free_nodes = []      # nodes created by add_node (no elements)
@@ -336,8 +353,35 @@ class Model:
             raise InputError(f"add_load({node}): scale must be callable t -> float, got {scale!r}")
         self.loads.append(Load(i, F, M, bool(follower), CheckedScalar(scale, f"add_load({node}): scale")))
 
+    def add_line_load(self, beam, force_per_length=None, moment_per_length=None, follower=False, scale=_ramp):
+        """A distributed load on every element of ``beam``, per unit reference length: force
+        ``force_per_length`` (force / length) and moment ``moment_per_length`` (force), ramped by
+        ``scale(t)`` (default ``t``); returns the ``LineLoad``.
+
+        Dead loads (default) are given in global components; a ``follower`` load in the section
+        frame (``e1`` the tangent) and turns with it.  The element integrates it consistently
+        over its length along ``H_A exp(xi h)`` (``line_load``; two-node elements only).
+        """
+        what = f"add_line_load({beam!r})"
+        if not isinstance(beam, Beam) or beam.id >= len(self.beams) or self.beams[beam.id] is not beam:
+            raise InputError(f"{what}: expected a Beam of this model")
+        if beam.element_type.n_nodes != 2:
+            raise InputError(f"{what}: line loads need two-node elements, the beam has "
+                             f"{beam.element_type.name!r} elements")
+        q = np.zeros(3) if force_per_length is None else as_array(force_per_length, "force_per_length", what).reshape(-1)
+        m = np.zeros(3) if moment_per_length is None else as_array(moment_per_length, "moment_per_length",
+                                                                   what).reshape(-1)
+        for name, v in (("force_per_length", q), ("moment_per_length", m)):
+            if v.shape != (3,) or not np.all(np.isfinite(v)):
+                raise InputError(f"{what}: {name} must be 3 finite numbers, got {v.tolist()}")
+        if not callable(scale):
+            raise InputError(f"{what}: scale must be callable t -> float, got {scale!r}")
+        load = LineLoad(beam, q, m, bool(follower), CheckedScalar(scale, f"{what}: scale"))
+        self.line_loads.append(load)
+        return load
+
     # ------------------------------------------------------------ contact
-    def add_contact(self, slave, master, mu=0.0, penalty=None, **options):
+    def add_contact(self, slave, master, mu=0.0, penalty=None, active_from=None, friction_from=None, **options):
         """Declare contact between ``slave`` and ``master`` (a Beam or a list of Beams each).
 
         ``mu``: Coulomb friction coefficient (default 0: frictionless).
@@ -367,6 +411,11 @@ class Model:
           (default None: the penalty / augmented-Lagrangian / smoothed normal law with
           Coulomb friction; docs/theory.md section 15).
 
+        Switched in pseudo-time (default None: from the start): ``active_from``: the
+        declaration acts only in steps ending after this time; ``friction_from``: frictionless
+        in the steps ending at or before it, then friction from zero tangential traction at the
+        state the first frictional step starts from (a pretension applied frictionless).
+
         Unknown options are refused.  The same beams on both
         sides (``add_contact(group, group)``, as for the wires of a cable) declare every
         unordered pair of distinct beams once, as one declaration per pair (the same as
@@ -388,10 +437,13 @@ class Model:
         mu = real(mu, "mu", "add_contact", minimum=0.0)
         penalty = real(penalty, "penalty", "add_contact", above=0.0, none=True)
         options = check_contact_options(options)
+        active_from = real(active_from, "active_from", "add_contact", none=True)
+        friction_from = real(friction_from, "friction_from", "add_contact", none=True)
+        switch = dict(active_from=active_from, friction_from=friction_from)
         same = {b.id for b in s} & {b.id for b in m}
         if not same:
             self._refuse_declared(_distinct_pairs(s, m))
-            decl = ContactDeclaration(s, m, mu, penalty, options)
+            decl = ContactDeclaration(s, m, mu, penalty, options, **switch)
             self.contacts.append(decl)
             return decl
         pairs = _distinct_pairs(s, m) if {b.id for b in s} == {b.id for b in m} else []
@@ -401,7 +453,7 @@ class Model:
                                 " (a group in contact within itself is declared with the same beams on "
                                 "both sides)"))
         self._refuse_declared(pairs)
-        decls = [ContactDeclaration([a], [b], mu, penalty, dict(options)) for a, b in pairs]
+        decls = [ContactDeclaration([a], [b], mu, penalty, dict(options), **switch) for a, b in pairs]
         self.contacts.extend(decls)
         return decls
 
@@ -476,4 +528,5 @@ class Model:
     def __repr__(self):
         return (f"Model({len(self.beams)} beams, {self.n_nodes} nodes, {self.n_elements} elements, "
                 f"{len(self.constraints)} constrained nodes, {len(self.loads)} loads, "
+                f"{len(self.line_loads)} line loads, "
                 f"{len(self.contacts)} contact declarations)")

@@ -22,7 +22,7 @@ solver uses, and nothing else of the physics:
   ``name/key`` per contribution;
 - ``smooth``: True when every contribution is smooth (the solver damps Newton on
   its correction), else the solver backtracks on the residual;
-  ``conservative``: no follower loads and every contribution derives from a potential.
+  ``conservative``: no follower loads (nodal or line) and every contribution derives from a potential.
 
 ``system`` is the DOF map and constraints the solver reads (free unknowns,
 prescribed nodes and their targets, reactions).  docs/theory.md section 10
@@ -97,6 +97,8 @@ class Problem:
     def conservative(self):
         s = self.system
         if len(s.load_nodes) and np.any(s.load_follower):
+            return False
+        if s.line is not None and len(s.line.follower):
             return False
         return all(c.conservative for c in self.contributions)
 

@@ -212,8 +212,16 @@ class Solution:
     ``stats``            list of ``s`` dicts: ``iterations``, ``residuals``, ``wall_time``, ``dt``,
                          ``cutbacks``, and whatever the solver adds (``failed_dt``, ``warnings``,
                          ``timings``, ``stable``, ``negative_eigenvalues``, ``lowest_eigenvalue``)
-    ``contacts``         list of ``s`` contact point tables (dicts of arrays of equal length; ``{}``
-                         for a step without contact)
+    ``contacts``         list of ``s`` contact point tables (dicts of arrays of equal length ``k``,
+                         one row per contact point the search found; ``{}`` for a step without
+                         contact): ``position`` (k, 3) midway between the contour points, ``gap``,
+                         ``normal_force`` and ``tangential_force`` (k, 3) on the slave (integrated
+                         over the point's ``weight``, a length), ``status`` (``contact.OPEN`` 0: no
+                         normal force, ``STICK`` 1, ``SLIP`` 2: sliding or frictionless), ``stick``
+                         (True for status STICK only), ``slip_increment`` (k, 2) of the step,
+                         ``kind`` (0 line, 1 orthogonal, 2 point), ``angle`` between the tangents
+                         (degrees), ``slave_element``, ``master_element``, ``xi1``, ``xi2``,
+                         ``normal`` (k, 3)
     ``extra``            dict ``name -> list`` of ``s`` per-step values (arrays or numbers; ``None``
                          where a step has none): room for per-step data of any kind (buckling modes,
                          path-following data) without a new field
@@ -461,6 +469,13 @@ class Solution:
         """Node displacements ``(n, 3)`` at ``step`` from step 0."""
         P = self.poses
         return P[self._step(step)][:, :3, 3] - P[0][:, :3, 3]
+
+    def cut_resultant(self, beams, position, axis=(0.0, 0.0, 1.0), origin=(0.0, 0.0, 0.0), point=None,
+                      bending_axis=(0.0, 1.0, 0.0), step=-1):
+        """Axial force, torque and bending moments across the material cut ``(x_ref - origin) . axis =
+        position`` through ``beams`` at ``step`` (``None``: every step): ``resultants.cut_resultant``."""
+        from .resultants import cut_resultant
+        return cut_resultant(self, beams, position, axis, origin, point, bending_axis, step)
 
     def contact(self, step=-1):
         """Per active contact point: dict of arrays (empty when the scene has no contact)."""

@@ -162,12 +162,17 @@ class Run:
             sys.sync_members(H)
         stats, record = dict(iterations=0, residuals=[], wall_time=0.0, dt=0.0, cutbacks=0), None
         acts = _acts_at(sys, H0, t_start)
-        pushed = False
+        pushed, overlap = False, None
         if not acts:
             ev0 = problem.evaluate(H, t_start, tangent=False)
             # contact alone may push the given poses (touching wires under the smoothed law,
             # docs/theory.md 19.2); round-off contact forces ask for a correction at round-off
             pushed = problem.solves_start and not self.newton.at_rest(ev0, H, t_start)
+            overlap = problem.contact.overlap(H) if pushed else None
+            if overlap:                  # e.g. a strand's wires built overlapping (cables.build_strand)
+                self.sol.message = overlap
+                log.warning(overlap)
+                warnings.warn(overlap, RuntimeWarning, stacklevel=4)
         if acts or pushed:
             t0 = time.perf_counter()
             self.H, self.t = H0, None
@@ -189,6 +194,8 @@ class Run:
             finally:
                 self.t, conv.max_iter = t_start, max_iter
             stats.update(wall_time=time.perf_counter() - t0, dt=0.0, cutbacks=0)
+            if overlap:
+                stats.setdefault("warnings", []).append(overlap)
             record = problem.commit(H)
             if problem.contributions:
                 self.sol.contact_state = problem.get_state()
@@ -485,10 +492,8 @@ def _reference(resume, key="reference"):
 
 def _acts_at(system, H, t):
     """Whether loads, prescribed motions or ``fix`` values act at ``t`` on the state ``H``."""
-    if len(system.load_scales):
-        lf = system.load_factors(t)
-        if np.any(lf * (np.abs(system.load_F).sum(axis=1) + np.abs(system.load_M).sum(axis=1)) != 0):
-            return True
+    if len(system.load_scales) and system.loads_act(system.load_factors(t)):
+        return True
     if len(system.prescribed_nodes) and np.any(system.prescribed_poses(t) != H[system.prescribed_nodes]):
         return True
     return any(dx != 0 for _, _, dx in system.fixed_value_increments(H, t)) if system.fix_values else False

@@ -252,7 +252,7 @@ def check_solve_arguments(model, *, steps, t_end, t_start, rtol, dtol, max_iter,
                              f"(t = {last:.6g}); give t_end >= {last:.6g}")
         t0 = last
     for t in (t0, t1):                 # CheckedScalar: every later evaluation is checked too
-        for ld in model.loads:
+        for ld in model.loads + model.line_loads:
             ld.scale(t)
         for fns in model.fix_values.values():
             for fn in fns.values():

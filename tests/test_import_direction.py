@@ -23,17 +23,17 @@ LAYER = {
     "modes": 1, "material_range": 1,
     # 2: element and contact kernels
     "element": 2, "element_jit": 2, "elements": 2, "elements.base": 2, "elements.se3_2": 2, "elements.se3_3": 2,
-    "blocks": 2, "contact": 2, "contact.law": 2, "contact.kinematics": 2,
+    "blocks": 2, "line_load": 2, "contact": 2, "contact.law": 2, "contact.kinematics": 2,
     "contact.pairs": 2, "contact.search": 2, "contact.kernel_jit": 2, "contact.options": 2, "contact.record": 2,
     "contact.projection": 2, "contact.rules": 2, "contact.ownership": 2, "contact.state": 2,
     # 3: model declarations and their assembly
-    "model": 3, "contributions": 3, "cables": 3, "assembly": 3, "stabilize": 3, "topology": 1, "assembly_jit": 3,
+    "model": 3, "contributions": 3, "cables": 3, "bending": 3, "assembly": 3, "stabilize": 3, "topology": 1, "assembly_jit": 3,
     "extra_pattern": 3,
     "contact.system": 3, "contact.conditioning": 3, "linsolve": 3, "bifurcation": 3,
     # 4: the Problem interface between the solver and the physics
     "problem": 4,
     # 5: results
-    "results": 5, "restart": 5, "study": 5,
+    "results": 5, "resultants": 5, "restart": 5, "study": 5,
     # 6: solver, its stepping and failure diagnosis, linearisation
     "solver": 6, "stepping": 6, "arclength": 6, "diagnosis": 6, "linear": 6, "branching": 6,
     # 7: output, pictures, command line, the package's public face

@@ -10,7 +10,12 @@ from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ["PairSet", "Candidates"]
+__all__ = ["PairSet", "Candidates", "OPEN", "STICK", "SLIP", "STATUS_NAMES"]
+
+# ``status`` of a point in the contact table (``ContactSystem.results``): open (no normal force),
+# stick (friction holds it), slip (sliding: Coulomb friction at mu lam_N, or frictionless)
+OPEN, STICK, SLIP = 0, 1, 2
+STATUS_NAMES = ("open", "stick", "slip")
 
 
 class Candidates(NamedTuple):

@@ -53,7 +53,7 @@ from . import kernel_jit, pairs
 from .kernel_jit import contact_kernel, kernel_and_tangent      # compiled; pairs.py's are the oracle
 from .options import SMOOTHING, ContactOptions
 from .pairs import LINE, NORMAL_TOL, POINT, material_frames, no_normal, touch_tolerance
-from .record import Candidates, PairSet
+from .record import OPEN, SLIP, STICK, Candidates, PairSet
 from .ownership import gauss_owners, gauss_record
 from .projection import closest_points, element_twists, gauss_projections, section_points
 from .search import broad_pairs, element_spheres
@@ -62,6 +62,8 @@ from . import rules
 
 
 MAX_AUGMENT = 30
+OVERLAP_REPORT = 1e-4    # penetration / (R1 + R2) in the given poses that step 0 reports (100 x the smoothing)
+SWITCH_TOL = 1e-12        # a step ending within this (relative) of active_from / friction_from ends before it
 TIMED = ("search", "rules", "projection", "params", "kernel", "blocks")   # parts of ``ContactSystem.timings``
 
 
@@ -124,7 +126,11 @@ class ContactSystem(Contribution):
         # per-declaration parameters as arrays, indexed by a pair's ``decl`` (no loop over pairs)
         self._decl_penalty = np.array([d.penalty for d in self.decls])
         self._decl_penalty_t = np.array([d.penalty_t for d in self.decls])
-        self._decl_mu = np.array([d.mu for d in self.decls])
+        self._mu = np.array([d.mu for d in self.decls])
+        self._switch = [(d.active_from, d.friction_from) for d in model.contacts]
+        self._decl_on = np.ones(len(self.decls), dtype=bool)
+        self._switch_to(-np.inf)
+        self._mu_committed = self._decl_mu       # friction of the last committed step (None: unknown)
         self._decl_slip_tol = np.array([d.slip_tolerance for d in self.decls])
         self._decl_smoothing = np.array([np.nan if d.smoothing is None else d.smoothing for d in self.decls])
         self._decl_tolerance = np.array([np.inf if d.tolerance is None else d.tolerance for d in self.decls])
@@ -144,6 +150,26 @@ class ContactSystem(Contribution):
         self._K_pool = []          # tangent buffers of the compiled kernel (``_tangent_out``)
         self.timings = dict.fromkeys(TIMED, 0.0)
         self._clock = time.process_time()
+
+    def _switch_to(self, t):
+        """Declarations and friction acting in a step ending at ``t`` (``add_contact``'s
+        ``active_from``, ``friction_from``: on for ``t`` after them); before any step, off."""
+        def on(t0):
+            return t0 is None or t > t0 + SWITCH_TOL * max(1.0, abs(t0))
+        self._decl_on = np.array([on(a) for a, _ in self._switch], dtype=bool)
+        self._decl_mu = np.where([on(f) for _, f in self._switch], self._mu, 0.0)
+        committed = getattr(self, "_mu_committed", None)       # None: at construction, or restarted
+        if committed is not None:
+            starts = (self._decl_mu > 0) & (committed == 0)
+            if starts.any():     # friction starts this step: as at first contact, from the step's start
+                self._history = {k: v[~starts[self._history_decl()]] for k, v in self._history.items()}
+
+    def _history_decl(self):
+        """Declaration of every row of the friction history (decoded from the point keys)."""
+        key, n_el = self._history["key"], np.int64(self.sys.n_elements)
+        gauss = key < self.point_offset
+        return np.where(gauss, key // np.maximum(n_el * self.max_gp * self.n_beams, 1),
+                        (key - self.point_offset) // (n_el * n_el)).astype(int)
 
     # ------------------------------------------------------------ history
     def get_state(self):
@@ -174,6 +200,7 @@ class ContactSystem(Contribution):
             raise InputError(f"contact state: the history has {sorted(n)} rows in different entries "
                              f"(given: {sorted(history or {})}; all of {sorted(hist)} are needed)")
         self._history = hist
+        self._mu_committed = None          # a restart keeps its history also at a friction switch
         if mult is not None:
             self._mult_committed = mult
         self._mult = self._mult_committed
@@ -280,6 +307,8 @@ class ContactSystem(Contribution):
         self._lap()
         geo = self._twists(H)
         for d in self.decls:
+            if not self._decl_on[d.index]:
+                continue
             c = self._candidates(d, geo)
             part, ids = self._point_pairs(d, H, c)
             rec, own, tied = self._gauss_pairs(d, geo, c)
@@ -595,6 +624,25 @@ class ContactSystem(Contribution):
         self._blocks = (np.array(H), (P, sel, p, f, K, out))
         return self._blocks[1]
 
+    def overlap(self, H):
+        """Initial overlaps at poses ``H``: ``None`` when no pair penetrates by more than
+        ``OVERLAP_REPORT (R1 + R2)``, else a sentence naming the deepest pair, its penetration and
+        the normal force of the overlapping points (the pre-stress they put into an unloaded model)."""
+        blocks = self._local_blocks(H, False)
+        if blocks is None:
+            return None
+        P, sel, p, f, K, out = blocks
+        depth = -out["gap"] / (p["R1"] + p["R2"])
+        over = depth > OVERLAP_REPORT
+        if not over.any():
+            return None
+        k = int(np.argmax(depth))
+        force = float(np.sum(p["weight"][over] * out["lam_n"][over]))
+        return (f"{int(over.sum())} contact points overlap in the given poses, the deepest by "
+                f"{-out['gap'][k]:.3g} ({depth[k]:.2g} (R1 + R2); {self.element_label(P.e[sel][k])} against "
+                f"{self.element_label(P.m[sel][k])}): their normal force, {force:.4g} in all, pre-stresses "
+                "the model at t_start")
+
     def kernel_inputs(self, H):
         """Node poses ``(m, 4, 4, 4)`` and kernel parameters (dict of arrays) of the pairs active at
         ``H``, as the kernel receives them (benchmarks, tests); ``None`` without active pairs."""
@@ -669,6 +717,7 @@ class ContactSystem(Contribution):
 
     # ------------------------------------------------------------ per step
     def begin_step(self, H, t):
+        self._switch_to(t)
         self._blocks = None
         self._forget_kinds()
         self._H_prev = np.array(H, dtype=float)
@@ -740,6 +789,7 @@ class ContactSystem(Contribution):
         """Store friction history and multipliers of the converged state."""
         self._blocks = None
         self._mult_committed = self._mult
+        self._mu_committed = self._decl_mu
         P, sel, po = self._state(H)
         if P is None or len(sel) == 0:
             self._history = self._empty_history()
@@ -763,7 +813,8 @@ class ContactSystem(Contribution):
 
         ``position`` (k, 3) midway between the contour points, ``gap``, ``normal_force``
         and ``tangential_force`` (k, 3) (forces on the slave, integrated over the point's
-        weight), ``stick`` (False for frictionless or open points), ``slip_increment``
+        weight), ``stick`` (False for frictionless or open points), ``status`` (``record.OPEN``
+        no normal force, ``STICK``, ``SLIP`` sliding or frictionless), ``slip_increment``
         (k, 2) of the step, ``kind`` (0 line, 1 orthogonal, 2 point), ``angle`` between
         the tangents (degrees), element ids, ``xi1``, ``xi2``, ``weight``, ``normal``.
         """
@@ -771,6 +822,7 @@ class ContactSystem(Contribution):
         if last is None:
             return dict(position=np.zeros((0, 3)), gap=np.zeros(0), normal_force=np.zeros(0),
                         tangential_force=np.zeros((0, 3)), stick=np.zeros(0, dtype=bool),
+                        status=np.zeros(0, dtype=np.int8),
                         slip_increment=np.zeros((0, 2)), kind=np.zeros(0, dtype=int),
                         angle=np.zeros(0), slave_element=np.zeros(0, dtype=int),
                         master_element=np.zeros(0, dtype=int), xi1=np.zeros(0), xi2=np.zeros(0),
@@ -784,9 +836,11 @@ class ContactSystem(Contribution):
         e1s, e1m = HC[:, :3, 0], HF[:, :3, 0]
         ang = np.degrees(np.arccos(np.clip(np.abs(np.sum(e1s * e1m, axis=1)), 0.0, 1.0)))
         active = out["lam_n"] > 0
+        stick = out["stick"] & active & (p["mu"] > 0)
+        status = np.where(active, np.where(stick, STICK, SLIP), OPEN).astype(np.int8)
         return dict(position=0.5 * (out["xC"] + out["xF"]) + 0.5 * (p["R1"] - p["R2"])[:, None] * out["n"],
                     gap=out["gap"], normal_force=w * out["lam_n"], tangential_force=ft,
-                    stick=out["stick"] & active & (p["mu"] > 0), slip_increment=out["slip"], kind=p["kind"],
+                    stick=stick, status=status, slip_increment=out["slip"], kind=p["kind"],
                     angle=ang, slave_element=P.e[sel], master_element=P.m[sel],
                     xi1=out["xi1"], xi2=out["xi2"], weight=w, normal=out["n"])
 

@@ -13,7 +13,8 @@ Files in the output folder (``solve(model, output=folder)``, or
   contact point (``normal_force > 0``; the candidates the search found open
   are left out, so a Glyph draws contacts only), with ``gap``,
   ``normal_force``, ``tangential_force`` (3), ``stick`` (1 stick, 0 slip or
-  frictionless), ``slip_increment`` (2), ``normal`` (3), ``kind``.  A step
+  frictionless), ``slip_increment`` (2), ``normal`` (3), ``kind``, ``status``
+  (``contact.OPEN``/``STICK``/``SLIP``: 0/1/2; the stick/slip map).  A step
   without contact has no points and one empty poly-vertex cell (VTK type 2):
   meshio cannot read a file without cells, and skips that one with a warning.
 - ``beams.pvd`` and ``contact.pvd``: the collections with the pseudo-times,
@@ -61,7 +62,8 @@ CONTACT = "contact"
 ARCHIVE = "solution.npz"
 SERIES = rf"({BEAMS}|{CONTACT})_[0-9]+\.vtu"     # names of the numbered files of a run
 CONTACT_FIELDS = {"gap": (), "normal_force": (), "tangential_force": (3,), "stick": (),
-                  "slip_increment": (2,), "normal": (3,), "kind": ()}
+                  "slip_increment": (2,), "normal": (3,), "kind": (), "status": ()}
+INT_FIELDS = ("stick", "kind", "status")
 
 
 def _atomic(path, write):
@@ -291,7 +293,7 @@ def contact_points(table):
     pdata = {}
     for name, shape in CONTACT_FIELDS.items():
         v = np.asarray(table[name]).reshape((n,) + shape)[on] if name in table else np.zeros((k,) + shape)
-        if name in ("stick", "kind"):
+        if name in INT_FIELDS:
             v = v.astype(np.int32)
         else:
             v = v.astype(float)
@@ -305,7 +307,7 @@ def _write_empty_points(path):
     meshio (5.3) can neither write this nor read a file without cells, nor an empty
     ``format="ascii"`` array without text (hence the blank); ParaView and pyvista read both.
     """
-    arrays = "".join(f'<DataArray type="{"Int32" if k in ("stick", "kind") else "Float64"}" Name="{k}" '
+    arrays = "".join(f'<DataArray type="{"Int32" if k in INT_FIELDS else "Float64"}" Name="{k}" '
                      f'NumberOfComponents="{int(np.prod(shape))}" format="ascii"> </DataArray>\n'
                      for k, shape in CONTACT_FIELDS.items())
     text = ('<?xml version="1.0"?>\n'

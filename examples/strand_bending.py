@@ -1,0 +1,286 @@
+"""Bending hysteresis of a tensioned 1+6 strand with Coulomb friction, against the closed-form theory.
+
+The strand: a straight core (radius 1.97 mm) and six helical wires (1.865 mm) with a lay length of
+114.6 mm (lay angle 11.9 deg): the 1+6 strand tested by Utting & Jones (1987), whose geometry is
+the common test case of strand theories (Costello 1997); steel, E = 200 GPa, nu = 0.3, mu = 0.3.
+With these radii the outer wires do not touch each other (clearance 42 um, ``cables.layer_clearance``).
+
+History (pseudo-time ``t``): ``[0, 1]`` the pull ``T`` (wire strain about 1e-3) is applied
+frictionless (``friction_from=1``: friction starts from zero traction at the tensioned state);
+``[1, 2]`` the curvature goes ``0 -> +k``, ``[2, 4]`` ``+k -> -k``, ``[4, 6]`` ``-k -> +k``, with
+``k = amplitude * kappa_b``.  ``cables.bending_fixture`` turns the end plates by ``-+kappa L / 2``,
+leaves the top plate free axially under the dead pull and cancels the P-delta with the line load
+``w = T kappa``.  The moment is measured across the cross-section at mid-length
+(``Strand.cut``, the wires' axial forces with their lever arms), the stick/slip state from the
+contact points of the middle half (``status``).
+
+Theory (docs/theory_strand_bending.md; Papailiou 1997, Foti & Martinelli 2016, Cardou 2013):
+``EI_min = E I_c + n c E I_w``, ``c = cos b (1 + cos^2 b + sin^2 b / (1 + nu)) / 2`` (full slip);
+``EI_max = EI_min + S``, ``S = (n / 2) E A_w r^2 cos^3 b`` (full stick, plane sections);
+first slip ``kappa_b = mu F sin b / (E A_w cos^2 b r)``; slipping share ``2 psi / pi`` with
+``sin(psi) / psi = kappa_b / kappa`` up to ``kappa_t = (pi / 2) kappa_b``; saturated friction moment
+``M_f = (2 n / pi) mu F r sin b cos b``; reversals by Masing's rule; loop energy from it.
+
+What a penalty-stick beam model meets today (numbers in docs/benchmarks.md, "Strand bending"):
+the full-slip quantities (``M_f``, the Masing branch at the end of a half cycle, the loop energy
+within 10 %) need only Coulomb's limit.  The full-stick stiffness depends on the elastic slip of
+the penalty stick, which makes the stick compliant: with the default ``slip_tolerance`` (0.005
+element lengths) the strand does not stick at all, with the example's 5e-6 the initial stiffness
+is still 15 % below ``EI_max`` and the slipping share lags the theory.  The exact stick of issue
+26 is meant to remove this; rerun ``benchmarks/strand_bending.py`` then.
+``tied=True`` ties the wires rigidly to the core (no contact) to measure the beam model's own
+full-stick stiffness (shear and torsion of the wires included) against ``EI_max``.
+
+    python examples/strand_bending.py [--lays 2] [--elements 16] [--amplitude 3] [--steps 8]
+"""
+import argparse
+import time
+
+import numpy as np
+
+import beamsolver as bs
+from beamsolver import cables
+from beamsolver.contact import SLIP
+
+E, NU, MU = 200e9, 0.3, 0.3
+RC, RW, LAY, N = 1.97e-3, 1.865e-3, 114.6e-3, 6
+STRAIN = 1e-3                     # axial strain of the strand under the pull
+
+LAYS, ELEMENTS, AMPLITUDE, STEPS = 2, 8, 5.0, 4   # default size: about 30 s of CPU (2 lays: the cut in the middle)
+solve_options = dict(steps=6 * STEPS, t_end=6.0)   # for `beamsolver run examples/strand_bending.py`
+
+
+# ---------------------------------------------------------------- theory
+def theory(F, mu=MU):
+    """Closed-form quantities for a wire force ``F`` (docs/theory_strand_bending.md): dict."""
+    r = RC + RW
+    b = np.arctan(2 * np.pi * r / LAY)
+    Aw, Iw, Ic = np.pi * RW**2, np.pi * RW**4 / 4, np.pi * RC**4 / 4
+    c = np.cos(b) * (1 + np.cos(b) ** 2 + np.sin(b) ** 2 / (1 + NU)) / 2
+    EI_min = E * Ic + N * c * E * Iw
+    S = 0.5 * N * E * Aw * r**2 * np.cos(b) ** 3
+    kb = mu * F * np.sin(b) / (E * Aw * np.cos(b) ** 2 * r)
+    Mf = 2 * N / np.pi * mu * F * r * np.sin(b) * np.cos(b)
+    return dict(beta=b, r=r, c=c, EI_min=EI_min, S=S, EI_max=EI_min + S, kappa_b=kb, kappa_t=0.5 * np.pi * kb,
+                M_f=Mf, F=F)
+
+
+def slip_angle(kappa, th):
+    """``psi`` with ``sin(psi) / psi = kappa_b / kappa`` (0 below kappa_b, pi / 2 from kappa_t on)."""
+    kappa = np.abs(np.atleast_1d(np.asarray(kappa, dtype=float)))
+    out = np.zeros_like(kappa)
+    x = np.linspace(1e-9, 0.5 * np.pi, 20001)
+    ratio = np.sin(x) / x                                   # decreasing from 1 to 2 / pi
+    mid = (kappa > th["kappa_b"]) & (kappa < th["kappa_t"])
+    out[mid] = np.interp(-th["kappa_b"] / kappa[mid], -ratio, x)
+    out[kappa >= th["kappa_t"]] = 0.5 * np.pi
+    return out
+
+
+def friction_moment(kappa, th):
+    """Virgin friction part ``M - EI_min kappa`` (odd in ``kappa``): ``S kappa`` in stick,
+    ``S kappa (4 / pi) g(psi)`` while slip spreads, ``M_f`` in full slip."""
+    kappa = np.atleast_1d(np.asarray(kappa, dtype=float))
+    k, psi = np.abs(kappa), slip_angle(kappa, th)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        g = np.pi / 4 - psi / 2 + np.sin(psi) ** 2 / np.where(psi > 0, psi, 1) - np.sin(psi) * np.cos(psi) / 2
+    m = np.where(k <= th["kappa_b"], th["S"] * k, np.where(k >= th["kappa_t"], th["M_f"],
+                                                                 th["S"] * k * 4 / np.pi * g))
+    return np.sign(kappa) * m
+
+
+def moment(kappa, th, reversal=None):
+    """Virgin ``M(kappa)``; after a reversal at ``(kappa_r, M_fr_r)`` (friction part) Masing's branch
+    ``M_fr = M_fr_r - 2 f((kappa_r - kappa) / 2)``."""
+    kappa = np.asarray(kappa, dtype=float)
+    if reversal is None:
+        return th["EI_min"] * kappa + friction_moment(kappa, th)
+    kr, mr = reversal
+    return th["EI_min"] * kappa + mr - 2 * friction_moment((kr - kappa) / 2, th)
+
+
+def loop_energy(kappa_a, th):
+    """Energy dissipated per cycle between ``-+kappa_a`` (Masing): ``8 int_0^k f - 4 k f(k)``."""
+    x = np.linspace(0.0, kappa_a, 4001)
+    f = friction_moment(x, th)
+    return 8 * np.trapezoid(f, x) - 4 * kappa_a * f[-1]
+
+
+# ---------------------------------------------------------------- model
+SLIP_TOLERANCE = 5e-6            # elastic slip of the penalty stick / element length (default 0.005: see above)
+
+
+def build(lays=LAYS, elements_per_lay=ELEMENTS, mu=MU, amplitude=AMPLITUDE, tied=False, kappa_b=None, slip_tolerance=SLIP_TOLERANCE):
+    """The strand in its bending fixture: ``(model, strand, fixture, T, k)``; ``kappa_b`` sets the
+    curvature unit (default: the theory's with the fibre-limit wire force)."""
+    b = np.arctan(2 * np.pi * (RC + RW) / LAY)
+    layers = [cables.Layer(RC, 1), cables.Layer(RW, N, lay_length=LAY)]
+    st = cables.build_strand(layers, lays * LAY, E, nu=NU, elements_per_lay=elements_per_lay, mu=mu,
+                             contact=not tied, touch_tol=0.0, contact_options=dict(friction_from=1.0, slip_tolerance=slip_tolerance))
+    if tied:                                   # every wire node rigidly on the core node at its height
+        core = st.wires[0][0]
+        for w in st.wires[1]:
+            for a, c in zip(w.nodes, core.nodes):
+                st.model.join(c, a, rigid=True)
+    Kee = E * np.pi * RC**2 + N * E * np.pi * RW**2 * np.cos(b) ** 3
+    T = Kee * STRAIN
+    kb = theory(E * np.pi * RW**2 * np.cos(b) ** 2 * STRAIN, mu if mu > 0 else MU)["kappa_b"] \
+        if kappa_b is None else kappa_b
+    k = amplitude * kb
+
+    def curvature(t):
+        if t <= 1.0:
+            return 0.0
+        if t <= 2.0:
+            return k * (t - 1.0)
+        if t <= 4.0:
+            return k * (3.0 - t)
+        return k * (t - 5.0)
+    fx = cables.bending_fixture(st, curvature=curvature, pull=lambda t: T * min(t, 1.0))
+    return st.model, st, fx, T, k
+
+
+def run(lays=LAYS, elements_per_lay=ELEMENTS, mu=MU, amplitude=AMPLITUDE, steps=STEPS, tied=False, t_end=6.0, verbose=False,
+        slip_tolerance=SLIP_TOLERANCE):
+    """Solve with ``steps`` steps per unit pseudo-time; returns a dict of the measured curves."""
+    model, st, fx, T, k = build(lays, elements_per_lay, mu, amplitude, tied, slip_tolerance=slip_tolerance)
+    t0 = time.perf_counter()
+    sol = bs.solve(model, steps=int(round(steps * t_end)), t_end=t_end, verbose=verbose)
+    wall = time.perf_counter() - t0
+    kappa = np.array([fx.curvature(t) for t in sol.times])
+    M = fx.moment(sol)
+    outer = np.concatenate([w.elements for w in st.wires[1]])
+    F = float(np.mean(sol.section_forces[int(np.argmin(np.abs(sol.times - 1.0))), outer, 0]))
+    share = np.full(len(sol.times), np.nan)
+    for i, c in enumerate(sol.contacts):
+        if not len(c.get("status", ())):
+            continue
+        z = c["position"][:, 2]
+        mid = (c["normal_force"] > 0) & (np.abs(z - 0.5 * fx.length) < 0.25 * fx.length)
+        share[i] = np.mean(c["status"][mid] == SLIP) if mid.any() else np.nan
+    return dict(sol=sol, fixture=fx, strand=st, times=sol.times, kappa=kappa, M=M, F=F, T=T, k=k, share=share,
+                wall=wall, iterations=int(sol.iterations.sum()), cutbacks=sum(s.get("cutbacks", 0) for s in sol.stats))
+
+
+def compare(res):
+    """Theory against the model's measurements: list of ``(name, theory, model, relative error)``."""
+    th = theory(res["F"])
+    t, kap, M = res["times"], res["kappa"], res["M"]
+    up = (t > 1.0) & (t <= 2.0 + 1e-9)
+    down = (t > 2.0) & (t <= 4.0 + 1e-9)
+    rows = []
+    first = np.flatnonzero(up)[0]
+    rows.append(("EI initial (stick) [N m^2]", th["EI_max"], M[first] / kap[first]))
+    slip = up & (kap >= max(th["kappa_t"] * 1.05, 0.6 * res["k"]))     # the last part of the virgin branch
+    ks, Ms = kap[slip], M[slip]
+    EI_slip = np.polyfit(ks, Ms, 1)[0] if len(ks) >= 2 else np.nan
+    rows.append(("EI full slip, slope of the virgin branch [N m^2]", th["EI_min"], EI_slip))
+    Mf = float(np.mean(Ms - th["EI_min"] * ks)) if len(ks) else np.nan
+    rows.append(("M_f [N m]", th["M_f"], Mf))
+    onset = np.flatnonzero(up & (res["share"] > 0))
+    rows.append(("kappa first slip [1/m]", th["kappa_b"], kap[onset[0]] if len(onset) else np.nan))
+    mid = up & (kap > th["kappa_b"]) & (kap < th["kappa_t"])
+    if mid.any():
+        j = np.flatnonzero(mid)[-1]
+        rows.append((f"slipping share at {kap[j] / th['kappa_b']:.2f} kappa_b", 2 * slip_angle(kap[j], th)[0] / np.pi,
+                     res["share"][j]))
+    kr = kap[np.flatnonzero(up)[-1]]
+    rev = (kr, friction_moment(kr, th)[0])
+    masing = moment(kap[down], th, rev)
+    err = np.abs(M[down] - masing) / th["M_f"]
+    rows.append(("Masing branch: max |M - M_Masing| / M_f", 0.0, err.max()))
+    rows.append(("Masing branch at -k: |M - M_Masing| / M_f", 0.0, err[-1]))
+    last = t >= 2.0 - 1e-9
+    W = np.trapezoid(M[last], kap[last])                         # one full cycle +k -> -k -> +k
+    rows.append(("loop energy [J/m]", loop_energy(res["k"], th), W))
+    return th, [(n, a, b, (b - a) / a if a else b) for n, a, b in rows]
+
+
+def first_slip(lays=LAYS, elements_per_lay=ELEMENTS, steps=40, upto=2.0):
+    """``(kappa at the first slipping point of the middle half, kappa_b of the theory)`` on a virgin
+    ramp ``0 -> upto kappa_b`` in ``steps`` steps (``t`` in ``[1, 2]``; the flags resolve ``upto / steps``)."""
+    res = run(lays, elements_per_lay, amplitude=upto, steps=steps, t_end=2.0)
+    th = theory(res["F"])
+    hit = np.flatnonzero((res["times"] > 1.0) & (res["share"] > 0))
+    return (res["kappa"][hit[0]] if len(hit) else np.nan), th["kappa_b"]
+
+
+def stiffness_checks(lays=LAYS, elements_per_lay=ELEMENTS, steps=STEPS):
+    """``(EI frictionless, EI tied)``: the initial slopes ``M / kappa`` of the strand with frictionless
+    contact (full slip: against ``EI_min``) and with the wires tied rigidly to the core (against
+    ``EI_max``), each on the virgin branch ``t`` in ``[1, 2]``, with their wire forces."""
+    out = []
+    for kw in (dict(mu=0.0), dict(tied=True)):
+        res = run(lays, elements_per_lay, amplitude=AMPLITUDE, steps=steps, t_end=2.0, **kw)
+        j = np.flatnonzero(res["times"] > 1.0)[-1]
+        out.append((res["M"][j] / res["kappa"][j], res["F"]))
+    return out
+
+
+def main(lays=LAYS, elements_per_lay=ELEMENTS, amplitude=AMPLITUDE, steps=STEPS, mu=MU, checks=True):
+    res = run(lays, elements_per_lay, mu, amplitude, steps)
+    th, rows = compare(res)
+    if checks:
+        (EI0, F0), (EIt, Ft) = stiffness_checks(lays, elements_per_lay, steps)
+        rows += [("EI frictionless contact (full slip) [N m^2]", theory(F0)["EI_min"], EI0,
+                  EI0 / theory(F0)["EI_min"] - 1),
+                 ("EI wires tied to the core (full stick) [N m^2]", theory(Ft)["EI_max"], EIt,
+                  EIt / theory(Ft)["EI_max"] - 1)]
+    print(f"1+6 strand (Utting & Jones 1987): Rc = {RC * 1e3} mm, Rw = {RW * 1e3} mm, lay {LAY * 1e3} mm, "
+          f"beta = {np.degrees(th['beta']):.2f} deg, mu = {mu}, T = {res['T']:.4g} N, wire force F = {res['F']:.4g} N;"
+          f" {lays} lays, {elements_per_lay} elements per lay, +-{amplitude} kappa_b, {steps} steps per unit t, "
+          f"slip_tolerance {SLIP_TOLERANCE}")
+    print("| quantity | theory | model | model / theory - 1 |")
+    print("|---|---:|---:|---:|")
+    for name, a, b, e in rows:
+        print(f"| {name} | {a:.5g} | {b:.5g} | {e:+.3g} |")
+    print(f"| Newton iterations / cut-backs / wall time (cyclic run) | | {res['iterations']} / {res['cutbacks']} / "
+          f"{res['wall']:.1f} s | |")
+    return res, th, rows
+
+
+def stick_slip_map(res, th, path):
+    """PNG at ``path`` of the contact points (stick blue, slip red) on the wires at the first step of the
+    virgin branch where slip has spread part way (needs pyvista, the ``viz`` extra)."""
+    import os
+    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    import pyvista as pv
+    sol, t = res["sol"], res["times"]
+    k = int(np.flatnonzero((t > 1.0) & (res["share"] > 0) & (res["share"] < 1))[0])
+    H = sol.poses[k]
+    pl = pv.Plotter(off_screen=True, window_size=(1600, 360))
+    for w in res["strand"].all_wires:
+        x = H[w.nodes, :3, 3]
+        pl.add_mesh(pv.Spline(x, 4 * len(x)).tube(radius=0.9 * w.section.radius), color="lightgray", opacity=0.35)
+    c = sol.contacts[k]
+    on = c["normal_force"] > 0
+    for code, colour in ((bs.contact.STICK, "royalblue"), (bs.contact.SLIP, "crimson")):
+        pts = c["position"][on & (c["status"] == code)]
+        if len(pts):
+            pl.add_points(pv.PolyData(pts), color=colour, point_size=9, render_points_as_spheres=True,
+                          label=bs.contact.STATUS_NAMES[code])
+    pl.add_legend()
+    pl.view_vector((0.0, -1.0, 0.0), viewup=(1.0, 0.0, 0.0))     # the strand axis e_z across the picture
+    pl.enable_parallel_projection()
+    pl.reset_camera()
+    pl.camera.zoom(3.5)
+    pl.add_text(f"kappa = {res['kappa'][k] / th['kappa_b']:.2f} kappa_b: slipping share {res['share'][k]:.2f} "
+                f"(theory {2 * slip_angle(res['kappa'][k], th)[0] / np.pi:.2f}, middle half)", font_size=10)
+    pl.screenshot(path)
+    pl.close()
+
+
+if __name__ == "__main__":
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--lays", type=float, default=LAYS)
+    ap.add_argument("--elements", type=int, default=ELEMENTS)
+    ap.add_argument("--amplitude", type=float, default=AMPLITUDE)
+    ap.add_argument("--steps", type=int, default=STEPS)
+    ap.add_argument("--mu", type=float, default=MU)
+    ap.add_argument("--plot", default=None, help="PNG of the loop against the theory (needs matplotlib)")
+    ap.add_argument("--map", default=None, help="PNG of the stick/slip map where slip spreads (needs pyvista)")
+    a = ap.parse_args()
+    res, th, rows = main(a.lays, a.elements, a.amplitude, a.steps, a.mu)
+    if a.map:
+        stick_slip_map(res, th, a.map)
+        print(f"written: {a.map}")
