@@ -31,7 +31,6 @@ myst_heading_anchors = 3
 
 autodoc_default_options = {"members": True, "member-order": "bysource"}
 autodoc_typehints = "none"
-autodoc_class_signature = "separated"
 napoleon_google_docstring = False
 
 html_theme = "pydata_sphinx_theme"
