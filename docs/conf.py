@@ -48,7 +48,7 @@ html_theme_options = {
     "footer_start": ["copyright"],
     "footer_end": ["sphinx-version"],
 }
-html_sidebars = {"index": []}
+html_sidebars = {"index": [], "getting_started": [], "benchmarks": []}   # pages without sub-pages
 
 
 def _theory_topics(app, docname, source):
