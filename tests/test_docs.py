@@ -30,6 +30,7 @@ API = {
     "api/topology.html": ["beamsolver.topology.writhe_closed"],
     "api/stabilize.html": ["beamsolver.stabilize.Stabilization"],
     "api/viz.html": ["beamsolver.viz.render"],
+    "api/elements.html": ["beamsolver.elements.ElementType"],
 }
 
 
