@@ -3,7 +3,7 @@
     python docs/gallery/regenerate.py [NAME ...]      # all examples, or the named ones
 
 For each example, ``python examples/NAME.py`` runs in a scratch folder and its printed output
-goes to ``docs/gallery/output/NAME.txt``.  The picture ``docs/gallery/NAME.png`` is drawn by
+goes to ``docs/gallery/printed/NAME.txt``.  The picture ``docs/gallery/NAME.png`` is drawn by
 ``beamsolver.viz.render`` from ``beamsolver run examples/NAME.py`` (the example's ``build()``
 with its defaults) for the examples in ``RENDER``; the others show a picture they make
 themselves (``OWN``).  Needs the ``[viz]`` extra; with the kernels compiled about three minutes
@@ -39,7 +39,7 @@ def run_example(name, scratch):
     """Print-out of ``python examples/NAME.py`` run in ``scratch`` (exit status checked)."""
     cmd = [sys.executable, str(ROOT / "examples" / f"{name}.py"), *OWN.get(name, [])]
     out = subprocess.run(cmd, cwd=scratch, capture_output=True, text=True, check=True)
-    (GALLERY / "output" / f"{name}.txt").write_text(out.stdout)
+    (GALLERY / "printed" / f"{name}.txt").write_text(out.stdout)
 
 
 def draw(name, scratch):
@@ -58,7 +58,7 @@ def main(names):
             run_example(name, scratch)
             if name in RENDER:
                 draw(name, scratch)
-        print(f"{name}: output/{name}.txt" + (f", {name}.png" if name in RENDER or name in OWN else ""))
+        print(f"{name}: printed/{name}.txt" + (f", {name}.png" if name in RENDER or name in OWN else ""))
 
 
 if __name__ == "__main__":
