@@ -84,6 +84,15 @@ def test_api_reference_documents_public_paths(site):
 
 
 @pytest.mark.slow
+def test_docstring_citations_link_to_the_topic_page(site):
+    """``docs/theory.md eq. 2.1`` in ``se3.exp_so3``'s docstring links to the SE(3) page, and
+    ``section 15`` in ``Model.add_contact``'s to the contact-laws page (the section map)."""
+    link = '<a class="reference internal" href="../theory/{}.html"><span class="doc">docs/theory.md</span></a>'
+    assert link.format("se3") + " eq. 2.1" in (site / "api" / "se3.html").read_text()
+    assert link.format("contact_laws") + " section 15" in (site / "api" / "beamsolver.html").read_text()
+
+
+@pytest.mark.slow
 def test_theory_pages_and_section_map(site):
     """Every numbered section of the old docs/theory.md is on one topic page and in the map."""
     text = "".join(p.read_text() for p in sorted((ROOT / "docs" / "theory").glob("*.md")))
