@@ -26,7 +26,7 @@ API = {
     "api/cables.html": ["beamsolver.cables.build_strand"],
     "api/se3.html": ["beamsolver.se3.exp", "beamsolver.se3.tangent_inv"],
     "api/contact.html": ["beamsolver.contact.slip_increment"],
-    "api/io.html": ["beamsolver.io.save"],
+    "api/io.html": ["beamsolver.io.save", "beamsolver.io.vtk.StepWriter", "beamsolver.io.paraview.paraview_script"],
     "api/topology.html": ["beamsolver.topology.writhe_closed"],
     "api/stabilize.html": ["beamsolver.stabilize.Stabilization"],
     "api/viz.html": ["beamsolver.viz.render"],
