@@ -8,7 +8,8 @@ relative tolerance ``STEP_TOLERANCE``, and a grown step cut back below
 ``dt_min`` tries ``dt_min`` itself); after two easy steps running the next one
 grows (``growth``), never past the user's step (easy: no cut-back and at most ``easy_limit``
 Newton iterations, the more of ``EASY_ITERATIONS`` and the iterations of the last step taken at
-the user's size: a contact step that needs 15 iterations at any size regrows too), and not back to the size of the
+the user's size: a contact step that needs 15 iterations at any size regrows too; or a steady count,
+``steady``: slip steps of 7-12 iterations after a cut-back regrow), and not back to the size of the
 last failed step before ``wait`` easy steps running (``next_step``: the wait doubles
 each time that size fails again, up to ``WAIT_MAX``; 2, the fixed rule, until then), and
 lands on the grid (no sliver shorter than ``LANDING`` steps before a grid point).  Every loop is
@@ -24,15 +25,15 @@ import warnings
 
 import numpy as np
 
-from . import branching, diagnosis, motion_path
+from . import branching, diagnosis, motion_path, stable_branch
 from .definiteness import negative_eigenvalues
 from .errors import ConvergenceError, InputError, StabilityWarning
-from .failures import AugmentationFailed, MotionTooFast, NonFinite, StepFailed
+from .failures import AugmentationFailed, LeftStableBranch, MotionTooFast, NonFinite, StepFailed
 from .progress import Progress
 from .results import Solution
 
-__all__ = ["Run", "growth", "easy_limit", "next_step", "after_failure", "STEP_TOLERANCE", "EASY_ITERATIONS", "WAIT_MAX",
-           "STEP_ZERO_ITERATIONS"]
+__all__ = ["Run", "growth", "steady", "easy_limit", "next_step", "after_failure", "STEP_TOLERANCE", "EASY_ITERATIONS", "WAIT_MAX",
+           "STEP_ZERO_ITERATIONS", "STEADY_SLACK"]
 
 log = logging.getLogger("beamsolver")
 
@@ -40,6 +41,7 @@ STEP_TOLERANCE = 1e-9      # relative rounding allowed when comparing step sizes
 LANDING = 0.1              # a step ending within this fraction of a step before a grid point lands on it
 EASY_ITERATIONS = 6        # a step converging within these iterations is easy (growth)
 EASY_RUN = 2               # easy steps running before the step grows (growth)
+STEADY_SLACK = 1           # iterations more than the step before that still count as a steady count (steady)
 WAIT_MAX = 32              # most easy steps running before a step regrows to a size that failed again
 MAX_OUTER = 100            # outer iterations of a step (Problem.repeat_step) before it fails
 STEP_ZERO_ITERATIONS = 4   # Newton budget at t_start / max_iter (no cut-back there; docs/theory.md section 17)
@@ -50,6 +52,20 @@ def growth(iterations, easy):
     at most ``EASY_ITERATIONS`` Newton iterations without cut-back (``easy`` counts them, this
     one included), else 1."""
     return 2.0 if easy >= EASY_RUN else 1.0
+
+
+def steady(iterations, cutbacks, reference, previous, max_iter):
+    """Whether a converged step counts towards growth (``growth``'s ``easy``): no cut-back, and
+    either at most ``easy_limit(reference)`` Newton iterations or a steady count: at most
+    ``STEADY_SLACK`` more than the step before (``previous``; ``None``: none) and at most half
+    of ``max_iter``.  A slip-dominated stretch that needs 7-12 iterations at any size (issue 27)
+    regrows after a cut-back; the failed-size memory of ``next_step`` keeps it off sizes that
+    failed."""
+    if cutbacks:
+        return False
+    if iterations <= easy_limit(reference):
+        return True
+    return previous is not None and iterations <= previous + STEADY_SLACK and 2 * iterations <= max_iter
 
 
 def easy_limit(reference):
@@ -94,6 +110,7 @@ class Run:
         self.sol = None
         self.progress = None
         self.warned_unstable = False
+        self.negative = None          # negative eigenvalues of the last converged state's tangent, if known
 
     # ------------------------------------------------------------------ start
     def start(self, restart_solution, initial_poses):
@@ -206,7 +223,8 @@ class Run:
 
     def _attempt(self, t_next):
         """Converge the step ``t -> t_next``, halving it on failure; returns the step reached."""
-        t, cutbacks, rotation_limit, failed_sizes = self.t, 0, None, []
+        t, cutbacks, rotation_limit, failed_sizes, branch_tries = self.t, 0, None, [], 0
+        before = self._negative_before()
         while True:
             t_try, rot = motion_path.limit_step(self.sys, t, t_next)
             if t_try < t_next and t_try - t < self.dt_min * (1.0 - STEP_TOLERANCE):
@@ -220,26 +238,74 @@ class Run:
                 self._check_finite(H, ev.r, ev.state, t_try)
                 stats.update(cutbacks=cutbacks, timings=dict(self.newton.timings))
                 if failed_sizes:
-                    stats["failed_dt"] = failed_sizes
+                    stats["failed_dt"] = list(failed_sizes)
                 if t_try < t_next:
                     stats["motion_rotation"] = rot
+                self._keep_branch(t_try, H, ev, stats, before)
                 return t_try, H, ev, stats
             except StepFailed as e:
                 if isinstance(e, NonFinite):
                     self._name_nonfinite(t_try)
+                h = 0.5 * (t_try - t)
+                if self.dt_min * (1.0 + STEP_TOLERANCE) < t_try - t and h < self.dt_min:
+                    h = self.dt_min             # a grown step cut back: the smallest step is still tried
+                if isinstance(e, LeftStableBranch):
+                    branch_tries += 1
+                    if branch_tries > stable_branch.RETRIES or h < self.dt_min * (1.0 - STEP_TOLERANCE):
+                        return self._keep_unstable(e)
                 cutbacks += 1
                 failed_sizes.append(t_try - t)
                 self.failed, self.wait = after_failure(t_try - t, self.failed, self.wait)
                 if e.rotation:
                     rotation_limit = str(e)
-                h = 0.5 * (t_try - t)
-                if self.dt_min * (1.0 + STEP_TOLERANCE) < t_try - t and h < self.dt_min:
-                    h = self.dt_min             # a grown step cut back: the smallest step is still tried
                 log.info("t = %.6g: step %.3g failed (%s); cutting back to %.3g", t_try, t_try - t, e, h)
                 if not e.retry or h < self.dt_min * (1.0 - STEP_TOLERANCE):
                     self._stop(e, rotation_limit)
                 t_next = t + h
                 self.easy = 0
+
+    def _negative_before(self):
+        """``before()`` of ``stable_branch.verdict`` for a step from the current state: its
+        negative-eigenvalue count, known from the last step's check or computed once when asked
+        (``None`` where the problem is not conservative)."""
+        known, ev = self.negative, getattr(self.newton, "last_evaluation", None)
+        cache = []
+
+        def before():
+            if known is not None:
+                return known
+            if not cache:
+                e = ev if ev is not None else self.problem.evaluate(self.H, self.t, tangent=True)
+                cache.append(stable_branch.negative_count(self.problem, e))
+            return cache[0]
+        return before
+
+    def _keep_branch(self, t, H, ev, stats, before):
+        """``stable_branch.verdict`` on the step converged at ``t``: raises ``LeftStableBranch``
+        carrying the step, for ``_keep_unstable`` (not with ``branch_switching``, whose switch
+        moves the path onto a stable branch itself)."""
+        if self.opt.get("branch_switching"):
+            return
+        try:
+            self.negative = stable_branch.verdict(self.problem, self.newton.last_evaluation, before, t)
+        except LeftStableBranch as e:
+            e.t, e.result = t, (t, H, ev, stats)
+            raise
+
+    def _keep_unstable(self, failure):
+        """Keep the unstable state of ``failure`` (``LeftStableBranch``) after ``stable_branch.RETRIES``
+        cut-backs or at the smallest step, and say so once (``StabilityWarning``; with
+        ``check_stability`` its own warning reports it)."""
+        t, H, ev, stats = failure.result
+        self.negative = failure.negative
+        stats.update(left_stable_branch=True)
+        text = stable_branch.kept(failure)
+        if not self.warned_unstable and not self.opt.get("check_stability"):
+            self.warned_unstable = True
+            log.warning(text)
+            warnings.warn(text, StabilityWarning, stacklevel=5)
+            self.sol.message = text if not self.sol.message else self.sol.message + "; " + text
+        return failure.result
 
     def newton_step(self, t_next, start=None):
         """Newton at ``t_next`` (from the last converged state, or from ``start`` at ``t_next``),
@@ -286,7 +352,9 @@ class Run:
             t, k = self.grid[k], k + 1
         if stats["cutbacks"] == 0 and dt >= self.dt_user * (1.0 - STEP_TOLERANCE):
             self.reference = stats["iterations"]
-        easy = self.easy + 1 if stats["iterations"] <= easy_limit(self.reference) and stats["cutbacks"] == 0 else 0
+        previous = self.sol.stats[-1]["iterations"] if self.sol.n_steps else None
+        easy = self.easy + 1 if steady(stats["iterations"], stats["cutbacks"], self.reference, previous,
+                                       self.newton.conv.max_iter) else 0
         dt, self.failed, self.wait = next_step(dt, stats["iterations"], easy, self.failed, self.wait)
         dt = min(dt, self.dt_user)
         if problem.contributions:
@@ -320,7 +388,7 @@ class Run:
             t, H, ev, K = branching.switch(self, stats, t, H, ev, K)
         if self.opt.get("modes"):
             branching.record_modes(self.sys, stats, H, K, self.opt["modes"])
-        neg = stats["negative_eigenvalues"]
+        neg = self.negative = stats["negative_eigenvalues"]
         if neg and not self.warned_unstable:
             self.warned_unstable = True
             text = (f"t = {t:.6g}: the equilibrium is unstable (the tangent has {neg} negative "

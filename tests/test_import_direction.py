@@ -35,7 +35,7 @@ LAYER = {
     # 5: results
     "results": 5, "restart": 5, "study": 5,
     # 6: solver, its stepping and failure diagnosis, linearisation
-    "solver": 6, "stepping": 6, "arclength": 6, "diagnosis": 6, "linear": 6, "branching": 6,
+    "solver": 6, "stepping": 6, "stable_branch": 6, "arclength": 6, "diagnosis": 6, "linear": 6, "branching": 6,
     # 7: output, pictures, command line, the package's public face
     "io": 7, "io.archive": 7, "io.lines": 7, "io.vtk": 7, "io.vtu": 7, "viz": 7, "cli": 7, "sweep_engine": 7, "sweep_cli": 7, "": 7,
 }
