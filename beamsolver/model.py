@@ -364,7 +364,14 @@ class Model:
         - ``margin``: search margin around every element (default twice the largest radius).
         - ``law``: the contact law, a ``contact.law.ContactLaw`` of compiled functions
           (default None: the penalty / augmented-Lagrangian / smoothed normal law with
-          Coulomb friction; docs/theory.md section 15).
+          Coulomb friction; docs/theory.md section 15);
+        - ``adjust``: strain-free adjustment of initial overclosures (Abaqus' contact
+          ``ADJUST``): a contact point whose gap at the reference poses lies between
+          ``-adjust`` and 0 starts touching (its gap offset by the overlap for the whole
+          run: the overlap puts no force on the reference state); deeper overlaps are left
+          as they are (default None: ``1e-3 (R1 + R2)``; 0: no adjustment; the count and
+          the largest overlap adjusted are in ``Solution.stats[0]["adjusted"]``;
+          docs/theory_adjust.md).
 
         Unknown options are refused.  The same beams on both
         sides (``add_contact(group, group)``, as for the wires of a cable) declare every

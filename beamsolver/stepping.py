@@ -175,7 +175,8 @@ class Run:
                 self.sol.converged, self.sol.message = False, str(e)
                 if pushed:
                     why = (f"contact forces already act ({diagnosis.pushing_point(problem, H)}): {e}; "
-                           "separate the beams by a small gap or raise max_iter")
+                           "separate the beams by a small gap, let add_contact(adjust=) cover the overlap "
+                           "(strain-free adjustment) or raise max_iter")
                 else:
                     why = f"loads or motions already act: {e}; start the loads from zero or use more steps"
                 err = ConvergenceError(f"solve: no equilibrium at t_start = {t_start:.6g}, where {why}", self.sol)
@@ -188,6 +189,11 @@ class Run:
             if problem.contributions:
                 self.sol.contact_state = problem.get_state()
         self._check_finite(H, ev0.r, ev0.state, t_start)
+        adjusted = problem.contact.adjusted if problem.contact is not None else None
+        if adjusted and adjusted["count"]:
+            stats["adjusted"] = dict(adjusted)
+            log.info("t = %.6g: %d contact point(s) adjusted to touching, strain-free (largest reference overlap "
+                     "%.3g)", t_start, adjusted["count"], adjusted["largest"])
         self.sol.append(t_start, H, sys.reactions(H, ev0.r), ev0.state.sigma, ev0.state.strain, stats, record)
         self.H = H
         if self.writer is not None:
