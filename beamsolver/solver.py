@@ -196,6 +196,8 @@ class Newton:
         self._smallest_limit = (1.0 - 1e-9) * float(system.rotation_limit.min(initial=np.inf))
         self.linsolver = linsolve.Solver()    # solve(linear_solver=...) replaces it
         self.stall_ratio = np.inf             # correction growth of the shortest damped trial
+        self.indefinite_seen = False          # the step's first tangent had det < 0 (or a back-end that cannot tell)
+        self.watch_sign = False               # whether to look (stepping.Run: conservative problems)
         self.reset_timings()
 
     def reset_timings(self):
@@ -351,6 +353,7 @@ class Newton:
         conv, problem = self.conv, self.problem
         H_start = H
         residuals = []
+        self.indefinite_seen = False
         damped_its = 0
         dz_c, targets = self._predictor(H, t, t_prev, H_target)
         floor = conv.floor(H, self.L_ref)
@@ -379,6 +382,9 @@ class Newton:
                 raise self._failure(verdict, ratio)
             if dzf is None:
                 lu, dzf = self._direction(ev, dz_c)
+            if it == 0 and self.watch_sign:     # the first tangent K(H_n, t_n+1): indefinite where a step may jump
+                sign = getattr(lu, "det_sign", None)
+                self.indefinite_seen = sign is None or sign() < 0
             dz = self._full(dzf)
             if dz_c is not None:
                 H = self._reach_targets(H, dz + dz_c, H_target, bool(targets), t)

@@ -9,23 +9,28 @@ indefinite, or the undamped fallback of ``solver.Newton.step``, lands there and
 the step "converges".  Short steps, where the tangent at the new load is still
 positive definite, follow the stable branch (docs/theory_stable_branch.md).
 
-``verdict`` decides after every converged step of a conservative problem
+``verdict`` decides after a converged step of a conservative problem
 (``Problem.conservative``: a symmetric tangent, a potential) that started from
-a stable state: the end state's tangent is checked
+a stable state and is flagged by the stepping (``stepping.Run._keep_branch``: the
+step's first tangent had ``det < 0``, ``Newton.indefinite_seen``, or the step
+took undamped Newton iterations): the end state's tangent is checked
 (``definiteness.negative_eigenvalues``: a Cholesky factorisation of the scaled
 tangent when it is positive definite).  Stable: kept.  Unstable: the step left
 the stable branch, ``LeftStableBranch`` is raised and the step is cut back, at
-most ``RETRIES`` times running; past that (the stable branch itself ends there:
-a limit point, or the bifurcation of a perfect structure) the unstable state is
-kept, and said so.  Steps from an unstable state and non-conservative problems
-(friction, follower loads, stabilisation) are not checked.
+most ``RETRIES`` times for one step and ``RETRIES_RUN`` times since a step last
+converged at its first try; past that
+(the stable branch itself ends there: a limit point, or the bifurcation of a
+perfect structure) the unstable state is kept, and said so.  Steps from an
+unstable state and non-conservative problems (friction, follower loads,
+stabilisation) are not checked.
 """
 from .definiteness import negative_eigenvalues
 from .failures import LeftStableBranch
 
-__all__ = ["negative_count", "verdict", "kept", "RETRIES"]
+__all__ = ["negative_count", "verdict", "kept", "RETRIES", "RETRIES_RUN"]
 
-RETRIES = 3        # cut-backs of a step that left the stable branch before its end state is kept (1/8 of it)
+RETRIES = 3        # cut-backs of one step for leaving the stable branch before its unstable end state is kept
+RETRIES_RUN = 8    # the same since a step last converged at its first try (no homing in on a critical load)
 
 
 def negative_count(problem, ev):

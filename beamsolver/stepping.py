@@ -111,6 +111,8 @@ class Run:
         self.progress = None
         self.warned_unstable = False
         self.negative = None          # negative eigenvalues of the last converged state's tangent, if known
+        self.branch_tries = 0         # LeftStableBranch failures since a step converged at its first try
+        newton.watch_sign = problem.conservative and not options.get("branch_switching")   # stable_branch
 
     # ------------------------------------------------------------------ start
     def start(self, restart_solution, initial_poses):
@@ -229,7 +231,7 @@ class Run:
 
     def _attempt(self, t_next):
         """Converge the step ``t -> t_next``, halving it on failure; returns the step reached."""
-        t, cutbacks, rotation_limit, failed_sizes, branch_tries = self.t, 0, None, [], 0
+        t, cutbacks, rotation_limit, failed_sizes, branch_here = self.t, 0, None, [], 0
         before = self._negative_before()
         while True:
             t_try, rot = motion_path.limit_step(self.sys, t, t_next)
@@ -248,6 +250,8 @@ class Run:
                 if t_try < t_next:
                     stats["motion_rotation"] = rot
                 self._keep_branch(t_try, H, ev, stats, before)
+                if not cutbacks:
+                    self.branch_tries = 0
                 return t_try, H, ev, stats
             except StepFailed as e:
                 if isinstance(e, NonFinite):
@@ -256,8 +260,9 @@ class Run:
                 if self.dt_min * (1.0 + STEP_TOLERANCE) < t_try - t and h < self.dt_min:
                     h = self.dt_min             # a grown step cut back: the smallest step is still tried
                 if isinstance(e, LeftStableBranch):
-                    branch_tries += 1
-                    if branch_tries > stable_branch.RETRIES or h < self.dt_min * (1.0 - STEP_TOLERANCE):
+                    branch_here, self.branch_tries = branch_here + 1, self.branch_tries + 1
+                    if branch_here > stable_branch.RETRIES or self.branch_tries > stable_branch.RETRIES_RUN or \
+                            h < self.dt_min * (1.0 - STEP_TOLERANCE):
                         return self._keep_unstable(e)
                 cutbacks += 1
                 failed_sizes.append(t_try - t)
@@ -289,8 +294,13 @@ class Run:
     def _keep_branch(self, t, H, ev, stats, before):
         """``stable_branch.verdict`` on the step converged at ``t``: raises ``LeftStableBranch``
         carrying the step, for ``_keep_unstable`` (not with ``branch_switching``, whose switch
-        moves the path onto a stable branch itself)."""
+        moves the path onto a stable branch itself).  Only a step whose first tangent had ``det < 0``
+        (``Newton.indefinite_seen``) or that took undamped Newton iterations (the fallback, or
+        ``line_search=False``) is checked."""
         if self.opt.get("branch_switching"):
+            return
+        if not (self.newton.indefinite_seen or stats.get("undamped") is not None or not self.newton.line_search):
+            self.negative = None        # every tangent of the step had det > 0: not checked (stable_branch)
             return
         try:
             self.negative = stable_branch.verdict(self.problem, self.newton.last_evaluation, before, t)
@@ -300,10 +310,11 @@ class Run:
 
     def _keep_unstable(self, failure):
         """Keep the unstable state of ``failure`` (``LeftStableBranch``) after ``stable_branch.RETRIES``
-        cut-backs or at the smallest step, and say so once (``StabilityWarning``; with
+        such failures of a step, or ``RETRIES_RUN`` since a step converged at its first try, or at
+        the smallest step, and say so once (``StabilityWarning``; with
         ``check_stability`` its own warning reports it)."""
         t, H, ev, stats = failure.result
-        self.negative = failure.negative
+        self.negative, self.branch_tries = failure.negative, 0
         stats.update(left_stable_branch=True)
         text = stable_branch.kept(failure)
         if not self.warned_unstable and not self.opt.get("check_stability"):
