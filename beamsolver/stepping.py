@@ -191,11 +191,11 @@ class Run:
             if problem.contributions:
                 self.sol.contact_state = problem.get_state()
         self._check_finite(H, ev0.r, ev0.state, t_start)
-        adjusted = problem.contact.adjusted if problem.contact is not None else None
+        adjusted = problem.adjusted
         if adjusted and adjusted["count"]:
             stats["adjusted"] = dict(adjusted)
-            log.info("t = %.6g: %d contact point(s) adjusted to touching, strain-free (largest reference overlap "
-                     "%.3g)", t_start, adjusted["count"], adjusted["largest"])
+            log.info("t = %.6g: %d point(s) of reference overlap adjusted to touching, strain-free (largest "
+                     "overlap %.3g)", t_start, adjusted["count"], adjusted["largest"])
         self.sol.append(t_start, H, sys.reactions(H, ev0.r), ev0.state.sigma, ev0.state.strain, stats, record)
         self.H = H
         if self.writer is not None:
