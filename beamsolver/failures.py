@@ -7,7 +7,7 @@ attribute is the instance (``isinstance(error.failure, RotationLimit)``).
 
 __all__ = ["StepFailed", "RotationLimit", "NotConverged", "Diverged", "DampingStalled",
            "SingularTangent", "NonFinite", "AugmentationFailed", "MotionTooFast",
-           "ContactTunnelling", "NoContactNormal"]
+           "ContactTunnelling", "NoContactNormal", "LeftStableBranch"]
 
 
 class StepFailed(Exception):
@@ -69,3 +69,13 @@ class ContactTunnelling(StepFailed):
 
 class NoContactNormal(StepFailed):
     """The centre lines of a contact pair intersect: the pair has no normal."""
+
+
+class LeftStableBranch(StepFailed):
+    """A step from a stable equilibrium converged to an unstable one (``stable_branch``): a
+    shorter step is tried; ``negative``: negative eigenvalues of the end state's tangent, ``t``
+    its time, ``result``: the converged step ``(t, H, ev, stats)`` (kept if no shorter step helps)."""
+
+    def __init__(self, message, negative, t=float("nan"), result=None):
+        super().__init__(message)
+        self.negative, self.t, self.result = negative, t, result

@@ -45,7 +45,7 @@ import scipy.sparse.linalg as spla
 from ._jit import jit
 from .errors import InputError
 
-__all__ = ["factorize", "Solver", "SingularMatrixError", "available", "BACKENDS", "DEFAULT"]
+__all__ = ["factorize", "Solver", "SingularMatrixError", "available", "permutation_sign", "BACKENDS", "DEFAULT"]
 
 BACKENDS = ("splu", "splu-rcm", "pardiso", "auto")
 DEFAULT = "auto"          # splu for beams and small scenes; splu-rcm/pardiso for large bundles
@@ -154,6 +154,34 @@ class _SpluFactor:
 
     def solve(self, b):
         return self._lu.solve(np.asarray(b, dtype=float))
+
+    def det_sign(self):
+        """Sign of ``det(K)`` (1, -1; 0 for a zero pivot): SuperLU factors ``Pr K Pc = L U`` with a
+        unit diagonal in ``L``, so it is the sign of ``prod diag(U)`` times the parities of the
+        two permutations."""
+        d = self._lu.U.diagonal()
+        return int(np.prod(np.sign(d))) * permutation_sign(self._lu.perm_r) * permutation_sign(self._lu.perm_c)
+
+
+def permutation_sign(p):
+    """Sign (1 or -1) of the permutation ``p`` of ``0..n-1``: ``(-1)^(n - cycles)`` (compiled cycle count)."""
+    p = np.ascontiguousarray(p, dtype=np.int64)
+    return -1 if (len(p) - _cycles(p)) % 2 else 1
+
+
+@jit
+def _cycles(p):
+    """Number of cycles of the permutation ``p``."""
+    seen = np.zeros(len(p), dtype=np.bool_)
+    count = 0
+    for i in range(len(p)):
+        if not seen[i]:
+            count += 1
+            j = i
+            while not seen[j]:
+                seen[j] = True
+                j = p[j]
+    return count
 
 
 class _SpluRcmFactor:

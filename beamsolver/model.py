@@ -409,7 +409,14 @@ class Model:
         - ``margin``: search margin around every element (default twice the largest radius).
         - ``law``: the contact law, a ``contact.law.ContactLaw`` of compiled functions
           (default None: the penalty / augmented-Lagrangian / smoothed normal law with
-          Coulomb friction; docs/theory.md section 15).
+          Coulomb friction; docs/theory.md section 15);
+        - ``adjust``: strain-free adjustment of initial overclosures (Abaqus' contact
+          ``ADJUST``): a contact point whose gap at the reference poses lies between
+          ``-adjust`` and 0 starts touching (its gap offset by the overlap for the whole
+          run: the overlap puts no force on the reference state); deeper overlaps are left
+          as they are (default None: ``1e-3 (R1 + R2)``; 0: no adjustment; the count and
+          the largest overlap adjusted are in ``Solution.stats[0]["adjusted"]``;
+          docs/theory_adjust.md).
 
         Switched in pseudo-time (default None: from the start): ``active_from``: the
         declaration acts only in steps ending after this time; ``friction_from``: frictionless

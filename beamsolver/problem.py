@@ -83,6 +83,12 @@ class Problem:
 
     # ------------------------------------------------------------ properties
     @property
+    def adjusted(self):
+        """The strain-free adjustment of the reference overlaps (``contact.adjust``): ``dict(count,
+        largest)``, ``None`` without contact."""
+        return self.contact.adjusted if self.contact is not None else None
+
+    @property
     def solves_start(self):
         """Whether forces of the contributions on the load-free given poses make step 0 an
         equilibrium to solve (``Newton.at_rest`` decides): contact, whose smoothed law pushes

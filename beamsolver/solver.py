@@ -42,6 +42,7 @@ LS_GROWTH = 10.0                     # full Newton steps are kept unless the mer
 DAMPING_MIN = 1.0 / 64.0             # shortest damped Newton step (smooth problems)
 STALL_RATIO = 1.5                    # undamped fallback if the shortest damped step grows the correction less
 MIN_STEP_RATIO = 1e-15               # smallest min_step_ratio: below, t + dt rounds to t
+STEP_ROUNDOFF = 1e3                  # steps below this many ulps of |t| are not taken (round-off in t + dt)
 ROUNDOFF = 64.0 * np.finfo(float).eps   # position round-off, relative to the distance from the origin
 SQRT3 = np.sqrt(3.0)                 # |w|_2 <= SQRT3 |w|_inf (the rotation check's shortcut)
 CONTINUITY_MARGIN = 1e-6             # check_continuity's shortcut: far above the ~1e-8 round-off of arccos at 0
@@ -196,6 +197,8 @@ class Newton:
         self._smallest_limit = (1.0 - 1e-9) * float(system.rotation_limit.min(initial=np.inf))
         self.linsolver = linsolve.Solver()    # solve(linear_solver=...) replaces it
         self.stall_ratio = np.inf             # correction growth of the shortest damped trial
+        self.indefinite_seen = False          # the step's first tangent had det < 0 (or a back-end that cannot tell)
+        self.watch_sign = False               # whether to look (stepping.Run: conservative problems)
         self.reset_timings()
 
     def reset_timings(self):
@@ -356,10 +359,12 @@ class Newton:
         conv, problem = self.conv, self.problem
         H_start = H
         residuals = []
+        self.indefinite_seen = False
         damped_its = 0
         dz_c, targets = self._predictor(H, t, t_prev, H_target)
         floor = conv.floor(H, self.L_ref)
         damping = self.line_search and problem.smooth
+        plain = False                # undamped Newton after the damped iteration stalled
         last_inc = np.inf
         ahead = None                 # the ``_Measured`` evaluation of an accepted trial (line search, damping)
         lam = 1.0
@@ -383,6 +388,9 @@ class Newton:
                 raise self._failure(verdict, ratio)
             if dzf is None:
                 lu, dzf = self._direction(ev, dz_c)
+            if it == 0 and self.watch_sign:     # the first tangent K(H_n, t_n+1): indefinite where a step may jump
+                sign = getattr(lu, "det_sign", None)
+                self.indefinite_seen = sign is None or sign() < 0
             dz = self._full(dzf)
             if dz_c is not None:
                 H = self._reach_targets(H, dz + dz_c, H_target, bool(targets), t)
@@ -391,7 +399,7 @@ class Newton:
                 continue
             if not damping:
                 last_inc = conv.increment_ratio(dz, self.L_ref)
-                if not self.line_search:
+                if not self.line_search or plain:
                     H = problem.update(H, dz)
                     continue
                 H, ahead = self._line_search(H, dz, ev.r, scales, t)
@@ -408,7 +416,7 @@ class Newton:
                 # stable paths past which the damping test stalls; max_iter bounds it
                 log.debug("t = %.6g: damped Newton stalled (correction ratio %.3g); undamped Newton steps", t,
                           self.stall_ratio)
-                damping = False
+                damping, plain = False, True
                 stats_extra["undamped"] = it
                 last_inc = inc
                 H = problem.update(H, dz)
@@ -673,7 +681,10 @@ def _run_options(problem, t_start, t_end, allow_unmet_tolerance, check_stability
 
 
 def _step_floor(min_step_ratio, grid):
-    """Smallest step ``min_step_ratio`` times the user's, which must be representable at ``t``."""
+    """Smallest step: ``min_step_ratio`` times the user's, raised to ``STEP_ROUNDOFF`` ulps of the
+    largest ``|t|`` (shorter steps vanish in round-off).  Only a user's step that is itself not
+    representable is refused: a short interval (e.g. bisecting for a critical load) is attempted,
+    only its cut-backs are limited."""
     dt_user = grid[1] - grid[0]
     try:
         ratio = float(min_step_ratio)
@@ -683,12 +694,12 @@ def _step_floor(min_step_ratio, grid):
     if not MIN_STEP_RATIO <= ratio <= 1.0:
         raise InputError(f"solve: min_step_ratio must lie in [{MIN_STEP_RATIO:g}, 1] (smaller steps vanish "
                          f"in round-off), got {min_step_ratio!r}")
-    dt_min = dt_user * ratio
     t_max = float(np.abs(grid).max())
-    if dt_min <= 1e3 * np.finfo(float).eps * t_max:
-        raise InputError(f"solve: the smallest step {dt_min:.3g} (min_step_ratio {min_step_ratio!r} of the step "
-                         f"{dt_user:.3g}) vanishes in round-off at t = {t_max:.6g}: raise min_step_ratio")
-    return dt_min
+    floor = STEP_ROUNDOFF * np.finfo(float).eps * t_max
+    if dt_user <= floor:
+        raise InputError(f"solve: the step {dt_user:.3g} ((t_end - t_start) / steps) vanishes in round-off at "
+                         f"t = {t_max:.6g} (it must exceed {floor:.3g}): use fewer steps or a longer interval")
+    return max(dt_user * ratio, floor)
 
 
 def _writer(output, system, checkpoint):

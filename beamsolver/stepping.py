@@ -26,10 +26,10 @@ import warnings
 
 import numpy as np
 
-from . import branching, diagnosis, motion_path
+from . import branching, diagnosis, motion_path, stable_branch
 from .definiteness import negative_eigenvalues
 from .errors import ConvergenceError, InputError, StabilityWarning, StabilizationWarning
-from .failures import AugmentationFailed, MotionTooFast, NonFinite, StepFailed
+from .failures import AugmentationFailed, LeftStableBranch, MotionTooFast, NonFinite, StepFailed
 from .progress import Progress
 from .material_range import RangeCheck
 from .results import Solution, describe_model
@@ -112,6 +112,9 @@ class Run:
         self.progress = None
         self.warned_unstable = False
         self.range = None             # material_range.RangeCheck: sections with a yield limit only
+        self.negative = None          # negative eigenvalues of the last converged state's tangent, if known
+        self.branch_tries = 0         # LeftStableBranch failures since a step converged at its first try
+        newton.watch_sign = problem.conservative and not options.get("branch_switching")   # stable_branch
 
     # ------------------------------------------------------------------ start
     def start(self, restart_solution, initial_poses):
@@ -184,7 +187,8 @@ class Run:
                 self.sol.converged, self.sol.message = False, str(e)
                 if pushed:
                     why = (f"contact forces already act ({diagnosis.pushing_point(problem, H)}): {e}; "
-                           "separate the beams by a small gap or raise max_iter")
+                           "separate the beams by a small gap, let add_contact(adjust=) cover the overlap "
+                           "(strain-free adjustment) or raise max_iter")
                 else:
                     why = f"loads or motions already act: {e}; start the loads from zero or use more steps"
                 why += self.opt.get("penalty_hint", "")
@@ -202,6 +206,11 @@ class Run:
         self._check_finite(H, ev0.r, ev0.state, t_start)
         if self.range is not None:
             self.range.check(ev0.state.strain, stats, 0)
+        adjusted = problem.adjusted
+        if adjusted and adjusted["count"]:
+            stats["adjusted"] = dict(adjusted)
+            log.info("t = %.6g: %d point(s) of reference overlap adjusted to touching, strain-free (largest "
+                     "overlap %.3g)", t_start, adjusted["count"], adjusted["largest"])
         self.sol.append(t_start, H, sys.reactions(H, ev0.r), ev0.state.sigma, ev0.state.strain, stats, record)
         self.H = H
         if self.writer is not None:
@@ -237,7 +246,8 @@ class Run:
 
     def _attempt(self, t_next):
         """Converge the step ``t -> t_next``, halving it on failure; returns the step reached."""
-        t, cutbacks, rotation_limit, failed_sizes = self.t, 0, None, []
+        t, cutbacks, rotation_limit, failed_sizes, branch_here = self.t, 0, None, [], 0
+        before = self._negative_before()
         while True:
             t_try, rot = motion_path.limit_step(self.sys, t, t_next)
             if t_try < t_next and t_try - t < self.dt_min * (1.0 - STEP_TOLERANCE):
@@ -251,26 +261,83 @@ class Run:
                 self._check_finite(H, ev.r, ev.state, t_try)
                 stats.update(cutbacks=cutbacks, timings=dict(self.newton.timings))
                 if failed_sizes:
-                    stats["failed_dt"] = failed_sizes
+                    stats["failed_dt"] = list(failed_sizes)
                 if t_try < t_next:
                     stats["motion_rotation"] = rot
+                self._keep_branch(t_try, H, ev, stats, before)
+                if not cutbacks:
+                    self.branch_tries = 0
                 return t_try, H, ev, stats
             except StepFailed as e:
                 if isinstance(e, NonFinite):
                     self._name_nonfinite(t_try)
+                h = 0.5 * (t_try - t)
+                if self.dt_min * (1.0 + STEP_TOLERANCE) < t_try - t and h < self.dt_min:
+                    h = self.dt_min             # a grown step cut back: the smallest step is still tried
+                if isinstance(e, LeftStableBranch):
+                    branch_here, self.branch_tries = branch_here + 1, self.branch_tries + 1
+                    if branch_here > stable_branch.RETRIES or self.branch_tries > stable_branch.RETRIES_RUN or \
+                            h < self.dt_min * (1.0 - STEP_TOLERANCE):
+                        return self._keep_unstable(e)
                 cutbacks += 1
                 failed_sizes.append(t_try - t)
                 self.failed, self.wait = after_failure(t_try - t, self.failed, self.wait)
                 if e.rotation:
                     rotation_limit = str(e)
-                h = 0.5 * (t_try - t)
-                if self.dt_min * (1.0 + STEP_TOLERANCE) < t_try - t and h < self.dt_min:
-                    h = self.dt_min             # a grown step cut back: the smallest step is still tried
                 log.info("t = %.6g: step %.3g failed (%s); cutting back to %.3g", t_try, t_try - t, e, h)
                 if not e.retry or h < self.dt_min * (1.0 - STEP_TOLERANCE):
                     self._stop(e, rotation_limit)
                 t_next = t + h
                 self.easy = 0
+
+    def _negative_before(self):
+        """``before()`` of ``stable_branch.verdict`` for a step from the current state: its
+        negative-eigenvalue count, known from the last step's check or computed once when asked
+        (``None`` where the problem is not conservative)."""
+        known, ev = self.negative, getattr(self.newton, "last_evaluation", None)
+        cache = []
+
+        def before():
+            if known is not None:
+                return known
+            if not cache:
+                e = ev if ev is not None else self.problem.evaluate(self.H, self.t, tangent=True)
+                cache.append(stable_branch.negative_count(self.problem, e))
+            return cache[0]
+        return before
+
+    def _keep_branch(self, t, H, ev, stats, before):
+        """``stable_branch.verdict`` on the step converged at ``t``: raises ``LeftStableBranch``
+        carrying the step, for ``_keep_unstable`` (not with ``branch_switching``, whose switch
+        moves the path onto a stable branch itself).  Only a step whose first tangent had ``det < 0``
+        (``Newton.indefinite_seen``) or that took undamped Newton iterations (the fallback, or
+        ``line_search=False``) is checked."""
+        if self.opt.get("branch_switching"):
+            return
+        if not (self.newton.indefinite_seen or stats.get("undamped") is not None or not self.newton.line_search):
+            self.negative = None        # every tangent of the step had det > 0: not checked (stable_branch)
+            return
+        try:
+            self.negative = stable_branch.verdict(self.problem, self.newton.last_evaluation, before, t)
+        except LeftStableBranch as e:
+            e.t, e.result = t, (t, H, ev, stats)
+            raise
+
+    def _keep_unstable(self, failure):
+        """Keep the unstable state of ``failure`` (``LeftStableBranch``) after ``stable_branch.RETRIES``
+        such failures of a step, or ``RETRIES_RUN`` since a step converged at its first try, or at
+        the smallest step, and say so once (``StabilityWarning``; with
+        ``check_stability`` its own warning reports it)."""
+        t, H, ev, stats = failure.result
+        self.negative, self.branch_tries = failure.negative, 0
+        stats.update(left_stable_branch=True)
+        text = stable_branch.kept(failure)
+        if not self.warned_unstable and not self.opt.get("check_stability"):
+            self.warned_unstable = True
+            log.warning(text)
+            warnings.warn(text, StabilityWarning, stacklevel=5)
+            self.sol.message = text if not self.sol.message else self.sol.message + "; " + text
+        return failure.result
 
     def newton_step(self, t_next, start=None):
         """Newton at ``t_next`` (from the last converged state, or from ``start`` at ``t_next``),
@@ -409,7 +476,7 @@ class Run:
             t, H, ev, K = branching.switch(self, stats, t, H, ev, K)
         if self.opt.get("modes"):
             branching.record_modes(self.sys, stats, H, K, self.opt["modes"])
-        neg = stats["negative_eigenvalues"]
+        neg = self.negative = stats["negative_eigenvalues"]
         if neg and not self.warned_unstable:
             self.warned_unstable = True
             text = (f"t = {t:.6g}: the equilibrium is unstable (the tangent has {neg} negative "

@@ -177,6 +177,7 @@ CONTACT_OPTIONS = {   # name -> check(value, owner) returning the stored value (
     "point_ratio": lambda v, o: real(v, "point_ratio", o, minimum=0.0, maximum=1.0),
     "margin": lambda v, o: real(v, "margin", o, minimum=0.0),
     "law": lambda v, o: _contact_law(v, o),
+    "adjust": lambda v, o: real(v, "adjust", o, minimum=0.0, none=True),
 }
 
 

@@ -209,10 +209,11 @@ def case_guided_roll_up(turns=1.0, n=16):
     one user step: damped Newton, cut-backs and regrowth."""
     sol, wall, err = roll_up(turns=turns, n=n, steps=1, guided=True)
     dts = np.array([s["dt"] for s in sol.stats[1:]])
+    first = np.array([s.get("failed_dt", [s["dt"]])[0] for s in sol.stats[1:]])     # each step's first try
     cut = sum(s["cutbacks"] for s in sol.stats[1:])
-    regrew = int(np.sum(dts[1:] > 1.5 * dts[:-1]))
+    regrew = int(np.sum(first[1:] > 1.5 * dts[:-1]))
     return _row(f"roll-up to {turns:g} turn, tip guided in its plane, 1 user step", sol, wall,
-                f"circle error {err:.1e} L; cut-backs {cut}, step regrown {regrew} times, "
+                f"circle error {err:.1e} L; cut-backs {cut}, step regrown {regrew} times (tried), "
                 f"largest step {dts.max():.3g}")
 
 

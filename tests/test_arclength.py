@@ -67,12 +67,18 @@ def test_cylindrical_constraint_traces_the_same_curve():
     assert all(s["psi"] == 0.0 for s in sol.stats[1:])
 
 
-def test_load_control_stops_at_the_truss_limit():
-    """Today's default (``path="load"``) cannot pass the limit point: the reason for the option."""
-    P_lim, _ = truss_limit()
+def test_load_control_snaps_past_the_truss_limit_onto_the_inverted_truss(truss_path):
+    """Load control cannot follow the path past the limit point (the reason for arc length): the
+    step past it lands, by the undamped Newton after the damped one stalls (issue 31), on the only
+    equilibrium at that load, the inverted truss -- stable, and the one arc length reaches at
+    ``t_end`` -- with no state recorded between the limit and the snap."""
+    arc, apex, P_lim = truss_path
     m, _ = truss(P_lim)
-    with pytest.raises(bs.ConvergenceError):
-        bs.solve(m, steps=10, t_end=1.5, verbose=False)
+    sol = bs.solve(m, steps=10, t_end=1.5, verbose=False, check_stability=True)
+    y = heights(sol, apex)
+    assert all(s["stable"] for s in sol.stats[1:]) and np.all(np.diff(sol.times) > 0)
+    assert y[-1] < -RISE and not np.any((y > -RISE) & (y < truss_limit()[1]))
+    np.testing.assert_allclose(y[-1], heights(arc, apex)[-1], atol=1e-9 * RISE)
 
 
 # ------------------------------------------------------------------ DaDeppo & Schmidt's deep arch

@@ -15,6 +15,8 @@ MU = 0.4
 
 
 def _crossing(depth, **options):
+    """Crossing beams pressed together by the reference overlap ``depth`` (kept: ``adjust=0``)."""
+    options.setdefault("adjust", 0.0)
     m = bs.Model()
     master = m.add_beam(bs.geometry.straight((0, -1, 0), (0, 1, 0), 5), SEC)
     slave = m.add_beam(bs.geometry.straight((-1, 0, 2 * R - depth), (1, 0, 2 * R - depth), 5), SEC)

@@ -16,7 +16,7 @@ from beamsolver.contact.conditioning import ILL_CONDITIONED_PENALTY, STIFF_PENAL
 from beamsolver.problem import Problem
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
-import twisted_pair  # noqa: E402
+import twisted_pair_extreme as twisted_pair  # noqa: E402
 
 R, E = 0.05, 1e7
 SEC = bs.Section.circular(radius=R, E=E, nu=0.3)
@@ -84,7 +84,7 @@ def test_a_failed_solve_names_the_penalty_not_large_rotations():
 
 
 def test_no_equilibrium_at_t_start_names_the_penalty():
-    """The twisted pair (4 elements) with penalty 1e18 (5e6 x its default) finds no first state."""
+    """The 20 mm twisted pair (4 elements) with penalty 1e18 (5e6 x its default) finds no first state."""
     m = twisted_pair.build(turns=0.25, n_elements=4)[0]
     m.contacts[0].penalty = 1e18
     with pytest.warns(bs.ConditioningWarning):

@@ -25,7 +25,7 @@ LAYER = {
     "element": 2, "element_jit": 2, "elements": 2, "elements.base": 2, "elements.se3_2": 2, "elements.se3_3": 2,
     "blocks": 2, "line_load": 2, "contact": 2, "contact.law": 2, "contact.kinematics": 2,
     "contact.pairs": 2, "contact.search": 2, "contact.kernel_jit": 2, "contact.options": 2, "contact.record": 2,
-    "contact.projection": 2, "contact.rules": 2, "contact.ownership": 2, "contact.state": 2,
+    "contact.projection": 2, "contact.rules": 2, "contact.ownership": 2, "contact.state": 2, "contact.adjust": 2,
     # 3: model declarations and their assembly
     "model": 3, "contributions": 3, "cables": 3, "bending": 3, "assembly": 3, "stabilize": 3, "topology": 1, "assembly_jit": 3,
     "extra_pattern": 3,
@@ -35,7 +35,7 @@ LAYER = {
     # 5: results
     "results": 5, "resultants": 5, "restart": 5, "study": 5,
     # 6: solver, its stepping and failure diagnosis, linearisation
-    "solver": 6, "stepping": 6, "arclength": 6, "diagnosis": 6, "linear": 6, "branching": 6,
+    "solver": 6, "stepping": 6, "stable_branch": 6, "arclength": 6, "diagnosis": 6, "linear": 6, "branching": 6,
     # 7: output, pictures, command line, the package's public face
     "io": 7, "io.archive": 7, "io.lines": 7, "io.vtk": 7, "io.vtu": 7, "io.paraview": 7, "viz": 7, "cli": 7, "sweep_engine": 7, "sweep_cli": 7, "": 7,
 }

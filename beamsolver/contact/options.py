@@ -13,11 +13,13 @@ import numpy as np
 
 from ..validation import check_contact_options
 
-__all__ = ["ContactOptions", "SMOOTHING", "SLIP_TOLERANCE", "LINE_ANGLE"]
+__all__ = ["ContactOptions", "SMOOTHING", "SLIP_TOLERANCE", "LINE_ANGLE", "ADJUST"]
 
 SMOOTHING = 1e-6          # default smoothing gap of the normal law / (R1 + R2) (benchmarks/touching_defaults.py)
 SLIP_TOLERANCE = 0.005    # elastic slip at the onset of sliding / slave element length (Abaqus' default)
 LINE_ANGLE = float(np.deg2rad(20.0))   # below this crossing angle: line contact (search.py, rule 1)
+ADJUST = 1e-3             # default overclosure adjusted away at the reference poses / (R1 + R2)
+                          # (chords of a polyline on a post: 1.1e-4 at R1 + R2 = 1.02; docs/theory_adjust.md)
 
 
 @dataclass(frozen=True)
@@ -30,7 +32,9 @@ class ContactOptions:
     (None: pure penalty); ``line_angle`` [rad], ``point_ratio``: the search's kind rules;
     ``margin``: search margin (None: twice the largest radius); ``law``: the contact law of the
     compiled kernel, a ``law.ContactLaw`` (None: ``law.PENALTY_COULOMB``, the penalty /
-    augmented-Lagrangian / smoothed normal law with Coulomb friction)."""
+    augmented-Lagrangian / smoothed normal law with Coulomb friction); ``adjust``: largest
+    overclosure at the reference poses taken as touching, strain-free (None: ``ADJUST (R1 + R2)``
+    per pair; 0: none; ``contact.adjust``)."""
     smoothing: Optional[float] = None
     gauss_points: int = 5
     penalty_t: Optional[float] = None
@@ -40,6 +44,7 @@ class ContactOptions:
     point_ratio: float = 0.5
     margin: Optional[float] = None
     law: Optional[Any] = None
+    adjust: Optional[float] = None
 
     @classmethod
     def from_dict(cls, options, owner="add_contact"):

@@ -51,14 +51,14 @@ from ..model import JOIN_TOL
 from .law import default_penalty
 from . import kernel_jit, pairs
 from .kernel_jit import contact_kernel, kernel_and_tangent      # compiled; pairs.py's are the oracle
-from .options import SMOOTHING, ContactOptions
+from .options import ADJUST, SMOOTHING, ContactOptions
 from .pairs import LINE, NORMAL_TOL, POINT, material_frames, no_normal, touch_tolerance
 from .record import OPEN, SLIP, STICK, Candidates, PairSet
 from .ownership import gauss_owners, gauss_record
 from .projection import closest_points, element_twists, gauss_projections, section_points
 from .search import broad_pairs, element_spheres
 from .state import KeyLayout, check_state
-from . import rules
+from . import adjust, rules
 
 
 MAX_AUGMENT = 30
@@ -134,6 +134,7 @@ class ContactSystem(Contribution):
         self._decl_slip_tol = np.array([d.slip_tolerance for d in self.decls])
         self._decl_smoothing = np.array([np.nan if d.smoothing is None else d.smoothing for d in self.decls])
         self._decl_tolerance = np.array([np.inf if d.tolerance is None else d.tolerance for d in self.decls])
+        self._decl_adjust = np.array([np.nan if d.options.adjust is None else d.options.adjust for d in self.decls])
         self.max_gp = max(d.n_gp for d in self.decls)
         self.point_offset = np.int64(n_el) * self.max_gp * self.n_beams * len(self.decls)
         self._history = self._empty_history()
@@ -150,6 +151,24 @@ class ContactSystem(Contribution):
         self._K_pool = []          # tangent buffers of the compiled kernel (``_tangent_out``)
         self.timings = dict.fromkeys(TIMED, 0.0)
         self._clock = time.process_time()
+        self._adjusted = adjust.EMPTY
+        self._adjusted = self._reference_adjustment(system.poses0)
+        self.adjusted = adjust.summary(self._adjusted)    # count and largest overlap adjusted away
+
+    def _reference_adjustment(self, H0):
+        """``adjust.offsets`` of the pairs at the reference poses ``H0``; the search's memory
+        (owners, point pairs, kinds) is left as it was."""
+        saved = (self._prev_points, self._prev_owners, self._kind_keys, self._kind_values)
+        P = self.pairs(H0)
+        self._prev_points, self._prev_owners, self._kind_keys, self._kind_values = saved
+        self.timings = dict.fromkeys(TIMED, 0.0)
+        if P is None:
+            return adjust.EMPTY
+        xC, xF = self._centres(H0, P)
+        gap = np.linalg.norm(xF - xC, axis=1) - P.R1 - P.R2
+        tol = self._decl_adjust[P.decl]
+        tol = np.where(np.isnan(tol), ADJUST * (P.R1 + P.R2), tol)
+        return adjust.offsets(P.key, gap, tol)
 
     def _switch_to(self, t):
         """Declarations and friction acting in a step ending at ``t`` (``add_contact``'s
@@ -325,9 +344,10 @@ class ContactSystem(Contribution):
         # grows with ``decl``)
         self._prev_owners = np.concatenate(owners) if owners else np.zeros(0, dtype=np.int64)
         out = [p for p in out if p is not None and len(p)]
-        if len(out) == 1:
-            return out[0]
-        return PairSet.concatenate(out) if out else None
+        P = (out[0] if len(out) == 1 else PairSet.concatenate(out)) if out else None
+        if P is not None and len(self._adjusted[0]):
+            P.R1, P.R2 = adjust.apply(P.key, P.R1, P.R2, self._adjusted)
+        return P
 
     def _candidates(self, d, geo, sweep=True):
         """Broad phase and pair rules of declaration ``d``: element pairs not sharing a node,
@@ -518,8 +538,9 @@ class ContactSystem(Contribution):
         """Smoothing gap per pair: the declaration's, else ``SMOOTHING (R1 + R2)`` for line
         contact (touching, nearly parallel wires, whose many Gauss points hover at gap zero)
         and 0 (sharp) for point and orthogonal pairs (crossings and wraps keep the exact
-        penalty law)."""
-        rsum = P.R1[sel] + P.R2[sel]
+        penalty law).  ``R1 + R2`` of the sections: a pair's radii reduced by an adjustment
+        (``contact.adjust``) leave it as it was."""
+        rsum = self.el_radius[P.e[sel]] + self.el_radius[P.m[sel]]
         given = self._decl_smoothing[P.decl[sel]]
         return np.where(np.isnan(given), np.where(P.kind[sel] == LINE, SMOOTHING * rsum, 0.0), given)
 
