@@ -81,6 +81,17 @@ class Problem:
         """The contact contribution (``contact.system.ContactSystem``), ``None`` without contact."""
         return next((c for c in self.contributions if c.name == "contact"), None)
 
+    def initial_overlap(self, H):
+        """A sentence naming the pre-stress that overlaps at the given poses ``H`` put into the model
+        (the contributions' optional ``overlap(H)``), ``None`` if none."""
+        texts = [t for t in (c.overlap(H) for c in self.contributions if hasattr(c, "overlap")) if t]
+        return "; ".join(texts) or None
+
+    def failure_hint(self):
+        """What the contributions would add to a ``ConvergenceError`` (their optional ``failure_hint()``,
+        e.g. a contact penalty far stiffer than its default), ``""`` if nothing."""
+        return "".join(c.failure_hint() for c in self.contributions if hasattr(c, "failure_hint"))
+
     # ------------------------------------------------------------ properties
     @property
     def adjusted(self):

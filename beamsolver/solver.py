@@ -23,7 +23,6 @@ import numpy as np
 
 from . import diagnosis, elements, linsolve, se3
 from .arclength import ArcLengthRun, check_arc_length_arguments
-from .contact import conditioning
 from .errors import InputError
 from .failures import DampingStalled, Diverged, NonFinite, NotConverged, RotationLimit, SingularTangent, StepFailed
 from .problem import Problem
@@ -641,15 +640,13 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     arc = check_arc_length_arguments(path, arc_length, restart, branch_switching, stabilize)
     problem = Problem.from_model(model, check_rigid_modes=check_rigid_modes)
     system = problem.system
-    penalties = conditioning.penalty_ratios(model, system)
-    conditioning.warn_ill_conditioned(penalties)
     sol, t_start = _starting_point(restart, model, problem, t_start, t_end)
     grid = np.linspace(t_start, t_end, int(steps) + 1)
     dt_min = _step_floor(min_step_ratio, grid)
     newton = Newton(problem, Convergence(rtol=rtol, dtol=dtol, max_iter=max_iter), line_search, callback)
     newton.linsolver = linsolve.Solver(linear_solver)
     options = _run_options(problem, t_start, t_end, allow_unmet_tolerance, check_stability, modes,
-                           branch_switching, stabilize, conditioning.stiff_penalty_hint(penalties))
+                           branch_switching, stabilize, problem.failure_hint())
     if sol is not None and options["stabilizer"] is not None:
         options["stabilizer"].resume(sol)
     run = None
@@ -668,8 +665,8 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
 def _run_options(problem, t_start, t_end, allow_unmet_tolerance, check_stability, modes, branch_switching,
                  stabilize, penalty_hint=""):
     """The options of ``stepping.Run``; a stabilisation joins ``problem``'s contributions;
-    ``penalty_hint``: the tail of a ``ConvergenceError`` naming a stiff contact penalty
-    (``contact.conditioning.stiff_penalty_hint``), in place of the generic advice."""
+    ``penalty_hint``: the tail of a ``ConvergenceError`` the contributions give
+    (``Problem.failure_hint``: a stiff penalty named), in place of the generic advice."""
     modes, branch_switching = check_stability_options(modes, branch_switching)
     stabilizer = stabilize_option(problem.system, stabilize, check=problem.conservative)
     if stabilizer is not None:

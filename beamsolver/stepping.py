@@ -171,7 +171,7 @@ class Run:
             # contact alone may push the given poses (touching wires under the smoothed law,
             # docs/theory.md 19.2); round-off contact forces ask for a correction at round-off
             pushed = problem.solves_start and not self.newton.at_rest(ev0, H, t_start)
-            overlap = problem.contact.overlap(H) if pushed else None
+            overlap = problem.initial_overlap(H) if pushed else None
             if overlap:                  # e.g. a strand's wires built overlapping (cables.build_strand)
                 self.sol.message = overlap
                 log.warning(overlap)

@@ -79,14 +79,21 @@ def test_core_is_meshed_per_lay_and_each_layer_has_its_section():
 
 def test_step_zero_reports_the_prestress_of_initial_overlaps():
     # the outer wires' pitch radius 2 um inside the core: they press on it in the unloaded model
+    # (adjust=0: the default strain-free adjustment, 1e-3 (R1 + R2) = 2.1 um, takes it as touching)
     layers = [cables.Layer(1.1e-3, 1), cables.Layer(1.0e-3, 6, lay_angle=B12, pitch_radius=2.098e-3)]
     lay = 2 * np.pi * 2.1e-3 / np.tan(B12)
-    st = cables.build_strand(layers, 0.5 * lay, E, elements_per_lay=12)
+    st = cables.build_strand(layers, 0.5 * lay, E, elements_per_lay=12, contact_options=dict(adjust=0))
     st.clamp("bottom")
     st.clamp("top")
     with pytest.warns(RuntimeWarning, match=r"overlap in the given poses, the deepest by 2e-06"):
         sol = bs.solve(st.model, steps=1)
     assert "pre-stresses" in sol.message and "pre-stresses" in sol.stats[0]["warnings"][0]
+    adjusted = cables.build_strand(layers, 0.5 * lay, E, elements_per_lay=12)
+    adjusted.clamp("bottom")
+    adjusted.clamp("top")
+    sol = bs.solve(adjusted.model, steps=1)
+    assert sol.message == "" and sol.stats[0]["adjusted"]["count"] > 0
+    assert sol.stats[0]["adjusted"]["largest"] == pytest.approx(2e-6, rel=1e-2)
     ok = cables.build_strand([cables.Layer(1.1e-3, 1), cables.Layer(1.0e-3, 6, lay_angle=B12)], 0.5 * lay, E,
                              elements_per_lay=12)
     ok.clamp("bottom")

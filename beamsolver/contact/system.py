@@ -58,7 +58,7 @@ from .ownership import gauss_owners, gauss_record
 from .projection import closest_points, element_twists, gauss_projections, section_points
 from .search import broad_pairs, element_spheres
 from .state import KeyLayout, check_state
-from . import adjust, rules
+from . import adjust, conditioning, rules
 
 
 MAX_AUGMENT = 30
@@ -151,6 +151,8 @@ class ContactSystem(Contribution):
         self._K_pool = []          # tangent buffers of the compiled kernel (``_tangent_out``)
         self.timings = dict.fromkeys(TIMED, 0.0)
         self._clock = time.process_time()
+        self._penalties = conditioning.penalty_ratios(model, system)
+        conditioning.warn_ill_conditioned(self._penalties)
         self._adjusted = adjust.EMPTY
         self._adjusted = self._reference_adjustment(system.poses0)
         self.adjusted = adjust.summary(self._adjusted)    # count and largest overlap adjusted away
@@ -169,6 +171,11 @@ class ContactSystem(Contribution):
         tol = self._decl_adjust[P.decl]
         tol = np.where(np.isnan(tol), ADJUST * (P.R1 + P.R2), tol)
         return adjust.offsets(P.key, gap, tol)
+
+    def failure_hint(self):
+        """The tail of a ``ConvergenceError`` naming a penalty far stiffer than its default
+        (``conditioning.stiff_penalty_hint``), else ``""``."""
+        return conditioning.stiff_penalty_hint(self._penalties)
 
     def _switch_to(self, t):
         """Declarations and friction acting in a step ending at ``t`` (``add_contact``'s
