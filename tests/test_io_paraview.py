@@ -1,5 +1,6 @@
 """``beamsolver paraview OUT``: a ParaView script that shows an output folder in one step,
 run in real ParaView (``pvbatch``, Debian's ``paraview`` package, installed by .ci/run)."""
+import os
 import shutil
 import subprocess
 import sys
@@ -59,9 +60,12 @@ def test_cli_without_pvbatch_says_how_to_get_it(folder, monkeypatch):
 
 @pytest.mark.skipif(shutil.which("pvbatch") is None, reason="ParaView's pvbatch not installed (.ci/run installs it)")
 def test_real_paraview_draws_tubes_and_contact_points(folder, tmp_path):
+    """Also with the vtk wheel's EGL window asked for (``viz`` sets it in-process): Debian's
+    ParaView has no EGL and aborted with it."""
     png = tmp_path / "shot.png"         # kept by pytest's tmp_path for a look
+    env = dict(os.environ, VTK_DEFAULT_OPENGL_WINDOW="vtkEGLRenderWindow")
     out = subprocess.run([sys.executable, "-m", "beamsolver.cli", "paraview", str(folder), "--screenshot", str(png),
-                          "--color-by", "M2"], capture_output=True, text=True, timeout=600)
+                          "--color-by", "M2"], capture_output=True, text=True, timeout=600, env=env)
     assert out.returncode == 0, out.stderr
     assert "view.py" in out.stdout and png.is_file()
     import matplotlib.image

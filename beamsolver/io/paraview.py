@@ -171,7 +171,9 @@ def screenshot(script, png, step=-1, timeout=300):
     cmd = [pvbatch, str(script), "--screenshot", str(Path(png).resolve()), "--step", str(int(step))]
     if not os.environ.get("DISPLAY") and shutil.which("xvfb-run"):
         cmd = ["xvfb-run", "-a"] + cmd
-    out = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    # viz sets vtkEGLRenderWindow for the vtk wheel; ParaView's own VTK may have no EGL (Debian's aborts)
+    env = {k: v for k, v in os.environ.items() if k != "VTK_DEFAULT_OPENGL_WINDOW"}
+    out = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=env)
     if out.returncode != 0 or not Path(png).is_file():
         raise RuntimeError(f"pvbatch failed (exit {out.returncode}):\n{out.stdout[-2000:]}\n{out.stderr[-2000:]}")
     return Path(png)
