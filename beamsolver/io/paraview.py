@@ -173,7 +173,10 @@ def screenshot(script, png, step=-1, timeout=300):
         cmd = ["xvfb-run", "-a"] + cmd
     # viz sets vtkEGLRenderWindow for the vtk wheel; ParaView's own VTK may have no EGL (Debian's aborts)
     env = {k: v for k, v in os.environ.items() if k != "VTK_DEFAULT_OPENGL_WINDOW"}
-    out = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=env)
-    if out.returncode != 0 or not Path(png).is_file():
-        raise RuntimeError(f"pvbatch failed (exit {out.returncode}):\n{out.stdout[-2000:]}\n{out.stderr[-2000:]}")
-    return Path(png)
+    for attempt in range(2 if cmd[0] == "xvfb-run" else 1):    # a virtual X server may fail to start under load
+        out = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=env)
+        if out.returncode == 0 and Path(png).is_file():
+            return Path(png)
+    errors = [line for line in out.stderr.splitlines() if "ERR" in line or "FATL" in line or "rror" in line]
+    raise RuntimeError(f"pvbatch failed (exit {out.returncode}): " + "\n".join(errors[:10])
+                       + f"\n{out.stdout[-1000:]}\n{out.stderr[-1000:]}")
