@@ -294,8 +294,9 @@ def main(argv=None):
     v = sub.add_parser("paraview", help="write OUT/view.py, a ParaView script: smooth tubes at the real radii, "
                                         "contact points coloured by stick/slip, a camera across the scene")
     v.add_argument("folder", help="output folder with beams.pvd")
-    v.add_argument("--color-by", choices=("N", "Q2", "Q3", "T", "M2", "M3"),
-                   help="section force or moment of the tubes (default: the largest moment)")
+    v.add_argument("--color-by", choices=("N", "Q2", "Q3", "T", "M2", "M3", "utilisation", "equivalent_strain"),
+                   help="field of the tubes (default: utilisation where sections have a yield limit, "
+                        "else the largest moment)")
     v.add_argument("--screenshot", metavar="PNG", help="also run it in pvbatch and save this picture")
     v.add_argument("--step", type=int, default=-1, help="step of the screenshot (default: the last)")
     v.set_defaults(func=cmd_paraview)

@@ -21,7 +21,7 @@ from ..errors import InputError
 
 __all__ = ["paraview_script", "FIELDS"]
 
-FIELDS = ("N", "Q2", "Q3", "T", "M2", "M3")      # cell data of beams_<k>.vtu (io.vtk)
+FIELDS = ("N", "Q2", "Q3", "T", "M2", "M3", "utilisation", "equivalent_strain")   # cell data of beams_<k>.vtu
 
 _TEMPLATE = '''"""ParaView view of a beamsolver output folder (written by beamsolver.io.paraview_script).
 
@@ -35,7 +35,7 @@ import sys
 from paraview import simple as pv
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-COLOR_BY = {color_by!r}          # None: the moment (T, M2, M3) that varies most at the last step
+COLOR_BY = {color_by!r}          # None: utilisation where sections have a material range, else the largest moment
 SIZE = [{width}, {height}]
 
 
@@ -59,7 +59,12 @@ def main():
     times = list(beams.TimestepValues) if beams.TimestepValues else [0.0]
     time = times[args.step]
     beams.UpdatePipeline(time)
-    color = args.color_by or max(("T", "M2", "M3"), key=lambda n: max(abs(v) for v in array_range(beams, n)))
+    if args.color_by:
+        color = args.color_by
+    elif beams.CellData.GetArray("utilisation") is not None:     # sections with a material range
+        color = "utilisation"
+    else:
+        color = max(("T", "M2", "M3"), key=lambda n: max(abs(v) for v in array_range(beams, n)))
     radius = array_range(beams, "radius")
 
     points = pv.CellDatatoPointData(registrationName="point data", Input=beams)
@@ -101,7 +106,11 @@ def main():
     shown.RescaleTransferFunctionToDataRange(False, True)
     lut = pv.GetColorTransferFunction(color)
     low, high = lut.RGBPoints[0], lut.RGBPoints[-4]
-    lut.RescaleTransferFunction(-max(abs(low), abs(high)), max(abs(low), abs(high)))   # zero in the middle
+    if color in ("utilisation", "equivalent_strain"):
+        lut.ApplyPreset("Inferno (matplotlib)", True)
+        lut.RescaleTransferFunction(0.0, max(high, 1.0) if color == "utilisation" else high)
+    else:
+        lut.RescaleTransferFunction(-max(abs(low), abs(high)), max(abs(low), abs(high)))   # zero in the middle
 
     # look across the longest side of the bounding box, from the direction of its thinnest side
     b = beams.GetDataInformation().GetBounds()
@@ -131,7 +140,7 @@ def paraview_script(folder, path=None, color_by=None, size=(1200, 800)):
 
     ``path``: where to write it (default ``folder/view.py``); it reads ``beams.pvd`` and
     ``contact.pvd`` from ``folder`` given relative to itself when written in ``folder``.
-    ``color_by``: one of ``FIELDS`` (None: the moment that varies most).  ``size``: pixels.
+    ``color_by``: one of ``FIELDS`` (None: ``utilisation`` when written, else the largest moment).  ``size``: pixels.
     """
     folder = Path(folder)
     if not (folder / "beams.pvd").is_file():
