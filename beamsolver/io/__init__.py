@@ -18,7 +18,7 @@ def write_vtk(solution, folder, steps=None, refine=8, compression="zlib"):
 
 
 def __getattr__(name):
-    """``bs.io.vtk`` without an explicit import, loaded on first use."""
-    if name == "vtk":
-        return importlib.import_module(".vtk", __name__)
+    """``bs.io.vtk`` and ``bs.io.paraview`` without an explicit import, loaded on first use."""
+    if name in ("vtk", "paraview"):
+        return importlib.import_module(f".{name}", __name__)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
