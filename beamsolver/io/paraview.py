@@ -6,7 +6,8 @@
 into poly-lines, Tube with the radius taken from the point data ``radius``), draws the
 contact points as spheres of half the smallest wire radius coloured by ``stick`` (stick red,
 slip yellow), colours the tubes by a section force or moment, goes to the last step and looks at
-the scene across its longest side.  Run it with
+the scene across its longest side (a scene more than 20 times longer than wide is drawn with its
+length squeezed, and says so).  Run it with
 
 - ``paraview --script=OUT/view.py`` (the GUI, with the pipeline to edit), or
 - ``pvbatch OUT/view.py --screenshot shot.png`` (no window: a PNG; Debian's ``pvbatch``
@@ -37,6 +38,7 @@ from paraview import simple as pv
 HERE = os.path.dirname(os.path.abspath(__file__))
 COLOR_BY = {color_by!r}          # None: utilisation where sections have a material range, else the largest moment
 SIZE = [{width}, {height}]
+MAX_ASPECT = 20.0                # longer scenes are drawn with their length squeezed to this aspect
 
 
 def arguments():
@@ -115,9 +117,19 @@ def main():
     # look across the longest side of the bounding box, from the direction of its thinnest side
     b = beams.GetDataInformation().GetBounds()
     extent = [b[1] - b[0], b[3] - b[2], b[5] - b[4]]
-    centre = [(b[0] + b[1]) / 2, (b[2] + b[3]) / 2, (b[4] + b[5]) / 2]
     up = max(range(3), key=lambda i: extent[i])
     across = min((i for i in range(3) if i != up), key=lambda i: extent[i])
+    width = max(extent[i] for i in range(3) if i != up) + 2 * radius[1]
+    if extent[up] > MAX_ASPECT * width:       # a slender scene (a 1 m cable of 1 mm wires): squeeze its length
+        squeeze = [1.0, 1.0, 1.0]
+        squeeze[up] = MAX_ASPECT * width / extent[up]
+        for source in [tubes] + ([glyphs] if os.path.exists(contact_file) else []):
+            pv.GetDisplayProperties(source, view).Scale = squeeze
+        note = pv.Text(registrationName="note", Text=f"length squeezed {{1 / squeeze[up]:.0f}} times")
+        pv.Show(note, view).WindowLocation = "Upper Left Corner"
+        extent[up] *= squeeze[up]
+        b = [b[2 * i + j] * squeeze[i] for i in range(3) for j in range(2)]
+    centre = [(b[0] + b[1]) / 2, (b[2] + b[3]) / 2, (b[4] + b[5]) / 2]
     direction = [0.0, 0.0, 0.0]
     direction[across] = 1.0
     view_up = [0.0, 0.0, 0.0]
@@ -182,7 +194,7 @@ def screenshot(script, png, step=-1, timeout=300):
         cmd = ["xvfb-run", "-a"] + cmd
     # viz sets vtkEGLRenderWindow for the vtk wheel; ParaView's own VTK may have no EGL (Debian's aborts)
     env = {k: v for k, v in os.environ.items() if k != "VTK_DEFAULT_OPENGL_WINDOW"}
-    for attempt in range(2 if cmd[0] == "xvfb-run" else 1):    # a virtual X server may fail to start under load
+    for attempt in range(3 if cmd[0] == "xvfb-run" else 1):    # pvbatch under xvfb-run fails now and then (1 in ~10 here)
         out = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=env)
         if out.returncode == 0 and Path(png).is_file():
             return Path(png)
