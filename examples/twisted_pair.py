@@ -212,8 +212,9 @@ def main(output=None, turns=2.0, steps=16, n_elements=16, mu=0.3, length=1.0, pu
                   f"(lowest {lam:.3g} N m at the end): the straight two-ply is then an unstable equilibrium "
                   f"(Greenhill's limit under tension 2 sqrt(T B) = {mc:.3g} N m)")
     if output is not None:
-        print(f"ParaView: open {output}/*.pvd; tubes: Cell Data to Point Data, Extract Surface, Triangle Strips, "
-              "Tube with radius by 'radius' (README); colour by 'utilisation'")
+        script = bs.io.paraview.paraview_script(output)
+        print(f"ParaView: paraview --script={script} (smooth tubes at the real radii coloured by utilisation, "
+              "contact points green stick / yellow slip; or open the .pvd files)")
         try:
             from beamsolver import viz
             png = f"{output}/twisted_pair.png"
