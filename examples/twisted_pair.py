@@ -126,12 +126,12 @@ def crossing(model, sol, plate, turns):
 def main(output=None, turns=2.0, steps=16, n_elements=16, mu=0.3, length=0.02, verbose=False, swap=False):
     """Solve and print the summary; returns ``(solution, rows, wall time)``."""
     model, plate, (a, b) = build(length=length, n_elements=n_elements, turns=turns, mu=mu, swap=swap)
+    print(f"twisted pair: 2 wires R = 0.5 mm, L = {length * 1e3:g} mm, {n_elements} elements each, "
+          f"mu = {mu}, {turns:g} turns in {steps} steps", flush=True)
     t0 = time.perf_counter()
     sol = bs.solve(model, steps=steps, output=output, verbose=verbose)
     wall = time.perf_counter() - t0
     rows = table(sol, plate, (a.first, b.first), turns)
-    print(f"twisted pair: 2 wires R = 0.5 mm, L = {length * 1e3:g} mm, {n_elements} elements each, "
-          f"mu = {mu}, {turns:g} turns in {steps} steps")
     print("| " + " | ".join(COLUMNS) + " |")
     print("|" + "---:|" * len(COLUMNS))
     for tw, tq, ax, z, nc, ns, g, it, w in rows:
