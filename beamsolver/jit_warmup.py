@@ -22,6 +22,7 @@ stderr, ``beamsolver: compiling the compiled kernels, first run only, ~N s`` (``
 a tqdm bar of the elapsed seconds against that estimate, refreshed twice a second and naming the
 function being compiled (or the second process waited for), while compilations go on.
 """
+import logging
 import os
 import subprocess
 import sys
@@ -37,6 +38,7 @@ __all__ = ["estimate", "kernel_cached", "listen", "warm_up", "ESTIMATE"]
 # CPU seconds of the first run's compilation of the main job (examples/twisted_pair.py) on the project's
 # 2-core x86-64 machines: the contact kernel, the other contact functions, elements and assembly
 ESTIMATE = dict(kernel=36.0, contact=13.0, elements=9.0)
+log = logging.getLogger("beamsolver")
 _REFRESH = 0.5          # seconds between refreshes of the bar
 _IDLE = 1.0             # seconds without compilation that close it
 
@@ -170,10 +172,15 @@ def warm_up(model):
     """Compile what solving ``model`` needs before its first step, on a first run (see the module)."""
     if _disabled() or not model.contacts or kernel_cached() is not False:
         return
-    _scene(model, _start_kernel_process())
+    proc = _start_kernel_process()
+    try:
+        _scene(model, proc)
+    except Exception as exc:          # the solve compiles what is left, as it goes
+        log.info("compilation before step 0 stopped early: %r", exc)
 
 
 def _scene(model, proc):
+    """The warm-up of ``model`` in this process; ``proc``: the process compiling the kernel (or None)."""
     from .contact import system as contact_system
     from .contact.projection import closest_points
     from .problem import Problem
@@ -199,6 +206,9 @@ def _scene(model, proc):
         c._candidates(d, geo, sweep=False)
     en = problem.system.enodes
     closest_points(H, en[:0, 0], np.zeros((0, 6)), en[:0, 0], np.zeros((0, 6)))
+    if proc is not None and proc.poll() is None:      # no contact point at the initial poses
+        _wait(proc)
+    _kernel_call()
 
 
 def _wait(proc):
