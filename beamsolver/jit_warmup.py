@@ -7,8 +7,8 @@ the contact kernel (``contact.kernel_jit``).  ``warm_up(model)``, run by ``solve
 - does nothing when the contact kernel is in the cache (the cached runs: one index lookup) or
   without contact, or under ``NUMBA_DISABLE_JIT``;
 - else starts a second process compiling the default law's contact kernel into the cache
-  (``python -m beamsolver.jit_warmup``; not on a single core, nor with the environment variable
-  ``BEAMSOLVER_COMPILE_PROCESS=0``) while this process compiles the
+  (``python -m beamsolver.jit_warmup``; when a core is free, or as the environment variable
+  ``BEAMSOLVER_COMPILE_PROCESS`` (``1``/``0``) says) while this process compiles the
   rest: one evaluation of residual and tangent of a throwaway ``Problem`` of the model at its
   initial poses (the signatures step 0 uses), a pose update, and the two functions that are
   otherwise compiled in the middle of a solve, on the first crossing of two wires
@@ -40,7 +40,7 @@ __all__ = ["estimate", "kernel_cached", "listen", "warm_up", "ESTIMATE"]
 ESTIMATE = dict(kernel=36.0, contact=13.0, elements=9.0)
 log = logging.getLogger("beamsolver")
 _REFRESH = 0.5          # seconds between refreshes of the bar
-_IDLE = 1.0             # seconds without compilation that close it
+_IDLE = 3.0             # seconds without compilation that close it (imports between two compilations)
 
 
 def _disabled():
@@ -87,13 +87,17 @@ class _Announcer(event.Listener):
         while True:
             time.sleep(_REFRESH)
             with self.lock:
-                if self.depth == 0 and not self.waiting and time.perf_counter() - self.idle > _IDLE:
-                    bar.close()
+                try:
+                    if self.depth == 0 and not self.waiting and time.perf_counter() - self.idle > _IDLE:
+                        bar.close()
+                        self.bar = None
+                        return
+                    bar.n = min(time.perf_counter() - self.t0, 0.99 * bar.total)
+                    bar.set_postfix_str(self.name, refresh=False)
+                    bar.refresh()
+                except (ValueError, OSError):        # the stream was closed (a test's captured stderr)
                     self.bar = None
                     return
-                bar.n = min(time.perf_counter() - self.t0, 0.99 * bar.total)
-                bar.set_postfix_str(self.name, refresh=False)
-                bar.refresh()
 
 
 _LISTENER = []
@@ -152,13 +156,20 @@ def kernel_cached():
 
 
 def _two_processes():
+    """Whether the kernel compiles in a second process: ``BEAMSOLVER_COMPILE_PROCESS`` ``1`` yes, ``0`` no,
+    unset: when a core is free (two or more cores, 1-minute load average at most their number less one;
+    on a machine kept busy by other jobs a second process gains no core and only adds its imports and
+    the callees both processes compile)."""
+    flag = os.environ.get("BEAMSOLVER_COMPILE_PROCESS", "")
+    if flag in ("0", "1"):
+        return flag == "1"
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-    return cores >= 2 and os.environ.get("BEAMSOLVER_COMPILE_PROCESS", "1") != "0"
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else 0.0
+    return cores >= 2 and load <= cores - 1
 
 
 def _start_kernel_process():
-    """A process compiling the contact kernel into the cache (None on one core or with the environment
-    variable ``BEAMSOLVER_COMPILE_PROCESS=0``)."""
+    """A process compiling the contact kernel into the cache (None unless ``_two_processes()``)."""
     if not _two_processes():
         return None
     root = str(Path(__file__).resolve().parent.parent)

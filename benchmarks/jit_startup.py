@@ -17,9 +17,13 @@ section ``jit_startup`` of ``docs/benchmarks.md`` (unless ``--skip-main``).
 start to its first line of output, to the end of step 1 (the solver's per-step log record,
 shown by a ``logging`` handler the job is started with), to the end, the longest silence (no
 byte on stdout or stderr; a progress bar's refresh counts), and CPU time of the job and its
-child processes; empty cache with the second compiling process (default), without it
-(``BEAMSOLVER_COMPILE_PROCESS=0``) and cached; ``--ref DIR`` adds the first run of the checkout
+child processes; empty cache with the second compiling process (``BEAMSOLVER_COMPILE_PROCESS=1``; by default only
+when a core is free), without it (``=0``) and cached; ``--ref DIR`` adds the first run of the checkout
 ``DIR`` (e.g. ``/work/main``), interleaved.  Section ``jit_first_run`` of ``docs/benchmarks.md``.
+
+``--functions``: the compiled functions of the main job's first run (one process, empty cache) by
+the CPU time numba spends compiling each (numba's ``numba:compile`` events: inclusive of the
+functions it compiles on the way, and exclusive); section ``jit_compile_functions``.
 """
 import argparse
 import os
@@ -98,19 +102,92 @@ def timeline(root, cache, cwd, env=None):
     return dict(first=first, step1=step1, end=end, silence=silence, cpu=cpu, iterations=iterations)
 
 
-def first_run(ref=None):
+COMPILE_PROFILE = """
+import atexit, json, runpy, sys, time
+from numba.core import event
+rows, stack = [], []
+class Timer(event.Listener):
+    def on_start(self, ev):
+        stack.append([time.process_time(), 0.0])
+    def on_end(self, ev):
+        t0, inner = stack.pop()
+        dt = time.process_time() - t0
+        if stack:
+            stack[-1][1] += dt
+        f = ev.data["dispatcher"].py_func
+        rows.append((f.__module__ + "." + f.__qualname__.split("__")[0], dt, dt - inner, len(stack)))
+event.register("numba:compile", Timer())
+path = sys.argv[2]
+atexit.register(lambda: open(path, "w").write(json.dumps(dict(rows=rows, cpu=time.process_time()))))
+sys.argv = [sys.argv[1]]
+runpy.run_path(sys.argv[0], run_name="__main__")
+"""
+
+
+def compile_profile(top=15):
+    """Table of the functions compiled by the main job's first run, by exclusive CPU seconds (section
+    ``jit_compile_functions`` of ``docs/benchmarks.md``)."""
+    from _report import table
+    with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as cwd:
+        out = Path(cwd) / "profile.json"
+        env = {**os.environ, "NUMBA_CACHE_DIR": cache, "PYTHONPATH": str(ROOT), "BEAMSOLVER_COMPILE_PROCESS": "0"}
+        subprocess.run([sys.executable, "-c", COMPILE_PROFILE, str(ROOT / "examples" / "twisted_pair.py"), str(out)],
+                       cwd=cwd, env=env, check=True, capture_output=True)
+        import json
+        data = json.loads(out.read_text())
+    by = {}
+    for name, inc, exc, depth in data["rows"]:
+        b = by.setdefault(name, [0, 0.0, 0.0])
+        b[0] += 1
+        b[1] = max(b[1], inc) if depth else b[1] + inc
+        b[2] += exc
+    total = sum(r[2] for r in data["rows"])
+    rows = sorted(by.items(), key=lambda kv: -kv[1][2])[:top]
+    md = table(["function", "compilations", "exclusive CPU [s]", "share"],
+               [(n.replace("beamsolver.", ""), c, f"{e:.2f}", f"{e / total:.0%}") for n, (c, _, e) in rows])
+    head = f"compilation CPU {total:.1f} s of the process's {data['cpu']:.1f} s; the {top} costliest functions:"
+    print(head)
+    print(md)
+    from _report import machine, write_section
+    write_section("jit_compile_functions", f"""## What the first run compiles (issue 29)
+
+`python benchmarks/jit_startup.py --functions` ({machine()}): the main job in one process
+(`BEAMSOLVER_COMPILE_PROCESS=0`) from an empty numba cache; CPU seconds numba spends compiling each function,
+exclusive of the functions it compiles on the way (a function compiled for two argument types, e.g. a literal
+integer argument, counts twice).
+
+{head}
+
+{md}
+""")
+    return by
+
+
+def _auto_two():
+    sys.path.insert(0, str(ROOT))
+    from beamsolver.jit_warmup import _two_processes
+    return _two_processes()
+
+
+def first_run(ref=None, skip=()):
     """Rows of the ``--timeline`` table (see the module docstring)."""
-    variants = [("this tree, first run (2 processes)", ROOT, {}),
+    variants = [("this tree, first run (default)", ROOT, {}),
+                ("this tree, first run (2 processes)", ROOT, {"BEAMSOLVER_COMPILE_PROCESS": "1"}),
                 ("this tree, first run (1 process)", ROOT, {"BEAMSOLVER_COMPILE_PROCESS": "0"})]
     if ref:
         variants.append((f"{ref}, first run", Path(ref), {"PYTHONDONTWRITEBYTECODE": "1"}))   # writes nothing there
     rows = []
     for name, root, env in variants:
+        if any(k in name for k in skip):
+            continue
         with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as cwd:
+            if not env:
+                name += f" (load {os.getloadavg()[0]:.1f}: {'2 processes' if _auto_two() else '1 process'})"
             rows.append((name, timeline(root, cache, cwd, env)))
             if root == ROOT and not env:
                 rows.append(("this tree, cached run", timeline(root, cache, cwd)))
-        print(f"{name}: {rows[-1][1]}", file=sys.stderr, flush=True)
+    for name, r in rows:
+        print(f"{name}: {r}", file=sys.stderr, flush=True)
     return rows
 
 
@@ -119,9 +196,13 @@ def main(argv=None):
     ap.add_argument("--skip-main", action="store_true", help="only the tiny job (no docs update)")
     ap.add_argument("--timeline", action="store_true", help="the main job's first run as a user sees it")
     ap.add_argument("--ref", help="with --timeline: also the first run of this checkout")
+    ap.add_argument("--skip", nargs="*", default=(), help="with --timeline: leave out the variants naming these")
+    ap.add_argument("--functions", action="store_true", help="compile CPU time per function of the main job")
     args = ap.parse_args(argv)
+    if args.functions:
+        return compile_profile()
     if args.timeline:
-        return main_timeline(args.ref)
+        return main_timeline(args.ref, args.skip)
     jobs = [("tiny: import + 2-element solve", [sys.executable, "-c", TINY])]
     if not args.skip_main:
         jobs.append(("main: python examples/twisted_pair.py", [sys.executable, str(ROOT / "examples" / "twisted_pair.py")]))
@@ -145,9 +226,9 @@ compiles nothing.
     return rows
 
 
-def main_timeline(ref):
+def main_timeline(ref, skip=()):
     from _report import machine, table, write_section
-    rows = first_run(ref)
+    rows = first_run(ref, skip)
     load = os.getloadavg()
     md = table(["run of `python examples/twisted_pair.py`", "first output [s]", "step 1 done [s]", "end [s]",
                 "longest silence [s]", "CPU, job + children [s]", "Newton it."],
@@ -156,7 +237,7 @@ def main_timeline(ref):
     print(md)
     write_section("jit_first_run", f"""## The main job's first run: compilation announced, before step 0, in two processes (issue 29)
 
-`python benchmarks/jit_startup.py --timeline{' --ref ' + ref if ref else ''}` ({machine()}; load average at the end
+`python benchmarks/jit_startup.py --timeline{' --ref ' + ref if ref else ''}{' --skip ' + ' '.join(skip) if skip else ''}` ({machine()}; load average at the end
 {load[0]:.1f} / {load[1]:.1f} / {load[2]:.1f} over 1 / 5 / 15 min)
 
 Each run is a fresh process started from an empty numba cache (`NUMBA_CACHE_DIR`; the cached run reuses the

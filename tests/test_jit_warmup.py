@@ -102,3 +102,19 @@ def test_kernel_process_runs():
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     out = subprocess.run([sys.executable, "-m", "beamsolver.jit_warmup"], env=env, capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
+
+
+def test_second_process_only_with_a_free_core(monkeypatch):
+    """``BEAMSOLVER_COMPILE_PROCESS`` decides; unset, a second process only when a core is free."""
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 1})
+    monkeypatch.setenv("BEAMSOLVER_COMPILE_PROCESS", "0")
+    assert not jit_warmup._two_processes()
+    monkeypatch.setenv("BEAMSOLVER_COMPILE_PROCESS", "1")
+    monkeypatch.setattr(os, "getloadavg", lambda: (9.0, 9.0, 9.0))
+    assert jit_warmup._two_processes()
+    monkeypatch.delenv("BEAMSOLVER_COMPILE_PROCESS")
+    assert not jit_warmup._two_processes()
+    monkeypatch.setattr(os, "getloadavg", lambda: (0.3, 0.3, 0.3))
+    assert jit_warmup._two_processes()
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0})
+    assert not jit_warmup._two_processes()
