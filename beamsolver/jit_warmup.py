@@ -49,19 +49,21 @@ def _disabled():
 
 
 class _Announcer(event.Listener):
-    """numba ``numba:compile`` listener (see the module): the line at the first compilation of the
-    process, then a bar while compiling, closed after ``_IDLE`` s without compilation."""
+    """numba ``numba:compile`` listener (see the module): the line at the first compilation of a
+    function of ``package`` in the process, then a bar while compiling, closed after ``_IDLE`` s
+    without compilation."""
 
-    def __init__(self, stream=None):
-        self.stream = stream
+    def __init__(self, stream=None, package="beamsolver"):
+        self.stream, self.package = stream, package
         self.depth, self.bar, self.name, self.said = 0, None, "", False
         self.waiting = False        # for the second process: the bar stays
         self.t0 = self.idle = 0.0
         self.lock = threading.Lock()
 
     def on_start(self, event):
-        if self.depth == 0:
-            self.name = event.data["dispatcher"].py_func.__qualname__.split("__")[0]
+        f = event.data["dispatcher"].py_func
+        if self.depth == 0 and f.__module__.startswith(self.package):     # not a user's own numba function
+            self.name = f.__qualname__.split("__")[0]
             with self.lock:
                 if self.bar is None:
                     self._open()

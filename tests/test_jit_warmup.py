@@ -73,7 +73,7 @@ def test_first_compilation_is_announced_once():
     def f(x):
         return x + 1
 
-    with event.install_listener("numba:compile", jit_warmup._Announcer(out)):
+    with event.install_listener("numba:compile", jit_warmup._Announcer(out, package=__name__)):
         f(1)
         said = out.getvalue()
         f(1.5)                                 # another compilation: no second line
@@ -90,7 +90,7 @@ def test_nothing_is_announced_without_compilation():
 
     g(1.0)
     out = io.StringIO()
-    with event.install_listener("numba:compile", jit_warmup._Announcer(out)):
+    with event.install_listener("numba:compile", jit_warmup._Announcer(out, package=__name__)):
         g(3.0)
     assert out.getvalue() == ""
 
@@ -118,3 +118,16 @@ def test_second_process_only_with_a_free_core(monkeypatch):
     assert jit_warmup._two_processes()
     monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0})
     assert not jit_warmup._two_processes()
+
+
+@pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
+def test_a_users_own_numba_function_is_not_announced():
+    out = io.StringIO()
+
+    @numba.njit
+    def h(x):
+        return x - 1
+
+    with event.install_listener("numba:compile", jit_warmup._Announcer(out)):
+        h(1)
+    assert out.getvalue() == ""
