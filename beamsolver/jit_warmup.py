@@ -37,6 +37,7 @@ __all__ = ["estimate", "kernel_cached", "listen", "warm_up", "ESTIMATE"]
 
 # CPU seconds of the first run's compilation of the main job (examples/twisted_pair.py) on the project's
 # 2-core x86-64 machines: the contact kernel, the other contact functions, elements and assembly
+# (docs/benchmarks.md, jit_compile_functions)
 ESTIMATE = dict(kernel=36.0, contact=13.0, elements=9.0)
 log = logging.getLogger("beamsolver")
 _REFRESH = 0.5          # seconds between refreshes of the bar
@@ -106,7 +107,7 @@ _LISTENER = []
 
 
 def listen(stream=None):
-    """Announce the compilations of this process (idempotent; ``_jit`` runs it at import)."""
+    """Announce the compilations of this process (idempotent; ``import beamsolver`` runs it)."""
     if not _LISTENER and not _disabled():
         _LISTENER.append(_Announcer(stream))
         event.register("numba:compile", _LISTENER[0])
