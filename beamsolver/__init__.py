@@ -11,6 +11,9 @@ from .section import Section
 from .solver import Convergence, solve
 from .version import __version__
 from .sweep_engine import sweep   # dask is imported when a sweep runs, not here
+from .jit_warmup import listen
+
+listen()        # the first compilation of a process prints a line and a progress bar (jit_warmup)
 
 
 __all__ = ["Model", "Beam", "Section", "Solution", "solve", "Convergence", "InputError",

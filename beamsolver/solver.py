@@ -25,6 +25,7 @@ from . import diagnosis, elements, linsolve, se3
 from .arclength import ArcLengthRun, check_arc_length_arguments
 from .errors import InputError
 from .failures import DampingStalled, Diverged, NonFinite, NotConverged, RotationLimit, SingularTangent, StepFailed
+from .jit_warmup import warm_up
 from .problem import Problem
 from .restart import restart_from
 from .stabilize import from_option as stabilize_option
@@ -638,6 +639,7 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
                           min_step_ratio=min_step_ratio, checkpoint=checkpoint, initial_poses=initial_poses,
                           restart=restart, callback=callback, output=output)
     arc = check_arc_length_arguments(path, arc_length, restart, branch_switching, stabilize)
+    warm_up(model)          # a first run: compile before step 0, in two processes (jit_warmup)
     problem = Problem.from_model(model, check_rigid_modes=check_rigid_modes)
     system = problem.system
     sol, t_start = _starting_point(restart, model, problem, t_start, t_end)

@@ -12,9 +12,22 @@ nothing is compiled).  Jobs:
 
 ``python benchmarks/jit_startup.py [--skip-main]``; table on stdout and in the
 section ``jit_startup`` of ``docs/benchmarks.md`` (unless ``--skip-main``).
+
+``--timeline``: instead, the main job's first run as a user sees it (issue 29): seconds from the
+start to its first line of output, to the end of step 1 (the solver's per-step log record,
+shown by a ``logging`` handler the job is started with), to the end, the longest silence (no
+byte on stdout or stderr; a progress bar's refresh counts), and CPU time of the job and its
+child processes; empty cache with the second compiling process (``BEAMSOLVER_COMPILE_PROCESS=1``; by default only
+when a core is free), without it (``=0``) and cached; ``--ref DIR`` adds the first run of the checkout
+``DIR`` (e.g. ``/work/main``), interleaved.  Section ``jit_first_run`` of ``docs/benchmarks.md``.
+
+``--functions``: the compiled functions of the main job's first run (one process, empty cache) by
+the CPU time numba spends compiling each (numba's ``numba:compile`` events: inclusive of the
+functions it compiles on the way, and exclusive); section ``jit_compile_functions``.
 """
 import argparse
 import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -52,10 +65,144 @@ def measure(name, args):
     return dict(job=name, first=first, cached=min(cached), compile=first - min(cached))
 
 
+MAIN_LOGGED = """
+import logging, runpy, sys
+logging.basicConfig(level=logging.INFO, format="%(message)s")
+sys.argv = [sys.argv[1]]
+runpy.run_path(sys.argv[0], run_name="__main__")
+"""
+
+
+def timeline(root, cache, cwd, env=None):
+    """The main job of checkout ``root`` in a fresh process: seconds to the first output, to the end of
+    step 1, to the end; longest silence [s]; CPU [s] of the job and its children; Newton iterations."""
+    env = {**os.environ, "NUMBA_CACHE_DIR": cache, "PYTHONPATH": str(root), "PYTHONUNBUFFERED": "1", **(env or {})}
+    cpu0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    p = subprocess.Popen([sys.executable, "-c", MAIN_LOGGED, str(Path(root) / "examples" / "twisted_pair.py")],
+                         cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    first = step1 = None
+    last, silence, text = 0.0, 0.0, b""
+    while chunk := p.stdout.read1(1 << 16):
+        t = time.perf_counter() - t0
+        first = t if first is None else first
+        silence, last = max(silence, t - last), t
+        text += chunk
+        if step1 is None and b"step 1 " in text:
+            step1 = t
+    p.wait()
+    end = time.perf_counter() - t0
+    silence = max(silence, end - last)
+    cpu1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (cpu1.ru_utime + cpu1.ru_stime) - (cpu0.ru_utime + cpu0.ru_stime)
+    if p.returncode != 0:
+        raise RuntimeError(f"the main job failed:\n{text.decode(errors='replace')[-2000:]}")
+    out = text.decode(errors="replace")
+    iterations = out.split("Newton iterations ")[1].split(",")[0] if "Newton iterations " in out else "?"
+    return dict(first=first, step1=step1, end=end, silence=silence, cpu=cpu, iterations=iterations)
+
+
+COMPILE_PROFILE = """
+import atexit, json, runpy, sys, time
+from numba.core import event
+rows, stack = [], []
+class Timer(event.Listener):
+    def on_start(self, ev):
+        stack.append([time.process_time(), 0.0])
+    def on_end(self, ev):
+        t0, inner = stack.pop()
+        dt = time.process_time() - t0
+        if stack:
+            stack[-1][1] += dt
+        f = ev.data["dispatcher"].py_func
+        rows.append((f.__module__ + "." + f.__qualname__.split("__")[0], dt, dt - inner, len(stack)))
+event.register("numba:compile", Timer())
+path = sys.argv[2]
+atexit.register(lambda: open(path, "w").write(json.dumps(dict(rows=rows, cpu=time.process_time()))))
+sys.argv = [sys.argv[1]]
+runpy.run_path(sys.argv[0], run_name="__main__")
+"""
+
+
+def compile_profile(top=15):
+    """Table of the functions compiled by the main job's first run, by exclusive CPU seconds (section
+    ``jit_compile_functions`` of ``docs/benchmarks.md``)."""
+    from _report import table
+    with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as cwd:
+        out = Path(cwd) / "profile.json"
+        env = {**os.environ, "NUMBA_CACHE_DIR": cache, "PYTHONPATH": str(ROOT), "BEAMSOLVER_COMPILE_PROCESS": "0"}
+        subprocess.run([sys.executable, "-c", COMPILE_PROFILE, str(ROOT / "examples" / "twisted_pair.py"), str(out)],
+                       cwd=cwd, env=env, check=True, capture_output=True)
+        import json
+        data = json.loads(out.read_text())
+    by = {}
+    for name, inc, exc, depth in data["rows"]:
+        b = by.setdefault(name, [0, 0.0, 0.0])
+        b[0] += 1
+        b[1] = max(b[1], inc) if depth else b[1] + inc
+        b[2] += exc
+    total = sum(r[2] for r in data["rows"])
+    rows = sorted(by.items(), key=lambda kv: -kv[1][2])[:top]
+    md = table(["function", "compilations", "exclusive CPU [s]", "share"],
+               [(n.replace("beamsolver.", ""), c, f"{e:.2f}", f"{e / total:.0%}") for n, (c, _, e) in rows])
+    head = f"compilation CPU {total:.1f} s of the process's {data['cpu']:.1f} s; the {top} costliest functions:"
+    print(head)
+    print(md)
+    from _report import machine, write_section
+    write_section("jit_compile_functions", f"""## What the first run compiles (issue 29)
+
+`python benchmarks/jit_startup.py --functions` ({machine()}): the main job in one process
+(`BEAMSOLVER_COMPILE_PROCESS=0`) from an empty numba cache; CPU seconds numba spends compiling each function,
+exclusive of the functions it compiles on the way (a function compiled for two argument types, e.g. a literal
+integer argument, counts twice).
+
+{head}
+
+{md}
+""")
+    return by
+
+
+def _auto_two():
+    sys.path.insert(0, str(ROOT))
+    from beamsolver.jit_warmup import _two_processes
+    return _two_processes()
+
+
+def first_run(ref=None, skip=()):
+    """Rows of the ``--timeline`` table (see the module docstring)."""
+    variants = [("this tree, first run (default)", ROOT, {}),
+                ("this tree, first run (2 processes)", ROOT, {"BEAMSOLVER_COMPILE_PROCESS": "1"}),
+                ("this tree, first run (1 process)", ROOT, {"BEAMSOLVER_COMPILE_PROCESS": "0"})]
+    if ref:
+        variants.append((f"{ref}, first run", Path(ref), {"PYTHONDONTWRITEBYTECODE": "1"}))   # writes nothing there
+    rows = []
+    for name, root, env in variants:
+        if any(k in name for k in skip):
+            continue
+        with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as cwd:
+            if not env:
+                name += f" (load {os.getloadavg()[0]:.1f}: {'2 processes' if _auto_two() else '1 process'})"
+            rows.append((name, timeline(root, cache, cwd, env)))
+            if root == ROOT and not env:
+                rows.append(("this tree, cached run", timeline(root, cache, cwd)))
+    for name, r in rows:
+        print(f"{name}: {r}", file=sys.stderr, flush=True)
+    return rows
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--skip-main", action="store_true", help="only the tiny job (no docs update)")
+    ap.add_argument("--timeline", action="store_true", help="the main job's first run as a user sees it")
+    ap.add_argument("--ref", help="with --timeline: also the first run of this checkout")
+    ap.add_argument("--skip", nargs="*", default=(), help="with --timeline: leave out the variants naming these")
+    ap.add_argument("--functions", action="store_true", help="compile CPU time per function of the main job")
     args = ap.parse_args(argv)
+    if args.functions:
+        return compile_profile()
+    if args.timeline:
+        return main_timeline(args.ref, args.skip)
     jobs = [("tiny: import + 2-element solve", [sys.executable, "-c", TINY])]
     if not args.skip_main:
         jobs.append(("main: python examples/twisted_pair.py", [sys.executable, str(ROOT / "examples" / "twisted_pair.py")]))
@@ -73,6 +220,32 @@ Wall time of a fresh process; the first run starts from an empty numba cache (`N
 compiles the kernels (`element_jit`, `assembly_jit`, `se3_jit`) into it, the cached runs (best of two)
 load them. `tests/test_kernels_jit.py::test_second_process_loads_the_cache` checks that a cached run
 compiles nothing.
+
+{md}
+""")
+    return rows
+
+
+def main_timeline(ref, skip=()):
+    from _report import machine, table, write_section
+    rows = first_run(ref, skip)
+    load = os.getloadavg()
+    md = table(["run of `python examples/twisted_pair.py`", "first output [s]", "step 1 done [s]", "end [s]",
+                "longest silence [s]", "CPU, job + children [s]", "Newton it."],
+               [(n, f"{r['first']:.1f}", "-" if r["step1"] is None else f"{r['step1']:.1f}", f"{r['end']:.1f}",
+                 f"{r['silence']:.1f}", f"{r['cpu']:.1f}", r["iterations"]) for n, r in rows])
+    print(md)
+    write_section("jit_first_run", f"""## The main job's first run: compilation announced, before step 0, in two processes (issue 29)
+
+`python benchmarks/jit_startup.py --timeline{' --ref ' + ref if ref else ''}{' --skip ' + ' '.join(skip) if skip else ''}` ({machine()}; load average at the end
+{load[0]:.1f} / {load[1]:.1f} / {load[2]:.1f} over 1 / 5 / 15 min)
+
+Each run is a fresh process started from an empty numba cache (`NUMBA_CACHE_DIR`; the cached run reuses the
+first run's); the job runs with a `logging` handler so the end of step 1 is seen. Seconds from the start to its first
+byte of output (the line `beamsolver: compiling the compiled kernels, first run only, ~N s`), to the end of step 1
+and to the end; longest silence: the longest time without a byte on stdout or stderr (the compile bar refreshes
+twice a second); CPU: user + system time of the job and its child processes (the second compiling process
+included). On a loaded machine wall times stretch with the load; the CPU column does not.
 
 {md}
 """)

@@ -182,12 +182,12 @@ def main(output=None, turns=2.0, steps=16, n_elements=16, mu=0.3, length=1.0, pu
     """Solve and print the summary; returns ``(solution, rows, wall time)``."""
     scene = dict(length=length, pull=pull)
     model, plate, (a, b) = build(n_elements=n_elements, turns=turns, mu=mu, swap=swap, **scene)
+    print(f"twisted pair: 2 steel wires (grade 1770, yield stress 1416 MPa) R = 0.5 mm, L = {length:g} m, "
+          f"{n_elements} elements each, pull {pull:g} N, mu = {mu}, {turns:g} turns in {steps} steps", flush=True)
     t0 = time.perf_counter()
     sol = bs.solve(model, steps=steps, output=output, verbose=verbose)
     wall = time.perf_counter() - t0
     rows = table(sol, plate, (a.first, b.first), turns, **scene)
-    print(f"twisted pair: 2 steel wires (grade 1770, yield stress 1416 MPa) R = 0.5 mm, L = {length:g} m, "
-          f"{n_elements} elements each, pull {pull:g} N, mu = {mu}, {turns:g} turns in {steps} steps")
     print("| " + " | ".join(COLUMNS) + " |")
     print("|" + "---:|" * len(COLUMNS))
     for tw, tq, cf, ax, dz, nc, ns, g, u, it, w in rows:

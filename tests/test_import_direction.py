@@ -31,7 +31,7 @@ LAYER = {
     "extra_pattern": 3,
     "contact.system": 3, "contact.conditioning": 3, "linsolve": 3, "bifurcation": 3,
     # 4: the Problem interface between the solver and the physics
-    "problem": 4,
+    "problem": 4, "jit_warmup": 4,
     # 5: results
     "results": 5, "resultants": 5, "restart": 5, "study": 5,
     # 6: solver, its stepping and failure diagnosis, linearisation
