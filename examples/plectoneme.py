@@ -300,7 +300,7 @@ def main(output=None, turns=5.0, steps=40, n_elements=16, mu=0.3, stabilize=2e-2
     print(f"onset of writhing at {tw_c:.3f} turns, torque {m_c:.4g} N m: M L / B = {checks['onset_ratio']:.2f} "
           f"(B = 2 E I; Greenhill clamped-clamped {GREENHILL}, the pair's frictionless tangent 8.36)")
     if output is not None:
-        print(f"ParaView: open {output}/*.pvd (README: Tube filter with radius 'radius')")
+        print(f"ParaView: paraview --script={bs.io.paraview.paraview_script(output)} (or open {output}/*.pvd)")
         try:
             from beamsolver import viz
             png = f"{output}/plectoneme.png"

@@ -163,8 +163,7 @@ def main(output=None, turns=2.0, steps=16, n_elements=16, mu=0.3, length=0.02, v
               f"each other), as in Greenhill's twisted rod,\n  but a little below Greenhill's M L / B = 8.99 "
               f"({8.99 * B / length:.3g} N m; benchmarks/twisted_pair_stability.py).")
     if output is not None:
-        print(f"ParaView: open {output}/*.pvd; tubes: Cell Data to Point Data, Extract Surface, Triangle Strips, "
-              "Tube with radius by 'radius' (README)")
+        print(f"ParaView: paraview --script={bs.io.paraview.paraview_script(output)} (or open {output}/*.pvd)")
         try:
             from beamsolver import viz
             png = f"{output}/twisted_pair_extreme.png"

@@ -1,5 +1,5 @@
 """Which contact kinds give a symmetric tangent at a frictionless equilibrium (issue 14 defect 6;
-the statement is in the README, section 'Contact and friction options').
+the statement is in docs/guide/contact.md, "The normal law and friction").
 
 Point-to-point pairs (closest points) and the orthogonal projection derive from a potential
 (``1/2 penalty <-g>^2`` at fixed weights, ``g`` a distance): ``bs.linearize`` is symmetric at

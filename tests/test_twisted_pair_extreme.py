@@ -16,7 +16,7 @@ R = 0.5e-3
 def test_pair_loses_stability_at_the_greenhill_torque():
     """Frictionless pair twisted by 2 turns: the lowest eigenvalue of the tangent changes sign
     near Greenhill's clamped-clamped limit M_c = 8.99 B / L (B = 2 E I, small pull), between two
-    converged steps; interpolated, at M L / B = 8.2-8.4, some 7 % below it (README; one wire
+    converged steps; interpolated, at M L / B = 8.2-8.4, some 7 % below it (examples/twisted_pair_extreme.py; one wire
     alone gives 8.99, benchmarks/twisted_pair_stability.py).  The torques of the two steps
     around the crossing depend on the step sizes (steps regrown after a cut-back bracket it by
     0.91-0.95 M_c, the user's steps by 0.91-0.99 M_c): the interpolated torque is the measure."""

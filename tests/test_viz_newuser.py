@@ -28,7 +28,7 @@ def _pieces(tube):
 
 
 def test_readme_tube_recipe_gives_one_capped_tube_per_beam(pair_run):
-    """The README's ParaView chain, with pyvista's wrappers of the same VTK filters: Cell Data to
+    """The user guide's ParaView chain (docs/guide/output.md), with pyvista's wrappers of the same VTK filters: Cell Data to
     Point Data, Extract Surface, Triangle Strips (vtkStripper: segments -> poly-lines), Tube."""
     pv = pytest.importorskip("pyvista")
     sol, out = pair_run

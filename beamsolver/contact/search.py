@@ -10,7 +10,7 @@ criterion, of the owners; where neither can depend on it (no pair steeper than
 compiled sort and sweep along the axis of the largest spread (``sweep_phase``, ~4x cheaper).
 
 Narrow phase, the choice rule per slave/master element pair (documented in
-the README, tested on both sides of each switch):
+docs/guide/contact.md, tested on both sides of each switch):
 
 1. angle between the mid-point tangents below ``line_angle`` (default 20 deg):
    **line contact**, the seed's slave-section-plane projection of each slave

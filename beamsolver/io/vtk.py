@@ -40,7 +40,7 @@ other run's result behind.
 The VTU files are written by ``io.vtu`` (numpy and zlib; meshio's binary layout, read
 by meshio, pyvista and ParaView) with two-point ``line`` cells, which meshio reads (it
 cannot read VTK poly-lines, type 4); for smooth tubes ParaView joins them into
-poly-lines with *Triangle Strips* before the Tube filter (README, "ParaView").
+poly-lines with *Triangle Strips* before the Tube filter (docs/guide/output.md, "ParaView by hand"; or io.paraview).
 """
 import os
 import tempfile
