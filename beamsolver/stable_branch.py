@@ -27,7 +27,10 @@ stabilisation) are not checked.
 from .definiteness import negative_eigenvalues
 from .failures import LeftStableBranch
 
-__all__ = ["negative_count", "verdict", "kept", "RETRIES", "RETRIES_RUN"]
+__all__ = ["negative_count", "verdict", "kept", "RETRIES", "RETRIES_RUN", "ENABLED"]
+
+ENABLED = True     # False: no step is checked (the determinant sign is not read either); benchmarks measure
+                   # the rule's cost with it, and a user can follow an unstable branch on purpose
 
 RETRIES = 3        # cut-backs of one step for leaving the stable branch before its unstable end state is kept
 RETRIES_RUN = 8    # the same since a step last converged at its first try (no homing in on a critical load)

@@ -114,7 +114,8 @@ class Run:
         self.range = None             # material_range.RangeCheck: sections with a yield limit only
         self.negative = None          # negative eigenvalues of the last converged state's tangent, if known
         self.branch_tries = 0         # LeftStableBranch failures since a step converged at its first try
-        newton.watch_sign = problem.conservative and not options.get("branch_switching")   # stable_branch
+        newton.watch_sign = (problem.conservative and not options.get("branch_switching")   # stable_branch
+                             and stable_branch.ENABLED)
 
     # ------------------------------------------------------------------ start
     def start(self, restart_solution, initial_poses):
@@ -312,7 +313,7 @@ class Run:
         moves the path onto a stable branch itself).  Only a step whose first tangent had ``det < 0``
         (``Newton.indefinite_seen``) or that took undamped Newton iterations (the fallback, or
         ``line_search=False``) is checked."""
-        if self.opt.get("branch_switching"):
+        if self.opt.get("branch_switching") or not stable_branch.ENABLED:
             return
         if not (self.newton.indefinite_seen or stats.get("undamped") is not None or not self.newton.line_search):
             self.negative = None        # every tangent of the step had det > 0: not checked (stable_branch)

@@ -23,7 +23,7 @@ single_thread()
 import numpy as np  # noqa: E402
 
 import beamsolver as bs  # noqa: E402
-from beamsolver import linsolve, stepping  # noqa: E402
+from beamsolver import stable_branch  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "published"))
 import scenes  # noqa: E402
@@ -89,21 +89,17 @@ def cases():
 
 def overhead():
     """Wall time with the stable-branch rule (the determinant sign of each step's first factorisation and
-    the check of the steps it flags, ``stepping.Run._keep_branch``) and with both switched off
-    (monkeypatched)."""
+    the check of the steps it flags) and with it switched off (``stable_branch.ENABLED = False``)."""
     rows = []
-    keep, sign = stepping.Run._keep_branch, linsolve._SpluFactor.det_sign
     for name, build in (("cantilever", cantilever), ("joined cantilever", joined), ("column 0.9 P_E", column)):
         for n in (16, 256):
             walls = {}
             for label in ("off", "on", "off", "on"):
-                if label == "off":
-                    stepping.Run._keep_branch = lambda *a: None
-                    linsolve._SpluFactor.det_sign = lambda self: 1
+                stable_branch.ENABLED = label == "on"
                 try:
                     times = [_timed(lambda: bs.solve(build(n), steps=8, verbose=False))[1] for _ in range(REPEATS)]
                 finally:
-                    stepping.Run._keep_branch, linsolve._SpluFactor.det_sign = keep, sign
+                    stable_branch.ENABLED = True
                 walls.setdefault(label, []).extend(times)
             off, on = float(np.median(walls["off"])), float(np.median(walls["on"]))
             rows.append((name, n, off, on, on / off))
