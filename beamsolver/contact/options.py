@@ -13,10 +13,11 @@ import numpy as np
 
 from ..validation import check_contact_options
 
-__all__ = ["ContactOptions", "SMOOTHING", "SLIP_TOLERANCE", "LINE_ANGLE"]
+__all__ = ["ContactOptions", "SMOOTHING", "SLIP_TOLERANCE", "STICK_TOLERANCE", "LINE_ANGLE"]
 
 SMOOTHING = 1e-6          # default smoothing gap of the normal law / (R1 + R2) (benchmarks/touching_defaults.py)
 SLIP_TOLERANCE = 0.005    # elastic slip at the onset of sliding / slave element length (Abaqus' default)
+STICK_TOLERANCE = 1e-6    # weighted slip of a sticking node / (R1 + R2) with stick="exact"
 LINE_ANGLE = float(np.deg2rad(20.0))   # below this crossing angle: line contact (search.py, rule 1)
 
 
@@ -30,7 +31,14 @@ class ContactOptions:
     (None: pure penalty); ``line_angle`` [rad], ``point_ratio``: the search's kind rules;
     ``margin``: search margin (None: twice the largest radius); ``law``: the contact law of the
     compiled kernel, a ``law.ContactLaw`` (None: ``law.PENALTY_COULOMB``, the penalty /
-    augmented-Lagrangian / smoothed normal law with Coulomb friction)."""
+    augmented-Lagrangian / smoothed normal law with Coulomb friction);
+    ``stick``: ``"penalty"`` (a tangential penalty per Gauss point, the elastic slip set by
+    ``slip_tolerance`` or ``penalty_t``) or ``"exact"`` (mortar nodal multipliers on the slave
+    beam, ``contact/mortar.py``, iterated by augmented-Lagrangian updates until every sticking
+    node's weighted slip is below ``stick_tolerance``; ``penalty_t`` is then only the
+    augmentation penalty, force / length^2, default the normal penalty);
+    ``stick_tolerance``: that slip, a length (None: ``STICK_TOLERANCE (R1 + R2)`` of the largest
+    radii of the declaration)."""
     smoothing: Optional[float] = None
     gauss_points: int = 5
     penalty_t: Optional[float] = None
@@ -40,6 +48,8 @@ class ContactOptions:
     point_ratio: float = 0.5
     margin: Optional[float] = None
     law: Optional[Any] = None
+    stick: str = "penalty"
+    stick_tolerance: Optional[float] = None
 
     @classmethod
     def from_dict(cls, options, owner="add_contact"):
