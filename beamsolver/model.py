@@ -365,6 +365,12 @@ class Model:
         - ``law``: the contact law, a ``contact.law.ContactLaw`` of compiled functions
           (default None: the penalty / augmented-Lagrangian / smoothed normal law with
           Coulomb friction; docs/theory.md section 15).
+        - ``stick``: ``"penalty"`` (default: the tangential penalty above, per Gauss point;
+          sticking points slip elastically by ``lam_T / penalty_t``) or ``"exact"`` (mortar
+          nodal multipliers on the slave beam, iterated until every sticking node's weighted
+          slip is below ``stick_tolerance``; ``penalty_t`` is then only the augmentation
+          penalty, default the normal penalty; docs/theory_mortar.md);
+        - ``stick_tolerance``: that slip, a length (default ``1e-8 (R1 + R2)``).
 
         Unknown options are refused.  The same beams on both
         sides (``add_contact(group, group)``, as for the wires of a cable) declare every

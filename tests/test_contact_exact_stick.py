@@ -96,3 +96,48 @@ def test_exact_stick_tangent_matches_finite_differences(regime):
     else:
         assert stick.all() and len(stick)
     assert err < 1e-6, err
+
+
+def _shear_lag(n_wire, **options):
+    sol, wire, a = shear_lag.main(n_wire=n_wire, stick="exact", **options)
+    x, N = shear_lag.axial_force(sol, wire)
+    return sol, wire, a, x, N
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("n_wire", [10, 20])
+def test_shear_lag_slip_zone_and_force_profile(n_wire):
+    """Slip zone ``F / (mu q)`` from the pulled end within one element, the axial force on the
+    closed form ``mu q (x - (L - a))`` there and nothing carried in the stick zone (away from the
+    free end, where the pressing phase leaves a small self-equilibrated force)."""
+    sol, wire, a, x, N = _shear_lag(n_wire)
+    le = 1.0 / n_wire
+    assert abs(shear_lag.slip_zone(sol, wire) - a) < le
+    F = 15.0
+    exact = np.maximum(0.3 * 100.0 * (x - (1.0 - a)), 0.0)
+    slip = x > 1.0 - a + le
+    stick = (x < 1.0 - a - le) & (x > 0.2)
+    assert np.abs(N[slip] - exact[slip]).max() < 0.02 * F
+    assert np.abs(N[stick]).max() < 0.01 * F
+
+
+@pytest.mark.slow
+def test_shear_lag_does_not_depend_on_the_penalty():
+    """Augmentation penalties 1e9 (default, the normal penalty) and 1e10: the same axial forces
+    to 1e-3 F (measured 3.1e-3 N of F = 15 N, at the free end; the penalty sets how fast the
+    updates converge, the stick tolerance what is left), where the penalty stick
+    (``stick="penalty"``) differs by newtons."""
+    N = [_shear_lag(10, penalty_t=pt)[4] for pt in (None, 1e10)]
+    assert np.abs(N[0] - N[1]).max() < 1e-3 * 15.0
+    sol, wire, _ = shear_lag.main(n_wire=10)
+    assert np.abs(shear_lag.axial_force(sol, wire)[1] - N[0]).max() > 1.0
+
+
+def test_stick_option_is_checked():
+    m = bs.Model()
+    a = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 2), SEC)
+    b = m.add_beam(bs.geometry.straight((0, 0, 2 * R), (1, 0, 2 * R), 2), SEC)
+    with pytest.raises(bs.InputError, match="stick must be 'penalty' or 'exact'"):
+        m.add_contact(a, b, mu=0.3, stick="mortar")
+    with pytest.raises(bs.InputError, match="stick_tolerance"):
+        m.add_contact(a, b, mu=0.3, stick="exact", stick_tolerance=-1.0)

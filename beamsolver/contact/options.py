@@ -17,7 +17,7 @@ __all__ = ["ContactOptions", "SMOOTHING", "SLIP_TOLERANCE", "STICK_TOLERANCE", "
 
 SMOOTHING = 1e-6          # default smoothing gap of the normal law / (R1 + R2) (benchmarks/touching_defaults.py)
 SLIP_TOLERANCE = 0.005    # elastic slip at the onset of sliding / slave element length (Abaqus' default)
-STICK_TOLERANCE = 1e-6    # weighted slip of a sticking node / (R1 + R2) with stick="exact"
+STICK_TOLERANCE = 1e-8    # weighted slip of a sticking node / (R1 + R2) with stick="exact"
 LINE_ANGLE = float(np.deg2rad(20.0))   # below this crossing angle: line contact (search.py, rule 1)
 
 
