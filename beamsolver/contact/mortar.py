@@ -72,14 +72,15 @@ def point_derivatives(X, p, T, h=1e-30):
     """Complex-step derivatives of ``point_friction`` on the group, batched over ``P`` pairs.
 
     Returns a dict: ``f`` ``(P, 24)``, ``dfdq`` ``(P, 24, 24)`` at fixed ``T``, ``G = df/dT``
-    ``(P, 24, 3)``, ``S`` ``(P, 3)``, ``dS`` ``(P, 3, 24)``, ``lam_n`` ``(P,)``, ``dlam_n`` ``(P, 24)`` and
+    ``(P, 24, 3)``, ``S`` ``(P, 3)``, ``dS`` ``(P, 3, 24)``, ``lam_n`` ``(P,)``, ``dlam_n`` ``(P, 24)``, ``dn``
+    ``(P, 3, 24)`` (of the normal) and
     the real point data of ``point_friction`` (``slip``, ``n``, ``t1``, ``t2``, ``HL``, ``HK``, ...).
     Column ``6 j + k`` perturbs node ``j`` by the body increment ``exp(i h e_k)``; columns 24-26
     perturb ``T``.
     """
     P = X.shape[0]
     res = dict(f=np.empty((P, 24)), dfdq=np.empty((P, 24, 24)), G=np.empty((P, 24, 3)), S=np.empty((P, 3)),
-               dS=np.empty((P, 3, 24)), lam_n=np.empty(P), dlam_n=np.empty((P, 24)))
+               dS=np.empty((P, 3, 24)), lam_n=np.empty(P), dlam_n=np.empty((P, 24)), dn=np.empty((P, 3, 24)))
     E = se3.exp(1j * h * np.eye(6))
     outs = []
     for a in range(0, P, CHUNK):
@@ -99,6 +100,7 @@ def point_derivatives(X, p, T, h=1e-30):
         res["dS"][a:b] = np.transpose(oc["S"][:24].imag, (1, 2, 0)) / h
         res["lam_n"][a:b] = oc["lam_n"][0].real
         res["dlam_n"][a:b] = oc["lam_n"][:24].imag.T / h
+        res["dn"][a:b] = np.transpose(oc["n"][:24].imag, (1, 2, 0)) / h
         outs.append({k: np.real(v[0]) for k, v in oc.items() if k not in ("S", "lam_n")})
     res.update({k: np.concatenate([o[k] for o in outs]) for k in outs[0]} if outs else {})
     return res
@@ -149,24 +151,36 @@ def return_mapping(trial, cap):
     return lam, stick, C, c
 
 
-def nodal_state(G, w, S, lam_n, R, Lam, eps, mu):
+def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu):
     """Nodal weighted slip, normal traction and multipliers of the groups ``G`` (``groups``).
 
-    ``w`` ``(P,)`` point weights, ``S`` ``(P, 3)`` slips, ``lam_n`` ``(P,)``; per group: ``R`` ``(n, 3, 3)``
+    ``w`` ``(P,)`` point weights, ``S`` ``(P, 3)`` slips, ``lam_n`` ``(P,)``, ``n`` ``(P, 3)`` normals; per group:
+    the nodal normal ``nu = nbar / |nbar|``, ``nbar = sum_p Phi_j w_p n_p / m_j``, whose projector ``Pi = I - nu nu^T``
+    keeps the trial ``Pi (R Lam + eps u)`` and the slip ``Pi u`` tangential (the points' tangent planes
+    differ along a curved contact line: a normal part could not be held by their tractions); ``R`` ``(n, 3, 3)``
     the slave node's rotation, ``Lam`` ``(n, 3)`` the step's multiplier in that frame, ``eps`` and
-    ``mu`` ``(n,)``.  Returns a dict with ``m``, ``u``, ``lamN``, ``trial``, ``lam``, ``stick``, ``C``,
-    ``c`` per group and the point tractions ``T`` ``(P, 3)``.
+    ``mu`` ``(n,)``.  Returns a dict with ``m``, ``u`` (projected), ``lamN``, ``trial``, ``lam``, ``stick``,
+    ``C``, ``c``, ``Pi``, ``Q`` (d trial / d nbar) per group and the point tractions ``T`` ``(P, 3)``.
     """
-    n = len(G["key"])
+    k = len(G["key"])
     wphi = G["phi"] * w[:, None]
-    m = np.bincount(G["g"].ravel(), weights=wphi.ravel(), minlength=n)
+    m = np.bincount(G["g"].ravel(), weights=wphi.ravel(), minlength=k)
     u = np.stack([np.bincount(G["g"].ravel(), weights=(wphi[:, :, None] * S[:, None, :])[..., i].ravel(),
-                              minlength=n) for i in range(3)], axis=1) / m[:, None]
-    lamN = np.bincount(G["g"].ravel(), weights=(wphi * lam_n[:, None]).ravel(), minlength=n) / m
-    trial = np.einsum("gij,gj->gi", R, Lam) + eps[:, None] * u
+                              minlength=k) for i in range(3)], axis=1) / m[:, None]
+    lamN = np.bincount(G["g"].ravel(), weights=(wphi * lam_n[:, None]).ravel(), minlength=k) / m
+    nbar = np.stack([np.bincount(G["g"].ravel(), weights=(wphi[:, :, None] * n[:, None, :])[..., i].ravel(),
+                                 minlength=len(m)) for i in range(3)], axis=1) / m[:, None]
+    size = np.linalg.norm(nbar, axis=1)
+    nu = nbar / size[:, None]
+    Pi = np.eye(3) - nu[:, :, None] * nu[:, None, :]
+    v = np.einsum("gij,gj->gi", R, Lam) + eps[:, None] * u
+    trial = np.einsum("gij,gj->gi", Pi, v)
+    # d trial = Pi dv + Q dnbar, Q = -((nu . v) Pi + nu (Pi v)^T) / |nbar|
+    Q = -(np.sum(nu * v, axis=1)[:, None, None] * Pi + nu[:, :, None] * trial[:, None, :]) / size[:, None, None]
     lam, stick, C, c = return_mapping(trial, mu * np.maximum(lamN, 0.0))
     T = np.einsum("pa,pai->pi", G["phi"], lam[G["g"]])
-    return dict(m=m, u=u, lamN=lamN, trial=trial, lam=lam, stick=stick, C=C, c=c, T=T, wphi=wphi)
+    return dict(m=m, u=np.einsum("gij,gj->gi", Pi, u), lamN=lamN, trial=trial, lam=lam, stick=stick, C=C, c=c,
+                T=T, wphi=wphi, Pi=Pi, Q=Q)
 
 
 def blocks(G, d, st, R, Lam, eps, mu):
@@ -187,12 +201,13 @@ def blocks(G, d, st, R, Lam, eps, mu):
     np.add.at(f, (gA[:, None], rowsA), d["f"])
     K = np.zeros((n, 6 * k, 6 * k))
     np.add.at(K, (gA[:, None, None], rowsA[:, :, None], rowsA[:, None, :]), d["dfdq"])
-    # d lam_g / d q = C (eps du + d(R Lam)) + c mu dlamN, rows over the group's slots
+    # d lam_g / d q = C (Pi (eps du + d(R Lam)) + Q dnbar) + c mu dlamN, rows over the group's slots
     B = np.zeros((n, 3, 6 * k))
     for a in range(2):
         g, rows = G["g"][:, a], (6 * G["pos"][:, a, :, None] + np.arange(6)).reshape(P, 24)
         wg = st["wphi"][:, a] / st["m"][g]
-        dtrial = (eps[g] * wg)[:, None, None] * d["dS"]
+        dtrial = (eps[g] * wg)[:, None, None] * np.einsum("pij,pjq->piq", st["Pi"][g], d["dS"]) + \
+            wg[:, None, None] * np.einsum("pij,pjq->piq", st["Q"][g], d["dn"])
         dlam = np.einsum("pij,pjq->piq", st["C"][g], dtrial) + \
             (mu[g] * wg)[:, None, None] * st["c"][g][:, :, None] * d["dlam_n"][:, None, :]
         np.add.at(B, (g[:, None, None], np.arange(3)[None, :, None], rows[:, None, :]), dlam)
@@ -201,7 +216,7 @@ def blocks(G, d, st, R, Lam, eps, mu):
     rot = 6 * own[:, None] + np.arange(3, 6)
     dR = -np.einsum("gij,gjk->gik", R, se3.skew(Lam))
     np.add.at(B, (np.arange(n)[:, None, None], np.arange(3)[None, :, None], rot[:, None, :]),
-              np.einsum("gij,gjk->gik", st["C"], dR))
+              np.einsum("gij,gjk,gkl->gil", st["C"], st["Pi"], dR))
     # forces of the interpolated tractions: A_g = sum_p Phi_j(p) G_p (rows over the group's slots)
     A = np.zeros((n, 6 * k, 3))
     for a in range(2):

@@ -625,7 +625,7 @@ class ContactSystem(Contribution):
         Lam[mf] = self._tmult[1][mi[mf]]
         eps, mu = self._decl_eps_t[gdecl], self._decl_mu[gdecl]
         _, o = mortar.point_friction(X, pm, np.zeros((len(idx), 3)))
-        st = mortar.nodal_state(G, pm["weight"], o["S"], o["lam_n"], R, Lam, eps, mu)
+        st = mortar.nodal_state(G, pm["weight"], o["S"], o["lam_n"], o["n"], R, Lam, eps, mu)
         if tangent:
             d = mortar.point_derivatives(X, pm, st["T"])
             f, K = mortar.blocks(G, d, st, R, Lam, eps, mu)
