@@ -106,8 +106,14 @@ def point_derivatives(X, p, T, h=1e-30):
     return res
 
 
-def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams):
+def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=None):
     """Nodal groups (one slave node against one master beam) of ``P`` points.
+
+    ``held`` ``(P, 2)``: whether the point's slave node A, B has a prescribed slip (every increment
+    fixed, or joined to a node of the master element: they move as one body).  Their slip is given, so a multiplier there would be redundant (an element between a held node and a
+    sliding one could not stick: Uzawa updates grow without bound); as in the boundary
+    modification of mortar multiplier spaces (Wohlmuth 2000), the hat of a held node is added to
+    its neighbour's in the element, whose multiplier then spans the whole element.
 
     ``slave_nodes`` ``(P, 2)``: the slave element's nodes A, B; ``xi1`` ``(P,)``; ``nodes`` ``(P, 4)``:
     the pairs' nodes.  Returns a dict: ``key`` ``(G,)`` (``(decl n_nodes + node) n_beams + beam``,
@@ -116,6 +122,11 @@ def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams):
     and ``pos`` ``(P, 2, 4)`` the slot of each pair node in the group of its node A and B.
     """
     P = len(xi1)
+    if held is not None:
+        slave_nodes = slave_nodes.copy()
+        hA, hB = held[:, 0], held[:, 1]
+        slave_nodes[hA & ~hB, 0] = slave_nodes[hA & ~hB, 1]
+        slave_nodes[hB & ~hA, 1] = slave_nodes[hB & ~hA, 0]
     key = (np.asarray(decl, dtype=np.int64)[:, None] * n_nodes + slave_nodes) * n_beams + master_beam[:, None]
     ukey, g = np.unique(key.ravel(), return_inverse=True)
     g = g.reshape(P, 2)

@@ -138,6 +138,8 @@ class ContactSystem(Contribution):
         # exact stick: nodal multipliers per (declaration, slave node, master beam) in the node's frame
         self._tmult_committed = (np.zeros(0, dtype=np.int64), np.zeros((0, 3)))
         self._tmult = self._tmult_committed
+        # slave nodes whose every increment is fixed (``mortar.groups``' boundary modification)
+        self._held = ~system.free.reshape(-1, 6)[system.rep].any(axis=1)
         self.max_gp = max(d.n_gp for d in self.decls)
         self.point_offset = np.int64(n_el) * self.max_gp * self.n_beams * len(self.decls)
         self._history = self._empty_history()
@@ -617,7 +619,7 @@ class ContactSystem(Contribution):
         X = H[P.nodes[sel[idx]]]
         pm = {k: (v[idx] if np.ndim(v) else v) for k, v in p.items()}
         G = mortar.groups(P.nodes[sel[idx], :2], pm["xi1"], self.el_beam[P.m[sel[idx]]], P.decl[sel[idx]],
-                          P.nodes[sel[idx]], n_nodes, self.n_beams)
+                          P.nodes[sel[idx]], n_nodes, self.n_beams, self._held_slip(P.nodes[sel[idx]]))
         gdecl = G["key"] // (np.int64(n_nodes) * self.n_beams)
         R = H[G["node"], :3, :3]
         mi, mf = self._lookup(self._tmult[0], G["key"])
@@ -647,6 +649,13 @@ class ContactSystem(Contribution):
             out[name][idx] = d[name]
         return dict(members=G["members"], f=-f, K=None if K is None else -K, key=G["key"], decl=gdecl,
                     lam=st["lam"], u=st["u"], stick=st["stick"], R=R)
+
+    def _held_slip(self, nodes):
+        """``(P, 2)``: slave nodes A, B of the pairs over ``nodes`` ``(P, 4)`` whose slip is prescribed:
+        every increment fixed, or joined to a node of the master element (``mortar.groups``)."""
+        r = self.sys.rep[nodes]
+        joined = (r[:, :2, None] == r[:, None, 2:]).any(axis=2)
+        return self._held[nodes[:, :2]] | joined
 
     def kernel_inputs(self, H):
         """Node poses ``(m, 4, 4, 4)`` and kernel parameters (dict of arrays) of the pairs active at
