@@ -6,7 +6,7 @@ carried as the global vector ``S_p = s_p1 t1 + s_p2 t2``.  A group ``g`` is one 
 against one master beam; with the linear slave shape functions ``Phi_j`` (``1 - xi1`` at node A,
 ``xi1`` at node B) and the point weights ``w_p`` (length):
 
-- nodal weight ``m_g = sum_p Phi_j(p) w_p``, weighted slip ``u_g = sum_p Phi_j w_p S_p / m_g``,
+- nodal weight ``m_g = int Phi_j ds`` over the slave elements around the node, weighted slip ``u_g = sum_p Phi_j w_p S_p / m_g``,
   weighted normal traction ``lamN_g = sum_p Phi_j w_p lamN_p / m_g``;
 - trial ``lam*_g = R_j Lam_g + eps u_g`` (``Lam_g``: the step's multiplier in the section frame of
   node ``j``, ``R_j`` its current rotation; ``eps``: force / length^2), Coulomb return mapping onto
@@ -162,7 +162,7 @@ def return_mapping(trial, cap):
     return lam, stick, C, c
 
 
-def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu):
+def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu, m):
     """Nodal weighted slip, normal traction and multipliers of the groups ``G`` (``groups``).
 
     ``w`` ``(P,)`` point weights, ``S`` ``(P, 3)`` slips, ``lam_n`` ``(P,)``, ``n`` ``(P, 3)`` normals; per group:
@@ -170,12 +170,13 @@ def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu):
     keeps the trial ``Pi (R Lam + eps u)`` and the slip ``Pi u`` tangential (the points' tangent planes
     differ along a curved contact line: a normal part could not be held by their tractions); ``R`` ``(n, 3, 3)``
     the slave node's rotation, ``Lam`` ``(n, 3)`` the step's multiplier in that frame, ``eps`` and
-    ``mu`` ``(n,)``.  Returns a dict with ``m``, ``u`` (projected), ``lamN``, ``trial``, ``lam``, ``stick``,
+    ``mu`` ``(n,)``; ``m`` ``(n,)`` the nodal weights ``int Phi_j ds`` over the whole slave elements around the
+    node, in or out of contact (constant: a point entering contact with zero slip and traction changes
+    nothing, where a weight over the active points would jump).  Returns a dict with ``m``, ``u`` (projected), ``lamN``, ``trial``, ``lam``, ``stick``,
     ``C``, ``c``, ``Pi``, ``Q`` (d trial / d nbar) per group and the point tractions ``T`` ``(P, 3)``.
     """
     k = len(G["key"])
     wphi = G["phi"] * w[:, None]
-    m = np.bincount(G["g"].ravel(), weights=wphi.ravel(), minlength=k)
     u = np.stack([np.bincount(G["g"].ravel(), weights=(wphi[:, :, None] * S[:, None, :])[..., i].ravel(),
                               minlength=k) for i in range(3)], axis=1) / m[:, None]
     lamN = np.bincount(G["g"].ravel(), weights=(wphi * lam_n[:, None]).ravel(), minlength=k) / m

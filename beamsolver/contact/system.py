@@ -140,6 +140,8 @@ class ContactSystem(Contribution):
         self._tmult = self._tmult_committed
         # slave nodes whose every increment is fixed (``mortar.groups``' boundary modification)
         self._held = ~system.free.reshape(-1, 6)[system.rep].any(axis=1)
+        self._node_len = np.bincount(system.enodes.ravel(), weights=np.repeat(0.5 * system.L, 2),
+                                     minlength=len(system.poses0))
         self.max_gp = max(d.n_gp for d in self.decls)
         self.point_offset = np.int64(n_el) * self.max_gp * self.n_beams * len(self.decls)
         self._history = self._empty_history()
@@ -627,7 +629,13 @@ class ContactSystem(Contribution):
         Lam[mf] = self._tmult[1][mi[mf]]
         eps, mu = self._decl_eps_t[gdecl], self._decl_mu[gdecl]
         _, o = mortar.point_friction(X, pm, np.zeros((len(idx), 3)))
-        st = mortar.nodal_state(G, pm["weight"], o["S"], o["lam_n"], o["n"], R, Lam, eps, mu)
+        # nodal weights: half of each element at the node, the whole element beside a held node
+        e = P.e[sel[idx]]
+        merged = np.unique(G["g"][:, 0][G["g"][:, 0] == G["g"][:, 1]] * np.int64(len(self.sys.L))
+                           + e[G["g"][:, 0] == G["g"][:, 1]])
+        m = self._node_len[G["node"]] + np.bincount(merged // len(self.sys.L), weights=0.5 * self.sys.L[
+            merged % len(self.sys.L)], minlength=len(G["key"]))
+        st = mortar.nodal_state(G, pm["weight"], o["S"], o["lam_n"], o["n"], R, Lam, eps, mu, m)
         if tangent:
             d = mortar.point_derivatives(X, pm, st["T"])
             f, K = mortar.blocks(G, d, st, R, Lam, eps, mu)
