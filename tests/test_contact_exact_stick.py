@@ -141,3 +141,41 @@ def test_stick_option_is_checked():
         m.add_contact(a, b, mu=0.3, stick="mortar")
     with pytest.raises(bs.InputError, match="stick_tolerance"):
         m.add_contact(a, b, mu=0.3, stick="exact", stick_tolerance=-1.0)
+
+
+def test_nodal_return_mapping_derivatives():
+    """``mortar.return_mapping``'s ``C = d lam / d trial`` and ``c = d lam / d cap`` against central
+    differences, in stick and slip."""
+    from beamsolver.contact.mortar import return_mapping
+    rng = np.random.default_rng(26)
+    trial = rng.normal(size=(40, 3))
+    cap = np.abs(rng.normal(size=40)) * 1.5
+    lam, stick, C, c = return_mapping(trial, cap)
+    assert 5 < stick.sum() < 35
+    h = 1e-6
+    for i in range(3):
+        d = np.zeros(3)
+        d[i] = h
+        fd = (return_mapping(trial + d, cap)[0] - return_mapping(trial - d, cap)[0]) / (2 * h)
+        np.testing.assert_allclose(C[:, :, i], fd, atol=1e-8)
+    fd = (return_mapping(trial, cap + h)[0] - return_mapping(trial, cap - h)[0]) / (2 * h)
+    np.testing.assert_allclose(c, fd, atol=1e-8)
+    np.testing.assert_allclose(np.linalg.norm(lam[~stick], axis=1), cap[~stick])
+
+
+def test_groups_move_a_held_node_to_its_neighbour():
+    """``mortar.groups``: a held slave node has no group; the points of its element count wholly
+    for the neighbour (boundary modification), the others are split by the hats."""
+    from beamsolver.contact.mortar import groups
+    slave = np.array([[0, 1], [0, 1], [1, 2]])
+    nodes = np.array([[0, 1, 5, 6], [0, 1, 5, 6], [1, 2, 6, 7]])
+    xi1 = np.array([0.2, 0.8, 0.5])
+    G = groups(slave, xi1, np.zeros(3, dtype=int), np.zeros(3, dtype=int), nodes, 8, 2,
+               held=np.array([[True, False], [True, False], [False, False]]))
+    assert G["node"].tolist() == [1, 2]
+    assert (G["g"][:2] == 0).all() and G["g"][2].tolist() == [0, 1]
+    np.testing.assert_allclose(G["phi"].sum(axis=1), 1.0)
+    # every node of a group's points is among its members, in the slot given by pos
+    for p in range(3):
+        for a in range(2):
+            assert (G["members"][G["g"][p, a], G["pos"][p, a]] == nodes[p]).all()
