@@ -416,7 +416,13 @@ class Model:
           run: the overlap puts no force on the reference state); deeper overlaps are left
           as they are (default None: ``1e-3 (R1 + R2)``; 0: no adjustment; the count and
           the largest overlap adjusted are in ``Solution.stats[0]["adjusted"]``;
-          docs/theory_adjust.md).
+          docs/theory_adjust.md);
+        - ``stick``: ``"penalty"`` (default: the tangential penalty above, per Gauss point;
+          sticking points slip elastically by ``lam_T / penalty_t``) or ``"exact"`` (mortar
+          nodal multipliers on the slave beam, iterated until every sticking node's weighted
+          slip is below ``stick_tolerance``; ``penalty_t`` is then only the augmentation
+          penalty, default the normal penalty; docs/theory_mortar.md);
+        - ``stick_tolerance``: that slip, a length (default ``1e-8 (R1 + R2)``).
 
         Switched in pseudo-time (default None: from the start): ``active_from``: the
         declaration acts only in steps ending after this time; ``friction_from``: frictionless

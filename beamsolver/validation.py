@@ -178,7 +178,15 @@ CONTACT_OPTIONS = {   # name -> check(value, owner) returning the stored value (
     "margin": lambda v, o: real(v, "margin", o, minimum=0.0),
     "law": lambda v, o: _contact_law(v, o),
     "adjust": lambda v, o: real(v, "adjust", o, minimum=0.0, none=True),
+    "stick": lambda v, o: _stick(v, o),
+    "stick_tolerance": lambda v, o: real(v, "stick_tolerance", o, above=0.0, none=True),
 }
+
+
+def _stick(v, owner):
+    if v in ("penalty", "exact"):
+        return v
+    raise InputError(f"{owner}: stick must be 'penalty' or 'exact', got {v!r}")
 
 
 def _contact_law(v, owner):

@@ -25,7 +25,7 @@ LAYER = {
     "element": 2, "element_jit": 2, "elements": 2, "elements.base": 2, "elements.se3_2": 2, "elements.se3_3": 2,
     "blocks": 2, "line_load": 2, "contact": 2, "contact.law": 2, "contact.kinematics": 2,
     "contact.pairs": 2, "contact.search": 2, "contact.kernel_jit": 2, "contact.options": 2, "contact.record": 2,
-    "contact.projection": 2, "contact.rules": 2, "contact.ownership": 2, "contact.state": 2, "contact.adjust": 2,
+    "contact.projection": 2, "contact.rules": 2, "contact.ownership": 2, "contact.state": 2, "contact.adjust": 2, "contact.mortar": 2,
     # 3: model declarations and their assembly
     "model": 3, "contributions": 3, "cables": 3, "bending": 3, "assembly": 3, "stabilize": 3, "topology": 1, "assembly_jit": 3,
     "extra_pattern": 3,

@@ -13,10 +13,11 @@ import numpy as np
 
 from ..validation import check_contact_options
 
-__all__ = ["ContactOptions", "SMOOTHING", "SLIP_TOLERANCE", "LINE_ANGLE", "ADJUST"]
+__all__ = ["ContactOptions", "SMOOTHING", "SLIP_TOLERANCE", "STICK_TOLERANCE", "LINE_ANGLE", "ADJUST"]
 
 SMOOTHING = 1e-6          # default smoothing gap of the normal law / (R1 + R2) (benchmarks/touching_defaults.py)
 SLIP_TOLERANCE = 0.005    # elastic slip at the onset of sliding / slave element length (Abaqus' default)
+STICK_TOLERANCE = 1e-8    # weighted slip of a sticking node / (R1 + R2) with stick="exact"
 LINE_ANGLE = float(np.deg2rad(20.0))   # below this crossing angle: line contact (search.py, rule 1)
 ADJUST = 1e-3             # default overclosure adjusted away at the reference poses / (R1 + R2)
                           # (chords of a polyline on a post: 1.1e-4 at R1 + R2 = 1.02; docs/theory_adjust.md)
@@ -34,7 +35,14 @@ class ContactOptions:
     compiled kernel, a ``law.ContactLaw`` (None: ``law.PENALTY_COULOMB``, the penalty /
     augmented-Lagrangian / smoothed normal law with Coulomb friction); ``adjust``: largest
     overclosure at the reference poses taken as touching, strain-free (None: ``ADJUST (R1 + R2)``
-    per pair; 0: none; ``contact.adjust``)."""
+    per pair; 0: none; ``contact.adjust``);
+    ``stick``: ``"penalty"`` (a tangential penalty per Gauss point, the elastic slip set by
+    ``slip_tolerance`` or ``penalty_t``) or ``"exact"`` (mortar nodal multipliers on the slave
+    beam, ``contact/mortar.py``, iterated by augmented-Lagrangian updates until every sticking
+    node's weighted slip is below ``stick_tolerance``; ``penalty_t`` is then only the
+    augmentation penalty, force / length^2, default the normal penalty);
+    ``stick_tolerance``: that slip, a length (None: ``STICK_TOLERANCE (R1 + R2)`` of the largest
+    radii of the declaration)."""
     smoothing: Optional[float] = None
     gauss_points: int = 5
     penalty_t: Optional[float] = None
@@ -45,6 +53,8 @@ class ContactOptions:
     margin: Optional[float] = None
     law: Optional[Any] = None
     adjust: Optional[float] = None
+    stick: str = "penalty"
+    stick_tolerance: Optional[float] = None
 
     @classmethod
     def from_dict(cls, options, owner="add_contact"):

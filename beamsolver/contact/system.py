@@ -49,9 +49,9 @@ from ..errors import InputError
 from ..failures import ContactTunnelling, NoContactNormal
 from ..model import JOIN_TOL
 from .law import default_penalty
-from . import kernel_jit, pairs
+from . import kernel_jit, mortar, pairs
 from .kernel_jit import contact_kernel, kernel_and_tangent      # compiled; pairs.py's are the oracle
-from .options import ADJUST, SMOOTHING, ContactOptions
+from .options import ADJUST, SMOOTHING, STICK_TOLERANCE, ContactOptions
 from .pairs import LINE, NORMAL_TOL, POINT, material_frames, no_normal, touch_tolerance
 from .record import OPEN, SLIP, STICK, Candidates, PairSet
 from .ownership import gauss_owners, gauss_record
@@ -101,6 +101,11 @@ class _Decl:
         self.margin = 2.0 * max(s.radius for s in secs) if o.margin is None else o.margin
         self.smoothing = o.smoothing          # None: SMOOTHING * (R1 + R2) per pair
         self.law = o.law                      # None: the kernel's default law
+        self.exact = o.stick == "exact" and decl.mu > 0
+        # exact stick: augmentation penalty (force / length^2) and slip tolerance (length)
+        self.eps_t = self.penalty if o.penalty_t is None else o.penalty_t
+        self.stick_tolerance = (STICK_TOLERANCE * 2.0 * max(s.radius for s in secs)
+                                if o.stick_tolerance is None else o.stick_tolerance)
 
 
 class ContactSystem(Contribution):
@@ -135,11 +140,22 @@ class ContactSystem(Contribution):
         self._decl_smoothing = np.array([np.nan if d.smoothing is None else d.smoothing for d in self.decls])
         self._decl_tolerance = np.array([np.inf if d.tolerance is None else d.tolerance for d in self.decls])
         self._decl_adjust = np.array([np.nan if d.options.adjust is None else d.options.adjust for d in self.decls])
+        self._decl_exact = np.array([d.exact for d in self.decls])
+        self._decl_eps_t = np.array([d.eps_t for d in self.decls])
+        self._decl_stick_tol = np.array([d.stick_tolerance for d in self.decls])
+        # exact stick: nodal multipliers per (declaration, slave node, master beam) in the node's frame
+        self._tmult_committed = (np.zeros(0, dtype=np.int64), np.zeros((0, 3)))
+        self._tmult = self._tmult_committed
+        # slave nodes whose every increment is fixed (``mortar.groups``' boundary modification)
+        self._held = ~system.free.reshape(-1, 6)[system.rep].any(axis=1)
+        self._node_len = np.bincount(system.enodes.ravel(), weights=np.repeat(0.5 * system.L, 2),
+                                     minlength=len(system.poses0))
         self.max_gp = max(d.n_gp for d in self.decls)
         self.point_offset = np.int64(n_el) * self.max_gp * self.n_beams * len(self.decls)
         self._history = self._empty_history()
         self._mult_committed = (np.zeros(0, dtype=np.int64), np.zeros(0))
         self._mult = self._mult_committed
+        self._tmult = self._tmult_committed
         self._augments = 0
         self._prev_points = np.zeros(0, dtype=np.int64)
         self._prev_owners = np.zeros(0, dtype=np.int64)   # Gauss-point key * n_elements + master element
@@ -203,11 +219,13 @@ class ContactSystem(Contribution):
 
         ``history.<field>``: friction history per point key (material frames, ``xi``,
         traction); ``mult_keys``/``mult_values``: augmented-Lagrangian multipliers;
+        ``tmult_keys``/``tmult_values``: exact stick's nodal tangential multipliers (``mortar.py``);
         ``prev_points``/``prev_owners``: the point pairs and Gauss-point owners of the last
         evaluation (the hysteresis of the ownership rules).  ``set_state`` restores it.
         """
         out = {f"history.{k}": np.array(v) for k, v in self._history.items()}
         out["mult_keys"], out["mult_values"] = (np.array(a) for a in self._mult_committed)
+        out["tmult_keys"], out["tmult_values"] = (np.array(a) for a in self._tmult_committed)
         out["prev_points"] = np.array(self._prev_points)
         out["prev_owners"] = np.array(self._prev_owners)
         return out
@@ -230,6 +248,10 @@ class ContactSystem(Contribution):
         if mult is not None:
             self._mult_committed = mult
         self._mult = self._mult_committed
+        if "tmult_keys" in state:
+            self._tmult_committed = (np.asarray(state["tmult_keys"], dtype=np.int64),
+                                     np.asarray(state["tmult_values"], dtype=float).reshape(-1, 3))
+        self._tmult = self._tmult_committed
         for name, v in prev.items():
             setattr(self, f"_{name}", np.sort(v))
         self._forget_kinds()
@@ -641,13 +663,17 @@ class ContactSystem(Contribution):
         p = self._params(P, sel, H)
         self._lap("params")
         self._blocks = None        # its tangent buffer may be reused (``_tangent_out``)
-        f, K, out = self._kernels(H[P.nodes[sel]], p, P.decl[sel], tangent)
+        mort = self._decl_exact[P.decl[sel]] & (p["kind"] != POINT) & (p["mu"] > 0)
+        f, K, out = self._kernels(H[P.nodes[sel]], p, P.decl[sel], tangent,
+                                  friction=(p["mu"] > 0) & ~mort if mort.any() else None)
         np.negative(f, out=f)
         if K is not None:
             np.negative(K, out=K)
+        if mort.any():
+            out["mortar"] = self._mortar(H, P, sel, p, np.flatnonzero(mort), out, tangent)
         self._lap("kernel")
         # kept for commit/augment at the same poses (the converged iterate): no second pass
-        if (p["mu"] > 0).all() or not (p["mu"] > 0).any():
+        if (p["mu"] > 0).all() or not (p["mu"] > 0).any() or mort.any():
             self._cache = (H.copy(), P, sel, p, out)
         self._blocks = (np.array(H), (P, sel, p, f, K, out))
         return self._blocks[1]
@@ -671,6 +697,58 @@ class ContactSystem(Contribution):
                 f"{self.element_label(P.m[sel][k])}): their normal force, {force:.4g} in all, pre-stresses "
                 "the model at t_start")
 
+    def _mortar(self, H, P, sel, p, idx, out, tangent=True):
+        """Exact stick (``mortar.py``) on the pairs ``sel[idx]``: nodal groups, multipliers and blocks
+        (residual signs: minus the forces); the point data ``lam_t``, ``stick``, ``slip``, ``HL``,
+        ``HK`` of ``out`` are overwritten for these pairs."""
+        n_nodes = len(H)
+        X = H[P.nodes[sel[idx]]]
+        pm = {k: (v[idx] if np.ndim(v) else v) for k, v in p.items()}
+        G = mortar.groups(P.nodes[sel[idx], :2], pm["xi1"], self.el_beam[P.m[sel[idx]]], P.decl[sel[idx]],
+                          P.nodes[sel[idx]], n_nodes, self.n_beams, self._held_slip(P.nodes[sel[idx]]))
+        gdecl = G["key"] // (np.int64(n_nodes) * self.n_beams)
+        R = H[G["node"], :3, :3]
+        mi, mf = self._lookup(self._tmult[0], G["key"])
+        Lam = np.zeros((len(G["key"]), 3))
+        Lam[mf] = self._tmult[1][mi[mf]]
+        eps, mu = self._decl_eps_t[gdecl], self._decl_mu[gdecl]
+        _, o = mortar.point_friction(X, pm, np.zeros((len(idx), 3)))
+        # nodal weights: half of each element at the node, the whole element beside a held node
+        e = P.e[sel[idx]]
+        merged = np.unique(G["g"][:, 0][G["g"][:, 0] == G["g"][:, 1]] * np.int64(len(self.sys.L))
+                           + e[G["g"][:, 0] == G["g"][:, 1]])
+        m = self._node_len[G["node"]] + np.bincount(merged // len(self.sys.L), weights=0.5 * self.sys.L[
+            merged % len(self.sys.L)], minlength=len(G["key"]))
+        st = mortar.nodal_state(G, pm["weight"], o["S"], o["lam_n"], o["n"], R, Lam, eps, mu, m)
+        if tangent:
+            d = mortar.point_derivatives(X, pm, st["T"])
+            f, K = mortar.blocks(G, d, st, R, Lam, eps, mu)
+        else:
+            fp, d = mortar.point_friction(X, pm, st["T"])
+            f = np.zeros((len(G["key"]), 6 * G["members"].shape[1]))
+            rows = (6 * G["pos"][:, 0, :, None] + np.arange(6)).reshape(len(idx), 24)
+            np.add.at(f, (G["g"][:, 0][:, None], rows), fp.reshape(-1, 24))
+            K = None
+        n, t1, t2 = d["n"], d["t1"], d["t2"]
+        Tt = st["T"] - np.sum(st["T"] * n, axis=1)[:, None] * n
+        out["lam_t"][idx] = np.stack([np.sum(Tt * t1, axis=1), np.sum(Tt * t2, axis=1)], axis=1)
+        held = st["stick"][G["g"]] | (G["phi"] == 0.0)
+        out["stick"][idx] = held.all(axis=1)
+        out["slip"][idx] = d["slip"]
+        for name in ("HL", "HK"):
+            if name not in out:
+                out[name] = np.tile(np.eye(4), (len(sel), 1, 1))
+            out[name][idx] = d[name]
+        return dict(members=G["members"], f=-f, K=None if K is None else -K, key=G["key"], decl=gdecl,
+                    lam=st["lam"], u=st["u"], stick=st["stick"], R=R)
+
+    def _held_slip(self, nodes):
+        """``(P, 2)``: slave nodes A, B of the pairs over ``nodes`` ``(P, 4)`` whose slip is prescribed:
+        every increment fixed, or joined to a node of the master element (``mortar.groups``)."""
+        r = self.sys.rep[nodes]
+        joined = (r[:, :2, None] == r[:, None, 2:]).any(axis=2)
+        return self._held[nodes[:, :2]] | joined
+
     def kernel_inputs(self, H):
         """Node poses ``(m, 4, 4, 4)`` and kernel parameters (dict of arrays) of the pairs active at
         ``H``, as the kernel receives them (benchmarks, tests); ``None`` without active pairs."""
@@ -689,7 +767,7 @@ class ContactSystem(Contribution):
         if any(law is not None for law in laws) and kernel_and_tangent is pairs.kernel_and_tangent:
             raise InputError("contact: the numpy oracle kernel (use_numpy_kernel) has only the default law; "
                              f"add_contact declared law={next(law for law in laws if law is not None)!r}")
-        fric = p["mu"] > 0 if friction is None else np.full(len(X), friction)
+        fric = p["mu"] > 0 if friction is None else np.broadcast_to(friction, (len(X),))
         group = np.unique([id(law) for law in laws], return_inverse=True)[1][decl] * 2 + fric
         kinds = np.unique(group)
         if len(kinds) == 1:                     # one kind: no masked copies of the (m, 24, 24) blocks
@@ -739,7 +817,10 @@ class ContactSystem(Contribution):
         if blocks is None:
             return Blocks.empty(4, tangent), dict(n_active=0)
         P, sel, p, f, K, out = blocks
-        b = Blocks(P.nodes[sel], f.reshape(-1, 24), K if tangent else None)
+        if "mortar" in out:
+            b = _with_mortar(P.nodes[sel], f.reshape(-1, 24), K if tangent else None, out["mortar"])
+        else:
+            b = Blocks(P.nodes[sel], f.reshape(-1, 24), K if tangent else None)
         self._lap("blocks")
         return b, dict(n_active=len(sel))
 
@@ -751,9 +832,12 @@ class ContactSystem(Contribution):
         self._H_prev = np.array(H, dtype=float)
         self._geo_prev = None
         self._mult = self._mult_committed
+        self._tmult = self._tmult_committed
         self._augments = 0
 
     def _state(self, H):
+        if self._decl_exact.any():      # the mortar pass: through the evaluation (kept for these poses)
+            self._local_blocks(H, False)
         cache = getattr(self, "_cache", None)
         if cache is not None and cache[0].shape == H.shape and np.array_equal(cache[0], H):
             _, P, sel, p, out = cache
@@ -782,17 +866,21 @@ class ContactSystem(Contribution):
         ``MAX_AUGMENT`` updates), or ``None``."""
         if not getattr(self, "unmet_tolerance", None):
             return None
-        return (f"augmented Lagrangian: after {self._augments} updates the penetration "
-                f"is {self.unmet_tolerance:.3g} times the requested tolerance at t = {t:.6g}")
+        return (f"augmented Lagrangian: after {self._augments} updates the penetration (or, with "
+                f"stick='exact', a sticking node's slip) is {self.unmet_tolerance:.3g} times the requested "
+                f"tolerance at t = {t:.6g}")
 
     def augment(self, H):
         """Augmented-Lagrangian update; True when the step must be re-solved.
 
-        After ``MAX_AUGMENT`` updates without meeting the tolerance it returns False with
-        ``unmet_tolerance`` set to the largest ratio penetration / tolerance (else ``None``)."""
+        Normal multipliers where the penetration exceeds ``tolerance``; with exact stick, the nodal
+        tangential multipliers (``mortar.py``) where a sticking node's weighted slip exceeds
+        ``stick_tolerance``.  After ``MAX_AUGMENT`` updates without meeting the tolerances it returns
+        False with ``unmet_tolerance`` set to the largest ratio penetration or slip / tolerance
+        (else ``None``)."""
         self.unmet_tolerance = None
         tol = [d.tolerance for d in self.decls]
-        if all(t is None for t in tol):
+        if all(t is None for t in tol) and not self._decl_exact.any():
             return False
         P, sel, po = self._state(H)
         if P is None or len(sel) == 0:
@@ -800,15 +888,27 @@ class ContactSystem(Contribution):
         p, out = po
         gap = out["gap"]
         tols = self._decl_tolerance[P.decl[sel]]
-        if np.all(-gap <= tols):
+        ratio, mult, tmult = 0.0, None, None
+        if np.any(-gap > tols):
+            ratio = float(np.max(-gap / tols))
+            keys = P.key[sel]
+            lam = np.where(np.isfinite(tols), out["lam_n"], 0.0)
+            order = np.argsort(keys)
+            mult = (keys[order], lam[order])
+        m = out.get("mortar")
+        if m is not None:
+            slip, stol = np.linalg.norm(m["u"], axis=1), self._decl_stick_tol[m["decl"]]
+            bad = m["stick"] & (slip > stol)
+            if bad.any():
+                ratio = max(ratio, float(np.max(slip[bad] / stol[bad])))
+                tmult = (m["key"], np.einsum("gji,gj->gi", m["R"], m["lam"]))
+        if ratio == 0.0:
             return False
         if self._augments >= MAX_AUGMENT:      # not met: the caller decides (error or warning)
-            self.unmet_tolerance = float(np.max(-gap / tols))
+            self.unmet_tolerance = ratio
             return False
-        keys = P.key[sel]
-        lam = np.where(np.isfinite(tols), out["lam_n"], 0.0)
-        order = np.argsort(keys)
-        self._mult = (keys[order], lam[order])
+        self._mult = self._mult if mult is None else mult
+        self._tmult = self._tmult if tmult is None else tmult
         self._augments += 1
         self._blocks = None
         return True
@@ -821,9 +921,13 @@ class ContactSystem(Contribution):
         P, sel, po = self._state(H)
         if P is None or len(sel) == 0:
             self._history = self._empty_history()
+            self._tmult_committed = self._tmult = (np.zeros(0, dtype=np.int64), np.zeros((0, 3)))
             self._last = None
             return
         p, out = po
+        m = out.get("mortar")
+        self._tmult_committed = self._tmult = (np.zeros(0, dtype=np.int64), np.zeros((0, 3))) if m is None else \
+            (m["key"], np.einsum("gji,gj->gi", m["R"], m["lam"]))
         keys = P.key[sel]
         order = np.argsort(keys)
         HL, HK = _frames(out)
@@ -889,6 +993,20 @@ def _frames(out):
 def _extent(H):
     """Largest node coordinate of the poses ``H`` (``pairs.touch_tolerance``)."""
     return float(np.abs(H[..., :3, 3]).max(initial=0.0))
+
+def _with_mortar(nodes, f, K, m):
+    """The pairs' 4-node blocks and the mortar groups' blocks (``ContactSystem._mortar``) as one
+    ``Blocks`` over the groups' ``k`` nodes: the pair blocks padded with their first node (zero rows)."""
+    k = m["members"].shape[1]
+    n = len(nodes)
+    nodes = np.concatenate([np.concatenate([nodes, np.repeat(nodes[:, :1], k - 4, axis=1)], axis=1), m["members"]])
+    fa = np.zeros((n, 6 * k))
+    fa[:, :24] = f
+    if K is None:
+        return Blocks(nodes, np.concatenate([fa, m["f"]]))
+    Ka = np.zeros((n, 6 * k, 6 * k))
+    Ka[:, :24, :24] = K
+    return Blocks(nodes, np.concatenate([fa, m["f"]]), np.concatenate([Ka, m["K"]]))
 
 
 def _kernel(X, p, friction, law, tangent, K=None):

@@ -1,0 +1,238 @@
+"""Mortar friction: nodal tangential multipliers on the slave beam (docs/theory_mortar.md).
+
+Per slave Gauss point ``p`` (line and orthogonal pairs; point pairs keep the point law) the
+seed's slip increment ``s_p = (dy[1], dy[2])``, ``dy = log(H_LK_prev^-1 H_LK)`` (``pairs.py``), is
+carried as the global vector ``S_p = s_p1 t1 + s_p2 t2``.  A group ``g`` is one slave node ``j``
+against one master beam; with the linear slave shape functions ``Phi_j`` (``1 - xi1`` at node A,
+``xi1`` at node B) and the point weights ``w_p`` (length):
+
+- nodal weight ``m_g = int Phi_j ds`` over the slave elements around the node, weighted slip ``u_g = sum_p Phi_j w_p S_p / m_g``,
+  weighted normal traction ``lamN_g = sum_p Phi_j w_p lamN_p / m_g``;
+- trial ``lam*_g = R_j Lam_g + eps u_g`` (``Lam_g``: the step's multiplier in the section frame of
+  node ``j``, ``R_j`` its current rotation; ``eps``: force / length^2), Coulomb return mapping onto
+  the disk ``mu lamN_g``: ``lam_g``;
+- traction at a point ``T_p = sum_j Phi_j(p) lam_g`` (global, force per length), applied by its
+  tangential part ``T_p - (T_p . n) n`` at the contour points like the point law (``point_friction``).
+
+Augmented-Lagrangian updates ``Lam_g <- R_j^T lam_g`` repeat the step until every sticking group's
+``|u_g|`` is below the tolerance (``ContactSystem.augment``).  All functions are batched numpy; the
+derivatives of the point quantities come from complex steps on the group (``point_derivatives``).
+"""
+import numpy as np
+
+from .. import se3
+from ..se3 import cross as _cross, dot as _dot
+from .law import normal_force
+from .pairs import _axes, _body_wrench, _contact_frames, _log_c, _node_jacobians, _project, _section
+
+__all__ = ["point_friction", "point_derivatives", "groups", "return_mapping", "nodal_state", "blocks"]
+
+CHUNK = 256         # pairs per complex-step block
+
+
+def point_friction(X, p, T):
+    """Friction wrenches ``(..., 4, 6)`` of the global traction ``T`` ``(..., 3)`` (force per length,
+    its tangential part applied), the slip ``S`` ``(..., 3)`` (global), the normal traction and frames.
+
+    ``X`` ``(..., 4, 4, 4)``: node poses A1, B1, A2, B2; ``p``: the kernel parameters of
+    ``pairs.contact_kernel`` (friction history included).  Complex inputs give complex-step
+    derivatives (branches on the real part).
+    """
+    HA1, HB1, HA2, HB2 = X[..., 0, :, :], X[..., 1, :, :], X[..., 2, :, :], X[..., 3, :, :]
+    E1, E2 = se3.relative(HA1, HB1), se3.relative(HA2, HB2)
+    h1, h2 = _log_c(E1), _log_c(E2)
+    xi1, xi2 = _project(p["kind"], HA1, h1, p["xi1"] + 0 * h1[..., 0], HA2, h2, p["xi2"] + 0 * h2[..., 0],
+                        iterations=2)
+    HC, _, _ = _section(HA1, h1, xi1)
+    HF, _, _ = _section(HA2, h2, xi2)
+    R1, R2 = p["R1"], p["R2"]
+    xC, xF, n, t1, t2, dist = _axes(HC, HF, R1, R2)
+    lam_n, active = normal_force(dist - R1 - R2, p["penalty"], p["multiplier"], p.get("smoothing", 0.0))
+    HL, HK = _contact_frames(n, t1, t2, xC, xF, R1, R2)
+    HCm, _, _ = _section(HA1, h1, p["xi1_prev"] + 0 * xi1)
+    HFm, _, _ = _section(HA2, h2, p["xi2_prev"] + 0 * xi2)
+    dy = _log_c(se3.relative(p["H_LK_prev"], se3.relative(se3.compose(HCm, p["H_CL"]), se3.compose(HFm, p["H_FK"]))))
+    s = np.where(p["has_history"][..., None], dy[..., 1:3], 0.0)
+    S = s[..., :1] * t1 + s[..., 1:] * t2
+    Tt = T - _dot(T, n)[..., None] * n
+    F_slave = p["weight"][..., None] * Tt
+    m_slave = _cross(R1[..., None] * n, F_slave)
+    m_master = _cross(R2[..., None] * n, F_slave)
+    wC = _body_wrench(HC, F_slave, m_slave)
+    wF = _body_wrench(HF, -F_slave, m_master)
+    JA1, JB1 = _node_jacobians(h1, xi1, E1, se3.relative(HA1, HC))
+    JA2, JB2 = _node_jacobians(h2, xi2, E2, se3.relative(HA2, HF))
+    f = np.stack([np.einsum("...ji,...j->...i", JA1, wC), np.einsum("...ji,...j->...i", JB1, wC),
+                  np.einsum("...ji,...j->...i", JA2, wF), np.einsum("...ji,...j->...i", JB2, wF)], axis=-2)
+    out = dict(lam_n=lam_n, S=S, slip=s, n=n, t1=t1, t2=t2, HL=HL, HK=HK, HC=HC, HF=HF, xi1=xi1, xi2=xi2)
+    return f, out
+
+
+def point_derivatives(X, p, T, h=1e-30):
+    """Complex-step derivatives of ``point_friction`` on the group, batched over ``P`` pairs.
+
+    Returns a dict: ``f`` ``(P, 24)``, ``dfdq`` ``(P, 24, 24)`` at fixed ``T``, ``G = df/dT``
+    ``(P, 24, 3)``, ``S`` ``(P, 3)``, ``dS`` ``(P, 3, 24)``, ``lam_n`` ``(P,)``, ``dlam_n`` ``(P, 24)``, ``dn``
+    ``(P, 3, 24)`` (of the normal) and
+    the real point data of ``point_friction`` (``slip``, ``n``, ``t1``, ``t2``, ``HL``, ``HK``, ...).
+    Column ``6 j + k`` perturbs node ``j`` by the body increment ``exp(i h e_k)``; columns 24-26
+    perturb ``T``.
+    """
+    P = X.shape[0]
+    res = dict(f=np.empty((P, 24)), dfdq=np.empty((P, 24, 24)), G=np.empty((P, 24, 3)), S=np.empty((P, 3)),
+               dS=np.empty((P, 3, 24)), lam_n=np.empty(P), dlam_n=np.empty((P, 24)), dn=np.empty((P, 3, 24)))
+    E = se3.exp(1j * h * np.eye(6))
+    outs = []
+    for a in range(0, P, CHUNK):
+        b = min(a + CHUNK, P)
+        Xc = np.broadcast_to(X[a:b].astype(complex), (27,) + X[a:b].shape).copy()
+        for j in range(4):
+            Xc[6 * j:6 * j + 6, :, j] = se3.compose(X[None, a:b, j], E[:, None])
+        Tc = np.broadcast_to(T[a:b].astype(complex), (27, b - a, 3)).copy()
+        Tc[24:] += 1j * h * np.eye(3)[:, None, :]
+        pc = {k: (np.broadcast_to(v[a:b], (27,) + np.shape(v[a:b])) if np.ndim(v) else v) for k, v in p.items()}
+        fc, oc = point_friction(Xc, pc, Tc)
+        fc = fc.reshape(27, b - a, 24)
+        res["f"][a:b] = fc[0].real
+        res["dfdq"][a:b] = np.transpose(fc[:24].imag, (1, 2, 0)) / h
+        res["G"][a:b] = np.transpose(fc[24:].imag, (1, 2, 0)) / h
+        res["S"][a:b] = oc["S"][0].real
+        res["dS"][a:b] = np.transpose(oc["S"][:24].imag, (1, 2, 0)) / h
+        res["lam_n"][a:b] = oc["lam_n"][0].real
+        res["dlam_n"][a:b] = oc["lam_n"][:24].imag.T / h
+        res["dn"][a:b] = np.transpose(oc["n"][:24].imag, (1, 2, 0)) / h
+        outs.append({k: np.real(v[0]) for k, v in oc.items() if k not in ("S", "lam_n")})
+    res.update({k: np.concatenate([o[k] for o in outs]) for k in outs[0]} if outs else {})
+    return res
+
+
+def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=None):
+    """Nodal groups (one slave node against one master beam) of ``P`` points.
+
+    ``held`` ``(P, 2)``: whether the point's slave node A, B has a prescribed slip (every increment
+    fixed, or joined to a node of the master element: they move as one body).  Their slip is given, so a multiplier there would be redundant (an element between a held node and a
+    sliding one could not stick: Uzawa updates grow without bound); as in the boundary
+    modification of mortar multiplier spaces (Wohlmuth 2000), the hat of a held node is added to
+    its neighbour's in the element, whose multiplier then spans the whole element.
+
+    ``slave_nodes`` ``(P, 2)``: the slave element's nodes A, B; ``xi1`` ``(P,)``; ``nodes`` ``(P, 4)``:
+    the pairs' nodes.  Returns a dict: ``key`` ``(G,)`` (``(decl n_nodes + node) n_beams + beam``,
+    sorted), ``node`` ``(G,)``, ``g`` ``(P, 2)`` the groups of each point's nodes A and B, ``phi`` ``(P, 2)``
+    the shape functions, ``members`` ``(G, k)`` the nodes of each group (padded with its first node)
+    and ``pos`` ``(P, 2, 4)`` the slot of each pair node in the group of its node A and B.
+    """
+    P = len(xi1)
+    if held is not None:
+        slave_nodes = slave_nodes.copy()
+        hA, hB = held[:, 0], held[:, 1]
+        slave_nodes[hA & ~hB, 0] = slave_nodes[hA & ~hB, 1]
+        slave_nodes[hB & ~hA, 1] = slave_nodes[hB & ~hA, 0]
+    key = (np.asarray(decl, dtype=np.int64)[:, None] * n_nodes + slave_nodes) * n_beams + master_beam[:, None]
+    ukey, g = np.unique(key.ravel(), return_inverse=True)
+    g = g.reshape(P, 2)
+    node = (ukey // n_beams) % n_nodes
+    # the nodes of each group: every pair node of every member point
+    gn = np.repeat(g[:, :, None], 4, axis=2)                       # (P, 2, 4)
+    nn = np.repeat(nodes[:, None, :], 2, axis=1)
+    gk = gn.astype(np.int64) * n_nodes + nn
+    u, inv = np.unique(gk.ravel(), return_inverse=True)
+    ug = u // n_nodes
+    first = np.searchsorted(ug, np.arange(len(ukey)))
+    slot = np.arange(len(u)) - first[ug]
+    k = max(4, int(slot.max(initial=0)) + 1)
+    members = np.repeat(node[:, None], k, axis=1)
+    members[ug, slot] = u % n_nodes
+    return dict(key=ukey, node=node, g=g, phi=np.stack([1.0 - xi1, xi1], axis=1), members=members,
+                pos=slot[inv].reshape(P, 2, 4))
+
+
+def return_mapping(trial, cap):
+    """Coulomb return mapping of ``(G, 3)`` trial tractions onto the disk ``cap`` ``(G,)``.
+
+    Returns ``lam``, ``stick``, ``C`` ``(G, 3, 3)`` = d lam / d trial and ``c`` ``(G, 3)`` = d lam / d cap.
+    """
+    norm = np.linalg.norm(trial, axis=1)
+    stick = norm <= cap
+    safe = np.where(stick, 1.0, norm)
+    t = trial / safe[:, None]
+    C = np.where(stick[:, None, None], np.eye(3),
+                 (cap / safe)[:, None, None] * (np.eye(3) - t[:, :, None] * t[:, None, :]))
+    lam = np.where(stick[:, None], trial, cap[:, None] * t)
+    c = np.where(stick[:, None], 0.0, t)
+    return lam, stick, C, c
+
+
+def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu, m):
+    """Nodal weighted slip, normal traction and multipliers of the groups ``G`` (``groups``).
+
+    ``w`` ``(P,)`` point weights, ``S`` ``(P, 3)`` slips, ``lam_n`` ``(P,)``, ``n`` ``(P, 3)`` normals; per group:
+    the nodal normal ``nu = nbar / |nbar|``, ``nbar = sum_p Phi_j w_p n_p / m_j``, whose projector ``Pi = I - nu nu^T``
+    keeps the trial ``Pi (R Lam + eps u)`` and the slip ``Pi u`` tangential (the points' tangent planes
+    differ along a curved contact line: a normal part could not be held by their tractions); ``R`` ``(n, 3, 3)``
+    the slave node's rotation, ``Lam`` ``(n, 3)`` the step's multiplier in that frame, ``eps`` and
+    ``mu`` ``(n,)``; ``m`` ``(n,)`` the nodal weights ``int Phi_j ds`` over the whole slave elements around the
+    node, in or out of contact (constant: a point entering contact with zero slip and traction changes
+    nothing, where a weight over the active points would jump).  Returns a dict with ``m``, ``u`` (projected), ``lamN``, ``trial``, ``lam``, ``stick``,
+    ``C``, ``c``, ``Pi``, ``Q`` (d trial / d nbar) per group and the point tractions ``T`` ``(P, 3)``.
+    """
+    k = len(G["key"])
+    wphi = G["phi"] * w[:, None]
+    u = np.stack([np.bincount(G["g"].ravel(), weights=(wphi[:, :, None] * S[:, None, :])[..., i].ravel(),
+                              minlength=k) for i in range(3)], axis=1) / m[:, None]
+    lamN = np.bincount(G["g"].ravel(), weights=(wphi * lam_n[:, None]).ravel(), minlength=k) / m
+    nbar = np.stack([np.bincount(G["g"].ravel(), weights=(wphi[:, :, None] * n[:, None, :])[..., i].ravel(),
+                                 minlength=len(m)) for i in range(3)], axis=1) / m[:, None]
+    size = np.linalg.norm(nbar, axis=1)
+    nu = nbar / size[:, None]
+    Pi = np.eye(3) - nu[:, :, None] * nu[:, None, :]
+    v = np.einsum("gij,gj->gi", R, Lam) + eps[:, None] * u
+    trial = np.einsum("gij,gj->gi", Pi, v)
+    # d trial = Pi dv + Q dnbar, Q = -((nu . v) Pi + nu (Pi v)^T) / |nbar|
+    Q = -(np.sum(nu * v, axis=1)[:, None, None] * Pi + nu[:, :, None] * trial[:, None, :]) / size[:, None, None]
+    lam, stick, C, c = return_mapping(trial, mu * np.maximum(lamN, 0.0))
+    T = np.einsum("pa,pai->pi", G["phi"], lam[G["g"]])
+    return dict(m=m, u=np.einsum("gij,gj->gi", Pi, u), lamN=lamN, trial=trial, lam=lam, stick=stick, C=C, c=c,
+                T=T, wphi=wphi, Pi=Pi, Q=Q)
+
+
+def blocks(G, d, st, R, Lam, eps, mu):
+    """Friction force and tangent blocks over the groups' nodes ``G["members"]`` ``(n, k)``.
+
+    ``d``: ``point_derivatives`` at the point tractions ``st["T"]``; ``st``: ``nodal_state``.
+    Returns ``f`` ``(n, 6 k)`` and ``K`` ``(n, 6 k, 6 k)`` (``d f / d q``): the point forces and
+    their derivatives at fixed traction go to the group of the point's node A; the traction's
+    dependence on the slips, normal tractions and node rotation of a group couples every node of
+    it: ``K_g += A_g B_g``, ``A_g = sum_p Phi_j(p) df_p/dT`` (rows over the group's nodes, which hold
+    every member point's nodes) and ``B_g = d lam_g / d q``.
+    """
+    n, k = G["members"].shape
+    P = len(d["f"])
+    gA = G["g"][:, 0]
+    rowsA = (6 * G["pos"][:, 0, :, None] + np.arange(6)).reshape(P, 24)
+    f = np.zeros((n, 6 * k))
+    np.add.at(f, (gA[:, None], rowsA), d["f"])
+    K = np.zeros((n, 6 * k, 6 * k))
+    np.add.at(K, (gA[:, None, None], rowsA[:, :, None], rowsA[:, None, :]), d["dfdq"])
+    # d lam_g / d q = C (Pi (eps du + d(R Lam)) + Q dnbar) + c mu dlamN, rows over the group's slots
+    B = np.zeros((n, 3, 6 * k))
+    for a in range(2):
+        g, rows = G["g"][:, a], (6 * G["pos"][:, a, :, None] + np.arange(6)).reshape(P, 24)
+        wg = st["wphi"][:, a] / st["m"][g]
+        dtrial = (eps[g] * wg)[:, None, None] * np.einsum("pij,pjq->piq", st["Pi"][g], d["dS"]) + \
+            wg[:, None, None] * np.einsum("pij,pjq->piq", st["Q"][g], d["dn"])
+        dlam = np.einsum("pij,pjq->piq", st["C"][g], dtrial) + \
+            (mu[g] * wg)[:, None, None] * st["c"][g][:, :, None] * d["dlam_n"][:, None, :]
+        np.add.at(B, (g[:, None, None], np.arange(3)[None, :, None], rows[:, None, :]), dlam)
+    # the multiplier turns with its node: d(R Lam) = -R hat(Lam) dtheta (body increment of the node)
+    own = np.argmax(G["members"] == G["node"][:, None], axis=1)
+    rot = 6 * own[:, None] + np.arange(3, 6)
+    dR = -np.einsum("gij,gjk->gik", R, se3.skew(Lam))
+    np.add.at(B, (np.arange(n)[:, None, None], np.arange(3)[None, :, None], rot[:, None, :]),
+              np.einsum("gij,gjk,gkl->gil", st["C"], st["Pi"], dR))
+    # forces of the interpolated tractions: A_g = sum_p Phi_j(p) G_p (rows over the group's slots)
+    A = np.zeros((n, 6 * k, 3))
+    for a in range(2):
+        g, rows = G["g"][:, a], (6 * G["pos"][:, a, :, None] + np.arange(6)).reshape(P, 24)
+        np.add.at(A, (g[:, None], rows), G["phi"][:, a, None, None] * d["G"])
+    K += A @ B
+    return f, K
