@@ -38,6 +38,10 @@ def check_folder(folder):
             assert bs.load(p).n_steps >= 1
         elif p.suffix == ".png":
             assert p.read_bytes()[:4] == b"\x89PNG"
+        elif p.name == "view.py":                     # the ParaView script (bs.io.paraview)
+            text = p.read_text()
+            compile(text, str(p), "exec")
+            assert "beams.pvd" in text
         else:
             raise AssertionError(f"unexpected file {p.name}")
     return {p.name for p in files}
@@ -62,7 +66,8 @@ def test_main_job_script_export_and_render(tmp_path):
     assert "| 0.000 | 0 | 0 | 500 | 0 |" in out.stdout     # step 0 carries the constant 500 N pull, no twist
     assert "within the elastic range" in out.stdout and "stays positive definite" in out.stdout
     names = check_folder(tmp_path / "out")
-    assert {"beams.pvd", "contact.pvd", "solution.npz", "twisted_pair.png"} <= names
+    assert {"beams.pvd", "contact.pvd", "solution.npz", "twisted_pair.png", "view.py"} <= names
+    assert "paraview --script=out/view.py" in out.stdout
     exp = run("-m", "beamsolver.cli", "export", "out", "again", cwd=tmp_path)
     assert exp.returncode == 0, exp.stderr
     assert {n for n in names if n.endswith((".vtu", ".pvd"))} == {n for n in check_folder(tmp_path / "again")}
