@@ -20,7 +20,7 @@ GALLERY = ROOT / "docs" / "gallery"
 
 # viz.render options of the picture of each example drawn from its solution
 RENDER = {
-    "twisted_pair": dict(color_by="T", view="iso", window_size=(300, 640), zoom=1.8),
+    "twisted_pair": dict(color_by="utilisation", view="xz", scale=(1, 1, 0.02), window_size=(300, 640)),
     "three_wires": dict(color_by="T", view="iso", window_size=(300, 640), zoom=2.2),
     "seven_wire_strand": dict(color_by="beam_id", view="iso", window_size=(480, 640), zoom=1.4),
     "bend45": dict(color_by="displacement", view="iso", window_size=(640, 480)),
