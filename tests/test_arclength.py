@@ -199,6 +199,7 @@ def _driven_frame():
     return m
 
 
+@pytest.mark.slow
 def test_rate_matches_the_finite_difference_of_the_residual():
     """``dr_f/dt`` of ``rate`` (analytic in the load factors, ``K_fc dz_c/dt`` for the constrained
     nodes) against a central difference of the residual at fixed free unknowns, the constrained

@@ -33,6 +33,7 @@ def cli(*args, cwd):
                           capture_output=True, text=True, timeout=120)
 
 
+@pytest.mark.slow
 def test_run_info_export(tmp_path):
     (tmp_path / "scene.py").write_text(SCENE)
     out = cli("run", "scene.py", "--steps", 2, cwd=tmp_path)
@@ -49,6 +50,7 @@ def test_run_info_export(tmp_path):
     assert out.returncode == 0 and (tmp_path / "again" / "beams_0002.vtu").exists()
 
 
+@pytest.mark.slow
 def test_run_with_model_global_and_errors(tmp_path):
     (tmp_path / "g.py").write_text(SCENE + "\nmodel = build()[0]\nsolve_options = dict(steps=1)\n")
     out = cli("run", "g.py", "-o", "res", "-q", cwd=tmp_path)
@@ -61,6 +63,7 @@ def test_run_with_model_global_and_errors(tmp_path):
     assert out.returncode == 1 and "nothing.npz" in out.stderr
 
 
+@pytest.mark.slow
 def test_render(tmp_path):
     pytest.importorskip("pyvista")
     (tmp_path / "scene.py").write_text(SCENE)

@@ -29,6 +29,7 @@ def _cli(cwd, *args):
                           timeout=120)
 
 
+@pytest.mark.slow
 def test_typo_in_solve_options_is_named(tmp_path):
     (tmp_path / "s.py").write_text(SCENE + "solve_options = dict(stpes=2)\n")
     out = _cli(tmp_path, "run", "s.py", "-q")
@@ -45,6 +46,7 @@ def test_typo_in_solve_options_is_named(tmp_path):
                                          ({"names": ["load"], "options": "{}", "points": [{"id": "a"}]},
                                           "point 0 is not"),
                                          ([1, 2], "incomplete")])
+@pytest.mark.slow
 def test_info_on_a_partial_study_json_is_named(tmp_path, meta, words):
     (tmp_path / "st").mkdir()
     (tmp_path / "st" / study.STUDY).write_text(json.dumps(meta))

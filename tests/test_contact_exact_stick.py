@@ -74,6 +74,7 @@ def _fd_error(problem, H, eps=1e-7):
     return worst
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("regime", ["stick", "slip", "turned"])
 def test_exact_stick_tangent_matches_finite_differences(regime):
     model, slave, master = _parallel(0.5 if regime != "slip" else 0.05)

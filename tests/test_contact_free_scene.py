@@ -1,4 +1,5 @@
 """A scene without contact runs none of the contact code (fresh interpreter, clean sys.modules)."""
+import pytest
 import json
 import subprocess
 import sys
@@ -57,6 +58,7 @@ def test_scene_without_contact_never_imports_the_contact_system():
     assert out == dict(system=False, search=False, pairs=False, contact=[0, 0, 0])
 
 
+@pytest.mark.slow
 def test_contact_code_runs_when_there_is_contact():
     calls = _run(SCRIPT_CONTACT)          # the sys.modules probe above would see this code if it ran
     assert calls.get("search", 0) > 0 and calls.get("evaluate", 0) > 0

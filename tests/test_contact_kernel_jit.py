@@ -67,6 +67,7 @@ CASES = [(f, s, m, h, e) for f in (False, True) for s in (0.0, 0.02) for m in (0
          for e in (0.005, 0.5)]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("friction, smoothing, multiplier, history, elastic_slip", CASES)
 def test_forces_tangent_and_fields_equal_the_oracle(friction, smoothing, multiplier, history, elastic_slip):
     seed = CASES.index((friction, smoothing, multiplier, history, elastic_slip))
@@ -168,6 +169,7 @@ def test_runs_as_plain_python_without_jit():
     assert eK <= 1e-8 and ef <= 1e-8
 
 
+@pytest.mark.slow
 def test_compiled_projection_equals_the_numpy_projection():
     """``kernel_jit.project`` (a drop-in for the search's ``pairs._project``) on all kinds, 8 iterations."""
     rng = np.random.default_rng(11)

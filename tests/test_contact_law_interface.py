@@ -79,6 +79,7 @@ def _fd_tangent(X, p, friction, law, eps=1e-6):
     return K
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("friction", [False, True])
 def test_a_new_normal_law_plugs_in_without_kernel_edits_with_an_fd_correct_tangent(friction):
     X, p = _scene(7, friction, 0.0, 0.0, True, 0.5)

@@ -1,6 +1,7 @@
 """The staged contact pipeline (issue 14): compiled projections equal their numpy oracle, the
 evaluation kept for the same poses and state is the one a fresh evaluation gives, and the
 public per-stage timings."""
+import pytest
 import sys
 from pathlib import Path
 
@@ -57,6 +58,7 @@ def test_closest_points_equal_the_numpy_projection_and_ratio():
     np.testing.assert_allclose(r, ratio, rtol=1e-10, atol=1e-12)
 
 
+@pytest.mark.slow
 def test_gauss_point_projection_equals_the_numpy_projection_from_the_chord():
     rng, H, kinds, A1, A2, h1, h2 = _poses(3)
     kinds = np.where(kinds == pairs.POINT, pairs.ORTHOGONAL, kinds)

@@ -64,6 +64,7 @@ def _gauss_reference(H, A1, h1, xg, kind, A2, B2, h2, c2, reach):
     return rep, g, xi2, dist, start
 
 
+@pytest.mark.slow
 def test_gauss_projections_equal_the_kernel_projection_bit_for_bit():
     rng, H, kind, enodes, h = _poses(2)
     A1, A2 = enodes[0::2, 0], enodes[1::2, 0]

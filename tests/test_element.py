@@ -105,6 +105,7 @@ def test_tangent_batched_equals_single():
         assert np.abs(Ki[0] - K[i]).max() <= 1e-13 * np.abs(Ki).max()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["straight", "arc", "helix"])
 def test_reference_pose_is_stress_free(kind):
     P = _reference(kind)

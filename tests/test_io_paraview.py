@@ -58,6 +58,7 @@ def test_cli_without_pvbatch_says_how_to_get_it(folder, monkeypatch):
         screenshot(folder / "view.py", folder / "x.png")
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(shutil.which("pvbatch") is None, reason="ParaView's pvbatch not installed (.ci/run installs it)")
 def test_real_paraview_draws_tubes_and_contact_points(folder, tmp_path):
     """Also with the vtk wheel's EGL window asked for (``viz`` sets it in-process): Debian's

@@ -138,6 +138,7 @@ def _run(code, **env):
     return out.stdout
 
 
+@pytest.mark.slow
 def test_kernel_tests_pass_without_jit():
     """``NUMBA_DISABLE_JIT=1`` (plain Python, for debugging and coverage) runs the same checks."""
     out = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", __file__,
@@ -147,6 +148,7 @@ def test_kernel_tests_pass_without_jit():
     assert " passed" in out.stdout
 
 
+@pytest.mark.slow
 def test_second_process_loads_the_cache():
     """Compiled once per machine: a later process loads every kernel from numba's cache."""
     code = """

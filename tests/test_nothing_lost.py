@@ -136,6 +136,7 @@ def _reference():
     return bs.solve(m, steps=STEPS, verbose=False)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig, checkpoint", [(signal.SIGINT, 60.0), (signal.SIGKILL, 0)])
 def test_fault_injection_signal_mid_run_then_restart(tmp_path, sig, checkpoint):
     folder = tmp_path / ("int" if sig == signal.SIGINT else "kill")

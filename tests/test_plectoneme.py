@@ -113,6 +113,7 @@ def test_two_stage_path_holds_the_turns_while_the_pull_relaxes():
         plectoneme.build(n_elements=8, twist_until=0.0)
 
 
+@pytest.mark.slow
 def test_two_stage_run_holds_lk_while_the_pull_relaxes():
     """A reduced two-stage run: the straight two-ply twisted 1 turn under 2000 N, the pull then
     lowered to 300 N (still far above the critical pull of 1 turn): ``Lk`` stays 1, all twist."""

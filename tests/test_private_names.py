@@ -73,6 +73,7 @@ def _files():
         yield from sorted((ROOT / folder).rglob("*.py"))
 
 
+@pytest.mark.slow
 def test_no_private_cross_module_access():
     owned = {m: private_names(PACKAGE / f"{m}.py") for m in OWNERS}
     bad = []

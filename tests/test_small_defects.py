@@ -102,6 +102,7 @@ def test_large_but_finite_sections_still_work():
 
 
 # ------------------------------------------------------------------ render into a new folder
+@pytest.mark.slow
 def test_render_creates_the_output_folder(tmp_path):
     pytest.importorskip("pyvista")
     sec = bs.Section(EA=1e4, GA2=1e4, GA3=1e4, GJ=1e2, EI2=1e2, EI3=1e2, radius=0.1)

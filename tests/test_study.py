@@ -137,6 +137,7 @@ def test_progress_bar_over_points(monkeypatch, capsys):
     assert "Dask dashboard at http://127.0.0.1:8787/status" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_cli_sweep_refuses_a_script_without_build(tmp_path):
     (tmp_path / "s.py").write_text("model = None\n")
     out = subprocess.run([sys.executable, "-m", "beamsolver.cli", "sweep", "s.py", "--param", "a=1,2"],

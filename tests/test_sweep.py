@@ -63,6 +63,7 @@ def client():
     c._beamsolver_cluster.close()
 
 
+@pytest.mark.slow
 def test_local_workers_single_threaded_with_one_blas_thread(client):
     assert list(client.nthreads().values()) == [1, 1]
     env = client.run(lambda: [os.environ.get(v) for v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS",
@@ -126,6 +127,7 @@ def test_a_scene_the_workers_cannot_import_is_recorded(client, tmp_path, monkeyp
                     verbose=False)[0]["status"] == "converged"           # the workers survived
 
 
+@pytest.mark.slow
 def test_an_interrupted_study_resumes(client, tmp_path, monkeypatch):
     log = tmp_path / "log"
     grid = [dict(turns=t, log=str(log), delay=0.0 if t == 0.25 else 0.3) for t in (0.25, 0.5, 0.75, 1.0)]
@@ -158,6 +160,7 @@ def test_an_interrupted_study_resumes(client, tmp_path, monkeypatch):
     assert len(log.read_text().split()) == 6                    # other solve options: solved again
 
 
+@pytest.mark.slow
 def test_default_local_cluster_and_progress_lines(capsys):
     rows = bs.sweep(cantilever, {"turns": [0.25, 0.5]}, summary=tip, solve_options=OPTIONS, verbose=True)
     assert [r["status"] for r in rows] == ["converged", "converged"]
@@ -193,6 +196,7 @@ def _start(args, env, cwd):
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
 
+@pytest.mark.slow
 def test_cli_sweep_on_a_scheduler_and_worker_started_here(tmp_path):
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     sched_file = tmp_path / "scheduler.json"
@@ -233,6 +237,7 @@ def test_cli_sweep_on_a_scheduler_and_worker_started_here(tmp_path):
                 p.wait()
 
 
+@pytest.mark.slow
 def test_strand_sweep_example_against_strand_theory(client, tmp_path):
     sys.path.insert(0, str(ROOT / "examples"))
     try:

@@ -47,6 +47,7 @@ def check_folder(folder):
     return {p.name for p in files}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("example", sorted(p.name for p in EXAMPLES.glob("*.py")))
 def test_every_example_runs_under_beamsolver_run(example, tmp_path):
     out = run("-m", "beamsolver.cli", "run", EXAMPLES / example, "-o", "out", *REDUCED, cwd=tmp_path)
@@ -59,6 +60,7 @@ def test_every_example_runs_under_beamsolver_run(example, tmp_path):
     assert info.returncode == 0 and "; converged" in info.stdout, info.stderr
 
 
+@pytest.mark.slow
 def test_main_job_script_export_and_render(tmp_path):
     out = run(EXAMPLES / "twisted_pair.py", "--output", "out", "--turns", "0.25", "--steps", "2",
               "--elements", "8", cwd=tmp_path)
