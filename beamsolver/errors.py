@@ -28,7 +28,7 @@ class StabilizationWarning(RuntimeWarning):
 
 class MaterialRangeWarning(UserWarning):
     """A section is used beyond the yield stress or strain it was given (``Section(yield_stress=)``):
-    the linear-elastic answer is no longer the material's (``beamsolver.material_range``)."""
+    the linear-elastic answer is no longer the material's (``beamsolver.model.material_range``)."""
 
 
 class ConditioningWarning(RuntimeWarning):

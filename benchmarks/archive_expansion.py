@@ -20,7 +20,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 
 import beamsolver as bs  # noqa: E402
-from beamsolver import solution_file  # noqa: E402
+from beamsolver.results import solution_file# noqa: E402
 
 from _report import machine, table, write_section  # noqa: E402
 

@@ -8,7 +8,7 @@ buckles sideways near ``F = 1.09 N``.  Solved by force control to ``F_max`` in
 table.  Issue 12 item 8: the damped Newton stalled there on a stable path, and
 after a cut-back the step regrew to the size that had just failed, every third
 step.  Each case runs with the step growth of ``solve`` (``rule`` "memory": a size
-that failed again waits twice as many easy steps, ``bs.stepping.WAIT_MAX``) and
+that failed again waits twice as many easy steps, ``bs.stepping.steps.WAIT_MAX``) and
 with the fixed rule (``WAIT_MAX = 2``: back to the failed size after two easy
 steps); "all iterations" counts the failed attempts' too (``callback``).
 
@@ -30,9 +30,9 @@ def run(F_max, steps, n, imperfection=1e-4, wait_max=None):
 
     def callback(info):
         count[0] += info["iteration"] > 0
-    saved = bs.stepping.WAIT_MAX
+    saved = bs.stepping.steps.WAIT_MAX
     if wait_max is not None:
-        bs.stepping.WAIT_MAX = wait_max
+        bs.stepping.steps.WAIT_MAX = wait_max
     t0 = time.perf_counter()
     try:
         sol = bs.solve(m, steps=steps, verbose=False, callback=callback)
@@ -41,7 +41,7 @@ def run(F_max, steps, n, imperfection=1e-4, wait_max=None):
         sol = e.solution
         outcome = f"stopped at F = {sol.times[-1] * F_max:.4f} N ({type(getattr(e, 'failure', None) or e).__name__})"
     finally:
-        bs.stepping.WAIT_MAX = saved
+        bs.stepping.steps.WAIT_MAX = saved
     wall = time.perf_counter() - t0
     return dict(F_max=F_max, n=n, steps=steps, imperfection=imperfection, outcome=outcome, taken=sol.n_steps,
                 cutbacks=sum(s["cutbacks"] for s in sol.stats[1:]), iterations=int(sol.iterations.sum()),

@@ -46,8 +46,8 @@ from _report import machine, single_thread, table, write_section  # noqa: E402
 single_thread()
 import numpy as np  # noqa: E402
 
-from beamsolver import linsolve  # noqa: E402
-from beamsolver.problem import Problem  # noqa: E402
+from beamsolver.nonlinear import linsolve# noqa: E402
+from beamsolver.nonlinear.problem import Problem  # noqa: E402
 from beamsolver.contact.system import TIMED  # noqa: E402
 from scaling import WIRE_R, bundle_model, bundle_per_wire  # noqa: E402
 
@@ -56,7 +56,7 @@ SHIFT = 0.003          # of the wire radius: the move of one outer wire that cha
 COUNTED = ("twisted_pair", "three_wires", "seven_wire_strand")     # examples whose new patterns are counted
 _COUNTER = """
 import json, runpy, sys
-from beamsolver import assembly
+from beamsolver.assembly import system as assembly
 n = dict(tangents=0, new=0)
 matrix = assembly.System.matrix
 def counted(self, kvals, extra=None):

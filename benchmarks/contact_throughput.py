@@ -28,7 +28,7 @@ single_thread()
 import numpy as np  # noqa: E402
 
 import beamsolver as bs  # noqa: E402
-from beamsolver.problem import Problem  # noqa: E402
+from beamsolver.nonlinear.problem import Problem  # noqa: E402
 from beamsolver.contact import kernel_jit, pairs  # noqa: E402
 from beamsolver.contact.system import use_numpy_kernel  # noqa: E402
 

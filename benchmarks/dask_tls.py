@@ -17,7 +17,7 @@ from _report import machine, single_thread, table, write_section  # noqa: E402
 
 single_thread()
 
-from beamsolver.sweep_engine import local_client  # noqa: E402
+from beamsolver.app.sweep_engine import local_client  # noqa: E402
 
 REPEATS = 3
 N_WORKERS = 2

@@ -38,8 +38,8 @@ import numpy as np  # noqa: E402
 import scipy.sparse.linalg as spla  # noqa: E402
 
 import beamsolver as bs  # noqa: E402
-from beamsolver import element  # noqa: E402
-from beamsolver.assembly import System  # noqa: E402
+from beamsolver.elements import element# noqa: E402
+from beamsolver.assembly.system import System  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "results"
 TARGET = 2e6            # elements per second for the kernel on one core at 1e4 elements (issue 13)

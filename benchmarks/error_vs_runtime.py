@@ -46,7 +46,7 @@ if "numpy" not in sys.modules:          # pin BLAS before numpy loads (the test 
 import numpy as np  # noqa: E402
 
 import beamsolver as bs  # noqa: E402
-from beamsolver import cables, geometry, se3  # noqa: E402
+from beamsolver import cables, geometry, se3# noqa: E402
 
 import bend45  # noqa: E402
 import capstan  # noqa: E402

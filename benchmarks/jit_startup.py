@@ -165,7 +165,7 @@ integer argument, counts twice).
 
 def _auto_two():
     sys.path.insert(0, str(ROOT))
-    from beamsolver.jit_warmup import _two_processes
+    from beamsolver.nonlinear.jit_warmup import _two_processes
     return _two_processes()
 
 

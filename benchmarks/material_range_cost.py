@@ -14,7 +14,7 @@ import warnings
 import numpy as np
 
 import beamsolver as bs
-from beamsolver.material_range import RangeCheck
+from beamsolver.model.material_range import RangeCheck
 
 
 def description(n_el, yield_stress):

@@ -23,7 +23,7 @@ single_thread()
 import numpy as np  # noqa: E402
 
 import beamsolver as bs  # noqa: E402
-from beamsolver import stable_branch  # noqa: E402
+from beamsolver.stepping import stable_branch# noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "published"))
 import scenes  # noqa: E402

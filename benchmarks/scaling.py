@@ -98,7 +98,7 @@ PARTS = ("element", "contact_search", "contact_kernels", "contact_other", "assem
 def cable(n):
     """A clamped cable of ``n`` elements along a gentle helix (10 m, 1 turn per 2 m), deformed."""
     import beamsolver as bs
-    from beamsolver.assembly import System
+    from beamsolver.assembly.system import System
     sec = bs.Section.circular(radius=0.005, E=2e11)
     m = bs.Model()
     beam = m.add_beam(bs.geometry.helix(radius=0.5, pitch=2.0, length=10.0, n_elements=n), sec)
@@ -185,7 +185,7 @@ def contact_parts(problem, H, tangent=True):
 
 def linear_solvers(K, rhs, out, skip=()):
     """splu, splu-rcm and pardiso on ``K``: factorisation + solve; pardiso also re-factorised (same pattern)."""
-    from beamsolver import linsolve
+    from beamsolver.nonlinear import linsolve
     for b, key in (("splu", "splu"), ("splu-rcm", "splu_rcm")):
         if b in skip:
             out[f"{key}_s"] = out[f"{key}_factor_nnz"] = np.nan
@@ -228,7 +228,7 @@ def warm_up():
     """Import and first-call costs out of the timings (MKL initialisation, meshio import)."""
     import scipy.sparse as sp
 
-    from beamsolver import linsolve
+    from beamsolver.nonlinear import linsolve
     K = sp.csc_matrix(sp.eye(50) * 2.0 + sp.eye(50, k=1))
     for b in linsolve.available():
         linsolve.factorize(K, b).solve(np.ones(50))
@@ -237,7 +237,7 @@ def warm_up():
 
 # ------------------------------------------------------------------ one size (child process)
 def measure_cable(n, skip=()):
-    from beamsolver.results import Solution
+    from beamsolver.results.solution import Solution
     warm_up()
     m, system, H = cable(n)
     lf = system.load_factors(1.0)
@@ -250,7 +250,7 @@ def measure_cable(n, skip=()):
     linear_solvers(K, rhs, out, skip)
     out["solve"] = out["splu_s"]
     dz = np.zeros(6 * system.n_nodes)
-    from beamsolver import linsolve
+    from beamsolver.nonlinear import linsolve
     dz[system.free_dofs] = linsolve.factorize(K).solve(rhs)
     dz = dz.reshape(-1, 6)
     out["update"], H1 = _best(lambda: system.update(H, dz))
@@ -269,7 +269,7 @@ def replicated_contact(system, wires, per_wire, unit=None):
     """Contact COO of the long bundle from the interior lay of a 1.5-lay one (see module docstring)."""
     import scipy.sparse as sp
 
-    from beamsolver.problem import Problem
+    from beamsolver.nonlinear.problem import Problem
     if unit is None:
         um, uw = bundle_model(UNIT)
         up = Problem.from_model(um)
@@ -314,8 +314,8 @@ def replicated_contact(system, wires, per_wire, unit=None):
 
 
 def measure_bundle(n, cap, predicted_contact, skip=()):
-    from beamsolver.problem import Problem
-    from beamsolver.results import Solution
+    from beamsolver.nonlinear.problem import Problem
+    from beamsolver.results.solution import Solution
     warm_up()
     per_wire = bundle_per_wire(n)
     m, wires = bundle_model(per_wire)
@@ -387,8 +387,8 @@ def measure_pays_nothing(n=10_000):
     """One Newton iteration of ``bs.solve`` on the cable (no contact, no output) vs the sum of its parts
     (called through the public ``problem.Problem``) and the solve's own ``stats["timings"]``."""
     import beamsolver as bs
-    from beamsolver import linsolve
-    from beamsolver.problem import Problem
+    from beamsolver.nonlinear import linsolve
+    from beamsolver.nonlinear.problem import Problem
     m, system, H = cable(n)
     problem = Problem(system)
     med = _median

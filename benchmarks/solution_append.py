@@ -14,7 +14,7 @@ import time
 import numpy as np
 
 import beamsolver as bs
-from beamsolver.results import Solution
+from beamsolver.results.solution import Solution
 
 REPEATS = 3
 

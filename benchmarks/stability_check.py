@@ -26,8 +26,8 @@ single_thread()   # a BLAS pool on a shared 2-core machine makes a 96 x 96 dense
 import numpy as np  # noqa: E402
 
 import beamsolver as bs  # noqa: E402
-from beamsolver.definiteness import negative_eigenvalues  # noqa: E402
-from beamsolver.modes import lowest_modes  # noqa: E402
+from beamsolver.nonlinear.definiteness import negative_eigenvalues  # noqa: E402
+from beamsolver.nonlinear.modes import lowest_modes  # noqa: E402
 
 REPEATS = 3
 

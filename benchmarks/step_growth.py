@@ -25,7 +25,7 @@ from _report import machine, single_thread, table, write_section  # noqa: E402
 single_thread()
 
 import beamsolver as bs  # noqa: E402
-from beamsolver import stepping  # noqa: E402
+from beamsolver.stepping import steps as stepping# noqa: E402
 from beamsolver.failures import NotConverged  # noqa: E402
 
 EXAMPLES = {"twisted_pair": 16, "three_wires": 8}

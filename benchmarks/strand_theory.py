@@ -24,7 +24,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 
 import beamsolver as bs  # noqa: E402
 import seven_wire_strand as sw  # noqa: E402
-from beamsolver import cables  # noqa: E402
+from beamsolver import cables# noqa: E402
 
 RC, RW, EPS = 1.03e-3, 1.0e-3, 1e-4
 

@@ -34,7 +34,7 @@ from _report import machine, single_thread, table, write_section  # noqa: E402
 single_thread()
 
 import beamsolver as bs  # noqa: E402
-from beamsolver.sweep_engine import local_client  # noqa: E402
+from beamsolver.app.sweep_engine import local_client  # noqa: E402
 
 LOADS = [0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0]
 SIZES = {"small": 80, "large": 4000}
@@ -73,7 +73,7 @@ def started(n_workers):
     """A local client of ``n_workers`` with beamsolver imported in every worker; and the time it took."""
     t0 = time.perf_counter()
     client = local_client(n_workers)
-    client.run(lambda: __import__("beamsolver.solver") and __import__("scipy.sparse.linalg"))
+    client.run(lambda: __import__("beamsolver.driver") and __import__("scipy.sparse.linalg"))
     return client, time.perf_counter() - t0
 
 

@@ -40,7 +40,7 @@ import numpy as np  # noqa: E402
 import beamsolver as bs  # noqa: E402
 import three_wires  # noqa: E402
 import twisted_pair_extreme as twisted_pair  # noqa: E402
-from beamsolver.stepping import STEP_ZERO_ITERATIONS  # noqa: E402
+from beamsolver.stepping.steps import STEP_ZERO_ITERATIONS  # noqa: E402
 
 R = 0.5e-3
 SMOOTHING = (0.0, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2)      # x (R1 + R2)

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
-from beamsolver import solution_file
+from beamsolver.results import solution_file
 
 
 def _model():
@@ -92,7 +92,7 @@ def test_unknown_member_and_lying_sizes_are_refused(saved, tmp_path):
 
 def test_cli_info_refuses_a_bomb(saved, tmp_path):
     bomb = _rewrite(saved, tmp_path / "bomb.npz", {"poses.npy": _zeros("poses.npy", 300 * 2**20)})
-    out = subprocess.run([sys.executable, "-m", "beamsolver.cli", "info", str(bomb)], capture_output=True,
+    out = subprocess.run([sys.executable, "-m", "beamsolver.app.cli", "info", str(bomb)], capture_output=True,
                          text=True, timeout=120)
     assert out.returncode == 1 and "archive bomb" in out.stderr and "Traceback" not in out.stderr
 

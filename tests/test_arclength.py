@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
-from beamsolver import arclength
-from beamsolver.arclength import next_arc_length, rate, sphere_root
-from beamsolver.problem import Problem
+from beamsolver.stepping import arclength
+from beamsolver.stepping.arclength import next_arc_length, rate, sphere_root
+from beamsolver.nonlinear.problem import Problem
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -410,6 +410,6 @@ def test_history_plot_and_info_of_an_arc_length_run(tmp_path):
     fig = viz.plot_history(sol, "position", node=apex, component="y", path=tmp_path / "h.png")
     x, _ = fig.axes[0].lines[0].get_data()
     np.testing.assert_array_equal(x, sol.times)
-    out = subprocess.run([sys.executable, "-m", "beamsolver.cli", "info", str(tmp_path / "out")],
+    out = subprocess.run([sys.executable, "-m", "beamsolver.app.cli", "info", str(tmp_path / "out")],
                          capture_output=True, text=True, timeout=120)
     assert out.returncode == 0 and "; converged" in out.stdout, out.stderr

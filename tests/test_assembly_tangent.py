@@ -4,7 +4,7 @@ import pytest
 
 import beamsolver as bs
 from beamsolver import geometry, se3
-from beamsolver.assembly import GLOBAL, System
+from beamsolver.assembly.system import GLOBAL, System
 
 from conftest import rel_err, spd_matrix
 

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from beamsolver import bandfactor
-from beamsolver.definiteness import DENSE_MAX, negative_eigenvalues, scaled_symmetric
-from beamsolver.modes import lowest_modes
+from beamsolver.nonlinear import bandfactor
+from beamsolver.nonlinear.definiteness import DENSE_MAX, negative_eigenvalues, scaled_symmetric
+from beamsolver.nonlinear.modes import lowest_modes
 
 
 def shuffled_band(rng, n, b, shift):

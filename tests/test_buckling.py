@@ -22,10 +22,10 @@ from scipy.optimize import brentq
 from scipy.special import ellipe, ellipk
 
 import beamsolver as bs
-from beamsolver import bifurcation
-from beamsolver.assembly import System
-from beamsolver.definiteness import DENSE_MAX
-from beamsolver.modes import lowest_modes
+from beamsolver.stepping import bifurcation
+from beamsolver.assembly.system import System
+from beamsolver.nonlinear.definiteness import DENSE_MAX
+from beamsolver.nonlinear.modes import lowest_modes
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 from limit_points import argyris_frame  # noqa: E402
@@ -322,7 +322,7 @@ def test_bad_stability_options_are_refused(kw):
 
 def test_modes_reach_the_saved_result_the_vtu_and_info(tmp_path, capsys):
     meshio = pytest.importorskip("meshio")
-    from beamsolver import cli
+    from beamsolver.app import cli
     m, b = _cantilever_column(2.0, 8)
     sol = bs.solve(m, steps=4, verbose=False, branch_switching="auto", modes=2, output=tmp_path / "out")
     lam, modes = sol.modes(-1)
@@ -367,7 +367,7 @@ def test_locate_switches_between_distinct_crossings_only(monkeypatch, second, sw
     step is the same (a double eigenvalue split by round-off): switch at the step's end; a distinct
     one: switch halfway between them, where only the first mode is unstable."""
     from types import SimpleNamespace
-    from beamsolver import branching
+    from beamsolver.stepping import branching
 
     def state(run, t):
         return (None, None, None, int(t >= 0.5) + int(t >= second), None)

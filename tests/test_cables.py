@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from beamsolver import cables
-from beamsolver.assembly import System
+from beamsolver.assembly.system import System
 from beamsolver.errors import InputError
 
 E = 200e9

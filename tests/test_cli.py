@@ -29,7 +29,7 @@ SCENE = textwrap.dedent("""
 
 
 def cli(*args, cwd):
-    return subprocess.run([sys.executable, "-m", "beamsolver.cli", *map(str, args)], cwd=cwd,
+    return subprocess.run([sys.executable, "-m", "beamsolver.app.cli", *map(str, args)], cwd=cwd,
                           capture_output=True, text=True, timeout=120)
 
 

@@ -8,8 +8,8 @@ import sys
 import pytest
 
 import beamsolver as bs
-from beamsolver import study
-from beamsolver.sweep_engine import sweep
+from beamsolver.app import study
+from beamsolver.app.sweep_engine import sweep
 
 SCENE = """
 import beamsolver as bs
@@ -25,7 +25,7 @@ def build(load=1.0, n=2):
 
 
 def _cli(cwd, *args):
-    return subprocess.run([sys.executable, "-m", "beamsolver.cli", *args], cwd=cwd, capture_output=True, text=True,
+    return subprocess.run([sys.executable, "-m", "beamsolver.app.cli", *args], cwd=cwd, capture_output=True, text=True,
                           timeout=120)
 
 

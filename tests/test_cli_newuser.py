@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
-from beamsolver import cli
+from beamsolver.app import cli
 
 
 def cantilever():
@@ -35,7 +35,7 @@ def test_info_of_an_interrupted_run_says_stopped(tmp_path, capsys):
 
 def test_build_with_required_arguments_gets_one_line(tmp_path):
     (tmp_path / "s.py").write_text("def build(n_elements, load):\n    raise AssertionError('not called')\n")
-    out = subprocess.run([sys.executable, "-m", "beamsolver.cli", "run", "s.py"], cwd=tmp_path,
+    out = subprocess.run([sys.executable, "-m", "beamsolver.app.cli", "run", "s.py"], cwd=tmp_path,
                          capture_output=True, text=True, timeout=120)
     assert out.returncode == 1
     assert out.stderr.strip().splitlines() == [

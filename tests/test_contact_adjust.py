@@ -5,7 +5,7 @@ import pytest
 
 import beamsolver as bs
 from beamsolver.contact import adjust
-from beamsolver.problem import Problem
+from beamsolver.nonlinear.problem import Problem
 
 
 def test_offsets_take_only_overlaps_within_the_tolerance():

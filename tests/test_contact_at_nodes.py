@@ -11,7 +11,7 @@
 import numpy as np
 
 import beamsolver as bs
-from beamsolver.problem import Problem
+from beamsolver.nonlinear.problem import Problem
 
 
 def test_crossing_at_a_kink_node_keeps_its_contact_point():

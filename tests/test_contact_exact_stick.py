@@ -13,7 +13,7 @@ import pytest
 
 import beamsolver as bs
 from beamsolver import se3
-from beamsolver.problem import Problem
+from beamsolver.nonlinear.problem import Problem
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 import contact_patch  # noqa: E402

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
-from beamsolver.problem import Problem
+from beamsolver.nonlinear.problem import Problem
 from beamsolver import se3
 from beamsolver.contact.pairs import PENALTY_T_MIN
 from beamsolver.errors import InputError

@@ -18,7 +18,7 @@ import pytest
 
 import beamsolver as bs
 from beamsolver.contact import rules
-from beamsolver.problem import Problem
+from beamsolver.nonlinear.problem import Problem
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 

@@ -14,7 +14,7 @@ import numpy as np
 
 import beamsolver as bs
 from beamsolver.contact.pairs import ORTHOGONAL, POINT
-from beamsolver.problem import Problem
+from beamsolver.nonlinear.problem import Problem
 
 
 def _scene(angle_deg):

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
-from beamsolver.problem import Problem
+from beamsolver.nonlinear.problem import Problem
 from beamsolver.contact.options import SLIP_TOLERANCE, SMOOTHING, ContactOptions
 
 

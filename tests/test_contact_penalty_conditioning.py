@@ -13,7 +13,7 @@ import pytest
 
 import beamsolver as bs
 from beamsolver.contact.conditioning import ILL_CONDITIONED_PENALTY, STIFF_PENALTY, penalty_ratios
-from beamsolver.problem import Problem
+from beamsolver.nonlinear.problem import Problem
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 import twisted_pair_extreme as twisted_pair  # noqa: E402

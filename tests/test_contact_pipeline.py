@@ -9,7 +9,7 @@ import numpy as np
 
 import beamsolver as bs
 from beamsolver import se3
-from beamsolver.problem import Problem
+from beamsolver.nonlinear.problem import Problem
 from beamsolver.contact import kernel_jit, pairs, projection
 from beamsolver.contact.system import TIMED
 from beamsolver.contact import system as cs

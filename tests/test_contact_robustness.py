@@ -55,7 +55,7 @@ def test_intersecting_centre_lines_name_the_pair():
 
 
 def test_tunnelling_is_a_typed_step_failure_naming_the_pair():
-    from beamsolver.problem import Problem
+    from beamsolver.nonlinear.problem import Problem
     from beamsolver.failures import ContactTunnelling
     m, slave, master = _pushed_crossing(6.5 * R, height=2.5 * R)
     problem = Problem.from_model(m)

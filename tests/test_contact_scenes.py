@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
-from beamsolver.problem import Problem
+from beamsolver.nonlinear.problem import Problem
 from beamsolver.contact.pairs import LINE, ORTHOGONAL, POINT
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))

@@ -219,7 +219,7 @@ def test_gauss_owners_report_a_choice_by_the_order_of_the_rows():
 def _line_scene(n_el=40):
     """Two nearly parallel wires in line contact (``benchmarks/contact_throughput.py``' scene)."""
     import beamsolver as bs
-    from beamsolver.problem import Problem
+    from beamsolver.nonlinear.problem import Problem
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
     from contact_throughput import line_model
     m = line_model(bs, n_el)

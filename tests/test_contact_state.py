@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 
 import beamsolver as bs
-from beamsolver.problem import Problem
-from beamsolver import restart
+from beamsolver.nonlinear.problem import Problem
+from beamsolver.stepping import restart
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 

@@ -12,7 +12,7 @@ import pytest
 
 import beamsolver as bs
 from beamsolver import se3
-from beamsolver.problem import Problem
+from beamsolver.nonlinear.problem import Problem
 from beamsolver.contact.pairs import LINE, ORTHOGONAL, POINT
 
 R = 0.05

@@ -16,7 +16,7 @@ import pytest
 
 import beamsolver as bs
 from beamsolver.contact import kernel_jit, pairs
-from beamsolver.problem import Problem
+from beamsolver.nonlinear.problem import Problem
 
 SHIFTS = {"origin": (0.0, 0.0, 0.0), "far": (1e3, -5e2, 3e2), "high": (0.0, 0.0, 1e3)}
 

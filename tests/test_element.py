@@ -6,7 +6,8 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 import beamsolver as bs
-from beamsolver import element, geometry, se3
+from beamsolver import geometry, se3
+from beamsolver.elements import element
 
 from conftest import random_pose, random_rotation_vector, rel_err, spd_matrix
 

@@ -233,13 +233,13 @@ def test_rotation_limit_of_the_type_stops_the_solver():
 def test_a_step_through_pi_of_the_mid_pair_is_refused():
     """The continuity check reads every logarithm pair of the type: a 3-node element whose
     mid node turns from 0.7 pi to 1.3 pi within one step is refused, naming the element."""
-    from beamsolver import solver
+    from beamsolver import driver as solver
     from beamsolver.failures import RotationLimit
     m = bs.Model()
     bs_ = [m.add_beam(geometry.straight((0, y, 0), (1, y, 0), 2), SEC, element="se3-3") for y in (0.0, 1.0)]
     for b in bs_:
         m.clamp(b.first)
-    from beamsolver.problem import Problem
+    from beamsolver.nonlinear.problem import Problem
     newton = solver.Newton(Problem.from_model(m), solver.Convergence(), True, None)
 
     def poses(angle):

@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
-from beamsolver import element, elements, geometry, se3
-from beamsolver.assembly import System
+from beamsolver import elements, geometry, se3
+from beamsolver.elements import element
+from beamsolver.assembly.system import System
 from beamsolver.errors import InputError
 
 from conftest import spd_matrix

@@ -3,7 +3,7 @@ scipy's ``K_el + csc_matrix((v, (r, c)))`` bit for bit (values, stored entries, 
 import numpy as np
 import scipy.sparse as sp
 
-from beamsolver.extra_pattern import ExtraPattern
+from beamsolver.assembly.extra_pattern import ExtraPattern
 
 
 def _scipy(el, rows, cols, vals, red):
@@ -91,8 +91,8 @@ def _twisted_pair_tangent():
     from pathlib import Path
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
     import twisted_pair_extreme as twisted_pair
-    from beamsolver import assembly_jit
-    from beamsolver.problem import Problem
+    from beamsolver.assembly import compiled as assembly_jit
+    from beamsolver.nonlinear.problem import Problem
 
     model, _, _ = twisted_pair.build(n_elements=8, turns=0.5)
     problem = Problem.from_model(model)
@@ -133,8 +133,8 @@ def test_solve_bit_identical_to_the_scipy_assembly(monkeypatch):
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
     import twisted_pair_extreme as twisted_pair
     import beamsolver as bs
-    from beamsolver import assembly_jit
-    from beamsolver.assembly import System
+    from beamsolver.assembly import compiled as assembly_jit
+    from beamsolver.assembly.system import System
 
     def scipy_matrix(self, kvals, extra=None):
         data = np.empty(self.nnz + 1)
@@ -210,7 +210,7 @@ def test_block_pattern_is_scipys_matrix_bit_for_bit():
     """``BlockPattern`` (built from the block dofs alone) gives scipy's ``K_el + csc_matrix`` of the
     blocks' COO entries, on long columns (> 16 entries: std::sort's partitions, not an insertion
     sort), clamped and partly fixed nodes, repeated nodes in a block, and for new values."""
-    from beamsolver.extra_pattern import BlockPattern, whole_nodes
+    from beamsolver.assembly.extra_pattern import BlockPattern, whole_nodes
     rng = np.random.default_rng(11)
     for trial in range(5):
         n_nodes = 60 + 40 * trial
@@ -231,7 +231,7 @@ def test_block_pattern_is_scipys_matrix_bit_for_bit():
 
 
 def test_whole_nodes_recognised():
-    from beamsolver.extra_pattern import whole_nodes
+    from beamsolver.assembly.extra_pattern import whole_nodes
     d = ((6 * np.array([[3, 1], [0, 2]]))[:, :, None] + np.arange(6)).reshape(2, 12)
     assert whole_nodes(d)
     bad = d.copy()
@@ -242,7 +242,7 @@ def test_whole_nodes_recognised():
 def _system_matrices(s, nodes, K):
     """``System.matrix`` of element values plus blocks ``K`` over ``nodes`` ``(m, 4)`` handed over by
     ``assemble_blocks`` (as contact's), and scipy's matrix of the same COO data."""
-    from beamsolver import assembly_jit
+    from beamsolver.assembly import compiled as assembly_jit
     from beamsolver.blocks import Blocks
     kvals = np.random.default_rng(len(nodes)).standard_normal(s.group_kslices[-1] + 36 * len(s.block_nodes))
     _, extra, _, _ = s.assemble_blocks(s.poses0, Blocks(nodes, np.zeros((len(nodes), 24)), K))
@@ -260,8 +260,8 @@ def test_system_matrix_as_the_active_set_changes():
     from pathlib import Path
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
     import twisted_pair_extreme as twisted_pair
-    from beamsolver.assembly import System
-    from beamsolver.extra_pattern import BlockPattern
+    from beamsolver.assembly.system import System
+    from beamsolver.assembly.extra_pattern import BlockPattern
 
     model, _, _ = twisted_pair.build(n_elements=12, turns=0.5)
     s = System(model)
@@ -285,7 +285,7 @@ def test_system_matrix_as_the_active_set_changes():
 def test_block_pattern_with_a_tail_of_entries():
     """Blocks followed by other COO entries (``assemble_blocks``' terms of global-type nodes, any
     entries): the columns they reach are sorted on their own, with scipy's result bit for bit."""
-    from beamsolver.extra_pattern import BlockPattern
+    from beamsolver.assembly.extra_pattern import BlockPattern
     rng = np.random.default_rng(17)
     for trial in range(4):
         n_nodes = 80 + 30 * trial
@@ -308,7 +308,7 @@ def test_block_pattern_with_a_tail_of_entries():
 def test_contact_scene_with_global_nodes_takes_the_block_path():
     """The twisted pair's contact reaches global-type nodes (partly fixed ends): its tangent is
     built by ``BlockPattern`` with the global-node terms as a tail, equal to scipy's."""
-    from beamsolver.extra_pattern import BlockPattern
+    from beamsolver.assembly.extra_pattern import BlockPattern
 
     problem, s, ev, el = _twisted_pair_tangent()
     assert _identical(problem.tangent(ev), _scipy(el, *ev.extra, s.red))
@@ -322,7 +322,7 @@ def test_block_index_arrays_reused_only_when_free():
     from pathlib import Path
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
     import twisted_pair_extreme as twisted_pair
-    from beamsolver.assembly import REUSE_BUFFERS, System
+    from beamsolver.assembly.system import REUSE_BUFFERS, System
     from beamsolver.blocks import Blocks
 
     model, _, _ = twisted_pair.build(n_elements=12, turns=0.5)

@@ -17,7 +17,8 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
-from beamsolver import InputError, cli
+from beamsolver import InputError
+from beamsolver.app import cli
 from beamsolver.io import archive
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -256,7 +257,7 @@ def test_cli_reports_a_damaged_archive_in_one_line(command, saved, tmp_path, cap
 
 
 def test_cli_info_of_a_non_archive_says_so():
-    out = subprocess.run([sys.executable, "-m", "beamsolver.cli", "info", "README.md"], cwd=ROOT,
+    out = subprocess.run([sys.executable, "-m", "beamsolver.app.cli", "info", "README.md"], cwd=ROOT,
                          capture_output=True, text=True, timeout=120, env=dict(os.environ, PYTHONPATH=str(ROOT)))
     assert out.returncode == 1
     assert "README.md'): not a beamsolver result" in out.stderr

@@ -3,8 +3,9 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
-from beamsolver import element, geometry
-from beamsolver.assembly import System
+from beamsolver import geometry
+from beamsolver.elements import element
+from beamsolver.assembly.system import System
 
 
 def _check_frames(P, tol=1e-14):

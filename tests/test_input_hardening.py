@@ -50,7 +50,7 @@ def test_helix_refuses_one_element_per_turn():
 
 def test_helix_element_rotation_is_two_pi_per_turn():
     """The limit the generator applies is the element's true rotation (Darboux vector)."""
-    from beamsolver.element import reference_strain
+    from beamsolver.elements.element import reference_strain
     P = geometry.helix(radius=0.3, pitch=0.7, length=0.7, n_elements=4)
     L, eps0 = reference_strain(P[:-1], P[1:])
     np.testing.assert_allclose(np.linalg.norm(eps0[:, 3:] * L[:, None], axis=1), 2 * np.pi / 4, rtol=1e-12)

@@ -65,7 +65,7 @@ def test_real_paraview_draws_tubes_and_contact_points(folder, tmp_path):
     ParaView has no EGL and aborted with it."""
     png = tmp_path / "shot.png"         # kept by pytest's tmp_path for a look
     env = dict(os.environ, VTK_DEFAULT_OPENGL_WINDOW="vtkEGLRenderWindow")
-    out = subprocess.run([sys.executable, "-m", "beamsolver.cli", "paraview", str(folder), "--screenshot", str(png),
+    out = subprocess.run([sys.executable, "-m", "beamsolver.app.cli", "paraview", str(folder), "--screenshot", str(png),
                           "--color-by", "M2"], capture_output=True, text=True, timeout=600, env=env)
     assert out.returncode == 0, out.stderr
     assert "view.py" in out.stdout and png.is_file()

@@ -12,7 +12,7 @@ from numba.core import event
 from numba.core.registry import CPUDispatcher
 
 import beamsolver as bs
-from beamsolver import jit_warmup
+from beamsolver.nonlinear import jit_warmup
 from beamsolver.contact import kernel_jit
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -97,10 +97,10 @@ def test_nothing_is_announced_without_compilation():
 
 @pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
 def test_kernel_process_runs():
-    """The second process (``python -m beamsolver.jit_warmup``) compiles or loads the kernel and exits 0."""
+    """The second process (``python -m beamsolver.nonlinear.jit_warmup``) compiles or loads the kernel and exits 0."""
     jit_warmup._kernel_call()          # this process's cache: the other process loads it
     env = dict(os.environ, PYTHONPATH=str(ROOT))
-    out = subprocess.run([sys.executable, "-m", "beamsolver.jit_warmup"], env=env, capture_output=True, text=True)
+    out = subprocess.run([sys.executable, "-m", "beamsolver.nonlinear.jit_warmup"], env=env, capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
 
 

@@ -16,8 +16,10 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
-from beamsolver import assembly_jit, element, geometry, se3
-from beamsolver.assembly import System
+from beamsolver import geometry, se3
+from beamsolver.assembly import compiled as assembly_jit
+from beamsolver.elements import element
+from beamsolver.assembly.system import System
 
 from conftest import random_pose, random_rotation_vector, spd_matrix
 
@@ -153,7 +155,10 @@ def test_second_process_loads_the_cache():
     """Compiled once per machine: a later process loads every kernel from numba's cache."""
     code = """
 import json, numpy as np
-from beamsolver import assembly_jit, element, element_jit, geometry
+from beamsolver import geometry
+from beamsolver.assembly import compiled as assembly_jit
+from beamsolver.elements import element
+from beamsolver.elements import element_jit
 P = geometry.helix(0.4, 1.5, 3.0, 4 * 2)[:5]
 L, e0 = element.reference_strain(P[:-1], P[1:])
 C = np.broadcast_to(np.diag([1e3, 4e2, 5e2, 20.0, 30.0, 40.0]), (4, 6, 6))

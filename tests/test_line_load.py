@@ -1,4 +1,4 @@
-"""Line loads (Model.add_line_load, beamsolver.line_load): consistent nodal loads, their stiffness
+"""Line loads (Model.add_line_load, beamsolver.elements.line_load): consistent nodal loads, their stiffness
 on the group, and cantilevers under uniform load against closed forms and an elastica shooting."""
 import numpy as np
 import pytest
@@ -6,7 +6,8 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 import beamsolver as bs
-from beamsolver import line_load, se3
+from beamsolver import se3
+from beamsolver.elements import line_load
 
 EI = 2.0
 STIFF = 1e7          # EA, GA: a nearly inextensible, unshearable beam (the elastica's assumptions)
@@ -113,7 +114,7 @@ def test_large_deflection_matches_the_elastica_with_distributed_load():
 def test_follower_line_load_is_non_conservative_and_differs_from_dead():
     dead = bs.solve(_cantilever(16, 6.0 * EI)[0], steps=6)
     model, beam = _cantilever(16, 6.0 * EI, follower=True)
-    from beamsolver.problem import Problem
+    from beamsolver.nonlinear.problem import Problem
     assert not Problem.from_model(model).conservative
     fol = bs.solve(model, steps=6)
     assert fol.converged

@@ -1,10 +1,10 @@
-"""Linear-solver back-ends (``beamsolver.linsolve``): same solution as a dense solve, errors."""
+"""Linear-solver back-ends (``beamsolver.nonlinear.linsolve``): same solution as a dense solve, errors."""
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
 import beamsolver as bs
-from beamsolver import linsolve
+from beamsolver.nonlinear import linsolve
 from beamsolver.errors import InputError
 
 HAVE_PARDISO = "pardiso" in linsolve.available()
@@ -194,7 +194,7 @@ def test_compiled_rcm_is_scipys():
     mats.append(E)
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
     import twisted_pair_extreme as twisted_pair
-    from beamsolver.problem import Problem
+    from beamsolver.nonlinear.problem import Problem
     model, _, _ = twisted_pair.build(n_elements=8, turns=0.5)
     problem = Problem.from_model(model)
     problem.begin_step(problem.system.poses0, 0.0)

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
-from beamsolver import material_range as mr
+from beamsolver.model import material_range as mr
 
 R, E, NU, L = 1e-3, 200e9, 0.3, 0.1
 G = E / (2 * (1 + NU))

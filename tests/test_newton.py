@@ -15,7 +15,7 @@ import pytest
 
 import beamsolver as bs
 from beamsolver import geometry
-from beamsolver.assembly import System
+from beamsolver.assembly.system import System
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 import bend45  # noqa: E402

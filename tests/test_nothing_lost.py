@@ -116,7 +116,7 @@ def test_checkpoint_none_still_saves_at_the_end(tmp_path):
 def _start(folder, checkpoint, steps=STEPS, restart=False):
     script = folder.parent / f"scene_{folder.name}.py"
     script.write_text(textwrap.dedent(SCENE.format(sleep=0.03, steps=steps, checkpoint=checkpoint)))
-    cmd = [sys.executable, "-m", "beamsolver.cli", "run", str(script), "--output", str(folder), "--quiet"]
+    cmd = [sys.executable, "-m", "beamsolver.app.cli", "run", str(script), "--output", str(folder), "--quiet"]
     if restart:
         cmd += ["--restart", str(folder)]
     env = dict(os.environ, PYTHONPATH=str(ROOT))

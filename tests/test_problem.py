@@ -15,10 +15,11 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
-from beamsolver import element, geometry
-from beamsolver.assembly import System
+from beamsolver import geometry
+from beamsolver.elements import element
+from beamsolver.assembly.system import System
 from beamsolver.blocks import Blocks, Contribution
-from beamsolver.problem import Problem
+from beamsolver.nonlinear.problem import Problem
 from beamsolver.se3 import skew
 
 from conftest import rel_err
@@ -163,8 +164,8 @@ def test_life_cycle_outer_iteration_commit_and_globalisation():
     problem, spring = _problem(k=50.0)
     assert problem.smooth and problem.conservative
     assert Problem(problem.system, []).get_state() == {} and problem.timing_names == ("contact", "spring")
-    from beamsolver.solver import Convergence, Newton
-    from beamsolver.stepping import Run
+    from beamsolver.driver import Convergence, Newton
+    from beamsolver.stepping.steps import Run
     newton = Newton(problem, Convergence(), True, None)
     grid = np.linspace(0.0, 1.0, 3)
     run = Run(problem, newton, None, grid, 1e-3, False, dict(advice=lambda *a: ""))
@@ -181,9 +182,10 @@ def test_life_cycle_outer_iteration_commit_and_globalisation():
 
 def test_outer_iterations_are_bounded():
     """A contribution that always asks to re-solve the step: a typed failure after MAX_OUTER."""
-    from beamsolver import failures, stepping
+    from beamsolver import failures
+    from beamsolver.stepping import steps as stepping
     from beamsolver.errors import ConvergenceError
-    from beamsolver.solver import Convergence, Newton
+    from beamsolver.driver import Convergence, Newton
     problem, spring = _problem(k=50.0)
     spring.repeat_step = lambda H: True
     run = stepping.Run(problem, Newton(problem, Convergence(), True, None), None, np.linspace(0.0, 1.0, 2),
@@ -199,7 +201,7 @@ def _names(path):
     return {t.string for t in toks if t.type == tokenize.NAME}
 
 
-@pytest.mark.parametrize("module", ["solver.py", "stepping.py"])
+@pytest.mark.parametrize("module", ["driver.py", "stepping/steps.py"])
 def test_solver_knows_nothing_of_contact(module):
     """No import of, and no name containing, contact (``Solution.contact_state`` is the Solution's field,
     the history of any contribution)."""
@@ -272,7 +274,7 @@ def test_problem_owns_the_contact_contribution():
     with pytest.raises(AttributeError):
         problem.contact = None
     assert Problem(problem.system).contributions == []
-    assert "contact" not in _names(PACKAGE / "assembly.py") - {"contacts", "in_contact"}
+    assert "contact" not in _names(PACKAGE / "assembly" / "system.py") - {"contacts", "in_contact"}
 
 
 class _Counter(Contribution):

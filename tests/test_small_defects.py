@@ -111,7 +111,7 @@ def test_render_creates_the_output_folder(tmp_path):
     m.clamp(b.first)
     bs.solve(m, steps=1).save(tmp_path / "r.npz")
     target = tmp_path / "missing" / "deeper" / "x.png"
-    out = subprocess.run([sys.executable, "-m", "beamsolver.cli", "render", str(tmp_path / "r.npz"), "-o",
+    out = subprocess.run([sys.executable, "-m", "beamsolver.app.cli", "render", str(tmp_path / "r.npz"), "-o",
                           str(target), "--size", "64", "48"], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
     assert target.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

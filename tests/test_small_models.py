@@ -15,12 +15,13 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 import beamsolver as bs
-from beamsolver import assembly, geometry
-from beamsolver.assembly import System
+from beamsolver import geometry
+from beamsolver.assembly import system as assembly
+from beamsolver.assembly.system import System
 from beamsolver.errors import InputError
 from beamsolver.failures import RotationLimit
-from beamsolver.problem import Problem
-from beamsolver.solver import Convergence, Newton
+from beamsolver.nonlinear.problem import Problem
+from beamsolver.driver import Convergence, Newton
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 import bend45  # noqa: E402
@@ -180,7 +181,7 @@ def test_bend45_single_step_keeps_six_newton_iterations():
 def test_scaled_dead_loads_kernel_equals_numpy(bad):
     """``assembly_jit.scaled_dead_loads`` gives ``dead_loads`` of the numpy-scaled loads and
     numpy's ``max(|F lf|)``, ``max(|M lf|)`` (a NaN anywhere gives NaN, as numpy's max)."""
-    from beamsolver import assembly_jit
+    from beamsolver.assembly import compiled as assembly_jit
     rng = np.random.default_rng(3)
     k = 4
     H = np.stack([np.eye(4)] * 6)
@@ -229,7 +230,7 @@ def test_continuity_shortcut_bound_holds():
     (angles of the relative rotations before and after the step): then the change ``angle(R0^T R1)
     <= a0 + a1`` can never reach ``(pi - a0) + (pi - a1) - 1e-9``, checked on random rotations, and
     a turn through pi within a step is still refused."""
-    from beamsolver.solver import CONTINUITY_MARGIN
+    from beamsolver.driver import CONTINUITY_MARGIN
 
     def angle(R):
         return np.arccos(np.clip(0.5 * (np.trace(R, axis1=-2, axis2=-1) - 1.0), -1.0, 1.0))

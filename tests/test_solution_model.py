@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
-from beamsolver.results import Solution, Step, describe_model
+from beamsolver.results.solution import Solution, Step, describe_model
 
 ROOT = Path(__file__).resolve().parents[1]
 L, EI = 10.0, 1e2
@@ -80,7 +80,7 @@ def test_append_names_the_bad_field_and_value(solved, field, bad, match):
 def test_an_append_interrupted_halfway_records_nothing(solved, monkeypatch):
     """Ctrl-C inside ``append`` (here: while writing the third array): the step is not recorded,
     every field keeps the same number of steps, and the next append goes on from there."""
-    from beamsolver import results
+    from beamsolver.results import solution as results
     _, _, sol = solved
     new = empty_like(sol)
     new.append(*step_args(sol, 0))
@@ -353,7 +353,7 @@ def test_consumers_use_only_public_fields(solved, tmp_path):
         img = viz.render(pub, step=[0, -1], window_size=(64, 48))
         assert img.shape == (48, 64, 3) and np.array_equal(img, viz.render(sol, step=[0, -1], window_size=(64, 48)))
     pub.save(tmp_path / "pub")
-    out = subprocess.run([sys.executable, "-m", "beamsolver.cli", "info", str(tmp_path / "pub.npz")],
+    out = subprocess.run([sys.executable, "-m", "beamsolver.app.cli", "info", str(tmp_path / "pub.npz")],
                          capture_output=True, text=True, cwd=tmp_path, timeout=300)
     assert out.returncode == 0 and "2 steps to t = 1," in out.stdout, out.stderr
 
@@ -373,7 +373,7 @@ def test_no_module_outside_results_touches_private_attributes():
     hits = []
     for folder in ("beamsolver", "benchmarks", "examples"):
         for path in sorted((ROOT / folder).rglob("*.py")):
-            if path == ROOT / "beamsolver" / "results.py":
+            if path == ROOT / "beamsolver" / "results" / "solution.py":
                 continue
             for i, line in enumerate(path.read_text().splitlines(), 1):
                 if pattern.search(line):

@@ -11,7 +11,7 @@ import pytest
 
 import beamsolver as bs
 from beamsolver import failures
-from beamsolver.solver import CONTINUE, CONVERGED, DIVERGED, MAX_ITER
+from beamsolver.driver import CONTINUE, CONVERGED, DIVERGED, MAX_ITER
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 from limit_points import argyris_frame  # noqa: E402
@@ -242,8 +242,8 @@ def test_damped_newton_falls_back_to_newton_past_the_argyris_buckling_load():
 def test_failure_advice_reads_the_tangent():
     """A failure after an unstable equilibrium says the tangent is indefinite (a limit point or
     bifurcation), not "lower min_step_ratio"; after a stable one it says it is positive definite."""
-    from beamsolver import diagnosis
-    from beamsolver.problem import Problem
+    from beamsolver.stepping import diagnosis
+    from beamsolver.nonlinear.problem import Problem
     for factor, expect in ((2.0, "already indefinite"), (0.5, "positive definite")):
         model = _column(factor)
         sol = bs.solve(model, steps=1, verbose=False)
@@ -265,9 +265,9 @@ def _two_stiffnesses(ratio, unit=1.0):
 
 
 def test_singular_tangent_advice_tells_ill_conditioning_from_a_free_mode():
-    from beamsolver import diagnosis
-    from beamsolver.problem import Problem
-    from beamsolver.assembly import System
+    from beamsolver.stepping import diagnosis
+    from beamsolver.nonlinear.problem import Problem
+    from beamsolver.assembly.system import System
     for ratio, expect in ((1.0, "rigid-body mode"), (1e12, "ill-conditioned")):
         problem = Problem.from_model(_two_stiffnesses(ratio))
         H0 = problem.system.poses0

@@ -104,9 +104,9 @@ def test_near_pi_without_strain_space_update_is_refused_too():
 def test_a_step_through_pi_is_refused():
     """An element whose relative rotation goes from 0.7 pi to 1.3 pi (which its log sees as
     0.7 pi the other way round) within one step: refused, not accepted as a short turn."""
-    from beamsolver import solver
+    from beamsolver import driver as solver
     from beamsolver.failures import RotationLimit
-    from beamsolver.problem import Problem
+    from beamsolver.nonlinear.problem import Problem
     model = S.bs.Model()
     b = model.add_beam(S.bs.geometry.straight((0, 0, 0), (1, 0, 0), 1), S.bs.Section.circular(radius=0.01, E=1e9))
     model.clamp(b.first)

@@ -10,8 +10,8 @@ from scipy.special import ellipk
 
 import beamsolver as bs
 from beamsolver import se3, stabilize
-from beamsolver.assembly import System
-from beamsolver.problem import Problem
+from beamsolver.assembly.system import System
+from beamsolver.nonlinear.problem import Problem
 
 
 def _cantilever(n=6):

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
-from beamsolver import study
-from beamsolver.sweep_engine import run_point
+from beamsolver.app import study
+from beamsolver.app.sweep_engine import run_point
 
 P = 10.0      # N
 
@@ -48,7 +48,7 @@ def test_damping_carrying_the_load_is_not_a_converged_equilibrium(tmp_path):
     saved = bs.load(tmp_path / "out")
     assert saved.status == "off-equilibrium" and saved.message == sol.message
     assert saved.stats[-1]["stabilization"]["equilibrium"] is False
-    out = subprocess.run([sys.executable, "-m", "beamsolver.cli", "info", str(tmp_path / "out")],
+    out = subprocess.run([sys.executable, "-m", "beamsolver.app.cli", "info", str(tmp_path / "out")],
                          capture_output=True, text=True, timeout=120)
     assert out.returncode == 0 and "OFF-EQUILIBRIUM" in out.stdout and "; converged" not in out.stdout
     lines = out.stdout.splitlines()

@@ -8,8 +8,8 @@ import pytest
 import scipy.sparse as sp
 
 import beamsolver as bs
-from beamsolver import stable_branch
-from beamsolver.linsolve import Solver, permutation_sign
+from beamsolver.stepping import stable_branch
+from beamsolver.nonlinear.linsolve import Solver, permutation_sign
 
 
 def _sign_by_inversions(p):

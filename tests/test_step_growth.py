@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
-from beamsolver.stepping import EASY_ITERATIONS, EASY_RUN, WAIT_MAX, after_failure, growth, next_step
+from beamsolver.stepping.steps import EASY_ITERATIONS, EASY_RUN, WAIT_MAX, after_failure, growth, next_step
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 from argyris_frame import frame  # noqa: E402
@@ -100,7 +100,7 @@ def test_a_restart_keeps_the_failed_size_memory(window):
 
 
 def test_easy_limit_is_the_users_steps_iterations_when_more():
-    from beamsolver.stepping import easy_limit
+    from beamsolver.stepping.steps import easy_limit
     assert easy_limit(None) == EASY_ITERATIONS
     assert easy_limit(3) == EASY_ITERATIONS
     assert easy_limit(21) == 21
@@ -120,7 +120,7 @@ def test_contact_steps_regrow_after_a_cut_back():
 
 
 def test_steady_is_about_the_previous_steps_iterations_within_the_budget():
-    from beamsolver.stepping import STEADY_GROWTH, STEADY_SHARE, steady
+    from beamsolver.stepping.steps import STEADY_GROWTH, STEADY_SHARE, steady
     assert not steady(3, None, 30)                                  # no step before: not steady
     assert steady(11, 10, 30) and steady(int(STEADY_GROWTH * 8 + 1), 8, 30)
     assert not steady(12, 8, 30)                                    # rising: 8 -> 12

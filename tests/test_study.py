@@ -7,8 +7,8 @@ import sys
 import pytest
 
 import beamsolver as bs
-from beamsolver import study
-from beamsolver.sweep_cli import SceneScript, parse_param
+from beamsolver.app import study
+from beamsolver.app.sweep_cli import SceneScript, parse_param
 
 
 def test_grid_product_order_and_ids():
@@ -107,8 +107,8 @@ def test_cli_params_and_scene_script_pickle(tmp_path):
 
 
 def test_core_import_path_is_free_of_dask():
-    code = ("import sys, beamsolver as bs, beamsolver.cli, beamsolver.study, beamsolver.sweep_cli, "
-            "beamsolver.sweep_engine; assert callable(bs.sweep); "
+    code = ("import sys, beamsolver as bs, beamsolver.app.cli, beamsolver.app.study, beamsolver.app.sweep_cli, "
+            "beamsolver.app.sweep_engine; assert callable(bs.sweep); "
             "print(sorted({m.split('.')[0] for m in sys.modules} & {'dask', 'distributed', 'cloudpickle'}))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
@@ -116,7 +116,7 @@ def test_core_import_path_is_free_of_dask():
 
 
 def test_progress_bar_over_points(monkeypatch, capsys):
-    from beamsolver.sweep_engine import _Progress
+    from beamsolver.app.sweep_engine import _Progress
 
     class Client:
         def nthreads(self):
@@ -140,11 +140,11 @@ def test_progress_bar_over_points(monkeypatch, capsys):
 @pytest.mark.slow
 def test_cli_sweep_refuses_a_script_without_build(tmp_path):
     (tmp_path / "s.py").write_text("model = None\n")
-    out = subprocess.run([sys.executable, "-m", "beamsolver.cli", "sweep", "s.py", "--param", "a=1,2"],
+    out = subprocess.run([sys.executable, "-m", "beamsolver.app.cli", "sweep", "s.py", "--param", "a=1,2"],
                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert out.returncode == 1 and "defines no function build(**params)" in out.stderr
     (tmp_path / "s.py").write_text("def build(a):\n    return None\n")
-    out = subprocess.run([sys.executable, "-m", "beamsolver.cli", "sweep", "s.py", "--param", "a"],
+    out = subprocess.run([sys.executable, "-m", "beamsolver.app.cli", "sweep", "s.py", "--param", "a"],
                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert out.returncode == 1 and "NAME=VALUE" in out.stderr
 
@@ -173,7 +173,7 @@ def tip_summary(sol, model, beam):
 def test_run_point_records_every_kind_of_failure(tmp_path):
     """``run_point`` (what a worker runs) without Dask: pickled scene and summary in, row and record out."""
     import pickle
-    from beamsolver.sweep_engine import run_point
+    from beamsolver.app.sweep_engine import run_point
     code = pickle.dumps((small_scene, tip_summary))
     row = run_point(code, {"load": 1.0}, "p", str(tmp_path), {"steps": 2})
     model, beam = small_scene()

@@ -7,8 +7,8 @@ import stat
 import pytest
 
 import beamsolver as bs
-from beamsolver import study
-from beamsolver.sweep_engine import run_point
+from beamsolver.app import study
+from beamsolver.app.sweep_engine import run_point
 
 
 def scene(load=1.0, at_start=False):

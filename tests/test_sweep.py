@@ -13,11 +13,11 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
-from beamsolver import study
+from beamsolver.app import study
 
 pytest.importorskip("distributed")
 
-from beamsolver.sweep_engine import local_client  # noqa: E402
+from beamsolver.app.sweep_engine import local_client  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 OPTIONS = dict(steps=4)
@@ -212,7 +212,7 @@ def test_cli_sweep_on_a_scheduler_and_worker_started_here(tmp_path):
         procs.append(_start(["worker", address, "--host", "127.0.0.1", "--nthreads", "1", "--nworkers", "1",
                              "--no-dashboard"], env, tmp_path))
         (tmp_path / "scene.py").write_text(SCENE)
-        run = [sys.executable, "-m", "beamsolver.cli"]
+        run = [sys.executable, "-m", "beamsolver.app.cli"]
         out = subprocess.run(run + ["sweep", "scene.py", "--param", "turns=0.25,1.0", "--param", "n_elements=2,8",
                                     "-o", "study", "--scheduler", address, "--paraview"],
                              cwd=tmp_path, env=env, capture_output=True, text=True, timeout=180)

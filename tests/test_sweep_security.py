@@ -9,7 +9,7 @@ import pytest
 pytest.importorskip("distributed")
 pytest.importorskip("cryptography")
 
-from beamsolver.sweep_engine import local_client  # noqa: E402
+from beamsolver.app.sweep_engine import local_client  # noqa: E402
 
 INTRUDER = """
 import sys

@@ -13,7 +13,7 @@ import pytest
 import beamsolver as bs
 from beamsolver import geometry
 from beamsolver.blocks import Blocks
-from beamsolver.problem import Problem
+from beamsolver.nonlinear.problem import Problem
 from beamsolver.se3 import skew
 
 from conftest import rel_err

@@ -50,13 +50,13 @@ def check_folder(folder):
 @pytest.mark.slow
 @pytest.mark.parametrize("example", sorted(p.name for p in EXAMPLES.glob("*.py")))
 def test_every_example_runs_under_beamsolver_run(example, tmp_path):
-    out = run("-m", "beamsolver.cli", "run", EXAMPLES / example, "-o", "out", *REDUCED, cwd=tmp_path)
+    out = run("-m", "beamsolver.app.cli", "run", EXAMPLES / example, "-o", "out", *REDUCED, cwd=tmp_path)
     assert out.returncode == 0, out.stderr
     names = check_folder(tmp_path / "out")
     written = out.stdout.splitlines()[-1]
     assert written.startswith("written:") and "beams.pvd" in written and "solution.npz" in written
     assert ("contact.pvd" in written) == ("contact.pvd" in names)
-    info = run("-m", "beamsolver.cli", "info", "out", cwd=tmp_path)
+    info = run("-m", "beamsolver.app.cli", "info", "out", cwd=tmp_path)
     assert info.returncode == 0 and "; converged" in info.stdout, info.stderr
 
 
@@ -70,8 +70,8 @@ def test_main_job_script_export_and_render(tmp_path):
     names = check_folder(tmp_path / "out")
     assert {"beams.pvd", "contact.pvd", "solution.npz", "twisted_pair.png", "view.py"} <= names
     assert "paraview --script=out/view.py" in out.stdout
-    exp = run("-m", "beamsolver.cli", "export", "out", "again", cwd=tmp_path)
+    exp = run("-m", "beamsolver.app.cli", "export", "out", "again", cwd=tmp_path)
     assert exp.returncode == 0, exp.stderr
     assert {n for n in names if n.endswith((".vtu", ".pvd"))} == {n for n in check_folder(tmp_path / "again")}
-    pic = run("-m", "beamsolver.cli", "render", "out", "-o", "pic.png", "--size", "160", "120", cwd=tmp_path)
+    pic = run("-m", "beamsolver.app.cli", "render", "out", "-o", "pic.png", "--size", "160", "120", cwd=tmp_path)
     assert pic.returncode == 0 and (tmp_path / "pic.png").read_bytes()[:4] == b"\x89PNG", pic.stderr

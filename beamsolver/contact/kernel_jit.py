@@ -55,10 +55,9 @@ from numba.extending import intrinsic
 
 from .._jit import jit, jit_inline
 from ..errors import InputError
-from ..element_jit import _dq_du, _dq_dw
-from ..se3_jit import madd, mscale
-from ..se3_jit import (A_, B_, C_, CP_, D_, Q2P_, Q2_, Q3P_, Q3_, add, add_outer, coefficient, cross, dot,
-                       log_relative, mat, mm, mv, q_matrix, scale, ti_matrix, transpose)
+from ..elements.element_jit import _dq_du, _dq_dw
+from ..lie.se3_jit import madd, mscale
+from ..lie.se3_jit import A_, B_, C_, CP_, D_, Q2P_, Q2_, Q3P_, Q3_, add, add_outer, coefficient, cross, dot, log_relative, mat, mm, mv, q_matrix, scale, ti_matrix, transpose
 from .law import PENALTY_COULOMB
 from .pairs import LINE, ORTHOGONAL, PENALTY_T_MIN
 

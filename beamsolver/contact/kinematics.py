@@ -7,7 +7,7 @@ axes ``(n, t1, t2)``; ``H_LK = H_L^-1 H_K``; the normal gap is ``[H_LK]_{1,4}``
 """
 import numpy as np
 
-from .. import se3
+from ..lie import se3
 
 __all__ = ["relative_motion", "slip_increment", "normal_gap"]
 

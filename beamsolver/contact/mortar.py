@@ -20,8 +20,8 @@ derivatives of the point quantities come from complex steps on the group (``poin
 """
 import numpy as np
 
-from .. import se3
-from ..se3 import cross as _cross, dot as _dot
+from ..lie import se3
+from ..lie.se3 import cross as _cross, dot as _dot
 from .law import normal_force
 from .pairs import _axes, _body_wrench, _contact_frames, _log_c, _node_jacobians, _project, _section
 

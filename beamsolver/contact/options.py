@@ -11,7 +11,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-from ..validation import check_contact_options
+from ..model.validation import check_contact_options
 
 __all__ = ["ContactOptions", "SMOOTHING", "SLIP_TOLERANCE", "STICK_TOLERANCE", "LINE_ANGLE", "ADJUST"]
 

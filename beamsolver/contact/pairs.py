@@ -23,8 +23,8 @@ linearised exactly around its real part (``_log_c``).
 """
 import numpy as np
 
-from .. import se3
-from ..se3 import cross as _cross, dot as _dot
+from ..lie import se3
+from ..lie.se3 import cross as _cross, dot as _dot
 from .law import coulomb_return_mapping, normal_force
 
 LINE, ORTHOGONAL, POINT = 0, 1, 2

@@ -23,9 +23,9 @@ with the digest of every package module it imports.)  The sections are inlined
 """
 import numpy as np
 
-from .. import se3
+from ..lie import se3
 from .._jit import jit, jit_inline
-from ..se3_jit import _SERIES_TABLE, _SWITCH, A_, B_, C_, add, add_outer, cross, dot, mat, mm, mv, scale
+from ..lie.se3_jit import _SERIES_TABLE, _SWITCH, A_, B_, C_, add, add_outer, cross, dot, mat, mm, mv, scale
 from .kernel_jit import _pose_of, _project, _section, _section_inline
 from .pairs import LINE, POINT
 

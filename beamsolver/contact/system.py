@@ -43,11 +43,11 @@ import time
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .. import se3
-from ..blocks import REUSE_BUFFERS, Blocks, Contribution
+from ..lie import se3
+from ..model.blocks import REUSE_BUFFERS, Blocks, Contribution
 from ..errors import InputError
 from ..failures import ContactTunnelling, NoContactNormal
-from ..model import JOIN_TOL
+from ..model.model import JOIN_TOL
 from .law import default_penalty
 from . import kernel_jit, mortar, pairs
 from .kernel_jit import contact_kernel, kernel_and_tangent      # compiled; pairs.py's are the oracle

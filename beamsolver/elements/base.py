@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..element import ElementState, is_diagonal
+from .element import ElementState, is_diagonal
 from ..errors import InputError
 
 __all__ = ["ElementType", "Reference", "ElementState", "MAX_ELEMENT_ROTATION", "is_diagonal"]

@@ -5,7 +5,8 @@ its interpolation ``H_A exp(xi h)`` is the element's own kinematics.
 """
 import numpy as np
 
-from .. import element, se3
+from . import element
+from ..lie import se3
 from .base import ElementType, Reference, is_diagonal
 
 __all__ = ["SE3Two"]

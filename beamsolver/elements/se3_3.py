@@ -28,8 +28,8 @@ is the pair twist of largest rotation (what the solver's rotation check reads).
 """
 import numpy as np
 
-from .. import se3
-from ..element import ElementState, geometric
+from ..lie import se3
+from .element import ElementState, geometric
 from .base import ElementType, Reference, is_diagonal
 
 __all__ = ["SE3Three", "GAUSS"]

@@ -18,12 +18,12 @@ kappa_1..3`` minus the reference, so ``sigma = C strain`` and a beam at rest
 shows 0; ``Solution.strains`` is the strain itself, reference included:
 ``strain = Solution.strains - eps0``), ``equivalent_strain`` and ``utilisation``
 (``Solution.equivalent_strain``, ``Solution.utilisation``: the material range,
-``beamsolver.material_range``), ``element``.
+``beamsolver.model.material_range``), ``element``.
 """
 import numpy as np
 
 from .. import elements
-from ..material_range import element_properties, utilisation
+from ..model.material_range import element_properties, utilisation
 
 __all__ = ["LineLayout", "FORCE_NAMES", "STRAIN_NAMES"]
 

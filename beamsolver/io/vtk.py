@@ -51,7 +51,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from ..errors import InputError
-from ..files import follow_umask, previous_series
+from ..results.files import follow_umask, previous_series
 from .lines import LineLayout
 from .vtu import write_vtu
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
-from beamsolver.definiteness import negative_eigenvalues
+from beamsolver.nonlinear.definiteness import negative_eigenvalues
 from scenes import argyris_frame
 
 

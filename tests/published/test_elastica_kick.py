@@ -16,7 +16,7 @@ from scipy.optimize import brentq
 from scipy.special import ellipe, ellipk
 
 import beamsolver as bs
-from beamsolver.definiteness import negative_eigenvalues
+from beamsolver.nonlinear.definiteness import negative_eigenvalues
 from scenes import column
 
 

@@ -1,0 +1,1 @@
+"""Command line, parameter sweeps and studies, pictures."""

@@ -1,0 +1,1 @@
+"""What the user declares: Model, sections, geometry, cables, motions, loads, contributions, checks."""

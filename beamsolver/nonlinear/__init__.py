@@ -1,0 +1,1 @@
+"""The Problem interface, linear solvers, definiteness and modes of the tangent."""

@@ -1,0 +1,240 @@
+"""The first run: compile a scene's kernels before its first step, say so, and use both cores.
+
+numba compiles a function at its first call with new argument types (then writes it to the disk
+cache, ``_jit``); on a fresh install that is about a minute of CPU for a contact scene, most of it
+the contact kernel (``contact.kernel_jit``).  ``warm_up(model)``, run by ``solve`` before step 0:
+
+- does nothing when the contact kernel is in the cache (the cached runs: one index lookup) or
+  without contact, or under ``NUMBA_DISABLE_JIT``;
+- else starts a second process compiling the default law's contact kernel into the cache
+  (``python -m beamsolver.nonlinear.jit_warmup``; when a core is free, or as the environment variable
+  ``BEAMSOLVER_COMPILE_PROCESS`` (``1``/``0``) says) while this process compiles the
+  rest: one evaluation of residual and tangent of a throwaway ``Problem`` of the model at its
+  initial poses (the signatures step 0 uses), a pose update, and the two functions that are
+  otherwise compiled in the middle of a solve, on the first crossing of two wires
+  (``search._pairs_apart`` for the distance matrix's pair arrays, ``projection._closest``).
+  The throwaway evaluation waits for the second process before it calls the contact kernel,
+  which it then loads from the cache.
+
+``listen()`` (run at ``import beamsolver``): the first compilation of the process (a cache
+miss, numba's ``numba:compile`` event; loading from the cache is silent) prints one line on
+stderr, ``beamsolver: compiling the compiled kernels, first run only, ~N s`` (``estimate``), then
+a tqdm bar of the elapsed seconds against that estimate, refreshed twice a second and naming the
+function being compiled (or the second process waited for), while compilations go on.
+"""
+import logging
+import os
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+from numba.core import event
+
+__all__ = ["estimate", "kernel_cached", "listen", "warm_up", "ESTIMATE"]
+
+# CPU seconds of the first run's compilation of the main job (examples/twisted_pair.py) on the project's
+# 2-core x86-64 machines: the contact kernel, the other contact functions, elements and assembly
+# (docs/benchmarks.md, jit_compile_functions)
+ESTIMATE = dict(kernel=36.0, contact=13.0, elements=9.0)
+log = logging.getLogger("beamsolver")
+_REFRESH = 0.5          # seconds between refreshes of the bar
+_IDLE = 3.0             # seconds without compilation that close it (imports between two compilations)
+
+
+def _disabled():
+    from numba import config
+    return bool(config.DISABLE_JIT)
+
+
+class _Announcer(event.Listener):
+    """numba ``numba:compile`` listener (see the module): the line at the first compilation of a
+    function of ``package`` in the process, then a bar while compiling, closed after ``_IDLE`` s
+    without compilation."""
+
+    def __init__(self, stream=None, package="beamsolver"):
+        self.stream, self.package = stream, package
+        self.depth, self.bar, self.name, self.said = 0, None, "", False
+        self.waiting = False        # for the second process: the bar stays
+        self.t0 = self.idle = 0.0
+        self.lock = threading.Lock()
+
+    def on_start(self, event):
+        f = event.data["dispatcher"].py_func
+        if self.depth == 0 and f.__module__.startswith(self.package):     # not a user's own numba function
+            self.name = f.__qualname__.split("__")[0]
+            with self.lock:
+                if self.bar is None:
+                    self._open()
+        self.depth += 1
+
+    def on_end(self, event):
+        self.depth -= 1
+        if self.depth == 0:
+            self.idle = time.perf_counter()
+
+    def _open(self):
+        from tqdm import tqdm
+        stream = self.stream or sys.stderr
+        total = max(1, int(round(estimate())))
+        if not self.said:
+            print(f"beamsolver: compiling the compiled kernels, first run only, ~{total} s", file=stream, flush=True)
+            self.said, self.t0 = True, time.perf_counter()
+        self.bar = tqdm(total=total, file=stream, desc="compiling", leave=False, mininterval=0.0,
+                        bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.0f}/{total} s {postfix}")
+        threading.Thread(target=self._tick, args=(self.bar,), daemon=True).start()
+
+    def _tick(self, bar):
+        while True:
+            time.sleep(_REFRESH)
+            with self.lock:
+                try:
+                    if self.depth == 0 and not self.waiting and time.perf_counter() - self.idle > _IDLE:
+                        bar.close()
+                        self.bar = None
+                        return
+                    bar.n = min(time.perf_counter() - self.t0, 0.99 * bar.total)
+                    bar.set_postfix_str(self.name, refresh=False)
+                    bar.refresh()
+                except (ValueError, OSError):        # the stream was closed (a test's captured stderr)
+                    self.bar = None
+                    return
+
+
+_LISTENER = []
+
+
+def listen(stream=None):
+    """Announce the compilations of this process (idempotent; ``import beamsolver`` runs it)."""
+    if not _LISTENER and not _disabled():
+        _LISTENER.append(_Announcer(stream))
+        event.register("numba:compile", _LISTENER[0])
+
+
+def estimate():
+    """Seconds the first run of a contact scene compiles (``ESTIMATE``; the kernel in its own process
+    on two cores), or those of the element kernels when the contact kernel is cached."""
+    if kernel_cached() is True:
+        return ESTIMATE["elements"]
+    if not _two_processes():
+        return sum(ESTIMATE.values())
+    return ESTIMATE["elements"] + max(ESTIMATE["kernel"], ESTIMATE["contact"])
+
+
+# ---------------------------------------------------------------- the contact kernel
+def _kernel_args():
+    """Arguments of the default law's compiled kernel as ``kernel_jit.kernel_and_tangent`` passes them
+    (the same types), for no contact point."""
+    from ..contact import kernel_jit
+    X = np.zeros((0, 4, 4, 4))
+    kind, par, has, frames, lamp = kernel_jit._table(X, dict(kind=np.zeros(0, dtype=np.int64)))
+    out = (np.empty((0, 4, 6)), np.empty((0, 24, 24)), np.empty((0, 4)), np.empty((0, 6, 3)), np.empty((0, 2, 2)),
+           np.empty((0, 2), dtype=np.bool_), np.empty((0, 4, 4, 4)))
+    return (X, kind, par, has, *frames, lamp, True) + out
+
+
+def _kernel_call():
+    """Compile (or load) the default law's contact kernel."""
+    from ..contact import kernel_jit
+    kernel_jit.evaluate(*_kernel_args())
+
+
+def kernel_cached():
+    """Whether the default law's contact kernel is loaded or in numba's disk cache for this code
+    (numba's own index lookup: its key and the digest stamp of ``jit_cache``); ``None`` if that
+    cannot be told."""
+    try:
+        import numba
+        from ..contact import kernel_jit
+        disp = kernel_jit.evaluate
+        sig = tuple(numba.typeof(a) for a in _kernel_args())
+        if sig in disp.overloads:
+            return True
+        cache = disp._cache
+        return cache._index_key(sig, disp.targetctx.codegen()) in cache._cache_file._load_index()
+    except Exception:           # a numba without these internals: not known
+        return None
+
+
+def _two_processes():
+    """Whether the kernel compiles in a second process: ``BEAMSOLVER_COMPILE_PROCESS`` ``1`` yes, ``0`` no,
+    unset: when a core is free (two or more cores, 1-minute load average at most their number less one;
+    on a machine kept busy by other jobs a second process gains no core and only adds its imports and
+    the callees both processes compile)."""
+    flag = os.environ.get("BEAMSOLVER_COMPILE_PROCESS", "")
+    if flag in ("0", "1"):
+        return flag == "1"
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else 0.0
+    return cores >= 2 and load <= cores - 1
+
+
+def _start_kernel_process():
+    """A process compiling the contact kernel into the cache (None unless ``_two_processes()``)."""
+    if not _two_processes():
+        return None
+    root = str(Path(__file__).resolve().parent.parent)
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([root] + [p for p in [os.environ.get("PYTHONPATH")] if p]))
+    return subprocess.Popen([sys.executable, "-m", "beamsolver.nonlinear.jit_warmup"], env=env, stdin=subprocess.DEVNULL,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
+# ---------------------------------------------------------------- a scene's kernels
+def warm_up(model):
+    """Compile what solving ``model`` needs before its first step, on a first run (see the module)."""
+    if _disabled() or not model.contacts or kernel_cached() is not False:
+        return
+    proc = _start_kernel_process()
+    try:
+        _scene(model, proc)
+    except Exception as exc:          # the solve compiles what is left, as it goes
+        log.info("compilation before step 0 stopped early: %r", exc)
+
+
+def _scene(model, proc):
+    """The warm-up of ``model`` in this process; ``proc``: the process compiling the kernel (or None)."""
+    from ..contact import system as contact_system
+    from ..contact.projection import closest_points
+    from .problem import Problem
+    problem = Problem.from_model(model, check_rigid_modes=False)
+    compiled = contact_system.kernel_and_tangent
+
+    def after_the_process(*args, **kw):
+        if proc is not None and proc.poll() is None:
+            _wait(proc)
+        return compiled(*args, **kw)
+
+    H = problem.system.poses0.copy()
+    contact_system.kernel_and_tangent = after_the_process
+    try:
+        ev = problem.evaluate(H, 0.0)
+    finally:
+        contact_system.kernel_and_tangent = compiled
+    problem.tangent(ev)
+    problem.update(H, np.zeros((problem.system.n_nodes, 6)))
+    c = problem.contact
+    geo = c._twists(H)
+    for d in c.decls:
+        c._candidates(d, geo, sweep=False)
+    en = problem.system.enodes
+    closest_points(H, en[:0, 0], np.zeros((0, 6)), en[:0, 0], np.zeros((0, 6)))
+    if proc is not None and proc.poll() is None:      # no contact point at the initial poses
+        _wait(proc)
+    _kernel_call()
+
+
+def _wait(proc):
+    a = _LISTENER[0] if _LISTENER else None
+    if a is not None:
+        a.waiting, a.name = True, "the contact kernel, in a second process"
+    try:
+        proc.wait()
+    finally:
+        if a is not None:
+            a.waiting, a.idle = False, time.perf_counter()
+
+
+if __name__ == "__main__":
+    _kernel_call()

@@ -1,0 +1,506 @@
+"""Sparse direct solvers for the Newton loop: ``factorize(K, backend)`` -> object with ``.solve(b)``.
+
+Back-ends (``backend=`` here, ``linear_solver=`` in ``beamsolver.solve``):
+
+- ``"splu"``: scipy's SuperLU, ``permc_spec="MMD_AT_PLUS_A"``
+  (1.5x faster than scipy's default ordering on beam matrices); fine for
+  beam-like matrices (cables, frames, a few wires).  SuperLU has no
+  "re-factorise with the same pattern" entry point in scipy, so every Newton
+  iteration re-orders and re-factorises from scratch.
+- ``"pardiso"``: Intel MKL PARDISO through ``pypardiso`` (optional,
+  ``pip install "beamsolver[fast]"``, x86-64 only, ~0.9 GB with MKL).  A
+  ``Solver`` keeps PARDISO's handle: while the sparsity pattern stays the
+  same (no contact pair appearing or vanishing) only the numerical
+  factorisation is redone (PARDISO phase 22), the ordering and symbolic
+  analysis (phase 11) are reused.  (``pypardiso``'s own ``solve``
+  re-analyses every new matrix; it only skips work for an identical one.)
+  Measured on one thread (``benchmarks/scaling.py``): a re-factorisation is
+  1.1-2x faster than splu on a cable and 1.1-1.8x faster than splu-rcm on a
+  19-wire bundle; a first factorisation (with the analysis) is 1.5-4x
+  slower than splu on a cable.
+- ``"splu-rcm"``: SuperLU after a reverse Cuthill-McKee symmetric
+  permutation (``scipy.sparse.csgraph``), natural column order.  On long
+  bundles of wires in contact SuperLU's MMD ordering fills in badly and grows
+  like n^2.4-3 (19-wire strand, 3000 elements: 62e6 factor entries, 28 s,
+  against 4.4e6 and 0.36 s with RCM; ``benchmarks/scaling.py``); RCM stays
+  linear.  On a single beam both give the same factor.
+- ``"auto"`` (default): for matrices with contact couplings (more than
+  ``AUTO_COUPLED_NNZ`` non-zeros per column on average; a beam or a frame has
+  about 18) of at least ``AUTO_MIN_UNKNOWNS`` unknowns, ``"pardiso"`` if
+  pypardiso is installed, else ``"splu-rcm"``; otherwise ``"splu"``.
+
+A singular matrix raises ``SingularMatrixError`` (a ``RuntimeError``), from
+``factorize`` (splu: exactly zero pivot) or from ``solve`` (pardiso perturbs
+tiny pivots instead of failing, so its ``solve`` checks the solution with
+one sparse product, see ``_poor``, and re-analyses once before giving up).
+
+Threads: PARDISO uses MKL's OpenMP threads (``MKL_NUM_THREADS``), SuperLU one.
+"""
+import copy
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from .._jit import jit
+from ..errors import InputError
+
+__all__ = ["factorize", "Solver", "SingularMatrixError", "available", "permutation_sign", "BACKENDS", "DEFAULT"]
+
+BACKENDS = ("splu", "splu-rcm", "pardiso", "auto")
+DEFAULT = "auto"          # splu for beams and small scenes; splu-rcm/pardiso for large bundles
+AUTO_MIN_UNKNOWNS = 1_500      # "auto": below this size the default splu is as fast as any
+AUTO_COUPLED_NNZ = 24.0        # "auto": non-zeros per column above which contact couples the beams
+BACKWARD_ERROR = 1e-9          # pardiso, splu-rcm: |K x - b| / (|K| |x| + |b|) above this -> re-analyse / pivot fully
+RCM_PIVOT_THRESHOLD = 1e-3     # splu-rcm: keep the diagonal pivot unless below this fraction of the column's largest
+SINGULAR_RESIDUAL = 1e-6       # pardiso, with perturbed pivots: |K x - b| / |b| above this -> singular
+
+
+class SingularMatrixError(RuntimeError):
+    """The tangent is (numerically) singular."""
+
+
+_PYPARDISO = []
+
+
+def _pypardiso():
+    """The pypardiso module, or None if it is not installed (looked up once)."""
+    if not _PYPARDISO:
+        try:
+            import pypardiso
+        except ImportError:
+            pypardiso = None
+        _PYPARDISO.append(pypardiso)
+    return _PYPARDISO[0]
+
+
+def available():
+    """The back-ends usable here (``"auto"`` always is)."""
+    return [b for b in BACKENDS if b != "pardiso" or _pypardiso() is not None]
+
+
+def _check(backend):
+    backend = DEFAULT if backend is None else backend
+    if backend not in BACKENDS:
+        raise InputError(f"linear_solver: unknown back-end {backend!r}; known: {', '.join(BACKENDS)}")
+    if backend == "pardiso" and _pypardiso() is None:
+        raise InputError("linear_solver='pardiso': the pardiso back-end needs the package pypardiso, "
+                         "which is not installed (pip install \"beamsolver[fast]\" or pip install pypardiso; "
+                         "x86-64 only)")
+    return backend
+
+
+def factorize(K, backend=None):
+    """Factorise the square sparse matrix ``K``; returns an object with ``solve(b)``.
+
+    A one-shot call: for repeated factorisations of matrices with the same
+    pattern (Newton iterations) keep a ``Solver`` instead, which reuses
+    PARDISO's symbolic analysis.
+    """
+    return Solver(backend).factorize(K)
+
+
+class Solver:
+    """A linear-solver back-end kept across Newton iterations (``factorize(K)`` per iteration)."""
+
+    def __init__(self, backend=None):
+        self.requested = _check(backend)
+        self._pardiso = None            # _Pardiso handle, created on first use
+        self.stats = dict(factorizations=0, analyses=0)
+
+    def backend_for(self, K):
+        """The back-end ``factorize`` uses for ``K`` (resolves ``"auto"``)."""
+        if self.requested != "auto":
+            return self.requested
+        n = K.shape[0]
+        if n >= AUTO_MIN_UNKNOWNS and K.nnz > AUTO_COUPLED_NNZ * n:
+            return "pardiso" if _pypardiso() is not None else "splu-rcm"
+        return "splu"
+
+    def factorize(self, K):
+        if K.shape[0] != K.shape[1]:
+            raise InputError(f"linsolve: the matrix must be square, got shape {K.shape}")
+        self.stats["factorizations"] += 1
+        backend = self.backend_for(K)
+        if backend == "splu":
+            return _SpluFactor(K)
+        if backend == "splu-rcm":
+            return _SpluRcmFactor(K)
+        if self._pardiso is None:
+            self._pardiso = _Pardiso(_pypardiso())
+        return self._pardiso.factorize(K, self.stats)
+
+    def close(self):
+        """Release PARDISO's memory now (it is also released when the ``Solver`` is collected)."""
+        if self._pardiso is not None:
+            self._pardiso.release()
+            self._pardiso = None
+
+
+class _SpluFactor:
+    backend = "splu"
+
+    def __init__(self, K):
+        if not (sp.issparse(K) and K.format == "csc"):
+            K = sp.csc_matrix(K)
+        try:
+            self._lu = spla.splu(K, permc_spec="MMD_AT_PLUS_A")
+        except RuntimeError as e:          # "Factor is exactly singular"
+            raise SingularMatrixError(str(e)) from None
+
+    @property
+    def factor_nnz(self):
+        return int(self._lu.L.nnz + self._lu.U.nnz)
+
+    def solve(self, b):
+        return self._lu.solve(np.asarray(b, dtype=float))
+
+    def det_sign(self):
+        """Sign of ``det(K)`` (1, -1; 0 for a zero pivot): SuperLU factors ``Pr K Pc = L U`` with a
+        unit diagonal in ``L``, so it is the sign of ``prod diag(U)`` times the parities of the
+        two permutations."""
+        d = self._lu.U.diagonal()
+        return int(np.prod(np.sign(d))) * permutation_sign(self._lu.perm_r) * permutation_sign(self._lu.perm_c)
+
+
+def permutation_sign(p):
+    """Sign (1 or -1) of the permutation ``p`` of ``0..n-1``: ``(-1)^(n - cycles)`` (compiled cycle count)."""
+    p = np.ascontiguousarray(p, dtype=np.int64)
+    return -1 if (len(p) - _cycles(p)) % 2 else 1
+
+
+@jit
+def _cycles(p):
+    """Number of cycles of the permutation ``p``."""
+    seen = np.zeros(len(p), dtype=np.bool_)
+    count = 0
+    for i in range(len(p)):
+        if not seen[i]:
+            count += 1
+            j = i
+            while not seen[j]:
+                seen[j] = True
+                j = p[j]
+    return count
+
+
+class _SpluRcmFactor:
+    """SuperLU on the matrix symmetrically permuted by reverse Cuthill-McKee, natural column order.
+
+    For long bundles of wires in contact SuperLU's own orderings give much more
+    fill (MMD_AT_PLUS_A 18x on a 19-wire strand of 3000 elements, time 60x);
+    the RCM band (``scipy.sparse.csgraph``, O(nnz)) is near optimal for long,
+    thin structures.  ``SymmetricMode`` prefers the diagonal, and threshold partial
+    pivoting (``RCM_PIVOT_THRESHOLD``) keeps it unless it is smaller than that fraction of
+    the column's largest entry: the band stays a band (19-wire strand, 3000 elements: 3.2e6
+    factor entries instead of 4.4e6, 0.10 s instead of 0.17 s).  A solution whose backward
+    error exceeds ``BACKWARD_ERROR`` is recomputed with full partial pivoting.  The ordering
+    and the permuted pattern are kept for the next matrix of the same pattern (``_rcm``).
+    """
+    backend = "splu-rcm"
+
+    def __init__(self, K):
+        if not sp.issparse(K) or K.format not in ("csc", "csr"):
+            K = sp.csc_matrix(K)
+        if not K.has_canonical_format:          # no duplicates: the entries map one to one
+            K = K.copy()
+            K.sum_duplicates()
+        perm, where, indices, indptr = _rcm(K)
+        self.perm, self._K = perm, K
+        self._Kp = sp.csc_matrix((np.asarray(K.data)[where], indices, indptr), shape=K.shape)
+        self._lu = self._splu(RCM_PIVOT_THRESHOLD)
+
+    def _splu(self, threshold):
+        try:
+            return spla.splu(self._Kp, permc_spec="NATURAL", diag_pivot_thresh=threshold,
+                             options=dict(SymmetricMode=True))
+        except RuntimeError as e:
+            raise SingularMatrixError(str(e)) from None
+
+    @property
+    def factor_nnz(self):
+        return int(self._lu.L.nnz + self._lu.U.nnz)
+
+    def _solve(self, b):
+        y = self._lu.solve(b[self.perm])
+        x = np.empty_like(y)
+        x[self.perm] = y
+        return x
+
+    def solve(self, b):
+        b = np.asarray(b, dtype=float)
+        x = self._solve(b)
+        if not np.all(np.isfinite(x)) or _backward_error(self._K, x, b) > BACKWARD_ERROR:   # a small pivot grew
+            self._lu = self._splu(1.0)
+            x = self._solve(b)
+        return x
+
+
+_RCM_LAST = []      # the last (pattern, ordering) of ``_rcm``
+
+
+def _rcm(K):
+    """RCM ordering of ``K``'s pattern and the symmetrically permuted CSC pattern:
+    ``(perm, where, indices, indptr)`` with ``K_p.data = K.data[where]``.  Kept for the last
+    pattern (Newton iterations with the same active contact pairs).  A CSC ``K`` (what
+    ``System.matrix`` gives) takes the compiled ``_rcm_csc``, others scipy's ``_rcm_scipy``:
+    the same arrays (both canonical, the same graph for the ordering)."""
+    key = (K.format, K.shape)
+    if _RCM_LAST:
+        k, ptr, ind, out = _RCM_LAST[0]
+        if k == key and np.array_equal(ptr, K.indptr) and np.array_equal(ind, K.indices):
+            return out
+    fast = K.format == "csc" and K.nnz < np.iinfo(np.int32).max and K.has_canonical_format
+    out = _rcm_csc(K) if fast else _rcm_scipy(K)
+    _RCM_LAST[:] = [(key, K.indptr.copy(), K.indices.copy(), out)]
+    return out
+
+
+def _rcm_scipy(K):
+    """``_rcm`` by scipy: the entry numbers (1..nnz, exact as floats) travel through the same
+    permutation as the values."""
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
+    numbers = K.__class__((np.arange(1.0, K.nnz + 1.0), K.indices, K.indptr), shape=K.shape)
+    A = sp.csr_matrix(numbers)
+    pattern = sp.csr_matrix((np.ones(A.nnz), A.indices, A.indptr), shape=A.shape)
+    perm = reverse_cuthill_mckee((pattern + pattern.T).tocsr(), symmetric_mode=True)
+    Ap = A[perm][:, perm].tocsc()
+    return perm, Ap.data.astype(np.int64) - 1, Ap.indices, Ap.indptr
+
+
+def _rcm_csc(K):
+    """``_rcm_scipy`` of a canonical CSC ``K`` in compiled passes, no sparse temporaries: the
+    transposed pattern (``_transpose``), the graph ``pattern + pattern^T`` (``_union``) and the
+    permuted pattern (``_permuted``), the canonical arrays scipy builds."""
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
+    n = K.shape[0]
+    ptr, ind = np.asarray(K.indptr, dtype=np.int64), np.asarray(K.indices, dtype=np.int32)
+    t_ptr = np.empty(n + 1, dtype=np.int64)
+    t_ind = np.empty(len(ind), dtype=np.int32)
+    t_pos = np.empty(len(ind), dtype=np.int64)
+    _transpose(ptr, ind, t_ptr, t_ind, t_pos)
+    s_ptr = np.empty(n + 1, dtype=np.int32)
+    s_ind = np.empty(2 * len(ind), dtype=np.int32)
+    m = _union(ptr, ind, t_ptr, t_ind, s_ptr, s_ind)
+    perm = reverse_cuthill_mckee(sp.csr_matrix((np.ones(m), s_ind[:m], s_ptr), shape=K.shape), symmetric_mode=True)
+    where = np.empty(len(ind), dtype=np.int64)
+    indices = np.empty(len(ind), dtype=np.int32)
+    indptr = np.empty(n + 1, dtype=np.int32)
+    _permuted(ptr, t_ptr, t_ind, t_pos, perm, where, indices, indptr)
+    return perm, where, indices, indptr
+
+
+@jit
+def _transpose(ptr, ind, t_ptr, t_ind, t_pos):
+    """The transpose of the compressed pattern ``(ptr, ind)`` (square): sorted, with each entry's
+    position ``t_pos`` in the input (a stable counting sort)."""
+    n = len(ptr) - 1
+    t_ptr[:] = 0
+    for p in range(len(ind)):
+        t_ptr[ind[p] + 1] += 1
+    for i in range(n):
+        t_ptr[i + 1] += t_ptr[i]
+    nxt = t_ptr[:-1].copy()
+    for j in range(n):
+        for p in range(ptr[j], ptr[j + 1]):
+            i = ind[p]
+            t_ind[nxt[i]] = j
+            t_pos[nxt[i]] = p
+            nxt[i] += 1
+
+
+@jit
+def _union(ptr, ind, t_ptr, t_ind, s_ptr, s_ind):
+    """The union of two sorted patterns (a pattern and its transpose), sorted; returns its size."""
+    m = 0
+    s_ptr[0] = 0
+    for j in range(len(ptr) - 1):
+        a, a_end, b, b_end = ptr[j], ptr[j + 1], t_ptr[j], t_ptr[j + 1]
+        while a < a_end or b < b_end:
+            if b >= b_end or (a < a_end and ind[a] < t_ind[b]):
+                s_ind[m] = ind[a]
+                a += 1
+            elif a >= a_end or t_ind[b] < ind[a]:
+                s_ind[m] = t_ind[b]
+                b += 1
+            else:
+                s_ind[m] = ind[a]
+                a += 1
+                b += 1
+            m += 1
+        s_ptr[j + 1] = m
+    return m
+
+
+@jit
+def _permuted(ptr, t_ptr, t_ind, t_pos, perm, where, indices, indptr):
+    """CSC pattern of ``K[perm][:, perm]`` and the position in ``K`` of each entry (``where``), from
+    ``K``'s column starts ``ptr`` and its transpose ``(t_ptr, t_ind, t_pos)``: the rows taken in the
+    new order fill each new column in ascending row order."""
+    n = len(ptr) - 1
+    inv = np.empty(n, dtype=np.int64)
+    indptr[0] = 0
+    for j in range(n):
+        inv[perm[j]] = j
+        indptr[j + 1] = indptr[j] + (ptr[perm[j] + 1] - ptr[perm[j]])
+    nxt = np.empty(n, dtype=np.int64)
+    for j in range(n):
+        nxt[j] = indptr[j]
+    for i in range(n):
+        r = perm[i]
+        for q in range(t_ptr[r], t_ptr[r + 1]):
+            j = inv[t_ind[q]]
+            indices[nxt[j]] = i
+            where[nxt[j]] = t_pos[q]
+            nxt[j] += 1
+
+
+def _backward_error(K, x, b):
+    """``|K x - b| / (|K| |x| + |b|)`` in the max norm."""
+    r = np.abs(K @ x - b).max(initial=0.0)
+    scale = np.asarray(abs(K).sum(axis=1)).max(initial=0.0) * np.abs(x).max(initial=0.0) + np.abs(b).max(initial=0.0)
+    return r / scale if scale > 0 else r
+
+
+class _Pardiso:
+    """One PARDISO handle (``pypardiso.PyPardisoSolver``), driven phase by phase.
+
+    Uses pypardiso's ``_check_A`` / ``_call_pardiso`` / ``set_phase`` to run
+    phase 11 (ordering + symbolic analysis) only when the pattern changes,
+    22 (numerical factorisation) per matrix and 33 (solve) per right-hand
+    side; falls back to pypardiso's public ``factorize`` / ``solve`` (an
+    analysis per matrix) if those helpers are missing.
+    """
+
+    def __init__(self, pypardiso):
+        self.ps = _pardiso_handle(pypardiso)
+        self._phased = all(hasattr(self.ps, a) for a in ("_check_A", "_check_b", "_call_pardiso", "set_phase"))
+        self.pattern = None           # (indptr, indices) of the analysed matrix
+        self.current = None           # the factorisation whose values PARDISO holds
+
+    def factorize(self, K, stats):
+        K = K.tocsr() if K.format not in ("csr", "csc") else K
+        if K.dtype != np.float64:
+            K = K.astype(np.float64)
+        if K.shape[0] and not np.diff(K.indptr).all():
+            raise SingularMatrixError("the matrix has an empty row or column")
+        f = _PardisoFactor(self, K)
+        self._factor(f, stats)
+        return f
+
+    def _factor(self, f, stats=None, fresh=False):
+        K, ps = f.K, self.ps
+        if not self._phased:
+            ps.factorize(K)
+            f.reused = False
+        else:
+            ps._check_A(K)                     # sorts indices, sets the CSR/CSC (transposed) flag
+            same = (not fresh and self.pattern is not None and self.pattern[2] == K.format
+                    and np.array_equal(self.pattern[0], K.indptr) and np.array_equal(self.pattern[1], K.indices))
+            ps.set_phase(22 if same else 12)
+            if not same and stats is not None:
+                stats["analyses"] += 1
+            ps._call_pardiso(K, np.zeros((K.shape[0], 1)))
+            self.pattern = (K.indptr.copy(), K.indices.copy(), K.format)
+            f.reused = same
+        self.current = f
+        iparm = ps.iparm
+        f.perturbed = int(iparm[13])
+        f.factor_nnz = int(iparm[17])
+        f.peak_kb = int(max(iparm[14], iparm[15] + iparm[16]))
+
+    def solve(self, f, b):
+        if self.current is not f:             # another matrix was factorised since: redo this one
+            self._factor(f)
+        b = np.asarray(b, dtype=float)
+        x = self._solve(f, b)
+        # PARDISO perturbs tiny pivots instead of stopping at a singular matrix, and a
+        # reused analysis (pivot order and scaling from older values) may lose accuracy:
+        # check the solution (one product with K) and re-analyse once if it is poor
+        bad = _poor(f, x, b)
+        if bad and f.reused:
+            self._factor(f, fresh=True)
+            x = self._solve(f, b)
+            bad = _poor(f, x, b)
+        if bad:
+            raise SingularMatrixError(f"pardiso: singular matrix ({bad}, {f.perturbed} perturbed pivots)")
+        return x
+
+    def _solve(self, f, b):
+        ps, K = self.ps, f.K
+        if not self._phased:
+            return ps.solve(K, b)
+        ps._check_A(K)
+        bb = ps._check_b(K, b)
+        ps.set_phase(33)
+        return ps._call_pardiso(K, bb).reshape(b.shape)
+
+    def release(self):
+        try:
+            self.ps.free_memory(everything=True)
+        except Exception:    # noqa: BLE001  (interpreter shutdown: the library may be gone)
+            pass
+        self.pattern = self.current = None
+
+    def __del__(self):
+        self.release()
+
+
+_TEMPLATE = []
+
+
+def _pardiso_handle(pypardiso):
+    """A fresh ``PyPardisoSolver`` (own PARDISO handle ``pt``) sharing one loaded MKL library.
+
+    ``PyPardisoSolver()`` looks MKL up with ``ctypes.util.find_library``, which
+    runs a subprocess (~0.2 s): that is done once, later handles are copies
+    of the first with new ``pt``/``iparm``/``perm`` arrays.
+    """
+    if not _TEMPLATE:
+        _TEMPLATE.append(pypardiso.PyPardisoSolver())
+    t = _TEMPLATE[0]
+    if not all(hasattr(t, a) for a in ("pt", "iparm", "perm", "factorized_A")):
+        return pypardiso.PyPardisoSolver()
+    ps = copy.copy(t)
+    ps.pt, ps.iparm, ps.perm = np.zeros_like(t.pt), np.zeros_like(t.iparm), np.zeros_like(t.perm)
+    ps.factorized_A = sp.csr_matrix((0, 0))
+    return ps
+
+
+class _PardisoFactor:
+    backend = "pardiso"
+
+    def __init__(self, owner, K):
+        self._owner = owner
+        self.K = K
+        self.perturbed = 0
+        self.reused = False
+        self.norm = None           # |K|_inf, computed on the first check
+        self.factor_nnz = 0
+        self.peak_kb = 0
+
+    def solve(self, b):
+        return self._owner.solve(self, b)
+
+
+def _poor(f, x, b):
+    """Why the PARDISO solution ``x`` of ``K x = b`` is not acceptable ('' if it is).
+
+    Normwise backward error ``|K x - b| / (|K| |x| + |b|)`` (infinity norms)
+    above ``BACKWARD_ERROR`` (a stable solve gives ~1e-15 however ill-conditioned
+    ``K`` is); and, when pivots were perturbed (a zero pivot replaced by a tiny
+    one: the matrix is singular to working precision, where splu raises), a
+    residual above ``SINGULAR_RESIDUAL |b|``.
+    """
+    if not np.all(np.isfinite(x)):
+        return "non-finite solution"
+    r = np.abs(f.K @ x - b).max(initial=0.0)
+    nb = np.abs(b).max(initial=0.0)
+    if f.norm is None:
+        f.norm = float(np.abs(f.K).sum(axis=1).max()) if f.K.nnz else 0.0
+    eta = r / (f.norm * np.abs(x).max(initial=0.0) + nb) if r > 0 else 0.0
+    if eta > BACKWARD_ERROR:
+        return f"backward error {eta:.3g}"
+    if f.perturbed and r > SINGULAR_RESIDUAL * nb:
+        return f"relative residual {r / nb if nb > 0 else np.inf:.3g}"
+    return ""

@@ -1,0 +1,223 @@
+"""The Problem interface between the solver and the physics.
+
+A ``Problem`` is composed of the elements, loads and constraints of an
+``assembly.System`` (DOF map, joins, prescribed motions, the fixed CSC pattern)
+and of contributions (``blocks.Contribution``: contact, or any other) that hand
+local blocks to the generic assembler ``System.assemble_blocks``.  What the
+solver uses, and nothing else of the physics:
+
+- ``evaluate(H, t, tangent=True)`` -> ``Evaluation``: residual ``r`` ``(6 n,)`` in the
+  unknowns ``z`` (all contributions in it), force levels ``f_level``/``m_level``
+  for the convergence test, element ``state``, tangent data and ``timings``;
+- ``tangent(ev)``: the reduced (free x free) CSC tangent with every contribution;
+  ``full_tangent(ev)`` over all ``6 n`` unknowns; ``coupling(ev, dz_c)``: ``K_fc dz_c``
+  on the free rows for prescribed increments ``dz_c`` ``(n, 6)``;
+- ``update(H, dz)``: the poses after increments ``dz`` ``(n, 6)``;
+- step life cycle: ``begin_step(H, t)`` (``H`` the converged poses before the step),
+  ``repeat_step(H)`` after Newton converged (True: re-solve the step, the outer
+  iteration of an augmented Lagrangian), ``unmet(t)`` (why the step may not be
+  accepted, or ``None``), ``commit(H)`` when it is accepted (returns the step's
+  record of the contributions, e.g. the contact point table, or ``None``);
+- ``get_state()``/``set_state(state)``: the committed history (restart), keys
+  ``name/key`` per contribution;
+- ``smooth``: True when every contribution is smooth (the solver damps Newton on
+  its correction), else the solver backtracks on the residual;
+  ``conservative``: no follower loads (nodal or line) and every contribution derives from a potential.
+
+``system`` is the DOF map and constraints the solver reads (free unknowns,
+prescribed nodes and their targets, reactions).  docs/theory.md section 10
+gives the equations and the data flow of one Newton iteration.
+"""
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..model import contributions
+from ..assembly.system import System
+from ..errors import InputError
+
+__all__ = ["Problem", "Evaluation"]
+
+ALWAYS_TIMED = ("contact",)      # parts reported in the timings of every step, 0 when absent
+SEP = "/"                        # between a contribution's name and its own keys in ``get_state``
+
+
+@dataclass
+class Evaluation:
+    """One evaluation at poses ``H``: ``r`` ``(6 n,)``, ``f_level``, ``m_level``, element ``state``;
+    ``kvals`` (COO values on the System's fixed pattern, ``None`` without tangent), ``extra``
+    (COO ``(rows, cols, vals)`` of the contributions' blocks), ``timings`` (seconds per
+    contribution name, part of the evaluation), ``details`` (info per contribution name)."""
+    r: np.ndarray
+    f_level: float
+    m_level: float
+    state: object
+    kvals: np.ndarray = None
+    extra: tuple = None
+    timings: dict = field(default_factory=dict)
+    details: dict = field(default_factory=dict)
+
+
+class Problem:
+    """Elements, loads and constraints of ``system`` plus ``contributions`` (``Problem.from_model``
+    builds them from the model: contact, then the user's); see the module docstring for the protocol."""
+
+    def __init__(self, system, contributions=()):
+        self.system = system
+        self.contributions = list(contributions)
+        self._lf = (None, np.zeros(0))
+
+    @classmethod
+    def from_model(cls, model, check_rigid_modes=True):
+        """The Problem of ``model``: its System, its contact (if declared) and its user contributions
+        (``Model.add_contribution``, checked: ``contributions.checked``)."""
+        user = contributions.checked(model)
+        system = System(model, check_rigid_modes=check_rigid_modes)
+        return cls(system, _contact(system) + user)
+
+    @property
+    def contact(self):
+        """The contact contribution (``contact.system.ContactSystem``), ``None`` without contact."""
+        return next((c for c in self.contributions if c.name == "contact"), None)
+
+    def initial_overlap(self, H):
+        """A sentence naming the pre-stress that overlaps at the given poses ``H`` put into the model
+        (the contributions' optional ``overlap(H)``), ``None`` if none."""
+        texts = [t for t in (c.overlap(H) for c in self.contributions if hasattr(c, "overlap")) if t]
+        return "; ".join(texts) or None
+
+    def failure_hint(self):
+        """What the contributions would add to a ``ConvergenceError`` (their optional ``failure_hint()``,
+        e.g. a contact penalty far stiffer than its default), ``""`` if nothing."""
+        return "".join(c.failure_hint() for c in self.contributions if hasattr(c, "failure_hint"))
+
+    # ------------------------------------------------------------ properties
+    @property
+    def adjusted(self):
+        """The strain-free adjustment of the reference overlaps (``contact.adjust``): ``dict(count,
+        largest)``, ``None`` without contact."""
+        return self.contact.adjusted if self.contact is not None else None
+
+    @property
+    def solves_start(self):
+        """Whether forces of the contributions on the load-free given poses make step 0 an
+        equilibrium to solve (``Newton.at_rest`` decides): contact, whose smoothed law pushes
+        touching wires apart (docs/theory.md 19.2); user contributions keep the given state."""
+        return self.contact is not None
+
+    @property
+    def smooth(self):
+        return all(c.smooth for c in self.contributions)
+
+    @property
+    def conservative(self):
+        s = self.system
+        if len(s.load_nodes) and np.any(s.load_follower):
+            return False
+        if s.line is not None and len(s.line.follower):
+            return False
+        return all(c.conservative for c in self.contributions)
+
+    @property
+    def timing_names(self):
+        """Names of the parts timed in ``Evaluation.timings``: ``contact`` always (0 without
+        contact: ``Solution.stats[k]["timings"]`` has the same keys in every scene), then those of
+        the other contributions."""
+        return ALWAYS_TIMED + tuple(c.name for c in self.contributions if c.name not in ALWAYS_TIMED)
+
+    # ------------------------------------------------------------ evaluation
+    def load_factors(self, t):
+        """Load scales at ``t`` (the last ``t`` is cached: a step evaluates many iterates)."""
+        if self._lf[0] != t:
+            s = self.system
+            self._lf = (t, s.load_factors(t) if len(s.load_scales) else np.zeros(0))
+        return self._lf[1]
+
+    def evaluate(self, H, t, tangent=True):
+        """Residual, force levels and tangent data of every part at poses ``H``, time ``t``."""
+        s = self.system
+        r, kvals, info = s.evaluate(H, self.load_factors(t), tangent=tangent)
+        ev = Evaluation(r, info["f_level"], info["m_level"], info["state"], kvals)
+        coo = []
+        for c in self.contributions:
+            t0 = time.perf_counter()
+            blocks, cinfo = c.evaluate(H, tangent)
+            rc, cc, fl, ml = s.assemble_blocks(H, blocks)
+            ev.timings[c.name] = time.perf_counter() - t0
+            ev.details[c.name] = cinfo
+            ev.r = ev.r + rc
+            ev.f_level, ev.m_level = max(ev.f_level, fl), max(ev.m_level, ml)
+            if len(cc[2]):
+                coo.append(cc)
+        if len(coo) == 1:
+            ev.extra = coo[0]
+        elif coo:
+            ev.extra = tuple(np.concatenate(a) for a in zip(*coo))
+        return ev
+
+    def tangent(self, ev):
+        """Reduced tangent (free x free) as CSC, every contribution in it."""
+        return self.system.matrix(ev.kvals, ev.extra)
+
+    def full_tangent(self, ev):
+        """Tangent over all ``6 n`` unknowns as CSR."""
+        return self.system.full_matrix(ev.kvals, ev.extra)
+
+    def coupling(self, ev, dz_c):
+        """``K_fc dz_c`` on the free rows for prescribed increments ``dz_c`` ``(n, 6)``."""
+        return self.system.prescribed_coupling(ev.kvals, np.ravel(dz_c), ev.extra)
+
+    def update(self, H, dz):
+        return self.system.update(H, dz)
+
+    # ------------------------------------------------------------ step life cycle
+    def begin_step(self, H, t):
+        for c in self.contributions:
+            c.begin_step(H, t)
+
+    def repeat_step(self, H):
+        """True when a contribution asks to re-solve the step (every one is asked)."""
+        return any([c.repeat_step(H) for c in self.contributions])
+
+    def unmet(self, t):
+        texts = [u for u in (c.unmet(t) for c in self.contributions) if u]
+        return "; ".join(texts) if texts else None
+
+    def commit(self, H):
+        """Accept the step at ``H``; returns the contributions' record of it (or ``None``)."""
+        record = None
+        for c in self.contributions:
+            c.commit(H)
+            res = c.results(H)
+            if res is not None:
+                record = res if record is None else {**record, **res}
+        return record
+
+    def get_state(self):
+        """Committed history of the contributions as one flat dict of arrays, keys ``name/key``
+        (``name`` the contribution's, ``key`` its own: equal keys of two contributions are kept apart)."""
+        return {f"{c.name}{SEP}{k}": v for c in self.contributions for k, v in c.get_state().items()}
+
+    def set_state(self, state):
+        """Give every contribution its part of ``state`` (``get_state``), its own keys.  Keys without
+        ``/`` come from archives written before the keys were namespaced, which held only the contact
+        history: they go to the contribution named ``contact``."""
+        legacy = {k: v for k, v in state.items() if SEP not in k}
+        names = {c.name for c in self.contributions}
+        foreign = sorted({k.split(SEP, 1)[0] for k in state if SEP in k} - names)
+        if foreign or (legacy and "contact" not in names):
+            raise InputError(f"contact state: entries of {foreign or ['contact']}, which this model does not have "
+                             f"(its contributions: {sorted(names) or 'none'}): the state of another model")
+        for c in self.contributions:
+            prefix = c.name + SEP
+            part = {k[len(prefix):]: v for k, v in state.items() if k.startswith(prefix)}
+            c.set_state({**legacy, **part} if c.name == "contact" else part)
+
+
+def _contact(system):
+    """``[ContactSystem]`` for a model with contact declarations, else ``[]``."""
+    if not system.model.contacts:    # scenes without contact never import or run contact code
+        return []
+    from ..contact.system import ContactSystem
+    return [ContactSystem(system)]

@@ -1,0 +1,1 @@
+"""Solution, its archive format, linearisation, topology and resultants."""

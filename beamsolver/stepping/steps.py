@@ -1,0 +1,570 @@
+"""Pseudo-time stepping of ``solve``: step sizes, cut-back, recording, and stopping without loss.
+
+``Run`` walks the user's grid ``t_0 < t_1 < ... < t_steps``.  A step is first
+shortened where a prescribed rotation would be ambiguous
+(``motion_path.limit_step``); a step whose Newton iterations fail with a
+retryable ``failures.StepFailed`` is halved down to ``dt_min`` (compared with a
+relative tolerance ``STEP_TOLERANCE``, and a grown step cut back below
+``dt_min`` tries ``dt_min`` itself); after two easy steps running the next one
+grows (``growth``), never past the user's step (easy: no cut-back and at most ``easy_limit``
+Newton iterations, the more of ``EASY_ITERATIONS`` and the iterations of the last step taken at
+the user's size: a contact step that needs 15 iterations at any size regrows too; or ``steady``:
+about as many iterations as the step before, within 2/3 of the Newton budget, as slip steps of 7-12
+iterations at any size), and not back to the size of the
+last failed step before ``wait`` easy steps running (``next_step``: the wait doubles
+each time that size fails again, up to ``WAIT_MAX``; 2, the fixed rule, until then), and
+lands on the grid (no sliver shorter than ``LANDING`` steps before a grid point).  Every loop is
+bounded: each pass of the main loop advances by at least ``dt_min`` or stops.
+
+Whatever ends a run (``ConvergenceError``, Ctrl-C, an exception from a callback
+or a motion), ``abort`` records the converged steps in the output folder
+(``solution.npz``, atomically) and attaches the ``Solution`` to the exception.
+"""
+import logging
+import time
+import warnings
+
+import numpy as np
+
+from . import branching, diagnosis, stable_branch
+from ..model import motion_path
+from ..nonlinear.definiteness import negative_eigenvalues
+from ..errors import ConvergenceError, InputError, StabilityWarning, StabilizationWarning
+from ..failures import AugmentationFailed, LeftStableBranch, MotionTooFast, NonFinite, StepFailed
+from .progress import Progress
+from ..model.material_range import RangeCheck
+from ..results.solution import Solution, describe_model
+
+__all__ = ["Run", "growth", "easy_limit", "steady", "next_step", "after_failure", "STEP_TOLERANCE", "EASY_ITERATIONS", "WAIT_MAX",
+           "STEP_ZERO_ITERATIONS", "STEADY_GROWTH", "STEADY_SHARE"]
+
+log = logging.getLogger("beamsolver")
+
+STEP_TOLERANCE = 1e-9      # relative rounding allowed when comparing step sizes
+LANDING = 0.1              # a step ending within this fraction of a step before a grid point lands on it
+EASY_ITERATIONS = 6        # a step converging within these iterations is easy (growth)
+EASY_RUN = 2               # easy steps running before the step grows (growth)
+STEADY_GROWTH = 1.25       # steady: at most this times the previous step's iterations, plus one (steady)
+STEADY_SHARE = 2.0 / 3.0   # steady: at most this share of max_iter (steady)
+WAIT_MAX = 32              # most easy steps running before a step regrows to a size that failed again
+MAX_OUTER = 100            # outer iterations of a step (Problem.repeat_step) before it fails
+UNDAMPED_MARGIN = 2.0      # an undamped residual up to this times the damped one Newton accepted is equilibrium
+STEP_ZERO_ITERATIONS = 4   # Newton budget at t_start / max_iter (no cut-back there; docs/theory.md section 17)
+
+
+def growth(iterations, easy):
+    """Factor for the next step after a converged one: 2 from the second step running that took
+    at most ``EASY_ITERATIONS`` Newton iterations without cut-back (``easy`` counts them, this
+    one included), else 1."""
+    return 2.0 if easy >= EASY_RUN else 1.0
+
+
+def easy_limit(reference):
+    """Most Newton iterations of an easy step: ``EASY_ITERATIONS``, or ``reference`` (the iterations
+    of the last step converged at the user's size without cut-back, ``None``: none yet) if more.
+    After a cut-back, a step that converges as fast as the user's steps did counts as easy."""
+    return EASY_ITERATIONS if reference is None else max(EASY_ITERATIONS, int(reference))
+
+
+def steady(iterations, previous, max_iter):
+    """Whether a step converged in a steady number of Newton ``iterations``: at most
+    ``STEADY_GROWTH * previous + 1`` (``previous``: the iterations of the step before, ``None``:
+    none) and at most ``STEADY_SHARE * max_iter``.  A slip-dominated stretch of contact steps
+    takes 7-12 iterations at every size; such steps count as easy (the failed-size memory of
+    ``next_step`` still holds back a size that failed)."""
+    if previous is None:
+        return False
+    return iterations <= STEADY_GROWTH * previous + 1 and iterations <= STEADY_SHARE * max_iter
+
+
+def next_step(dt, iterations, easy, failed=np.inf, wait=EASY_RUN):
+    """Size of the next step after one of size ``dt`` converged in ``iterations`` (``easy`` as in
+    ``growth``), and the memory ``(failed, wait)``: ``failed`` the size of the last failed step
+    (``inf``: none), ``wait`` the easy steps running needed before growing back to it.  A step of
+    at least ``failed`` converged: forgotten.  Returns ``(size, failed, wait)``, size before the
+    cap at the user's step."""
+    if dt >= failed * (1.0 - STEP_TOLERANCE):
+        failed, wait = np.inf, EASY_RUN
+    size = growth(iterations, easy) * dt
+    if size >= failed * (1.0 - STEP_TOLERANCE) and easy < wait:
+        size = dt
+    return size, failed, wait
+
+
+def after_failure(size, failed=np.inf, wait=EASY_RUN):
+    """Memory ``(failed, wait)`` after a step of ``size`` failed: a size at least the last one that
+    failed doubles the wait (at most ``WAIT_MAX``), as the fixed rule would retry it every third step."""
+    if size >= failed * (1.0 - STEP_TOLERANCE):
+        wait = max(min(2 * wait, WAIT_MAX), EASY_RUN)
+    return size, wait
+
+
+class Run:
+    """One call of ``solve``: ``start``, then ``loop``; ``abort(exc)`` on any exception."""
+
+    def __init__(self, problem, newton, writer, grid, dt_min, verbose, options):
+        self.problem, self.sys = problem, problem.system
+        self.newton, self.writer, self.grid = newton, writer, grid
+        self.dt_user = grid[1] - grid[0]
+        self.dt_min = dt_min
+        self.verbose = verbose
+        self.opt = options            # allow_unmet_tolerance, check_stability
+        self.sol = None
+        self.progress = None
+        self.warned_unstable = False
+        self.range = None             # material_range.RangeCheck: sections with a yield limit only
+        self.negative = None          # negative eigenvalues of the last converged state's tangent, if known
+        self.branch_tries = 0         # LeftStableBranch failures since a step converged at its first try
+        newton.watch_sign = (problem.conservative and not options.get("branch_switching")   # stable_branch
+                             and stable_branch.ENABLED)
+
+    # ------------------------------------------------------------------ start
+    def start(self, restart_solution, initial_poses):
+        sys, grid = self.sys, self.grid
+        t_start, steps = grid[0], len(grid) - 1
+        self.dt, self.t, self.k, self.easy = self.dt_user, t_start, 1, 0
+        self.failed, self.wait, self.reference, self.previous = np.inf, EASY_RUN, None, None
+        if restart_solution is None:
+            self.sol = Solution(sys.model, sys)
+            self.range = RangeCheck.of(self.sol.description)
+            H0 = sys.poses0.copy() if initial_poses is None else np.array(initial_poses, dtype=float)
+            self._step_zero(H0, t_start)
+        else:
+            self.sol = sol = restart_solution
+            self.range = RangeCheck.of(describe_model(sys.model, sys))
+            self.H = sol.poses[-1].copy()
+            self.t = float(sol.times[-1])
+            self.k = int(np.searchsorted(grid, self.t + 1e-12 * self.dt_user, side="right"))
+            rs = sol.resume
+            if rs.get("t0") == t_start and rs.get("t_end") == grid[-1] and rs.get("steps") == steps:
+                dt = float(rs["dt"])
+                if np.isfinite(dt) and dt >= self.dt_min * (1.0 - STEP_TOLERANCE):   # else: a bad file
+                    self.dt, self.easy = min(dt, self.dt_user), int(rs["easy"])
+                    self.failed, self.wait = _memory(rs)
+                    self.reference = _reference(rs)
+                    self.previous = _reference(rs, "previous")
+            if self.writer is not None:
+                for j in range(len(sol)):
+                    self.writer.write(sol, j)
+        # the stepping state before the first step: a checkpoint of a run stopped at once says how far it went
+        self.sol.resume = dict(t0=float(grid[0]), t_end=float(grid[-1]), steps=int(steps), dt=float(self.dt),
+                               easy=int(self.easy), **self._memory_state())
+        self.progress = Progress(self.verbose, t_start, grid[-1], self.t)
+        if self.opt.get("stabilizer") is not None:
+            self.opt["stabilizer"].t_last = self.t      # the converged state the first step starts from
+
+    def _step_zero(self, H0, t_start):
+        """Step 0: the state ``H0`` at ``t_start`` (prescribed nodes on their motion) or, when loads,
+        motions or ``fix`` values act there or contact pushes ``H0`` off balance
+        (``Newton.at_rest``), the equilibrium solved there from ``H0`` with
+        ``STEP_ZERO_ITERATIONS`` times the Newton budget ``max_iter``: no step can be cut back
+        there, and the first state of touching wires converges only linearly (docs/theory.md
+        section 17, touching wires at t_start)."""
+        sys, problem = self.sys, self.problem
+        H = H0.copy()
+        if len(sys.prescribed_nodes):
+            H[sys.prescribed_nodes] = sys.prescribed_poses(t_start)
+            sys.sync_members(H)
+        stats, record = dict(iterations=0, residuals=[], wall_time=0.0, dt=0.0, cutbacks=0), None
+        acts = _acts_at(sys, H0, t_start)
+        pushed, overlap = False, None
+        if not acts:
+            ev0 = problem.evaluate(H, t_start, tangent=False)
+            # contact alone may push the given poses (touching wires under the smoothed law,
+            # docs/theory.md 19.2); round-off contact forces ask for a correction at round-off
+            pushed = problem.solves_start and not self.newton.at_rest(ev0, H, t_start)
+            overlap = problem.initial_overlap(H) if pushed else None
+            if overlap:                  # e.g. a strand's wires built overlapping (cables.build_strand)
+                self.sol.message = overlap
+                log.warning(overlap)
+                warnings.warn(overlap, RuntimeWarning, stacklevel=4)
+        if acts or pushed:
+            t0 = time.perf_counter()
+            self.H, self.t = H0, None
+            conv = self.newton.conv
+            max_iter, conv.max_iter = conv.max_iter, STEP_ZERO_ITERATIONS * conv.max_iter
+            try:
+                H, ev0, stats = self.newton_step(t_start)
+            except StepFailed as e:
+                self.sol.converged, self.sol.message = False, str(e)
+                if pushed:
+                    why = (f"contact forces already act ({diagnosis.pushing_point(problem, H)}): {e}; "
+                           "separate the beams by a small gap, let add_contact(adjust=) cover the overlap "
+                           "(strain-free adjustment) or raise max_iter")
+                else:
+                    why = f"loads or motions already act: {e}; start the loads from zero or use more steps"
+                why += self.opt.get("penalty_hint", "")
+                err = ConvergenceError(f"solve: no equilibrium at t_start = {t_start:.6g}, where {why}", self.sol)
+                err.failure = e
+                raise err from None
+            finally:
+                self.t, conv.max_iter = t_start, max_iter
+            stats.update(wall_time=time.perf_counter() - t0, dt=0.0, cutbacks=0)
+            if overlap:
+                stats.setdefault("warnings", []).append(overlap)
+            record = problem.commit(H)
+            if problem.contributions:
+                self.sol.contact_state = problem.get_state()
+        self._check_finite(H, ev0.r, ev0.state, t_start)
+        if self.range is not None:
+            self.range.check(ev0.state.strain, stats, 0)
+        adjusted = problem.adjusted
+        if adjusted and adjusted["count"]:
+            stats["adjusted"] = dict(adjusted)
+            log.info("t = %.6g: %d point(s) of reference overlap adjusted to touching, strain-free (largest "
+                     "overlap %.3g)", t_start, adjusted["count"], adjusted["largest"])
+        self.sol.append(t_start, H, sys.reactions(H, ev0.r), ev0.state.sigma, ev0.state.strain, stats, record)
+        self.H = H
+        if self.writer is not None:
+            self.writer.write(self.sol, 0)
+
+    def _name_nonfinite(self, t):
+        """A non-finite residual from the user's input (a load scale or motion at ``t``): InputError."""
+        found = diagnosis.nonfinite_source(self.problem, self.H, t)
+        if found is not None and found[0]:
+            raise InputError(f"solve: at t = {t:.6g} {found[1]}")
+
+    def _check_finite(self, H, r, state, t):
+        """Never record a non-finite state: name the input behind it (``InputError``) or fail."""
+        if np.all(np.isfinite(r)) and np.all(np.isfinite(H)) and np.all(np.isfinite(state.sigma)):
+            return
+        found = diagnosis.nonfinite_source(self.problem, H, t)
+        if found is not None and found[0]:
+            raise InputError(f"solve: at t = {t:.6g} {found[1]}")
+        raise NonFinite(f"non-finite state at t = {t:.6g}" + (f": {found[1]}" if found else ""))
+
+    # ------------------------------------------------------------------ steps
+    def loop(self):
+        grid = self.grid
+        steps = len(grid) - 1
+        while self.k <= steps:
+            t_next = min(self.t + self.dt, grid[self.k])
+            if grid[self.k] - t_next < max(1e-9 * self.dt_user, LANDING * self.dt):
+                t_next = grid[self.k]           # no sliver before the grid point
+            t0 = time.perf_counter()
+            t_next, H, ev, stats = self._attempt(t_next)
+            stats.update(wall_time=time.perf_counter() - t0, dt=t_next - self.t)
+            self._record(t_next, H, ev, stats)
+
+    def _attempt(self, t_next):
+        """Converge the step ``t -> t_next``, halving it on failure; returns the step reached."""
+        t, cutbacks, rotation_limit, failed_sizes, branch_here = self.t, 0, None, [], 0
+        before = self._negative_before()
+        while True:
+            t_try, rot = motion_path.limit_step(self.sys, t, t_next)
+            if t_try < t_next and t_try - t < self.dt_min * (1.0 - STEP_TOLERANCE):
+                self._stop(MotionTooFast(f"a prescribed rotation turns by {rot:.3g} rad over a step of "
+                                      f"{t_try - t:.3g}, more than MAX_MOTION_ROTATION = "
+                                      f"{motion_path.MAX_MOTION_ROTATION:.3g} rad, even at the smallest step"),
+                           rotation_limit)
+            self.newton.reset_timings()
+            try:
+                H, ev, stats = self.newton_step(t_try)
+                self._check_finite(H, ev.r, ev.state, t_try)
+                stats.update(cutbacks=cutbacks, timings=dict(self.newton.timings))
+                if failed_sizes:
+                    stats["failed_dt"] = list(failed_sizes)
+                if t_try < t_next:
+                    stats["motion_rotation"] = rot
+                self._keep_branch(t_try, H, ev, stats, before)
+                if not cutbacks:
+                    self.branch_tries = 0
+                return t_try, H, ev, stats
+            except StepFailed as e:
+                if isinstance(e, NonFinite):
+                    self._name_nonfinite(t_try)
+                h = 0.5 * (t_try - t)
+                if self.dt_min * (1.0 + STEP_TOLERANCE) < t_try - t and h < self.dt_min:
+                    h = self.dt_min             # a grown step cut back: the smallest step is still tried
+                if isinstance(e, LeftStableBranch):
+                    branch_here, self.branch_tries = branch_here + 1, self.branch_tries + 1
+                    if branch_here > stable_branch.RETRIES or self.branch_tries > stable_branch.RETRIES_RUN or \
+                            h < self.dt_min * (1.0 - STEP_TOLERANCE):
+                        return self._keep_unstable(e)
+                cutbacks += 1
+                failed_sizes.append(t_try - t)
+                self.failed, self.wait = after_failure(t_try - t, self.failed, self.wait)
+                if e.rotation:
+                    rotation_limit = str(e)
+                log.info("t = %.6g: step %.3g failed (%s); cutting back to %.3g", t_try, t_try - t, e, h)
+                if not e.retry or h < self.dt_min * (1.0 - STEP_TOLERANCE):
+                    self._stop(e, rotation_limit)
+                t_next = t + h
+                self.easy = 0
+
+    def _negative_before(self):
+        """``before()`` of ``stable_branch.verdict`` for a step from the current state: its
+        negative-eigenvalue count, known from the last step's check or computed once when asked
+        (``None`` where the problem is not conservative)."""
+        known, ev = self.negative, getattr(self.newton, "last_evaluation", None)
+        cache = []
+
+        def before():
+            if known is not None:
+                return known
+            if not cache:
+                e = ev if ev is not None else self.problem.evaluate(self.H, self.t, tangent=True)
+                cache.append(stable_branch.negative_count(self.problem, e))
+            return cache[0]
+        return before
+
+    def _keep_branch(self, t, H, ev, stats, before):
+        """``stable_branch.verdict`` on the step converged at ``t``: raises ``LeftStableBranch``
+        carrying the step, for ``_keep_unstable`` (not with ``branch_switching``, whose switch
+        moves the path onto a stable branch itself).  Only a step whose first tangent had ``det < 0``
+        (``Newton.indefinite_seen``) or that took undamped Newton iterations (the fallback, or
+        ``line_search=False``) is checked."""
+        if self.opt.get("branch_switching") or not stable_branch.ENABLED:
+            return
+        if not (self.newton.indefinite_seen or stats.get("undamped") is not None or not self.newton.line_search):
+            self.negative = None        # every tangent of the step had det > 0: not checked (stable_branch)
+            return
+        try:
+            self.negative = stable_branch.verdict(self.problem, self.newton.last_evaluation, before, t)
+        except LeftStableBranch as e:
+            e.t, e.result = t, (t, H, ev, stats)
+            raise
+
+    def _keep_unstable(self, failure):
+        """Keep the unstable state of ``failure`` (``LeftStableBranch``) after ``stable_branch.RETRIES``
+        such failures of a step, or ``RETRIES_RUN`` since a step converged at its first try, or at
+        the smallest step, and say so once (``StabilityWarning``; with
+        ``check_stability`` its own warning reports it)."""
+        t, H, ev, stats = failure.result
+        self.negative, self.branch_tries = failure.negative, 0
+        stats.update(left_stable_branch=True)
+        text = stable_branch.kept(failure)
+        if not self.warned_unstable and not self.opt.get("check_stability"):
+            self.warned_unstable = True
+            log.warning(text)
+            warnings.warn(text, StabilityWarning, stacklevel=5)
+            self.sol.message = text if not self.sol.message else self.sol.message + "; " + text
+        return failure.result
+
+    def newton_step(self, t_next, start=None):
+        """Newton at ``t_next`` (from the last converged state, or from ``start`` at ``t_next``),
+        repeated while the problem asks to re-solve the step (outer iterations, e.g.
+        augmented-Lagrangian updates); refused or warned if ``Problem.unmet``."""
+        sys, newton, problem = self.sys, self.newton, self.problem
+        H_target = sys.prescribed_poses(t_next) if len(sys.prescribed_nodes) else None
+        problem.begin_step(self.H, t_next)
+        H0, t_prev = (self.H, self.t) if start is None else (start, t_next)
+        H, ev, stats = newton.step(H0, t_next, H_target, t_prev)
+        while problem.repeat_step(H):
+            if stats.get("augmentations", 0) >= MAX_OUTER:
+                raise AugmentationFailed(f"the outer iterations (augmented-Lagrangian updates) still ask to re-solve "
+                                         f"the step at t = {t_next:.6g} after MAX_OUTER = {MAX_OUTER}")
+            H, ev, more = newton.step(H, t_next, H_target, self.t)
+            stats["iterations"] += more["iterations"]
+            stats["residuals"] += more["residuals"]
+            stats["augmentations"] = stats.get("augmentations", 0) + 1
+        if self.opt.get("stabilizer") is not None:
+            self.opt["stabilizer"].check(problem.tangent(newton.last_evaluation), t_next)
+        text = problem.unmet(t_next)
+        if text:
+            if not self.opt.get("allow_unmet_tolerance"):
+                raise AugmentationFailed(text + " (solve(..., allow_unmet_tolerance=True) accepts it "
+                                         "with a warning)")
+            stats.setdefault("warnings", []).append(text)
+            log.warning(text)
+            warnings.warn(text, RuntimeWarning, stacklevel=4)
+        return H, ev, stats
+
+    def _record(self, t_next, H, ev, stats):
+        sys, sol, problem = self.sys, self.sol, self.problem
+        stab = self.opt.get("stabilizer")
+        damped = H
+        if stab is not None:
+            balance = self._undamped(stab, H, ev)
+            if stab.settle and not balance["equilibrium"] and t_next >= self.grid[-1] - 1e-12 * self.dt_user:
+                H, ev, balance = self._settle(stab, t_next, H, ev, stats, balance)
+        if self.opt.get("check_stability"):
+            t_next, H, ev = self._stability(stats, t_next, H, ev)
+        record = problem.commit(H)
+        if stab is not None:
+            stats["stabilization"] = dict(stab.record(damped, t_next), **balance)
+        for w in stats.get("warnings", ()):
+            sol.message = w if not sol.message else sol.message + "; " + w
+        # the stepping state after this step, set together with the step (restart reads both)
+        dt = t_next - self.t
+        t, k = t_next, self.k
+        if t >= self.grid[k] - 1e-12 * self.dt_user:
+            t, k = self.grid[k], k + 1
+        if stats["cutbacks"] == 0 and dt >= self.dt_user * (1.0 - STEP_TOLERANCE):
+            self.reference = stats["iterations"]
+        its, previous, self.previous = stats["iterations"], self.previous, stats["iterations"]
+        calm = its <= easy_limit(self.reference) or steady(its, previous, self.newton.conv.max_iter)
+        easy = self.easy + 1 if calm and stats["cutbacks"] == 0 else 0
+        dt, self.failed, self.wait = next_step(dt, stats["iterations"], easy, self.failed, self.wait)
+        dt = min(dt, self.dt_user)
+        if problem.contributions:
+            sol.contact_state = problem.get_state()
+        if self.range is not None:
+            self.range.check(ev.state.strain, stats, len(sol))
+        sol.append(t_next, H, sys.reactions(H, ev.r), ev.state.sigma, ev.state.strain, stats, record)
+        sol.resume = dict(t0=float(self.grid[0]), t_end=float(self.grid[-1]), steps=len(self.grid) - 1,
+                          dt=float(dt), easy=int(easy), **self._memory_state())
+        self.H, self.t, self.k, self.dt, self.easy = H, t, k, dt, easy
+        if self.writer is not None:
+            self.writer.write(sol, sol.n_steps)
+        self.progress.step(sol.n_steps, t_next, stats["dt"], stats)
+
+    def _undamped(self, stab, H, ev):
+        """The balance of the converged state ``H`` (evaluation ``ev``) without the viscous forces of
+        the stabilisation ``stab``: ``undamped_residual`` (scaled as Newton's residual) and
+        ``equilibrium``: at most the solve's ``rtol``, or twice the damped residual Newton accepted
+        (a step converged on its increment), i.e. an equilibrium of the model itself."""
+        full = self.newton.residual_ratio(ev)
+        if not stab.active:
+            return dict(undamped_residual=full, equilibrium=True)
+        blocks, _ = stab.evaluate(H, tangent=False)
+        ratio = self.newton.residual_ratio(ev, ev.r - self.sys.assemble_blocks(H, blocks)[0])
+        return dict(undamped_residual=ratio,
+                    equilibrium=bool(ratio <= max(self.newton.conv.rtol, UNDAMPED_MARGIN * full)))
+
+    def _settle(self, stab, t, H, ev, stats, balance):
+        """The last step's damped state ``H`` (evaluation ``ev``, ``balance`` of ``_undamped``) solved once
+        more at ``t`` without the viscous forces, from ``H``: ``(H, ev, balance)`` of the equilibrium
+        reached, or the damped ones if Newton fails there; ``stats["settle"]`` records which."""
+        stab.suspended = True
+        try:
+            H1, ev1, more = self.newton_step(t, start=H)
+            self._check_finite(H1, ev1.r, ev1.state, t)
+        except StepFailed as e:
+            stats["settle"] = dict(failed=str(e), from_residual=balance["undamped_residual"])
+            log.warning("t = %.6g: the undamped solve of the last step failed (%s); its damped state is kept", t, e)
+            return H, ev, balance
+        finally:
+            stab.suspended = False
+        stats["settle"] = dict(iterations=more["iterations"], residuals=more["residuals"],
+                               from_residual=balance["undamped_residual"])
+        return H1, ev1, dict(undamped_residual=self.newton.residual_ratio(ev1), equilibrium=True)
+
+    def _off_equilibrium(self):
+        """A stabilised run whose final state is not an equilibrium of the model (``_undamped``):
+        ``Solution.mark_off_equilibrium`` with the reason, and a ``StabilizationWarning``."""
+        sol = self.sol
+        rec = sol.stats[-1].get("stabilization", {}) if len(sol) else {}
+        if rec.get("equilibrium", True):
+            return
+        text = (f"t = {sol.times[-1]:.6g}: the final state is not an equilibrium of the model: without the "
+                f"stabilisation's viscous forces the scaled residual is {rec['undamped_residual']:.3g} (rtol "
+                f"{self.newton.conv.rtol:g}): the damping still carries that share of the largest force; "
+                "stabilize=dict(..., settle=True) solves the last step once more without damping, or use a "
+                "smaller stabilize fraction or factor")
+        log.warning(text)
+        warnings.warn(text, StabilizationWarning, stacklevel=4)
+        sol.mark_off_equilibrium(text)
+
+    def _memory_state(self):
+        """The failed-size memory of ``next_step``, the ``easy_limit`` reference and the ``steady``
+        previous iterations for ``resume`` (JSON: no inf)."""
+        return dict(failed=None if not np.isfinite(self.failed) else float(self.failed), wait=int(self.wait),
+                    reference=self.reference, previous=self.previous)
+
+    def _stability(self, stats, t, H, ev):
+        """Record whether the tangent at the converged state ``H`` (evaluation ``ev``) is positive
+        definite, its lowest modes (``modes``) and, with ``branch_switching``, move onto a stable
+        branch (``branching.switch``, which may record the step at an earlier ``t``, past a
+        crossing); warn once.  Returns the step to record ``(t, H, ev)``."""
+        problem = self.problem
+        if not problem.conservative:
+            stats.update(stable=None)
+            return t, H, ev
+        K = problem.tangent(self.newton.last_evaluation)
+        neg, lowest = negative_eigenvalues(K)
+        stats.update(stable=neg == 0, negative_eigenvalues=neg, lowest_eigenvalue=lowest)
+        if branching.wanted(self.opt.get("branch_switching"), self.sol.stats, neg):
+            t, H, ev, K = branching.switch(self, stats, t, H, ev, K)
+        if self.opt.get("modes"):
+            branching.record_modes(self.sys, stats, H, K, self.opt["modes"])
+        neg = self.negative = stats["negative_eigenvalues"]
+        if neg and not self.warned_unstable:
+            self.warned_unstable = True
+            text = (f"t = {t:.6g}: the equilibrium is unstable (the tangent has {neg} negative "
+                    "eigenvalue(s)): the path has passed a limit point or bifurcation")
+            log.warning(text)
+            warnings.warn(text, StabilityWarning, stacklevel=5)
+            self.sol.message = text if not self.sol.message else self.sol.message + "; " + text
+        return t, H, ev
+
+    # ------------------------------------------------------------------ end
+    def _stop(self, failure, rotation_limit, why=None):
+        """Raise ``ConvergenceError`` for ``failure`` at the current step; ``why``: what could not
+        advance (default: the step fell below its floor)."""
+        sol = self.sol
+        hint = self.opt["advice"](failure, rotation_limit, self.H, self.t)
+        sol.converged = False
+        sol.message = str(failure)
+        why = why or f"could not advance from t = {self.t:.6g} (step fell below {self.dt_min:.3g})"
+        err = ConvergenceError(f"solve: {why}: {failure}{hint}", sol)
+        err.failure = failure
+        raise err from None
+
+    def abort(self, exc):
+        """Keep what converged: save it, close the output, attach ``.solution`` to ``exc``."""
+        if self.progress is not None:
+            self.progress.close()
+        sol = self.sol
+        if sol is not None:
+            if not isinstance(exc, ConvergenceError):   # interrupted: what converged stands (restartable)
+                sol.message = f"stopped by {type(exc).__name__}: {exc}" if str(exc) else \
+                    f"stopped by {type(exc).__name__}"
+            if getattr(exc, "solution", None) is None:
+                try:
+                    exc.solution = sol
+                except AttributeError:
+                    pass
+        if self.writer is not None:
+            try:
+                entries = getattr(self.writer, "entries", None)
+                if sol is not None and len(sol) and entries is not None and sol.n_steps not in entries:
+                    self.writer.write(sol, sol.n_steps)
+            except Exception as e:      # never hide the exception that ended the run
+                log.error("could not save the solution after %s: %s", type(exc).__name__, e)
+            finally:
+                try:
+                    self.writer.close()
+                except Exception as e:
+                    log.error("could not close the output after %s: %s", type(exc).__name__, e)
+
+    def finish(self):
+        self.progress.close()
+        if self.opt.get("stabilizer") is not None:
+            self._off_equilibrium()
+        if self.writer is not None:
+            self.writer.close()
+        return self.sol
+
+
+def _memory(resume):
+    """``(failed, wait)`` from a ``resume`` dict; a missing or damaged entry: no memory."""
+    try:
+        failed = float(resume.get("failed"))
+        wait = int(resume.get("wait"))
+    except (TypeError, ValueError, OverflowError):
+        return np.inf, EASY_RUN
+    if not (np.isfinite(failed) and failed > 0):
+        return np.inf, EASY_RUN
+    return failed, min(max(wait, EASY_RUN), WAIT_MAX)
+
+
+def _reference(resume, key="reference"):
+    """The ``easy_limit`` reference (or ``key``: another iteration count) of a ``resume`` dict;
+    missing or damaged: ``None``."""
+    try:
+        ref = int(resume.get(key))
+    except (TypeError, ValueError, OverflowError):
+        return None
+    return ref if ref >= 0 else None
+
+
+def _acts_at(system, H, t):
+    """Whether loads, prescribed motions or ``fix`` values act at ``t`` on the state ``H``."""
+    if len(system.load_scales) and system.loads_act(system.load_factors(t)):
+        return True
+    if len(system.prescribed_nodes) and np.any(system.prescribed_poses(t) != H[system.prescribed_nodes]):
+        return True
+    return any(dx != 0 for _, _, dx in system.fixed_value_increments(H, t)) if system.fix_values else False
+
+
