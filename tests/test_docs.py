@@ -61,17 +61,17 @@ def screenshot(page, tmp_path):
 
 
 def looks_like_a_page_with_the_picture(img):
-    """Dark text on a light page, and the twisted pair picture: its yellow wires (lit, so
-    olive to yellow: red and green well above blue) and red contact points.  A broken image, or
-    a page of text and code without it (the API reference: 0 and 0), has neither."""
+    """Dark text on a light page, and the twisted pair picture: its wires coloured by utilisation
+    (mostly the dark purple of viridis' low end) and red contact points.  A broken image, or a page
+    of text and code without it (the API reference: 0 and 0), has neither."""
     grey = img.mean(axis=2)
     assert img.shape == (900, 1200, 3)
     assert (grey > 230).mean() > 0.5, "not a light page"
     assert (grey < 100).mean() > 0.005, "no text on the page"
     r, g, b = np.moveaxis(img.astype(int), 2, 0)
-    yellow = ((r > 90) & (g > 90) & (b < 0.45 * np.minimum(r, g))).sum()
+    purple = ((r > 40) & (r < 110) & (g < 40) & (b > 60) & (b < 140)).sum()
     red = ((r > 120) & (g < 50) & (b < 50)).sum()
-    assert yellow > 1000 and red > 100, f"the twisted pair picture is not shown ({yellow} yellow, {red} red pixels)"
+    assert purple > 300 and red > 100, f"the twisted pair picture is not shown ({purple} purple, {red} red pixels)"
 
 
 @pytest.mark.slow
