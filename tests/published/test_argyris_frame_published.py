@@ -15,7 +15,6 @@ from beamsolver.nonlinear.definiteness import negative_eigenvalues
 from scenes import argyris_frame
 
 
-@pytest.mark.slow
 @pytest.mark.parametrize("line_search", [True, False])
 def test_imperfect_frame_follows_the_stable_buckled_path(line_search):
     m, b = argyris_frame(1.15)

@@ -27,7 +27,6 @@ def _ratio(sol, rope, t_out, T_hold):
     return abs(float(np.dot(sol.reaction(rope.last)[:3], t_out))) / T_hold
 
 
-@pytest.mark.slow
 def test_full_wrap_on_a_helix_touching_the_post():
     m, rope, t_out = capstan(**HELIX)
     sol = bs.solve(m, steps=8, verbose=False)
