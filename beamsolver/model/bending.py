@@ -23,7 +23,7 @@ from typing import Callable
 import numpy as np
 
 from ..errors import InputError
-from .model import Beam
+from .model import Beam, _constant
 from .motion import rotation
 from .validation import CheckedScalar
 
@@ -61,15 +61,7 @@ class BendingFixture:
 
 
 def _function(value, what):
-    if callable(value):
-        return CheckedScalar(value, what)
-    try:
-        c = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{what} must be a number or a function t -> float, got {value!r}") from None
-    if not np.isfinite(c):
-        raise InputError(f"{what} must be finite, got {value!r}")
-    return lambda t: c
+    return CheckedScalar(value, what) if callable(value) else _constant(value, what)
 
 
 def bending_fixture(strand_or_beams, curvature, pull, axis="y", model=None):

@@ -1,7 +1,13 @@
 """Scenes of the published cases (tests/published/test_*.py): built here once, solved by the tests."""
+import sys
+from pathlib import Path
+
 import numpy as np
 
 import beamsolver as bs
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "examples"))
+from limit_points import argyris_frame  # noqa: E402,F401  (Argyris' frame, the example's scene)
 
 
 def column(n=16, ratio=1.1, kick=0.01, EI3=1.0, EI2=4.0, EA=1e7):
@@ -64,15 +70,3 @@ def capstan(mu, theta, R, r, n_arc, pitch=0.0, polyline=False, EA=1e5, EI=1e-5, 
     return m, rope, ta[-1]
 
 
-def argyris_frame(F, imperfection=1e-4, n=10):
-    """Argyris' right-angle frame (examples/limit_points.argyris_frame): legs of 240 mm, section
-    30 x 0.6 mm, E = 71240 N/mm^2, nu = 0.31, clamped at one end, tip force ``F`` (N) in plane with
-    ``imperfection F`` out of plane.  Returns ``(model, tip beam)``."""
-    m = bs.Model()
-    sec = bs.Section.rectangular(width=0.6, height=30.0, E=71240.0, nu=0.31)
-    a = m.add_beam(bs.geometry.straight((0, 0, 0), (0, 240, 0), n, e2=(0, 0, 1)), sec)
-    b = m.add_beam(bs.geometry.straight((0, 240, 0), (240, 240, 0), n, e2=(0, 0, 1)), sec)
-    m.join(a.last, b.first)
-    m.clamp(a.first)
-    m.add_load(b.last, force=(0, F, imperfection * F))
-    return m, b
