@@ -11,7 +11,7 @@ import pytest
 
 import beamsolver as bs
 from beamsolver import failures
-from beamsolver.driver import CONTINUE, CONVERGED, DIVERGED, MAX_ITER
+from beamsolver.nonlinear.convergence import CONTINUE, CONVERGED, DIVERGED, MAX_ITER
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 from limit_points import argyris_frame  # noqa: E402

@@ -44,8 +44,9 @@ import scipy.sparse.linalg as spla
 
 from .._jit import jit
 from ..errors import InputError
+from ..failures import SingularTangent
 
-__all__ = ["factorize", "Solver", "SingularMatrixError", "available", "permutation_sign", "BACKENDS", "DEFAULT"]
+__all__ = ["factorize", "factorize_tangent", "Solver", "SingularMatrixError", "available", "permutation_sign", "BACKENDS", "DEFAULT"]
 
 BACKENDS = ("splu", "splu-rcm", "pardiso", "auto")
 DEFAULT = "auto"          # splu for beams and small scenes; splu-rcm/pardiso for large bundles
@@ -98,6 +99,36 @@ def factorize(K, backend=None):
     PARDISO's symbolic analysis.
     """
     return Solver(backend).factorize(K)
+
+
+def factorize_tangent(K, solver=None, what="singular tangent"):
+    """``solver.factorize(K)`` (default a fresh ``Solver()``) as a factor whose singularity, found
+    by the factorisation or by a solve (pardiso), is the typed step failure
+    ``failures.SingularTangent(f"{what} ({error})")``: the one wrapper of the Newton loop, the
+    arc-length solves and the branch switch.  The factor keeps the back-end's ``det_sign`` and
+    ``factor_nnz`` where it has them."""
+    try:
+        return _Typed((solver if solver is not None else Solver()).factorize(K), what)
+    except SingularMatrixError as e:
+        raise SingularTangent(f"{what} ({e})") from None
+
+
+class _Typed:
+    """A back-end factor whose ``solve`` raises ``SingularTangent`` (``factorize_tangent``)."""
+
+    def __init__(self, lu, what):
+        self.lu, self.what = lu, what
+
+    def solve(self, b):
+        try:
+            return self.lu.solve(b)
+        except SingularMatrixError as e:       # pardiso reports singularity at the solve
+            raise SingularTangent(f"{self.what} ({e})") from None
+
+    def __getattr__(self, name):               # det_sign, factor_nnz of the back-end, if it has them
+        if name == "lu":
+            raise AttributeError(name)
+        return getattr(self.lu, name)
 
 
 class Solver:

@@ -32,10 +32,10 @@ from ..nonlinear import linsolve
 from ..model import motion_path
 from ..lie import se3
 from ..errors import InputError
-from ..failures import AugmentationFailed, Diverged, NonFinite, NotConverged, SingularTangent, StepFailed
+from ..failures import AugmentationFailed, NonFinite, SingularTangent, StepFailed
 from .steps import MAX_OUTER, STEP_TOLERANCE, Run
 
-__all__ = ["ArcLength", "arc_length_options", "check_arc_length_arguments", "ArcLengthRun", "sphere_root",
+__all__ = ["ArcLength", "arc_length_options", "check_arc_length_arguments", "ArcLengthRun", "Sphere", "sphere_root",
            "next_arc_length", "rate", "RATE_STEP", "TURN_BACK"]
 
 log = logging.getLogger("beamsolver")
@@ -172,6 +172,46 @@ def rate(problem, H, t, ev, delta, t_start):
     return out
 
 
+class Sphere:
+    """The arc-length constraint of one step for ``Newton.iterate`` (``nonlinear.newton.Constraint``):
+    every correction is ``dz_r + dt dz_t`` (``ArcLengthRun.solve2``) with ``dt`` the root of the
+    sphere of radius ``ds`` (``sphere_root``), or ``dt = t_fixed - t`` with ``t_fixed`` given;
+    the iterate then moves with its constrained nodes onto their targets at ``t + dt``
+    (``ArcLengthRun.move``).  ``w``, ``tau``: the step's scaled increment and pseudo-time change so
+    far (updated); ``linearised``: the iterations that took the linearised constraint."""
+    final = True
+    moves = True
+    damped = False
+    watch_sign = False
+
+    def __init__(self, run, w, tau, ds, t_fixed=None):
+        self.run, self.w, self.tau, self.ds, self.t_fixed = run, w, tau, ds, t_fixed
+        self.linearised = 0
+        self.dt = None
+
+    def direction(self, newton, ev, H, t):
+        run = self.run
+        dz_r, dz_t = run.solve2(ev, H, t)
+        if self.t_fixed is None:
+            dt, lin = sphere_root(self.w, self.tau, run.S * dz_r, run.S * dz_t, run.psi, self.ds)
+            self.linearised += lin
+        else:
+            dt = self.t_fixed - t
+        dzf = dz_r + dt * dz_t
+        self.w, self.tau, self.dt = self.w + run.S * dzf, self.tau + dt, dt
+        return None, dzf
+
+    def move(self, newton, H, t, dzf):
+        inc = newton.conv.increment_ratio(newton.full(dzf), newton.L_ref)
+        return self.run.move(H, t, dzf, t + self.dt), t + self.dt, inc
+
+    def accept(self, newton, H):
+        pass
+
+    def stats(self):
+        return dict(linearised=self.linearised)
+
+
 class ArcLengthRun(Run):
     """``stepping.Run`` with ``loop`` following the path by arc length (see the module docstring)."""
 
@@ -186,24 +226,28 @@ class ArcLengthRun(Run):
         self.S = scale[sys.free_dofs]           # unit-free weights of the free increments
         self.prev = None                        # (w, tau) of the last converged step
         self._converged = None                  # (H, t, evaluation) of the last converged iterate
-        self.t_iter = float(grid[0])            # pseudo-time of the current iterate (failure messages)
+
+    @property
+    def t_iter(self):
+        """Pseudo-time of the last evaluated iterate (failure messages)."""
+        t = self.newton.t_evaluated
+        return float(self.grid[0]) if t is None else t
 
     # ------------------------------------------------------------ linear algebra
-    def _solve2(self, ev, t):
-        """``(dz_r, dz_t)``: one factorisation of ``K_ff``, two solves (``-r_f`` and ``-dr_f/dt``)."""
+    def solve2(self, ev, H, t):
+        """``(dz_r, dz_t)`` at the iterate ``(H, t)`` (evaluation ``ev``): one factorisation of
+        ``K_ff``, two solves (``-r_f`` and ``-dr_f/dt``)."""
         newton, sys = self.newton, self.sys
         t0 = time.perf_counter()
         K = self.problem.tangent(ev)
-        drdt = rate(self.problem, self.Hcur, t, ev, RATE_STEP * self.span, float(self.grid[0]))
+        drdt = rate(self.problem, H, t, ev, RATE_STEP * self.span, float(self.grid[0]))
         if not np.all(np.isfinite(drdt)):
             raise NonFinite(f"the pseudo-time rate dr/dt is not finite at t = {t:.6g}")
         t1 = time.perf_counter()
         try:
-            lu = newton.linsolver.factorize(K)
+            lu = linsolve.factorize_tangent(K, newton.linsolver)
             dz_r = lu.solve(-ev.r[sys.free_dofs])
             dz_t = lu.solve(-drdt)
-        except linsolve.SingularMatrixError as e:
-            raise SingularTangent(f"singular tangent ({e})") from None
         finally:
             newton.timings["assembly"] += t1 - t0
             newton.timings["linear_solve"] += time.perf_counter() - t1
@@ -211,17 +255,11 @@ class ArcLengthRun(Run):
             raise SingularTangent("the linear solve returned non-finite values")
         return dz_r, dz_t
 
-    def _full(self, dzf):
-        """Increments ``(n, 6)`` of all nodes from those of the free unknowns (zero elsewhere)."""
-        dz = np.zeros(6 * self.sys.n_nodes)
-        dz[self.sys.free_dofs] = dzf
-        return dz.reshape(-1, 6)
-
-    def _move(self, H, t, dzf, t_new):
+    def move(self, H, t, dzf, t_new):
         """Free nodes by ``dzf``, constrained ones onto their targets at ``t_new`` (prescribed poses
         exactly, ``fix(values=)`` components by their increments, as the load path's predictor)."""
         sys = self.sys
-        dz = self._full(dzf)
+        dz = self.newton.full(dzf)
         p = sys.prescribed_nodes
         H_target = sys.prescribed_poses(t_new) if len(p) else None
         if len(p):
@@ -229,67 +267,29 @@ class ArcLengthRun(Run):
         targets = sys.fixed_value_increments(H, t_new, t) if sys.fix_values else []
         for node, comp, dx in targets:
             dz[node, comp] = dx
-        H = self.problem.update(H, dz)
-        if len(p):
-            H[p] = H_target
-        if targets:
-            sys.enforce_fixed_values(H, t_new)
-        sys.sync_members(H)
-        return H
-
-    def _ratio(self, ev):
-        """``Convergence.residual_ratio`` of the free residual of ``ev``."""
-        newton = self.newton
-        rf = ev.r[self.sys.free_dofs]
-        return newton.conv.residual_ratio(rf[newton.fu], rf[newton.fw], *newton.conv.scales(ev, newton.L_ref))
+        return self.newton.reach_targets(H, dz, H_target, bool(targets), t_new)
 
     def _tangent_at(self, H, t):
         """``dz/dt`` ``(n_free,)`` along the path at the equilibrium ``(H, t)``; without contributions
         (contact) the evaluation of the converged iterate is reused (committing a contribution's
         history may change the tangent)."""
-        self.Hcur = H
         last = self._converged
         if last is not None and last[0] is H and last[1] == t and not self.problem.contributions:
             ev = last[2]
         else:
             ev = self.newton.evaluate(H, t)
-        return self._solve2(ev, t)[1]
+        return self.solve2(ev, H, t)[1]
 
     # ------------------------------------------------------------ one step
     def _correct(self, H, t, w, tau, ds, t_fixed=None):
-        """Newton iterations from the iterate ``(H, t)`` of a step (scaled increment ``w``, pseudo-time
-        change ``tau`` so far) onto the sphere of radius ``ds``, or at ``t = t_fixed`` if given.
-        Returns ``(H, t, w, tau, ev, stats)``; raises a ``failures.StepFailed``."""
-        newton, conv = self.newton, self.newton.conv
-        floor = conv.floor(H, newton.L_ref)
-        residuals, last_inc, linearised = [], np.inf, 0
-        for it in range(conv.max_iter + 1):
-            self.Hcur, self.t_iter = H, t
-            ev = newton.evaluate(H, t)
-            ratio = self._ratio(ev)
-            residuals.append(ratio)
-            if newton.callback is not None:
-                newton.callback(dict(t=t, iteration=it, residual=ratio, poses=H))
-            verdict = conv.decide(ratio, last_inc, it, floor)
-            if verdict == "converged":
-                newton.last_evaluation = ev
-                self._converged = (H, t, ev)
-                return H, t, w, tau, ev, dict(iterations=it, residuals=residuals, linearised=linearised)
-            if verdict != "continue":
-                raise (NotConverged(f"no convergence in {conv.max_iter} iterations (scaled residual "
-                                    f"{ratio:.3g})", ratio) if verdict == "max_iter"
-                       else Diverged(f"diverging (scaled residual {ratio:.3g})"))
-            dz_r, dz_t = self._solve2(ev, t)
-            if t_fixed is None:
-                dt, lin = sphere_root(w, tau, self.S * dz_r, self.S * dz_t, self.psi, ds)
-                linearised += lin
-            else:
-                dt = t_fixed - t
-            dzf = dz_r + dt * dz_t
-            w, tau = w + self.S * dzf, tau + dt
-            last_inc = conv.increment_ratio(self._full(dzf), newton.L_ref)
-            H, t = self._move(H, t, dzf, t + dt), t + dt
-        raise AssertionError("unreachable: decide() returns MAX_ITER at iteration max_iter")
+        """Newton iterations (``Newton.iterate`` under the ``Sphere`` constraint) from the iterate
+        ``(H, t)`` of a step (scaled increment ``w``, pseudo-time change ``tau`` so far) onto the
+        sphere of radius ``ds``, or at ``t = t_fixed`` if given.  Returns ``(H, t, w, tau, ev,
+        stats)``; raises a ``failures.StepFailed``."""
+        sphere = Sphere(self, w, tau, ds, t_fixed)
+        H, t, ev, stats = self.newton.iterate(H, t, sphere)
+        self._converged = (H, t, ev)
+        return H, t, sphere.w, sphere.tau, ev, stats
 
     def _predict(self, v, ds):
         """Pseudo-time change of the predictor along ``v = dz/dt`` with arc length ``ds``, in the
@@ -315,7 +315,7 @@ class ArcLengthRun(Run):
         crossing = t0 < self.t_end <= t0 + tau * (1.0 + STEP_TOLERANCE)
         if crossing:                              # the last step: load control onto t_end
             tau = self.t_end - t0
-        H = self._move(H0, t0, tau * v, t0 + tau)
+        H = self.move(H0, t0, tau * v, t0 + tau)
         out = self._correct(H, t0 + tau, self.S * tau * v, tau, ds, self.t_end if crossing else None)
         H, t, w, tau, ev, stats = self._augment(out)
         if not crossing and t0 < self.t_end <= t:    # passed t_end on the sphere: redo by load control
@@ -332,7 +332,7 @@ class ArcLengthRun(Run):
         """The step from ``(H0, t0)`` with ``t = t_end`` held (predictor along ``v``)."""
         self.problem.begin_step(H0, t0)              # forget the first attempt's outer iterations
         tau = self.t_end - t0
-        H = self._move(H0, t0, tau * v, self.t_end)
+        H = self.move(H0, t0, tau * v, self.t_end)
         out = self._augment(self._correct(H, self.t_end, self.S * tau * v, tau, ds, self.t_end))
         self.newton.check_continuity(H0, out[0])
         return out

@@ -17,7 +17,7 @@ from . import bifurcation
 from ..nonlinear import linsolve
 from ..nonlinear.definiteness import negative_eigenvalues
 from ..errors import StabilityWarning
-from ..failures import SingularTangent, StepFailed
+from ..failures import StepFailed
 from ..nonlinear.modes import lowest_modes
 
 __all__ = ["wanted", "switch", "locate", "record_modes", "OPTIONS", "BISECTION"]
@@ -50,10 +50,7 @@ def record_modes(system, stats, H, K, k):
 
 
 def _factorize(K):
-    try:
-        return linsolve.Solver().factorize(K)
-    except linsolve.SingularMatrixError as e:
-        raise SingularTangent(f"branch switching: singular bordered tangent ({e})") from None
+    return linsolve.factorize_tangent(K, what="branch switching: singular bordered tangent")
 
 
 def _weights(system, phi):

@@ -1,0 +1,517 @@
+"""The one Newton loop of beamsolver: ``Newton.iterate`` with a pluggable constraint.
+
+One iteration (``iterate``): evaluate the ``problem.Problem`` at the iterate (residual,
+tangent; ``evaluate`` checks it is finite and that no element turns past
+``MAX_ELEMENT_ROTATION``), scale the residual and ask ``Convergence.decide`` for the
+``Verdict``; then the constraint gives the correction of the free unknowns (``direction``:
+one factorisation of the tangent, ``linsolve.factorize_tangent``) and, where it moves the
+constrained nodes or the pseudo-time, the next iterate (``move``).  Otherwise the correction
+is damped on the size of the Newton correction for a smooth problem (``Newton._damped``) or
+by a backtracking line search on the scaled residual (``Newton._line_search``).
+
+Constraints (the ``Constraint`` protocol):
+
+- ``FixedTime`` (load stepping, ``Newton.step``): ``t`` held at the step's end; the first
+  iteration carries the prescribed motions and ``fix(values=)`` targets into the free unknowns
+  through the tangent (``K_ff dz_f = -r_f - K_fc dz_c``), later ones are Newton ``K dz = -r``;
+- ``stepping.arclength.Sphere``: ``t`` an unknown on Crisfield's sphere (or held at the end).
+
+Elements may not turn by more than ``MAX_ELEMENT_ROTATION`` (nor pass pi within a step:
+``check_continuity``): such steps fail with a message saying how many elements the beam needs.
+Failures are typed (``beamsolver.failures``).
+"""
+import logging
+import time
+from typing import NamedTuple, Protocol
+
+import numpy as np
+
+from .. import elements
+from ..failures import DampingStalled, Diverged, NonFinite, NotConverged, RotationLimit, SingularTangent, StepFailed
+from ..lie import se3
+from . import linsolve
+from .convergence import CONTINUE, CONVERGED, MAX_ITER, Convergence, Verdict
+
+__all__ = ["Newton", "Constraint", "FixedTime", "Convergence", "Verdict", "relative_rotations", "angle",
+           "largest_element_rotation", "MAX_ELEMENT_ROTATION"]
+
+log = logging.getLogger("beamsolver")
+
+MAX_ELEMENT_ROTATION = elements.MAX_ELEMENT_ROTATION   # an iterate turning an element further is rejected
+LS_GROWTH = 10.0                     # full Newton steps are kept unless the merit grows this much
+DAMPING_MIN = 1.0 / 64.0             # shortest damped Newton step (smooth problems)
+STALL_RATIO = 1.5                    # undamped fallback if the shortest damped step grows the correction less
+SQRT3 = np.sqrt(3.0)                 # |w|_2 <= SQRT3 |w|_inf (the rotation check's shortcut)
+CONTINUITY_MARGIN = 1e-6             # check_continuity's shortcut: far above the ~1e-8 round-off of arccos at 0
+
+
+class Constraint(Protocol):
+    """What closes the Newton system of one step besides equilibrium (``Newton.iterate``).
+
+    ``final``: whether the iterate may be called converged (the load step's predictor must be
+    applied first); ``moves``: whether the next iterate comes from ``move`` (else the loop's
+    damping / line search updates the free unknowns); ``damped``: whether the loop may damp
+    the correction; ``watch_sign``: whether the first tangent's determinant sign is read
+    (``Newton.indefinite_seen``)."""
+    final: bool
+    moves: bool
+    damped: bool
+    watch_sign: bool
+
+    def direction(self, newton, ev, H, t):
+        """``(lu, dzf)``: the factorised tangent (or ``None``) and the correction ``(n_free,)``."""
+
+    def move(self, newton, H, t, dzf):
+        """``(H, t, increment)``: the next iterate and the ``increment_ratio`` of the correction
+        (``inf`` where it is no Newton increment)."""
+
+    def accept(self, newton, H):
+        """Checks of a converged iterate (raise a ``failures.StepFailed`` to refuse it)."""
+
+    def stats(self):
+        """The constraint's entries of the step's statistics."""
+
+
+class FixedTime:
+    """Load stepping: the pseudo-time ``t`` held; the first iteration carries the constrained
+    nodes onto their targets at ``t`` (``H_target``: the prescribed poses, ``None`` if none) with
+    the coupling ``K_fc dz_c`` (the predictor), later ones are Newton corrections, damped or
+    line-searched by the loop.  A converged iterate is refused if an element's relative rotation
+    may have passed pi since ``H`` (``Newton.check_continuity``)."""
+    damped = True
+    watch_sign = True
+
+    def __init__(self, newton, H, t, t_prev, H_target):
+        self.H_start, self.H_target = H, H_target
+        self.dz_c, self.targets = newton.constrained_increments(H, t, t_prev, H_target)
+
+    @property
+    def final(self):
+        return self.dz_c is None
+
+    @property
+    def moves(self):
+        return self.dz_c is not None
+
+    def direction(self, newton, ev, H, t):
+        return newton.direction(ev, self.dz_c)
+
+    def move(self, newton, H, t, dzf):
+        H = newton.reach_targets(H, newton.full(dzf) + self.dz_c, self.H_target, bool(self.targets), t)
+        self.dz_c = None
+        return H, t, np.inf
+
+    def accept(self, newton, H):
+        newton.check_continuity(self.H_start, H)
+
+    def stats(self):
+        return {}
+
+
+def relative_rotations(system, H):
+    """Rotations ``R_i^T R_j`` of the node pairs an element represents by a logarithm
+    (``system.rotation_pairs``: one per element for two-node elements), ``(n_pairs, 3, 3)``."""
+    en = system.rotation_pairs
+    return np.swapaxes(H[en[:, 0], :3, :3], 1, 2) @ H[en[:, 1], :3, :3]
+
+
+def angle(R):
+    """Rotation angles in ``[0, pi]`` of ``(..., 3, 3)`` rotation matrices."""
+    return np.arccos(np.clip(0.5 * (np.trace(R, axis1=-2, axis2=-1) - 1.0), -1.0, 1.0))
+
+
+def largest_element_rotation(system, H):
+    """Largest rotation angle between the two nodes of an element at poses ``H``."""
+    if system.n_elements == 0:
+        return 0.0
+    return float(angle(relative_rotations(system, H)).max())
+
+
+class _Measured(NamedTuple):
+    """An evaluation (``problem.Evaluation``) with its residual scales and scaled residual, and,
+    once computed, its factorised tangent ``lu``, Newton correction ``dzf`` of the free unknowns
+    and that correction's norm."""
+    ev: object
+    scales: tuple
+    ratio: float
+    lu: object = None
+    dzf: object = None
+    norm: float = None
+
+
+class Newton:
+    """Newton iterations of one step (``iterate`` under a ``Constraint``; ``step``: load stepping) on a
+    ``problem.Problem`` with the ``Convergence`` ``conv``; ``evaluate`` is the checked, timed evaluation it uses (also for branch switching),
+    ``last_evaluation`` that of the last converged state.  ``timings`` accumulates the wall time
+    of ``assembly`` (residual, tangent, sparse matrix), of each of the problem's contributions
+    (``Problem.timing_names``, part of assembly) and ``linear_solve`` (factorisation and solves)
+    until ``reset_timings``."""
+
+    def __init__(self, problem, conv, line_search=True, callback=None):
+        self.problem = problem
+        self.sys = system = problem.system
+        self.conv = conv
+        self.line_search = line_search
+        self.callback = callback
+        n = system.n_nodes
+        dof_u = np.zeros((n, 6), dtype=bool)
+        dof_u[:, :3] = True
+        fu = dof_u.ravel()[system.free_dofs]
+        self.fu, self.fw = np.flatnonzero(fu), np.flatnonzero(~fu)
+        self._dofs_u, self._dofs_w = system.free_dofs[self.fu], system.free_dofs[self.fw]   # in all 6 n unknowns
+        self.L_ref = system.length_scale
+        # the rotation check's shortcut bound, a margin far above the round-off of |w|
+        self._smallest_limit = (1.0 - 1e-9) * float(system.rotation_limit.min(initial=np.inf))
+        self.linsolver = linsolve.Solver()    # solve(linear_solver=...) replaces it
+        self.stall_ratio = np.inf             # correction growth of the shortest damped trial
+        self.indefinite_seen = False          # the step's first tangent had det < 0 (or a back-end that cannot tell)
+        self.watch_sign = False               # whether to look (stepping.Run: conservative problems)
+        self.t_evaluated = None               # t of the last evaluation (failure messages)
+        self.last_evaluation = None           # of the last converged state
+        self.reset_timings()
+
+    def reset_timings(self):
+        self.timings = dict(assembly=0.0, linear_solve=0.0, **dict.fromkeys(self.problem.timing_names, 0.0))
+
+    def _ratio(self, r, scales):
+        return self.conv.residual_ratio(r[self._dofs_u], r[self._dofs_w], *scales)
+
+    def residual_ratio(self, ev, r=None):
+        """Scaled residual (``Convergence.residual_ratio``) of the residual ``r`` ``(6 n,)`` (default
+        ``ev.r``) with the force scales of the evaluation ``ev``."""
+        return self._ratio(ev.r if r is None else r, self.conv.scales(ev, self.L_ref))
+
+    def _measured(self, ev):
+        """``ev`` with its residual scales and scaled residual (``_Measured``; no direction yet)."""
+        scales = self.conv.scales(ev, self.L_ref)
+        return _Measured(ev, scales, self._ratio(ev.r, scales))
+
+    def at_rest(self, ev, H, t):
+        """Whether the given poses ``H`` (evaluated in ``ev`` at ``t``) are an equilibrium by
+        Newton's tests (``Convergence.decide``): the scaled residual, else the Newton correction
+        one iteration would make, against its round-off floor.  A state Newton could not start
+        from (a singular tangent, a refused contact) counts as at rest: it is kept as given."""
+        if not np.all(np.isfinite(ev.r)) or self._ratio(ev.r, self.conv.scales(ev, self.L_ref)) <= self.conv.rtol:
+            return True
+        try:
+            _, dzf = self.direction(self.problem.evaluate(H, t, tangent=True))
+        except StepFailed:
+            return True
+        return self._inc(dzf) <= max(self.conv.dtol, self.conv.floor(H, self.L_ref))
+
+    def _merit(self, r, scales):
+        rf = r[self.sys.free_dofs]
+        F, M = scales
+        return float(np.sum((rf[self.fu] / F) ** 2) + np.sum((rf[self.fw] / M) ** 2))
+
+    def _element_label(self, e):
+        """``element e (element j of Beam b)`` for a global element id."""
+        for b in self.sys.model.beams:
+            if b.elements[0] <= e <= b.elements[-1]:
+                return f"element {e} (no. {e - b.elements[0]} of the {b.n_elements} of Beam {b.id})"
+        return f"element {e}"
+
+    def _check_rotation(self, state):
+        w = state.h[:, 3:]
+        # |w| <= sqrt(3) max|w_i|: far below every limit, nothing to measure
+        if len(w) and np.abs(w).max() * SQRT3 < self._smallest_limit:
+            return
+        ang = se3.rotation_angle(w)
+        limit = self.sys.rotation_limit          # of each element's type, MAX_ELEMENT_ROTATION for se3-2
+        worst = int(np.argmax(ang - limit)) if len(ang) else 0
+        if len(ang) and ang[worst] > limit[worst]:
+            raise RotationLimit(f"{self._element_label(worst)} turns by {ang[worst]:.4f} rad within one element "
+                                f"(limit MAX_ELEMENT_ROTATION = {limit[worst] / np.pi:.2g} pi = "
+                                f"{limit[worst]:.4f} rad; an element cannot turn by pi): refine the mesh")
+
+    def check_continuity(self, H0, H1):
+        """Refuse a step over which an element's relative rotation may have passed through pi.
+
+        The element only sees ``log(H_A^-1 H_B)``, whose angle lies in ``[0, pi]``: an element
+        turned past pi within one load step would look like one turned the short way round (a
+        silent wrong answer).  Passing pi and coming back to the angle ``t1`` from ``t0`` takes a
+        rotation of at least ``(pi - t0) + (pi - t1)``, so a step whose relative rotations change
+        by less than that (the geodesic angle between old and new) cannot have passed it.
+        """
+        if self.sys.n_elements == 0:
+            return
+        R0, R1 = relative_rotations(self.sys, H0), relative_rotations(self.sys, H1)
+        a0, a1 = angle(R0), angle(R1)
+        # the change is at most a0 + a1: below pi (a margin above the arccos round-off) nothing can pass
+        if (a0 + a1).max() < np.pi - CONTINUITY_MARGIN:
+            return
+        change = angle(np.swapaxes(R0, 1, 2) @ R1)
+        bad = np.flatnonzero(change >= (np.pi - a0) + (np.pi - a1) - 1e-9)
+        if len(bad):
+            e = int(bad[np.argmax(change[bad])])
+            raise RotationLimit(f"{self._element_label(self.sys.pair_element[e])} turns by {change[e]:.3f} rad "
+                                "within one element in "
+                                "one load step and may have passed pi, which an element cannot represent: "
+                                "use smaller steps or refine the mesh")
+
+    def _norm(self, dzf):
+        """Norm of free increments, translations in units of the model size (unit-independent)."""
+        return float(np.sqrt(np.sum((dzf[self.fu] / self.L_ref) ** 2) + np.sum(dzf[self.fw] ** 2)))
+
+    def _inc(self, dzf):
+        """``Convergence.increment_ratio`` of free increments."""
+        return max(np.abs(dzf[self.fu]).max(initial=0.0) / self.L_ref, np.abs(dzf[self.fw]).max(initial=0.0))
+
+    def direction(self, ev, dz_c=None):
+        """``(lu, dzf)``: the factorised tangent of ``ev`` and the Newton increment of the free
+        unknowns ``(n_free,)`` (with the prescribed-motion coupling of ``dz_c`` ``(n, 6)``)."""
+        problem = self.problem
+        t0 = time.perf_counter()
+        rhs = -ev.r[self.sys.free_dofs]
+        if dz_c is not None:
+            rhs -= problem.coupling(ev, dz_c)
+        K = problem.tangent(ev)
+        t1 = time.perf_counter()
+        try:
+            lu = linsolve.factorize_tangent(K, self.linsolver)
+            dzf = lu.solve(rhs)
+        finally:
+            t2 = time.perf_counter()
+            self.timings["assembly"] += t1 - t0
+            self.timings["linear_solve"] += t2 - t1
+        if not np.all(np.isfinite(dzf)):
+            raise SingularTangent("the linear solve returned non-finite values")
+        return lu, dzf
+
+    def evaluate(self, H, t, tangent=True):
+        """``Problem.evaluate`` timed into ``timings`` and checked (finite residual, element rotations
+        below ``MAX_ELEMENT_ROTATION``: ``NonFinite`` / ``RotationLimit``); ``t_evaluated``: its ``t``."""
+        self.t_evaluated = t
+        t0 = time.perf_counter()
+        ev = self.problem.evaluate(H, t, tangent=tangent)
+        self.timings["assembly"] += time.perf_counter() - t0
+        for name, seconds in ev.timings.items():
+            self.timings[name] = self.timings.get(name, 0.0) + seconds
+        if not np.isfinite(ev.r).all():
+            raise NonFinite("the residual is not finite")
+        self._check_rotation(ev.state)
+        return ev
+
+    def constrained_increments(self, H, t, t_prev, H_target):
+        """Increments ``dz_c`` ``(n, 6)`` carrying the constrained nodes to their targets at ``t``
+        (``None`` if there is nothing to move) and the ``fix(values=)`` targets."""
+        sys = self.sys
+        targets = sys.fixed_value_increments(H, t, t_prev) if sys.fix_values else []
+        if not (len(sys.prescribed_nodes) or targets):
+            return None, targets
+        dz_c = np.zeros((sys.n_nodes, 6))
+        if len(sys.prescribed_nodes):
+            p = sys.prescribed_nodes
+            dz_c[p] = se3.log(se3.relative(H[p], H_target))
+        for node, comp, dx in targets:
+            dz_c[node, comp] = dx
+        return (dz_c if np.any(dz_c) else None), targets
+
+    def reach_targets(self, H, dz, H_target, fix_values, t):
+        """The predictor update: free nodes by ``dz`` ``(n, 6)``, constrained ones exactly onto their
+        targets at ``t`` (``H_target`` the prescribed poses; ``fix_values``: whether ``fix(values=)``
+        components are enforced)."""
+        sys = self.sys
+        H = self.problem.update(H, dz)
+        if len(sys.prescribed_nodes):
+            H[sys.prescribed_nodes] = H_target
+        if fix_values:
+            sys.enforce_fixed_values(H, t)
+        sys.sync_members(H)
+        return H
+
+    def step(self, H, t, H_target, t_prev=None):
+        """Solve for equilibrium at ``t`` (from the equilibrium ``H`` at ``t_prev``) by ``iterate``
+        with the ``FixedTime`` constraint; returns ``(H, ev, stats)`` (``ev`` the
+        ``problem.Evaluation`` of the converged state) or raises a ``failures.StepFailed``."""
+        H, _, ev, stats = self.iterate(H, t, FixedTime(self, H, t, t_prev, H_target))
+        return H, ev, stats
+
+    def iterate(self, H, t, constraint):
+        """Newton iterations from the iterate ``(H, t)`` under ``constraint`` (``Constraint``) until
+        ``Convergence.decide`` says converged; returns ``(H, t, ev, stats)`` (``ev`` the
+        ``problem.Evaluation`` of the converged state, ``stats`` its ``iterations``, ``residuals``
+        and the constraint's entries) or raises a ``failures.StepFailed``.
+
+        With ``line_search``, the Newton step of a smooth problem (``Problem.smooth``) is damped
+        on the Newton correction (``_damped``); otherwise the residual line search
+        ``_line_search`` is used (only where the constraint lets the loop update the iterate).
+        """
+        conv, problem = self.conv, self.problem
+        residuals = []
+        if constraint.watch_sign:
+            self.indefinite_seen = False
+        damped_its = 0
+        floor = conv.floor(H, self.L_ref)
+        damping = self.line_search and problem.smooth and constraint.damped
+        plain = False                # undamped Newton after the damped iteration stalled
+        last_inc = np.inf
+        ahead = None                 # the ``_Measured`` evaluation of an accepted trial (line search, damping)
+        lam = 1.0
+        rotation_streak = 0
+        stats_extra = {}
+        for it in range(conv.max_iter + 1):
+            ev, scales, ratio, lu, dzf, nrm = self._measured(self.evaluate(H, t)) if ahead is None else ahead
+            ahead = None
+            residuals.append(ratio)
+            log.debug("t = %.6g  iteration %d  scaled residual %.3e", t, it, ratio)
+            if self.callback is not None:
+                self.callback(dict(t=t, iteration=it, residual=ratio, poses=H))
+            verdict = conv.decide(ratio, last_inc, it, floor, final=constraint.final)
+            if verdict is CONVERGED:
+                constraint.accept(self, H)
+                if damped_its:
+                    stats_extra["damped"] = damped_its
+                self.last_evaluation = ev     # of the converged state (its tangent: stability check)
+                return H, t, ev, dict(iterations=it, residuals=residuals, **stats_extra, **constraint.stats())
+            if verdict is not CONTINUE:
+                raise self._failure(verdict, ratio)
+            if dzf is None:
+                lu, dzf = constraint.direction(self, ev, H, t)
+            if it == 0 and self.watch_sign and constraint.watch_sign:
+                # the first tangent K(H_n, t_n+1): indefinite where a step may jump
+                sign = getattr(lu, "det_sign", None)
+                self.indefinite_seen = sign is None or sign() < 0
+            if constraint.moves:
+                H, t, last_inc = constraint.move(self, H, t, dzf)
+                continue
+            dz = self.full(dzf)
+            if not damping:
+                last_inc = conv.increment_ratio(dz, self.L_ref)
+                if not self.line_search or plain:
+                    H = problem.update(H, dz)
+                    continue
+                H, ahead = self._line_search(H, dz, ev.r, scales, t)
+                continue
+            lam0 = min(1.0, 2.0 * lam)          # after a damped iteration, try twice its length
+            inc = conv.increment_ratio(dz, self.L_ref)
+            try:
+                H, lam, ahead, rotation = self._damped(H, dz, dzf, t, lam0, nrm, inc)
+            except DampingStalled:
+                if not self.stall_ratio <= STALL_RATIO:
+                    raise
+                # the shortest damped step leaves the Newton correction about as it is (a flat
+                # direction, not a poor linearisation): plain Newton from here on, as on smooth
+                # stable paths past which the damping test stalls; max_iter bounds it
+                log.debug("t = %.6g: damped Newton stalled (correction ratio %.3g); undamped Newton steps", t,
+                          self.stall_ratio)
+                damping, plain = False, True
+                stats_extra["undamped"] = it
+                last_inc = inc
+                H = problem.update(H, dz)
+                continue
+            damped_its += lam < 1.0
+            # the full step turned an element past the limit in two iterations running: the
+            # equilibrium itself needs it (refine) rather than an overshooting iterate
+            rotation_streak = rotation_streak + 1 if rotation is not None else 0
+            if rotation_streak >= 2:
+                raise rotation
+            last_inc = inc if lam == 1.0 else np.inf
+        raise AssertionError("unreachable: decide() returns MAX_ITER at iteration max_iter")
+
+    def _failure(self, verdict, ratio):
+        """The typed failure of a ``Convergence.decide`` verdict other than converged / continue."""
+        if verdict is MAX_ITER:
+            return NotConverged(f"no convergence in {self.conv.max_iter} iterations (scaled residual {ratio:.3g})",
+                                ratio)
+        return Diverged(f"diverging (scaled residual {ratio:.3g})")
+
+    def full(self, dzf):
+        """Increments ``(n, 6)`` of all nodes from those of the free unknowns (zero elsewhere)."""
+        dz = np.zeros(6 * self.sys.n_nodes)
+        dz[self.sys.free_dofs] = dzf
+        return dz.reshape(-1, 6)
+
+    def _damped(self, H, dz, dzf, t, lam, nrm=None, inc=None):
+        """Damped Newton update ``H exp(lam dz)`` (smooth problems).
+
+        A trial length is accepted when the Newton correction at the trial point is smaller than
+        the current one (``|dz(trial)| < |dz|``, translations scaled by the model size): an
+        affine-invariant test, blind to the huge but harmless axial-force residuals a slender
+        beam shows after a large rotation increment (the next iteration removes them), which
+        made the residual line search crawl.  The trial's tangent, factorisation and
+        correction are those of the next iteration, so an accepted full step costs nothing
+        extra: where plain Newton converges, this is plain Newton.  Otherwise the length is
+        halved (a trial that is not finite, is singular or turns an element past the limit is
+        rejected too) down to ``DAMPING_MIN``.
+
+        ``nrm``, ``inc``: ``_norm(dzf)`` and ``_inc(dzf)`` if known.  Returns ``(H, lam, ahead,
+        rotation)``: ``ahead`` the trial's ``_Measured`` evaluation (its ``lu``, ``dzf``,
+        ``norm`` ``None`` if it converged), ``rotation`` the rotation-limit failure of the full first
+        trial, if that is what rejected it.
+        """
+        problem, conv = self.problem, self.conv
+        inc = self._inc(dzf) if inc is None else inc
+        if inc <= 1e3 * conv.dtol:     # round-off level: nothing to damp
+            return problem.update(H, dz), 1.0, None, None
+        if nrm is None:
+            nrm = self._norm(dzf)
+        rotation = None
+        failure = None
+        first = True
+        while True:
+            self.stall_ratio = np.inf
+            H1 = problem.update(H, dz if lam == 1.0 else lam * dz)
+            try:
+                m = self._measured(self.evaluate(H1, t))
+                if m.ratio <= conv.rtol:
+                    return H1, lam, m, None
+                lu1, d1 = self.direction(m.ev)
+                nrm1 = self._norm(d1)
+                self.stall_ratio = nrm1 / nrm
+                if nrm1 < nrm or self._inc(d1) <= conv.dtol:
+                    return H1, lam, m._replace(lu=lu1, dzf=d1, norm=nrm1), rotation
+            except StepFailed as e:
+                failure = e
+                if first and e.rotation:
+                    rotation = e
+            first = False
+            lam *= 0.5
+            if lam < DAMPING_MIN:
+                if failure is not None and failure.rotation:
+                    raise failure
+                raise DampingStalled(f"damped Newton stalled: no step length down to {DAMPING_MIN:g} of the "
+                                     "Newton increment reduces the Newton correction")
+
+    def _line_search(self, H, dz, r0, scales, t):
+        """Backtracking on the scaled residual (problems that are not smooth; the others use the
+        damped Newton of ``_damped``: a piecewise smooth residual made its natural-monotonicity
+        test accept steps that later stalled, e.g. in the twisted pair).
+
+        Returns ``(H1, ahead)``: the accepted poses and, when the full step is accepted, its
+        ``_Measured`` evaluation (with tangent: the next iteration's, computed once; ``None`` otherwise).
+        The residual does not depend on whether the tangent is computed."""
+        problem = self.problem
+        phi0 = self._merit(r0, scales)
+        H1 = problem.update(H, dz)
+        if phi0 <= (10.0 * self.conv.rtol) ** 2 * len(self.sys.free_dofs):
+            return H1, None
+        alpha = 1.0
+        best = (np.inf, H1)
+        for _ in range(8):
+            ev1 = None
+            try:
+                # the full step is nearly always accepted: evaluated with the tangent the next
+                # iteration needs; the backtracked trials need the residual only
+                ev1 = self.evaluate(H1, t, tangent=alpha == 1.0)
+                phi = self._merit(ev1.r, scales)
+            except StepFailed:
+                phi = np.inf
+            if phi < best[0]:
+                best = (phi, H1)
+            # Newton may raise the residual for a while: only a blow-up (factor
+            # LS_GROWTH) triggers backtracking, which then asks for a decrease
+            if phi <= (LS_GROWTH * phi0 if alpha == 1.0 else (1.0 - 1e-4 * alpha) * phi0):
+                return H1, (self._measured(ev1) if alpha == 1.0 else None)
+            # minimiser of the quadratic through phi(0), phi'(0) = -2 phi0, phi(alpha)
+            if np.isfinite(phi):
+                a_new = phi0 * alpha**2 / (phi - phi0 + 2.0 * alpha * phi0)
+            else:
+                a_new = 0.1 * alpha
+            alpha = float(np.clip(a_new, 0.1 * alpha, 0.5 * alpha))
+            H1 = problem.update(H, alpha * dz)
+        if not np.isfinite(best[0]):
+            raise NonFinite("line search found no finite residual along the Newton direction")
+        return best[1], None
+
+
