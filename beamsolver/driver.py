@@ -6,6 +6,7 @@ regrowth, landing on the user's grid, keeping what converged when a run stops) i
 ``stepping.arclength.ArcLengthRun``); the output a ``io.writers`` composite.
 """
 import logging
+from dataclasses import replace
 
 import numpy as np
 
@@ -13,14 +14,14 @@ from .stepping import diagnosis
 from .nonlinear import linsolve
 from .nonlinear.convergence import Convergence, Verdict
 from .nonlinear.newton import MAX_ELEMENT_ROTATION, Newton, angle, largest_element_rotation, relative_rotations
-from .stepping.arclength import ArcLengthRun, check_arc_length_arguments
+from .stepping import steppers
+from .stepping.options import RunOptions
 from .errors import InputError
 from .nonlinear.jit_warmup import warm_up
 from .nonlinear.problem import Problem
 from .stepping.restart import restart_from
 from .stepping.stabilize import from_option as stabilize_option
-from .stepping.steps import Run
-from .model.validation import check_solve_arguments, check_stability_options
+from .model.validation import check_solve_arguments, check_stability_options, count, real
 
 
 __all__ = ["solve", "Convergence", "Newton", "Verdict"]
@@ -65,7 +66,7 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
           max_iter=30, line_search=True, min_step_ratio=2.0**-12, callback=None,
           check_rigid_modes=True, verbose=None, initial_poses=None, restart=None, checkpoint=60.0,
           linear_solver=None, allow_unmet_tolerance=False, check_stability=False, modes=0,
-          branch_switching=False, stabilize=None, path="load", arc_length=None):
+          branch_switching=False, stabilize=None, path="load", arc_length=None, convergence=None):
     """Quasi-static solve of ``model`` from ``t_start`` to ``t_end`` in ``steps`` equal steps.
 
     Every converged (sub)step is recorded in the returned ``Solution``.  Step 0 is
@@ -144,31 +145,36 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     monotonic; ``stats[k]`` adds ``arc_length``, ``t`` and ``linearised``;
     ``restart``, ``branch_switching`` and ``stabilize`` are refused with it.
 
+    ``convergence``: the stopping rule of the Newton loop as a ``Convergence`` (``rtol``, ``dtol``,
+    ``max_iter``, ``divergence``) in place of ``rtol=``, ``dtol=``, ``max_iter=`` (giving both, with
+    values other than the defaults, is refused).
+
     ``Solution.stats[k]["timings"]``: wall time of the step's ``assembly``
     (residuals, tangents, sparse matrices), of each contribution to it (``contact``
     for scenes with contact, part of assembly) and ``linear_solve``
     (factorisations and solves), in seconds.
     """
-    check_solve_arguments(model, steps=steps, t_end=t_end, t_start=t_start, rtol=rtol, dtol=dtol, max_iter=max_iter,
-                          min_step_ratio=min_step_ratio, checkpoint=checkpoint, initial_poses=initial_poses,
-                          restart=restart, callback=callback, output=output)
-    arc = check_arc_length_arguments(path, arc_length, restart, branch_switching, stabilize)
+    conv = _convergence(convergence, rtol, dtol, max_iter)
+    check_solve_arguments(model, steps=steps, t_end=t_end, t_start=t_start, rtol=conv.rtol, dtol=conv.dtol,
+                          max_iter=conv.max_iter, min_step_ratio=min_step_ratio, checkpoint=checkpoint,
+                          initial_poses=initial_poses, restart=restart, callback=callback, output=output)
+    stepper = steppers.stepper(path)
+    path_options = stepper.path_options(arc_length, restart, branch_switching, stabilize)
     warm_up(model)          # a first run: compile before step 0, in two processes (jit_warmup)
     problem = Problem.from_model(model, check_rigid_modes=check_rigid_modes)
     system = problem.system
     sol, t_start = _starting_point(restart, model, problem, t_start, t_end)
     grid = np.linspace(t_start, t_end, int(steps) + 1)
     dt_min = _step_floor(min_step_ratio, grid)
-    newton = Newton(problem, Convergence(rtol=rtol, dtol=dtol, max_iter=max_iter), line_search, callback)
+    newton = Newton(problem, conv, line_search, callback)
     newton.linsolver = linsolve.Solver(linear_solver)
     options = _run_options(problem, t_start, t_end, allow_unmet_tolerance, check_stability, modes,
-                           branch_switching, stabilize, problem.failure_hint())
-    if sol is not None and options["stabilizer"] is not None:
-        options["stabilizer"].resume(sol)
+                           branch_switching, stabilize, problem.failure_hint(), path_options)
+    if sol is not None and options.stabilizer is not None:
+        options.stabilizer.resume(sol)
     run = None
     try:
-        args = (problem, newton, _writer(output, system, checkpoint), grid, dt_min, verbose, options)
-        run = Run(*args) if arc is None else ArcLengthRun(*args, arc)
+        run = stepper(problem, newton, _writer(output, system, checkpoint), grid, dt_min, verbose, options)
         run.start(sol, initial_poses)
         run.loop()
         return run.finish()         # inside: a failure of the output's last files carries .solution too
@@ -178,19 +184,40 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
         raise
 
 
+def _convergence(convergence, rtol, dtol, max_iter):
+    """The ``Convergence`` of ``solve``: a copy of ``convergence`` (its fields checked), else one of
+    ``rtol``, ``dtol``, ``max_iter``; both with values other than the defaults: ``InputError``."""
+    if convergence is None:
+        return Convergence(rtol=rtol, dtol=dtol, max_iter=max_iter)
+    if not isinstance(convergence, Convergence):
+        raise InputError(f"solve: convergence must be a beamsolver.Convergence or None, got {convergence!r}")
+    default = Convergence()
+    given = [f"{k}={v!r}" for k, v in (("rtol", rtol), ("dtol", dtol), ("max_iter", max_iter))
+             if v != getattr(default, k)]
+    if given:
+        raise InputError(f"solve: give either convergence= or {', '.join(given)}, not both "
+                         f"(convergence={convergence!r})")
+    real(convergence.rtol, "convergence.rtol", "solve", above=0.0)
+    real(convergence.dtol, "convergence.dtol", "solve", minimum=0.0)
+    count(convergence.max_iter, "convergence.max_iter", "solve")
+    real(convergence.divergence, "convergence.divergence", "solve", above=0.0)
+    return replace(convergence)
+
+
 def _run_options(problem, t_start, t_end, allow_unmet_tolerance, check_stability, modes, branch_switching,
-                 stabilize, penalty_hint=""):
-    """The options of ``stepping.Run``; a stabilisation joins ``problem``'s contributions;
+                 stabilize, penalty_hint="", path_options=None):
+    """The ``RunOptions`` of the stepper; a stabilisation joins ``problem``'s contributions;
     ``penalty_hint``: the tail of a ``ConvergenceError`` the contributions give
-    (``Problem.failure_hint``: a stiff penalty named), in place of the generic advice."""
+    (``Problem.failure_hint``: a stiff penalty named), in place of the generic advice;
+    ``path_options``: the stepper's own (``Stepper.path_options``)."""
     modes, branch_switching = check_stability_options(modes, branch_switching)
     stabilizer = stabilize_option(problem.system, stabilize, check=problem.conservative)
     if stabilizer is not None:
         problem.contributions.append(stabilizer)
-    return dict(allow_unmet_tolerance=allow_unmet_tolerance, advice=_advice(problem, t_start, t_end, penalty_hint),
-                penalty_hint=penalty_hint,
-                check_stability=bool(check_stability or modes or branch_switching), modes=modes,
-                branch_switching=branch_switching, stabilizer=stabilizer)
+    return RunOptions(advice=_advice(problem, t_start, t_end, penalty_hint), penalty_hint=penalty_hint,
+                      allow_unmet_tolerance=allow_unmet_tolerance,
+                      check_stability=bool(check_stability or modes or branch_switching), modes=modes,
+                      branch_switching=branch_switching, stabilizer=stabilizer, path=path_options)
 
 
 def _step_floor(min_step_ratio, grid):

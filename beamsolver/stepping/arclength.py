@@ -213,11 +213,13 @@ class Sphere:
 
 
 class ArcLengthRun(Run):
-    """``stepping.Run`` with ``loop`` following the path by arc length (see the module docstring)."""
+    """``stepping.Run`` with ``loop`` following the path by arc length (see the module docstring);
+    ``options.path``: its ``ArcLength`` (``None``: the defaults)."""
+    name = "arc-length"
 
-    def __init__(self, problem, newton, writer, grid, dt_min, verbose, options, arc):
+    def __init__(self, problem, newton, writer, grid, dt_min, verbose, options):
         super().__init__(problem, newton, writer, grid, dt_min, verbose, options)
-        self.arc = arc
+        self.arc = self.opt.path if self.opt.path is not None else ArcLength()
         self.t_end = float(grid[-1])
         self.span = float(grid[-1] - grid[0])
         sys = self.sys
@@ -226,6 +228,26 @@ class ArcLengthRun(Run):
         self.S = scale[sys.free_dofs]           # unit-free weights of the free increments
         self.prev = None                        # (w, tau) of the last converged step
         self._converged = None                  # (H, t, evaluation) of the last converged iterate
+
+    @staticmethod
+    def path_options(arc_length, restart, branch_switching=False, stabilize=None):
+        """``ArcLength`` options of ``path="arc-length"``; ``InputError`` on bad input.
+
+        ``restart``, ``branch_switching`` and ``stabilize`` are refused with ``"arc-length"``: the switch
+        bisects the load and re-solves under load control, and the viscous forces need the step ``dt``
+        known before the step, which a path past a limit point does not give (``modes=`` and
+        ``check_stability`` work)."""
+        if restart is not None:
+            raise InputError("solve: restart is not supported with path='arc-length' (start the run again)")
+        if branch_switching is not False and branch_switching is not None:
+            raise InputError(f"solve: branch_switching={branch_switching!r} is not supported with path='arc-length' "
+                             "(the switch re-solves under load control); use path='load' for it, or modes= to see "
+                             "the critical modes along the arc-length path")
+        if stabilize is not None and stabilize is not False:
+            raise InputError(f"solve: stabilize={stabilize!r} is not supported with path='arc-length' (the viscous "
+                             "forces divide by a pseudo-time step known in advance); arc length passes limit points "
+                             "without it, use stabilize with path='load'")
+        return arc_length_options(arc_length)
 
     @property
     def t_iter(self):
@@ -352,7 +374,7 @@ class ArcLengthRun(Run):
             stats["augmentations"] = stats.get("augmentations", 0) + 1
         text = problem.unmet(t)
         if text:
-            if not self.opt.get("allow_unmet_tolerance"):
+            if not self.opt.allow_unmet_tolerance:
                 raise AugmentationFailed(text + " (solve(..., allow_unmet_tolerance=True) accepts it)")
             stats.setdefault("warnings", []).append(text)
             warnings.warn(text, RuntimeWarning, stacklevel=4)
@@ -429,7 +451,7 @@ class ArcLengthRun(Run):
 
     def _record_arc(self, H, t, w, tau, ev, stats):
         sys, sol, problem = self.sys, self.sol, self.problem
-        if self.opt.get("check_stability"):         # no branch switching here: the same (t, H, ev)
+        if self.opt.check_stability:         # no branch switching here: the same (t, H, ev)
             t, H, ev = self._stability(stats, t, H, ev)
         record = problem.commit(H)
         if problem.contributions:
@@ -463,26 +485,9 @@ class ArcLengthRun(Run):
 
 
 def check_arc_length_arguments(path, arc_length, restart, branch_switching=False, stabilize=None):
-    """``ArcLength`` options for ``path="arc-length"`` (``None`` for ``"load"``); ``InputError`` on bad input.
-
-    ``restart``, ``branch_switching`` and ``stabilize`` are refused with ``"arc-length"``: the switch
-    bisects the load and re-solves under load control, and the viscous forces need the step ``dt``
-    known before the step, which a path past a limit point does not give (``modes=`` and
-    ``check_stability`` work)."""
+    """``ArcLength`` options for ``path="arc-length"`` (``None`` for ``"load"``); ``InputError`` on bad
+    input (``Run.path_options``, ``ArcLengthRun.path_options``; ``stepping.steppers`` has every stepper)."""
     if not isinstance(path, str) or path not in ("load", "arc-length"):
         raise InputError(f"solve: path must be 'load' or 'arc-length', got {path!r}")
-    if path == "load":
-        if arc_length is not None:
-            raise InputError("solve: arc_length options need path='arc-length'")
-        return None
-    if restart is not None:
-        raise InputError("solve: restart is not supported with path='arc-length' (start the run again)")
-    if branch_switching is not False and branch_switching is not None:
-        raise InputError(f"solve: branch_switching={branch_switching!r} is not supported with path='arc-length' "
-                         "(the switch re-solves under load control); use path='load' for it, or modes= to see "
-                         "the critical modes along the arc-length path")
-    if stabilize is not None and stabilize is not False:
-        raise InputError(f"solve: stabilize={stabilize!r} is not supported with path='arc-length' (the viscous "
-                         "forces divide by a pseudo-time step known in advance); arc length passes limit points "
-                         "without it, use stabilize with path='load'")
-    return arc_length_options(arc_length)
+    runner = Run if path == "load" else ArcLengthRun
+    return runner.path_options(arc_length, restart, branch_switching, stabilize)

@@ -32,6 +32,7 @@ from ..nonlinear.definiteness import negative_eigenvalues
 from ..errors import ConvergenceError, InputError, StabilityWarning, StabilizationWarning
 from ..failures import AugmentationFailed, LeftStableBranch, MotionTooFast, NonFinite, StepFailed
 from .progress import Progress
+from .options import RunOptions
 from ..model.material_range import RangeCheck
 from ..results.solution import Solution, describe_model
 
@@ -100,7 +101,16 @@ def after_failure(size, failed=np.inf, wait=EASY_RUN):
 
 
 class Run:
-    """One call of ``solve``: ``start``, then ``loop``; ``abort(exc)`` on any exception."""
+    """One call of ``solve`` under load control, the stepper ``"load"`` (``stepping.steppers``):
+    ``start``, then ``loop``, then ``finish``; ``abort(exc)`` on any exception."""
+    name = "load"
+
+    @staticmethod
+    def path_options(value, restart, branch_switching=False, stabilize=None):
+        """The stepper's own options from ``solve(arc_length=)``: none under load control."""
+        if value is not None:
+            raise InputError("solve: arc_length options need path='arc-length'")
+        return None
 
     def __init__(self, problem, newton, writer, grid, dt_min, verbose, options):
         self.problem, self.sys = problem, problem.system
@@ -108,14 +118,14 @@ class Run:
         self.dt_user = grid[1] - grid[0]
         self.dt_min = dt_min
         self.verbose = verbose
-        self.opt = options            # allow_unmet_tolerance, check_stability
+        self.opt = options = RunOptions.of(options)
         self.sol = None
         self.progress = None
         self.warned_unstable = False
         self.range = None             # material_range.RangeCheck: sections with a yield limit only
         self.negative = None          # negative eigenvalues of the last converged state's tangent, if known
         self.branch_tries = 0         # LeftStableBranch failures since a step converged at its first try
-        newton.watch_sign = (problem.conservative and not options.get("branch_switching")   # stable_branch
+        newton.watch_sign = (problem.conservative and not options.branch_switching   # stable_branch
                              and stable_branch.ENABLED)
 
     # ------------------------------------------------------------------ start
@@ -150,8 +160,8 @@ class Run:
         self.sol.resume = dict(t0=float(grid[0]), t_end=float(grid[-1]), steps=int(steps), dt=float(self.dt),
                                easy=int(self.easy), **self._memory_state())
         self.progress = Progress(self.verbose, t_start, grid[-1], self.t)
-        if self.opt.get("stabilizer") is not None:
-            self.opt["stabilizer"].t_last = self.t      # the converged state the first step starts from
+        if self.opt.stabilizer is not None:
+            self.opt.stabilizer.t_last = self.t      # the converged state the first step starts from
 
     def _step_zero(self, H0, t_start):
         """Step 0: the state ``H0`` at ``t_start`` (prescribed nodes on their motion) or, when loads,
@@ -193,7 +203,7 @@ class Run:
                            "(strain-free adjustment) or raise max_iter")
                 else:
                     why = f"loads or motions already act: {e}; start the loads from zero or use more steps"
-                why += self.opt.get("penalty_hint", "")
+                why += self.opt.penalty_hint
                 err = ConvergenceError(f"solve: no equilibrium at t_start = {t_start:.6g}, where {why}", self.sol)
                 err.failure = e
                 raise err from None
@@ -314,7 +324,7 @@ class Run:
         moves the path onto a stable branch itself).  Only a step whose first tangent had ``det < 0``
         (``Newton.indefinite_seen``) or that took undamped Newton iterations (the fallback, or
         ``line_search=False``) is checked."""
-        if self.opt.get("branch_switching") or not stable_branch.ENABLED:
+        if self.opt.branch_switching or not stable_branch.ENABLED:
             return
         if not (self.newton.indefinite_seen or stats.get("undamped") is not None or not self.newton.line_search):
             self.negative = None        # every tangent of the step had det > 0: not checked (stable_branch)
@@ -334,7 +344,7 @@ class Run:
         self.negative, self.branch_tries = failure.negative, 0
         stats.update(left_stable_branch=True)
         text = stable_branch.kept(failure)
-        if not self.warned_unstable and not self.opt.get("check_stability"):
+        if not self.warned_unstable and not self.opt.check_stability:
             self.warned_unstable = True
             log.warning(text)
             warnings.warn(text, StabilityWarning, stacklevel=5)
@@ -358,11 +368,11 @@ class Run:
             stats["iterations"] += more["iterations"]
             stats["residuals"] += more["residuals"]
             stats["augmentations"] = stats.get("augmentations", 0) + 1
-        if self.opt.get("stabilizer") is not None:
-            self.opt["stabilizer"].check(problem.tangent(newton.last_evaluation), t_next)
+        if self.opt.stabilizer is not None:
+            self.opt.stabilizer.check(problem.tangent(newton.last_evaluation), t_next)
         text = problem.unmet(t_next)
         if text:
-            if not self.opt.get("allow_unmet_tolerance"):
+            if not self.opt.allow_unmet_tolerance:
                 raise AugmentationFailed(text + " (solve(..., allow_unmet_tolerance=True) accepts it "
                                          "with a warning)")
             stats.setdefault("warnings", []).append(text)
@@ -372,13 +382,13 @@ class Run:
 
     def _record(self, t_next, H, ev, stats):
         sys, sol, problem = self.sys, self.sol, self.problem
-        stab = self.opt.get("stabilizer")
+        stab = self.opt.stabilizer
         damped = H
         if stab is not None:
             balance = self._undamped(stab, H, ev)
             if stab.settle and not balance["equilibrium"] and t_next >= self.grid[-1] - 1e-12 * self.dt_user:
                 H, ev, balance = self._settle(stab, t_next, H, ev, stats, balance)
-        if self.opt.get("check_stability"):
+        if self.opt.check_stability:
             t_next, H, ev = self._stability(stats, t_next, H, ev)
         record = problem.commit(H)
         if stab is not None:
@@ -474,10 +484,10 @@ class Run:
         K = problem.tangent(self.newton.last_evaluation)
         neg, lowest = negative_eigenvalues(K)
         stats.update(stable=neg == 0, negative_eigenvalues=neg, lowest_eigenvalue=lowest)
-        if branching.wanted(self.opt.get("branch_switching"), self.sol.stats, neg):
+        if branching.wanted(self.opt.branch_switching, self.sol.stats, neg):
             t, H, ev, K = branching.switch(self, stats, t, H, ev, K)
-        if self.opt.get("modes"):
-            branching.record_modes(self.sys, stats, H, K, self.opt["modes"])
+        if self.opt.modes:
+            branching.record_modes(self.sys, stats, H, K, self.opt.modes)
         neg = self.negative = stats["negative_eigenvalues"]
         if neg and not self.warned_unstable:
             self.warned_unstable = True
@@ -493,7 +503,7 @@ class Run:
         """Raise ``ConvergenceError`` for ``failure`` at the current step; ``why``: what could not
         advance (default: the step fell below its floor)."""
         sol = self.sol
-        hint = self.opt["advice"](failure, rotation_limit, self.H, self.t)
+        hint = self.opt.advice(failure, rotation_limit, self.H, self.t)
         sol.converged = False
         sol.message = str(failure)
         why = why or f"could not advance from t = {self.t:.6g} (step fell below {self.dt_min:.3g})"
@@ -530,7 +540,7 @@ class Run:
 
     def finish(self):
         self.progress.close()
-        if self.opt.get("stabilizer") is not None:
+        if self.opt.stabilizer is not None:
             self._off_equilibrium()
         if self.writer is not None:
             self.writer.close()
