@@ -80,7 +80,7 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     is shortened first, so motions are followed as continuous paths.
 
     ``output``: folder for ParaView files and ``solution.npz`` (``None``: no
-    output; see ``beamsolver.io.vtk``), the latter saved at the end, whenever
+    output; see ``beamsolver.io.vtk`` and, for the formats, ``beamsolver.io.writers``), the latter saved at the end, whenever
     the run stops (also by Ctrl-C or an exception) and every ``checkpoint``
     seconds (0: every step; ``None``: only at the end or stop); or a writer
     object with ``write(solution, step)`` and ``close()`` such as ``io.vtk.StepWriter``.
@@ -247,12 +247,10 @@ def _writer(output, system, checkpoint):
         return None
     if hasattr(output, "write"):
         return output                     # e.g. io.vtk.StepWriter(folder, refine=4, compression=None)
-    if checkpoint is None:
-        checkpoint = np.inf               # saved at the end and when the run stops, not periodically
-    elif not (isinstance(checkpoint, (int, float)) and checkpoint >= 0):
+    if checkpoint is not None and not (isinstance(checkpoint, (int, float)) and checkpoint >= 0):
         raise InputError(f"solve: checkpoint must be a number of seconds >= 0 or None, got {checkpoint!r}")
-    from .io.vtk import StepWriter
-    return StepWriter(output, system, checkpoint=checkpoint)
+    from .io.writers import open_output   # solution.npz (its own writer) and every default format
+    return open_output(output, system, checkpoint)
 
 
 def _advice(problem, t_start, t_end, penalty_hint=""):

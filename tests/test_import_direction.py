@@ -35,6 +35,7 @@ LAYER = {
 ALLOWED_UPWARD = {
     ("driver", "io.vtk"): "solve(output=folder) creates the default step writer, imported only then",
     ("driver", "io"): "the package of io.vtk, which Python runs before it (same lazy import)",
+    ("driver", "io.writers"): "solve(output=folder) opens the writers (archive and formats), imported only then",
     ("model.validation", "results.solution_file"): "solve(restart=file) checks the file's last time",
     ("model.validation", "results"): "the package of results.solution_file (same lazy import)",
 }

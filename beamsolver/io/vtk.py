@@ -21,10 +21,11 @@ Files in the output folder (``solve(model, output=folder)``, or
   or with the step numbers when the pseudo-times do not increase from step to
   step (an arc-length run, ``solve(path="arc-length")``, goes back in ``t``
   past a limit point; ParaView sorts a collection by its times).
-- ``solution.npz``: the ``Solution`` (``io.archive``), saved at the end of the
-  run (also when it stops with ``ConvergenceError``) and every
-  ``checkpoint`` seconds of wall time (``0``: after every step), for
-  ``beamsolver info`` and ``solve(..., restart=folder)``.
+- ``solution.npz``: the ``Solution``, written by its own writer (``io.archive.ArchiveWriter``;
+  ``solve(output=folder)`` puts it in front of every format of ``io.writers``), saved at the end
+  of the run (also when it stops with ``ConvergenceError``) and every ``checkpoint`` seconds of
+  wall time (``0``: after every step), for ``beamsolver info`` and ``solve(..., restart=folder)``.
+  A ``StepWriter`` given a ``checkpoint`` (its default) keeps one itself.
 
 Every file is written under a temporary name in the same folder, given the
 mode ``open()`` would give it (``0666 & ~umask``), and then renamed
@@ -42,16 +43,15 @@ by meshio, pyvista and ParaView) with two-point ``line`` cells, which meshio rea
 cannot read VTK poly-lines, type 4); for smooth tubes ParaView joins them into
 poly-lines with *Triangle Strips* before the Tube filter (docs/guide/output.md, "ParaView by hand"; or io.paraview).
 """
-import os
-import tempfile
-import time
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
 from ..errors import InputError
-from ..results.files import follow_umask, previous_series
+from ..results.files import previous_series
+from .archive import ARCHIVE, ArchiveWriter
+from .folder import atomic as _atomic, output_folder as _output_folder
 from .lines import LineLayout
 from .vtu import write_vtu
 
@@ -59,51 +59,10 @@ __all__ = ["StepWriter", "write_vtk", "write_pvd"]
 
 BEAMS = "beams"
 CONTACT = "contact"
-ARCHIVE = "solution.npz"
 SERIES = rf"({BEAMS}|{CONTACT})_[0-9]+\.vtu"     # names of the numbered files of a run
 CONTACT_FIELDS = {"gap": (), "normal_force": (), "tangential_force": (3,), "stick": (),
                   "slip_increment": (2,), "normal": (3,), "kind": (), "status": ()}
 INT_FIELDS = ("stick", "kind", "status")
-
-
-def _atomic(path, write):
-    """Call ``write(tmp_path)`` then rename ``tmp_path`` to ``path``; a failing file system
-    (full disk, permissions) raises ``InputError`` naming the folder and the file."""
-    path = Path(path)
-    tmp = None
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".tmp" + path.suffix, dir=path.parent)
-        follow_umask(fd)
-        os.close(fd)
-        write(tmp)
-        os.replace(tmp, path)
-        tmp = None
-    except OSError as e:
-        raise InputError(f"output folder {str(path.parent)!r}: cannot write {path.name} "
-                         f"({e.strerror or e})") from None
-    finally:
-        if tmp is not None and os.path.exists(tmp):
-            os.unlink(tmp)
-
-
-def _output_folder(folder):
-    """``folder`` created if missing and checked writable (a probe file is written and removed)."""
-    folder = Path(folder)
-    for p in (folder, *folder.parents):
-        if p.exists():
-            if not p.is_dir():
-                raise InputError(f"output {str(folder)!r}: {str(p)!r} is a file, not a folder")
-            break
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError as e:
-        raise InputError(f"output folder {str(folder)!r}: cannot create it ({e.strerror or e})") from None
-    _atomic(folder / ".write-test", lambda tmp: None)
-    try:
-        os.unlink(folder / ".write-test")
-    except OSError as e:
-        raise InputError(f"output folder {str(folder)!r}: cannot write ({e.strerror or e})") from None
-    return folder
 
 
 def write_pvd(path, entries):
@@ -128,8 +87,9 @@ class StepWriter:
     ``folder``: created if missing; ``system``: the ``assembly.System`` (or
     ``None`` when writing a loaded solution); ``refine``: segments drawn per
     element; ``compression``: ``"zlib"``, ``"lzma"`` or ``None``;
-    ``checkpoint``: seconds between saves of ``solution.npz`` (``None``: never
-    save it, as for exporting a loaded solution).
+    ``checkpoint``: seconds between saves of ``solution.npz`` by the ``io.archive.ArchiveWriter``
+    it then keeps (``None``: never save it, as for exporting a loaded solution, or when the
+    archive has its own writer, as in ``solve(output=folder)``).
 
     ``write`` takes what it needs from the solution at once and leaves the files (encoding,
     compression, file system) to one background thread, which writes the steps in order, each
@@ -144,8 +104,8 @@ class StepWriter:
         stale = previous_series(self.folder, (f"{BEAMS}.pvd", f"{CONTACT}.pvd"), SERIES)
         for name in (f"{BEAMS}.pvd", f"{CONTACT}.pvd"):
             (self.folder / name).unlink(missing_ok=True)
-        if checkpoint is not None:     # this run's archive replaces the last one's, also when it saves nothing
-            (self.folder / ARCHIVE).unlink(missing_ok=True)
+        # this run's archive replaces the last one's, also when it saves nothing
+        self.archive = None if checkpoint is None else ArchiveWriter(self.folder, checkpoint, checked=True)
         self.refine = refine
         self.compression = compression
         if contact is None and system is not None:
@@ -155,8 +115,6 @@ class StepWriter:
         self.entries = {}          # step -> time
         self.width = 4
         self.checkpoint = checkpoint
-        self._solution = None
-        self._saved_at = time.perf_counter()
         self._pool = None          # the writing thread (started by the first write)
         self._jobs = []            # futures of the steps not yet known to be written
         self._failure = None       # the first error of the writing thread: nothing is written after it
@@ -188,9 +146,8 @@ class StepWriter:
                           None if pos is None else (pos, "vertex", np.arange(len(pos)).reshape(-1, 1), cpdata, None)))
         # the archive first, then the collections: a run killed in between never has a .pvd that
         # lists a step its solution.npz lacks (with checkpoint=0 both list the same steps)
-        self._solution = solution
-        if self.checkpoint is not None and time.perf_counter() - self._saved_at >= self.checkpoint:
-            self.save()
+        if self.archive is not None:
+            self.archive.write(solution, step)
         self.entries[step] = t
         self._submit(files, self._collections())
 
@@ -230,10 +187,9 @@ class StepWriter:
             raise self._failure
 
     def save(self):
-        """Save the solution written so far to ``solution.npz`` (atomically)."""
-        if self._solution is not None and self.checkpoint is not None:
-            self._solution.save(self.folder / ARCHIVE)
-            self._saved_at = time.perf_counter()
+        """Save the solution written so far to ``solution.npz`` (atomically; with a ``checkpoint``)."""
+        if self.archive is not None:
+            self.archive.save()
 
     def _collections(self):
         """``[(path, entries)]`` of the ``.pvd`` files listing the steps written so far."""
