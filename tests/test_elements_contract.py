@@ -48,6 +48,21 @@ def test_shapes_and_node_table(name, rng):
 
 
 @pytest.mark.parametrize("name", TYPES)
+def test_energy_is_the_potential_of_the_forces(name, rng):
+    """``energy`` is zero at the reference and its derivative along body increments ``H exp(s q)``
+    is ``f . q`` (central differences; the contract stabilisation relies on)."""
+    etype = elements.get(name)
+    P0, ref, H = _batch(etype, rng)
+    n, k = H.shape[:2]
+    assert etype.energy(P0, None, ref).shape == (n,) and np.abs(etype.energy(P0, None, ref)).max() < 1e-20
+    f, _, _ = etype.evaluate(H, None, ref, False)
+    q = rng.standard_normal((n, k, 6))
+    s = 1e-6
+    dE = (etype.energy(H @ se3.exp(s * q), None, ref) - etype.energy(H @ se3.exp(-s * q), None, ref)) / (2 * s)
+    np.testing.assert_allclose(dE, np.einsum("ni,ni->n", f, q.reshape(n, 6 * k)), rtol=1e-6)
+
+
+@pytest.mark.parametrize("name", TYPES)
 def test_reference_state_and_interpolation(name, rng):
     etype = elements.get(name)
     P0, ref, H = _batch(etype, rng)

@@ -139,16 +139,40 @@ def test_explicit_factor_damps_from_the_first_step():
     assert sol.stats[1]["stabilization"]["dissipated"] > 0
 
 
-def test_stabilisation_of_three_node_elements_is_refused_naming_the_type():
-    """The damping's lumped mass and strain energy are those of two-node elements: a model with
-    another element type must be refused, not damped with wrong masses."""
+def test_three_node_elements_are_damped_with_their_own_energy_and_masses():
+    """The damping reads the element contract (``ElementType.energy``) and lumps each element at all
+    its nodes: a three-node beam is damped, its recorded strain energy is that of its elements (the
+    two-node formula on its end nodes would differ), and ``M*`` carries the same total as the same
+    beam of two-node elements (the mid nodes take their share: 1/3 of each element)."""
     sec = bs.Section.circular(radius=1e-3, E=200e9, nu=0.3)
-    m = bs.Model()
-    b = m.add_beam(bs.geometry.straight(start=(0, 0, 0), end=(1, 0, 0), n_elements=8), sec, element="se3-3")
-    m.clamp(b.first)
-    m.add_load(b.last, force=(0, 0, 1.0))
-    with pytest.raises(bs.InputError, match="se3-3"):
-        bs.solve(m, steps=2, stabilize=1e-3, verbose=False)
+    models = {}
+    for kind, n in (("se3-3", 4), ("se3-2", 8)):
+        m = bs.Model()
+        b = m.add_beam(bs.geometry.straight(start=(0, 0, 0), end=(1, 0, 0), n_elements=n), sec, element=kind)
+        m.clamp(b.first)
+        m.add_load(b.last, force=(0, 0, 1e-2))
+        models[kind] = m
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", bs.StabilizationWarning)
+        sol = bs.solve(models["se3-3"], steps=2, stabilize=dict(factor=1e-3), verbose=False)
+    rec = sol.stats[-1]["stabilization"]
+    assert rec["dissipated"] > 0
+    system = Problem.from_model(models["se3-3"]).system
+    (g,) = system.groups
+    energy = float(g.element_type.energy(sol.poses[-1], g.nodes, g.ref).sum())
+    assert rec["strain_energy"] == energy
+    two_node = float(bs.elements.get("se3-2").energy(sol.poses[-1], g.nodes[:, [0, -1]],
+                                                      bs.elements.get("se3-2").reference(
+                                                          system.poses0[g.nodes[:, [0, -1]]], g.ref.C)).sum())
+    assert abs(two_node - energy) > 1e-3 * energy          # the old formula would be another number
+    totals = []
+    for sys_k in (system, Problem.from_model(models["se3-2"]).system):
+        (g,) = sys_k.groups
+        full = stabilize.mass_scales(sys_k.rep[g.nodes], g.ref.L, g.ref.C, sys_k.length_scale, sys_k.n_nodes)
+        totals.append(full.sum(axis=0))
+        assert np.all(full > 0)
+    np.testing.assert_allclose(totals[0], totals[1], rtol=1e-12)
+    assert np.all(stabilize.Stabilization(system, factor=1.0).m > 0)      # the mid nodes are damped too
 
 
 def test_restart_continues_with_the_same_damping():

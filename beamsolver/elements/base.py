@@ -14,6 +14,9 @@ and their tangent, batched over elements (docs/theory.md eqs. 14.1-14.2):
   ``out`` if given) and an ``ElementState`` (``h``: the relative twist the
   validity check reads, ``strain`` and ``sigma = C (strain - eps0)``, ``(n, 6)``
   each, for output);
+- ``energy(H, nodes, ref)``: strain energy per element ``(n,)``, ``int 1/2 (eps - eps0) C (eps -
+  eps0) ds`` (the potential whose gradient ``evaluate`` gives; stabilisation and diagnostics
+  read it);
 - ``rotation_pairs``: the local node pairs whose relative rotation the
   element represents through a logarithm; ``max_rotation``: the largest
   such rotation it accepts (rad), below pi where the logarithm jumps;
@@ -92,6 +95,9 @@ class ElementType:
         raise NotImplementedError
 
     def evaluate(self, H, nodes, ref, tangent, out=None):
+        raise NotImplementedError
+
+    def energy(self, H, nodes, ref):
         raise NotImplementedError
 
     def interpolate(self, H_el, e, xi):

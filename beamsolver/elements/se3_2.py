@@ -28,6 +28,11 @@ class SE3Two(ElementType):
             H, nodes = self.poses(H, nodes)
         return element.evaluate_nodes(H, nodes, ref.L, ref.eps0, ref.C, tangent, out, ref.diagonal)
 
+    def energy(self, H, nodes, ref):
+        """Strain energy per element ``(n,)`` (``element.energy``)."""
+        H, nodes = self.poses(H, nodes)
+        return element.energy(H[nodes[:, 0]], H[nodes[:, 1]], ref.L, ref.eps0, ref.C)
+
     def interpolate(self, H_el, e, xi):
         HA, HB = H_el[:, 0], H_el[:, 1]
         h = se3.log(se3.relative(HA, HB))

@@ -8,10 +8,11 @@ carries an artificial viscous force, body frame, translation first:
   last converged state and ``dt`` the pseudo-time step;
 - force ``f_v = c M* v`` (added to the residual ``r = f_int - f_ext + f_v``);
 - tangent ``df_v/dq = (c / dt) M* T(h)^-1`` (``H <- H exp(dq)``, ``T`` the right tangent of SE(3));
-- ``M*`` a lumped, mass-like diagonal: ``m_u = sum_e EA_e L_e / (2 l^2)`` on the three
-  translations [N/m] and ``m_w = sum_e EI_e L_e / (2 l^2)`` on the three rotations [N m]
-  (``EI_e`` the mean of ``EI2, EI3``; sums over the elements at the node; ``l`` the model size):
-  the beams' lumped mass matrix with the density replaced by ``E / l^2``, so ``c`` is unit-free;
+- ``M*`` a lumped, mass-like diagonal: ``m_u = sum_e EA_e L_e / (k l^2)`` on the three
+  translations [N/m] and ``m_w = sum_e EI_e L_e / (k l^2)`` on the three rotations [N m]
+  (``EI_e`` the mean of ``EI2, EI3``; sums over the elements at the node, each of an element's
+  ``k`` nodes taking ``1/k``; ``l`` the model size): the beams' lumped mass matrix with the
+  density replaced by ``E / l^2``, so ``c`` is unit-free;
 - energy dissipated over a step: ``D = f_v . h = (c / dt) h^T M* h``.
 
 The factor ``c`` follows from a dissipated-energy fraction ``fraction`` (Abaqus' default 2e-4):
@@ -37,7 +38,6 @@ import warnings
 
 import numpy as np
 
-from ..elements import element
 from ..lie import se3
 from ..assembly.system import FREE
 from ..model.blocks import Blocks, Contribution
@@ -60,13 +60,15 @@ class StabilizedSaddle(StepFailed):
     unstable equilibrium, not on the flow); a shorter step raises ``c / dt``."""
 
 
-def mass_scales(enodes, L, C, length, n_nodes):
+def mass_scales(enodes, L, C, length, n_nodes, m=None):
     """Diagonal ``M*`` per node, ``(n_nodes, 2)``: ``(m_u, m_w)`` from element tables ``enodes``
-    ``(n_el, 2)`` (node numbers), ``L`` ``(n_el,)``, ``C`` ``(n_el, 6, 6)`` and the model size ``length``."""
-    rho = np.stack([C[:, 0, 0], 0.5 * (C[:, 4, 4] + C[:, 5, 5])], axis=1) * (L / (2.0 * length**2))[:, None]
-    m = np.zeros((n_nodes, 2))
-    for end in (0, 1):
-        np.add.at(m, enodes[:, end], rho)
+    ``(n_el, k)`` (node numbers of ``k``-node elements), ``L`` ``(n_el,)``, ``C`` ``(n_el, 6, 6)``
+    and the model size ``length``, each node taking ``1/k`` of an element; added to ``m`` if given."""
+    k = enodes.shape[1]
+    rho = np.stack([C[:, 0, 0], 0.5 * (C[:, 4, 4] + C[:, 5, 5])], axis=1) * (L / (k * length**2))[:, None]
+    m = np.zeros((n_nodes, 2)) if m is None else m
+    for j in range(k):
+        np.add.at(m, enodes[:, j], rho)
     return m
 
 
@@ -106,16 +108,13 @@ class Stabilization(Contribution):
     conservative = False          # viscous: no potential
 
     def __init__(self, system, fraction=DEFAULT_FRACTION, factor=None, warn=WARN_FRACTION, check=True, settle=False):
-        for g in system.groups:
-            if g.element_type.n_nodes != 2:
-                # M* lumps each element at its two end nodes and the strain energy is the two-node one
-                raise InputError(f"solve: stabilize supports two-node elements only; element type "
-                                 f"{g.element_type.name!r} ({g.element_type.n_nodes} nodes) is in the model")
         self.sys = system
         self.check_saddle = check
         self.nodes = np.flatnonzero(system.is_rep & (system.kind == FREE))
-        m = mass_scales(system.rep[system.enodes], system.L, system.C, system.length_scale, system.n_nodes)
-        self.m = m[self.nodes]
+        m = None          # M* over every element type: each element lumped at all its nodes
+        for g in system.groups:
+            m = mass_scales(system.rep[g.nodes], g.ref.L, g.ref.C, system.length_scale, system.n_nodes, m)
+        self.m = (np.zeros((system.n_nodes, 2)) if m is None else m)[self.nodes]
         self.fraction, self.warn = fraction, warn
         self.c = 0.0 if factor is None else float(factor)
         self.H_prev, self.dt, self.t_last, self.t_next = None, None, None, None
@@ -168,8 +167,8 @@ class Stabilization(Contribution):
         self.total = float(rec.get("dissipated_total", 0.0))
 
     def strain_energy(self, H):
-        s = self.sys
-        return float(element.energy(H[s.enodes[:, 0]], H[s.enodes[:, 1]], s.L, s.eps0, s.C).sum())
+        """The beams' strain energy at ``H`` (``ElementType.energy`` of every element group)."""
+        return float(sum(g.element_type.energy(H, g.nodes, g.ref).sum() for g in self.sys.groups))
 
     def record(self, H, t):
         """After a converged step: calibrate ``c`` if not yet set, account the dissipated energy;
