@@ -83,3 +83,44 @@ def test_default_smoothing_only_for_line_contact():
     assert (first & (P.kind == POINT)).any() and np.all(w[first & (P.kind == POINT)] == 0.0)
     assert (~first).any()
     np.testing.assert_allclose(w[~first], 1e-3)
+
+
+def test_each_option_is_written_once_with_its_default_check_and_meaning():
+    """Every field carries its check and meaning; ``add_contact``'s docstring is made from them, and
+    ``add_contact`` refuses a bad value through the same check (naming the option)."""
+    from beamsolver.model.contact_options import describe
+    doc = bs.Model.add_contact.__doc__
+    for f in dataclasses.fields(ContactOptions):
+        assert callable(f.metadata["check"]) and f.metadata["doc"], f.name
+        assert f"``{f.name}``: " in doc and f"``{f.name}``: " in describe(), f.name
+    assert "{contact_options}" not in doc
+    m = bs.Model()
+    sec = bs.Section.circular(radius=0.05, E=1e7, nu=0.3)
+    a = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 2), sec)
+    b = m.add_beam(bs.geometry.straight((0, 0, 0.2), (1, 0, 0.2), 2), sec)
+    with pytest.raises(bs.InputError, match="add_contact: point_ratio"):
+        m.add_contact(a, b, point_ratio=1.5)
+
+
+def test_the_kernel_table_is_built_from_the_options():
+    """``declaration_table``: one entry per declaration, ``None`` as the option's ``kernel_none``
+    (smoothing and adjust: derived per pair, nan; tolerance: no updates, inf); the contact
+    system's per-declaration arrays are that table."""
+    from beamsolver.contact.options import declaration_table
+    sec = bs.Section.circular(radius=0.05, E=1e7, nu=0.3)
+    m = bs.Model()
+    a = m.add_beam(bs.geometry.straight((0, -1, 0), (0, 1, 0), 2), sec)
+    b = m.add_beam(bs.geometry.straight((-1, 0, 0.1), (1, 0, 0.1), 2), sec)
+    c = m.add_beam(bs.geometry.straight((-1, 0.5, 0.1), (1, 0.5, 0.1), 2), sec)
+    m.clamp(a.first)
+    m.add_contact(b, a)
+    m.add_contact(c, a, tolerance=1e-4, smoothing=2e-3, adjust=0.0)
+    cs = Problem.from_model(m, check_rigid_modes=False).contact
+    table = declaration_table([d.options for d in cs.decls])
+    assert sorted(table) == ["adjust", "penalty_t", "smoothing", "tolerance"]
+    np.testing.assert_array_equal(table["tolerance"], [np.inf, 1e-4])
+    np.testing.assert_array_equal(table["smoothing"], [np.nan, 2e-3])
+    np.testing.assert_array_equal(table["adjust"], [np.nan, 0.0])
+    np.testing.assert_array_equal(cs._decl_tolerance, table["tolerance"])
+    np.testing.assert_array_equal(cs._decl_smoothing, table["smoothing"])
+    np.testing.assert_array_equal(cs._decl_adjust, table["adjust"])

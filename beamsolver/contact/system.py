@@ -51,7 +51,7 @@ from ..model.model import JOIN_TOL
 from .law import default_penalty
 from . import kernel_jit, mortar, pairs
 from .kernel_jit import contact_kernel, kernel_and_tangent      # compiled; pairs.py's are the oracle
-from .options import ADJUST, SMOOTHING, STICK_TOLERANCE, ContactOptions
+from .options import ADJUST, SMOOTHING, STICK_TOLERANCE, ContactOptions, declaration_table
 from .pairs import LINE, NORMAL_TOL, POINT, material_frames, no_normal, touch_tolerance
 from .record import OPEN, SLIP, STICK, Candidates, PairSet
 from .ownership import gauss_owners, gauss_record
@@ -136,10 +136,10 @@ class ContactSystem(Contribution):
         self._decl_on = np.ones(len(self.decls), dtype=bool)
         self._switch_to(-np.inf)
         self._mu_committed = self._decl_mu       # friction of the last committed step (None: unknown)
+        table = declaration_table([d.options for d in self.decls])    # None as each option's kernel_none
         self._decl_slip_tol = np.array([d.slip_tolerance for d in self.decls])
-        self._decl_smoothing = np.array([np.nan if d.smoothing is None else d.smoothing for d in self.decls])
-        self._decl_tolerance = np.array([np.inf if d.tolerance is None else d.tolerance for d in self.decls])
-        self._decl_adjust = np.array([np.nan if d.options.adjust is None else d.options.adjust for d in self.decls])
+        self._decl_smoothing, self._decl_tolerance = table["smoothing"], table["tolerance"]
+        self._decl_adjust = table["adjust"]
         self._decl_exact = np.array([d.exact for d in self.decls])
         self._decl_eps_t = np.array([d.eps_t for d in self.decls])
         self._decl_stick_tol = np.array([d.stick_tolerance for d in self.decls])

@@ -14,7 +14,8 @@ import numpy as np
 from .. import elements
 from ..errors import InputError
 from .section import Section
-from .validation import MAX_REFERENCE_ELEMENT_ROTATION, ORTHONORMAL_TOL, CheckedScalar, as_array, check_contact_options, check_node_id, check_pose, real
+from .contact_options import check_contact_options, describe as describe_contact_options
+from .validation import MAX_REFERENCE_ELEMENT_ROTATION, ORTHONORMAL_TOL, CheckedScalar, as_array, check_node_id, check_pose, real
 
 __all__ = ["Model", "Beam", "Load", "LineLoad", "ContactDeclaration", "ElementGroup", "DOF_NAMES"]
 
@@ -390,38 +391,7 @@ class Model:
         ``penalty L_e^2 / EA`` passes 1e6, ``contact.conditioning``).  Options, lengths in the
         model's unit:
 
-        - ``smoothing``: gap over which the normal law is made C1 (default None:
-          ``1e-6 (R1 + R2)`` for line contact, so touching, lightly loaded wires converge,
-          and sharp for point and orthogonal pairs; 0: sharp everywhere);
-        - ``tolerance``: penetration below which augmented-Lagrangian updates stop
-          (default None: pure penalty, no updates);
-        - ``slip_tolerance``: elastic slip at the onset of sliding, in slave element
-          lengths (default 0.005, Abaqus' default); the tangential stiffness of a point
-          is then ``mu lam_N / (slip_tolerance L_e)``;
-        - ``penalty_t``: a fixed tangential penalty instead, force / length^3
-          (default None: from ``slip_tolerance``);
-        - ``gauss_points``: integration points per slave element for line contact (5);
-        - ``line_angle``: crossing angle (rad) below which a pair is line contact
-          (default ``radians(20)``);
-        - ``point_ratio``: from this ``sin^2`` of the crossing angle up a pair is one
-          point contact, below it orthogonal projection (0.5);
-        - ``margin``: search margin around every element (default twice the largest radius).
-        - ``law``: the contact law, a ``contact.law.ContactLaw`` of compiled functions
-          (default None: the penalty / augmented-Lagrangian / smoothed normal law with
-          Coulomb friction; docs/theory.md section 15);
-        - ``adjust``: strain-free adjustment of initial overclosures (Abaqus' contact
-          ``ADJUST``): a contact point whose gap at the reference poses lies between
-          ``-adjust`` and 0 starts touching (its gap offset by the overlap for the whole
-          run: the overlap puts no force on the reference state); deeper overlaps are left
-          as they are (default None: ``1e-3 (R1 + R2)``; 0: no adjustment; the count and
-          the largest overlap adjusted are in ``Solution.stats[0]["adjusted"]``;
-          docs/theory_adjust.md);
-        - ``stick``: ``"penalty"`` (default: the tangential penalty above, per Gauss point;
-          sticking points slip elastically by ``lam_T / penalty_t``) or ``"exact"`` (mortar
-          nodal multipliers on the slave beam, iterated until every sticking node's weighted
-          slip is below ``stick_tolerance``; ``penalty_t`` is then only the augmentation
-          penalty, default the normal penalty; docs/theory_mortar.md);
-        - ``stick_tolerance``: that slip, a length (default ``1e-8 (R1 + R2)``).
+{contact_options}
 
         Switched in pseudo-time (default None: from the start): ``active_from``: the
         declaration acts only in steps ending after this time; ``friction_from``: frictionless
@@ -542,3 +512,7 @@ class Model:
                 f"{len(self.constraints)} constrained nodes, {len(self.loads)} loads, "
                 f"{len(self.line_loads)} line loads, "
                 f"{len(self.contacts)} contact declarations)")
+
+
+# the options' meanings are written once, with their defaults and checks (model.contact_options)
+Model.add_contact.__doc__ = Model.add_contact.__doc__.replace("{contact_options}", describe_contact_options(" " * 8))

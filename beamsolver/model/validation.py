@@ -1,4 +1,5 @@
-"""Checks of user input: numbers, counts, poses, contact options and ``solve``'s arguments.
+"""Checks of user input: numbers, counts, poses and ``solve``'s arguments (contact options:
+``model.contact_options``).
 
 Every check raises ``InputError`` naming where the value came from (``owner``,
 e.g. ``"solve"`` or ``"Section 'wire'"``), the argument and the value; none of
@@ -14,7 +15,7 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["real", "count", "as_array", "vector", "check_pose", "check_poses", "check_node_id", "check_contact_options",
+__all__ = ["real", "count", "as_array", "vector", "check_pose", "check_poses", "check_node_id",
            "check_solve_arguments", "MAX_REFERENCE_ELEMENT_ROTATION", "ORTHONORMAL_TOL", "MAX_COUNT"]
 
 # a reference element may turn by at most this much; the solver refuses iterates beyond
@@ -153,72 +154,6 @@ def scalar_of(fn, t, where):
         kind = f"an array of shape {np.shape(v)}" if isinstance(v, np.ndarray) else repr(v)
         raise InputError(f"{where}({t:.6g}) must return a finite number, got {kind}")
     return float(v)
-
-
-# ------------------------------------------------------------ contact options
-def _gauss_points(v, owner):
-    return count(v, "gauss_points", owner, maximum=64)
-
-
-def _line_angle(v, owner):
-    a = real(v, "line_angle", owner)
-    if not 0.0 <= a <= 0.5 * np.pi:
-        raise InputError(f"{owner}: line_angle must lie in [0, pi/2] rad, got {v!r}")
-    return a
-
-
-CONTACT_OPTIONS = {   # name -> check(value, owner) returning the stored value (see contact.system)
-    "smoothing": lambda v, o: real(v, "smoothing", o, minimum=0.0, none=True),
-    "gauss_points": _gauss_points,
-    "penalty_t": lambda v, o: real(v, "penalty_t", o, above=0.0, none=True),
-    "slip_tolerance": lambda v, o: real(v, "slip_tolerance", o, above=0.0),
-    "tolerance": lambda v, o: real(v, "tolerance", o, above=0.0, none=True),
-    "line_angle": _line_angle,
-    "point_ratio": lambda v, o: real(v, "point_ratio", o, minimum=0.0, maximum=1.0),
-    "margin": lambda v, o: real(v, "margin", o, minimum=0.0),
-    "law": lambda v, o: _contact_law(v, o),
-    "adjust": lambda v, o: real(v, "adjust", o, minimum=0.0, none=True),
-    "stick": lambda v, o: _stick(v, o),
-    "stick_tolerance": lambda v, o: real(v, "stick_tolerance", o, above=0.0, none=True),
-}
-
-
-def _stick(v, owner):
-    if v in ("penalty", "exact"):
-        return v
-    raise InputError(f"{owner}: stick must be 'penalty' or 'exact', got {v!r}")
-
-
-def _contact_law(v, owner):
-    """A ``contact.law.ContactLaw`` (checked by its fields: ``name``, compiled ``normal`` and
-    ``tangential``) or None."""
-    if v is None:
-        return v
-    if isinstance(getattr(v, "name", None), str) and callable(getattr(v, "normal", None)) \
-            and callable(getattr(v, "tangential", None)):
-        plain = [k for k in ("normal", "tangential") if not _compiled(getattr(v, k))]
-        if plain:
-            raise InputError(f"{owner}: law {v.name!r}: {' and '.join(plain)} must be numba-compiled functions "
-                             "(decorate them with beamsolver._jit.jit, i.e. numba.njit): the compiled contact "
-                             f"kernel cannot call the plain Python function(s) {plain}")
-        return v
-    raise InputError(f"{owner}: law must be a beamsolver.contact.law.ContactLaw (name, normal, tangential) "
-                     f"or None, got {type(v).__name__} {v!r}")
-
-
-def _compiled(f):
-    """Whether ``f`` is a numba dispatcher (anything callable when numba's JIT is disabled)."""
-    from numba.core import config
-    from numba.core.dispatcher import Dispatcher
-    return isinstance(f, Dispatcher) or bool(config.DISABLE_JIT)
-
-
-def check_contact_options(options, owner="add_contact"):
-    """Validated copy of ``Model.add_contact``'s keyword options (unknown names refused)."""
-    bad = sorted(set(options) - set(CONTACT_OPTIONS))
-    if bad:
-        raise InputError(f"{owner}: unknown options {bad}; known: {sorted(CONTACT_OPTIONS)}")
-    return {k: CONTACT_OPTIONS[k](v, owner) for k, v in options.items()}
 
 
 # ------------------------------------------------------------ solve
