@@ -292,20 +292,39 @@ class Newton:
         self._check_rotation(ev.state)
         return ev
 
+    def _write_targets(self, dz, H, t, t_prev, H_target):
+        """Write into ``dz`` ``(n, 6)`` the increments carrying the constrained nodes from ``H`` (at
+        ``t_prev``) to their targets at ``t`` (prescribed poses ``H_target``; ``fix(values=)``
+        components); returns the ``fix(values=)`` targets."""
+        sys = self.sys
+        targets = sys.fixed_value_increments(H, t, t_prev) if sys.fix_values else []
+        if len(sys.prescribed_nodes):
+            p = sys.prescribed_nodes
+            dz[p] = se3.log(se3.relative(H[p], H_target))
+        for node, comp, dx in targets:
+            dz[node, comp] = dx
+        return targets
+
     def constrained_increments(self, H, t, t_prev, H_target):
         """Increments ``dz_c`` ``(n, 6)`` carrying the constrained nodes to their targets at ``t``
         (``None`` if there is nothing to move) and the ``fix(values=)`` targets."""
         sys = self.sys
-        targets = sys.fixed_value_increments(H, t, t_prev) if sys.fix_values else []
+        if not (len(sys.prescribed_nodes) or sys.fix_values):
+            return None, []
+        dz_c = np.zeros((sys.n_nodes, 6))
+        targets = self._write_targets(dz_c, H, t, t_prev, H_target)
         if not (len(sys.prescribed_nodes) or targets):
             return None, targets
-        dz_c = np.zeros((sys.n_nodes, 6))
-        if len(sys.prescribed_nodes):
-            p = sys.prescribed_nodes
-            dz_c[p] = se3.log(se3.relative(H[p], H_target))
-        for node, comp, dx in targets:
-            dz_c[node, comp] = dx
         return (dz_c if np.any(dz_c) else None), targets
+
+    def move(self, H, t_prev, t, dz):
+        """The iterate at ``t`` from ``H`` at ``t_prev``: free nodes by ``dz`` ``(n, 6)`` (its
+        constrained entries are overwritten), constrained ones onto their targets at ``t`` (the
+        arc-length iterations, whose ``t`` moves with every correction)."""
+        sys = self.sys
+        H_target = sys.prescribed_poses(t) if len(sys.prescribed_nodes) else None
+        targets = self._write_targets(dz, H, t, t_prev, H_target)
+        return self.reach_targets(H, dz, H_target, bool(targets), t)
 
     def reach_targets(self, H, dz, H_target, fix_values, t):
         """The predictor update: free nodes by ``dz`` ``(n, 6)``, constrained ones exactly onto their

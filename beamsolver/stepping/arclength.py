@@ -278,18 +278,9 @@ class ArcLengthRun(Run):
         return dz_r, dz_t
 
     def move(self, H, t, dzf, t_new):
-        """Free nodes by ``dzf``, constrained ones onto their targets at ``t_new`` (prescribed poses
-        exactly, ``fix(values=)`` components by their increments, as the load path's predictor)."""
-        sys = self.sys
-        dz = self.newton.full(dzf)
-        p = sys.prescribed_nodes
-        H_target = sys.prescribed_poses(t_new) if len(p) else None
-        if len(p):
-            dz[p] = se3.log(se3.relative(H[p], H_target))
-        targets = sys.fixed_value_increments(H, t_new, t) if sys.fix_values else []
-        for node, comp, dx in targets:
-            dz[node, comp] = dx
-        return self.newton.reach_targets(H, dz, H_target, bool(targets), t_new)
+        """Free nodes by ``dzf``, constrained ones onto their targets at ``t_new`` (``Newton.move``:
+        prescribed poses exactly, ``fix(values=)`` components by their increments)."""
+        return self.newton.move(H, t, t_new, self.newton.full(dzf))
 
     def _tangent_at(self, H, t):
         """``dz/dt`` ``(n_free,)`` along the path at the equilibrium ``(H, t)``; without contributions
