@@ -32,8 +32,8 @@ from ..nonlinear import linsolve
 from ..model import motion_path
 from ..lie import se3
 from ..errors import InputError
-from ..failures import AugmentationFailed, NonFinite, SingularTangent, StepFailed
-from .steps import MAX_OUTER, STEP_TOLERANCE, Run
+from ..failures import NonFinite, SingularTangent, StepFailed
+from .steps import STEP_TOLERANCE, Run
 
 __all__ = ["ArcLength", "arc_length_options", "check_arc_length_arguments", "ArcLengthRun", "Sphere", "sphere_root",
            "next_arc_length", "rate", "RATE_STEP", "TURN_BACK"]
@@ -353,22 +353,13 @@ class ArcLengthRun(Run):
     def _augment(self, out):
         """Outer iterations at the converged ``t`` (``Problem.repeat_step``, e.g. augmented-Lagrangian
         updates) with ``t`` held; refused or warned if ``Problem.unmet``."""
-        problem = self.problem
         H, t, w, tau, ev, stats = out
-        while problem.repeat_step(H):
-            if stats.get("augmentations", 0) >= MAX_OUTER:
-                raise AugmentationFailed(f"the outer iterations (augmented-Lagrangian updates) still ask to "
-                                         f"re-solve the step at t = {t:.6g} after MAX_OUTER = {MAX_OUTER}")
-            H, t, w, tau, ev, more = self._correct(H, t, w, tau, 0.0, t_fixed=t)
-            stats["iterations"] += more["iterations"]
-            stats["residuals"] += more["residuals"]
-            stats["augmentations"] = stats.get("augmentations", 0) + 1
-        text = problem.unmet(t)
-        if text:
-            if not self.opt.allow_unmet_tolerance:
-                raise AugmentationFailed(text + " (solve(..., allow_unmet_tolerance=True) accepts it)")
-            stats.setdefault("warnings", []).append(text)
-            warnings.warn(text, RuntimeWarning, stacklevel=4)
+
+        def again(state):
+            H, t, w, tau, ev, more = self._correct(*state[:4], 0.0, t_fixed=state[1])
+            return (H, t, w, tau, ev), more
+        H, t, w, tau, ev = self.outer_iterations((H, t, w, tau, ev), stats, t, again)
+        self.check_unmet(t, stats)
         return H, t, w, tau, ev, stats
 
     def _check_turn(self, w, tau):

@@ -360,25 +360,42 @@ class Run:
         problem.begin_step(self.H, t_next)
         H0, t_prev = (self.H, self.t) if start is None else (start, t_next)
         H, ev, stats = newton.step(H0, t_next, H_target, t_prev)
-        while problem.repeat_step(H):
+
+        def again(state):
+            H, ev, more = newton.step(state[0], t_next, H_target, self.t)
+            return (H, ev), more
+        H, ev = self.outer_iterations((H, ev), stats, t_next, again)
+        if self.opt.stabilizer is not None:
+            self.opt.stabilizer.check(problem.tangent(newton.last_evaluation), t_next)
+        self.check_unmet(t_next, stats)
+        return H, ev, stats
+
+    def outer_iterations(self, state, stats, t, again):
+        """Re-solve the step converged at ``t`` while the problem asks (``Problem.repeat_step``, e.g.
+        augmented-Lagrangian updates), at most ``MAX_OUTER`` times: ``state`` a tuple whose first
+        item is the converged poses, ``again(state)`` -> ``(state, more stats)``; the iterations and
+        residuals are added to ``stats``.  Returns the last state."""
+        while self.problem.repeat_step(state[0]):
             if stats.get("augmentations", 0) >= MAX_OUTER:
                 raise AugmentationFailed(f"the outer iterations (augmented-Lagrangian updates) still ask to re-solve "
-                                         f"the step at t = {t_next:.6g} after MAX_OUTER = {MAX_OUTER}")
-            H, ev, more = newton.step(H, t_next, H_target, self.t)
+                                         f"the step at t = {t:.6g} after MAX_OUTER = {MAX_OUTER}")
+            state, more = again(state)
             stats["iterations"] += more["iterations"]
             stats["residuals"] += more["residuals"]
             stats["augmentations"] = stats.get("augmentations", 0) + 1
-        if self.opt.stabilizer is not None:
-            self.opt.stabilizer.check(problem.tangent(newton.last_evaluation), t_next)
-        text = problem.unmet(t_next)
+        return state
+
+    def check_unmet(self, t, stats):
+        """Refuse (``AugmentationFailed``) or, with ``allow_unmet_tolerance``, warn about a step whose
+        contributions' tolerance is unmet (``Problem.unmet``)."""
+        text = self.problem.unmet(t)
         if text:
             if not self.opt.allow_unmet_tolerance:
                 raise AugmentationFailed(text + " (solve(..., allow_unmet_tolerance=True) accepts it "
                                          "with a warning)")
             stats.setdefault("warnings", []).append(text)
             log.warning(text)
-            warnings.warn(text, RuntimeWarning, stacklevel=4)
-        return H, ev, stats
+            warnings.warn(text, RuntimeWarning, stacklevel=5)
 
     def _record(self, t_next, H, ev, stats):
         sys, sol, problem = self.sys, self.sol, self.problem
