@@ -230,7 +230,7 @@ def test_continuity_shortcut_bound_holds():
     (angles of the relative rotations before and after the step): then the change ``angle(R0^T R1)
     <= a0 + a1`` can never reach ``(pi - a0) + (pi - a1) - 1e-9``, checked on random rotations, and
     a turn through pi within a step is still refused."""
-    from beamsolver.nonlinear.newton import CONTINUITY_MARGIN
+    from beamsolver.nonlinear.rotations import CONTINUITY_MARGIN
 
     def angle(R):
         return np.arccos(np.clip(0.5 * (np.trace(R, axis1=-2, axis2=-1) - 1.0), -1.0, 1.0))

@@ -43,7 +43,6 @@ by meshio, pyvista and ParaView) with two-point ``line`` cells, which meshio rea
 cannot read VTK poly-lines, type 4); for smooth tubes ParaView joins them into
 poly-lines with *Triangle Strips* before the Tube filter (docs/guide/output.md, "ParaView by hand"; or io.paraview).
 """
-from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 import numpy as np

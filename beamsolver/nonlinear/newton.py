@@ -26,23 +26,21 @@ from typing import NamedTuple, Protocol
 
 import numpy as np
 
-from .. import elements
-from ..failures import DampingStalled, Diverged, NonFinite, NotConverged, RotationLimit, SingularTangent, StepFailed
+from ..failures import DampingStalled, Diverged, NonFinite, NotConverged, SingularTangent, StepFailed
 from ..lie import se3
 from . import linsolve
 from .convergence import CONTINUE, CONVERGED, MAX_ITER, Convergence, Verdict
+from .rotations import (MAX_ELEMENT_ROTATION, RotationGuard, angle, largest_element_rotation,
+                        relative_rotations)
 
-__all__ = ["Newton", "Constraint", "FixedTime", "Convergence", "Verdict", "relative_rotations", "angle",
+__all__ = ["Newton", "Constraint", "FixedTime", "Convergence", "Verdict", "RotationGuard", "relative_rotations", "angle",
            "largest_element_rotation", "MAX_ELEMENT_ROTATION"]
 
 log = logging.getLogger("beamsolver")
 
-MAX_ELEMENT_ROTATION = elements.MAX_ELEMENT_ROTATION   # an iterate turning an element further is rejected
 LS_GROWTH = 10.0                     # full Newton steps are kept unless the merit grows this much
 DAMPING_MIN = 1.0 / 64.0             # shortest damped Newton step (smooth problems)
 STALL_RATIO = 1.5                    # undamped fallback if the shortest damped step grows the correction less
-SQRT3 = np.sqrt(3.0)                 # |w|_2 <= SQRT3 |w|_inf (the rotation check's shortcut)
-CONTINUITY_MARGIN = 1e-6             # check_continuity's shortcut: far above the ~1e-8 round-off of arccos at 0
 
 
 class Constraint(Protocol):
@@ -108,25 +106,6 @@ class FixedTime:
         return {}
 
 
-def relative_rotations(system, H):
-    """Rotations ``R_i^T R_j`` of the node pairs an element represents by a logarithm
-    (``system.rotation_pairs``: one per element for two-node elements), ``(n_pairs, 3, 3)``."""
-    en = system.rotation_pairs
-    return np.swapaxes(H[en[:, 0], :3, :3], 1, 2) @ H[en[:, 1], :3, :3]
-
-
-def angle(R):
-    """Rotation angles in ``[0, pi]`` of ``(..., 3, 3)`` rotation matrices."""
-    return np.arccos(np.clip(0.5 * (np.trace(R, axis1=-2, axis2=-1) - 1.0), -1.0, 1.0))
-
-
-def largest_element_rotation(system, H):
-    """Largest rotation angle between the two nodes of an element at poses ``H``."""
-    if system.n_elements == 0:
-        return 0.0
-    return float(angle(relative_rotations(system, H)).max())
-
-
 class _Measured(NamedTuple):
     """An evaluation (``problem.Evaluation``) with its residual scales and scaled residual, and,
     once computed, its factorised tangent ``lu``, Newton correction ``dzf`` of the free unknowns
@@ -160,8 +139,7 @@ class Newton:
         self.fu, self.fw = np.flatnonzero(fu), np.flatnonzero(~fu)
         self._dofs_u, self._dofs_w = system.free_dofs[self.fu], system.free_dofs[self.fw]   # in all 6 n unknowns
         self.L_ref = system.length_scale
-        # the rotation check's shortcut bound, a margin far above the round-off of |w|
-        self._smallest_limit = (1.0 - 1e-9) * float(system.rotation_limit.min(initial=np.inf))
+        self.rotations = RotationGuard(system)
         self.linsolver = linsolve.Solver()    # solve(linear_solver=...) replaces it
         self.stall_ratio = np.inf             # correction growth of the shortest damped trial
         self.indefinite_seen = False          # the step's first tangent had det < 0 (or a back-end that cannot tell)
@@ -204,50 +182,10 @@ class Newton:
         F, M = scales
         return float(np.sum((rf[self.fu] / F) ** 2) + np.sum((rf[self.fw] / M) ** 2))
 
-    def _element_label(self, e):
-        """``element e (element j of Beam b)`` for a global element id."""
-        for b in self.sys.model.beams:
-            if b.elements[0] <= e <= b.elements[-1]:
-                return f"element {e} (no. {e - b.elements[0]} of the {b.n_elements} of Beam {b.id})"
-        return f"element {e}"
-
-    def _check_rotation(self, state):
-        w = state.h[:, 3:]
-        # |w| <= sqrt(3) max|w_i|: far below every limit, nothing to measure
-        if len(w) and np.abs(w).max() * SQRT3 < self._smallest_limit:
-            return
-        ang = se3.rotation_angle(w)
-        limit = self.sys.rotation_limit          # of each element's type, MAX_ELEMENT_ROTATION for se3-2
-        worst = int(np.argmax(ang - limit)) if len(ang) else 0
-        if len(ang) and ang[worst] > limit[worst]:
-            raise RotationLimit(f"{self._element_label(worst)} turns by {ang[worst]:.4f} rad within one element "
-                                f"(limit MAX_ELEMENT_ROTATION = {limit[worst] / np.pi:.2g} pi = "
-                                f"{limit[worst]:.4f} rad; an element cannot turn by pi): refine the mesh")
-
     def check_continuity(self, H0, H1):
-        """Refuse a step over which an element's relative rotation may have passed through pi.
-
-        The element only sees ``log(H_A^-1 H_B)``, whose angle lies in ``[0, pi]``: an element
-        turned past pi within one load step would look like one turned the short way round (a
-        silent wrong answer).  Passing pi and coming back to the angle ``t1`` from ``t0`` takes a
-        rotation of at least ``(pi - t0) + (pi - t1)``, so a step whose relative rotations change
-        by less than that (the geodesic angle between old and new) cannot have passed it.
-        """
-        if self.sys.n_elements == 0:
-            return
-        R0, R1 = relative_rotations(self.sys, H0), relative_rotations(self.sys, H1)
-        a0, a1 = angle(R0), angle(R1)
-        # the change is at most a0 + a1: below pi (a margin above the arccos round-off) nothing can pass
-        if (a0 + a1).max() < np.pi - CONTINUITY_MARGIN:
-            return
-        change = angle(np.swapaxes(R0, 1, 2) @ R1)
-        bad = np.flatnonzero(change >= (np.pi - a0) + (np.pi - a1) - 1e-9)
-        if len(bad):
-            e = int(bad[np.argmax(change[bad])])
-            raise RotationLimit(f"{self._element_label(self.sys.pair_element[e])} turns by {change[e]:.3f} rad "
-                                "within one element in "
-                                "one load step and may have passed pi, which an element cannot represent: "
-                                "use smaller steps or refine the mesh")
+        """``RotationGuard.check_continuity``: refuse a step over which an element's relative rotation
+        may have passed through pi (``failures.RotationLimit``)."""
+        self.rotations.check_continuity(H0, H1)
 
     def _norm(self, dzf):
         """Norm of free increments, translations in units of the model size (unit-independent)."""
@@ -289,7 +227,7 @@ class Newton:
             self.timings[name] = self.timings.get(name, 0.0) + seconds
         if not np.isfinite(ev.r).all():
             raise NonFinite("the residual is not finite")
-        self._check_rotation(ev.state)
+        self.rotations.check(ev.state)
         return ev
 
     def _write_targets(self, dz, H, t, t_prev, H_target):
