@@ -143,7 +143,8 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     ``arclength.ArcLength``: ``initial``, ``min``, ``max``,
     ``target_iterations``, ``max_steps``, ``psi``).  Its ``times`` are not
     monotonic; ``stats[k]`` adds ``arc_length``, ``t`` and ``linearised``;
-    ``restart``, ``branch_switching`` and ``stabilize`` are refused with it.
+    ``restart``, ``branch_switching`` and ``stabilize`` are refused with it.  Other names: the
+    steppers registered in ``beamsolver.stepping.steppers`` (``register``).
 
     ``convergence``: the stopping rule of the Newton loop as a ``Convergence`` (``rtol``, ``dtol``,
     ``max_iter``, ``divergence``) in place of ``rtol=``, ``dtol=``, ``max_iter=`` (giving both, with
