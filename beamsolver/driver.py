@@ -80,7 +80,8 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     is shortened first, so motions are followed as continuous paths.
 
     ``output``: folder for ParaView files and ``solution.npz`` (``None``: no
-    output; see ``beamsolver.io.vtk`` and, for the formats, ``beamsolver.io.writers``), the latter saved at the end, whenever
+    output; see ``beamsolver.io.vtk`` and, for the formats, ``beamsolver.io.writers``), the
+    latter saved at the end, whenever
     the run stops (also by Ctrl-C or an exception) and every ``checkpoint``
     seconds (0: every step; ``None``: only at the end or stop); or a writer
     object with ``write(solution, step)`` and ``close()`` such as ``io.vtk.StepWriter``.

@@ -201,7 +201,8 @@ def _names(path):
     return {t.string for t in toks if t.type == tokenize.NAME}
 
 
-@pytest.mark.parametrize("module", ["driver.py", "nonlinear/newton.py", "nonlinear/convergence.py", "nonlinear/rotations.py", "stepping/steps.py"])
+@pytest.mark.parametrize("module", ["driver.py", "nonlinear/newton.py", "nonlinear/convergence.py", "nonlinear/rotations.py",
+                                    "stepping/steps.py"])
 def test_solver_knows_nothing_of_contact(module):
     """No import of, and no name containing, contact (``Solution.contact_state`` is the Solution's field,
     the history of any contribution)."""

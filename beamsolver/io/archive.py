@@ -33,8 +33,8 @@ class ArchiveWriter:
     ``write(solution, step)`` saves the solution (atomically) when ``checkpoint`` seconds of wall
     time have passed since the last save (``0``: every step; ``inf``: never before ``close``);
     ``close`` saves it.  ``checked``: the folder exists and was found writable (by a writer of
-    the same run), else it is created and checked here.  The folder's previous archive is removed at once, so a run that fails
-    before its first save leaves no other run's result behind.  ``entries``: step -> time written."""
+    the same run), else it is created and checked here.  The folder's previous archive is removed
+    at once, so a run that fails before its first save leaves no other run's result behind.  ``entries``: step -> time written."""
     archives = True
 
     def __init__(self, folder, checkpoint=60.0, checked=False):

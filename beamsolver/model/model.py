@@ -15,7 +15,8 @@ from .. import elements
 from ..errors import InputError
 from .section import Section
 from .contact_options import check_contact_options, describe as describe_contact_options
-from .validation import MAX_REFERENCE_ELEMENT_ROTATION, ORTHONORMAL_TOL, CheckedScalar, as_array, check_node_id, check_pose, real
+from .validation import (MAX_REFERENCE_ELEMENT_ROTATION, ORTHONORMAL_TOL, CheckedScalar, as_array, check_node_id,
+                         check_pose, real)
 
 __all__ = ["Model", "Beam", "Load", "LineLoad", "ContactDeclaration", "ElementGroup", "DOF_NAMES"]
 

@@ -46,7 +46,8 @@ from .._jit import jit
 from ..errors import InputError
 from ..failures import SingularTangent
 
-__all__ = ["factorize", "factorize_tangent", "Solver", "SingularMatrixError", "available", "permutation_sign", "BACKENDS", "DEFAULT"]
+__all__ = ["factorize", "factorize_tangent", "Solver", "SingularMatrixError", "available", "permutation_sign",
+           "BACKENDS", "DEFAULT"]
 
 BACKENDS = ("splu", "splu-rcm", "pardiso", "auto")
 DEFAULT = "auto"          # splu for beams and small scenes; splu-rcm/pardiso for large bundles

@@ -30,11 +30,10 @@ from ..failures import DampingStalled, Diverged, NonFinite, NotConverged, Singul
 from ..lie import se3
 from . import linsolve
 from .convergence import CONTINUE, CONVERGED, MAX_ITER, Convergence, Verdict
-from .rotations import (MAX_ELEMENT_ROTATION, RotationGuard, angle, largest_element_rotation,
-                        relative_rotations)
+from .rotations import MAX_ELEMENT_ROTATION, RotationGuard, angle, largest_element_rotation, relative_rotations
 
-__all__ = ["Newton", "Constraint", "FixedTime", "Convergence", "Verdict", "RotationGuard", "relative_rotations", "angle",
-           "largest_element_rotation", "MAX_ELEMENT_ROTATION"]
+__all__ = ["Newton", "Constraint", "FixedTime", "Convergence", "Verdict", "RotationGuard", "relative_rotations",
+           "angle", "largest_element_rotation", "MAX_ELEMENT_ROTATION"]
 
 log = logging.getLogger("beamsolver")
 
@@ -120,8 +119,9 @@ class _Measured(NamedTuple):
 
 class Newton:
     """Newton iterations of one step (``iterate`` under a ``Constraint``; ``step``: load stepping) on a
-    ``problem.Problem`` with the ``Convergence`` ``conv``; ``evaluate`` is the checked, timed evaluation it uses (also for branch switching),
-    ``last_evaluation`` that of the last converged state.  ``timings`` accumulates the wall time
+    ``problem.Problem`` with the ``Convergence`` ``conv``; ``evaluate`` is the checked, timed
+    evaluation it uses (also for branch switching), ``last_evaluation`` that of the last converged
+    state.  ``timings`` accumulates the wall time
     of ``assembly`` (residual, tangent, sparse matrix), of each of the problem's contributions
     (``Problem.timing_names``, part of assembly) and ``linear_solve`` (factorisation and solves)
     until ``reset_timings``."""
