@@ -1,14 +1,13 @@
 """Compiled (numba) path of the two-node SE(3) beam element: one element per call, a batch driver.
 
 The maths and names are those of ``element`` (its numpy version is the test
-oracle; both agree to round-off, ``tests/test_kernels_jit.py``): for the side
+oracle; both agree to round-off, ``tests/elements/test_compiled_kernels.py``): for the side
 ``s`` of node A (argument ``-h``, sign -1) and of node B (argument ``h``, sign
 +1), ``T(h_s)^-1 = [[Ti, X], [0, Ti]]``, the force block ``g_s = [Ti n; X n + Ti m]``
 and the geometric blocks ``G12, G21, G22`` of ``element._geometric``
 (docs/theory.md eqs. 3.4-3.7).  The tangent goes to an array ``(n, 12, 12)``,
-element-major (each element's 144 entries contiguous: element-axis-last storage
-made every element touch 144 pages, measured 2x slower at 1e4 elements), the
-order ``assembly.System`` scatters.  Node poses are read through a node table
+element-major (each element's 144 entries contiguous, so an element touches one or two
+pages; docs/benchmarks.md), the order ``assembly.System`` scatters.  Node poses are read through a node table
 ``(n, 2)`` from the model's pose array (``elements.se3_2``), not gathered first.
 """
 from .._jit import jit, jit_inline

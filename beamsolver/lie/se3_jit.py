@@ -5,7 +5,7 @@ its small algebra in registers and allocates nothing.  Conventions are those of
 ``se3`` (docs/theory.md section 1): twists ``(u, w)``, translation first, right
 tangent operators.  Every singular coefficient switches from its nine-term
 series to its closed form at the same point ``se3.SWITCH`` as the numpy
-version, so both agree to round-off (``tests/test_kernels_jit.py``).
+version, so both agree to round-off (``tests/elements/test_compiled_kernels.py``).
 
 ``NUMBA_DISABLE_JIT=1`` runs these functions as plain Python (slowly).
 """
