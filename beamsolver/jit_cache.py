@@ -29,7 +29,6 @@ stamped by the statement its code comes from.  The cache stays where numba would
 (``NUMBA_CACHE_DIR``, the in-tree ``__pycache__``, else the user-wide cache for read-only installs).
 """
 import ast
-import copy
 import hashlib
 from functools import lru_cache
 from pathlib import Path
@@ -50,7 +49,7 @@ class _Module:
         self.defs = {}          # name -> [statement], in file order
         self.imports = {}       # name -> (module path, attribute or None for the module itself)
         self.functions = {}     # function name -> [(first line, statement)] of every def of that name
-        self._dumps = {}
+        self._dumps, self._refs = {}, {}
         here = path.relative_to(root).parent.parts
         for node in tree.body:
             if isinstance(node, (ast.Import, ast.ImportFrom)):
@@ -89,15 +88,27 @@ class _Module:
         """The statement's syntax tree as text: comments, docstrings and layout do not count."""
         key = (node.lineno, node.col_offset)
         if key not in self._dumps:
-            node = copy.deepcopy(node)
+            held = []                    # docstrings taken out for the dump, put back after
             for sub in ast.walk(node):
                 body = getattr(sub, "body", None)
                 if isinstance(sub, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)) and body \
                         and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant) \
                         and isinstance(body[0].value.value, str):
+                    held.append((sub, body))
                     sub.body = body[1:] or [ast.Pass()]
-            self._dumps[key] = ast.dump(node)
+            try:
+                self._dumps[key] = ast.dump(node)
+            finally:
+                for sub, body in held:
+                    sub.body = body
         return self._dumps[key]
+
+    def references(self, node):
+        """``_references`` of a statement of this module, computed once."""
+        key = (node.lineno, node.col_offset)
+        if key not in self._refs:
+            self._refs[key] = _references(node)
+        return self._refs[key]
 
 
 def _bound(node):
@@ -174,7 +185,7 @@ def _statements(mod, node, root):
         if key in seen:
             continue
         seen[key] = (m, n)
-        for name, attr in _references(n):
+        for name, attr in m.references(n):
             hit = _resolve(m, name, root)
             if hit is None:
                 continue
