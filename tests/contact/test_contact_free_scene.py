@@ -1,4 +1,5 @@
-"""A scene without contact runs none of the contact code (fresh interpreter, clean sys.modules)."""
+"""A scene without contact runs none of the contact code, and no solve loads a test oracle
+(``contact.reference``, ``elements.reference``) (fresh interpreter, clean sys.modules)."""
 import pytest
 import json
 import subprocess
@@ -17,6 +18,7 @@ SCRIPT = textwrap.dedent("""
     out = dict(system="beamsolver.contact.system" in sys.modules,
                search="beamsolver.contact.search" in sys.modules,
                pairs="beamsolver.contact.pairs" in sys.modules,
+               oracle="beamsolver.elements.reference" in sys.modules,
                contact=[len(c) for c in sol.contacts])
     print(json.dumps(out))
 """)
@@ -41,8 +43,9 @@ SCRIPT_CONTACT = textwrap.dedent("""
     b = m.add_beam(bs.geometry.straight((-1, 0, 1), (1, 0, 1), 3), sec)
     for n in (a.first, a.last, b.first, b.last):
         m.clamp(n)
-    m.add_contact(b, a)
+    m.add_contact(b, a, mu=0.2)
     bs.solve(m, steps=1)
+    calls["oracles"] = sum(k in sys.modules for k in ("beamsolver.contact.reference", "beamsolver.elements.reference"))
     print(json.dumps(dict(calls)))
 """)
 
@@ -55,10 +58,11 @@ def _run(script):
 
 def test_scene_without_contact_never_imports_the_contact_system():
     out = _run(SCRIPT)
-    assert out == dict(system=False, search=False, pairs=False, contact=[0, 0, 0])
+    assert out == dict(system=False, search=False, pairs=False, oracle=False, contact=[0, 0, 0])
 
 
 @pytest.mark.slow
 def test_contact_code_runs_when_there_is_contact():
     calls = _run(SCRIPT_CONTACT)          # the sys.modules probe above would see this code if it ran
     assert calls.get("search", 0) > 0 and calls.get("evaluate", 0) > 0
+    assert calls["oracles"] == 0                 # a frictional contact solve runs without the oracles
