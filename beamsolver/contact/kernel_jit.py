@@ -74,7 +74,8 @@ _normal_law = _tangential_law = None
 @intrinsic
 def _borrowed_intrinsic(typingctx, a):
     """A view of the array ``a`` without its memory owner (meminfo): numba's reference counting
-    (an atomic increment and decrement per array passed to a function or sliced) skips it.  The caller keeps ``a`` alive while the view is in use."""
+    (an atomic increment and decrement per array passed to a function or sliced) skips it.
+    The caller keeps ``a`` alive while the view is in use."""
     if not isinstance(a, nb_types.Array):
         return None
 
