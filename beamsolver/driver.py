@@ -107,10 +107,8 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     problem is conservative (no follower loads, no friction), record
     ``stable``, ``negative_eigenvalues`` and ``lowest_eigenvalue`` (scaled;
     ``None`` where not computed) in ``stats`` and warn once
-    (``StabilityWarning``) on an unstable equilibrium; opt-in: on stable 8-step
-    solves of 96-6144 unknowns (2-3 Newton iterations a step) it added 6-27 % to
-    the wall time, ``modes=3`` 22-112 % (``benchmarks/stability_check.py``, one
-    run on a shared 2-core machine).  "Stable" means the
+    (``StabilityWarning``) on an unstable equilibrium; opt-in (its cost:
+    docs/benchmarks.md, ``benchmarks/stability_check.py``).  "Stable" means the
     symmetric tangent is positive definite: the converged state is a strict
     minimum of the potential energy.  With friction or follower loads the
     tangent is unsymmetric and depends on the history, there is no potential,

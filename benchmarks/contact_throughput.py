@@ -5,7 +5,7 @@ all active, friction on), ``n`` slave points from 1e2 to 1e5.  Per size, in one 
 
 - search (broad phase, pair rules, compiled projections: ``ContactSystem.pairs``) per Newton iteration;
 - kernel + tangent: the compiled kernel (``contact.kernel_jit``, forward-mode exact tangent)
-  and the numpy oracle (``contact.pairs``, 24 complex-step kernel evaluations; up to 1e4 points);
+  and the numpy oracle (``contact.reference``, 24 complex-step kernel evaluations; up to 1e4 points);
 - search + kernel + tangent (the issue's measure: target 2e5 points/s at 1e4 points);
 - a whole ``ContactSystem.evaluate`` (search + kernel + tangent, the local blocks), compiled kernel.
 
@@ -29,7 +29,7 @@ import numpy as np  # noqa: E402
 
 import beamsolver as bs  # noqa: E402
 from beamsolver.nonlinear.problem import Problem  # noqa: E402
-from beamsolver.contact import kernel_jit, pairs  # noqa: E402
+from beamsolver.contact import kernel_jit, reference# noqa: E402
 from beamsolver.contact.system import use_numpy_kernel  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "results"
@@ -91,7 +91,7 @@ def measure(n_points, oracle_max=10_000):
     kernel_jit.kernel_and_tangent(X[:2], {k: (v[:2] if np.ndim(v) else v) for k, v in p.items()})   # compiled
     K = np.empty((len(X), 24, 24))      # the tangent buffer a caller keeps (ContactSystem does)
     t_jit = _best(lambda: kernel_jit.kernel_and_tangent(X, p, friction=True, K=K), repeat)
-    t_np = _best(lambda: pairs.kernel_and_tangent(X, p, friction=True), 1) if n_points <= oracle_max else np.nan
+    t_np = _best(lambda: reference.kernel_and_tangent(X, p, friction=True), 1) if n_points <= oracle_max else np.nan
     use_numpy_kernel(False)
     # a new step before each evaluation: the contact system keeps its last evaluation for the same poses
     t_eval = _best(lambda: (c.begin_step(H, 0.0), c.evaluate(H, tangent=True)), repeat)
@@ -186,7 +186,7 @@ sections, sphere filter and projections in one compiled pass); kernel + tangent 
 through the projection, the frames, the laws and the node Jacobians; an element's twist and
 operators computed once for consecutive points on it; the tangent written to a
 buffer kept between calls, as `ContactSystem` does); numpy oracle =
-`contact.pairs.kernel_and_tangent` (24 complex-step kernel evaluations per point, measured up
+`contact.reference.kernel_and_tangent` (24 complex-step kernel evaluations per point, measured up
 to 1e4 points); evaluate = `ContactSystem.evaluate` (search + compiled kernel + tangent, the
 local blocks handed to the assembler; after `begin_step`: the contact system keeps its last
 evaluation for the same poses); the rest of evaluate is the refusals, the active set, the

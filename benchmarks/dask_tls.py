@@ -58,7 +58,7 @@ def main(write=False):
 
 {machine()}; {N_WORKERS} worker processes, {REPEATS} starts of each kind, alternating. A sweep's local cluster
 uses TLS with credentials made for it (`Security.temporary()`): other processes of the machine cannot connect to
-its scheduler (tests/test_sweep_security.py). Start: client and cluster up, workers registered.
+its scheduler (tests/app/test_sweep_security.py). Start: client and cluster up, workers registered.
 
 {text}""")
 

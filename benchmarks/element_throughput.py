@@ -8,7 +8,7 @@ deformed, non-equilibrium state.  Per size ``n = 1e2 .. 1e5``:
   (``bs.elements.get("se3-2").evaluate(H, nodes, ref, True)``: forces + exact
   tangent by the compiled numba path, poses read through the node table), and
   the same by the numpy kernel kept as its oracle
-  (``element.internal_forces_and_tangent_numpy``), measured in the same run;
+  (``reference.internal_forces_and_tangent_numpy``), measured in the same run;
 - assembly: ``System.evaluate`` (kernel + loads + residual scatter) and
   ``System.matrix`` (tangent values scattered into the CSC pattern built once);
 - iteration: assembly plus the sparse factorisation and solve of one Newton
@@ -38,7 +38,7 @@ import numpy as np  # noqa: E402
 import scipy.sparse.linalg as spla  # noqa: E402
 
 import beamsolver as bs  # noqa: E402
-from beamsolver.elements import element# noqa: E402
+from beamsolver.elements import reference  # noqa: E402
 from beamsolver.assembly.system import System  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "results"
@@ -83,7 +83,7 @@ def measure(n):
     etype, nodes, ref = group.element_type, group.nodes, group.ref
     etype.evaluate(H, nodes, ref, True)                    # compile (or load the cache) before timing
     t_kernel = _best(lambda: etype.evaluate(H, nodes, ref, True), min_time=1.0, max_repeat=200)
-    t_numpy = _best(lambda: element.internal_forces_and_tangent_numpy(*args))
+    t_numpy = _best(lambda: reference.internal_forces_and_tangent_numpy(*args))
     t_forces = _best(lambda: etype.evaluate(H, nodes, ref, False), min_time=1.0, max_repeat=200)
 
     def assemble():

@@ -28,7 +28,7 @@ small copy ``docs/error_vs_runtime.png`` and the section ``error_vs_runtime``
 of ``docs/benchmarks.md``.  ``--quick``: smaller sweeps (under a minute).
 The problem functions (``bend45_mesh``, ``bend45_steps``, ``roll_up_rows``,
 ``helix_rows``, ``capstan_mesh``, ``capstan_steps``, ``strand_rows``) return
-lists of row dicts and can be called with small sizes (``tests/test_benchmarks_smoke.py``).
+lists of row dicts and can be called with small sizes (``tests/benchmarks/test_benchmarks_smoke.py``).
 """
 import sys
 import time
@@ -58,7 +58,7 @@ CSV = RESULTS / "error_vs_runtime.csv"
 PNG = RESULTS / "error_vs_runtime.png"
 DOC_PNG = _report.ROOT / "docs" / "error_vs_runtime.png"
 
-# the constant of tests/test_reference_problems.py (Richardson of 512/1024 elements), for comparison only
+# the constant of tests/published/test_reference_problems.py (Richardson of 512/1024 elements), for comparison only
 TEST_CONVERGED_600 = np.array([47.150439, 15.684800, 53.474859])
 BEND_LENGTH = bend45.RADIUS * np.pi / 4.0
 BEND_TIP0 = np.array([bend45.RADIUS * np.sin(np.pi / 4), bend45.RADIUS * (1 - np.cos(np.pi / 4)), 0.0])
@@ -379,7 +379,7 @@ def report(res, quick, total_wall):
            "No closed form: the reference is the converged tip, the Richardson extrapolation "
            f"of {'/'.join(map(str, ref_meshes))} elements (one load step, rtol 1e-12; observed order "
            f"{p_ref:.3f}): ({ref[0]:.6f}, {ref[1]:.6f}, {ref[2]:.6f}); the constant of "
-           f"`tests/test_reference_problems.py` (512/1024 elements) differs by "
+           f"`tests/published/test_reference_problems.py` (512/1024 elements) differs by "
            f"{np.linalg.norm(ref - TEST_CONVERGED_600):.1e}. The error is the distance of the tip from it "
            "(relative: divided by the tip displacement, "
            f"{np.linalg.norm(ref - BEND_TIP0):.2f}). The element has constant strain, so the "

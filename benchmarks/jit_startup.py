@@ -218,7 +218,7 @@ def main(argv=None):
 
 Wall time of a fresh process; the first run starts from an empty numba cache (`NUMBA_CACHE_DIR`) and
 compiles the kernels (`element_jit`, `assembly_jit`, `se3_jit`) into it, the cached runs (best of two)
-load them. `tests/test_kernels_jit.py::test_second_process_loads_the_cache` checks that a cached run
+load them. `tests/elements/test_compiled_kernels.py::test_second_process_loads_the_cache` checks that a cached run
 compiles nothing.
 
 {md}

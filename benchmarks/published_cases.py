@@ -26,6 +26,7 @@ import beamsolver as bs  # noqa: E402
 from beamsolver.stepping import stable_branch# noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "published"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))      # scenes imports limit_points
 import scenes  # noqa: E402
 from test_elastica_kick import elastica  # noqa: E402
 from test_capstan_published import CHORDS, HELIX  # noqa: E402

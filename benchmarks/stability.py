@@ -11,7 +11,7 @@ penetration / radius, or Coulomb ratio |F_t| / (mu F_n) while sliding).
 
 Markdown on stdout, CSV in ``benchmarks/results/stability.csv``, the
 ``stability`` section of ``docs/benchmarks.md`` (full run only).  The cases are
-plain functions returning a row, so ``tests/test_stability.py`` runs a subset.
+plain functions returning a row, so ``tests/stepping/test_hard_cases.py`` runs a subset.
 """
 import argparse
 import csv
@@ -563,7 +563,7 @@ def main(quick=False):
     if not quick:
         write_section("stability", f"""## Stability on stiff and extreme cases (issue 7)
 
-`python benchmarks/stability.py` ({machine()}; `--quick` for the subset; `tests/test_stability.py`
+`python benchmarks/stability.py` ({machine()}; `--quick` for the subset; `tests/stepping/test_hard_cases.py`
 asserts a fast subset).  Every case converges to the stated accuracy or stops with a clear
 `ConvergenceError`/`InputError` (a case still running after {CASE_TIME:g} s would be listed as a hang).
 `r+/r^2`: the largest `r_(k+1) / r_k^2` of the iterations above the round-off floor (bounded:

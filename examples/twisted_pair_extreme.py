@@ -5,7 +5,7 @@ linear-elastic rod with steel's moduli (``E = 200 GPa``, ``nu = 0.3``) and no yi
 on purpose: two turns over ``L = 20 mm`` give a surface shear strain ``R Phi / L = 0.31``
 (printed: the largest von Mises equivalent strain 0.25), some thirty times the elastic range
 of steel wire; the answer is the elastic rod's, kept as a hard test of contact, stability
-checks and path following (``tests/test_twisted_pair_extreme.py``, ``examples/plectoneme.py``).
+checks and path following (``tests/examples/test_twisted_pair_extreme.py``, ``examples/plectoneme.py``).
 
 Two straight wires (radius ``R``) touch along their length, side by side
 at ``x = +-R``; both are clamped at ``z = 0``.  Their upper ends are rigidly

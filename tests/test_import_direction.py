@@ -152,9 +152,9 @@ def test_the_walk_sees_known_edges():
     """The checker itself: it finds the edges it must (so an empty list of violations means something)."""
     _, edges = _edges()
     pairs = {(a, b) for a, b, _ in edges}
-    assert {("elements.se3_2", "elements.element"), ("elements.element", "lie.se3"), ("driver", "nonlinear.problem"),
+    assert {("elements.se3_2", "elements.element"), ("elements.geometric", "lie.se3"), ("driver", "nonlinear.problem"),
             ("nonlinear.problem", "assembly.system"), ("results.solution", "results.solution_file"),
-            ("io.archive", "results.solution"), ("contact.pairs", "lie.se3"),
+            ("io.archive", "results.solution"), ("contact.frames", "lie.se3"), ("contact.reference", "contact.frames"),
             ("nonlinear.problem", "contact.system"), ("", "driver"), ("driver", "io")} <= pairs
     assert _cycle([("a", "b", False), ("b", "c", True), ("c", "a", True)]) is not None
 
@@ -168,6 +168,23 @@ def test_importing_a_submodule_counts_its_package():
     assert ("results.solution", "io") not in {(a, b) for a, b, _ in edges}
     old = [("results", "io.archive", True), ("results", "io", True), ("io", "results", False)]
     assert _cycle(old) is not None
+
+
+# the test oracles: beside their kernels, imported by tests and benchmarks only
+ORACLES = ("contact.reference", "elements.reference")
+# lazy imports of an oracle, each with its reason
+ALLOWED_ORACLE = {
+    ("contact.system", "contact.reference"): "use_numpy_kernel(True) switches a run to the oracle, imported only then",
+    ("contact.pairs", "contact.reference"): "old names of the oracle, read through the module's __getattr__ only",
+}
+
+
+def test_production_never_imports_an_oracle():
+    modules, edges = _edges()
+    assert set(ORACLES) <= set(modules)
+    bad = [(a, b, "lazy" if lazy else "module level") for a, b, lazy in edges
+           if b in ORACLES and a not in ORACLES and ((a, b) not in ALLOWED_ORACLE or not lazy)]
+    assert bad == []
 
 
 def test_few_modules_at_the_top():

@@ -6,6 +6,7 @@ import os
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 
@@ -75,7 +76,7 @@ def test_an_edited_callee_is_compiled_again(tmp_path, guard):
 @pytest.mark.parametrize("guard", [False, True])
 def test_a_frozen_constant_of_a_plain_module_is_seen(tmp_path, guard):
     """``consts`` has no compiled code; ``g`` freezes its ``K`` (as the contact kernel freezes
-    ``contact.pairs``' constants)."""
+    ``contact.frames``' kinds)."""
     pkg = _package(tmp_path, guard)
     assert _run(tmp_path) == (1.0, False)
     _write(pkg / "consts.py", "K = 10.0\n", 3)
@@ -117,13 +118,62 @@ def test_a_process_running_old_code_cannot_stamp_it_new(tmp_path):
 
 def test_dependencies_follow_imports_transitively(tmp_path):
     pkg = _package(tmp_path, True)
-    deps = {p.name for p in jit_cache.dependencies(pkg / "caller.py", pkg)}
-    assert deps == {"caller.py", "callee.py", "consts.py", "_jit.py"}
+    deps = {(rel, line) for rel, line in jit_cache.dependencies(pkg / "caller.py", "g", pkg)}
+    assert {rel for rel, _ in deps} == {"caller.py", "callee.py", "consts.py", "_jit.py"}
+    line = next(n for rel, n in deps if rel == "_jit.py")
+    assert (pkg / "_jit.py").read_text().splitlines()[line - 1].startswith("jit = njit(")   # the decorator's options
+
+
+def _stamp(pkg, module, name):
+    """The stamp ``jit_cache`` gives the function ``name`` of ``pkg.module`` (read, not imported)."""
+    src = (pkg / f"{module}.py").read_text()
+    code = compile(src, str(pkg / f"{module}.py"), "exec")
+    func = next(c for c in code.co_consts if getattr(c, "co_name", None) == name)
+    jit_cache._module.cache_clear()
+    return jit_cache.function_digest(type("F", (), {"__code__": func})(), pkg / f"{module}.py", pkg)
+
+
+def test_the_stamp_covers_exactly_what_the_function_names(tmp_path):
+    """Editing a plain function of the same module, a plain module it imports, a comment or a
+    docstring keeps ``g``'s stamp (and its rank, the cache file's name); editing the jitted helper
+    it calls, the constant it freezes or the decorator's options changes it."""
+    pkg = _package(tmp_path, True)
+    before = _stamp(pkg, "caller", "g")
+    assert before[1] == 0
+    (pkg / "caller.py").write_text("import os\n\n\ndef plain(x):\n    return os.sep * x\n\n\n" + CALLER
+                                   + "\n\ndef later():\n    return 2\n")
+    assert _stamp(pkg, "caller", "g") == before                   # lines moved, plain functions added
+    (pkg / "caller.py").write_text(CALLER.replace("    return f() + K", '    """Doc."""\n    return f() + K  # sum'))
+    assert _stamp(pkg, "caller", "g") == before
+    (pkg / "consts.py").write_text("K = 0.0\n\n\ndef unrelated():\n    return 3\n")
+    assert _stamp(pkg, "caller", "g") == before
+    (pkg / "caller.py").write_text(CALLER)
+    for path, text in (("callee.py", "from ._jit import jit\n\n\n@jit\ndef f():\n    return 2.0\n"),
+                       ("consts.py", "K = 1.0\n"),
+                       ("_jit.py", JIT.format(guard=GUARD).replace("cache=True", "cache=True, fastmath=True"))):
+        old = (pkg / path).read_text()
+        (pkg / path).write_text(text)
+        assert _stamp(pkg, "caller", "g")[0] != before[0], path
+        (pkg / path).write_text(old)
+    assert _stamp(pkg, "caller", "g") == before
+
+
+@pytest.mark.slow
+def test_an_edit_moving_a_kernel_keeps_its_cache(tmp_path):
+    """numba names a cache entry by the function's first line: a plain function added above ``g``
+    would compile it again; the locators name it by its rank instead."""
+    pkg = _package(tmp_path, True)
+    assert _run(tmp_path) == (1.0, False)
+    _write(pkg / "caller.py", "def plain():\n    return 1\n\n\n" + CALLER, 5)
+    assert _run(tmp_path) == (1.0, True)
 
 
 def test_the_contact_kernel_depends_on_the_constants_it_freezes():
-    root = os.path.dirname(jit_cache.__file__)
-    kernel = os.path.join(root, "contact", "kernel_jit.py")
-    rel = {os.path.relpath(p, root) for p in jit_cache.dependencies(kernel, root)}
-    assert {os.path.join("contact", "pairs.py"), os.path.join("contact", "law.py"), "_jit.py"} <= rel
-    assert not any(os.path.basename(p) in ("solver.py", "driver.py", "linsolve.py") for p in rel)
+    root = Path(jit_cache.__file__).resolve().parent
+    deps = jit_cache.dependencies(root / "contact" / "kernel_jit.py", "_evaluate", root)
+    rel = {r for r, _ in deps}
+    assert {"contact/frames.py", "contact/law.py", "lie/se3_jit.py", "_jit.py"} <= rel
+    assert not rel & {"driver.py", "nonlinear/linsolve.py", "contact/system.py", "contact/reference.py"}
+    frames = (root / "contact" / "frames.py").read_text().splitlines()
+    used = {frames[line - 1].split(" = ")[0] for r, line in deps if r == "contact/frames.py"}
+    assert used == {"LINE, ORTHOGONAL, POINT"}                    # not the numpy geometry beside them

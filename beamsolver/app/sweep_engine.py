@@ -152,7 +152,7 @@ def local_client(n_workers=None, secure=True, **cluster_options):
     ``secure``: the scheduler, workers and client talk TLS with credentials made for this cluster
     (``_temporary_security``): another process of the machine cannot connect and run code in the
     workers, which a plain ``tcp://`` scheduler on 127.0.0.1 lets any local user do.  ``False``:
-    plain TCP (0.4-0.6 s faster to start, ~20 ms less per task: docs/benchmarks.md, ``dask_tls``), for
+    plain TCP (faster to start and per task: docs/benchmarks.md, ``dask_tls``), for
     a machine no one else uses."""
     import multiprocessing
     if multiprocessing.parent_process() is not None:

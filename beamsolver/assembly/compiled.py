@@ -8,7 +8,7 @@
   poses re-chained from the anchored node, ``H_b = H_a exp(h_e)``.
 
 The numpy versions (``np.bincount``, ``se3.compose``/``se3.exp``,
-``System.rechain_numpy``) are the test oracles (``tests/test_kernels_jit.py``).
+``System.rechain_numpy``) are the test oracles (``tests/elements/test_compiled_kernels.py``).
 """
 import numpy as np
 

@@ -3,9 +3,8 @@
 ``System.matrix`` adds the COO entries of the contributions (``assemble_blocks``: contact
 blocks, 576 entries per pair) to the element tangent.  Through scipy that is
 ``K_el + csc_matrix((v, (r, c)))`` every evaluation: a COO -> CSC conversion with a sort of
-every column and a sparse sum, 0.2 s for the 14e3 contact points of the 19-wire bundle,
-although the pattern is the same from one Newton iteration to the next while the active
-set does not change.
+every column and a sparse sum, although the pattern is the same from one Newton iteration to
+the next while the active set does not change.
 
 ``ExtraPattern`` is built once per pattern of the COO entries and gives the same matrix,
 bit for bit (the same values summed in the same order, the same stored entries):
@@ -32,9 +31,8 @@ only caveat is scipy's "skip the sort when every column is sorted": the node col
 of the kept dof columns, so the test sees the same columns.  Entries after the blocks (a
 ``tail``: ``assemble_blocks``' terms of global-type nodes) make the dof columns they reach
 special: those are bucketed (block entries, then tail entries) and sorted on their own, in
-the same scipy sort.  A new active set costs a new pattern (about half of the Newton
-iterations of the example solves meet one): 19-wire bundle, 3002 elements, 8.2e6 contact
-entries, 1.4e6 node-column entries, build 30-70 ms against 280-540 ms for ``ExtraPattern``.
+the same scipy sort.  A new active set costs a new pattern (build times of both:
+docs/benchmarks.md).
 """
 import numpy as np
 import scipy.sparse as sp
@@ -160,8 +158,8 @@ class ExtraPattern:
 
     ``el_indptr``, ``el_indices``: the element tangent's CSC pattern (canonical: sorted, no
     duplicates), ``n_free`` its size.  ``spare``: the pattern this one replaces, whose two
-    per-entry buffers (12 bytes per entry) are reused when large enough: fresh memory costs
-    page faults, up to 1 s of system time for the 8e6 entries of the 19-wire bundle.
+    per-entry buffers (12 bytes per entry) are reused when large enough (fresh memory costs
+    page faults).
     """
 
     def __init__(self, rows, cols, red, n_free, el_indptr, el_indices, spare=None):

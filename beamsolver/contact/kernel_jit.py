@@ -1,8 +1,8 @@
 """Compiled (numba) contact kernel with its exact tangent, one contact point per call.
 
-The same maths, arguments and results as ``pairs.contact_kernel`` /
-``pairs.kernel_and_tangent`` (their complex-step version is the test oracle,
-``tests/test_contact_kernel_jit.py``): projection (the same two Newton
+The same maths, arguments and results as ``reference.contact_kernel`` /
+``reference.kernel_and_tangent`` (their complex-step version is the test oracle,
+``tests/contact/test_contact_kernel_jit.py``): projection (the same two Newton
 iterations), section frames ``{C}``, ``{F}``, axes ``n, t1, t2``, gap, normal
 law, friction (material frames, slip ``log(H_LK_prev^-1 H_LK)[1:3]`` as
 ``kinematics.slip_increment``, transported traction, slip-tolerance penalty,
@@ -11,7 +11,7 @@ Coulomb return mapping) and the nodal wrenches ``J^T w``.
 The tangent is forward mode done by hand: every quantity carries its gradient
 ``(k, 24)`` with respect to the body increments of the nodes ``A1, B1, A2, B2``
 (column ``6 j + k``).  Section frames vary as ``dq_C = J_A dq_A + J_B dq_B + h dxi``
-(``pairs._node_jacobians``), the twist as ``dh = T(h)^-1 (dq_B - Ad(exp(-h)) dq_A)``,
+(``frames.node_jacobians``), the twist as ``dh = T(h)^-1 (dq_B - Ad(exp(-h)) dq_A)``,
 the projection parameters by the implicit-function theorem at the converged
 projection, and the node Jacobians themselves through
 
@@ -58,8 +58,8 @@ from ..errors import InputError
 from ..elements.element_jit import _dq_du, _dq_dw
 from ..lie.se3_jit import madd, mscale
 from ..lie.se3_jit import A_, B_, C_, CP_, D_, Q2P_, Q2_, Q3P_, Q3_, add, add_outer, coefficient, cross, dot, log_relative, mat, mm, mv, q_matrix, scale, ti_matrix, transpose
-from .law import PENALTY_COULOMB
-from .pairs import LINE, ORTHOGONAL, PENALTY_T_MIN
+from .frames import LINE, ORTHOGONAL
+from .law import PENALTY_COULOMB, PENALTY_T_MIN
 
 # columns of the per-point parameter table ``par``
 XI1, XI2, R1_, R2_, WEIGHT, PENALTY, MULT, MU, PEN_T, SMOOTH, ESLIP, XI1P, XI2P, TOUCH = range(14)
@@ -74,8 +74,8 @@ _normal_law = _tangential_law = None
 @intrinsic
 def _borrowed_intrinsic(typingctx, a):
     """A view of the array ``a`` without its memory owner (meminfo): numba's reference counting
-    (an atomic increment and decrement per array passed to a function or sliced: ~10 % of the
-    kernel's perf samples) skips it.  The caller keeps ``a`` alive while the view is in use."""
+    (an atomic increment and decrement per array passed to a function or sliced) skips it.
+    The caller keeps ``a`` alive while the view is in use."""
     if not isinstance(a, nb_types.Array):
         return None
 
@@ -131,7 +131,7 @@ def _exp(u, w):
 
 @jit
 def _section(RA, xA, u, w, xi):
-    """Pose of ``H_A exp(xi h)``, ``x' = R u`` and ``x'' = R (w x u)`` (``pairs._section``)."""
+    """Pose of ``H_A exp(xi h)``, ``x' = R u`` and ``x'' = R (w x u)`` (``frames.section``)."""
     return _section_inline(RA, xA, u, w, xi)
 
 
@@ -285,7 +285,7 @@ def _side(u, w, S):
 
 @jit_inline
 def _jacobians(u, w, xi, t2, co, Ti, Ah, Ts, As, JA, JB, tmp):
-    """``J_A, J_B`` of ``H_C = H_A exp(xi h)`` (``pairs._node_jacobians``); ``Ti = T(h)^-1``,
+    """``J_A, J_B`` of ``H_C = H_A exp(xi h)`` (``frames.node_jacobians``); ``Ti = T(h)^-1``,
     ``Ah = Ad(exp(-h))``; also ``Ts = T(xi h)`` and ``As = Ad(exp(-xi h))``; ``t2, co = _coefficients(xi w)``."""
     su, sw = scale(xi, u), scale(xi, w)
     _tangent_co(su, sw, Ts, t2, co)
@@ -431,7 +431,7 @@ def _same(a, b):
 
 @jit_inline
 def _project(kind, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations=2):
-    """Newton iterations of ``pairs._project`` (two in the kernel, from the search's converged point).
+    """Newton iterations of ``frames.project`` (two in the kernel, from the search's converged point).
 
     The slave section is computed once where ``xi1`` is fixed (line, orthogonal), and the iterations
     stop at an exact fixed point (an iterate equal to the last, bit for bit, fixes all later ones), so
@@ -585,7 +585,7 @@ def _variations(S, c0, G, DH, V):
 # ---------------------------------------------------------------- 3-vectors with gradients (3, 24)
 @jit_inline
 def _axes(RC, xC, RF, xF, G):
-    """``n, t1, t2`` (``pairs._axes``), centre distance, and the gradients of ``n, t1, t2, dist``
+    """``n, t1, t2`` (``frames.axes``), centre distance, and the gradients of ``n, t1, t2, dist``
     into ``G`` (rows ``G_DN``, ``G_DT1``, ``G_DT2``, ``G_DDIST``; one pass over the 24 columns)."""
     d = add(xF, scale(-1.0, xC))
     dist = np.sqrt(dot(d, d))
@@ -782,7 +782,7 @@ def _friction(slip, lamp, t1, t2, lam, par, G):
     for k in range(24):
         G[G_DPT * W + k] = 0.0
     if np.isnan(pen_t) and not np.isnan(par[ESLIP]):
-        lam_min = PENALTY_T_MIN * par[PENALTY] * par[ESLIP]      # pairs.stick_penalty
+        lam_min = PENALTY_T_MIN * par[PENALTY] * par[ESLIP]      # reference.stick_penalty
         if lam >= lam_min:
             pen_t = mu * lam / par[ESLIP]
             for k in range(24):
@@ -878,7 +878,7 @@ def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, G, DXI, DW,
 
 @jit_inline
 def _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2):
-    """``HL, HK, HC, HF`` (``pairs._contact_frames``)."""
+    """``HL, HK, HC, HF`` (``frames.contact_frames``)."""
     for k in range(4):
         frames[k, :, :] = 0.0
         frames[k, 3, 3] = 1.0
@@ -948,7 +948,7 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
     n, t1, t2, dist = _axes(RC, xC, RF, xF, G)
     R1, R2, wgt = par[R1_], par[R2_], par[WEIGHT]
     gap = dist - R1 - R2
-    touching = 0.0 < gap <= par[TOUCH]          # round-off of a touching pair's gap: touching (pairs.touching_gap)
+    touching = 0.0 < gap <= par[TOUCH]          # round-off of a touching pair's gap: touching (reference.touching_gap)
     lam, dlam, active = _normal_law(0.0 if touching else gap, par[PENALTY], par[MULT], par[SMOOTH])  # make_kernel
     for k in range(24):
         G[G_DLAM * W + k] = dlam * G[G_DDIST * W + k]
@@ -1035,7 +1035,7 @@ def make_kernel(law):
     the name ``<template>__<law name>_<code digest>``: numba's disk cache (``cache=True``) keys
     on that name and the template's source file, so each law's kernel compiles once per machine
     and loads from the cache afterwards (closures or functions passed as arguments are
-    recompiled in every process, measured with numba 0.68).
+    recompiled in every process with numba 0.68).
     """
     key = f"{law.name}_{_digest(law)}"
     if key not in _KERNELS:
@@ -1063,7 +1063,7 @@ def _project_all(kind, HA1, h1, xi1, HA2, h2, xi2, iterations, out1, out2):
 
 
 def project(kind, HA1, h1, xi1, HA2, h2, xi2, iterations=3):
-    """Compiled ``pairs._project`` (same arguments, batches ``(P, ...)``): ``xi1, xi2`` after
+    """Compiled ``frames.project`` (same arguments, batches ``(P, ...)``): ``xi1, xi2`` after
     ``iterations`` Newton iterations on the projection conditions of each pair's ``kind``."""
     P = len(h1)
     args = [np.ascontiguousarray(np.broadcast_to(a, (P,) + np.shape(a)[-s:] if s else (P,)), dtype=float)
@@ -1074,7 +1074,7 @@ def project(kind, HA1, h1, xi1, HA2, h2, xi2, iterations=3):
     return out1, out2
 
 
-# ---------------------------------------------------------------- the signatures of pairs.py
+# ---------------------------------------------------------------- the signatures of reference.py
 _PAR_COLUMNS = ((XI1, "xi1", np.nan), (XI2, "xi2", np.nan), (R1_, "R1", np.nan), (R2_, "R2", np.nan),
                 (WEIGHT, "weight", np.nan), (PENALTY, "penalty", np.nan), (MULT, "multiplier", 0.0),
                 (MU, "mu", np.nan), (PEN_T, "penalty_t", np.nan), (SMOOTH, "smoothing", 0.0),
@@ -1110,13 +1110,13 @@ def _table(X, p):
 
 
 def kernel_and_tangent(X, p, friction=True, law=None, K=None):
-    """Wrenches ``(P, 4, 6)``, exact tangent ``(P, 24, 24)`` and point data (``pairs.kernel_and_tangent``).
+    """Wrenches ``(P, 4, 6)``, exact tangent ``(P, 24, 24)`` and point data (``reference.kernel_and_tangent``).
 
     ``X``: ``(P, 4, 4, 4)`` node poses ``A1, B1, A2, B2``; ``p``: the per-pair parameters of
-    ``pairs.contact_kernel``.  Column ``6 j + k`` of the tangent is the body increment ``k``
-    of node ``j``.  ``law``: a ``law.ContactLaw`` (default ``PENALTY_COULOMB``, the law of ``pairs.py``).
+    ``reference.contact_kernel``.  Column ``6 j + k`` of the tangent is the body increment ``k``
+    of node ``j``.  ``law``: a ``law.ContactLaw`` (default ``PENALTY_COULOMB``, the law of ``reference.py``).
     ``K``: optional C-contiguous float array ``(P, 24, 24)`` the tangent is written to (a buffer the
-    caller keeps: no fresh 4.6 kB per point, whose page faults cost ~1 us per point at 1e4 points).
+    caller keeps: no fresh 4.6 kB per point and its page faults).
     """
     X = np.ascontiguousarray(X, dtype=float)
     P = X.shape[0]
@@ -1140,6 +1140,6 @@ def kernel_and_tangent(X, p, friction=True, law=None, K=None):
 
 
 def contact_kernel(X, p, friction=True, law=None):
-    """Wrenches ``(P, 4, 6)`` and point data (``pairs.contact_kernel``, for batches ``(P, 4, 4, 4)``)."""
+    """Wrenches ``(P, 4, 6)`` and point data (``reference.contact_kernel``, for batches ``(P, 4, 4, 4)``)."""
     f, _, out = kernel_and_tangent(X, p, friction, law)
     return f, out

@@ -1,7 +1,7 @@
 """Contact laws (docs/theory.md section 7): batched numpy forms and the compiled law interface.
 
 ``normal_force`` and ``coulomb_return_mapping`` are batched over contact points and
-accept complex inputs (the complex-step oracle, ``pairs.py``): every branch is decided
+accept complex inputs (the complex-step oracle, ``reference.py``): every branch is decided
 on the real part, arithmetic stays analytic.  ``ContactLaw`` bundles the scalar
 compiled forms with their derivatives (``penalty_normal``, ``coulomb``, tested equal to
 the numpy forms) that the compiled kernel calls; a new law is a new ``ContactLaw``,
@@ -15,7 +15,9 @@ import numpy as np
 from .._jit import jit
 
 __all__ = ["normal_force", "coulomb_return_mapping", "default_penalty", "ContactLaw", "penalty_normal",
-           "coulomb", "PENALTY_COULOMB"]
+           "coulomb", "PENALTY_COULOMB", "PENALTY_T_MIN"]
+
+PENALTY_T_MIN = 1e-3     # floor of lam_N in the slip-tolerance stick stiffness, / (normal penalty x elastic slip)
 
 
 def normal_force(gap, penalty, multiplier=0.0, smoothing=0.0):
@@ -72,7 +74,7 @@ class ContactLaw:
 
     ``normal(gap, penalty, multiplier, smoothing) -> (lam, dlam_dgap, active)``: normal traction per
     unit weight, its derivative with respect to the gap and whether the point carries force or
-    stiffness (a gap within round-off above zero arrives as 0: ``pairs.touching_gap``); ``tangential(trial0, trial1, Dtrial, mu, lam, Dlam) -> (lt0, lt1, D, stick)``:
+    stiffness (a gap within round-off above zero arrives as 0: ``reference.touching_gap``); ``tangential(trial0, trial1, Dtrial, mu, lam, Dlam) -> (lt0, lt1, D, stick)``:
     tangential traction from the trial ``(trial0, trial1)`` (in ``t1, t2``) in forward mode, ``D``
     ``(2, k)`` its gradient from the gradients ``Dtrial`` ``(2, k)`` of the trial and ``Dlam`` ``(k,)``
     of the normal traction.  Both are numba-jitted (``_jit.jit``).  ``name`` names the compiled kernel (and its numba cache entry).

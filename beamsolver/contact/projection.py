@@ -4,7 +4,7 @@ Pure batched functions over element or pair arrays; node poses are read from the
 pose array ``H`` ``(n, 4, 4)`` through node indices (no gathered copies).  Sections
 follow the constant-strain interpolation ``H_A exp(xi h)`` with the element twist
 ``h = log(H_A^-1 H_B)``; the projections are the Newton iterations of
-``kernel_jit._project`` (``pairs._project`` is their numpy oracle):
+``kernel_jit._project`` (``frames.project`` is their numpy oracle):
 
 - ``spheres``: the broad phase's element bounding spheres and mid-point tangents;
 - ``closest_points``: closest points of two centre lines (kind ``POINT``) and the
@@ -27,15 +27,15 @@ from ..lie import se3
 from .._jit import jit, jit_inline
 from ..lie.se3_jit import _SERIES_TABLE, _SWITCH, A_, B_, C_, add, add_outer, cross, dot, mat, mm, mv, scale
 from .kernel_jit import _pose_of, _project, _section, _section_inline
-from .pairs import LINE, POINT
+from .frames import LINE, POINT
 
 __all__ = ["element_twists", "section_points", "spheres", "overlap", "closest_points", "project_points", "gauss_projections"]
 
 
 def element_twists(H, enodes):
     """Twists ``h = log(H_A^-1 H_B)`` ``(n, 6)`` of the elements ``enodes`` ``(n, 2)``: one batched
-    ``se3.log`` (the compiled ``se3_jit.log_relative`` differs in round-off, which was measured to
-    change the twisted pair's Newton iteration counts: 139 instead of 135)."""
+    ``se3.log`` (the compiled ``se3_jit.log_relative`` differs in round-off, which changes the
+    Newton iteration counts of the contact examples: docs/benchmarks.md)."""
     return se3.log(se3.relative(H[enodes[:, 0]], H[enodes[:, 1]]))
 
 

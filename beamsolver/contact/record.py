@@ -38,7 +38,7 @@ class Candidates(NamedTuple):
 class PairSet:
     """Arrays over ``P`` pairs.
 
-    ``kind`` (pairs.LINE / ORTHOGONAL / POINT), slave and master element ids ``e``, ``m``;
+    ``kind`` (frames.LINE / ORTHOGONAL / POINT), slave and master element ids ``e``, ``m``;
     ``xi1``, ``xi2``: projection parameters on them (0..1, a little past an inner node);
     ``weight``: integration weight (length); ``key``: material point identity (int64, for
     the friction history); ``gp``: Gauss point index (0 for point pairs); ``decl``: index of

@@ -16,7 +16,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from .pairs import ORTHOGONAL, POINT
+from .frames import ORTHOGONAL, POINT
 from .search import XI_TOL
 
 __all__ = ["joint_nodes", "apart", "crossing", "may_cross", "point_or_orthogonal", "extend_wrap", "xi_range", "owners", "dedupe_points", "XI_OVERHANG", "OWNER_TIE"]

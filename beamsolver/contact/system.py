@@ -34,7 +34,7 @@ defaults and their meaning live there).  Without ``penalty_t`` the tangential
 stiffness of a point is ``mu lam_N / (slip_tolerance L_e)``, so the elastic slip
 at the onset of sliding is ``slip_tolerance`` times the slave element length
 ``L_e`` (Abaqus' default penalty friction; below a floor traction, see
-``pairs.stick_penalty``).
+``reference.stick_penalty``).
 """
 
 import sys
@@ -49,10 +49,10 @@ from ..errors import InputError
 from ..failures import ContactTunnelling, NoContactNormal
 from ..model.model import JOIN_TOL
 from .law import default_penalty
-from . import kernel_jit, mortar, pairs
-from .kernel_jit import contact_kernel, kernel_and_tangent      # compiled; pairs.py's are the oracle
+from . import kernel_jit, mortar
+from .kernel_jit import contact_kernel, kernel_and_tangent      # compiled; reference.py's are the oracle
 from .options import ADJUST, SMOOTHING, STICK_TOLERANCE, ContactOptions, declaration_table
-from .pairs import LINE, NORMAL_TOL, POINT, material_frames, no_normal, touch_tolerance
+from .frames import LINE, NORMAL_TOL, POINT, material_frames, no_normal, touch_tolerance
 from .record import OPEN, SLIP, STICK, Candidates, PairSet
 from .ownership import gauss_owners, gauss_record
 from .projection import closest_points, element_twists, gauss_projections, section_points
@@ -67,13 +67,20 @@ SWITCH_TOL = 1e-12        # a step ending within this (relative) of active_from 
 TIMED = ("search", "rules", "projection", "params", "kernel", "blocks")   # parts of ``ContactSystem.timings``
 
 
+_numpy_oracle = False     # whether ``use_numpy_kernel`` switched to the oracle
+
+
 def use_numpy_kernel(flag=True):
-    """Evaluate contact with the complex-step numpy kernel of ``pairs`` (the test oracle, slow)
-    instead of the compiled ``kernel_jit`` (default); returns the previous setting."""
-    global contact_kernel, kernel_and_tangent
-    previous = kernel_and_tangent is pairs.kernel_and_tangent
-    mod = pairs if flag else kernel_jit
+    """Evaluate contact with the complex-step numpy kernel of ``reference`` (the test oracle, slow,
+    imported only here) instead of the compiled ``kernel_jit`` (default); returns the previous setting."""
+    global contact_kernel, kernel_and_tangent, _numpy_oracle
+    previous = _numpy_oracle
+    if flag:
+        from . import reference as mod
+    else:
+        mod = kernel_jit
     contact_kernel, kernel_and_tangent = mod.contact_kernel, mod.kernel_and_tangent
+    _numpy_oracle = bool(flag)
     return previous
 
 
@@ -487,7 +494,7 @@ class ContactSystem(Contribution):
         # elastic slip at the onset of sliding (used where no penalty_t is given)
         p["elastic_slip"] = self._decl_slip_tol[dec] * self.sys.L[P.e[sel]]
         p["smoothing"] = self._smoothing(P, sel)
-        # round-off gaps touch (pairs.touching_gap) where the law's smoothing gap does not cover them already
+        # round-off gaps touch (reference.touching_gap, the kernels' rule) where the law's smoothing gap does not cover them already
         touch = touch_tolerance(_extent(H), p["R1"], p["R2"])
         p["touch"] = np.where(p["smoothing"] >= touch, 0.0, touch)
         key = P.key[sel]
@@ -648,7 +655,7 @@ class ContactSystem(Contribution):
         c = self._blocks
         if c is not None and np.array_equal(c[0], H) and (c[1] is None or c[1][4] is not None or not tangent):
             return c[1]
-        tangent = tangent or kernel_and_tangent is not pairs.kernel_and_tangent
+        tangent = tangent or not _numpy_oracle
         P = self.pairs(H)
         self._lap()
         sel = np.zeros(0, dtype=int)
@@ -764,7 +771,7 @@ class ContactSystem(Contribution):
         """The kernel of each declaration's law on the pairs with friction and on those without
         (``friction``: the friction branch for all): ``f``, ``K`` (or None), ``out``."""
         laws = [d.law for d in self.decls]
-        if any(law is not None for law in laws) and kernel_and_tangent is pairs.kernel_and_tangent:
+        if any(law is not None for law in laws) and _numpy_oracle:
             raise InputError("contact: the numpy oracle kernel (use_numpy_kernel) has only the default law; "
                              f"add_contact declared law={next(law for law in laws if law is not None)!r}")
         fric = p["mu"] > 0 if friction is None else np.broadcast_to(friction, (len(X),))
@@ -991,7 +998,7 @@ def _frames(out):
 
 
 def _extent(H):
-    """Largest node coordinate of the poses ``H`` (``pairs.touch_tolerance``)."""
+    """Largest node coordinate of the poses ``H`` (``frames.touch_tolerance``)."""
     return float(np.abs(H[..., :3, 3]).max(initial=0.0))
 
 def _with_mortar(nodes, f, K, m):

@@ -1,14 +1,13 @@
 """Compiled (numba) path of the two-node SE(3) beam element: one element per call, a batch driver.
 
-The maths and names are those of ``element`` (its numpy version is the test
-oracle; both agree to round-off, ``tests/test_kernels_jit.py``): for the side
+The maths and names are those of ``geometric`` and of the numpy test oracle ``reference``
+(both agree to round-off, ``tests/elements/test_compiled_kernels.py``): for the side
 ``s`` of node A (argument ``-h``, sign -1) and of node B (argument ``h``, sign
 +1), ``T(h_s)^-1 = [[Ti, X], [0, Ti]]``, the force block ``g_s = [Ti n; X n + Ti m]``
-and the geometric blocks ``G12, G21, G22`` of ``element._geometric``
+and the geometric blocks ``G12, G21, G22`` of ``geometric._geometric``
 (docs/theory.md eqs. 3.4-3.7).  The tangent goes to an array ``(n, 12, 12)``,
-element-major (each element's 144 entries contiguous: element-axis-last storage
-made every element touch 144 pages, measured 2x slower at 1e4 elements), the
-order ``assembly.System`` scatters.  Node poses are read through a node table
+element-major (each element's 144 entries contiguous, so an element touches one or two
+pages; docs/benchmarks.md), the order ``assembly.System`` scatters.  Node poses are read through a node table
 ``(n, 2)`` from the model's pose array (``elements.se3_2``), not gathered first.
 """
 from .._jit import jit, jit_inline
@@ -26,7 +25,7 @@ def _side(u, w, d, t2, wu, axu, c1, c2, c3):
 
 @jit
 def _d_tinv_t(w, d, dp, v):
-    """``d(T_SO3(w)^-T v)/dw`` (``element._d_tinv_t``)."""
+    """``d(T_SO3(w)^-T v)/dw`` (``geometric._d_tinv_t``)."""
     wwv = cross(w, cross(w, v))
     M = add_outer(mat(scale(0.5, v), d * dot(w, v)), axpy(dp, wwv, scale(-2.0 * d, v)), w)
     return add_outer(M, w, scale(d, v))
@@ -34,7 +33,7 @@ def _d_tinv_t(w, d, dp, v):
 
 @jit
 def _dq_du(y, yw, yww, w, t2, wy, c1, c2, c3):
-    """``dQ/du`` of ``Q(u, w) y`` at fixed ``y`` (``element._geometric``)."""
+    """``dQ/du`` of ``Q(u, w) y`` at fixed ``y`` (``geometric._geometric``)."""
     M = mat(scale(-1.0, add(add(scale(0.5 - c2 * t2, y), scale(c1 - c3 * t2, yw)), scale(c2, yww))), c1 * wy)
     M = add_outer(M, scale(-1.0, add(add(scale(c1, y), scale(c1 - 3.0 * c2, yw)), scale(c3, yww))), w)
     return add_outer(M, w, scale(-1.0, add(scale(c2, yw), scale(c3, yww))))
@@ -42,7 +41,7 @@ def _dq_du(y, yw, yww, w, t2, wy, c1, c2, c3):
 
 @jit
 def _dq_dw(u, w, y, yw, a_, b_, e_, wa_, gp, t2, wy, uy, wu, uxw, c1, c2, c3):
-    """``dQ/dw`` of ``Q(u, w) y`` at fixed ``y`` (``element._geometric``)."""
+    """``dQ/dw`` of ``Q(u, w) y`` at fixed ``y`` (``geometric._geometric``)."""
     sk = add(add(add(scale(-c1, a_), scale(3.0 * c2 - c1, b_)), scale(-c3, e_)),
              add(scale((c1 - 3.0 * c2) * uy, w), scale(c2 * wy, u)))
     diag = c1 * uy + c2 * dot(w, a_) - c3 * wy * wu + c3 * dot(w, b_) - c3 * t2 * uy

@@ -19,7 +19,7 @@ negative): with ``D = d f_ext / d h`` by complex steps in the six directions of 
 round-off; ``se3.exp`` and the tangents are analytic), ``K_B = D T(h)^-1`` and
 ``K_A = -D T(-h)^-1 + d f_ext / d w_A|_h``, the last the rigid turn of a dead load's element
 (closed form, ``_loads``; zero for a follower load).
-docs/theory_line_loads.md derives it; tests/test_line_load.py checks it by finite differences.
+docs/theory_line_loads.md derives it; tests/elements/test_line_load.py checks it by finite differences.
 """
 import numpy as np
 

@@ -1,4 +1,4 @@
-"""The two-node SE(3) element (``element``, compiled ``element_jit``) as an element type, ``"se3-2"``.
+"""The two-node SE(3) element (``element`` over the compiled ``element_jit``) as an element type, ``"se3-2"``.
 
 Constant strain ``h / L``, ``h = log(H_A^-1 H_B)`` (docs/theory.md section 3);
 its interpolation ``H_A exp(xi h)`` is the element's own kinematics.

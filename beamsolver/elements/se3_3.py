@@ -21,7 +21,7 @@ functions ``N_1 = 4 s (1 - s)``, ``N_2 = s (2 s - 1)`` (docs/theory.md eqs. 14.3
   ``dh_i = -T(-h_i)^-1 q_0 + T(h_i)^-1 q_i`` (``B``), ``f = B^T dV/dx``,
   ``K = B^T (d2V/dx2) B + sum_i [G(-h_i, g_i); G(h_i, g_i)] [-T(-h_i)^-1, T(h_i)^-1]``
   with ``g_i = dV/dh_i`` and ``G`` the pair stiffness of the two-node element
-  (``element.geometric``).
+  (``geometric.geometric``).
 
 The reported state is the Gauss-point mean of strain and section forces; ``h``
 is the pair twist of largest rotation (what the solver's rotation check reads).
@@ -29,7 +29,8 @@ is the pair twist of largest rotation (what the solver's rotation check reads).
 import numpy as np
 
 from ..lie import se3
-from .element import ElementState, geometric
+from .element import ElementState
+from .geometric import geometric
 from .base import ElementType, Reference, is_diagonal
 
 __all__ = ["SE3Three", "GAUSS"]

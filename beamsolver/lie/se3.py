@@ -11,7 +11,7 @@ Conventions (stated once, used everywhere in beamsolver):
 
 Every coefficient that is 0/0 at zero angle has its own Taylor switch point,
 chosen where the truncated series (nine terms in t^2) and the closed form
-agree to round-off; ``tests/test_se3_coefficients.py`` sweeps them against
+agree to round-off; ``tests/lie/test_se3_coefficients.py`` sweeps them against
 200-digit arithmetic.
 """
 import numpy as np
@@ -105,7 +105,7 @@ _CLOSED = {"a": _closed_a, "b": _closed_b, "c": _closed_c, "d": _closed_d,
            "q2p": _closed_q2p, "q3p": _closed_q3p}
 
 # Switch points, one per coefficient, from a sweep against 200-digit
-# arithmetic (tests/test_se3_coefficients.py): below them the nine-term
+# arithmetic (tests/lie/test_se3_coefficients.py): below them the nine-term
 # series is exact to round-off, above them the closed form has lost little to
 # cancellation.  `d` and `dp` have poles at 2 pi, so their series converge
 # more slowly and switch earlier.  Worst relative errors over t in

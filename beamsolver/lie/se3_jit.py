@@ -5,7 +5,7 @@ its small algebra in registers and allocates nothing.  Conventions are those of
 ``se3`` (docs/theory.md section 1): twists ``(u, w)``, translation first, right
 tangent operators.  Every singular coefficient switches from its nine-term
 series to its closed form at the same point ``se3.SWITCH`` as the numpy
-version, so both agree to round-off (``tests/test_kernels_jit.py``).
+version, so both agree to round-off (``tests/elements/test_compiled_kernels.py``).
 
 ``NUMBA_DISABLE_JIT=1`` runs these functions as plain Python (slowly).
 """
@@ -150,7 +150,7 @@ def ti_matrix(w, d, t2):
 
 @jit
 def q_matrix(u, w, wu, a, t2, c1, c2, c3):
-    """``Q(u, w)`` (docs/theory.md eq. 2.6), ``wu = w.u``, ``a = w x u``, ``t2 = |w|^2`` (as ``element._q_mat``)."""
+    """``Q(u, w)`` (docs/theory.md eq. 2.6), ``wu = w.u``, ``a = w x u``, ``t2 = |w|^2`` (as ``elements.geometric._q_mat``)."""
     M = mat(add(scale(0.5 - 2.0 * c2 * t2, u), scale((3.0 * c2 - c1) * wu, w)), (2.0 * c3 * t2 - 2.0 * c1) * wu)
     M = add_outer(M, add(scale(c1, u), add(scale(-c2, a), scale(-2.0 * c3 * wu, w))), w)
     return add_outer(M, w, add(scale(c1, u), scale(c2, a)))

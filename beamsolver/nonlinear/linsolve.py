@@ -2,8 +2,8 @@
 
 Back-ends (``backend=`` here, ``linear_solver=`` in ``beamsolver.solve``):
 
-- ``"splu"``: scipy's SuperLU, ``permc_spec="MMD_AT_PLUS_A"``
-  (1.5x faster than scipy's default ordering on beam matrices); fine for
+- ``"splu"``: scipy's SuperLU, ``permc_spec="MMD_AT_PLUS_A"`` (less fill than
+  scipy's default ordering on beam matrices); fine for
   beam-like matrices (cables, frames, a few wires).  SuperLU has no
   "re-factorise with the same pattern" entry point in scipy, so every Newton
   iteration re-orders and re-factorises from scratch.
@@ -14,16 +14,12 @@ Back-ends (``backend=`` here, ``linear_solver=`` in ``beamsolver.solve``):
   factorisation is redone (PARDISO phase 22), the ordering and symbolic
   analysis (phase 11) are reused.  (``pypardiso``'s own ``solve``
   re-analyses every new matrix; it only skips work for an identical one.)
-  Measured on one thread (``benchmarks/scaling.py``): a re-factorisation is
-  1.1-2x faster than splu on a cable and 1.1-1.8x faster than splu-rcm on a
-  19-wire bundle; a first factorisation (with the analysis) is 1.5-4x
-  slower than splu on a cable.
+  Timings against the SuperLU back-ends: docs/benchmarks.md (``benchmarks/scaling.py``).
 - ``"splu-rcm"``: SuperLU after a reverse Cuthill-McKee symmetric
   permutation (``scipy.sparse.csgraph``), natural column order.  On long
-  bundles of wires in contact SuperLU's MMD ordering fills in badly and grows
-  like n^2.4-3 (19-wire strand, 3000 elements: 62e6 factor entries, 28 s,
-  against 4.4e6 and 0.36 s with RCM; ``benchmarks/scaling.py``); RCM stays
-  linear.  On a single beam both give the same factor.
+  bundles of wires in contact SuperLU's MMD ordering fills in superlinearly;
+  the RCM band's fill stays linear in the length (docs/benchmarks.md,
+  ``benchmarks/scaling.py``).  On a single beam both give the same factor.
 - ``"auto"`` (default): for matrices with contact couplings (more than
   ``AUTO_COUPLED_NNZ`` non-zeros per column on average; a beam or a frame has
   about 18) of at least ``AUTO_MIN_UNKNOWNS`` unknowns, ``"pardiso"`` if
@@ -220,12 +216,10 @@ class _SpluRcmFactor:
     """SuperLU on the matrix symmetrically permuted by reverse Cuthill-McKee, natural column order.
 
     For long bundles of wires in contact SuperLU's own orderings give much more
-    fill (MMD_AT_PLUS_A 18x on a 19-wire strand of 3000 elements, time 60x);
-    the RCM band (``scipy.sparse.csgraph``, O(nnz)) is near optimal for long,
-    thin structures.  ``SymmetricMode`` prefers the diagonal, and threshold partial
+    fill (docs/benchmarks.md); the RCM band (``scipy.sparse.csgraph``, O(nnz)) is near
+    optimal for long, thin structures.  ``SymmetricMode`` prefers the diagonal, and threshold partial
     pivoting (``RCM_PIVOT_THRESHOLD``) keeps it unless it is smaller than that fraction of
-    the column's largest entry: the band stays a band (19-wire strand, 3000 elements: 3.2e6
-    factor entries instead of 4.4e6, 0.10 s instead of 0.17 s).  A solution whose backward
+    the column's largest entry: the band stays a band.  A solution whose backward
     error exceeds ``BACKWARD_ERROR`` is recomputed with full partial pivoting.  The ordering
     and the permuted pattern are kept for the next matrix of the same pattern (``_rcm``).
     """
@@ -485,7 +479,7 @@ def _pardiso_handle(pypardiso):
     """A fresh ``PyPardisoSolver`` (own PARDISO handle ``pt``) sharing one loaded MKL library.
 
     ``PyPardisoSolver()`` looks MKL up with ``ctypes.util.find_library``, which
-    runs a subprocess (~0.2 s): that is done once, later handles are copies
+    runs a subprocess: that is done once, later handles are copies
     of the first with new ``pt``/``iparm``/``perm`` arrays.
     """
     if not _TEMPLATE:

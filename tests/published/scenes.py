@@ -1,13 +1,10 @@
 """Scenes of the published cases (tests/published/test_*.py): built here once, solved by the tests."""
-import sys
-from pathlib import Path
 
 import numpy as np
 
 import beamsolver as bs
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "examples"))
-from limit_points import argyris_frame  # noqa: E402,F401  (Argyris' frame, the example's scene)
+from limit_points import argyris_frame  # noqa: F401  (Argyris' frame, the example's scene)
 
 
 def column(n=16, ratio=1.1, kick=0.01, EI3=1.0, EI2=4.0, EA=1e7):

@@ -1,0 +1,179 @@
+"""Exact stick (``stick="exact"``, mortar nodal multipliers, ``contact/mortar.py``).
+
+Tangent against central finite differences perturbing on the group (stick, slip, turned
+multipliers); shear lag on a rigid rod (slip zone ``F / (mu q)``, unloaded stick zone) at two
+meshes; answers independent of the augmentation penalty; the patch test with friction (stick
+everywhere, no slip); option checks.
+"""
+
+import numpy as np
+import pytest
+
+import beamsolver as bs
+from beamsolver import se3
+from beamsolver.nonlinear.problem import Problem
+
+import contact_patch
+import shear_lag
+
+R = 0.05
+SEC = bs.Section.circular(radius=R, E=1e7, nu=0.3)
+
+
+def _parallel(mu, n_slave=4, **options):
+    """A slave beam slightly skew above a clamped master (non-matching meshes, 3-D)."""
+    m = bs.Model()
+    master = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 5), SEC)
+    slave = m.add_beam(bs.geometry.straight((0.1, 0.002, 2 * R), (0.9, -0.002, 2 * R), n_slave), SEC)
+    m.clamp(master.first)
+    m.clamp(master.last)
+    m.clamp(slave.first)
+    m.add_contact(slave, master, mu=mu, stick="exact", **options)
+    return m, slave, master
+
+
+def _move(H, nodes, G):
+    H = H.copy()
+    H[nodes] = se3.compose(np.broadcast_to(G, (len(nodes), 4, 4)), H[nodes])
+    return H
+
+
+def _pressed(problem, slave, depth):
+    """Translate the slave down so that its lowest contact point penetrates by ``depth``."""
+    H = problem.system.poses0.copy()
+    z = H[slave.nodes, 2, 3].min()
+    G = np.eye(4)
+    G[2, 3] = 2 * R - z - depth
+    H = _move(H, slave.nodes, G)
+    # bend it a little so the pressure varies along the slave
+    H[slave.nodes, 2, 3] -= depth * np.linspace(0.0, 1.0, len(slave.nodes)) ** 2
+    return H
+
+
+def _fd_error(problem, H, eps=1e-7):
+    """Largest difference between the assembled tangent and central differences of the residual
+    over the free unknowns, relative to the largest contact tangent entry."""
+    system = problem.system
+    ev = problem.evaluate(H, 0.0, tangent=True)
+    K = problem.full_tangent(ev).toarray()
+    free = system.free_dofs
+    n = system.n_nodes
+    Kc = np.zeros_like(K)
+    np.add.at(Kc, (ev.extra[0], ev.extra[1]), ev.extra[2])
+    scale = np.abs(Kc[np.ix_(free, free)]).max()
+    worst = 0.0
+    for d in free:
+        dz = np.zeros(6 * n)
+        dz[d] = eps
+        rp = problem.evaluate(problem.update(H, dz.reshape(n, 6)), 0.0, tangent=False).r
+        rm = problem.evaluate(problem.update(H, -dz.reshape(n, 6)), 0.0, tangent=False).r
+        worst = max(worst, np.abs((rp - rm)[free] / (2 * eps) - K[free, d]).max() / scale)
+    return worst
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("regime", ["stick", "slip", "turned"])
+def test_exact_stick_tangent_matches_finite_differences(regime):
+    model, slave, master = _parallel(0.5 if regime != "slip" else 0.05)
+    problem = Problem.from_model(model, check_rigid_modes=False)
+    c = problem.contact
+    H = _pressed(problem, slave, 2e-3 * R)
+    c.begin_step(H, 0.0)
+    c.commit(H)                                 # history and nodal multipliers (zero) at H
+    if regime == "turned":                      # multipliers in the nodes' frames, not zero
+        keys, lam = c._tmult
+        c._tmult = (keys, np.random.default_rng(3).normal(size=lam.shape) * 50.0)
+    slide = {"stick": 1e-7, "slip": 2e-3, "turned": 1e-7}[regime] * R
+    G = se3.exp(np.array([slide, slide, 0.0, slide, 0.0, 0.5 * slide]))
+    H = _move(H, slave.nodes, G)
+    err = _fd_error(problem, H)
+    m = c._local_blocks(H, True)[5]["mortar"]
+    stick = m["stick"][np.linalg.norm(m["lam"], axis=1) > 0]
+    if regime == "slip":
+        assert not stick.all()
+    else:
+        assert stick.all() and len(stick)
+    assert err < 1e-6, err
+
+
+def _shear_lag(n_wire, **options):
+    sol, wire, a = shear_lag.main(n_wire=n_wire, stick="exact", **options)
+    x, N = shear_lag.axial_force(sol, wire)
+    return sol, wire, a, x, N
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("n_wire", [10, 20])
+def test_shear_lag_slip_zone_and_force_profile(n_wire):
+    """Slip zone ``F / (mu q)`` from the pulled end within one element, the axial force on the
+    closed form ``mu q (x - (L - a))`` there and nothing carried in the stick zone (away from the
+    free end, where the pressing phase leaves a small self-equilibrated force)."""
+    sol, wire, a, x, N = _shear_lag(n_wire)
+    le = 1.0 / n_wire
+    assert abs(shear_lag.slip_zone(sol, wire) - a) < le
+    F = 15.0
+    exact = np.maximum(0.3 * 100.0 * (x - (1.0 - a)), 0.0)
+    slip = x > 1.0 - a + le
+    stick = (x < 1.0 - a - le) & (x > 0.2)
+    assert np.abs(N[slip] - exact[slip]).max() < 0.02 * F
+    assert np.abs(N[stick]).max() < 0.01 * F
+
+
+@pytest.mark.slow
+def test_shear_lag_does_not_depend_on_the_penalty():
+    """Augmentation penalties 1e9 (default, the normal penalty) and 1e10: the same axial forces
+    to 1e-3 F (measured 3.1e-3 N of F = 15 N, at the free end; the penalty sets how fast the
+    updates converge, the stick tolerance what is left), where the penalty stick
+    (``stick="penalty"``) differs by newtons."""
+    N = [_shear_lag(10, penalty_t=pt)[4] for pt in (None, 1e10)]
+    assert np.abs(N[0] - N[1]).max() < 1e-3 * 15.0
+    sol, wire, _ = shear_lag.main(n_wire=10)
+    assert np.abs(shear_lag.axial_force(sol, wire)[1] - N[0]).max() > 1.0
+
+
+def test_stick_option_is_checked():
+    m = bs.Model()
+    a = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 2), SEC)
+    b = m.add_beam(bs.geometry.straight((0, 0, 2 * R), (1, 0, 2 * R), 2), SEC)
+    with pytest.raises(bs.InputError, match="stick must be 'penalty' or 'exact'"):
+        m.add_contact(a, b, mu=0.3, stick="mortar")
+    with pytest.raises(bs.InputError, match="stick_tolerance"):
+        m.add_contact(a, b, mu=0.3, stick="exact", stick_tolerance=-1.0)
+
+
+def test_nodal_return_mapping_derivatives():
+    """``mortar.return_mapping``'s ``C = d lam / d trial`` and ``c = d lam / d cap`` against central
+    differences, in stick and slip."""
+    from beamsolver.contact.mortar import return_mapping
+    rng = np.random.default_rng(26)
+    trial = rng.normal(size=(40, 3))
+    cap = np.abs(rng.normal(size=40)) * 1.5
+    lam, stick, C, c = return_mapping(trial, cap)
+    assert 5 < stick.sum() < 35
+    h = 1e-6
+    for i in range(3):
+        d = np.zeros(3)
+        d[i] = h
+        fd = (return_mapping(trial + d, cap)[0] - return_mapping(trial - d, cap)[0]) / (2 * h)
+        np.testing.assert_allclose(C[:, :, i], fd, atol=1e-8)
+    fd = (return_mapping(trial, cap + h)[0] - return_mapping(trial, cap - h)[0]) / (2 * h)
+    np.testing.assert_allclose(c, fd, atol=1e-8)
+    np.testing.assert_allclose(np.linalg.norm(lam[~stick], axis=1), cap[~stick])
+
+
+def test_groups_move_a_held_node_to_its_neighbour():
+    """``mortar.groups``: a held slave node has no group; the points of its element count wholly
+    for the neighbour (boundary modification), the others are split by the hats."""
+    from beamsolver.contact.mortar import groups
+    slave = np.array([[0, 1], [0, 1], [1, 2]])
+    nodes = np.array([[0, 1, 5, 6], [0, 1, 5, 6], [1, 2, 6, 7]])
+    xi1 = np.array([0.2, 0.8, 0.5])
+    G = groups(slave, xi1, np.zeros(3, dtype=int), np.zeros(3, dtype=int), nodes, 8, 2,
+               held=np.array([[True, False], [True, False], [False, False]]))
+    assert G["node"].tolist() == [1, 2]
+    assert (G["g"][:2] == 0).all() and G["g"][2].tolist() == [0, 1]
+    np.testing.assert_allclose(G["phi"].sum(axis=1), 1.0)
+    # every node of a group's points is among its members, in the slot given by pos
+    for p in range(3):
+        for a in range(2):
+            assert (G["members"][G["g"][p, a], G["pos"][p, a]] == nodes[p]).all()

@@ -1,0 +1,161 @@
+"""Shared test helpers (one module, imported as ``helpers``: ``tests/`` is on pytest's ``pythonpath``).
+
+Paths of the repository, random poses and sections, relative errors, the quadratic-convergence
+check of Newton's residual histories, and random contact pairs for the contact kernels.
+"""
+from pathlib import Path
+
+import numpy as np
+
+from beamsolver import se3
+from beamsolver.assembly.system import System
+from beamsolver.contact import frames
+
+TESTS = Path(__file__).resolve().parent
+ROOT = TESTS.parent
+EXAMPLES = ROOT / "examples"
+BENCHMARKS = ROOT / "benchmarks"
+
+
+# ---------------------------------------------------------------- poses, sections, errors
+def random_rotation_vector(rng, angle, shape=()):
+    """Rotation vectors of norm ``angle`` in uniformly random directions, ``shape + (3,)``."""
+    v = rng.standard_normal(shape + (3,))
+    v /= np.linalg.norm(v, axis=-1, keepdims=True)
+    return v * np.asarray(angle)[..., None] if np.ndim(angle) else v * angle
+
+
+def random_pose(rng, angle=1.0, scale=1.0, shape=()):
+    """Poses with rotation angle up to ``angle`` and translation of order ``scale``."""
+    h = np.concatenate([scale * rng.standard_normal(shape + (3,)),
+                        random_rotation_vector(rng, angle * rng.uniform(size=shape))], axis=-1)
+    return se3.exp(h)
+
+
+def spd_matrix(rng, diag=(1e3, 4e2, 5e2, 20.0, 30.0, 40.0), coupling=0.3):
+    """A full symmetric positive definite 6x6 matrix with the given diagonal scale."""
+    d = np.sqrt(np.asarray(diag, dtype=float))
+    A = np.eye(6) + coupling * rng.uniform(-1, 1, (6, 6))
+    S = A @ A.T
+    s = np.sqrt(np.diag(S))
+    return (d / s)[:, None] * S * (d / s)[None, :]
+
+
+def rel_err(a, b):
+    a, b = np.asarray(a), np.asarray(b)
+    return float(np.abs(a - b).max() / max(np.abs(b).max(), 1e-300))
+
+
+# ---------------------------------------------------------------- assembled tangents
+def deformed_state(system, rng, size=0.15):
+    """A generic (non-equilibrium) state reached through ``System.update``."""
+    dz = size * rng.standard_normal((system.n_nodes, 6))
+    dz[:, :3] *= system.length_scale
+    return system.update(system.poses0, dz)
+
+
+def check_tangent(model, seed=0, t=1.0, eps=1e-6):
+    """The assembled tangent of ``model`` at a random deformed state against central differences of the
+    assembled residual (relative error below 1e-6); returns the system, the tangent and the differences."""
+    system = System(model)
+    rng = np.random.default_rng(seed)
+    H = deformed_state(system, rng)
+    lf = system.load_factors(t) if system.load_scales else np.zeros(0)
+    r, kvals, _ = system.evaluate(H, lf)
+    r2, _, _ = system.evaluate(H, lf, tangent=False)
+    assert np.abs(r - r2).max() <= 1e-14 * np.abs(r).max()
+    free = system.free_dofs
+    K = system.full_matrix(kvals).toarray()[np.ix_(free, free)]
+    Kred = system.matrix(kvals).toarray()
+    assert np.abs(K - Kred).max() <= 1e-14 * np.abs(K).max()
+    fd = np.zeros_like(K)
+    for j, dof in enumerate(free):
+        node, k = divmod(dof, 6)
+        e = eps * (system.length_scale if k < 3 else 1.0)
+        dz = np.zeros((system.n_nodes, 6))
+        dz[node, k] = e
+        rp, _, _ = system.evaluate(system.update(H, dz), lf, tangent=False)
+        rm, _, _ = system.evaluate(system.update(H, -dz), lf, tangent=False)
+        fd[:, j] = (rp[free] - rm[free]) / (2 * e)
+    err = rel_err(K, fd)
+    assert err < 1e-6, err
+    # the residual at the free unknowns is not zero (the check is not trivial)
+    assert np.abs(r[free]).max() > 1e-3 * np.abs(K).max() * 1e-3
+    return system, K, fd
+
+
+# ---------------------------------------------------------------- Newton's rate
+ASYMPTOTIC = 1e-2     # r_k below this: near the solution
+FLOOR_FACTOR = 10.0   # round-off floor: this times the smallest residual reached (docs/theory.md eq. 5.2)
+C_QUAD = 50.0         # r_{k+1} <= C r_k^2 (scaled, dimensionless residuals)
+
+
+def quadratic_pairs(residuals):
+    """Consecutive ``(r_k, r_{k+1})`` near the solution with ``r_{k+1}`` above the round-off floor.
+
+    The floor is where the history stagnates (the last iterations repeat the
+    smallest residual to within a few ulps of the force level), so it is
+    estimated from the history itself, not fixed: it depends on ``EA / EI``
+    and on the mesh.
+    """
+    r = np.asarray(residuals, dtype=float)
+    floor = FLOOR_FACTOR * r.min()
+    return [(a, b) for a, b in zip(r[:-1], r[1:]) if a < ASYMPTOTIC and b > floor]
+
+
+def assert_quadratic(residuals):
+    pairs = quadratic_pairs(residuals)
+    assert pairs, f"no iteration in the asymptotic range above round-off: {residuals}"
+    for a, b in pairs:
+        assert b <= C_QUAD * a * a, f"not quadratic: {a:.3e} -> {b:.3e} (history {np.array(residuals)})"
+    # the observed order of the last pair, log r_{k+1} / log r_k, is about 2 (or more)
+    a, b = pairs[-1]
+    assert np.log(b) / np.log(a) > 1.5, (a, b)
+    return pairs
+
+
+# ---------------------------------------------------------------- contact pairs for the kernels
+def kernel_element(rng, x0, angle, twist):
+    R = se3.exp_so3(np.array([0.0, 0.0, angle])) @ se3.exp_so3(rng.normal(size=3) * 0.05)
+    HA = np.eye(4)
+    HA[:3, :3], HA[:3, 3] = R, x0
+    h = np.concatenate([np.array([1.0, 0, 0]) + rng.normal(size=3) * 0.02, rng.normal(size=3) * twist])
+    return HA, HA @ se3.exp(h)
+
+
+def kernel_pairs(rng, P, angles):
+    """Pairs ``(P, 4, 4, 4)`` of a slave along x and a master at ``angles`` above it, kinds by angle."""
+    kinds = np.where(angles < 0.35, frames.LINE, np.where(angles < 0.8, frames.ORTHOGONAL, frames.POINT))
+    X = []
+    for a in angles:
+        A1, B1 = kernel_element(rng, [0, 0, 0], 0.0, 0.2)
+        A2, B2 = kernel_element(rng, [0.5 - 0.5 * np.cos(a), -0.5 * np.sin(a), 0.19], a, 0.2)
+        X.append([A1, B1, A2, B2])
+    X = np.array(X)
+    h1 = se3.log(se3.relative(X[:, 0], X[:, 1]))
+    h2 = se3.log(se3.relative(X[:, 2], X[:, 3]))
+    xi1 = np.where(kinds == frames.POINT, 0.5, rng.uniform(0.1, 0.9, P))
+    xi1, xi2 = frames.project(kinds, X[:, 0], h1, xi1, X[:, 2], h2, np.full(P, 0.5), iterations=30)
+    return X, kinds, xi1, xi2
+
+
+def kernel_scene(seed, friction, smoothing, multiplier, history, elastic_slip, angles=None):
+    """Node poses ``(P, 4, 4, 4)`` and kernel parameters of ``kernel_pairs`` (12 by default) with the
+    given friction, smoothing gap, multiplier, history and elastic slip."""
+    rng = np.random.default_rng(seed)
+    angles = np.tile([1e-3, 0.1, 0.5, 0.7, 1.2, np.pi / 2], 2) if angles is None else angles
+    P = len(angles)
+    X, kinds, xi1, xi2 = kernel_pairs(rng, P, angles)
+    p = dict(kind=kinds, xi1=xi1, xi2=xi2, R1=np.full(P, 0.1), R2=np.full(P, 0.1),
+             weight=rng.uniform(0.1, 0.5, P), penalty=np.full(P, 100.0), multiplier=np.full(P, multiplier),
+             mu=np.full(P, 0.3 if friction else 0.0), penalty_t=np.where(np.arange(P) % 2 == 0, np.nan, 50.0),
+             elastic_slip=np.full(P, elastic_slip), smoothing=np.full(P, smoothing))
+    if friction:
+        Xo = X.copy()
+        for j in range(4):
+            Xo[:, j] = se3.compose(X[:, j], se3.exp(rng.normal(size=(P, 6)) * 0.003))
+        H_CL, H_FK, H_LK = frames.material_frames(Xo, kinds, xi1, xi2, p["R1"], p["R2"])
+        p.update(H_CL=H_CL, H_FK=H_FK, H_LK_prev=H_LK, xi1_prev=xi1 + 0.01, xi2_prev=xi2 - 0.01,
+                 lam_t_prev=rng.normal(size=(P, 3)) * 0.5,
+                 has_history=np.full(P, history) | (np.arange(P) % 4 == 0))
+    return X, p

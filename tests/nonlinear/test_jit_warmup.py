@@ -1,0 +1,132 @@
+"""The first run (issue 29 item 1): compilations announced, a scene's kernels compiled before step 0."""
+import io
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numba
+import numpy as np
+import pytest
+from numba.core import event
+from numba.core.registry import CPUDispatcher
+
+import beamsolver as bs
+from beamsolver.nonlinear import jit_warmup
+from beamsolver.contact import kernel_jit
+
+ROOT = Path(__file__).resolve().parents[2]
+from twisted_pair import build
+
+
+def _dispatchers():
+    """Every compiled function of the package reachable from its modules: ``{id: (name, dispatcher)}``."""
+    out = {}
+    for name, mod in list(sys.modules.items()):
+        if not name.startswith("beamsolver"):
+            continue
+        for k, v in list(vars(mod).items()):
+            if isinstance(v, CPUDispatcher):
+                out[id(v)] = (f"{name}.{k}", v)
+    for k, v in kernel_jit._KERNELS.items():
+        out[id(v)] = (f"kernel {k}", v)
+    return out
+
+
+def _signatures():
+    return {i: (name, len(d.overloads)) for i, (name, d) in _dispatchers().items()}
+
+
+@pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
+def test_nothing_compiles_after_the_warm_up():
+    """After the warm-up of the main job's scene, its whole solve (crossings of the wires from about
+    one turn on) calls no compiled function with new argument types: no compilation in the middle
+    of a solve.  Fails if the warm-up leaves out a function (``projection._closest``, first called at
+    a crossing) or calls one with other types than the solve (``search._pairs_apart`` on the distance
+    matrix's non-contiguous pair arrays)."""
+    model = build()[0]
+    jit_warmup._scene(model, None)
+    before = _signatures()
+    bs.solve(model, steps=16, verbose=False)
+    after = _signatures()
+    new = sorted(name for i, (name, n) in after.items() if n > before.get(i, (name, 0))[1])
+    assert new == [], f"compiled or loaded during the solve: {new}"
+
+
+@pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
+def test_kernel_arguments_have_the_types_of_a_solve():
+    """``_kernel_args`` (what the second process compiles and ``kernel_cached`` looks up) has the
+    types ``kernel_and_tangent`` passes in a solve: fails when one of them changes alone."""
+    bs.solve(build(turns=0.125)[0], steps=1, verbose=False)
+    sig = tuple(numba.typeof(a) for a in jit_warmup._kernel_args())
+    assert sig in kernel_jit.evaluate.overloads
+    assert jit_warmup.kernel_cached() is True
+
+
+@pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
+def test_first_compilation_is_announced_once():
+    """The line at the first compilation (a cache miss) of the process, not again at the next one."""
+    out = io.StringIO()
+
+    @numba.njit
+    def f(x):
+        return x + 1
+
+    with event.install_listener("numba:compile", jit_warmup._Announcer(out, package=__name__)):
+        f(1)
+        said = out.getvalue()
+        f(1.5)                                 # another compilation: no second line
+    assert said.startswith("beamsolver: compiling the compiled kernels, first run only, ~")
+    assert out.getvalue().count("first run only") == 1
+
+
+@pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
+def test_nothing_is_announced_without_compilation():
+    """A call of a compiled function with known types prints nothing."""
+    @numba.njit
+    def g(x):
+        return 2 * x
+
+    g(1.0)
+    out = io.StringIO()
+    with event.install_listener("numba:compile", jit_warmup._Announcer(out, package=__name__)):
+        g(3.0)
+    assert out.getvalue() == ""
+
+
+@pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
+def test_kernel_process_runs():
+    """The second process (``python -m beamsolver.nonlinear.jit_warmup``) compiles or loads the kernel and exits 0."""
+    jit_warmup._kernel_call()          # this process's cache: the other process loads it
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    out = subprocess.run([sys.executable, "-m", "beamsolver.nonlinear.jit_warmup"], env=env, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+
+
+def test_second_process_only_with_a_free_core(monkeypatch):
+    """``BEAMSOLVER_COMPILE_PROCESS`` decides; unset, a second process only when a core is free."""
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 1})
+    monkeypatch.setenv("BEAMSOLVER_COMPILE_PROCESS", "0")
+    assert not jit_warmup._two_processes()
+    monkeypatch.setenv("BEAMSOLVER_COMPILE_PROCESS", "1")
+    monkeypatch.setattr(os, "getloadavg", lambda: (9.0, 9.0, 9.0))
+    assert jit_warmup._two_processes()
+    monkeypatch.delenv("BEAMSOLVER_COMPILE_PROCESS")
+    assert not jit_warmup._two_processes()
+    monkeypatch.setattr(os, "getloadavg", lambda: (0.3, 0.3, 0.3))
+    assert jit_warmup._two_processes()
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0})
+    assert not jit_warmup._two_processes()
+
+
+@pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
+def test_a_users_own_numba_function_is_not_announced():
+    out = io.StringIO()
+
+    @numba.njit
+    def h(x):
+        return x - 1
+
+    with event.install_listener("numba:compile", jit_warmup._Announcer(out)):
+        h(1)
+    assert out.getvalue() == ""

@@ -1,0 +1,203 @@
+"""Linear-solver back-ends (``beamsolver.nonlinear.linsolve``): same solution as a dense solve, errors."""
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+import beamsolver as bs
+from beamsolver.nonlinear import linsolve
+from beamsolver.errors import InputError
+
+HAVE_PARDISO = "pardiso" in linsolve.available()
+BACKENDS = ["splu", "splu-rcm", pytest.param("pardiso", marks=pytest.mark.skipif(not HAVE_PARDISO,
+                                                                                 reason="pypardiso not installed")),
+            "auto"]
+
+
+def spd_matrix(n=60, seed=0):
+    """Sparse SPD: a 1-D Laplacian plus a random sparse Gram part."""
+    rng = np.random.default_rng(seed)
+    lap = sp.diags([-np.ones(n - 1), 2.0 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1])
+    B = sp.random(n, n, density=0.05, random_state=rng)
+    return sp.csc_matrix(lap + B.T @ B + 0.1 * sp.eye(n))
+
+
+def nonsymmetric_matrix(n=80, seed=1):
+    """Sparse, non-symmetric, diagonally dominant, with a permuted pattern (pivoting needed elsewhere)."""
+    rng = np.random.default_rng(seed)
+    A = sp.random(n, n, density=0.08, random_state=rng).tolil()
+    A.setdiag(np.abs(A).sum(axis=1).A1 + 1.0)
+    A = sp.csc_matrix(A)
+    assert abs(A - A.T).max() > 0.1
+    return A
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("make", [spd_matrix, nonsymmetric_matrix])
+@pytest.mark.parametrize("fmt", ["csc", "csr"])
+def test_same_solution_as_dense(backend, make, fmt):
+    A = make().asformat(fmt)
+    b = np.random.default_rng(2).standard_normal(A.shape[0])
+    x_dense = np.linalg.solve(A.toarray(), b)
+    x = linsolve.factorize(A, backend).solve(b)
+    np.testing.assert_allclose(x, x_dense, rtol=1e-10, atol=1e-12 * np.abs(x_dense).max())
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_solver_refactorises_same_pattern(backend):
+    """A Solver kept across iterations: new values with the same pattern, and an older factor still solves."""
+    A = nonsymmetric_matrix()
+    A2 = A.copy()
+    A2.data = A2.data * np.linspace(0.5, 2.0, A2.nnz)
+    A2 = A2 + sp.diags(np.abs(A2).sum(axis=1).A1)          # same pattern (diagonal present), new values
+    b = np.ones(A.shape[0])
+    s = linsolve.Solver(backend)
+    f1 = s.factorize(A)
+    f2 = s.factorize(A2)
+    np.testing.assert_allclose(f2.solve(b), np.linalg.solve(A2.toarray(), b), rtol=1e-10)
+    np.testing.assert_allclose(f1.solve(b), np.linalg.solve(A.toarray(), b), rtol=1e-10)
+    if s.backend_for(A) == "pardiso":
+        assert s.stats["analyses"] == 1          # the symbolic analysis was reused
+    s.close()
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_singular_matrix_raises(backend):
+    A = sp.csc_matrix(np.array([[1.0, 2.0, 3.0], [2.0, 4.0, 6.0], [1.0, 1.0, 1.0]]))
+    with pytest.raises(linsolve.SingularMatrixError):
+        linsolve.factorize(A, backend).solve(np.ones(3))
+
+
+def test_bad_backend_name():
+    with pytest.raises(InputError, match="umfpack"):
+        linsolve.factorize(spd_matrix(), "umfpack")
+    with pytest.raises(InputError, match="linear_solver"):
+        linsolve.Solver("Pardiso")
+
+
+def test_missing_pardiso_is_an_input_error(monkeypatch):
+    monkeypatch.setattr(linsolve, "_pypardiso", lambda: None)
+    with pytest.raises(InputError, match="pypardiso"):
+        linsolve.Solver("pardiso")
+    assert linsolve.Solver("auto").backend_for(spd_matrix()) == "splu"
+    assert "pardiso" not in linsolve.available()
+    assert linsolve.Solver("auto").backend_for(coupled_matrix()) == "splu-rcm"
+
+
+def coupled_matrix(n=2000, half_band=20):
+    """Banded, 41 non-zeros per column: what contact couplings look like to ``auto``."""
+    offsets = list(range(-half_band, half_band + 1))
+    diags = [np.full(n - abs(k), -0.01) for k in offsets]
+    diags[half_band] = np.full(n, 1.0)
+    return sp.csc_matrix(sp.diags(diags, offsets))
+
+
+def test_auto_choice():
+    small, coupled = spd_matrix(), coupled_matrix()
+    assert linsolve.Solver("auto").backend_for(small) == "splu"
+    assert linsolve.Solver("auto").backend_for(coupled) == ("pardiso" if HAVE_PARDISO else "splu-rcm")
+    b = np.ones(coupled.shape[0])
+    np.testing.assert_allclose(linsolve.factorize(coupled, "auto").solve(b),
+                               linsolve.factorize(coupled, "splu").solve(b), rtol=1e-10)
+
+
+def _cantilever():
+    m = bs.Model()
+    beam = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 8), bs.Section.circular(radius=0.01, E=2e11))
+    m.clamp(beam.first)
+    m.add_load(beam.last, force=(0.0, 0.0, -100.0))
+    return m, beam
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_solve_keyword(backend):
+    m, beam = _cantilever()
+    ref = bs.solve(m, steps=2, verbose=False)
+    sol = bs.solve(m, steps=2, verbose=False, linear_solver=backend)
+    np.testing.assert_allclose(sol.position(beam.last), ref.position(beam.last), rtol=1e-9, atol=1e-12)
+
+
+def test_solve_keyword_bad_name():
+    m, _ = _cantilever()
+    with pytest.raises(InputError, match="linear_solver"):
+        bs.solve(m, steps=1, verbose=False, linear_solver="mumps")
+
+
+def _weak_diagonal(n=200, seed=4):
+    """Non-symmetric band of 2 x 2 blocks ``[[1e-12, 1], [1, 1e-12]]`` weakly coupled: elimination on
+    the diagonal grows entries by 1e12; pivoting must leave the diagonal (below
+    ``RCM_PIVOT_THRESHOLD`` of the column's largest entry)."""
+    rng = np.random.default_rng(seed)
+    A = sp.lil_matrix((n, n))
+    for i in range(0, n, 2):
+        A[i, i], A[i, i + 1], A[i + 1, i], A[i + 1, i + 1] = 1e-12, 1.0, rng.uniform(1, 2), 1e-12
+    for i in range(n - 2):
+        A[i, i + 2], A[i + 2, i] = 0.1 * rng.uniform(), 0.05 * rng.uniform()
+    return sp.csc_matrix(A)
+
+
+def test_rcm_threshold_pivoting_solves_weak_diagonals():
+    """splu-rcm with threshold pivoting: pivots away from a 1e-12 diagonal (no growth), backward
+    error at round-off, as with full partial pivoting."""
+    A = _weak_diagonal()
+    b = np.random.default_rng(5).standard_normal(A.shape[0])
+    f = linsolve.factorize(A, "splu-rcm")
+    assert not np.array_equal(f._lu.perm_r, np.arange(A.shape[0]))        # it did pivot
+    x = f.solve(b)
+    assert linsolve._backward_error(A, x, b) < 1e-14
+    np.testing.assert_allclose(x, np.linalg.solve(A.toarray(), b), rtol=1e-9)
+
+
+def test_rcm_falls_back_to_full_pivoting(monkeypatch):
+    """A factor whose solution has a large backward error (here: no pivoting at all on tiny
+    diagonals) is recomputed with full partial pivoting."""
+    monkeypatch.setattr(linsolve, "RCM_PIVOT_THRESHOLD", 0.0)
+    A = _weak_diagonal()
+    b = np.random.default_rng(5).standard_normal(A.shape[0])
+    f = linsolve.factorize(A, "splu-rcm")
+    x_bad = f._solve(b)
+    assert linsolve._backward_error(A, x_bad, b) > linsolve.BACKWARD_ERROR
+    x = f.solve(b)
+    assert linsolve._backward_error(A, x, b) < 1e-14
+
+
+def test_rcm_ordering_kept_for_the_same_pattern():
+    """The second matrix of the same pattern reuses the ordering and gives the factor of a fresh
+    ordering: the same solution bit for bit."""
+    A = nonsymmetric_matrix()
+    A2 = A.copy()
+    A2.data = A2.data * np.linspace(0.5, 2.0, A2.nnz)
+    b = np.ones(A.shape[0])
+    linsolve.factorize(A, "splu-rcm")
+    kept = linsolve._RCM_LAST[0][3]
+    x2 = linsolve.factorize(A2, "splu-rcm").solve(b)
+    assert linsolve._RCM_LAST[0][3] is kept
+    linsolve._RCM_LAST.clear()
+    np.testing.assert_array_equal(linsolve.factorize(A2, "splu-rcm").solve(b), x2)
+    np.testing.assert_allclose(x2, np.linalg.solve(A2.toarray(), b), rtol=1e-10)
+
+
+def test_compiled_rcm_is_scipys():
+    """``_rcm_csc`` gives ``_rcm_scipy``'s ordering and permuted pattern exactly, on unsymmetric
+    patterns, explicit zeros, empty columns and a contact tangent."""
+    rng = np.random.default_rng(8)
+    mats = [nonsymmetric_matrix()]
+    for n, dens in ((50, 0.05), (200, 0.02), (300, 0.005)):
+        A = sp.random(n, n, density=dens, random_state=rng, format="csc") + sp.eye(n, format="csc")
+        A.sum_duplicates()
+        mats.append(A)
+    Z = mats[2].copy()
+    Z.data[::3] = 0.0                    # stored zeros: part of the pattern
+    mats.append(Z)
+    E = sp.csc_matrix(sp.random(40, 40, density=0.05, random_state=rng).toarray() * (np.arange(40) % 5 != 0))
+    mats.append(E)
+    import twisted_pair_extreme as twisted_pair
+    from beamsolver.nonlinear.problem import Problem
+    model, _, _ = twisted_pair.build(n_elements=8, turns=0.5)
+    problem = Problem.from_model(model)
+    problem.begin_step(problem.system.poses0, 0.0)
+    mats.append(problem.tangent(problem.evaluate(problem.system.poses0, 0.0)))
+    for A in mats:
+        assert A.format == "csc" and A.has_canonical_format
+        ours, ref = linsolve._rcm_csc(A), linsolve._rcm_scipy(A)
+        for a, b in zip(ours, ref):
+            assert a.dtype == b.dtype and np.array_equal(a, b)
