@@ -12,7 +12,7 @@ from beamsolver.nonlinear import linsolve
 from beamsolver.nonlinear.convergence import Convergence, Verdict
 from beamsolver.nonlinear.newton import Newton
 
-PACKAGE = Path(__file__).resolve().parents[1] / "beamsolver"
+PACKAGE = Path(__file__).resolve().parents[2] / "beamsolver"
 
 
 def _calls(attr):
