@@ -21,13 +21,14 @@ first slip ``kappa_b = mu F sin b / (E A_w cos^2 b r)``; slipping share ``2 psi 
 ``sin(psi) / psi = kappa_b / kappa`` up to ``kappa_t = (pi / 2) kappa_b``; saturated friction moment
 ``M_f = (2 n / pi) mu F r sin b cos b``; reversals by Masing's rule; loop energy from it.
 
-What a penalty-stick beam model meets today (numbers in docs/benchmarks.md, "Strand bending"):
-the full-slip quantities (``M_f``, the Masing branch at the end of a half cycle, the loop energy
-within 10 %) need only Coulomb's limit.  The full-stick stiffness depends on the elastic slip of
-the penalty stick, which makes the stick compliant: with the default ``slip_tolerance`` (0.005
-element lengths) the strand does not stick at all, with the example's 5e-6 the initial stiffness
-is still 15 % below ``EI_max`` and the slipping share lags the theory.  The exact stick of issue
-26 is meant to remove this; rerun ``benchmarks/strand_bending.py`` then.
+Stick: the example uses ``stick="exact"`` (mortar nodal multipliers, docs/theory_mortar.md): the
+full-stick branch no longer depends on a penalty (``--stick penalty`` runs the Gauss-point penalty with
+``slip_tolerance`` 5e-6 element lengths for comparison; with the default 0.005 the strand does not
+stick at all).  The full-slip quantities (``M_f``, the Masing branch at the end of a half cycle, the
+loop energy) need only Coulomb's limit.  With exact stick the initial stiffness is about 12 % below
+the plane-section ``EI_max`` (the wires stick at their surface, a lever arm ``R_w`` from their axes,
+and bend under the friction's moment; tying the axes rigidly to the core gives ``EI_max``), and the
+first slip comes correspondingly later than ``kappa_b`` (numbers in docs/benchmarks.md).
 ``tied=True`` ties the wires rigidly to the core (no contact) to measure the beam model's own
 full-stick stiffness (shear and torsion of the wires included) against ``EI_max``.
 
@@ -107,16 +108,24 @@ def loop_energy(kappa_a, th):
 
 
 # ---------------------------------------------------------------- model
-SLIP_TOLERANCE = 5e-6            # elastic slip of the penalty stick / element length (default 0.005: see above)
+STICK = "exact"                  # mortar nodal multipliers (docs/theory_mortar.md); "penalty": the Gauss-point penalty
+SLIP_TOLERANCE = 5e-6            # with stick="penalty": its elastic slip / element length (default 0.005: see above)
 
 
-def build(lays=LAYS, elements_per_lay=ELEMENTS, mu=MU, amplitude=AMPLITUDE, tied=False, kappa_b=None, slip_tolerance=SLIP_TOLERANCE):
+def _contact_options(stick, slip_tolerance):
+    """Friction from the tensioned state; exact stick, or the penalty stick with ``slip_tolerance``."""
+    stick = STICK if stick is None else stick
+    return dict(friction_from=1.0, stick=stick) | (dict(slip_tolerance=slip_tolerance) if stick == "penalty" else {})
+
+
+def build(lays=LAYS, elements_per_lay=ELEMENTS, mu=MU, amplitude=AMPLITUDE, tied=False, kappa_b=None, slip_tolerance=SLIP_TOLERANCE,
+          stick=None):
     """The strand in its bending fixture: ``(model, strand, fixture, T, k)``; ``kappa_b`` sets the
     curvature unit (default: the theory's with the fibre-limit wire force)."""
     b = np.arctan(2 * np.pi * (RC + RW) / LAY)
     layers = [cables.Layer(RC, 1), cables.Layer(RW, N, lay_length=LAY)]
     st = cables.build_strand(layers, lays * LAY, E, nu=NU, elements_per_lay=elements_per_lay, mu=mu,
-                             contact=not tied, touch_tol=0.0, contact_options=dict(friction_from=1.0, slip_tolerance=slip_tolerance))
+                             contact=not tied, touch_tol=0.0, contact_options=_contact_options(stick, slip_tolerance))
     if tied:                                   # every wire node rigidly on the core node at its height
         core = st.wires[0][0]
         for w in st.wires[1]:
@@ -141,9 +150,9 @@ def build(lays=LAYS, elements_per_lay=ELEMENTS, mu=MU, amplitude=AMPLITUDE, tied
 
 
 def run(lays=LAYS, elements_per_lay=ELEMENTS, mu=MU, amplitude=AMPLITUDE, steps=STEPS, tied=False, t_end=6.0, verbose=False,
-        slip_tolerance=SLIP_TOLERANCE):
+        slip_tolerance=SLIP_TOLERANCE, stick=None):
     """Solve with ``steps`` steps per unit pseudo-time; returns a dict of the measured curves."""
-    model, st, fx, T, k = build(lays, elements_per_lay, mu, amplitude, tied, slip_tolerance=slip_tolerance)
+    model, st, fx, T, k = build(lays, elements_per_lay, mu, amplitude, tied, slip_tolerance=slip_tolerance, stick=stick)
     t0 = time.perf_counter()
     sol = bs.solve(model, steps=int(round(steps * t_end)), t_end=t_end, verbose=verbose)
     wall = time.perf_counter() - t0
@@ -196,10 +205,10 @@ def compare(res):
     return th, [(n, a, b, (b - a) / a if a else b) for n, a, b in rows]
 
 
-def first_slip(lays=LAYS, elements_per_lay=ELEMENTS, steps=40, upto=2.0):
+def first_slip(lays=LAYS, elements_per_lay=ELEMENTS, steps=40, upto=2.0, stick=None):
     """``(kappa at the first slipping point of the middle half, kappa_b of the theory)`` on a virgin
     ramp ``0 -> upto kappa_b`` in ``steps`` steps (``t`` in ``[1, 2]``; the flags resolve ``upto / steps``)."""
-    res = run(lays, elements_per_lay, amplitude=upto, steps=steps, t_end=2.0)
+    res = run(lays, elements_per_lay, amplitude=upto, steps=steps, t_end=2.0, stick=stick)
     th = theory(res["F"])
     hit = np.flatnonzero((res["times"] > 1.0) & (res["share"] > 0))
     return (res["kappa"][hit[0]] if len(hit) else np.nan), th["kappa_b"]
@@ -229,7 +238,7 @@ def main(lays=LAYS, elements_per_lay=ELEMENTS, amplitude=AMPLITUDE, steps=STEPS,
     print(f"1+6 strand (Utting & Jones 1987): Rc = {RC * 1e3} mm, Rw = {RW * 1e3} mm, lay {LAY * 1e3} mm, "
           f"beta = {np.degrees(th['beta']):.2f} deg, mu = {mu}, T = {res['T']:.4g} N, wire force F = {res['F']:.4g} N;"
           f" {lays} lays, {elements_per_lay} elements per lay, +-{amplitude} kappa_b, {steps} steps per unit t, "
-          f"slip_tolerance {SLIP_TOLERANCE}")
+          f"stick {STICK}" + (f", slip_tolerance {SLIP_TOLERANCE}" if STICK == "penalty" else ""))
     print("| quantity | theory | model | model / theory - 1 |")
     print("|---|---:|---:|---:|")
     for name, a, b, e in rows:
@@ -277,9 +286,11 @@ if __name__ == "__main__":
     ap.add_argument("--amplitude", type=float, default=AMPLITUDE)
     ap.add_argument("--steps", type=int, default=STEPS)
     ap.add_argument("--mu", type=float, default=MU)
+    ap.add_argument("--stick", default=STICK, choices=("exact", "penalty"))
     ap.add_argument("--plot", default=None, help="PNG of the loop against the theory (needs matplotlib)")
     ap.add_argument("--map", default=None, help="PNG of the stick/slip map where slip spreads (needs pyvista)")
     a = ap.parse_args()
+    STICK = a.stick
     res, th, rows = main(a.lays, a.elements, a.amplitude, a.steps, a.mu)
     if a.map:
         stick_slip_map(res, th, a.map)

@@ -1007,9 +1007,46 @@ def _evaluate(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, 
     own[0][0, 0, 0, 0] = 0.0           # the scratch arrays' owners live until here
 
 
+@jit
+def _friction_given(slip, lamp, t1, t2, lam, par, G):
+    """The mortar kernel's friction (``make_kernel(law, mortar=True)``): the given global traction
+    ``lamp`` (force per length) applied by its components ``(lamp . t1, lamp . t2)``, their gradient
+    at fixed ``lamp`` in the rows ``G_DTR``; no law (the nodal return mapping is in ``mortar.py``)."""
+    dt1, dt2, dtr = G_DT1 * W, G_DT2 * W, G_DTR * W
+    for k in range(24):
+        G[dtr + k] = lamp[0] * G[dt1 + k] + lamp[1] * G[dt1 + W + k] + lamp[2] * G[dt1 + 2 * W + k]
+        G[dtr + W + k] = lamp[0] * G[dt2 + k] + lamp[1] * G[dt2 + W + k] + lamp[2] * G[dt2 + 2 * W + k]
+    return (dot(lamp, t1), dot(lamp, t2)), G[dtr:dtr + 2 * W].reshape((2, W)), True
+
+
+# the gradient rows a mortar evaluation exports per point: n, t1, t2 (9), the slip (2), the normal traction (1)
+N_ROWS = 12
+
+
+def _evaluate_rows(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames, rows):
+    """``_evaluate`` that also copies each point's gradient rows to ``rows`` ``(P, N_ROWS, 24)``:
+    ``d n``, ``d t1``, ``d t2`` (rows 0-8), ``d slip`` (9-10), ``d lam_n`` (11).  A template of the mortar
+    kernel (``make_kernel(law, mortar=True)``)."""
+    own = _scratch()
+    ws = (_borrowed(own[0]), _borrowed(own[1]), _borrowed(own[2]), _borrowed(own[3]))
+    G = ws[2]
+    for p in range(X.shape[0]):
+        _point(X[p], kind[p], par[p], has[p], HCL[p], HFK[p], HLKp[p], lamp[p], friction, f[p], K[p], sc[p],
+               vec[p], two[p], flags[p], frames[p], ws)
+        r = rows[p]
+        for k in range(24):
+            for i in range(9):
+                r[i, k] = G[(G_DN + i) * W + k]
+            r[9, k] = G[G_DSLIP * W + k]
+            r[10, k] = G[(G_DSLIP + 1) * W + k]
+            r[11, k] = G[G_DLAM * W + k]
+    own[0][0, 0, 0, 0] = 0.0
+
+
 # ---------------------------------------------------------------- the kernel of a contact law
 _LAW_PATH = ("_friction", "_point", "_evaluate")      # the templates on the call path to the law, callee first
-_TEMPLATES = {name: globals()[name] for name in _LAW_PATH}
+_MORTAR_PATH = ("_point", "_evaluate_rows")          # the mortar kernel's (``_friction`` is ``_friction_given``)
+_TEMPLATES = {name: globals()[name] for name in _LAW_PATH + _MORTAR_PATH[1:]}
 _KERNELS = {}
 
 
@@ -1027,7 +1064,7 @@ def _digest(law):
     return hashlib.sha1(b"".join(code)).hexdigest()[:10]
 
 
-def make_kernel(law):
+def make_kernel(law, mortar=False):
     """The compiled batch driver ``_evaluate`` for ``law`` (a ``law.ContactLaw``), built once per process.
 
     The templates on the law's call path (``_friction``, ``_point``, ``_evaluate``) are copied
@@ -1037,15 +1074,17 @@ def make_kernel(law):
     and loads from the cache afterwards (closures or functions passed as arguments are
     recompiled in every process with numba 0.68).
     """
-    key = f"{law.name}_{_digest(law)}"
+    key = f"{'mortar_' if mortar else ''}{law.name}_{_digest(law)}"
     if key not in _KERNELS:
         glb = dict(globals(), _normal_law=law.normal, _tangential_law=law.tangential)
-        for name in _LAW_PATH:
+        if mortar:
+            glb["_friction"] = _friction_given
+        for name in _MORTAR_PATH if mortar else _LAW_PATH:
             t = _TEMPLATES[name]
             f = types.FunctionType(t.__code__, glb, f"{name}__{key}", t.__defaults__)
             f.__qualname__, f.__doc__ = f.__name__, t.__doc__
             glb[name] = jit(f)
-        _KERNELS[key] = glb["_evaluate"]
+        _KERNELS[key] = glb["_evaluate_rows" if mortar else "_evaluate"]
     return _KERNELS[key]
 
 
@@ -1143,3 +1182,40 @@ def contact_kernel(X, p, friction=True, law=None):
     """Wrenches ``(P, 4, 6)`` and point data (``reference.contact_kernel``, for batches ``(P, 4, 4, 4)``)."""
     f, _, out = kernel_and_tangent(X, p, friction, law)
     return f, out
+
+
+def mortar_terms(X, p, law=None):
+    """Point terms of the mortar friction (``mortar.py``) from the compiled mortar kernel.
+
+    A point's friction force is linear in the global traction ``T`` (force per length) it is given:
+    ``f = A T`` and, at fixed ``T``, ``df/dq = sum_k T_k dK_k``.  Four evaluations (``T = 0, e_x, e_y,
+    e_z``; the normal part cancels in the differences) give ``A`` ``(P, 24, 3)`` and ``dK``
+    ``(P, 3, 24, 24)``; the first also gives the slip ``S = s1 t1 + s2 t2`` ``(P, 3)`` (global) and
+    ``dS`` ``(P, 3, 24)``, ``lam_n`` ``(P,)``, ``dlam_n`` ``(P, 24)``, ``n``, ``t1``, ``t2`` ``(P, 3)``, ``dn``
+    ``(P, 3, 24)``, ``slip`` ``(P, 2)``, ``HL``, ``HK`` ``(P, 4, 4)``, ``active`` ``(P,)``.  Columns as in
+    ``kernel_and_tangent`` (body increments of the nodes A1, B1, A2, B2).
+    """
+    X = np.ascontiguousarray(X, dtype=float)
+    P = X.shape[0]
+    kind, par, has, (HCL, HFK, HLKp), _ = _table(X, p)
+    kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar=True)
+    f, K = np.empty((4, P, 4, 6)), np.empty((4, P, 24, 24))
+    sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
+    flags, frames, rows = np.empty((P, 2), dtype=np.bool_), np.empty((P, 4, 4, 4)), np.empty((P, N_ROWS, 24))
+    junk = np.empty((P, N_ROWS, 24))
+    for k in range(4):
+        lamp = np.zeros((P, 3))
+        if k:
+            lamp[:, k - 1] = 1.0
+        kern(X, kind, par, has, HCL, HFK, HLKp, lamp, True, f[k], K[k], sc, vec, two, flags, frames,
+             rows if k == 0 else junk)
+    A = np.transpose(f[1:] - f[0], (1, 2, 3, 0)).reshape(P, 24, 3)
+    dK = np.transpose(K[1:] - K[0], (1, 0, 2, 3))
+    n, t1, t2, s = vec[:, 0], vec[:, 1], vec[:, 2], two[:, 1]
+    dn, dt1, dt2 = rows[:, 0:3], rows[:, 3:6], rows[:, 6:9]
+    S = s[:, :1] * t1 + s[:, 1:] * t2
+    dS = (t1[:, :, None] * rows[:, None, 9] + s[:, 0, None, None] * dt1
+          + t2[:, :, None] * rows[:, None, 10] + s[:, 1, None, None] * dt2)
+    return dict(A=A, dK=dK, S=S, dS=dS, lam_n=sc[:, 1].copy(), dlam_n=rows[:, 11].copy(), n=n, t1=t1, t2=t2, dn=dn,
+                slip=s.copy(), HL=frames[:, 0].copy(), HK=frames[:, 1].copy(), active=flags[:, 0].copy(),
+                xi1=sc[:, 2].copy(), xi2=sc[:, 3].copy())

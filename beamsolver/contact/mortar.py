@@ -162,7 +162,7 @@ def return_mapping(trial, cap):
     return lam, stick, C, c
 
 
-def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu, m):
+def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu, m, active=None):
     """Nodal weighted slip, normal traction and multipliers of the groups ``G`` (``groups``).
 
     ``w`` ``(P,)`` point weights, ``S`` ``(P, 3)`` slips, ``lam_n`` ``(P,)``, ``n`` ``(P, 3)`` normals; per group:
@@ -172,15 +172,17 @@ def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu, m):
     the slave node's rotation, ``Lam`` ``(n, 3)`` the step's multiplier in that frame, ``eps`` and
     ``mu`` ``(n,)``; ``m`` ``(n,)`` the nodal weights ``int Phi_j ds`` over the whole slave elements around the
     node, in or out of contact (constant: a point entering contact with zero slip and traction changes
-    nothing, where a weight over the active points would jump).  Returns a dict with ``m``, ``u`` (projected), ``lamN``, ``trial``, ``lam``, ``stick``,
+    nothing, where a weight over the active points would jump); ``active`` ``(P,)``: the points whose
+    slip counts (where the traction acts; the mean normal takes every point).  Returns a dict with ``m``, ``u`` (projected), ``lamN``, ``trial``, ``lam``, ``stick``,
     ``C``, ``c``, ``Pi``, ``Q`` (d trial / d nbar) per group and the point tractions ``T`` ``(P, 3)``.
     """
     k = len(G["key"])
-    wphi = G["phi"] * w[:, None]
+    wn = G["phi"] * w[:, None]
+    wphi = wn if active is None else wn * active[:, None]
     u = np.stack([np.bincount(G["g"].ravel(), weights=(wphi[:, :, None] * S[:, None, :])[..., i].ravel(),
                               minlength=k) for i in range(3)], axis=1) / m[:, None]
     lamN = np.bincount(G["g"].ravel(), weights=(wphi * lam_n[:, None]).ravel(), minlength=k) / m
-    nbar = np.stack([np.bincount(G["g"].ravel(), weights=(wphi[:, :, None] * n[:, None, :])[..., i].ravel(),
+    nbar = np.stack([np.bincount(G["g"].ravel(), weights=(wn[:, :, None] * n[:, None, :])[..., i].ravel(),
                                  minlength=len(m)) for i in range(3)], axis=1) / m[:, None]
     size = np.linalg.norm(nbar, axis=1)
     nu = nbar / size[:, None]
@@ -192,7 +194,7 @@ def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu, m):
     lam, stick, C, c = return_mapping(trial, mu * np.maximum(lamN, 0.0))
     T = np.einsum("pa,pai->pi", G["phi"], lam[G["g"]])
     return dict(m=m, u=np.einsum("gij,gj->gi", Pi, u), lamN=lamN, trial=trial, lam=lam, stick=stick, C=C, c=c,
-                T=T, wphi=wphi, Pi=Pi, Q=Q)
+                T=T, wphi=wphi, wn=wn, Pi=Pi, Q=Q)
 
 
 def blocks(G, d, st, R, Lam, eps, mu):
@@ -217,9 +219,9 @@ def blocks(G, d, st, R, Lam, eps, mu):
     B = np.zeros((n, 3, 6 * k))
     for a in range(2):
         g, rows = G["g"][:, a], (6 * G["pos"][:, a, :, None] + np.arange(6)).reshape(P, 24)
-        wg = st["wphi"][:, a] / st["m"][g]
+        wg, wgn = st["wphi"][:, a] / st["m"][g], st["wn"][:, a] / st["m"][g]
         dtrial = (eps[g] * wg)[:, None, None] * np.einsum("pij,pjq->piq", st["Pi"][g], d["dS"]) + \
-            wg[:, None, None] * np.einsum("pij,pjq->piq", st["Q"][g], d["dn"])
+            wgn[:, None, None] * np.einsum("pij,pjq->piq", st["Q"][g], d["dn"])
         dlam = np.einsum("pij,pjq->piq", st["C"][g], dtrial) + \
             (mu[g] * wg)[:, None, None] * st["c"][g][:, :, None] * d["dlam_n"][:, None, :]
         np.add.at(B, (g[:, None, None], np.arange(3)[None, :, None], rows[:, None, :]), dlam)

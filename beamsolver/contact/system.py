@@ -719,22 +719,28 @@ class ContactSystem(Contribution):
         Lam = np.zeros((len(G["key"]), 3))
         Lam[mf] = self._tmult[1][mi[mf]]
         eps, mu = self._decl_eps_t[gdecl], self._decl_mu[gdecl]
-        _, o = mortar.point_friction(X, pm, np.zeros((len(idx), 3)))
+        laws = {id(self.decls[k].law): self.decls[k].law for k in np.unique(gdecl)}
+        if len(laws) > 1:
+            raise InputError("contact: exact stick needs one contact law over the declarations of a scene, "
+                             f"got {len(laws)}")
+        d = kernel_jit.mortar_terms(X, pm, next(iter(laws.values())))
         # nodal weights: half of each element at the node, the whole element beside a held node
         e = P.e[sel[idx]]
         merged = np.unique(G["g"][:, 0][G["g"][:, 0] == G["g"][:, 1]] * np.int64(len(self.sys.L))
                            + e[G["g"][:, 0] == G["g"][:, 1]])
         m = self._node_len[G["node"]] + np.bincount(merged // len(self.sys.L), weights=0.5 * self.sys.L[
             merged % len(self.sys.L)], minlength=len(G["key"]))
-        st = mortar.nodal_state(G, pm["weight"], o["S"], o["lam_n"], o["n"], R, Lam, eps, mu, m)
+        # the traction acts where the normal law does (the kernel applies it there): the slip is
+        # integrated over the same points
+        st = mortar.nodal_state(G, pm["weight"], d["S"], d["lam_n"], d["n"], R, Lam, eps, mu, m, d["active"])
+        d["f"] = np.einsum("pij,pj->pi", d["A"], st["T"])
         if tangent:
-            d = mortar.point_derivatives(X, pm, st["T"])
+            d["G"], d["dfdq"] = d["A"], np.einsum("pk,pkij->pij", st["T"], d["dK"])
             f, K = mortar.blocks(G, d, st, R, Lam, eps, mu)
         else:
-            fp, d = mortar.point_friction(X, pm, st["T"])
             f = np.zeros((len(G["key"]), 6 * G["members"].shape[1]))
             rows = (6 * G["pos"][:, 0, :, None] + np.arange(6)).reshape(len(idx), 24)
-            np.add.at(f, (G["g"][:, 0][:, None], rows), fp.reshape(-1, 24))
+            np.add.at(f, (G["g"][:, 0][:, None], rows), d["f"])
             K = None
         n, t1, t2 = d["n"], d["t1"], d["t2"]
         Tt = st["T"] - np.sum(st["T"] * n, axis=1)[:, None] * n

@@ -177,3 +177,43 @@ def test_groups_move_a_held_node_to_its_neighbour():
     for p in range(3):
         for a in range(2):
             assert (G["members"][G["g"][p, a], G["pos"][p, a]] == nodes[p]).all()
+
+
+def test_compiled_mortar_terms_match_the_complex_step_oracle(monkeypatch):
+    """``kernel_jit.mortar_terms`` (compiled, four evaluations, the friction linear in the given traction)
+    against ``mortar.point_derivatives`` (numpy complex steps) on pressed, slid pairs at a random
+    traction: forces, ``df/dT``, the tangent at fixed traction, the slip and its derivative, the normal
+    traction and the normal's derivative."""
+    from beamsolver.contact import kernel_jit, mortar
+    captured = {}
+    compiled = kernel_jit.mortar_terms
+
+    def spy(X, pm, law=None):
+        captured.update(X=X, pm=pm)
+        return compiled(X, pm, law)
+
+    monkeypatch.setattr(kernel_jit, "mortar_terms", spy)
+    model, slave, master = _parallel(0.5)
+    problem = Problem.from_model(model, check_rigid_modes=False)
+    c = problem.contact
+    H = _pressed(problem, slave, 2e-3 * R)
+    c.begin_step(H, 0.0)
+    c.commit(H)
+    slide = 1e-4 * R
+    H = _move(H, slave.nodes, se3.exp(np.array([slide, slide, 0.0, slide, 0.0, 0.5 * slide])))
+    c._local_blocks(H, True)
+    X, pm = captured["X"], captured["pm"]
+    assert len(X) > 4
+    T = np.random.default_rng(0).normal(size=(len(X), 3)) * 100.0
+    d = mortar.point_derivatives(X, pm, T)
+    m = compiled(X, pm)
+
+    def rel(a, b):
+        return np.abs(a - b).max() / np.abs(b).max()
+    assert m["active"].all()
+    assert rel(m["A"], d["G"]) < 1e-11
+    assert rel(np.einsum("pij,pj->pi", m["A"], T), d["f"]) < 1e-11
+    assert rel(np.einsum("pk,pkij->pij", T, m["dK"]), d["dfdq"]) < 1e-8
+    assert rel(m["S"], d["S"]) < 1e-12 and rel(m["dS"], d["dS"]) < 1e-12
+    assert rel(m["lam_n"], d["lam_n"]) < 1e-12 and rel(m["dlam_n"], d["dlam_n"]) < 1e-12
+    assert rel(m["dn"], d["dn"]) < 1e-12
