@@ -24,7 +24,8 @@ from ..lie.se3 import cross as _cross, dot as _dot
 from .frames import axes, body_wrench, contact_frames, log_c, node_jacobians, project, section
 from .law import PENALTY_T_MIN, coulomb_return_mapping, normal_force
 
-__all__ = ["contact_kernel", "kernel_and_tangent", "touching_gap", "stick_penalty", "CHUNK"]
+__all__ = ["contact_kernel", "kernel_and_tangent", "touching_gap", "stick_penalty", "CHUNK", "mortar_point_friction",
+           "mortar_point_derivatives"]
 
 
 def touching_gap(gap, touch):
@@ -153,3 +154,82 @@ def kernel_and_tangent(X, p, friction=True, h=1e-30):
         outs.append({k: np.real(v[0]) for k, v in oc.items()})
     out = {k: np.concatenate([o[k] for o in outs]) for k in outs[0]} if outs else contact_kernel(X, p, friction)[1]
     return f, K, out
+
+
+# ---------------------------------------------------------------- the mortar friction's point terms
+
+
+def mortar_point_friction(X, p, T):
+    """Friction wrenches ``(..., 4, 6)`` of the global traction ``T`` ``(..., 3)`` (force per length,
+    its tangential part applied), the slip ``S`` ``(..., 3)`` (global), the normal traction and frames.
+
+    ``X`` ``(..., 4, 4, 4)``: node poses A1, B1, A2, B2; ``p``: the kernel parameters of
+    ``pairs.contact_kernel`` (friction history included).  Complex inputs give complex-step
+    derivatives (branches on the real part).
+    """
+    HA1, HB1, HA2, HB2 = X[..., 0, :, :], X[..., 1, :, :], X[..., 2, :, :], X[..., 3, :, :]
+    E1, E2 = se3.relative(HA1, HB1), se3.relative(HA2, HB2)
+    h1, h2 = log_c(E1), log_c(E2)
+    xi1, xi2 = project(p["kind"], HA1, h1, p["xi1"] + 0 * h1[..., 0], HA2, h2, p["xi2"] + 0 * h2[..., 0],
+                        iterations=2)
+    HC, _, _ = section(HA1, h1, xi1)
+    HF, _, _ = section(HA2, h2, xi2)
+    R1, R2 = p["R1"], p["R2"]
+    xC, xF, n, t1, t2, dist = axes(HC, HF, R1, R2)
+    lam_n, active = normal_force(dist - R1 - R2, p["penalty"], p["multiplier"], p.get("smoothing", 0.0))
+    HL, HK = contact_frames(n, t1, t2, xC, xF, R1, R2)
+    HCm, _, _ = section(HA1, h1, p["xi1_prev"] + 0 * xi1)
+    HFm, _, _ = section(HA2, h2, p["xi2_prev"] + 0 * xi2)
+    dy = log_c(se3.relative(p["H_LK_prev"], se3.relative(se3.compose(HCm, p["H_CL"]), se3.compose(HFm, p["H_FK"]))))
+    s = np.where(p["has_history"][..., None], dy[..., 1:3], 0.0)
+    S = s[..., :1] * t1 + s[..., 1:] * t2
+    Tt = T - _dot(T, n)[..., None] * n
+    F_slave = p["weight"][..., None] * Tt
+    m_slave = _cross(R1[..., None] * n, F_slave)
+    m_master = _cross(R2[..., None] * n, F_slave)
+    wC = body_wrench(HC, F_slave, m_slave)
+    wF = body_wrench(HF, -F_slave, m_master)
+    JA1, JB1 = node_jacobians(h1, xi1, E1, se3.relative(HA1, HC))
+    JA2, JB2 = node_jacobians(h2, xi2, E2, se3.relative(HA2, HF))
+    f = np.stack([np.einsum("...ji,...j->...i", JA1, wC), np.einsum("...ji,...j->...i", JB1, wC),
+                  np.einsum("...ji,...j->...i", JA2, wF), np.einsum("...ji,...j->...i", JB2, wF)], axis=-2)
+    out = dict(lam_n=lam_n, S=S, slip=s, n=n, t1=t1, t2=t2, HL=HL, HK=HK, HC=HC, HF=HF, xi1=xi1, xi2=xi2)
+    return f, out
+
+
+def mortar_point_derivatives(X, p, T, h=1e-30):
+    """Complex-step derivatives of ``mortar_point_friction`` on the group, batched over ``P`` pairs.
+
+    Returns a dict: ``f`` ``(P, 24)``, ``dfdq`` ``(P, 24, 24)`` at fixed ``T``, ``G = df/dT``
+    ``(P, 24, 3)``, ``S`` ``(P, 3)``, ``dS`` ``(P, 3, 24)``, ``lam_n`` ``(P,)``, ``dlam_n`` ``(P, 24)``, ``dn``
+    ``(P, 3, 24)`` (of the normal) and
+    the real point data of ``mortar_point_friction`` (``slip``, ``n``, ``t1``, ``t2``, ``HL``, ``HK``, ...).
+    Column ``6 j + k`` perturbs node ``j`` by the body increment ``exp(i h e_k)``; columns 24-26
+    perturb ``T``.
+    """
+    P = X.shape[0]
+    res = dict(f=np.empty((P, 24)), dfdq=np.empty((P, 24, 24)), G=np.empty((P, 24, 3)), S=np.empty((P, 3)),
+               dS=np.empty((P, 3, 24)), lam_n=np.empty(P), dlam_n=np.empty((P, 24)), dn=np.empty((P, 3, 24)))
+    E = se3.exp(1j * h * np.eye(6))
+    outs = []
+    for a in range(0, P, CHUNK):
+        b = min(a + CHUNK, P)
+        Xc = np.broadcast_to(X[a:b].astype(complex), (27,) + X[a:b].shape).copy()
+        for j in range(4):
+            Xc[6 * j:6 * j + 6, :, j] = se3.compose(X[None, a:b, j], E[:, None])
+        Tc = np.broadcast_to(T[a:b].astype(complex), (27, b - a, 3)).copy()
+        Tc[24:] += 1j * h * np.eye(3)[:, None, :]
+        pc = {k: (np.broadcast_to(v[a:b], (27,) + np.shape(v[a:b])) if np.ndim(v) else v) for k, v in p.items()}
+        fc, oc = mortar_point_friction(Xc, pc, Tc)
+        fc = fc.reshape(27, b - a, 24)
+        res["f"][a:b] = fc[0].real
+        res["dfdq"][a:b] = np.transpose(fc[:24].imag, (1, 2, 0)) / h
+        res["G"][a:b] = np.transpose(fc[24:].imag, (1, 2, 0)) / h
+        res["S"][a:b] = oc["S"][0].real
+        res["dS"][a:b] = np.transpose(oc["S"][:24].imag, (1, 2, 0)) / h
+        res["lam_n"][a:b] = oc["lam_n"][0].real
+        res["dlam_n"][a:b] = oc["lam_n"][:24].imag.T / h
+        res["dn"][a:b] = np.transpose(oc["n"][:24].imag, (1, 2, 0)) / h
+        outs.append({k: np.real(v[0]) for k, v in oc.items() if k not in ("S", "lam_n")})
+    res.update({k: np.concatenate([o[k] for o in outs]) for k in outs[0]} if outs else {})
+    return res
