@@ -175,6 +175,8 @@ def rate(problem, H, t, ev, delta, t_start):
 class ArcLengthRun(Run):
     """``stepping.Run`` with ``loop`` following the path by arc length (see the module docstring)."""
 
+    switch_advice = False      # it follows unstable branches: the warning on one gives no advice
+
     def __init__(self, problem, newton, writer, grid, dt_min, verbose, options, arc):
         super().__init__(problem, newton, writer, grid, dt_min, verbose, options)
         self.arc = arc
@@ -429,8 +431,7 @@ class ArcLengthRun(Run):
 
     def _record_arc(self, H, t, w, tau, ev, stats):
         sys, sol, problem = self.sys, self.sol, self.problem
-        if self.opt.get("check_stability"):         # no branch switching here: the same (t, H, ev)
-            t, H, ev = self._stability(stats, t, H, ev)
+        t, H, ev = self._stability(stats, t, H, ev)     # no branch switching here: the same (t, H, ev)
         record = problem.commit(H)
         if problem.contributions:
             sol.contact_state = problem.get_state()
