@@ -22,6 +22,7 @@ from .nonlinear.problem import Problem
 from .stepping.restart import restart_from
 from .stepping.stabilize import from_option as stabilize_option
 from .model.validation import check_solve_arguments, check_stability_options, count, real
+from .stepping.stability import nonconservative_parts
 
 
 __all__ = ["solve", "Convergence", "Newton", "Verdict"]
@@ -65,7 +66,7 @@ def _starting_point(restart, model, problem, t_start, t_end):
 def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dtol=1e-11,
           max_iter=30, line_search=True, min_step_ratio=2.0**-12, callback=None,
           check_rigid_modes=True, verbose=None, initial_poses=None, restart=None, checkpoint=60.0,
-          linear_solver=None, allow_unmet_tolerance=False, check_stability=False, modes=0,
+          linear_solver=None, allow_unmet_tolerance=False, check_stability=None, modes=0,
           branch_switching=False, stabilize=None, path="load", arc_length=None, convergence=None):
     """Quasi-static solve of ``model`` from ``t_start`` to ``t_end`` in ``steps`` equal steps.
 
@@ -102,18 +103,29 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     exceeds ``add_contact(tolerance=)`` after the augmented-Lagrangian updates,
     with a warning in ``stats[k]["warnings"]`` and ``Solution.message``
     (default: a ``ConvergenceError``).
-    ``check_stability``: after every converged step count the negative
-    eigenvalues of the tangent (``definiteness.negative_eigenvalues``) where the
-    problem is conservative (no follower loads, no friction), record
-    ``stable``, ``negative_eigenvalues`` and ``lowest_eigenvalue`` (scaled;
-    ``None`` where not computed) in ``stats`` and warn once
-    (``StabilityWarning``) on an unstable equilibrium; opt-in (its cost:
-    docs/benchmarks.md, ``benchmarks/stability_check.py``).  "Stable" means the
-    symmetric tangent is positive definite: the converged state is a strict
-    minimum of the potential energy.  With friction or follower loads the
-    tangent is unsymmetric and depends on the history, there is no potential,
-    and the definiteness of its symmetric part would prove nothing either way:
-    such steps record ``stable=None`` and are not switched.
+    ``check_stability``: ``None`` (default) or ``True``: every converged step
+    (step 0 included) records in ``stats`` whether it is a stable equilibrium,
+    ``stable`` (``True``: the symmetric tangent is positive definite, the
+    state a strict minimum of the potential energy; ``False``: it has
+    negative eigenvalues), ``negative_eigenvalues`` and ``lowest_eigenvalue``
+    (scaled; ``None`` where not computed), and the first unstable state of a
+    run is warned about (``StabilityWarning``, naming the step, its ``t`` and
+    the count; also in ``Solution.message``).  The tangent of the converged
+    state is assembled already; a banded Cholesky or sparse LDL^T of it
+    (``definiteness.Inertia``) cost 0.5 % of the solve's CPU time on the
+    frictionless main job and Argyris' frame, 3.4 % on a 256-element beam
+    (2-3 Newton iterations a step), 5.2 % on a frictionless 19-wire strand;
+    nothing on frictional scenes (``benchmarks/stability_check.py --scenes``,
+    docs/benchmarks.md).  With friction, follower
+    loads or a contribution without a potential there is no potential and
+    the tangent is unsymmetric: ``stable=None`` and ``stats[k]["stable_note"]``
+    says why (``check_stability=True`` there warns once).  With ``stabilize``
+    the model's own tangent, without the damping, is checked (the note says
+    so).  ``False``: nothing is checked, ``stable=None`` with the note.
+    Options that would do nothing together are refused (``InputError``):
+    ``modes``/``branch_switching`` with ``check_stability=False`` or without
+    a potential, ``branch_switching`` with ``stabilize``
+    (``stepping.stability``).
     ``modes``: with it (a count ``k``), the ``k`` lowest eigenpairs of the
     scaled tangent (``modes.lowest_modes``) of every checked step, in
     ``stats[k]["mode_eigenvalues"]`` and ``stats[k]["modes"]`` ``(k, n_nodes, 6)``
@@ -128,7 +140,7 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     other unknowns relaxed, down the energy onto a stable branch
     (``bifurcation.descend``); ``stats[k]["branch_switch"]`` records the mode,
     the crossing, the descent and the counts before and after, and a state
-    still unstable after it is warned about.  Either implies ``check_stability``.
+    still unstable after it is warned about.
 
     ``stabilize``: artificial viscous damping in pseudo-time (Abaqus ``*STATIC, STABILIZE``) to pass
     instabilities under load control: ``True`` (dissipated-energy fraction 2e-4), a fraction, or
@@ -210,13 +222,14 @@ def _run_options(problem, t_start, t_end, allow_unmet_tolerance, check_stability
     ``penalty_hint``: the tail of a ``ConvergenceError`` the contributions give
     (``Problem.failure_hint``: a stiff penalty named), in place of the generic advice;
     ``path_options``: the stepper's own (``Stepper.path_options``)."""
-    modes, branch_switching = check_stability_options(modes, branch_switching)
+    modes, branch_switching = check_stability_options(modes, branch_switching, check_stability, stabilize,
+                                                      nonconservative_parts(problem))
     stabilizer = stabilize_option(problem.system, stabilize, check=problem.conservative)
     if stabilizer is not None:
         problem.contributions.append(stabilizer)
     return RunOptions(advice=_advice(problem, t_start, t_end, penalty_hint), penalty_hint=penalty_hint,
                       allow_unmet_tolerance=allow_unmet_tolerance,
-                      check_stability=bool(check_stability or modes or branch_switching), modes=modes,
+                      check_stability=check_stability, modes=modes,
                       branch_switching=branch_switching, stabilizer=stabilizer, path=path_options)
 
 

@@ -19,7 +19,8 @@ class ConvergenceError(RuntimeError):
 
 
 class StabilityWarning(RuntimeWarning):
-    """A converged equilibrium is unstable (its tangent is indefinite): see ``solve(check_stability=)``."""
+    """A converged equilibrium is unstable (its tangent is indefinite), said once a run, or a
+    stability check asked for where none can be made: see ``solve(check_stability=)``."""
 
 
 class StabilizationWarning(RuntimeWarning):

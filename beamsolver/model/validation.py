@@ -226,12 +226,28 @@ def _last_saved_time(restart):
     return float(times[-1]) if len(times) else -np.inf
 
 
-def check_stability_options(modes, branch_switching):
+def check_stability_options(modes, branch_switching, check_stability=None, stabilize=None, nonconservative=()):
     """``(modes, branch_switching)`` of ``solve`` checked: a count >= 0 and one of ``False``,
-    ``True``, ``"auto"``."""
+    ``True``, ``"auto"``; ``check_stability`` ``None``, ``True`` or ``False``.  Combinations that
+    would do nothing are refused: ``modes``/``branch_switching`` with ``check_stability=False``,
+    with ``stabilize`` (branch switching), or on a model without a potential (``nonconservative``:
+    the names of its parts without one, e.g. friction)."""
     if isinstance(modes, bool) or not isinstance(modes, (int, np.integer)) or modes < 0:
         raise InputError(f"solve: modes must be a whole number >= 0 (eigenpairs per step), got {modes!r}")
     if not any(branch_switching is v or (isinstance(v, str) and branch_switching == v)
                for v in (False, True, "auto")):
         raise InputError(f"solve: branch_switching must be False, True or 'auto', got {branch_switching!r}")
+    if check_stability is not None and not isinstance(check_stability, (bool, np.bool_)):
+        raise InputError(f"solve: check_stability must be None (default: checked), True or False, "
+                         f"got {check_stability!r}")
+    asked = [f"{k}={v!r}" for k, v in (("modes", modes), ("branch_switching", branch_switching)) if v]
+    if asked and check_stability is not None and not check_stability:
+        raise InputError(f"solve: check_stability=False contradicts {' and '.join(asked)}, which need the "
+                         "stability check of every step: drop one of them")
+    if branch_switching and stabilize is not None and stabilize is not False:
+        raise InputError(f"solve: branch_switching={branch_switching!r} with stabilize={stabilize!r}: two ways past "
+                         "an instability, and the switch needs the undamped problem: use one of them")
+    if asked and nonconservative:
+        raise InputError(f"solve: {' and '.join(asked)} need a potential energy (a symmetric tangent), which this "
+                         f"model does not have ({', '.join(nonconservative)}): no mode or switch would be computed")
     return int(modes), branch_switching

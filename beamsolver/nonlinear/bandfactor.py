@@ -8,6 +8,9 @@ general sparse factorisation's bookkeeping:
 
 - ``positive_definite(band)``: banded Cholesky (``dpbtrf``), which exists exactly
   when ``A`` is positive definite (as the dense Cholesky of ``definiteness``);
+- ``sum_positive_definite(...)``: the same question for ``K + K^T`` gathered straight from the
+  entries of a CSC ``K`` into row-wise band storage and factorised in one compiled loop
+  (``definiteness.Inertia``: twice as fast as the gather, the scatter and ``dpbtrf`` for a beam);
 - ``shifted_inverse(A, sigma)``: ``x = (A - sigma I)^-1 y`` as a ``LinearOperator``
   for the shift-invert Lanczos of ``eigsh`` (``OPinv``): banded LU with partial
   pivoting (``dgbtrf``/``dgbtrs``) when banded, else SuperLU as ``eigsh`` itself
@@ -19,7 +22,9 @@ Wider bands (contact between many beams, joins across a structure) return
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["BAND_MAX", "band", "positive_definite", "shifted_inverse"]
+from .._jit import jit
+
+__all__ = ["BAND_MAX", "band", "positive_definite", "sum_positive_definite", "shifted_inverse"]
 
 BAND_MAX = 64            # largest half-bandwidth (after reordering) for the banded factorisations
 
@@ -49,6 +54,35 @@ def positive_definite(banded):
     ab[b + rows[up] - cols[up], cols[up]] = values[up]
     _, info = dpbtrf(ab, lower=0, overwrite_ab=1)
     return info == 0
+
+
+@jit
+def sum_positive_definite(data, up, partner, rows, offsets, ab):
+    """Whether ``S = K + K^T`` is positive definite: its Cholesky factorisation in place in ``ab``
+    ``(n, b + 1)``, row ``j`` holding ``S[j, j + k]`` at ``k`` (zeroed first), filled from the CSC
+    values ``data`` of ``K``: the entry at position ``up[i]`` (row ``rows[i]``, ``offsets[i]`` to the
+    right of the diagonal) plus its transpose at ``partner[i]``.  A pivot that is not positive (or
+    NaN) stops it: ``False``."""
+    n, w = ab.shape
+    ab[:, :] = 0.0
+    for i in range(len(up)):
+        ab[rows[i], offsets[i]] = data[up[i]] + data[partner[i]]
+    for j in range(n):
+        d = ab[j, 0]
+        if not d > 0.0:
+            return False
+        s = np.sqrt(d)
+        ab[j, 0] = s
+        m = min(w - 1, n - 1 - j)
+        for k in range(1, m + 1):
+            ab[j, k] /= s
+        for k in range(1, m + 1):
+            v = ab[j, k]
+            if v != 0.0:
+                row = j + k
+                for col in range(k, m + 1):
+                    ab[row, col - k] -= v * ab[j, col]
+    return True
 
 
 def shifted_inverse(A, sigma, banded=None):

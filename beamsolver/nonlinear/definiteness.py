@@ -16,13 +16,20 @@ Lanczos (``eigsh``) give a lower bound of the count instead.  Before all that,
 a tangent that is banded once reordered (``bandfactor``: beams) and positive
 definite is recognised by a banded Cholesky, and the shifted Lanczos solves
 with a banded LU: the same answers, several times cheaper.
+
+``Inertia`` answers the same question for the tangents of one solve, one per
+converged step (``stepping.stability``): their sparsity pattern rarely changes,
+so the band layout (ordering, the place of every entry and of its transpose in
+LAPACK's band storage) is kept for the pattern, and the common case -- positive
+definite -- costs a few array operations and a banded Cholesky; any other case
+is ``negative_eigenvalues``.
 """
 import numpy as np
 import scipy.sparse as sp
 
-from .bandfactor import band, positive_definite, shifted_inverse
+from .bandfactor import BAND_MAX, band, positive_definite, shifted_inverse, sum_positive_definite
 
-__all__ = ["negative_eigenvalues", "scaled_symmetric", "nearest_zero", "DENSE_MAX", "SHIFT"]
+__all__ = ["negative_eigenvalues", "scaled_symmetric", "nearest_zero", "Inertia", "DENSE_MAX", "SHIFT"]
 
 DENSE_MAX = 600          # unknowns up to which the dense factorisations are used
 SHIFT = 1e-6             # Lanczos shift (scaled units) below zero: K itself may be singular
@@ -114,3 +121,101 @@ def negative_eigenvalues(K, k=6):
         pass
     lam = nearest_zero(A, min(k, n - 2))
     return int(np.sum(lam < -ZERO)), float(lam.min())
+
+
+class Inertia:
+    """``negative_eigenvalues`` of a sequence of tangents, the positive definite ones decided cheaply.
+
+    ``inertia(K)`` returns what ``negative_eigenvalues(K)`` returns.  For the pattern of ``K``
+    (CSC, canonical: sorted unique rows) a layout is built once and kept while the pattern
+    stays (also across instances: the last one, as a solve after a solve of the same model meets
+    it): the position of each entry's transpose in ``K.data`` and, when the pattern has a
+    half-bandwidth up to ``BAND_MAX`` as numbered (beams: nodes along the beam) or after a
+    reverse Cuthill-McKee ordering, the place of each entry on or above the diagonal in a
+    row-wise band.  ``K + K^T`` is then factorised: banded Cholesky
+    (``bandfactor.sum_positive_definite``), or else SuperLU with diagonal pivots
+    (``SymmetricMode``, an LDL^T: all pivots positive means positive definite, Sylvester).
+    Neither pivots, so neither needs the scaling ``D`` of ``scaled_symmetric``: factorising
+    ``D A D`` is factorising ``A`` with its pivots scaled by ``d_i^2``, to round-off.  Positive
+    definite: ``(0, None)``.  Anything else (a failed factorisation, a pattern not structurally
+    symmetric) is ``negative_eigenvalues(K)``.  ``layouts`` counts the layouts built.
+    """
+
+    def __init__(self):
+        self._layout = None
+        self._work = None         # the band buffer of the banded factorisation
+        self.layouts = 0
+
+    def __call__(self, K, k=6):
+        K = K if sp.issparse(K) and K.format == "csc" and K.has_canonical_format else _canonical(K)
+        layout = self._layout_of(K)
+        if layout is not None and self._positive_definite(K, layout):
+            return 0, None
+        return negative_eigenvalues(K, k)
+
+    def _layout_of(self, K):
+        kept = self._layout if self._layout is not None else (_LAST[0] if _LAST else None)
+        if kept is None or not _same_pattern(kept[0], K):
+            kept = ((K.indptr.copy(), K.indices.copy()), _layout(K))
+            self.layouts += 1
+            _LAST[:] = [kept]
+        self._layout = kept
+        return kept[1]
+
+    def _positive_definite(self, K, layout):
+        """Whether ``K + K^T`` is positive definite, by the factorisation of ``layout``."""
+        if layout[0] == "band":
+            _, shape, up, partner, rows, offsets = layout
+            if self._work is None or self._work.shape != shape:
+                self._work = np.empty(shape)
+            return bool(sum_positive_definite(K.data, up, partner, rows, offsets, self._work))
+        from scipy.sparse.linalg import splu
+        A = sp.csc_matrix((K.data + K.data[layout[1]], K.indices, K.indptr), shape=K.shape)
+        try:
+            lu = splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
+        except RuntimeError:        # an exactly zero pivot
+            return False
+        return bool(np.array_equal(lu.perm_r, lu.perm_c) and np.all(lu.U.diagonal() > 0.0))
+
+
+_LAST = []      # [((indptr, indices), layout)] of the last pattern an ``Inertia`` met
+
+
+def _same_pattern(pattern, K):
+    return pattern[0] is K.indptr and pattern[1] is K.indices or \
+        np.array_equal(pattern[0], K.indptr) and np.array_equal(pattern[1], K.indices)
+
+
+def _canonical(K):
+    K = sp.csc_matrix(K, copy=True)
+    K.sum_duplicates()
+    return K
+
+
+def _layout(K):
+    """The layout ``Inertia`` keeps for the pattern of the canonical CSC ``K``: ``("band", band
+    shape (n, b + 1), upper positions, their partners, their rows and offsets in the band)`` or
+    ``("lu", partners)``; ``None`` for a pattern that is not structurally symmetric."""
+    n = K.shape[0]
+    if n == 0 or K.nnz == 0:
+        return None
+    # K's CSR arrays are K^T's CSC arrays: equal to K's for a structurally symmetric pattern, and
+    # then the CSR form of the positions 0..nnz-1 gives each entry's transpose
+    T = sp.csc_matrix((np.arange(K.nnz, dtype=np.float64), K.indices, K.indptr), shape=K.shape).tocsr()
+    if not (np.array_equal(T.indptr, K.indptr) and np.array_equal(T.indices, K.indices)):
+        return None
+    partner = T.data.astype(np.int64)
+    rows = K.indices.astype(np.int64)
+    cols = np.repeat(np.arange(n, dtype=np.int64), np.diff(K.indptr))
+    pr, pc = rows, cols
+    if np.abs(rows - cols).max() > BAND_MAX:
+        from scipy.sparse.csgraph import reverse_cuthill_mckee
+        perm = reverse_cuthill_mckee(sp.csr_matrix(K.T), symmetric_mode=True)
+        where = np.empty(n, dtype=np.int64)
+        where[perm] = np.arange(n)
+        pr, pc = where[rows], where[cols]
+    b = int(np.abs(pr - pc).max())
+    if b > BAND_MAX:
+        return "lu", partner
+    up = np.flatnonzero(pr <= pc)
+    return "band", (n, b + 1), up, partner[up], pr[up], pc[up] - pr[up]

@@ -211,7 +211,9 @@ class Solution:
                          = C (strains - description["eps0"])``; the VTU ``strain`` is that difference
     ``stats``            list of ``s`` dicts: ``iterations``, ``residuals``, ``wall_time``, ``dt``,
                          ``cutbacks``, and whatever the solver adds (``failed_dt``, ``warnings``,
-                         ``timings``, ``stable``, ``negative_eigenvalues``, ``lowest_eigenvalue``)
+                         ``timings``; by default ``stable``, ``negative_eigenvalues``,
+                         ``lowest_eigenvalue`` and, where ``stable`` is ``None`` or not the step's own
+                         tangent's, ``stable_note``: ``stepping.stability``)
     ``contacts``         list of ``s`` contact point tables (dicts of arrays of equal length ``k``,
                          one row per contact point the search found; ``{}`` for a step without
                          contact): ``position`` (k, 3) midway between the contour points, ``gap``,

@@ -216,6 +216,7 @@ class ArcLengthRun(Run):
     """``stepping.Run`` with ``loop`` following the path by arc length (see the module docstring);
     ``options.path``: its ``ArcLength`` (``None``: the defaults)."""
     name = "arc-length"
+    switch_advice = False      # it follows unstable branches: the warning on one gives no advice
 
     def __init__(self, problem, newton, writer, grid, dt_min, verbose, options):
         super().__init__(problem, newton, writer, grid, dt_min, verbose, options)
@@ -433,8 +434,7 @@ class ArcLengthRun(Run):
 
     def _record_arc(self, H, t, w, tau, ev, stats):
         sys, sol, problem = self.sys, self.sol, self.problem
-        if self.opt.check_stability:         # no branch switching here: the same (t, H, ev)
-            t, H, ev = self._stability(stats, t, H, ev)
+        t, H, ev = self._stability(stats, t, H, ev)     # no branch switching here: the same (t, H, ev)
         record = problem.commit(H)
         if problem.contributions:
             sol.contact_state = problem.get_state()

@@ -19,14 +19,15 @@ class RunOptions:
     ``advice(failure, rotation_limit, H, t)``: the tail of a ``ConvergenceError`` message;
     ``penalty_hint``: the tail naming a stiff penalty (``Problem.failure_hint``), also at ``t_start``;
     ``allow_unmet_tolerance``: accept a step whose contributions' tolerance is unmet, with a warning;
-    ``check_stability``: count negative eigenvalues of every converged conservative step;
+    ``check_stability``: ``None``/``True``: judge every converged state (``stability.StepCheck``),
+    ``False``: not;
     ``modes``: lowest eigenpairs recorded per checked step; ``branch_switching``: ``False``, ``True``
     or ``"auto"``; ``stabilizer``: the ``stabilize.Stabilization`` (a contribution of the problem) or
     ``None``; ``path``: the stepper's own options (``arclength.ArcLength`` for ``"arc-length"``)."""
     advice: Callable = no_advice
     penalty_hint: str = ""
     allow_unmet_tolerance: bool = False
-    check_stability: bool = False
+    check_stability: Optional[bool] = None
     modes: int = 0
     branch_switching: Any = False
     stabilizer: Optional[Any] = None

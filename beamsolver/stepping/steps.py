@@ -26,9 +26,8 @@ import warnings
 
 import numpy as np
 
-from . import branching, diagnosis, stable_branch
+from . import branching, diagnosis, stability, stable_branch
 from ..model import motion_path
-from ..nonlinear.definiteness import negative_eigenvalues
 from ..errors import ConvergenceError, InputError, StabilityWarning, StabilizationWarning
 from ..failures import AugmentationFailed, LeftStableBranch, MotionTooFast, NonFinite, StepFailed
 from .progress import Progress
@@ -104,6 +103,7 @@ class Run:
     """One call of ``solve`` under load control, the stepper ``"load"`` (``stepping.steppers``):
     ``start``, then ``loop``, then ``finish``; ``abort(exc)`` on any exception."""
     name = "load"
+    switch_advice = True          # the warning on an unstable state says how to reach a stable one
 
     @staticmethod
     def path_options(value, restart, branch_switching=False, stabilize=None):
@@ -124,6 +124,8 @@ class Run:
         self.warned_unstable = False
         self.range = None             # material_range.RangeCheck: sections with a yield limit only
         self.negative = None          # negative eigenvalues of the last converged state's tangent, if known
+        self.step_negative = None     # the same of the step being tried, if the stable-branch rule counted them
+        self.stability = stability.StepCheck(problem, options.check_stability, options.stabilizer)
         self.branch_tries = 0         # LeftStableBranch failures since a step converged at its first try
         newton.watch_sign = (problem.conservative and not options.branch_switching   # stable_branch
                              and stable_branch.ENABLED)
@@ -218,6 +220,7 @@ class Run:
         self._check_finite(H, ev0.r, ev0.state, t_start)
         if self.range is not None:
             self.range.check(ev0.state.strain, stats, 0)
+        self._record_stability(stats, 0, t_start, H, ev0, solved=acts or pushed)
         adjusted = problem.adjusted
         if adjusted and adjusted["count"]:
             stats["adjusted"] = dict(adjusted)
@@ -261,6 +264,7 @@ class Run:
         t, cutbacks, rotation_limit, failed_sizes, branch_here = self.t, 0, None, [], 0
         before = self._negative_before()
         while True:
+            self.step_negative = None
             t_try, rot = motion_path.limit_step(self.sys, t, t_next)
             if t_try < t_next and t_try - t < self.dt_min * (1.0 - STEP_TOLERANCE):
                 self._stop(MotionTooFast(f"a prescribed rotation turns by {rot:.3g} rad over a step of "
@@ -330,7 +334,8 @@ class Run:
             self.negative = None        # every tangent of the step had det > 0: not checked (stable_branch)
             return
         try:
-            self.negative = stable_branch.verdict(self.problem, self.newton.last_evaluation, before, t)
+            self.negative = self.step_negative = stable_branch.verdict(self.problem, self.newton.last_evaluation,
+                                                                       before, t)
         except LeftStableBranch as e:
             e.t, e.result = t, (t, H, ev, stats)
             raise
@@ -338,13 +343,14 @@ class Run:
     def _keep_unstable(self, failure):
         """Keep the unstable state of ``failure`` (``LeftStableBranch``) after ``stable_branch.RETRIES``
         such failures of a step, or ``RETRIES_RUN`` since a step converged at its first try, or at
-        the smallest step, and say so once (``StabilityWarning``; with
-        ``check_stability`` its own warning reports it)."""
+        the smallest step, and say so once (``StabilityWarning``; where steps are checked
+        (``stability.StepCheck.checks``) the check's warning reports it)."""
         t, H, ev, stats = failure.result
-        self.negative, self.branch_tries = failure.negative, 0
+        self.negative = self.step_negative = failure.negative
+        self.branch_tries = 0
         stats.update(left_stable_branch=True)
         text = stable_branch.kept(failure)
-        if not self.warned_unstable and not self.opt.check_stability:
+        if not self.warned_unstable and not self.stability.checks:
             self.warned_unstable = True
             log.warning(text)
             warnings.warn(text, StabilityWarning, stacklevel=5)
@@ -405,8 +411,7 @@ class Run:
             balance = self._undamped(stab, H, ev)
             if stab.settle and not balance["equilibrium"] and t_next >= self.grid[-1] - 1e-12 * self.dt_user:
                 H, ev, balance = self._settle(stab, t_next, H, ev, stats, balance)
-        if self.opt.check_stability:
-            t_next, H, ev = self._stability(stats, t_next, H, ev)
+        t_next, H, ev = self._stability(stats, t_next, H, ev)
         record = problem.commit(H)
         if stab is not None:
             stats["stabilization"] = dict(stab.record(damped, t_next), **balance)
@@ -490,30 +495,45 @@ class Run:
                     reference=self.reference, previous=self.previous)
 
     def _stability(self, stats, t, H, ev):
-        """Record whether the tangent at the converged state ``H`` (evaluation ``ev``) is positive
-        definite, its lowest modes (``modes``) and, with ``branch_switching``, move onto a stable
-        branch (``branching.switch``, which may record the step at an earlier ``t``, past a
-        crossing); warn once.  Returns the step to record ``(t, H, ev)``."""
-        problem = self.problem
-        if not problem.conservative:
-            stats.update(stable=None)
-            return t, H, ev
-        K = problem.tangent(self.newton.last_evaluation)
-        neg, lowest = negative_eigenvalues(K)
-        stats.update(stable=neg == 0, negative_eigenvalues=neg, lowest_eigenvalue=lowest)
-        if branching.wanted(self.opt.branch_switching, self.sol.stats, neg):
-            t, H, ev, K = branching.switch(self, stats, t, H, ev, K)
-        if self.opt.modes:
-            branching.record_modes(self.sys, stats, H, K, self.opt.modes)
-        neg = self.negative = stats["negative_eigenvalues"]
-        if neg and not self.warned_unstable:
-            self.warned_unstable = True
-            text = (f"t = {t:.6g}: the equilibrium is unstable (the tangent has {neg} negative "
-                    "eigenvalue(s)): the path has passed a limit point or bifurcation")
-            log.warning(text)
-            warnings.warn(text, StabilityWarning, stacklevel=5)
-            self.sol.message = text if not self.sol.message else self.sol.message + "; " + text
+        """Record whether the converged state ``H`` (evaluation ``ev``) is a stable equilibrium
+        (``stability.StepCheck``), its lowest modes (``modes``) and, with ``branch_switching``, move
+        onto a stable branch (``branching.switch``, which may record the step at an earlier ``t``,
+        past a crossing); warn once.  Returns the step to record ``(t, H, ev)``."""
+        check = self.stability
+        K = check.tangent(H, t, self.newton.last_evaluation)
+        neg = check.record(stats, K, self.step_negative)
+        if K is not None:
+            if branching.wanted(self.opt.branch_switching, self.sol.stats, neg):
+                t, H, ev, K = branching.switch(self, stats, t, H, ev, K)
+            if self.opt.modes:
+                branching.record_modes(self.sys, stats, H, K, self.opt.modes)
+            neg = stats["negative_eigenvalues"]
+        self.negative = neg if self.problem.conservative else None
+        self._warn_unstable(stats, len(self.sol), t)
         return t, H, ev
+
+    def _record_stability(self, stats, step, t, H, ev, solved=True):
+        """``stability.StepCheck`` on a state recorded without ``_stability`` (step 0); one kept as
+        given (not ``solved``) is checked only if it is an equilibrium (``Newton.at_rest``)."""
+        check = self.stability
+        if check.checks and not solved and not self.newton.at_rest(ev, H, t):
+            neg = check.record(stats, None, note=stability.unsolved_note(self.newton.residual_ratio(ev)))
+        else:
+            neg = check.record(stats, check.tangent(H, t, ev))
+        self.negative = neg if self.problem.conservative else None
+        self._warn_unstable(stats, step, t)
+
+    def _warn_unstable(self, stats, step, t):
+        """The first unstable state of the run, recorded as step ``step`` at ``t``: ``StabilityWarning``
+        and ``Solution.message`` (``stability.unstable_text``)."""
+        if stats.get("stable") is not False or self.warned_unstable:
+            return
+        self.warned_unstable = True
+        text = stability.unstable_text(step, t, stats["negative_eigenvalues"], stats.get("left_stable_branch", False),
+                                       self.switch_advice)
+        log.warning(text)
+        warnings.warn(text, StabilityWarning, stacklevel=6)
+        self.sol.message = text if not self.sol.message else self.sol.message + "; " + text
 
     # ------------------------------------------------------------------ end
     def _stop(self, failure, rotation_limit, why=None):

@@ -93,3 +93,31 @@ def test_lowest_modes_above_dense_max_on_a_shuffled_band(rng):
     ref, Y = np.linalg.eigh(Ad)
     np.testing.assert_allclose(got, ref[:3], rtol=1e-8, atol=1e-12)
     np.testing.assert_allclose(np.abs(np.sum((phi / d[:, None]) * Y[:, :3], axis=0)), 1.0, atol=1e-8)
+
+
+@pytest.mark.parametrize("shift", [0.0, 0.9, 1.1, 6.0])
+def test_compiled_cholesky_of_the_symmetric_sum_is_the_eigenvalues_verdict(rng, shift):
+    """``sum_positive_definite`` on the CSC entries of an unsymmetric band matrix ``K`` (natural
+    order, half-bandwidth 5) decides as the eigenvalues of ``K + K^T`` do, and leaves its factor."""
+    n, b = 200, 5
+    K = sp.random(n, n, density=1.0, random_state=rng, format="csr")
+    K = sp.csc_matrix(sp.triu(sp.tril(K, b), -b) + sp.diags(np.full(n, b + 1.0)))
+    K.sort_indices()
+    S = (K + K.T).toarray()
+    K = sp.csc_matrix(K - 0.5 * shift * np.linalg.eigvalsh(S)[0] * sp.identity(n))
+    K.sort_indices()
+    S = (K + K.T).toarray()
+    rows = K.indices.astype(np.int64)
+    cols = np.repeat(np.arange(n), np.diff(K.indptr))
+    where = {(r, c): p for p, (r, c) in enumerate(zip(rows, cols))}
+    up = np.flatnonzero(rows <= cols)
+    partner = np.array([where[cols[p], rows[p]] for p in up])
+    ab = np.empty((n, b + 1))
+    verdict = bandfactor.sum_positive_definite(K.data, up, partner, rows[up], cols[up] - rows[up], ab)
+    assert verdict == (np.linalg.eigvalsh(S)[0] > 0) == (shift < 1.0)
+    if verdict:
+        L = np.zeros((n, n))
+        for j in range(n):
+            m = min(b, n - 1 - j)
+            L[j + np.arange(m + 1), j] = ab[j, :m + 1]
+        np.testing.assert_allclose(L @ L.T, S, atol=1e-12 * np.abs(S).max())

@@ -256,7 +256,7 @@ def test_stable_path_is_unchanged_by_the_stability_options():
     np.testing.assert_array_equal(checked.poses, plain.poses)
     assert all(s["stable"] and "branch_switch" not in s for s in checked.stats[1:])
     assert all(len(s["mode_eigenvalues"]) == 2 and min(s["mode_eigenvalues"]) > 0 for s in checked.stats[1:])
-    assert all("stable" not in s and "modes" not in s for s in plain.stats)
+    assert all(s["stable"] is True and "modes" not in s for s in plain.stats)    # checked by default (issue 28)
 
 
 def test_true_switches_an_unstable_state_auto_waits_for_a_crossing():
@@ -296,15 +296,18 @@ def test_a_failed_switch_is_recorded_and_keeps_the_state(monkeypatch):
 
 
 def test_non_conservative_problem_is_neither_judged_nor_switched():
-    """A follower load: no potential, the symmetric part's definiteness proves nothing."""
+    """A follower load: no potential, the symmetric part's definiteness proves nothing: ``stable=None``
+    with its reason, and modes or switching, which would do nothing, are refused (issue 28 item 5)."""
     m = bs.Model()
     b = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 8), _section())
     m.clamp(b.first)
     m.add_load(b.last, force=(-2.0 * np.pi**2 / 4.0, 0.0, 0.0), follower=True)
+    with pytest.raises(bs.InputError, match="follower loads"):
+        bs.solve(m, steps=2, verbose=False, branch_switching=True, modes=1)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        sol = bs.solve(m, steps=2, verbose=False, branch_switching=True, modes=1)
-    assert all(s["stable"] is None and "branch_switch" not in s and "modes" not in s for s in sol.stats[1:])
+        sol = bs.solve(m, steps=2, verbose=False)
+    assert all(s["stable"] is None and "follower loads" in s["stable_note"] for s in sol.stats)
 
 
 @pytest.mark.parametrize("kw", [dict(modes=-1), dict(modes=1.5), dict(modes=True), dict(modes="2"),
