@@ -181,7 +181,9 @@ def main(argv=None):
             "**(a) Twisted pair, 2 turns in 16 steps** (the main job's scene, default solver): counts per slave "
             "element / point averaged over the searches; ms per Newton iteration: all, of which the contact search "
             "(search + rules + projection), the contact kernels (params + kernel) and the linear solver; first "
-            "iteration of a step against the later ones (medians).\n",
+            "iteration of a step against the later ones (medians).  Warm: the kernels and PARDISO loaded first (the "
+            "default solver picks PARDISO from 1500 unknowns, 128 el/wire and up; a process loading it pays ~0.6 s "
+            "once, at its first factorisation: 6 ms per iteration of this run at 128 el/wire).\n",
             table(["el/wire", "slave points", "element pairs / slave el.", "projections / slave pt",
                    "contact pts / slave pt", "Newton it.", "ms / it.", "search", "kernels", "linear solver",
                    "first it. [ms]", "later it. [ms]", "first / later"], rows_a,
