@@ -51,7 +51,7 @@ def reference_package(ref):
 def scene(bs, n_points, gauss_points=5, mu=0.3):
     """``contact_throughput.scene`` built with the package ``bs``: the contact system and poses."""
     from contact_throughput import line_model
-    problem = importlib.import_module(bs.__name__ + ".problem")
+    problem = importlib.import_module(bs.__name__ + ".nonlinear.problem")
     m = line_model(bs, max(1, n_points // gauss_points), gauss_points, mu)
     contact = problem.Problem.from_model(m, check_rigid_modes=False).contact
     H = contact.sys.poses0.copy()

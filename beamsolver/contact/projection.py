@@ -233,11 +233,37 @@ def _finish(H, a2, h2, k, S, l, xi2, out2, dist, r):
     dist[r] = np.sqrt((xf[0] - S[_X1, l]) ** 2 + (xf[1] - S[_X1 + 1, l]) ** 2 + (xf[2] - S[_X1 + 2, l]) ** 2)
 
 
+# ``gauss_projections(window=)``: the cull's window is widened by ``CULL_PAD`` element lengths and its
+# bound by ``CULL_SLACK`` of the chord (far above the round-off of the Newton iterates and of
+# ``exp(log(H_A^-1 H_B)) = H_A^-1 H_B``, far below the ~1 element between a kept and a culled row)
+CULL_PAD = 0.01
+CULL_SLACK = 1e-9
+
+
+@jit_inline
+def _misses(xc, e1, xA2, xB2, lo, hi, bow):
+    """``LINE`` cull: the slave section plane (centre ``xc``, normal ``e1``) cannot meet the master centre
+    line on ``[lo, hi]``.  The line is within ``bow`` of its chord ``xA2 + xi (xB2 - xA2)`` there, so the
+    plane's signed distance differs from the chord's, linear in ``xi``, by at most ``bow``: no root where
+    the chord's stays beyond ``bow`` on one side at both ends.  Not finite: not culled."""
+    chord = (xB2[0] - xA2[0], xB2[1] - xA2[1], xB2[2] - xA2[2])
+    rel = (xA2[0] - xc[0], xA2[1] - xc[1], xA2[2] - xc[2])
+    g0, g1 = dot(rel, e1), dot(chord, e1)
+    f_lo, f_hi = g0 + lo * g1, g0 + hi * g1
+    b = bow + CULL_SLACK * np.sqrt(dot(chord, chord))
+    return (f_lo > b and f_hi > b) or (f_lo < -b and f_hi < -b)
+
+
 @jit
-def _gauss_project(H, enodes, h, e, m, xg, line, c2, reach, iterations, row, gp, out2, dist):
+def _gauss_project(H, enodes, h, e, m, xg, line, c2, reach, iterations, overhang, row, gp, out2, dist):
     """Slave Gauss points ``xg`` of element pairs ``k`` (slave ``e[k]``, master ``m[k]``) within ``reach[k]``
     of ``c2[k]``, projected on the master; rows in the order ``(k, g)``, returns their number.  A slave
-    element's sections are computed once."""
+    element's sections are computed once.  ``overhang >= 0``: ``LINE`` rows whose plane misses the master
+    on ``[-overhang, 1 + overhang]`` (``_misses``) are culled."""
+    cull = overhang >= 0.0
+    lo, hi = -overhang - CULL_PAD, 1.0 + overhang + CULL_PAD
+    # |x(xi) - chord(xi)| <= |x''| |xi (xi - 1)| / 2 for xi in and beyond [0, 1]; |x''| = |w x u|
+    quad = 0.5 * max(0.25, -lo * hi)
     S = np.empty((N_FIELDS, LANES))
     xi, nxt, ang = np.empty(LANES), np.empty(LANES), np.empty(LANES)
     ln = np.empty(LANES, dtype=np.bool_)
@@ -260,10 +286,16 @@ def _gauss_project(H, enodes, h, e, m, xg, line, c2, reach, iterations, row, gp,
         RA2, xA2 = _pose_of(H, enodes[m[k], 0])
         _, xB2 = _pose_of(H, enodes[m[k], 1])
         r2 = reach[k] * reach[k]
+        bow = 0.0
+        if cull and line[k]:
+            wxu = cross((h[m[k], 3], h[m[k], 4], h[m[k], 5]), (h[m[k], 0], h[m[k], 1], h[m[k], 2]))
+            bow = quad * np.sqrt(dot(wxu, wxu))
         for g in range(len(xg)):
             xc = (sec[s, g, 0], sec[s, g, 1], sec[s, g, 2])
             d0, d1, d2 = xc[0] - c2[k, 0], xc[1] - c2[k, 1], xc[2] - c2[k, 2]
             if not (d0 * d0 + d1 * d1) + d2 * d2 <= r2:
+                continue
+            if cull and line[k] and _misses(xc, (sec[s, g, 3], sec[s, g, 4], sec[s, g, 5]), xA2, xB2, lo, hi, bow):
                 continue
             _fill(S, l, RA2, xA2, h, m[k], xc, (sec[s, g, 3], sec[s, g, 4], sec[s, g, 5]))
             xi[l] = _chord_start(xc, xA2, xB2)
@@ -284,7 +316,7 @@ def _gauss_project(H, enodes, h, e, m, xg, line, c2, reach, iterations, row, gp,
     return n
 
 
-def gauss_projections(H, enodes, h, e, m, xg, kind, c2, reach, iterations=8):
+def gauss_projections(H, enodes, h, e, m, xg, kind, c2, reach, iterations=8, window=None):
     """Slave Gauss points ``xg`` ``(g,)`` of element pairs ``(n,)`` projected on their master elements.
 
     Pair ``k``: slave element ``e[k]`` (its sections are computed once), master element ``m[k]``,
@@ -294,13 +326,21 @@ def gauss_projections(H, enodes, h, e, m, xg, kind, c2, reach, iterations=8):
     master and is skipped.  The others are projected as ``project_points`` does (from the master
     chord, ``iterations`` Newton iterations).  Returns, over the rows kept in the order ``(k, g)``:
     pair ``row``, Gauss point ``gp``, ``xi2`` and centre distance.
+
+    ``window``: the overhang past the master's nodes of the projections the ownership accepts
+    (``rules.XI_OVERHANG``); given, a ``LINE`` row whose slave section plane cannot meet the master
+    centre line on ``[-window, 1 + window]`` (widened by ``CULL_PAD``; ``_misses``: the chord's
+    signed distance and the bound of the line's bow) is not projected: its converged projection
+    would be rejected.  Without it the rows within ``reach`` grow like ``1 + 7 R / L`` per slave
+    point as the elements get shorter than the radii; with it about one or two.
     """
     c = np.ascontiguousarray
     n = len(e) * len(xg)
     row, gp = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
     out2, dist = np.empty(n), np.empty(n)
     k = _gauss_project(H, enodes, c(h, dtype=float), c(e), c(m), c(xg, dtype=float), c(np.asarray(kind) == LINE),
-                       c(c2, dtype=float), c(reach, dtype=float), int(iterations), row, gp, out2, dist)
+                       c(c2, dtype=float), c(reach, dtype=float), int(iterations),
+                       -1.0 if window is None else float(window), row, gp, out2, dist)
     return row[:k], gp[:k], out2[:k], dist[:k]
 
 

@@ -469,10 +469,13 @@ class ContactSystem(Contribution):
             e, m, kind, c2, reach = e[gp], m[gp], kind[gp], c2[gp], reach[gp]
         H, h = geo
         # a slave Gauss point outside the master element's sphere (grown by R1) cannot touch that
-        # element: no projection for it; the others from the projection on the master chord, 8 Newton
-        # iterations (compiled, projection.py; the kernel polishes the point with 2 more and needs it
-        # converged for an exact tangent)
-        r, g, xi2, dist = gauss_projections(H, en, h, e, m, xg, kind, c2, reach, iterations=8)
+        # element: no projection for it, nor for a line row whose section plane misses the master on
+        # the overhang the owners accept (``window``: projections per slave point bounded as elements
+        # get finer); the others from the projection on the master chord, 8 Newton iterations
+        # (compiled, projection.py; the kernel polishes the point with 2 more and needs it converged
+        # for an exact tangent)
+        r, g, xi2, dist = gauss_projections(H, en, h, e, m, xg, kind, c2, reach, iterations=8,
+                                            window=rules.XI_OVERHANG)
         self._lap("projection")
         s, key, tied = gauss_owners(d.index, len(en), self.max_gp, self.n_beams, e, m, g, xi2, dist, self.el_first,
                                     self.el_last, self.el_beam, self.el_radius, self._prev_owners, pair=r, order=True)
