@@ -1,9 +1,7 @@
 """Unstable equilibria are said by default (issue 28 item 5): every converged step records ``stable``
 (``stepping.stability``), an unstable one is warned about once a run, ``stable=None`` always comes with
 its reason, and options that would do nothing together are refused."""
-import sys
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,9 +11,7 @@ import beamsolver as bs
 from beamsolver.nonlinear.definiteness import Inertia, negative_eigenvalues
 from beamsolver.stepping import stable_branch
 
-sys.path.insert(0, str(Path(__file__).resolve().parent / "published"))
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
-from scenes import argyris_frame, column  # noqa: E402
+from published.scenes import argyris_frame, column  # noqa: E402
 import crossing_beams  # noqa: E402
 from limit_points import truss  # noqa: E402
 
