@@ -7,27 +7,32 @@ Back-ends (``backend=`` here, ``linear_solver=`` in ``beamsolver.solve``):
   beam-like matrices (cables, frames, a few wires).  SuperLU has no
   "re-factorise with the same pattern" entry point in scipy, so every Newton
   iteration re-orders and re-factorises from scratch.
-- ``"pardiso"``: Intel MKL PARDISO through ``pypardiso`` (optional,
-  ``pip install "beamsolver[fast]"``, x86-64 only, ~0.9 GB with MKL).  A
+- ``"pardiso"``: Intel MKL PARDISO through ``pypardiso`` (a dependency where it has wheels:
+  x86-64 Linux and Windows; ~0.9 GB with MKL; elsewhere ``pip install pypardiso`` if available).
+  A supernodal LU with a METIS nested-dissection ordering and weighted matching.  A
   ``Solver`` keeps PARDISO's handle: while the sparsity pattern stays the
   same (no contact pair appearing or vanishing) only the numerical
   factorisation is redone (PARDISO phase 22), the ordering and symbolic
   analysis (phase 11) are reused.  (``pypardiso``'s own ``solve``
   re-analyses every new matrix; it only skips work for an identical one.)
-  Measured on one thread (``benchmarks/scaling.py``): a re-factorisation is
-  1.1-2x faster than splu on a cable and 1.1-1.8x faster than splu-rcm on a
-  19-wire bundle; a first factorisation (with the analysis) is 1.5-4x
-  slower than splu on a cable.
 - ``"splu-rcm"``: SuperLU after a reverse Cuthill-McKee symmetric
   permutation (``scipy.sparse.csgraph``), natural column order.  On long
   bundles of wires in contact SuperLU's MMD ordering fills in badly and grows
   like n^2.4-3 (19-wire strand, 3000 elements: 62e6 factor entries, 28 s,
   against 4.4e6 and 0.36 s with RCM; ``benchmarks/scaling.py``); RCM stays
   linear.  On a single beam both give the same factor.
-- ``"auto"`` (default): for matrices with contact couplings (more than
-  ``AUTO_COUPLED_NNZ`` non-zeros per column on average; a beam or a frame has
-  about 18) of at least ``AUTO_MIN_UNKNOWNS`` unknowns, ``"pardiso"`` if
-  pypardiso is installed, else ``"splu-rcm"``; otherwise ``"splu"``.
+- ``"auto"`` (default): the rule of ``Solver.backend_for``.
+
+Evaluated on the bundles' tangents and not used (``benchmarks/linear_solvers.py``, numbers in
+docs/benchmarks.md): SuperLU with COLAMD or MMD_AT_PLUS_A (9-20x the fill of RCM); SuperLU after
+a METIS nested dissection (``pymetis``: 1.4-1.6x RCM's fill, 3x its flops: a bundle is long and
+thin, and RCM's band is near optimal for it); UMFPACK (``kvxopt``: GPL, 3x PARDISO's time); MUMPS
+(``python-mumps``: its one CPython 3.11 wheel is built against numpy 1.x and does not import under
+numpy 2); CHOLMOD and PARDISO's symmetric modes: Newton tangents are not symmetric, not even
+frictionless ones (``max |K - K^T| / max |K|`` 1e-3 .. 9e-3 on the bundles: SE(3) beams off
+equilibrium, contact).  Saddle-point systems (multiplier contact: a zero diagonal block) go to
+the same unsymmetric back-ends, which pivot (SuperLU: threshold partial pivoting; PARDISO:
+weighted matching and pivot perturbation, its solutions checked by ``_poor``).
 
 A singular matrix raises ``SingularMatrixError`` (a ``RuntimeError``), from
 ``factorize`` (splu: exactly zero pivot) or from ``solve`` (pardiso perturbs
@@ -48,7 +53,7 @@ from ..errors import InputError
 __all__ = ["factorize", "Solver", "SingularMatrixError", "available", "permutation_sign", "BACKENDS", "DEFAULT"]
 
 BACKENDS = ("splu", "splu-rcm", "pardiso", "auto")
-DEFAULT = "auto"          # splu for beams and small scenes; splu-rcm/pardiso for large bundles
+DEFAULT = "auto"          # splu for beams and small scenes; pardiso (else splu-rcm) for coupled ones
 AUTO_MIN_UNKNOWNS = 1_500      # "auto": below this size the default splu is as fast as any
 AUTO_COUPLED_NNZ = 24.0        # "auto": non-zeros per column above which contact couples the beams
 BACKWARD_ERROR = 1e-9          # pardiso, splu-rcm: |K x - b| / (|K| |x| + |b|) above this -> re-analyse / pivot fully
@@ -109,7 +114,20 @@ class Solver:
         self.stats = dict(factorizations=0, analyses=0)
 
     def backend_for(self, K):
-        """The back-end ``factorize`` uses for ``K`` (resolves ``"auto"``)."""
+        """The back-end ``factorize`` uses for ``K`` (resolves ``"auto"``).
+
+        The rule of ``"auto"``, by size and coupling (symmetry plays no part: Newton tangents are
+        unsymmetric, module docstring):
+
+        - fewer than ``AUTO_MIN_UNKNOWNS`` unknowns, or at most ``AUTO_COUPLED_NNZ`` non-zeros per
+          column (a beam or a frame: about 18; no contact coupling many beams): ``"splu"``.  A
+          beam's matrix is a band, SuperLU's MMD ordering finds it, and neither PARDISO's analysis
+          nor an RCM pass pays (a 60 000-unknown cable factorises in 0.06-0.19 s);
+        - coupled (bundles, ropes): ``"pardiso"`` when pypardiso imports (a dependency on x86-64
+          Linux and Windows), else ``"splu-rcm"``, the pure-scipy fallback.  PARDISO does the
+          same work as SuperLU after RCM 3-4x faster from 37 wires on (1.7 s against 6.6 s at
+          61 wires) in a fifth of the memory, and ties on a re-factorisation at 19 wires.
+        """
         if self.requested != "auto":
             return self.requested
         n = K.shape[0]
@@ -377,6 +395,7 @@ class _Pardiso:
         self._phased = all(hasattr(self.ps, a) for a in ("_check_A", "_check_b", "_call_pardiso", "set_phase"))
         self.pattern = None           # (indptr, indices) of the analysed matrix
         self.current = None           # the factorisation whose values PARDISO holds
+        self.flops = float("nan")     # of the numerical factorisation, from the last analysis
 
     def factorize(self, K, stats):
         K = K.tocsr() if K.format not in ("csr", "csc") else K
@@ -398,9 +417,13 @@ class _Pardiso:
             same = (not fresh and self.pattern is not None and self.pattern[2] == K.format
                     and np.array_equal(self.pattern[0], K.indptr) and np.array_equal(self.pattern[1], K.indices))
             ps.set_phase(22 if same else 12)
-            if not same and stats is not None:
-                stats["analyses"] += 1
+            if not same:
+                ps.iparm[18] = -1              # report the factorisation's Mflops (MKL iparm(19))
+                if stats is not None:
+                    stats["analyses"] += 1
             ps._call_pardiso(K, np.zeros((K.shape[0], 1)))
+            if not same:
+                self.flops = 1e6 * float(ps.iparm[18])
             self.pattern = (K.indptr.copy(), K.indices.copy(), K.format)
             f.reused = same
         self.current = f
@@ -408,6 +431,7 @@ class _Pardiso:
         f.perturbed = int(iparm[13])
         f.factor_nnz = int(iparm[17])
         f.peak_kb = int(max(iparm[14], iparm[15] + iparm[16]))
+        f.flops = self.flops
 
     def solve(self, f, b):
         if self.current is not f:             # another matrix was factorised since: redo this one
@@ -478,6 +502,7 @@ class _PardisoFactor:
         self.norm = None           # |K|_inf, computed on the first check
         self.factor_nnz = 0
         self.peak_kb = 0
+        self.flops = float("nan")
 
     def solve(self, b):
         return self._owner.solve(self, b)
