@@ -26,7 +26,7 @@ Back-ends (``backend=`` here, ``linear_solver=`` in ``beamsolver.solve``):
 Evaluated on the bundles' tangents and not used (``benchmarks/linear_solvers.py``, numbers in
 docs/benchmarks.md): SuperLU with COLAMD or MMD_AT_PLUS_A (9-20x the fill of RCM); SuperLU after
 a METIS nested dissection (``pymetis``: 1.4-1.6x RCM's fill, 3x its flops: a bundle is long and
-thin, and RCM's band is near optimal for it); UMFPACK (``kvxopt``: GPL, 3x PARDISO's time); MUMPS
+thin, and RCM's band is near optimal for it); UMFPACK (``kvxopt``: GPL, 3-6x PARDISO's time); MUMPS
 (``python-mumps``: its one CPython 3.11 wheel is built against numpy 1.x and does not import under
 numpy 2); CHOLMOD and PARDISO's symmetric modes: Newton tangents are not symmetric, not even
 frictionless ones (``max |K - K^T| / max |K|`` 1e-3 .. 9e-3 on the bundles: SE(3) beams off
@@ -125,8 +125,8 @@ class Solver:
           nor an RCM pass pays (a 60 000-unknown cable factorises in 0.06-0.19 s);
         - coupled (bundles, ropes): ``"pardiso"`` when pypardiso imports (a dependency on x86-64
           Linux and Windows), else ``"splu-rcm"``, the pure-scipy fallback.  PARDISO does the
-          same work as SuperLU after RCM 3-4x faster from 37 wires on (1.7 s against 6.6 s at
-          61 wires) in a fifth of the memory, and ties on a re-factorisation at 19 wires.
+          same work as SuperLU after RCM 2x faster at 37 wires and 4x at 61 (1.6 s against 6.3 s,
+          0.6 GB against 2.4 GB), and ties on a re-factorisation at 19 wires (0.09 s).
         """
         if self.requested != "auto":
             return self.requested
