@@ -687,7 +687,8 @@ def scenes(names):
             "the first, with the pattern's analysis); solver: the default `linsolve.Solver` (`auto`); fill: "
             "factor entries; flops of the factorisation (PARDISO's report, or counted from SuperLU's factors); "
             f"loaded step: `bs.solve(steps=1)` stretching by {scaling_scenes.STRAIN:g}, CPU s (Newton "
-            f"iterations); peak MB: `ru_maxrss` of the child (import baseline {base['rss_mb']:.0f} MB).\n\n"
+            f"iterations); peak MB: `ru_maxrss` of the child after the two iterations and after the loaded step "
+            f"too (import baseline {base['rss_mb']:.0f} MB).\n\n"
             + scaling_scenes.report(rows, base["rss_mb"], table))
     print(text)
     RESULTS.mkdir(parents=True, exist_ok=True)

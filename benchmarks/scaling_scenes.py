@@ -167,7 +167,7 @@ def report(rows, base_mb, table):
         return "-" if v is None or (isinstance(v, float) and not np.isfinite(v)) else f.format(v)
     head = ["scene", "elements", "unknowns", "contact points", "solver", "fill (1e6)", "flops (1e9)",
             "element", "contact", "assembly", "solve", "update", "residual", "iteration (1st)", "iteration",
-            "loaded step (its)", "peak MB"]
+            "loaded step (its)", "peak MB, iteration", "peak MB, with the step"]
     body = []
     for r in rows:
         if "error" in r:
@@ -177,8 +177,9 @@ def report(rows, base_mb, table):
                      g(r["fill"] / 1e6), g(r.get("flops", np.nan) / 1e9)]
                     + [g(r[f"it2_{k}"]) for k in ("element", "contact", "assembly", "solve", "update", "residual")]
                     + [g(r["it1_iteration"]), g(r["it2_iteration"]),
-                       f"{g(r['step_s'])} ({r['step_iterations']}{'' if r['step_status'] == 'ok' else ', ' + r['step_status']})",
-                       f"{r['rss_mb']:.0f}"])
+                       f"{g(r['step_s'])} ({r['step_iterations']}"
+                       f"{'' if r['step_status'] == 'ok' else ', ' + r['step_status']})",
+                       f"{r['rss_it2_mb']:.0f}", f"{r['rss_mb']:.0f}"])
     lines = [table(head, body)]
     ropes = [r for r in rows if r["scene"].startswith("rope") and "error" not in r]
     if len(ropes) >= 2:
@@ -191,14 +192,15 @@ def report(rows, base_mb, table):
             return y[-1] * (full / n[-1]) ** max(slope, 1.0) + lo, slope
         it, p_it = fit("it2_iteration")
         sv, p_sv = fit("it2_solve")
-        mem, p_mem = fit("rss_mb", base_mb)
+        mem, p_mem = fit("rss_it2_mb", base_mb)
         pts = ropes[-1]["contact_points"] / n[-1] * full
         fill = ropes[-1]["fill"] / n[-1] * full
         lines.append(
             f"\nThe rope of {ROPE_FULL:g} m ({full:.3g} elements, ~{pts:.2g} contact points), extrapolated from "
             f"the pieces above (log-log slope over them, at least 1): one Newton iteration ~{it:.3g} s "
-            f"(slope {p_it:.2f}; of which the linear solve ~{sv:.3g} s, slope {p_sv:.2f}), peak memory "
-            f"~{mem / 1024:.3g} GB (slope {p_mem:.2f} above the {base_mb:.0f} MB baseline), fill ~{fill:.3g} "
+            f"(slope {p_it:.2f}; of which the linear solve ~{sv:.3g} s, slope {p_sv:.2f}), peak memory of the "
+            f"iteration ~{mem / 1024:.3g} GB (slope {p_mem:.2f} above the {base_mb:.0f} MB baseline), fill "
+            f"~{fill:.3g} "
             f"factor entries ({12 * fill / 2**30:.3g} GB at 12 bytes each), and the contact tangent's COO "
             f"triplets alone {24 * 576 * pts / 2**30:.3g} GB (576 entries per point, 24 bytes each).")
     return "\n".join(lines)
