@@ -1,6 +1,8 @@
 """Scaling of one Newton iteration with the model size, part by part, 1e2 .. 1e5 elements.
 
-``python benchmarks/scaling.py [max_elements] [--bundle-cap N]``
+``python benchmarks/scaling.py [max_elements] [--bundle-cap N]``; ``python benchmarks/scaling.py --scenes
+19,37,61,rope-20,rope-40`` instead runs the bundles of 19, 37 and 61 wires and pieces of a rope
+(issue 30: one Newton iteration by parts and a loaded step each, ``scaling_scenes.py``).
 
 Two scenes, sizes ~1e2, 3e2, 1e3, ... up to ``max_elements`` (default 1e5):
 
@@ -112,20 +114,21 @@ def cable(n):
     return m, system, H
 
 
-def bundle_model(per_wire, mu=0.3, gauss_points=5):
-    """The 1+6+12 strand, ``per_wire`` elements per wire (length ``per_wire / 24`` lays)."""
+def bundle_model(per_wire, mu=0.3, gauss_points=5, n_layers=2):
+    """The 1+6+12 strand (``n_layers`` = 2; 3: 37 wires, 1+6+12+18; 4: 61 wires), ``per_wire``
+    elements per wire (length ``per_wire / 24`` lays); layer ``k`` has ``6 k`` wires."""
     import beamsolver as bs
     length = LAY * per_wire / PER_LAY
     sec = bs.Section.circular(radius=WIRE_R, E=2e11)
     m = bs.Model()
     layers = [[m.add_beam(bs.geometry.straight((0, 0, 0), (0, 0, length), per_wire), sec, name="core")]]
-    for k, nw in ((1, 6), (2, 12)):
+    for k, nw in ((k, 6 * k) for k in range(1, n_layers + 1)):
         r = 2.0 * WIRE_R * k * TIGHT
         layers.append([m.add_beam(bs.geometry.helix(radius=r, pitch=LAY, length=length, n_elements=per_wire,
                                                     phase=2.0 * np.pi * i / nw), sec, name=f"layer {k} wire {i}")
                        for i in range(nw)])
     opts = dict(mu=mu, gauss_points=gauss_points)
-    for k in (1, 2):
+    for k in range(1, n_layers + 1):
         m.add_contact(layers[k], layers[k - 1], **opts)
         nw = len(layers[k])
         r = 2.0 * WIRE_R * k * TIGHT
@@ -431,6 +434,9 @@ def child(argv):
         out = measure_bundle(int(argv[1]), int(argv[2]), float(argv[3]), argv[4].split(","))
     elif kind == "nothing":
         out = measure_pays_nothing(int(argv[1]))
+    elif kind == "scene":
+        import scaling_scenes
+        out = scaling_scenes.measure_scene(argv[1], _maxrss_mb)
     else:
         raise SystemExit(f"unknown child {kind}")
     print("JSON " + json.dumps(out, default=float))
@@ -617,7 +623,11 @@ def main(argv):
     ap.add_argument("max_elements", nargs="?", type=float, default=100_000)
     ap.add_argument("--bundle-cap", type=float, default=BUNDLE_CAP,
                     help="largest bundle (elements) run through the contact code")
+    ap.add_argument("--scenes", default=None,
+                    help="instead: the scenes of issue 30, e.g. 19,37,61,rope-20,rope-40 (scaling_scenes.py)")
     a = ap.parse_args(argv)
+    if a.scenes:
+        return scenes(a.scenes.split(","))
     max_elements, cap = int(a.max_elements), int(a.bundle_cap)
     t_start = time.perf_counter()
     tmp = tempfile.TemporaryDirectory()
@@ -656,6 +666,40 @@ def main(argv):
         for r in rows:
             f.write(",".join(_csv(r.get(k, "")) for k in keys) + "\n")
     write_section("scaling", "## Scaling of a Newton iteration (issue 6)\n\n" + text)
+    return rows
+
+
+def scenes(names):
+    """``--scenes``: one Newton iteration by parts and a loaded step per scene (``scaling_scenes``)."""
+    import scaling_scenes
+    t_start = time.perf_counter()
+    base = run_child("baseline")
+    rows = []
+    for name in names:
+        try:
+            rows.append(run_child("scene", name, timeout=3000))
+        except (RuntimeError, subprocess.TimeoutExpired) as e:
+            rows.append(dict(scene=name, error=str(e).splitlines()[-1][:100] if str(e) else type(e).__name__))
+    wall = time.perf_counter() - t_start
+    text = (f"`python benchmarks/scaling.py --scenes {','.join(names)}` ({machine()}; one thread; whole run "
+            f"{wall:.0f} s). The scenes of issue 30 (`benchmarks/scaling_scenes.py`): one Newton iteration at the "
+            "reference poses by parts, CPU s, on the same pattern as the iteration before (`iteration (1st)`: "
+            "the first, with the pattern's analysis); solver: the default `linsolve.Solver` (`auto`); fill: "
+            "factor entries; flops of the factorisation (PARDISO's report, or counted from SuperLU's factors); "
+            f"loaded step: `bs.solve(steps=1)` stretching by {scaling_scenes.STRAIN:g}, CPU s (Newton "
+            f"iterations); peak MB: `ru_maxrss` of the child after the two iterations and after the loaded step "
+            f"too (import baseline {base['rss_mb']:.0f} MB).\n\n"
+            + scaling_scenes.report(rows, base["rss_mb"], table))
+    print(text)
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    keys = []
+    for r in rows:
+        keys += [k for k in r if k not in keys]
+    with open(RESULTS / "scaling_scenes.csv", "w") as f:
+        f.write(",".join(keys) + "\n")
+        for r in rows:
+            f.write(",".join(_csv(r.get(k, "")) for k in keys) + "\n")
+    write_section("scaling_scenes", "## Bundles of 19, 37, 61 wires and a rope (issue 30)\n\n" + text)
     return rows
 
 

@@ -1,4 +1,4 @@
-"""Cable builders: straight multi-layer strands of helical wires along ``e_z``.
+"""Cable builders: straight multi-layer strands of helical wires along ``e_z``, and ropes of strands.
 
 A strand is a list of ``Layer`` s from the centre out.  A layer of one wire
 with pitch radius 0 is a straight core; every other layer is ``n_wires``
@@ -34,6 +34,24 @@ end of that side (a rigid end plate), to be pulled / twisted with
 gives the axial force and the torque about the axis from the plate reaction, ``Strand.cut``
 the axial force, torque and bending moments across a cross-section at any height
 (``resultants.cut_resultant``).
+
+Ropes (``build_rope``; Costello 1997, ch. 4, "wire rope"): ``n_strands`` strands (e.g. 6 x 7,
+6 x 19) laid around a straight core along ``e_z``, a wire strand core (``core``: a list of
+``Layer``, built by ``build_strand``; an independent wire rope core simplified to a straight
+strand) or a fibre core (``core``: a ``Section``).  Strand ``j``'s centre line is a helix of
+pitch radius ``R_s``, lay length ``P``, phase ``2 pi j / n_strands``; wire ``i`` of its layer
+``k`` is a double helix about it (``geometry.double_helix``: pitch radius ``r_k`` and lay
+``p_k`` measured along the strand, phase ``Layer.phase + 2 pi i / n_k``), the strand's centre
+wire the helix itself.  Every wire of a strand lies inside the tube of radius ``rho_s = r_last
++ R_last`` (its envelope) about its centre line, so no wires overlap when the centre lines keep
+``2 rho_s`` apart and ``rho_s + rho_c`` from the axis (``rho_c``: the core's envelope): the
+default ``R_s`` is the larger of ``rho_c + rho_s`` (strands on the core) and the radius closing
+``n_strands`` envelopes (``layer_clearance`` = 0); a smaller given ``pitch_radius`` is refused.
+A wire gets ``elements_per_lay`` elements per its shortest lay along ``z`` (``P``, or
+``p_k cos(alpha)``, ``alpha`` the strands' lay angle); every core wire at least as many per the
+shortest lay of all.  Contact: inside each strand as ``build_strand``; the strands' outer layers
+on the core's outer layer, and neighbouring strands' outer layers on each other, when their
+envelopes are closer than ``touch_tol`` times the outer wire diameter.
 """
 from dataclasses import dataclass, replace
 from typing import Optional
@@ -48,7 +66,8 @@ from .model import Model
 from .section import Section
 from .validation import count, real
 
-__all__ = ["Layer", "Strand", "build_strand", "bending_fixture", "BendingFixture", "fibre_stiffness", "rod_stiffness",
+__all__ = ["Layer", "Strand", "build_strand", "Rope", "build_rope", "bending_fixture", "BendingFixture",
+           "fibre_stiffness", "rod_stiffness",
            "layer_clearance", "closing_radius", "steel_yield_stress", "PROOF_FRACTION"]
 
 OVERLAP_TOL = 1e-9       # a clearance above -OVERLAP_TOL R is no overlap (a layer closed to round-off)
@@ -408,3 +427,143 @@ def rod_stiffness(core_radius, wire_radius, n_wires, pitch_radius, lay_angle, E,
     w = m / c
     return (Kee + w * np.sum(D * k_ep * k_ep), Kew + w * np.sum(D * k_ep * k_th),
             Kww + w * np.sum(D * k_th * k_th))
+
+
+@dataclass
+class Rope:
+    """A rope built by ``build_rope``: ``strands[j][k][i]`` is wire ``i`` of layer ``k`` of outer strand ``j``."""
+    model: Model
+    core: list                 # per core layer, list of Beam (a fibre core: [[beam]])
+    strands: list              # per outer strand, per layer, list of Beam
+    core_strand: Optional[Strand]
+    pitch_radius: float        # of the strands' centre lines (R_s)
+    lay_length: float          # of the strands (P, > 0)
+    lay_angle: float
+    strand_layers: list        # the outer strands' Layers
+    strand_geometry: list      # per strand layer: (pitch radius r_k, lay angle in the strand, lay length p_k, R, n)
+    envelope: float            # rho_s, the outer strands' envelope radius
+    core_envelope: float       # rho_c
+    length: float
+    contacts: list             # every declaration: the core strand's, then the outer strands'
+    clearance: Optional[float]     # least distance of neighbouring strands' envelopes (negative: overlap)
+
+    @property
+    def all_wires(self):
+        return [w for layer in self.core for w in layer] + [w for s in self.strands for layer in s for w in layer]
+
+    def ends(self, side):
+        if side not in ("bottom", "top"):
+            raise InputError(f"Rope: side must be 'bottom' or 'top', got {side!r}")
+        return [w.first if side == "bottom" else w.last for w in self.all_wires]
+
+    def clamp(self, side):
+        for n in self.ends(side):
+            self.model.clamp(n)
+
+
+def build_rope(strand, length, E, nu=0.3, n_strands=6, lay_length=None, lay_angle=None, direction="right",
+               core=None, pitch_radius=None, elements_per_lay=24, min_elements=8, mu=0.0, contact=True,
+               touch_tol=0.05, model=None, contact_options=None):
+    """Build a rope of ``n_strands`` strands of design ``strand`` around ``core`` into ``model``; a ``Rope``
+    (geometry, meshing and contact declarations: the module docstring, "Ropes").
+
+    ``strand``: the outer strands' ``Layer`` s from their centre out (lay lengths measured along
+    the strand; pitch radii default to touching layers, as ``build_strand``); ``lay_length`` or
+    ``lay_angle`` [m, rad]: the strands' lay in the rope; ``direction``: ``'right'`` (Z) or
+    ``'left'`` (S) for the strands (each strand layer has its own, e.g. 'left' for a regular
+    lay); ``core``: a list of ``Layer`` (a wire strand core, built straight by ``build_strand``)
+    or a ``Section`` (a fibre core); ``pitch_radius``: of the strands' centre lines (default in
+    the module docstring).  Other arguments as ``build_strand``.
+    """
+    length = real(length, "length", "build_rope", above=0.0)
+    n_strands = count(n_strands, "n_strands", "build_rope")
+    elements_per_lay = count(elements_per_lay, "elements_per_lay", "build_rope")
+    min_elements = count(min_elements, "min_elements", "build_rope")
+    touch_tol = real(touch_tol, "touch_tol", "build_rope")
+    if n_strands < 2:
+        raise InputError(f"build_rope: n_strands must be at least 2, got {n_strands}")
+    if direction not in ("right", "left"):
+        raise InputError(f"build_rope: direction must be 'right' or 'left', got {direction!r}")
+    if not strand:
+        raise InputError("build_rope: strand needs at least one layer")
+    layers = [_layer(layer, k) for k, layer in enumerate(strand)]
+    geo = _geometry(layers)
+    rho_s = geo[-1][0] + geo[-1][3]
+    model = Model() if model is None else model
+    # the core
+    fibre = isinstance(core, Section)
+    if not fibre and not (isinstance(core, (list, tuple)) and core):
+        raise InputError(f"build_rope: core must be a list of cables.Layer (a wire strand core) or a Section "
+                         f"(a fibre core), got {core!r}")
+    if fibre:
+        rho_c, core_lays = float(core.radius), []
+    else:
+        cgeo = _geometry([_layer(layer, k) for k, layer in enumerate(core)])
+        rho_c = cgeo[-1][0] + cgeo[-1][3]
+        core_lays = [p for (_, _, p, _, _) in cgeo if np.isfinite(p)]
+    # the strands' helix
+    envelope = Layer(wire_radius=rho_s, n_wires=n_strands, lay_length=lay_length, lay_angle=lay_angle)
+    if (lay_length is None) == (lay_angle is None):
+        raise InputError("build_rope: give exactly one of lay_length, lay_angle (the strands' lay in the rope)")
+    fit = max(rho_c + rho_s, _closing_pitch_radius(envelope, rho_s, n_strands))
+    if pitch_radius is None:
+        R_s = fit
+    else:
+        R_s = real(pitch_radius, "pitch_radius", "build_rope", above=0.0)
+        if R_s < fit * (1.0 - 1e-12):
+            raise InputError(f"build_rope: pitch_radius {R_s!r} makes the strands (envelope radius {rho_s:.6g}) "
+                             f"overlap the core (radius {rho_c:.6g}) or each other; at least {fit:.6g} fits")
+    alpha, P = _lay(envelope, R_s)
+    clearance = layer_clearance(R_s, rho_s, n_strands, alpha)
+    c = (1.0 if direction == "right" else -1.0) * P / (2.0 * np.pi)
+    lays = [P] + [p * np.cos(alpha) for (_, _, p, _, _) in geo if np.isfinite(p)]
+    n_core = max(min_elements, elements_per_lay, int(np.ceil(elements_per_lay * length / min(lays + core_lays))))
+    if fibre:
+        core_strand = None
+        core_wires = [[model.add_beam(geometry.straight((0, 0, 0), (0, 0, length), n_core), core, name="core")]]
+    else:
+        core_strand = build_strand(core, length, E, nu, elements_per_lay=elements_per_lay, min_elements=n_core,
+                                   mu=mu, contact=contact, touch_tol=touch_tol, model=model,
+                                   contact_options=contact_options)
+        core_wires = core_strand.wires
+    # the outer strands
+    strands = []
+    for j in range(n_strands):
+        th0 = 2.0 * np.pi * j / n_strands
+        sl = []
+        for k, (layer, (r, beta, p, R, n_w)) in enumerate(zip(layers, geo)):
+            sec = _section(layer, k, R, E, nu)
+            lay_z = min(P, p * np.cos(alpha)) if np.isfinite(p) else P
+            n_el = max(min_elements, int(np.ceil(elements_per_lay * length / lay_z)))
+            z = np.linspace(0.0, length, n_el + 1)
+            wires = []
+            for i in range(n_w):
+                name = f"strand {j} layer {k} wire {i}"
+                if r == 0.0:
+                    P_ = geometry.helix(radius=R_s, pitch=2.0 * np.pi * c, length=length, n_elements=n_el, phase=th0)
+                else:
+                    sign = 1.0 if layer.direction == "right" else -1.0
+                    P_ = geometry.double_helix(R_s, 2.0 * np.pi * c, r, sign * p, length, n_el,
+                                               phase=layer.phase + 2.0 * np.pi * i / n_w, strand_phase=th0)
+                wires.append(model.add_beam(P_, sec, name=name))
+            sl.append(wires)
+        strands.append(sl)
+    contacts = list(core_strand.contacts) if core_strand is not None else []
+    if contact:
+        opts = dict(contact_options or {})
+        for sl in strands:
+            for k in range(1, len(sl)):
+                contacts.append(model.add_contact(sl[k], sl[k - 1], mu=mu, **opts))
+            for k, lw in enumerate(sl):
+                m = len(lw)
+                if m >= 2 and _neighbour_distance(model, lw[0], lw[1]) <= 2.0 * geo[k][3] * (1.0 + touch_tol):
+                    for i in range(m if m > 2 else 1):
+                        contacts.append(model.add_contact(lw[i], lw[(i + 1) % m], mu=mu, **opts))
+        gap = 2.0 * geo[-1][3] * touch_tol
+        if R_s - rho_s - rho_c <= gap:
+            contacts.append(model.add_contact([w for sl in strands for w in sl[-1]], core_wires[-1], mu=mu, **opts))
+        if clearance is not None and clearance <= gap:
+            for j in range(n_strands if n_strands > 2 else 1):
+                contacts.append(model.add_contact(strands[j][-1], strands[(j + 1) % n_strands][-1], mu=mu, **opts))
+    return Rope(model, core_wires, strands, core_strand, float(R_s), float(P), float(alpha), layers, geo,
+                float(rho_s), float(rho_c), float(length), contacts, clearance)

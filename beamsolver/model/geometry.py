@@ -17,7 +17,7 @@ import numpy as np
 from ..errors import InputError
 from .validation import MAX_REFERENCE_ELEMENT_ROTATION, count, real, vector
 
-__all__ = ["straight", "arc", "helix", "polyline", "frames_from_tangents"]
+__all__ = ["straight", "arc", "helix", "double_helix", "polyline", "frames_from_tangents"]
 
 _PARALLEL_TOL = 1e-9
 
@@ -139,6 +139,66 @@ def helix(radius, pitch, length, n_elements, phase=0.0, z0=0.0):
     e1 = np.stack([-radius * k * s, radius * k * c, np.ones_like(z)], axis=-1)
     e2 = np.stack([-c, -s, np.zeros_like(z)], axis=-1)
     return _poses(x, e1, e2)
+
+
+def double_helix(strand_radius, strand_pitch, radius, pitch, length, n_elements, phase=0.0, strand_phase=0.0):
+    """A wire of a strand laid in a rope: a helix of ``radius`` about a helical strand centre line.
+
+    The strand's centre line ``C(th) = R (cos(th + strand_phase), sin(th + strand_phase), 0) + (0, 0, c th)``,
+    ``R = strand_radius``, ``c = strand_pitch / (2 pi)``; the wire
+    ``x = C + radius (cos(phi) N + sin(phi) B)``, ``phi = phase + 2 pi s / pitch`` with ``N`` the
+    principal normal of ``C`` (towards the axis), ``B = T x N`` and ``s`` the arc length along ``C``
+    (Costello 1997, ch. 4).  Pitches are signed (> 0: right hand).  Nodes at uniform heights ``z``
+    of the wire itself from 0 to ``length``, exact tangents as ``e1``, ``e2`` parallel-transported.
+    """
+    n = _check_n(n_elements, "double_helix")
+    for name, v in (("strand_radius", strand_radius), ("radius", radius), ("length", length)):
+        real(v, name, "geometry.double_helix", above=0.0)
+    for name, v in (("strand_pitch", strand_pitch), ("pitch", pitch)):
+        if real(v, name, "geometry.double_helix") == 0.0:
+            raise InputError(f"geometry.double_helix: {name} must be finite and non-zero, got {v!r}")
+    L = np.hypot(strand_radius, strand_pitch / (2.0 * np.pi))
+    _check_turn(2.0 * np.pi * (length / abs(strand_pitch) + length * L / abs(strand_pitch * pitch) * 2.0 * np.pi) / n,
+                n, "double_helix")
+    z = np.linspace(0.0, length, n + 1)
+    x, t = double_helix_points(strand_radius, strand_pitch / (2.0 * np.pi), radius, phase,
+                               2.0 * np.pi / pitch, z)
+    c, s = np.cos(strand_phase), np.sin(strand_phase)
+    rot = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    return frames_from_tangents(x @ rot.T, t @ rot.T)
+
+
+def double_helix_points(R, c, r, phase, s_rate, z, iterations=8):
+    """Points ``(len(z), 3)`` and unit tangents of ``double_helix`` (strand radius ``R``, axial advance
+    ``c`` per radian, signed; wire radius ``r``; ``phi = phase + s_rate s``; strand phase 0) at the
+    points whose own height is ``z``: the strand parameter ``th`` solved from ``x_z(th) = z`` by Newton
+    from ``th = z / c`` (``|dx_z / dth| >= |c| - r |s_rate| L R / L``, > 0 for any strand whose wires
+    advance along it)."""
+    z = np.asarray(z, dtype=float)
+    th = z / c
+    for _ in range(iterations):
+        x, dx = _double_helix(R, c, r, phase, s_rate, th)
+        th = th - (x[:, 2] - z) / dx[:, 2]
+    x, dx = _double_helix(R, c, r, phase, s_rate, th)
+    x[:, 2] = z                                      # converged to round-off: the exact heights
+    return x, dx / np.linalg.norm(dx, axis=1, keepdims=True)
+
+
+def _double_helix(R, c, r, phase, s_rate, th):
+    """Points of the double helix and their ``d / dth`` at strand parameters ``th``."""
+    L = np.hypot(R, c)
+    ct, st = np.cos(th), np.sin(th)
+    zero = np.zeros_like(th)
+    C = np.stack([R * ct, R * st, c * th], axis=-1)
+    N = np.stack([-ct, -st, zero], axis=-1)
+    B = np.stack([c * st, -c * ct, np.full_like(th, R)], axis=-1) / L
+    phi = phase + s_rate * L * th                       # s = L th
+    cp, sp = np.cos(phi)[:, None], np.sin(phi)[:, None]
+    x = C + r * (cp * N + sp * B)
+    dC = np.stack([-R * st, R * ct, np.full_like(th, c)], axis=-1)
+    dN = np.stack([st, -ct, zero], axis=-1)
+    dB = np.stack([c * ct, c * st, zero], axis=-1) / L
+    return x, dC + r * (s_rate * L * (-sp * N + cp * B) + cp * dN + sp * dB)
 
 
 def _rotation_between(a, b):

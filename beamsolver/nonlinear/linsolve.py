@@ -7,8 +7,9 @@ Back-ends (``backend=`` here, ``linear_solver=`` in ``beamsolver.solve``):
   beam-like matrices (cables, frames, a few wires).  SuperLU has no
   "re-factorise with the same pattern" entry point in scipy, so every Newton
   iteration re-orders and re-factorises from scratch.
-- ``"pardiso"``: Intel MKL PARDISO through ``pypardiso`` (optional,
-  ``pip install "beamsolver[fast]"``, x86-64 only, ~0.9 GB with MKL).  A
+- ``"pardiso"``: Intel MKL PARDISO through ``pypardiso`` (a dependency where it has wheels:
+  x86-64 Linux and Windows; ~0.9 GB with MKL; elsewhere ``pip install pypardiso`` if available).
+  A supernodal LU with a METIS nested-dissection ordering and weighted matching.  A
   ``Solver`` keeps PARDISO's handle: while the sparsity pattern stays the
   same (no contact pair appearing or vanishing) only the numerical
   factorisation is redone (PARDISO phase 22), the ordering and symbolic
@@ -20,10 +21,18 @@ Back-ends (``backend=`` here, ``linear_solver=`` in ``beamsolver.solve``):
   bundles of wires in contact SuperLU's MMD ordering fills in superlinearly;
   the RCM band's fill stays linear in the length (docs/benchmarks.md,
   ``benchmarks/scaling.py``).  On a single beam both give the same factor.
-- ``"auto"`` (default): for matrices with contact couplings (more than
-  ``AUTO_COUPLED_NNZ`` non-zeros per column on average; a beam or a frame has
-  about 18) of at least ``AUTO_MIN_UNKNOWNS`` unknowns, ``"pardiso"`` if
-  pypardiso is installed, else ``"splu-rcm"``; otherwise ``"splu"``.
+- ``"auto"`` (default): the rule of ``Solver.backend_for``.
+
+Evaluated on the bundles' tangents and not used (``benchmarks/linear_solvers.py``, numbers in
+docs/benchmarks.md): SuperLU with COLAMD or MMD_AT_PLUS_A (9-20x the fill of RCM); SuperLU after
+a METIS nested dissection (``pymetis``: 1.4-1.6x RCM's fill, 3x its flops: a bundle is long and
+thin, and RCM's band is near optimal for it); UMFPACK (``kvxopt``: GPL, 3-6x PARDISO's time); MUMPS
+(``python-mumps``: its one CPython 3.11 wheel is built against numpy 1.x and does not import under
+numpy 2); CHOLMOD and PARDISO's symmetric modes: Newton tangents are not symmetric, not even
+frictionless ones (``max |K - K^T| / max |K|`` 1e-3 .. 9e-3 on the bundles: SE(3) beams off
+equilibrium, contact).  Saddle-point systems (multiplier contact: a zero diagonal block) go to
+the same unsymmetric back-ends, which pivot (SuperLU: threshold partial pivoting; PARDISO:
+weighted matching and pivot perturbation, its solutions checked by ``_poor``).
 
 A singular matrix raises ``SingularMatrixError`` (a ``RuntimeError``), from
 ``factorize`` (splu: exactly zero pivot) or from ``solve`` (pardiso perturbs
@@ -46,7 +55,7 @@ __all__ = ["factorize", "factorize_tangent", "Solver", "SingularMatrixError", "a
            "BACKENDS", "DEFAULT"]
 
 BACKENDS = ("splu", "splu-rcm", "pardiso", "auto")
-DEFAULT = "auto"          # splu for beams and small scenes; splu-rcm/pardiso for large bundles
+DEFAULT = "auto"          # splu for beams and small scenes; pardiso (else splu-rcm) for coupled ones
 AUTO_MIN_UNKNOWNS = 1_500      # "auto": below this size the default splu is as fast as any
 AUTO_COUPLED_NNZ = 24.0        # "auto": non-zeros per column above which contact couples the beams
 BACKWARD_ERROR = 1e-9          # pardiso, splu-rcm: |K x - b| / (|K| |x| + |b|) above this -> re-analyse / pivot fully
@@ -137,7 +146,20 @@ class Solver:
         self.stats = dict(factorizations=0, analyses=0)
 
     def backend_for(self, K):
-        """The back-end ``factorize`` uses for ``K`` (resolves ``"auto"``)."""
+        """The back-end ``factorize`` uses for ``K`` (resolves ``"auto"``).
+
+        The rule of ``"auto"``, by size and coupling (symmetry plays no part: Newton tangents are
+        unsymmetric, module docstring):
+
+        - fewer than ``AUTO_MIN_UNKNOWNS`` unknowns, or at most ``AUTO_COUPLED_NNZ`` non-zeros per
+          column (a beam or a frame: about 18; no contact coupling many beams): ``"splu"``.  A
+          beam's matrix is a band, SuperLU's MMD ordering finds it, and neither PARDISO's analysis
+          nor an RCM pass pays (a 60 000-unknown cable factorises in 0.06-0.19 s);
+        - coupled (bundles, ropes): ``"pardiso"`` when pypardiso imports (a dependency on x86-64
+          Linux and Windows), else ``"splu-rcm"``, the pure-scipy fallback.  PARDISO does the
+          same work as SuperLU after RCM 2x faster at 37 wires and 4x at 61 (1.6 s against 6.3 s,
+          0.6 GB against 2.4 GB), and ties on a re-factorisation at 19 wires (0.09 s).
+        """
         if self.requested != "auto":
             return self.requested
         n = K.shape[0]
@@ -403,6 +425,7 @@ class _Pardiso:
         self._phased = all(hasattr(self.ps, a) for a in ("_check_A", "_check_b", "_call_pardiso", "set_phase"))
         self.pattern = None           # (indptr, indices) of the analysed matrix
         self.current = None           # the factorisation whose values PARDISO holds
+        self.flops = float("nan")     # of the numerical factorisation, from the last analysis
 
     def factorize(self, K, stats):
         K = K.tocsr() if K.format not in ("csr", "csc") else K
@@ -424,9 +447,13 @@ class _Pardiso:
             same = (not fresh and self.pattern is not None and self.pattern[2] == K.format
                     and np.array_equal(self.pattern[0], K.indptr) and np.array_equal(self.pattern[1], K.indices))
             ps.set_phase(22 if same else 12)
-            if not same and stats is not None:
-                stats["analyses"] += 1
+            if not same:
+                ps.iparm[18] = -1              # report the factorisation's Mflops (MKL iparm(19))
+                if stats is not None:
+                    stats["analyses"] += 1
             ps._call_pardiso(K, np.zeros((K.shape[0], 1)))
+            if not same:
+                self.flops = 1e6 * float(ps.iparm[18])
             self.pattern = (K.indptr.copy(), K.indices.copy(), K.format)
             f.reused = same
         self.current = f
@@ -434,6 +461,7 @@ class _Pardiso:
         f.perturbed = int(iparm[13])
         f.factor_nnz = int(iparm[17])
         f.peak_kb = int(max(iparm[14], iparm[15] + iparm[16]))
+        f.flops = self.flops
 
     def solve(self, f, b):
         if self.current is not f:             # another matrix was factorised since: redo this one
@@ -504,6 +532,7 @@ class _PardisoFactor:
         self.norm = None           # |K|_inf, computed on the first check
         self.factor_nnz = 0
         self.peak_kb = 0
+        self.flops = float("nan")
 
     def solve(self, b):
         return self._owner.solve(self, b)

@@ -201,3 +201,47 @@ def test_compiled_rcm_is_scipys():
         ours, ref = linsolve._rcm_csc(A), linsolve._rcm_scipy(A)
         for a, b in zip(ours, ref):
             assert a.dtype == b.dtype and np.array_equal(a, b)
+
+
+def saddle_point(K, m, seed=6):
+    """``[[K, B^T], [B, 0]]``: ``m`` Lagrange multipliers on sparse full-rank constraint rows ``B``
+    (a zero diagonal block, as the exact-stick contact tangent), CSC."""
+    rng = np.random.default_rng(seed)
+    n = K.shape[0]
+    B = sp.random(m, n, density=min(1.0, 6.0 / n), random_state=rng, format="lil")
+    cols = rng.choice(n, size=m, replace=False)
+    for i, j in enumerate(cols):
+        B[i, j] = 1.0 + rng.uniform()                # full row rank
+    B = sp.csr_matrix(B)
+    return sp.csc_matrix(sp.bmat([[K, B.T], [B, None]]))
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("make", [spd_matrix, nonsymmetric_matrix])
+def test_saddle_point(backend, make):
+    """Symmetric-indefinite (SPD block) and unsymmetric saddle-point systems with a zero diagonal
+    block: the dense solution; ``splu``'s determinant sign is the dense one's."""
+    A = saddle_point(make(), 12)
+    assert np.all(A.diagonal()[-12:] == 0.0)
+    b = np.random.default_rng(7).standard_normal(A.shape[0])
+    x_dense = np.linalg.solve(A.toarray(), b)
+    f = linsolve.factorize(A, backend)
+    np.testing.assert_allclose(f.solve(b), x_dense, rtol=1e-9, atol=1e-11 * np.abs(x_dense).max())
+    if hasattr(f, "det_sign"):
+        assert f.det_sign() == np.sign(np.linalg.det(A.toarray()))
+
+
+def test_saddle_point_auto_coupled():
+    """A coupled saddle-point system large enough for ``auto``'s coupled back-end (PARDISO if installed,
+    else splu-rcm): the same solution as splu, also after a re-factorisation with the same pattern."""
+    A = saddle_point(coupled_matrix(), 200)
+    s = linsolve.Solver("auto")
+    assert s.backend_for(A) == ("pardiso" if HAVE_PARDISO else "splu-rcm")
+    b = np.random.default_rng(8).standard_normal(A.shape[0])
+    ref = linsolve.factorize(A, "splu").solve(b)
+    np.testing.assert_allclose(s.factorize(A).solve(b), ref, rtol=1e-9, atol=1e-12 * np.abs(ref).max())
+    A2 = A.copy()
+    A2.data[A2.indices < 2000] *= 1.5                      # new values, same pattern
+    ref2 = linsolve.factorize(A2, "splu").solve(b)
+    np.testing.assert_allclose(s.factorize(A2).solve(b), ref2, rtol=1e-9, atol=1e-12 * np.abs(ref2).max())
+    s.close()

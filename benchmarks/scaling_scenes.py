@@ -1,0 +1,206 @@
+"""The scenes of issue 30 for ``benchmarks/scaling.py --scenes``: 19-, 37-, 61-wire bundles and a rope.
+
+Each scene runs in its own child process (``scaling.py --child scene NAME``) and reports:
+
+- the model: elements, unknowns, active contact points;
+- one Newton iteration at the reference poses by parts (CPU s): ``element`` (``System.evaluate``),
+  ``contact`` (the rest of ``Problem.evaluate``: search, kernels, blocks, their assembly into the
+  residual and COO), ``assembly`` (``Problem.tangent``, CSC), ``solve`` (the default
+  ``linsolve.Solver``: factorisation + solve; its back-end, fill and flops, the flops reported by
+  PARDISO or counted from SuperLU's factors), ``update`` and ``residual`` (the line search's
+  evaluation); the first iteration (a new pattern: PARDISO's analysis, the maps of the tangent) and
+  a second one on the same pattern (analysis reused);
+- a loaded step: ``bs.solve(model, steps=1)`` stretching the scene by ``STRAIN`` (every wire end at
+  the top moved along ``e_z``, the bottom clamped): Newton iterations, CPU s.  The bundles of
+  ``scaling.bundle_model`` overlap by design (0.5 % of R: a pre-stress of ~3e7 N at 19 wires, from
+  which one step does not converge), so the step runs on their overlap-free twins
+  (``strand_model``: ``build_strand``, same wires, lay and length, core enlarged to close the first
+  layer, contact layer on layer as ``examples/seven_wire_strand.py``); the rope is overlap-free by
+  construction; at most three halvings of the step (``STEP_FLOOR``), then reported as failed;
+- peak memory: ``ru_maxrss`` of the child (MB).
+
+The bundles are those of ``scaling.bundle_model`` at ``PER_WIRE`` = 158 elements per wire (the
+issue's 3002 / 5846 / 9638 elements).  The rope (``cables.build_rope``): ``ROPE_STRAND`` strands
+(1+6+12, wires 0.55 / 0.5 mm) six times around a 1+6+12 wire strand core (0.6 / 0.55 mm), 133
+wires, rope lay ``ROPE_LAY``, 48 elements per shortest lay (``ROPE_PER_LAY``): a rope of
+``ROPE_FULL`` m has about 1e5 elements, too many for this machine's memory (see the report);
+shorter pieces of the same rope are run (``rope-<length in mm>``) and the cost per element
+extrapolated (the rope is long and thin: fill, flops and contact points per element settle once the
+piece is longer than a few elements, so time and memory grow linearly with the length).
+"""
+import time
+
+import numpy as np
+
+PER_WIRE = 158
+LAYERS = {"19": 2, "37": 3, "61": 4}
+STRAIN = 1e-4               # of the loaded step
+STEP_FLOOR = 2.0 ** -3      # of the loaded step: at most three halvings, then reported as not converged
+ROPE_LAY = 0.1              # m
+ROPE_PER_LAY = 48
+ROPE_FULL = 0.6             # m: about 1e5 elements
+clock = time.process_time
+
+
+def rope_model(length):
+    import beamsolver as bs
+    L = bs.cables.Layer
+    core = [L(0.6e-3), L(0.55e-3, 6, lay_length=0.05), L(0.55e-3, 12, lay_length=0.05)]
+    strand = [L(0.55e-3), L(0.5e-3, 6, lay_length=0.04, direction="left"),
+              L(0.5e-3, 12, lay_length=0.04, direction="left")]
+    rope = bs.cables.build_rope(strand, length=length, E=2e11, lay_length=ROPE_LAY, core=core,
+                                elements_per_lay=ROPE_PER_LAY, mu=0.3, contact_options=dict(gauss_points=5))
+    return rope.model, rope.all_wires, rope
+
+
+def strand_model(name):
+    """The bundle ``name`` without overlaps, for the loaded step: ``build_strand`` of 1+6+12(+18+24)
+    wires of the bundle's radius, the bundle's lay and length, layers touching, the core enlarged
+    so that the first layer closes (``fit_core``), contact layer on layer only (``touch_tol=-0.5``)."""
+    import beamsolver as bs
+    from scaling import LAY, PER_LAY, WIRE_R
+    L = bs.cables.Layer
+    layers = [L(WIRE_R)] + [L(WIRE_R, 6 * k, lay_length=LAY) for k in range(1, LAYERS[name] + 1)]
+    st = bs.cables.build_strand(layers, LAY * PER_WIRE / PER_LAY, E=2e11, elements_per_lay=PER_LAY, mu=0.3,
+                                contact_options=dict(gauss_points=5), fit_core=True, touch_tol=-0.5)
+    st.clamp("bottom")
+    return st.model, st.all_wires, st.length
+
+
+def scene_model(name):
+    if name.startswith("rope"):
+        length = float(name.split("-")[1]) * 1e-3 if "-" in name else ROPE_FULL
+        m, wires, _ = rope_model(length)
+        return m, wires, length
+    from scaling import LAY, PER_LAY, bundle_model
+    m, wires = bundle_model(PER_WIRE, n_layers=LAYERS[name])
+    return m, wires, LAY * PER_WIRE / PER_LAY
+
+
+def _solver_info(f):
+    """Back-end, fill and flops of a ``linsolve`` factor."""
+    from linear_solvers import lu_flops
+    out = dict(backend=getattr(f, "backend", "?"), fill=float(getattr(f, "factor_nnz", np.nan)))
+    if out["backend"] == "pardiso":
+        out["flops"] = float(getattr(f, "flops", np.nan))
+    elif hasattr(f, "_lu"):
+        out["flops"] = lu_flops(f._lu.L, f._lu.U)
+    return out
+
+
+def measure_scene(name, rss_mb):
+    import beamsolver as bs
+    from beamsolver.nonlinear import linsolve
+    from beamsolver.nonlinear.problem import Problem
+    from scaling import warm_up
+    warm_up()                                   # MKL's and meshio's first-call costs out of the timings
+    t0 = clock()
+    m, wires, length = scene_model(name)
+    if name.startswith("rope"):
+        for w in wires:                         # (the bundles come clamped)
+            m.clamp(w.first)
+    problem = Problem.from_model(m)
+    system = problem.system
+    out = dict(scene=name, build_s=clock() - t0, elements=system.n_elements, unknowns=system.n_free,
+               length_m=length)
+    H = system.poses0.copy()
+    solver = linsolve.Solver()
+    for it in (1, 2):
+        t = {}
+        problem.begin_step(H, 0.0)
+        t0 = clock()
+        system.evaluate(H, problem.load_factors(1.0), tangent=True)
+        t["element"] = clock() - t0
+        problem.begin_step(H, 0.0)
+        t0 = clock()
+        ev = problem.evaluate(H, 1.0, tangent=True)
+        t["contact"] = max(clock() - t0 - t["element"], 0.0)
+        t0 = clock()
+        K = problem.tangent(ev)
+        t["assembly"] = clock() - t0
+        rhs = -ev.r[system.free_dofs]
+        t0 = clock()
+        f = solver.factorize(K)
+        f.solve(rhs)
+        t["solve"] = clock() - t0
+        # update and residual timed on a tiny increment (as scaling.py): the full Newton increment of
+        # the pre-stressed bundles at the reference poses pushes wires through each other
+        dz = 1e-9 * np.random.default_rng(1).standard_normal((system.n_nodes, 6))
+        t0 = clock()
+        H1 = problem.update(H, dz)
+        t["update"] = clock() - t0
+        t0 = clock()
+        problem.evaluate(H1, 1.0, tangent=False)
+        t["residual"] = clock() - t0
+        t["iteration"] = sum(t.values())
+        out.update({f"it{it}_{k}": v for k, v in t.items()})
+        out["contact_points"] = int(ev.details["contact"].get("n_active", -1))
+        out["nnz"] = int(K.nnz)
+        out.update(_solver_info(f))
+        out[f"rss_it{it}_mb"] = rss_mb()
+        del f, K, ev
+    out["analyses"] = solver.stats["analyses"]
+    solver.close()
+    del problem, system
+    # a loaded step: stretch by STRAIN (the bundles: their overlap-free twins, ``strand_model``)
+    if not name.startswith("rope"):
+        m, wires, length = strand_model(name)
+    for w in wires:
+        m.prescribe(w.last, bs.motion.translation(lambda t: (0.0, 0.0, STRAIN * length * t)))
+    stamps = []
+    t0 = clock()
+    try:
+        sol = bs.solve(m, steps=1, verbose=False, callback=lambda d: stamps.append(clock()),
+                       min_step_ratio=STEP_FLOOR)
+        st = sol.stats[-1]
+        out.update(step_iterations=int(st["iterations"]), step_cutbacks=int(st["cutbacks"]), step_status="ok")
+    except Exception as e:                      # noqa: BLE001  (reported, the table goes on)
+        out.update(step_iterations=len(stamps), step_status=type(e).__name__)
+    out["step_s"] = clock() - t0
+    out["rss_mb"] = rss_mb()
+    return out
+
+
+def report(rows, base_mb, table):
+    """Markdown: the scenes table and the rope's extrapolation to ``ROPE_FULL``."""
+    def g(v, f="{:.3g}"):
+        return "-" if v is None or (isinstance(v, float) and not np.isfinite(v)) else f.format(v)
+    head = ["scene", "elements", "unknowns", "contact points", "solver", "fill (1e6)", "flops (1e9)",
+            "element", "contact", "assembly", "solve", "update", "residual", "iteration (1st)", "iteration",
+            "loaded step (its)", "peak MB, iteration", "peak MB, with the step"]
+    body = []
+    for r in rows:
+        if "error" in r:
+            body.append([r["scene"], r["error"]] + ["-"] * (len(head) - 2))
+            continue
+        body.append([r["scene"], r["elements"], r["unknowns"], r["contact_points"], r["backend"],
+                     g(r["fill"] / 1e6), g(r.get("flops", np.nan) / 1e9)]
+                    + [g(r[f"it2_{k}"]) for k in ("element", "contact", "assembly", "solve", "update", "residual")]
+                    + [g(r["it1_iteration"]), g(r["it2_iteration"]),
+                       f"{g(r['step_s'])} ({r['step_iterations']}"
+                       f"{'' if r['step_status'] == 'ok' else ', ' + r['step_status']})",
+                       f"{r['rss_it2_mb']:.0f}", f"{r['rss_mb']:.0f}"])
+    lines = [table(head, body)]
+    ropes = [r for r in rows if r["scene"].startswith("rope") and "error" not in r]
+    if len(ropes) >= 2:
+        n = np.array([r["elements"] for r in ropes], float)
+        full = ROPE_FULL / ropes[-1]["length_m"] * n[-1]
+
+        def fit(key, lo=0.0):
+            y = np.array([r[key] for r in ropes], float) - lo
+            slope = np.polyfit(np.log(n), np.log(np.maximum(y, 1e-9)), 1)[0]
+            return y[-1] * (full / n[-1]) ** max(slope, 1.0) + lo, slope
+        it, p_it = fit("it2_iteration")
+        sv, p_sv = fit("it2_solve")
+        mem, p_mem = fit("rss_it2_mb", base_mb)
+        pts = ropes[-1]["contact_points"] / n[-1] * full
+        fill = ropes[-1]["fill"] / n[-1] * full
+        lines.append(
+            f"\nThe rope of {ROPE_FULL:g} m ({full:.3g} elements, ~{pts:.2g} contact points), extrapolated from "
+            f"the pieces above (log-log slope over them, at least 1): one Newton iteration ~{it:.3g} s "
+            f"(slope {p_it:.2f}; of which the linear solve ~{sv:.3g} s, slope {p_sv:.2f}), peak memory of the "
+            f"iteration ~{mem / 1024:.3g} GB (slope {p_mem:.2f} above the {base_mb:.0f} MB baseline), fill "
+            f"~{fill:.3g} "
+            f"factor entries ({12 * fill / 2**30:.3g} GB at 12 bytes each), and the contact tangent's COO "
+            f"triplets alone {24 * 576 * pts / 2**30:.3g} GB (576 entries per point, 24 bytes each).")
+    return "\n".join(lines)
