@@ -37,7 +37,7 @@ and master beam the closest accepted projection is kept.
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .._jit import jit
+from .._jit import jit, jit_callee
 from .projection import overlap, spheres
 
 XI_TOL = 1e-9
