@@ -33,6 +33,7 @@ from .nonlinear.problem import Problem
 from .stepping.restart import restart_from
 from .stepping.stabilize import from_option as stabilize_option
 from .stepping.steps import Run
+from .model.sanity import check_sizes
 from .model.validation import check_solve_arguments, check_stability_options
 
 
@@ -642,6 +643,8 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
                           min_step_ratio=min_step_ratio, checkpoint=checkpoint, initial_poses=initial_poses,
                           restart=restart, callback=callback, output=output)
     arc = check_arc_length_arguments(path, arc_length, restart, branch_switching, stabilize)
+    if restart is None:
+        check_sizes(model)      # implausible radii or lengths: a GeometryWarning before anything is compiled
     warm_up(model)          # a first run: compile before step 0, in two processes (jit_warmup)
     problem = Problem.from_model(model, check_rigid_modes=check_rigid_modes)
     system = problem.system
