@@ -5,10 +5,12 @@ search finds wires that "changed sides".  ``check_sizes(model)``, run by ``solve
 warns once (``GeometryWarning``, the numbers in the message) when
 
 - a beam's radius is larger than its length (the arc length of its reference centre line), or
-- a beam's tube (its centre line and radius) reaches the centre line of another beam: their
-  centre lines come closer than the larger of the two radii (touching tubes are ``R1 + R2``
-  apart).  Beams joined to each other (``Model.join``, directly or through a node of
-  ``add_node``) are not compared: they meet at the joint.
+- a beam's tube (its centre line and radius) holds the centre line of another beam deep inside:
+  their centre lines come closer than ``OVERLAP`` (one half) of the larger of the two radii.
+  Touching tubes are ``R1 + R2`` apart; a start overlapping by less than half the larger radius
+  (a rope's polyline pulled onto a post, adjusted by ``add_contact(adjust=)``) is not flagged, a radius
+  a thousand times too large is.  Beams joined to each other (``Model.join``, directly or through a
+  node of ``add_node``) are not compared: they meet at the joint.
 
 The nearest approach of two centre lines is that of their reference polylines (segment to
 segment); candidate segments come from a k-d tree of the segments' midpoints, so a scene of
@@ -23,6 +25,7 @@ from ..errors import GeometryWarning
 __all__ = ["check_sizes", "size_problems", "segment_distances"]
 
 MAX_LISTED = 5        # problems named in the warning (the rest counted)
+OVERLAP = 0.5         # centre lines closer than this times the larger radius: implausible
 
 
 def segment_distances(a0, a1, b0, b1):
@@ -72,7 +75,7 @@ def _joined_pairs(model):
 
 def size_problems(model):
     """The implausible sizes of ``model``: a list of ``(kind, text)``, ``kind`` ``"radius"`` (a radius
-    above its beam's length) or ``"overlap"`` (a tube reaching another beam's centre line)."""
+    above its beam's length) or ``"overlap"`` (a tube holding another beam's centre line deep inside)."""
     beams = model.beams
     if not beams:
         return []
@@ -100,7 +103,7 @@ def size_problems(model):
     h_max = float(half.max())
     for i in range(len(beams)):
         mine = np.flatnonzero(owner == i)
-        reach = max(radius[i], radius.max()) + float(half[mine].max()) + h_max
+        reach = OVERLAP * max(radius[i], radius.max()) + float(half[mine].max()) + h_max
         cand = tree.query_ball_point(mid[mine], r=reach)
         s = np.repeat(mine, [len(c) for c in cand])
         t = np.fromiter((j for c in cand for j in c), dtype=np.int64, count=len(s))
@@ -113,15 +116,15 @@ def size_problems(model):
         if not len(s):
             continue
         d = segment_distances(A[s], B[s], A[t], B[t])
-        limit = np.maximum(radius[i], radius[owner[t]])
+        limit = OVERLAP * np.maximum(radius[i], radius[owner[t]])
         for j in np.unique(owner[t][d < limit]):
             sel = owner[t] == j
             found[(i, int(j))] = float(d[sel].min())
     for (i, j), d in sorted(found.items()):
         bi, bj = beams[i], beams[j]
         out.append(("overlap", f"the centre lines of {bi!r} (radius {bi.section.radius:.4g}) and {bj!r} (radius "
-                               f"{bj.section.radius:.4g}) come {d:.4g} apart, less than the larger radius: one tube "
-                               f"reaches the other's centre line (touching tubes are R1 + R2 = "
+                               f"{bj.section.radius:.4g}) come {d:.4g} apart, less than half the larger radius: one tube "
+                               f"holds the other's centre line deep inside (touching tubes are R1 + R2 = "
                                f"{bi.section.radius + bj.section.radius:.4g} apart)"))
     return out
 
