@@ -3,7 +3,7 @@ from . import contact, elements
 from .model import geometry, motion
 from .lie import se3
 from .stepping.arclength import ArcLength
-from .errors import ConditioningWarning, ConvergenceError, InputError, MaterialRangeWarning, StabilityWarning, StabilizationWarning
+from .errors import ConditioningWarning, ConvergenceError, GeometryWarning, InputError, MaterialRangeWarning, StabilityWarning, StabilizationWarning
 from .io import load
 from .results.linearize import Linearization, linearize
 from .model.model import Beam, Model
@@ -18,7 +18,7 @@ listen()        # the first compilation of a process prints a line and a progres
 
 
 __all__ = ["Model", "Beam", "Section", "Solution", "solve", "Convergence", "InputError",
-           "ConvergenceError", "MaterialRangeWarning", "StabilityWarning", "StabilizationWarning", "ConditioningWarning",
+           "ConvergenceError", "MaterialRangeWarning", "StabilityWarning", "StabilizationWarning", "ConditioningWarning", "GeometryWarning",
            "load", "linearize", "sweep", "Linearization", "se3", "geometry",
            "motion", "contact", "elements", "ArcLength", "__version__"]
 

@@ -23,6 +23,7 @@ from .stepping.restart import restart_from
 from .stepping.stabilize import from_option as stabilize_option
 from .model.validation import check_solve_arguments, check_stability_options, count, real
 from .stepping.stability import nonconservative_parts
+from .model.sanity import check_sizes
 
 
 __all__ = ["solve", "Convergence", "Newton", "Verdict"]
@@ -172,6 +173,8 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
                           initial_poses=initial_poses, restart=restart, callback=callback, output=output)
     stepper = steppers.stepper(path)
     path_options = stepper.path_options(arc_length, restart, branch_switching, stabilize)
+    if restart is None:
+        check_sizes(model)      # implausible radii or lengths: a GeometryWarning before anything is compiled
     warm_up(model)          # a first run: compile before step 0, in two processes (jit_warmup)
     problem = Problem.from_model(model, check_rigid_modes=check_rigid_modes)
     system = problem.system

@@ -1,7 +1,7 @@
 """Exceptions raised by beamsolver."""
 
 __all__ = ["InputError", "ConvergenceError", "StabilityWarning", "StabilizationWarning", "MaterialRangeWarning",
-           "ConditioningWarning"]
+           "ConditioningWarning", "GeometryWarning"]
 
 
 class InputError(ValueError):
@@ -35,3 +35,8 @@ class MaterialRangeWarning(UserWarning):
 class ConditioningWarning(RuntimeWarning):
     """A contact penalty far stiffer than the beams it couples leaves the tangent ill-conditioned:
     see ``beamsolver.contact.conditioning``."""
+
+
+class GeometryWarning(UserWarning):
+    """Sizes implausible for the scene at step 0 (a radius larger than its beam, a tube reaching another
+    beam's centre line: often a radius in another unit than the lengths): see ``beamsolver.model.sanity``."""

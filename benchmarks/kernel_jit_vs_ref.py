@@ -39,6 +39,9 @@ def load_ref(ref, directory):
     """``kernel_jit`` as of the git revision ``ref``, imported as ``beamsolver.contact.kernel_jit_ref``."""
     src = subprocess.run(["git", "show", f"{ref}:beamsolver/contact/kernel_jit.py"], cwd=ROOT, check=True,
                          capture_output=True, text=True).stdout
+    # revisions before _jit.jit_callee imported _jit's jit_inline (numba-level inlining): give them theirs
+    src = src.replace("from .._jit import jit, jit_inline\n", "from .._jit import jit\nfrom numba import njit as _njit\n"
+                      "jit_inline = _njit(cache=True, error_model=\"numpy\", inline=\"always\")\n")
     path = Path(directory) / "kernel_jit_ref.py"
     path.write_text(src)
     spec = importlib.util.spec_from_file_location("beamsolver.contact.kernel_jit_ref", path)

@@ -13,7 +13,8 @@
     An optional global dict ``solve_options`` gives keyword arguments of
     ``beamsolver.solve`` (``steps``, ``t_end``, ``rtol``, ...); ``--steps`` and
     ``--t-end`` override it.  Output (VTU/PVD and ``solution.npz``) goes to
-    ``DIR`` (default: ``<script name>_output`` in the current directory).
+    ``DIR`` (default: ``<script name>_run`` in the current directory; not the ``<name>_output`` a script's
+    own ``__main__`` writes, e.g. the main job's ``twisted_pair_output``).
     Exit status 0 when every step converged, 2 on ``ConvergenceError`` (the
     converged steps are written), 3 when the run reached its end off equilibrium
     (``Solution.status`` ``"off-equilibrium"``: a stabilised run whose damping still
@@ -108,7 +109,7 @@ def cmd_run(args):
         opts["steps"] = args.steps
     if args.t_end is not None:
         opts["t_end"] = args.t_end
-    out = Path(args.output) if args.output else Path(f"{script.stem}_output")
+    out = Path(args.output) if args.output else Path(f"{script.stem}_run")     # not the script's own <name>_output
     opts["output"] = str(out)
     opts.setdefault("verbose", False if args.quiet else None)
     if args.restart:
@@ -236,7 +237,12 @@ def cmd_render(args):
     from . import viz
     sol = bs.load(args.result)
     color = None if args.color_by == "none" else args.color_by
-    viz.render(sol, step=args.step, path=args.output, color_by=color, window_size=tuple(args.size))
+    try:
+        viz.render(sol, step=args.step, path=args.output, color_by=color, window_size=tuple(args.size),
+                   view=args.view, zoom=args.zoom, scale=args.scale)
+    except ImportError as e:                         # one line, as `beamsolver sweep` without dask
+        print(f"beamsolver render: {e}", file=sys.stderr)
+        return 1
     print(f"written: {args.output}")
     return 0
 
@@ -245,7 +251,10 @@ def cmd_export(args):
     import beamsolver as bs
     from ..io import write_vtk
     pvd = write_vtk(bs.load(args.result), args.folder)
-    print(f"written: {pvd}")
+    folder = pvd.parent
+    written = [p for p in (pvd, folder / "contact.pvd") if p.is_file()]
+    n_vtu = len(list(folder.glob("*.vtu")))
+    print(f"written: {', '.join(map(str, written))} ({n_vtu} .vtu files in {folder})")
     return 0
 
 
@@ -263,11 +272,13 @@ def cmd_paraview(args):
 
 
 def main(argv=None):
+    from ..version import __version__
     p = argparse.ArgumentParser(prog="beamsolver", description="Geometrically exact beams with contact.")
+    p.add_argument("--version", action="version", version=f"beamsolver {__version__}")
     sub = p.add_subparsers(dest="command", required=True)
     r = sub.add_parser("run", help="run a scene script (defines `model` or `build()`)")
     r.add_argument("script")
-    r.add_argument("--output", "-o", help="output folder (default <script>_output)")
+    r.add_argument("--output", "-o", help="output folder (default <script>_run)")
     r.add_argument("--steps", type=int, help="number of pseudo-time steps")
     r.add_argument("--t-end", type=float, help="end of the pseudo-time")
     r.add_argument("--restart", help="continue from a saved result (.npz or output folder)")
@@ -286,6 +297,11 @@ def main(argv=None):
     d.add_argument("--color-by", default="displacement",
                    help="displacement, radius, beam_id, N, Q2, Q3, T, M2, M3, strain or none")
     d.add_argument("--size", type=int, nargs=2, default=(800, 600), metavar=("W", "H"))
+    d.add_argument("--view", choices=("auto", "xy", "xz", "yz", "iso"), default="auto",
+                   help="direction of view (default: along the normal of a flat scene, else isometric)")
+    d.add_argument("--zoom", type=float, default=1.0, help="magnification (> 1 zooms in)")
+    d.add_argument("--scale", type=float, nargs=3, metavar=("SX", "SY", "SZ"),
+                   help="stretch the drawing along x, y, z (e.g. 1 1 0.02 to see the lay of a long cable)")
     d.set_defaults(func=cmd_render)
     e = sub.add_parser("export", help="write VTU/PVD files of a saved result")
     e.add_argument("result")

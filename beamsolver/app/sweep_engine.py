@@ -24,6 +24,7 @@ scheduler applies its own ``distributed.scheduler.allowed-failures`` first
 """
 import contextlib
 import os
+import sys
 import time
 import traceback
 import uuid
@@ -145,6 +146,34 @@ def _temporary_security(distributed):
                           'False) on a machine no one else uses)') from None
 
 
+def unguarded_main_call(stack=None):
+    """``"<script>, line N"`` when the running main script (a file) reaches this call from its module-level
+    code outside ``if __name__ == "__main__":`` (the spawned workers of a local cluster import it again and
+    would each start a sweep: ~500 lines of Dask tracebacks before any message); else ``""``."""
+    import ast
+    import inspect
+    main = sys.modules.get("__main__")
+    path = getattr(main, "__file__", None)
+    if not path or not os.path.isfile(path):
+        return ""               # interactive, python -c, a notebook: the workers do not import a script
+    for frame in stack or inspect.stack(context=0):
+        if frame.frame.f_globals is vars(main) and frame.frame.f_code.co_name == "<module>":
+            line = frame.frame.f_lineno
+            break
+    else:
+        return ""
+    try:
+        tree = ast.parse(open(path, encoding="utf-8").read())
+    except (OSError, SyntaxError, ValueError):
+        return ""
+    for node in tree.body:
+        if node.lineno <= line <= (node.end_lineno or node.lineno):
+            guarded = isinstance(node, ast.If) and "__name__" in ast.unparse(node.test) and \
+                "__main__" in ast.unparse(node.test)
+            return "" if guarded else f"{os.path.basename(path)}, line {line},"
+    return ""
+
+
 def local_client(n_workers=None, secure=True, **cluster_options):
     """A ``Client`` on a new ``LocalCluster``: ``n_workers`` (default: one per core) single-threaded
     worker processes with one BLAS thread each, on 127.0.0.1; closing the client closes the cluster.
@@ -155,9 +184,14 @@ def local_client(n_workers=None, secure=True, **cluster_options):
     plain TCP (faster to start and per task: docs/benchmarks.md, ``dask_tls``), for
     a machine no one else uses."""
     import multiprocessing
-    if multiprocessing.parent_process() is not None:
+    if multiprocessing.parent_process() is not None or getattr(multiprocessing.current_process(), "_inheriting", False):
         raise RuntimeError("beamsolver.sweep: a worker process started a sweep: put the code that calls "
                            "sweep under `if __name__ == \"__main__\":` (the workers import the main script)")
+    unguarded = unguarded_main_call()
+    if unguarded:
+        raise RuntimeError(f"beamsolver.sweep: {unguarded} calls sweep outside `if __name__ == \"__main__\":`; "
+                           "put it under that guard (the local cluster's workers import the main script, which "
+                           "would start a sweep in each of them)")
     distributed = _import_distributed()
     import dask
     opts = dict(n_workers=n_workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,

@@ -12,7 +12,7 @@ The numpy versions (``np.bincount``, ``se3.compose``/``se3.exp``,
 """
 import numpy as np
 
-from .._jit import jit
+from .._jit import jit, jit_callee
 from ..elements.element_jit import _side
 from ..lie.se3_jit import C_, Q2_, Q3_, add, coefficient, compose_into, cross, dot, exp_pose, log_relative, mv, pose, scale
 
@@ -37,7 +37,7 @@ def compose_exp(H, dz, nodes):
         compose_into(H[i], E, H[i])
 
 
-@jit
+@jit_callee
 def _tinv_apply(u, w, t, d, vu, vw):
     """``T(h)^-1 (vu, vw)`` at ``h = (u, w)``: ``(Ti vu + X vw, Ti vw)``."""
     c1, c2, c3 = coefficient(C_, t), coefficient(Q2_, t), coefficient(Q3_, t)

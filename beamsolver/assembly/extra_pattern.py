@@ -37,7 +37,7 @@ docs/benchmarks.md).
 import numpy as np
 import scipy.sparse as sp
 
-from .._jit import jit, jit_inline
+from .._jit import jit, jit_callee
 
 __all__ = ["ExtraPattern", "BlockPattern"]
 
@@ -86,7 +86,7 @@ def _runs(row, ptr, start):
     return n
 
 
-@jit_inline
+@jit_callee
 def _merge_column(j, el_row, a, a_end, c_row, c_start, r, r_end, n, p, u_row, u_col, el_pos, c_pos):
     """Column ``j`` of the union: element entries ``a:a_end`` and runs ``r:r_end`` (both sorted by
     row) written from union position ``n``, the runs' positions at ``c_pos[p:]``; returns ``(n, p)``."""

@@ -53,7 +53,7 @@ from numba import config as numba_config, types as nb_types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from .._jit import jit, jit_inline
+from .._jit import jit, jit_callee
 from ..errors import InputError
 from ..elements.element_jit import _dq_du, _dq_dw
 from ..lie.se3_jit import madd, mscale
@@ -97,7 +97,7 @@ _borrowed = _borrowed_python if numba_config.DISABLE_JIT else _borrowed_intrinsi
 
 
 # ---------------------------------------------------------------- small algebra (tuples; small arrays written in place)
-@jit_inline
+@jit_callee
 def _exp_abc(u, w, t2, a, b, c):
     """``exp(hat(u, w))`` as rotation and position tuples (``se3.exp``) from ``t2 = |w|^2`` and the
     coefficients ``a, b, c`` at ``|w|``."""
@@ -106,7 +106,7 @@ def _exp_abc(u, w, t2, a, b, c):
     return R, add(add(u, scale(b, wxu)), scale(c, cross(w, wxu)))
 
 
-@jit_inline
+@jit_callee
 def _exp_inline(u, w):
     """``exp(hat(u, w))`` as rotation and position tuples (``se3.exp``), inlined into its caller."""
     t2 = dot(w, w)
@@ -114,7 +114,7 @@ def _exp_inline(u, w):
     return _exp_abc(u, w, t2, coefficient(A_, t), coefficient(B_, t), coefficient(C_, t))
 
 
-@jit_inline
+@jit_callee
 def _section_inline(RA, xA, u, w, xi):
     """``_section`` inlined into its caller (the same operations; ``_project``'s iterations: the parts a
     projection kind does not use are dropped by the compiler)."""
@@ -123,19 +123,19 @@ def _section_inline(RA, xA, u, w, xi):
     return R, add(mv(RA, xs), xA), mv(R, u), mv(R, cross(w, u))
 
 
-@jit
+@jit_callee
 def _exp(u, w):
     """``_exp_inline`` as a function of its own (one copy of the maths, called where not inlined)."""
     return _exp_inline(u, w)
 
 
-@jit
+@jit_callee
 def _section(RA, xA, u, w, xi):
     """Pose of ``H_A exp(xi h)``, ``x' = R u`` and ``x'' = R (w x u)`` (``frames.section``)."""
     return _section_inline(RA, xA, u, w, xi)
 
 
-@jit
+@jit_callee
 def _coefficients(w):
     """``t^2 = |w|^2`` and the coefficients ``a, b, c, q2, q3, cp, q2p, q3p`` at ``t`` (``coefficient``,
     each once): the sections, node Jacobians and their derivatives at one ``xi h`` share them."""
@@ -145,13 +145,13 @@ def _coefficients(w):
                 coefficient(CP_, t), coefficient(Q2P_, t), coefficient(Q3P_, t))
 
 
-@jit
+@jit_callee
 def _exp_co(u, w, t2, co):
     """``_exp`` with the coefficients of ``_coefficients(w)``."""
     return _exp_abc(u, w, t2, co[0], co[1], co[2])
 
 
-@jit_inline
+@jit_callee
 def _section_co(RA, xA, u, w, xi, t2, co):
     """``_section`` with the coefficients of ``_coefficients(xi w)``."""
     Rs, xs = _exp_co(scale(xi, u), scale(xi, w), t2, co)
@@ -159,33 +159,33 @@ def _section_co(RA, xA, u, w, xi, t2, co):
     return R, add(mv(RA, xs), xA), mv(R, u), mv(R, cross(w, u))
 
 
-@jit
+@jit_callee
 def _pose_of(X, j):
     R = ((X[j, 0, 0], X[j, 0, 1], X[j, 0, 2]), (X[j, 1, 0], X[j, 1, 1], X[j, 1, 2]),
          (X[j, 2, 0], X[j, 2, 1], X[j, 2, 2]))
     return R, (X[j, 0, 3], X[j, 1, 3], X[j, 2, 3])
 
 
-@jit_inline
+@jit_callee
 def _put3(A, r0, c0, M):
     for i in range(3):
         for j in range(3):
             A[r0 + i, c0 + j] = M[i][j]
 
 
-@jit_inline
+@jit_callee
 def _zero3(A, r0, c0):
     for i in range(3):
         for j in range(3):
             A[r0 + i, c0 + j] = 0.0
 
 
-@jit
+@jit_callee
 def _col(R, j):
     return (R[0][j], R[1][j], R[2][j])
 
 
-@jit_inline
+@jit_callee
 def _mm_ut(A, B, out):
     """``out = A @ B`` for block upper-triangular ``(6, 6)`` arrays (``A[3:, :3] == B[3:, :3] == 0``, as
     ``T(h)``, ``T(h)^-1``, ``Ad(H)``): ``_mm`` without the terms of the zero blocks.  The same floats:
@@ -198,7 +198,7 @@ def _mm_ut(A, B, out):
             out[i, j] = acc
 
 
-@jit
+@jit_callee
 def _tangent(u, w, T):
     """``T = T(h) = [[T3, Q(-u, -w)], [0, T3]]`` (``se3.tangent``), ``(6, 6)``."""
     t2 = dot(w, w)
@@ -213,7 +213,7 @@ def _tangent(u, w, T):
     _zero3(T, 3, 0)
 
 
-@jit
+@jit_callee
 def _tangent_co(u, w, T, t2, co):
     """``_tangent`` with the coefficients of ``_coefficients(w)`` (or of ``-w``: the same)."""
     b, c = co[1], co[2]
@@ -225,7 +225,7 @@ def _tangent_co(u, w, T, t2, co):
     _zero3(T, 3, 0)
 
 
-@jit
+@jit_callee
 def _tangent_inv(u, w, T):
     """``T = T(h)^-1 = [[Ti, -Ti Q(-u, -w) Ti], [0, Ti]]`` (``se3.tangent_inv``), ``(6, 6)``."""
     t2 = dot(w, w)
@@ -242,7 +242,7 @@ def _tangent_inv(u, w, T):
     _zero3(T, 3, 0)
 
 
-@jit
+@jit_callee
 def _adjoint_inv(R, x, A):
     """``A = Ad(H^-1)`` of the pose ``(R, x)``; ``Ad(H) = [[R, hat(x) R], [0, R]]``, ``(6, 6)``."""
     Rt = transpose(R)
@@ -275,7 +275,7 @@ _OFFSETS = dict(zip(_SIZES, np.cumsum([0] + list(_SIZES.values()))[:-1].tolist()
 N_G = sum(_SIZES.values())
 
 
-@jit
+@jit_callee
 def _side(u, w, S):
     """``T(h)^-1`` and ``Ad(exp(-h))`` of an element twist into ``S[S_TI]``, ``S[S_AH]``."""
     _tangent_inv(u, w, S[S_TI])
@@ -283,7 +283,7 @@ def _side(u, w, S):
     _adjoint_inv(Rh, xh, S[S_AH])
 
 
-@jit_inline
+@jit_callee
 def _jacobians(u, w, xi, t2, co, Ti, Ah, Ts, As, JA, JB, tmp):
     """``J_A, J_B`` of ``H_C = H_A exp(xi h)`` (``frames.node_jacobians``); ``Ti = T(h)^-1``,
     ``Ah = Ad(exp(-h))``; also ``Ts = T(xi h)`` and ``As = Ad(exp(-xi h))``; ``t2, co = _coefficients(xi w)``."""
@@ -301,40 +301,40 @@ def _jacobians(u, w, xi, t2, co, Ti, Ah, Ts, As, JA, JB, tmp):
             JA[i, j] = As[i, j] - tmp[i, j]
 
 
-@jit_inline
+@jit_callee
 def _blk(A, r0, c0):
     """The 3x3 block ``A[r0:r0+3, c0:c0+3]`` of a ``(6, 6)`` array as a tuple."""
     return ((A[r0, c0], A[r0, c0 + 1], A[r0, c0 + 2]), (A[r0 + 1, c0], A[r0 + 1, c0 + 1], A[r0 + 1, c0 + 2]),
             (A[r0 + 2, c0], A[r0 + 2, c0 + 1], A[r0 + 2, c0 + 2]))
 
 
-@jit
+@jit_callee
 def _hat_mm(z, A):
     """``hat(z) A`` of a 3-vector and a 3x3 tuple: rows ``z1 A_2 - z2 A_1, z2 A_0 - z0 A_2, z0 A_1 - z1 A_0``."""
     return (add(scale(z[1], A[2]), scale(-z[2], A[1])), add(scale(z[2], A[0]), scale(-z[0], A[2])),
             add(scale(z[0], A[1]), scale(-z[1], A[0])))
 
 
-@jit
+@jit_callee
 def _msub(A, s, B):
     """``A - s B`` of 3x3 tuples."""
     return madd(A, mscale(-s, B))
 
 
-@jit
+@jit_callee
 def _mdiff(A, B):
     """``A - B`` of 3x3 tuples."""
     return (add(A[0], scale(-1.0, B[0])), add(A[1], scale(-1.0, B[1])), add(A[2], scale(-1.0, B[2])))
 
 
-@jit
+@jit_callee
 def _axmy(s, A, B):
     """``s A - B`` of 3x3 tuples."""
     return (add(scale(s, A[0]), scale(-1.0, B[0])), add(scale(s, A[1]), scale(-1.0, B[1])),
             add(scale(s, A[2]), scale(-1.0, B[2])))
 
 
-@jit
+@jit_callee
 def _d_t3t(w, v, b, c, bp, cp):
     """``d(T3(w)^T v)/dw`` at fixed ``v``, ``T3(w)^T v = v + b w x v + c w x (w x v)`` (the ``SO(3)`` block of
     ``T(h)^T``): ``-b hat(v) + bp (w x v) w^T + c ((w.v) I + w v^T - 2 v w^T) + cp (w x (w x v)) w^T`` with
@@ -345,7 +345,7 @@ def _d_t3t(w, v, b, c, bp, cp):
     return add_outer(M, scale(c, w), v)
 
 
-@jit
+@jit_callee
 def _dt_t(u, w, a, m, t2, ca, b, c1, c2, c3, cp, q2p, q3p):
     """``F = d(T(s)^T wr)/ds`` at fixed ``wr = (a, m)``, ``s = (u, w)``, as the blocks ``F12, F21, F22`` of
     ``[[0, F12], [F21, F22]]``; ``t2 = |w|^2`` and the coefficients ``a, b, c, q2, q3, cp, q2p, q3p`` at ``|w|``.
@@ -367,7 +367,7 @@ def _dt_t(u, w, a, m, t2, ca, b, c1, c2, c3, cp, q2p, q3p):
     return _d_t3t(w, a, b, c1, bp, cp), F21, madd(dQw, _d_t3t(w, m, b, c1, bp, cp))
 
 
-@jit_inline
+@jit_callee
 def _jacobian_derivatives(u, w, xi, t2, co, S, v, c):
     """``d(J_A^T wr)/dh, d(J_B^T wr)/dh`` into ``S[S_DA], S[S_DB]`` and ``d/dxi`` into ``v[V_DA], v[V_DB]``
     at fixed ``wr = v[V_WR]``; ``S`` holds ``TI, AH, TMH`` of the element and ``TS, AS, JB`` at this ``xi``;
@@ -423,13 +423,13 @@ def _jacobian_derivatives(u, w, xi, t2, co, S, v, c):
 
 
 # ---------------------------------------------------------------- projection and its derivative
-@jit
+@jit_callee
 def _same(a, b):
     """``a`` and ``b`` are the same float, bit for bit (not nan)."""
     return a == b and np.signbit(a) == np.signbit(b)
 
 
-@jit_inline
+@jit_callee
 def _project(kind, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations=2):
     """Newton iterations of ``frames.project`` (two in the kernel, from the search's converged point).
 
@@ -440,7 +440,7 @@ def _project(kind, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations=2):
                          iterations)
 
 
-@jit_inline
+@jit_callee
 def _project_from(kind, sec1, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations):
     """``_project`` given the slave section ``sec1 = _section(RA1, xA1, u1, w1, xi1)`` (a caller that has it)."""
     moving = kind != LINE and kind != ORTHOGONAL
@@ -473,7 +473,7 @@ def _project_from(kind, sec1, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iter
     return xi1, xi2
 
 
-@jit_inline
+@jit_callee
 def _rot_col(R, G, r0, k):
     """``R @ G[r0:r0+3, k]``, ``R`` a 3x3 tuple."""
     return (R[0][0] * G[r0 * W + k] + R[0][1] * G[(r0 + 1) * W + k] + R[0][2] * G[(r0 + 2) * W + k],
@@ -481,13 +481,13 @@ def _rot_col(R, G, r0, k):
             R[2][0] * G[r0 * W + k] + R[2][1] * G[(r0 + 1) * W + k] + R[2][2] * G[(r0 + 2) * W + k])
 
 
-@jit_inline
+@jit_callee
 def _col_dot(a, G, r0, k):
     """``a . G[r0:r0+3, k]`` (rows of ``G``)."""
     return a[0] * G[r0 * W + k] + a[1] * G[(r0 + 1) * W + k] + a[2] * G[(r0 + 2) * W + k]
 
 
-@jit_inline
+@jit_callee
 def _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, G):
     """``dxi1, dxi2`` (rows ``G_DXI1``, ``G_DXI2`` of ``G``) by the implicit-function theorem at the converged
     projection, from the section-frame variations at fixed ``xi`` (rows ``G_VC``, ``G_VF``) and the twist
@@ -528,7 +528,7 @@ def _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, G):
 C_POSE, C_U, C_W, C_T2, C_A, C_B, C_CO, N_CACHE = 0, 24, 27, 30, 31, 32, 33, 39
 
 
-@jit
+@jit_callee
 def _element_side(Xp, j0, S, c):
     """Twist ``h = log(H_A^-1 H_B)`` of the element of nodes ``j0, j0 + 1`` and the element's quantities:
     ``T(h)^-1``, ``Ad(exp(-h))``, ``T(h)^-1 Ad(exp(-h))``, ``T(-h)`` into ``S[S_TI], S[S_AH], S[S_TIAH],
@@ -565,7 +565,7 @@ def _element_side(Xp, j0, S, c):
     return RA, xA, u, w
 
 
-@jit_inline
+@jit_callee
 def _variations(S, c0, G, DH, V):
     """Twist variation ``dh = T(h)^-1 (dq_B - Ad(exp(-h)) dq_A)`` and section-frame variation at fixed
     ``xi`` ``(J_A dq_A + J_B dq_B)`` into the rows ``DH``, ``V`` of ``G`` (6 each), node A at column ``c0``
@@ -583,7 +583,7 @@ def _variations(S, c0, G, DH, V):
 
 
 # ---------------------------------------------------------------- 3-vectors with gradients (3, 24)
-@jit_inline
+@jit_callee
 def _axes(RC, xC, RF, xF, G):
     """``n, t1, t2`` (``frames.axes``), centre distance, and the gradients of ``n, t1, t2, dist``
     into ``G`` (rows ``G_DN``, ``G_DT1``, ``G_DT2``, ``G_DDIST``; one pass over the 24 columns)."""
@@ -614,25 +614,25 @@ def _axes(RC, xC, RF, xF, G):
 
 
 # ---------------------------------------------------------------- friction
-@jit_inline
+@jit_callee
 def _pose4(H):
     R = ((H[0, 0], H[0, 1], H[0, 2]), (H[1, 0], H[1, 1], H[1, 2]), (H[2, 0], H[2, 1], H[2, 2]))
     return R, (H[0, 3], H[1, 3], H[2, 3])
 
 
-@jit_inline
+@jit_callee
 def _compose(RA, xA, RB, xB):
     return mm(RA, RB), add(mv(RA, xB), xA)
 
 
-@jit_inline
+@jit_callee
 def _vm(y, M):
     """The row ``y^T M`` (``M^T y``) of a 3x3 tuple ``M``."""
     return (y[0] * M[0][0] + y[1] * M[1][0] + y[2] * M[2][0], y[0] * M[0][1] + y[1] * M[1][1] + y[2] * M[2][1],
             y[0] * M[0][2] + y[1] * M[1][2] + y[2] * M[2][2])
 
 
-@jit_inline
+@jit_callee
 def _row_ut(yf, ym, A):
     """The row ``y^T A``, ``y = (yf, ym)``, of a block upper-triangular ``(6, 6)`` array (``A[3:, :3] == 0``),
     as two 3-tuples (written out: nested inlined helpers cost compile time)."""
@@ -644,13 +644,13 @@ def _row_ut(yf, ym, A):
              yf[0] * A[0, 5] + yf[1] * A[1, 5] + yf[2] * A[2, 5] + ym[0] * A[3, 5] + ym[1] * A[4, 5] + ym[2] * A[5, 5]))
 
 
-@jit_inline
+@jit_callee
 def _row_adjoint_inv(yf, ym, R, xt):
     """The row ``y^T Ad(H^-1)`` of the pose ``H = (R, x)``, ``xt = -R^T x``: ``(R yf, R (ym + yf x xt))``."""
     return mv(R, yf), mv(R, add(ym, cross(yf, xt)))
 
 
-@jit_inline
+@jit_callee
 def _coefficients_exp_tangent(w):
     """``t^2 = |w|^2`` and the coefficients ``a, b, c, q2, q3`` at ``t``: those of ``exp`` and ``T`` (a
     section and its node Jacobians, without their derivatives; ``_coefficients`` has all ten)."""
@@ -659,7 +659,7 @@ def _coefficients_exp_tangent(w):
     return t2, (coefficient(A_, t), coefficient(B_, t), coefficient(C_, t), coefficient(Q2_, t), coefficient(Q3_, t))
 
 
-@jit_inline
+@jit_callee
 def _section_prev(RA, xA, u, w, xi, R, x, xip):
     """The section at ``xip`` and the factors of its node Jacobians ``J_B = xip T(s) T(h)^-1``,
     ``J_A = Ad(exp(-s)) - J_B Ad(exp(-h))``, ``s = xip h``: ``(same, R, x, Rs, xt, T3, Q)`` with the section
@@ -676,7 +676,7 @@ def _section_prev(RA, xA, u, w, xi, R, x, xip):
     return False, mm(RA, Rs), add(mv(RA, xs), xA), Rs, scale(-1.0, mv(transpose(Rs), xs)), T3, Q
 
 
-@jit_inline
+@jit_callee
 def _tangent_inv_rows(u, w):
     """Rows 1 and 2 of ``T(h)^-1 = [[Ti, -Ti Q Ti], [0, Ti]]`` (``_tangent_inv``) as ``(yf, ym)`` pairs."""
     t2 = dot(w, w)
@@ -687,14 +687,14 @@ def _tangent_inv_rows(u, w):
     return (Ti[1], scale(-1.0, _vm(_vm(Ti[1], Q), Ti))), (Ti[2], scale(-1.0, _vm(_vm(Ti[2], Q), Ti)))
 
 
-@jit_inline
+@jit_callee
 def _put_row(D, a, c0, yf, ym):
     """``D[a, c0:c0+6] = (yf, ym)``."""
     D[a, c0], D[a, c0 + 1], D[a, c0 + 2], D[a, c0 + 3], D[a, c0 + 4], D[a, c0 + 5] = yf[0], yf[1], yf[2], ym[0], \
         ym[1], ym[2]
 
 
-@jit_inline
+@jit_callee
 def _slip_row(yf, ym, prev, xip, S, D, a, c0):
     """``D[a, c0:c0+12] = y [J_A, J_B]`` at ``xip`` for the row ``y = (yf, ym)``; ``prev``: ``_section_prev``.
     Without forming ``J``: ``y J_B = xip (y T(s)) T(h)^-1``, ``y J_A = y Ad(exp(-s)) - xip (y T(s)) T(h)^-1
@@ -714,7 +714,7 @@ def _slip_row(yf, ym, prev, xip, S, D, a, c0):
     _put_row(D, a, c0 + 6, bf, bm)
 
 
-@jit
+@jit_callee
 def _slip_rows(row1, row2, R, xt, sign, prev, xip, S, D, c0):
     """``D[:, c0:c0+12] = sign (row Ad(H^-1)) [J_A, J_B]`` at ``xip`` for the rows ``row1``, ``row2`` ``(yf, ym)``
     of ``T(dy)^-1``; ``H = (R, x)``, ``xt = -R^T x``; ``prev``: ``_section_prev``."""
@@ -724,7 +724,7 @@ def _slip_rows(row1, row2, R, xt, sign, prev, xip, S, D, c0):
         _slip_row(scale(sign, cf), scale(sign, cm), prev, xip, S, D, a, c0)
 
 
-@jit_inline
+@jit_callee
 def _slip(side1, side2, S1, S2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp, D):
     """Slip ``log(H_LK_prev^-1 H_LK)[1:3]`` of the material frames (``kinematics.slip_increment``)
     and its gradient into ``D`` ``(2, 24)``; ``sec1``, ``sec2``: ``(xi, R, x)`` of the sections at the
@@ -800,7 +800,7 @@ def _friction(slip, lamp, t1, t2, lam, par, G):
 
 
 # ---------------------------------------------------------------- one contact point
-@jit
+@jit_callee
 def _wrench(R, F, neg, m, sm, G, V, DW, w):
     """Body wrench ``w = (R^T F, R^T m)`` and its gradient (rows ``DW`` of ``G``, 6) from ``dF = -dF_slave``
     if ``neg`` (else ``dF_slave``; rows ``G_DF``) and ``dm = sm d(n x F)`` (rows ``G_DMF``); ``V``: the rows
@@ -819,7 +819,7 @@ def _wrench(R, F, neg, m, sm, G, V, DW, w):
             G[(DW + i) * W + k], G[(DW + 3 + i) * W + k] = a[i], b[i]
 
 
-@jit
+@jit_callee
 def _nodal(u, w, xi, t2, co, S, v, c, G, DW, DH, DXI, f, K, j0):
     """``f_j = J_j^T wr`` (``wr = v[V_WR]``) for the two nodes of one side and their rows of the tangent:
     ``J^T dwr + d(J^T wr)/dh dh + d(J^T wr)/dxi dxi`` (rows ``DW``, ``DH``, ``DXI`` of ``G``; ``dh`` is zero
@@ -842,7 +842,7 @@ def _nodal(u, w, xi, t2, co, S, v, c, G, DW, DH, DXI, f, K, j0):
                          D[i, 4], D[i, 5], dd[i], G, DXI, DW, DH, False, K[r0 + i])
 
 
-@jit_inline
+@jit_callee
 def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, G, DXI, DW, DH, force, out):
     """One row of the tangent: ``out[c] = di dxi[c] + sum_l (j_l Dw[l, c] + d_l Dh[l, c])``, summed in this
     order (``dxi``, ``Dw``, ``Dh``: the rows ``DXI``, ``DW``, ``DH`` of ``G``).  ``force`` (a constant at each
@@ -876,7 +876,7 @@ def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, G, DXI, DW,
         out[c] = acc
 
 
-@jit_inline
+@jit_callee
 def _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2):
     """``HL, HK, HC, HF`` (``frames.contact_frames``)."""
     for k in range(4):
@@ -892,7 +892,7 @@ def _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2):
         frames[2, i, 3], frames[3, i, 3] = xC[i], xF[i]
 
 
-@jit_inline
+@jit_callee
 def _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, d, S1, S2, G):
     """Node Jacobians of both sides, twist variations (rows ``G_DH1``, ``G_DH2`` of ``G``), projection
     gradients (``G_DXI1``, ``G_DXI2``) and the section-frame variations (``G_VC``, ``G_VF``, 6 rows each);
@@ -911,7 +911,7 @@ def _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, d, S1, S
             G[(G_VF + i) * W + k] += h2[i] * G[G_DXI2 * W + k]
 
 
-@jit_inline
+@jit_callee
 def _add_friction_force(F, G, wgt, lt, Dlt, t1, t2):
     """``F + wgt (lt0 t1 + lt1 t2)`` and its gradient added to the rows ``G_DF`` of ``G`` (``Dlt`` ``(2, 24)``)."""
     for k in range(24):
@@ -921,7 +921,7 @@ def _add_friction_force(F, G, wgt, lt, Dlt, t1, t2):
     return add(F, add(scale(wgt * lt[0], t1), scale(wgt * lt[1], t2)))
 
 
-@jit
+@jit_callee
 def _moment_gradient(n, F, G):
     """``d(n x F)`` into the rows ``G_DMF`` of ``G`` from ``dF`` (``G_DF``) and ``dn`` (``G_DN``)."""
     f0, f1, f2, n0, n1, n2 = G_DF * W, (G_DF + 1) * W, (G_DF + 2) * W, G_DN * W, (G_DN + 1) * W, (G_DN + 2) * W
@@ -984,7 +984,7 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
     flags[0], flags[1] = active, stick
 
 
-@jit
+@jit_callee
 def _scratch():
     """Scratch arrays of one evaluation, reused by every point (the kernel allocates nothing per point); the
     gradients ``G`` start at zero (``_variations`` relies on it)."""
@@ -1007,7 +1007,7 @@ def _evaluate(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, 
     own[0][0, 0, 0, 0] = 0.0           # the scratch arrays' owners live until here
 
 
-@jit
+@jit_callee
 def _friction_given(slip, lamp, t1, t2, lam, par, G):
     """The mortar kernel's friction (``make_kernel(law, mortar=True)``): the given global traction
     ``lamp`` (force per length) applied by its components ``(lamp . t1, lamp . t2)``, their gradient
@@ -1083,7 +1083,7 @@ def make_kernel(law, mortar=False):
             t = _TEMPLATES[name]
             f = types.FunctionType(t.__code__, glb, f"{name}__{key}", t.__defaults__)
             f.__qualname__, f.__doc__ = f.__name__, t.__doc__
-            glb[name] = jit(f)
+            glb[name] = jit(f) if name in ("_evaluate", "_evaluate_rows") else jit_callee(f)
         _KERNELS[key] = glb["_evaluate_rows" if mortar else "_evaluate"]
     return _KERNELS[key]
 

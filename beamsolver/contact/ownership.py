@@ -10,14 +10,14 @@ xi2, dist, row)`` among the rows inside their element, else among those on an ex
 """
 import numpy as np
 
-from .._jit import jit
+from .._jit import jit, jit_callee
 from .rules import OWNER_TIE, XI_OVERHANG
 from .search import XI_TOL
 
 __all__ = ["gauss_owners", "gauss_record"]
 
 
-@jit
+@jit_callee
 def _known(sorted_ids, x):
     """``x`` in the sorted array ``sorted_ids`` (binary search)."""
     lo, hi = 0, len(sorted_ids)

@@ -24,7 +24,7 @@ with the digest of every package module it imports.)  The sections are inlined
 import numpy as np
 
 from ..lie import se3
-from .._jit import jit, jit_inline
+from .._jit import jit, jit_callee
 from ..lie.se3_jit import _SERIES_TABLE, _SWITCH, A_, B_, C_, add, add_outer, cross, dot, mat, mm, mv, scale
 from .kernel_jit import _pose_of, _project, _section, _section_inline
 from .frames import LINE, POINT
@@ -126,7 +126,7 @@ _SWITCH_ABC = float(min(_SWITCH[A_], _SWITCH[B_], _SWITCH[C_]))
 _RA, _XA, _U, _W, _X1, _E1, N_FIELDS = 0, 9, 12, 15, 18, 21, 24
 
 
-@jit_inline
+@jit_callee
 def _series(row, t):
     """``se3_jit.coefficient`` of the series ``row`` below its switch (the same operations)."""
     t2 = t * t
@@ -141,19 +141,19 @@ def _series(row, t):
     return v * t2 + row[0]
 
 
-@jit_inline
+@jit_callee
 def _vec(S, f, l):
     return (S[f, l], S[f + 1, l], S[f + 2, l])
 
 
-@jit_inline
+@jit_callee
 def _lane(S, l):
     """Master node pose, twist, slave centre and axis of lane ``l``."""
     RA = (_vec(S, _RA, l), _vec(S, _RA + 3, l), _vec(S, _RA + 6, l))
     return RA, _vec(S, _XA, l), _vec(S, _U, l), _vec(S, _W, l), _vec(S, _X1, l), _vec(S, _E1, l)
 
 
-@jit_inline
+@jit_callee
 def _update(line, x1, e1, x2, x2p, x2pp, xi2):
     """One Newton update of ``xi2`` (``kernel_jit._project_from``, ``LINE`` or ``ORTHOGONAL``) from the master
     section at ``xi2``; both kinds computed, one selected (no branch)."""
@@ -165,7 +165,7 @@ def _update(line, x1, e1, x2, x2p, x2pp, xi2):
     return xi2 - g / (j if j != 0.0 else 1.0)
 
 
-@jit_inline
+@jit_callee
 def _step_series(line, x1, e1, RA, xA, u, w, xi2):
     """``_update`` at the section ``kernel_jit._section_inline(RA, xA, u, w, xi2)`` computed with the
     coefficients' series; also the angle ``t`` (the series hold below ``_SWITCH_ABC``)."""
@@ -180,14 +180,14 @@ def _step_series(line, x1, e1, RA, xA, u, w, xi2):
     return _update(line, x1, e1, add(mv(RA, xs), xA), mv(R, u), mv(R, cross(w, u)), xi2), t
 
 
-@jit_inline
+@jit_callee
 def _step(line, x1, e1, RA, xA, u, w, xi2):
     """``_update`` at the section ``kernel_jit._section`` (any angle; scalar, a rare lane: not inlined)."""
     _, x2, x2p, x2pp = _section(RA, xA, u, w, xi2)
     return _update(line, x1, e1, x2, x2p, x2pp, xi2)
 
 
-@jit
+@jit_callee
 def _iterate(S, line, xi, nxt, ang, n, iterations):
     """``iterations`` Newton updates of ``xi[:n]`` for the lanes ``S[:, :n]`` (``line[l]``: kind ``LINE``,
     else ``ORTHOGONAL``); ``nxt``, ``ang`` scratch ``(LANES,)``."""
@@ -202,7 +202,7 @@ def _iterate(S, line, xi, nxt, ang, n, iterations):
             xi[l] = nxt[l]
 
 
-@jit_inline
+@jit_callee
 def _fill(S, l, RA2, xA2, h2, k, xc, e1):
     for i in range(3):
         for j in range(3):
@@ -214,7 +214,7 @@ def _fill(S, l, RA2, xA2, h2, k, xc, e1):
         S[_E1 + i, l] = e1[i]
 
 
-@jit_inline
+@jit_callee
 def _chord_start(xc, xA2, xB2):
     """Projection of ``xc`` on the master chord ``xA2 xB2``, clipped to ``[0, 1]``."""
     chord = (xB2[0] - xA2[0], xB2[1] - xA2[1], xB2[2] - xA2[2])
@@ -223,7 +223,7 @@ def _chord_start(xc, xA2, xB2):
     return min(max(s, 0.0), 1.0)
 
 
-@jit_inline
+@jit_callee
 def _finish(H, a2, h2, k, S, l, xi2, out2, dist, r):
     """Master parameter and centre distance of lane ``l`` (master first node ``a2``, twist ``h2[k]``)
     into row ``r``."""

@@ -40,7 +40,7 @@ whatever the element length (``benchmarks/search_scaling.py``).
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .._jit import jit
+from .._jit import jit, jit_callee
 from .projection import overlap, spheres
 
 XI_TOL = 1e-9

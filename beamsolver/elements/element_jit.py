@@ -10,12 +10,12 @@ element-major (each element's 144 entries contiguous, so an element touches one 
 pages; docs/benchmarks.md), the order ``assembly.System`` scatters.  Node poses are read through a node table
 ``(n, 2)`` from the model's pose array (``elements.se3_2``), not gathered first.
 """
-from .._jit import jit, jit_inline
+from .._jit import jit, jit_callee
 
 from ..lie.se3_jit import CP_, C_, DP_, Q2P_, Q2_, Q3P_, Q3_, add, add_outer, axpy, coefficient, cross, dot, log_relative, madd, mat, mm, mscale, mv, pose, q_matrix, scale, ti, ti_matrix, transpose
 
 
-@jit
+@jit_callee
 def _side(u, w, d, t2, wu, axu, c1, c2, c3):
     """``Ti``, ``X = -Ti Q(-u, -w) Ti`` of ``T(h)^-1`` at ``h = (u, w)``."""
     Ti = ti_matrix(w, d, t2)
@@ -23,7 +23,7 @@ def _side(u, w, d, t2, wu, axu, c1, c2, c3):
     return Ti, mscale(-1.0, mm(mm(Ti, Q), Ti))
 
 
-@jit
+@jit_callee
 def _d_tinv_t(w, d, dp, v):
     """``d(T_SO3(w)^-T v)/dw`` (``geometric._d_tinv_t``)."""
     wwv = cross(w, cross(w, v))
@@ -31,7 +31,7 @@ def _d_tinv_t(w, d, dp, v):
     return add_outer(M, w, scale(d, v))
 
 
-@jit
+@jit_callee
 def _dq_du(y, yw, yww, w, t2, wy, c1, c2, c3):
     """``dQ/du`` of ``Q(u, w) y`` at fixed ``y`` (``geometric._geometric``)."""
     M = mat(scale(-1.0, add(add(scale(0.5 - c2 * t2, y), scale(c1 - c3 * t2, yw)), scale(c2, yww))), c1 * wy)
@@ -39,7 +39,7 @@ def _dq_du(y, yw, yww, w, t2, wy, c1, c2, c3):
     return add_outer(M, w, scale(-1.0, add(scale(c2, yw), scale(c3, yww))))
 
 
-@jit
+@jit_callee
 def _dq_dw(u, w, y, yw, a_, b_, e_, wa_, gp, t2, wy, uy, wu, uxw, c1, c2, c3):
     """``dQ/dw`` of ``Q(u, w) y`` at fixed ``y`` (``geometric._geometric``)."""
     sk = add(add(add(scale(-c1, a_), scale(3.0 * c2 - c1, b_)), scale(-c3, e_)),
@@ -54,7 +54,7 @@ def _dq_dw(u, w, y, yw, a_, b_, e_, wa_, gp, t2, wy, uy, wu, uxw, c1, c2, c3):
     return add_outer(M, add(scale(c2, uxw), scale(c3, cross(w, uxw))), y)
 
 
-@jit
+@jit_callee
 def _geometric(u, w, n, mo, d, t2, co):
     """``G12, G21, G22`` of ``G(h, sigma) = d(T(h)^-T sigma)/dh`` at ``h = (u, w)``; ``co``: coefficients."""
     c1, c2, c3, dp, cp, q2p, q3p = co
@@ -81,20 +81,20 @@ def _geometric(u, w, n, mo, d, t2, co):
     return DAn, G21, G22
 
 
-@jit_inline
+@jit_callee
 def _put(K, e, r0, c0, M):
     for i in range(3):
         for j in range(3):
             K[e, r0 + i, c0 + j] = M[i][j]
 
 
-@jit
+@jit_callee
 def _scale_cols(M, k0, k1, k2):
     return ((M[0][0] * k0, M[0][1] * k1, M[0][2] * k2), (M[1][0] * k0, M[1][1] * k1, M[1][2] * k2),
             (M[2][0] * k0, M[2][1] * k1, M[2][2] * k2))
 
 
-@jit_inline
+@jit_callee
 def _block(C, i0, j0, e, invL):
     """``C[i0:i0+3, j0:j0+3] / L`` of element ``e`` as a 3x3 tuple."""
     return ((C[e, i0, j0] * invL, C[e, i0, j0 + 1] * invL, C[e, i0, j0 + 2] * invL),
@@ -102,7 +102,7 @@ def _block(C, i0, j0, e, invL):
             (C[e, i0 + 2, j0] * invL, C[e, i0 + 2, j0 + 1] * invL, C[e, i0 + 2, j0 + 2] * invL))
 
 
-@jit_inline
+@jit_callee
 def _z_rows(TiT, XT, G12, G21, G22, C, e, invL, diagonal):
     """Rows of one node: ``Z = sign B_s^T (C/L) + [[0, G12], [G21, G22]]`` as four 3x3 blocks."""
     if diagonal:
@@ -118,7 +118,7 @@ def _z_rows(TiT, XT, G12, G21, G22, C, e, invL, diagonal):
     return Z00, Z01, Z10, Z11
 
 
-@jit_inline
+@jit_callee
 def element_kernel(H, nodes, L, eps0, C, e, diagonal, tangent, f, h, strain, sigma, K):
     """Forces (and with ``tangent`` the tangent) of element ``e`` with node poses ``H[nodes[e]]``,
     written to row/column ``e``."""

@@ -10,7 +10,7 @@ version, so both agree to round-off (``tests/elements/test_compiled_kernels.py``
 ``NUMBA_DISABLE_JIT=1`` runs these functions as plain Python (slowly).
 """
 import numpy as np
-from .._jit import jit, jit_inline
+from .._jit import jit, jit_callee
 
 from .se3 import ATAN_SERIES_RATIO, COEFFICIENT_NAMES, SERIES, SWITCH
 
@@ -22,7 +22,7 @@ _SWITCH = np.array([SWITCH[k] for k in COEFFICIENT_NAMES])
 
 
 # ---------------------------------------------------------------- coefficients
-@jit
+@jit_callee
 def _closed(k, t):
     """Closed form of coefficient ``k`` at ``t > 0`` (formulas of ``se3``)."""
     s, c = np.sin(t), np.cos(t)
@@ -49,7 +49,7 @@ def _closed(k, t):
     return (-8.0 * t + 15.0 * s - 7.0 * t * c - t * t * s) / (2.0 * t**7)
 
 
-@jit
+@jit_callee
 def coefficient(k, t):
     """Singular coefficient number ``k`` (``se3.COEFFICIENT_NAMES``) at the angle ``t >= 0``."""
     if t >= _SWITCH[k]:
@@ -63,39 +63,39 @@ def coefficient(k, t):
 
 
 # ---------------------------------------------------------------- 3-vectors and 3x3 matrices
-@jit
+@jit_callee
 def dot(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-@jit
+@jit_callee
 def cross(a, b):
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
-@jit
+@jit_callee
 def axpy(s, a, b):
     """``s a + b``."""
     return (s * a[0] + b[0], s * a[1] + b[1], s * a[2] + b[2])
 
 
-@jit
+@jit_callee
 def scale(s, a):
     return (s * a[0], s * a[1], s * a[2])
 
 
-@jit
+@jit_callee
 def add(a, b):
     return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
 
 
-@jit
+@jit_callee
 def mat(skew, diag):
     """``hat(skew) + diag I``."""
     return ((diag, -skew[2], skew[1]), (skew[2], diag, -skew[0]), (-skew[1], skew[0], diag))
 
 
-@jit
+@jit_callee
 def add_outer(M, l, r):
     """``M + l r^T``."""
     return ((M[0][0] + l[0] * r[0], M[0][1] + l[0] * r[1], M[0][2] + l[0] * r[2]),
@@ -103,52 +103,52 @@ def add_outer(M, l, r):
             (M[2][0] + l[2] * r[0], M[2][1] + l[2] * r[1], M[2][2] + l[2] * r[2]))
 
 
-@jit
+@jit_callee
 def madd(A, B):
     return (add(A[0], B[0]), add(A[1], B[1]), add(A[2], B[2]))
 
 
-@jit
+@jit_callee
 def mscale(s, A):
     return (scale(s, A[0]), scale(s, A[1]), scale(s, A[2]))
 
 
-@jit
+@jit_callee
 def transpose(A):
     return ((A[0][0], A[1][0], A[2][0]), (A[0][1], A[1][1], A[2][1]), (A[0][2], A[1][2], A[2][2]))
 
 
-@jit
+@jit_callee
 def mv(A, v):
     return (dot(A[0], v), dot(A[1], v), dot(A[2], v))
 
 
-@jit
+@jit_callee
 def _row(a, B):
     return (a[0] * B[0][0] + a[1] * B[1][0] + a[2] * B[2][0],
             a[0] * B[0][1] + a[1] * B[1][1] + a[2] * B[2][1],
             a[0] * B[0][2] + a[1] * B[1][2] + a[2] * B[2][2])
 
 
-@jit
+@jit_callee
 def mm(A, B):
     return (_row(A[0], B), _row(A[1], B), _row(A[2], B))
 
 
-@jit
+@jit_callee
 def ti(w, d, v, sign):
     """``Ti v`` (sign +1) or ``Ti^T v`` (sign -1), ``Ti = T_SO3(w)^-1 = I + W/2 + d W^2``."""
     wv = cross(w, v)
     return add(add(v, scale(0.5 * sign, wv)), scale(d, cross(w, wv)))
 
 
-@jit
+@jit_callee
 def ti_matrix(w, d, t2):
     """``T_SO3(w)^-1 = hat(w)/2 + d w w^T + (1 - d t^2) I``."""
     return add_outer(mat(scale(0.5, w), 1.0 - d * t2), scale(d, w), w)
 
 
-@jit
+@jit_callee
 def q_matrix(u, w, wu, a, t2, c1, c2, c3):
     """``Q(u, w)`` (docs/theory.md eq. 2.6), ``wu = w.u``, ``a = w x u``, ``t2 = |w|^2`` (as ``elements.geometric._q_mat``)."""
     M = mat(add(scale(0.5 - 2.0 * c2 * t2, u), scale((3.0 * c2 - c1) * wu, w)), (2.0 * c3 * t2 - 2.0 * c1) * wu)
@@ -157,20 +157,20 @@ def q_matrix(u, w, wu, a, t2, c1, c2, c3):
 
 
 # ---------------------------------------------------------------- poses
-@jit
+@jit_callee
 def mtm(A, B):
     """``A^T B`` of 3x3 tuples."""
     return mm(transpose(A), B)
 
 
-@jit_inline
+@jit_callee
 def pose(H, e):
     """Rotation (3x3 tuple) and position (3-tuple) of the pose ``H[e]`` of an array ``(n, 4, 4)``."""
     return (((H[e, 0, 0], H[e, 0, 1], H[e, 0, 2]), (H[e, 1, 0], H[e, 1, 1], H[e, 1, 2]),
              (H[e, 2, 0], H[e, 2, 1], H[e, 2, 2])), (H[e, 0, 3], H[e, 1, 3], H[e, 2, 3]))
 
 
-@jit
+@jit_callee
 def log_relative(RA, xA, RB, xB):
     """``log(H_A^-1 H_B)`` as ``u, w`` tuples, ``t = |w|`` and ``d``; rotations 3x3 tuples, positions 3-tuples.
 
@@ -207,7 +207,7 @@ def log_relative(RA, xA, RB, xB):
     return ti(w, d, x, -1.0), w, t, d
 
 
-@jit_inline
+@jit_callee
 def exp_pose(u, w, out):
     """``exp(hat(u, w))`` into the pose ``out`` (4, 4)."""
     t = np.sqrt(dot(w, w))
@@ -223,7 +223,7 @@ def exp_pose(u, w, out):
     out[3, 3] = 1.0
 
 
-@jit_inline
+@jit_callee
 def compose_into(A, B, out):
     """``out = A @ B`` for poses (4, 4); ``out`` may be ``A`` or ``B``."""
     r0 = (A[0, 0] * B[0, 0] + A[0, 1] * B[1, 0] + A[0, 2] * B[2, 0],

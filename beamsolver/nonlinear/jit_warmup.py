@@ -37,8 +37,8 @@ __all__ = ["estimate", "kernel_cached", "listen", "warm_up", "ESTIMATE"]
 
 # CPU seconds of the first run's compilation of the main job (examples/twisted_pair.py) on the project's
 # 2-core x86-64 machines: the contact kernel, the other contact functions, elements and assembly
-# (docs/benchmarks.md, jit_compile_functions)
-ESTIMATE = dict(kernel=36.0, contact=13.0, elements=9.0)
+# (docs/benchmarks.md, jit_compile_functions; 36, 13 and 9 s before _jit.jit_callee)
+ESTIMATE = dict(kernel=18.0, contact=10.0, elements=9.0)
 log = logging.getLogger("beamsolver")
 _REFRESH = 0.5          # seconds between refreshes of the bar
 _IDLE = 3.0             # seconds without compilation that close it (imports between two compilations)
@@ -114,13 +114,14 @@ def listen(stream=None):
 
 
 def estimate():
-    """Seconds the first run of a contact scene compiles (``ESTIMATE``; the kernel in its own process
-    on two cores), or those of the element kernels when the contact kernel is cached."""
+    """Seconds the first run of a contact scene compiles (``ESTIMATE``; with two processes the kernel in
+    the second while this one compiles the rest), or those of the element kernels when the contact kernel
+    is cached."""
     if kernel_cached() is True:
         return ESTIMATE["elements"]
     if not _two_processes():
         return sum(ESTIMATE.values())
-    return ESTIMATE["elements"] + max(ESTIMATE["kernel"], ESTIMATE["contact"])
+    return max(ESTIMATE["elements"] + ESTIMATE["contact"], ESTIMATE["kernel"])      # both start before step 0
 
 
 # ---------------------------------------------------------------- the contact kernel

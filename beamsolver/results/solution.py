@@ -546,11 +546,14 @@ class Solution:
         return np.array([s.get("iterations", 0) for s in self.stats])
 
     def summary(self):
-        it = self.iterations[1:]
+        """One line: steps (step 0 not counted), Newton iterations (step 0's included and named: the same
+        total a script summing ``stats[k]["iterations"]`` prints), cut-backs, wall time."""
+        it = self.iterations
         wall = sum(s.get("wall_time", 0.0) for s in self.stats)
         end = f"{self.times[-1]:.6g}" if self._n else "-"
+        first = f" ({int(it[0])} at step 0)" if len(it) and it[0] else ""
         return (f"{self.n_steps} steps to t = {end}, Newton iterations "
-                f"total {int(it.sum())}, max {int(it.max(initial=0))}, "
+                f"total {int(it.sum())}{first}, max {int(it.max(initial=0))}, "
                 f"cut-backs {sum(s.get('cutbacks', 0) for s in self.stats)}, wall time {wall:.3f} s")
 
     def __repr__(self):

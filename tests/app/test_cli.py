@@ -39,7 +39,7 @@ def test_run_info_export(tmp_path):
     out = cli("run", "scene.py", "--steps", 2, cwd=tmp_path)
     assert out.returncode == 0, out.stderr
     assert "2 steps to t = 1" in out.stdout
-    folder = tmp_path / "scene_output"                     # default output folder
+    folder = tmp_path / "scene_run"                        # default output folder (not the script's own _output)
     assert (folder / "beams.pvd").exists() and (folder / "beams_0002.vtu").exists()
     assert bs.load(folder).n_steps == 2                    # --steps overrides solve_options
     out = cli("info", folder / "solution.npz", cwd=tmp_path)
@@ -48,6 +48,7 @@ def test_run_info_export(tmp_path):
     assert "-31.4" in out.stdout or "-15.7" in out.stdout   # Mz reaction = -M
     out = cli("export", folder, tmp_path / "again", cwd=tmp_path)
     assert out.returncode == 0 and (tmp_path / "again" / "beams_0002.vtu").exists()
+    assert "beams.pvd" in out.stdout and "3 .vtu files" in out.stdout
 
 
 @pytest.mark.slow

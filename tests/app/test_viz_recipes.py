@@ -18,6 +18,22 @@ def pair_run(tmp_path_factory):
     return bs.solve(model, steps=2, t_end=0.125, output=out), out
 
 
+def test_guide_pyvista_recipe_runs_as_written_without_warnings(pair_run):
+    """The one-line pyvista recipe of docs/guide/output.md, taken from the page: no warning (pyvista 0.49
+    raised a PyVistaFutureWarning on ``extract_surface()`` without ``algorithm``), one tube per beam."""
+    pv = pytest.importorskip("pyvista")
+    import re
+    import warnings
+    page = (Path(__file__).resolve().parents[1] / "docs" / "guide" / "output.md").read_text()
+    recipe = re.search(r"\(pyvista: `(grid\.[^`]*)`", page).group(1)
+    recipe = re.sub(r"\s*\n\s*", "", recipe)
+    grid = pv.read(pair_run[1] / "beams_0002.vtu")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        tube = eval(recipe, {"grid": grid})
+    assert tube.n_cells == 2 * (20 + 2)          # one capped tube per beam (pyvista's default 20 sides)
+
+
 def _pieces(tube):
     """Separate capped tubes in a Tube filter output: each is SIDES side strips and 2 caps."""
     assert tube.n_cells % (SIDES + 2) == 0
