@@ -10,7 +10,7 @@ import pytest
 import beamsolver as bs
 from beamsolver.app import cli
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 SCENE = textwrap.dedent("""
     import numpy as np
