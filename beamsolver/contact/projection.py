@@ -240,7 +240,7 @@ CULL_PAD = 0.01
 CULL_SLACK = 1e-9
 
 
-@jit_inline
+@jit_callee
 def _misses(xc, e1, xA2, xB2, lo, hi, bow):
     """``LINE`` cull: the slave section plane (centre ``xc``, normal ``e1``) cannot meet the master centre
     line on ``[lo, hi]``.  The line is within ``bow`` of its chord ``xA2 + xi (xB2 - xA2)`` there, so the
