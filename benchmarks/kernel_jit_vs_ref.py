@@ -67,19 +67,18 @@ def twisted_pair_calls(turns=0.5, steps=4):
     """Kernel inputs ``(X, p, friction)`` of every tangent evaluation of a short twisted-pair solve."""
     sys.path.insert(0, str(ROOT / "examples"))
     import beamsolver as bs
-    from beamsolver.contact import system
     from twisted_pair_extreme import build
-    calls, compiled = [], system.kernel_and_tangent
+    calls, compiled = [], kernel_jit.kernel_and_tangent     # the contact systems' kernel (``ContactSystem.kernel``)
 
     def record(X, p, friction=True, **kw):
         calls.append((np.array(X), {k: np.copy(v) for k, v in p.items()}, friction))
         return compiled(X, p, friction=friction, **kw)
 
-    system.kernel_and_tangent = record
+    kernel_jit.kernel_and_tangent = record
     try:
         bs.solve(build(turns=turns)[0], steps=steps)
     finally:
-        system.kernel_and_tangent = compiled
+        kernel_jit.kernel_and_tangent = compiled
     return calls
 
 

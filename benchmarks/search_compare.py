@@ -88,12 +88,18 @@ def _bits(a, b):
     return a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes()
 
 
+def _memory(c, name):
+    """The search's memory ``name`` of a contact system (``history.<name>``; ``_<name>`` before
+    ``ContactHistory``)."""
+    return getattr(c.history, name) if hasattr(c, "history") else getattr(c, "_" + name)
+
+
 def identical(old, new, H):
     """Pair sets (every field), owners and point pairs remembered, kernel inputs: the same bits."""
     P, Q = old.pairs(H), new.pairs(H)
     same = [f.name for f in fields(P)] == [f.name for f in fields(Q)]
     same = same and all(_bits(getattr(P, f.name), getattr(Q, f.name)) for f in fields(P))
-    same = same and all(_bits(getattr(old, k), getattr(new, k)) for k in ("_prev_owners", "_prev_points"))
+    same = same and all(_bits(_memory(old, k), _memory(new, k)) for k in ("prev_owners", "prev_points"))
     (X, p), (Y, q) = old.kernel_inputs(H), new.kernel_inputs(H)
     return same and _bits(X, Y) and sorted(p) == sorted(q) and all(_bits(p[k], q[k]) for k in p)
 

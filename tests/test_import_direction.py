@@ -174,7 +174,7 @@ def test_importing_a_submodule_counts_its_package():
 ORACLES = ("contact.reference", "elements.reference")
 # lazy imports of an oracle, each with its reason
 ALLOWED_ORACLE = {
-    ("contact.system", "contact.reference"): "use_numpy_kernel(True) switches a run to the oracle, imported only then",
+    ("contact.system", "contact.reference"): "use_numpy_kernel(True) makes the oracle the kernel of new contact systems, imported only then",
     ("contact.pairs", "contact.reference"): "old names of the oracle, read through the module's __getattr__ only",
 }
 

@@ -15,7 +15,6 @@ global-type nodes the term ``[[0, -hat(r_u)], [0, -hat(r_w)]]`` from the
 dependence of ``M`` on ``R`` (``r`` in global components), which keeps Newton
 quadratic.
 """
-import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,7 +25,7 @@ from ..model import contributions
 from ..elements import line_load
 from ..lie import se3
 from ..model import blocks as _blocks
-from ..model.blocks import REUSE_BUFFERS
+from ..model.buffers import REUSE_BUFFERS, BufferPool     # noqa: F401  (REUSE_BUFFERS: tests)
 from ..errors import InputError
 from .extra_pattern import BlockPattern, ExtraPattern, whole_nodes
 from ..lie.se3 import skew
@@ -163,6 +162,7 @@ class System:
         self.C = np.ascontiguousarray(self.C, dtype=float)
         self.C_diagonal = bool(not np.any(self.C[:, ~np.eye(6, dtype=bool)]))
         self.n_elements = len(self.L)
+        self._coo_pool = BufferPool(np.int32, axis=1)     # memory of the block COO index arrays
         self._build_rotation_pairs()
         self.poses0 = model.poses0
         self.length_scale = model.characteristic_length()
@@ -470,17 +470,11 @@ class System:
         return c[1], c[2]
 
     def _coo_buffer(self, n):
-        """A ``(2, >= n)`` int32 buffer for ``_block_coo``'s index arrays: a kept one that no array
-        handed out any more is a view of (an evaluation's ``extra`` may outlive the pattern), else a
-        new one with room for a few more blocks; at most two kept.  Fresh memory costs page faults
-        (66 MB for the 19-wire bundle's contact)."""
-        pool = getattr(self, "_coo_pool", [])
-        for b in pool if REUSE_BUFFERS else ():
-            if b.shape[1] >= n and sys.getrefcount(b) <= 3:      # the pool, ``b`` and the call's argument
-                return b
-        b = np.empty((2, n + n // 8 if REUSE_BUFFERS else n), dtype=np.int32)
-        self._coo_pool = [b] + pool[:1]
-        return b
+        """A ``(2, n)`` int32 array for ``_block_coo``'s index arrays (``buffers.BufferPool``): memory of
+        a kept buffer that no array handed out any more is a view of (an evaluation's ``extra`` may
+        outlive the pattern), else new; at most two kept.  Fresh memory costs page faults (66 MB for
+        the 19-wire bundle's contact)."""
+        return self._coo_pool.take((2, n))
 
     def _concat_coo(self, a, b):
         """``_concat(a, b)`` whose index arrays are kept (the same read-only arrays) while ``a``'s are the

@@ -14,8 +14,9 @@ geometry of ``frames``:
   give the moments ``R1 n x F`` and ``-R2 n x F``.
 
 Complex inputs give complex-step derivatives (``kernel_and_tangent``).  Production runs the
-compiled kernel (``kernel_jit``, the same maths and results to round-off); ``system.use_numpy_kernel``
-switches a run to this one.
+compiled kernel (``kernel_jit``, the same maths and results to round-off); a contact system given
+this module (``system.ContactSystem(..., kernel=reference)``, or made after
+``system.use_numpy_kernel(True)``) evaluates with it.
 """
 import numpy as np
 

@@ -22,12 +22,17 @@ contact declarations.  It orchestrates pure stages kept in their own modules:
 (``TIMED``: search = twists, spheres and broad phase; rules; projection; params = refusals,
 active set and history look-up; kernel; blocks) for benchmarks and profiles.
 
-Per step it keeps the friction history and augmented-Lagrangian multipliers,
-keyed by material slave point and master beam, committed only when a step is
-accepted (``get_state``/``set_state`` for saving and restart).  A pair with no
-history (it just came into contact) starts one from the poses at the start of
-the step (``begin_step``): its material frames are those of the pair there, its
-tangential traction zero, so friction acts from the first step of contact.
+What it carries between evaluations and steps -- the friction history and augmented-Lagrangian
+multipliers keyed by material slave point and master beam, committed only when a step is accepted,
+the kinds of crossings within a step, the search's memory, the restart state
+(``get_state``/``set_state``) -- is one ``history.ContactHistory`` (``ContactSystem.history``).  A
+pair with no history (it just came into contact) starts one from the poses at the start of the step
+(``begin_step``): its material frames are those of the pair there, its tangential traction zero, so
+friction acts from the first step of contact.
+
+The kernel is the system's own (``ContactSystem(system, kernel=...)``, the attribute ``kernel``):
+the compiled ``kernel_jit`` by default, the complex-step oracle ``reference`` for systems made after
+``use_numpy_kernel(True)``.
 
 Options per ``Model.add_contact`` declaration: ``options.ContactOptions`` (the
 defaults and their meaning live there).  Without ``penalty_t`` the tangential
@@ -37,27 +42,27 @@ at the onset of sliding is ``slip_tolerance`` times the slave element length
 ``reference.stick_penalty``).
 """
 
-import sys
 import time
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 from ..lie import se3
-from ..model.blocks import REUSE_BUFFERS, Blocks, Contribution
+from ..model.blocks import Blocks, Contribution
+from ..model.buffers import BufferPool
 from ..errors import InputError
 from ..failures import ContactTunnelling, NoContactNormal
 from ..model.model import JOIN_TOL
 from .law import default_penalty
 from . import kernel_jit, mortar
-from .kernel_jit import contact_kernel, kernel_and_tangent      # compiled; reference.py's are the oracle
 from .options import ADJUST, SMOOTHING, STICK_TOLERANCE, ContactOptions, declaration_table
 from .frames import LINE, NORMAL_TOL, POINT, material_frames, no_normal, touch_tolerance
 from .record import OPEN, SLIP, STICK, Candidates, PairSet
 from .ownership import gauss_owners, gauss_record
 from .projection import closest_points, element_twists, gauss_projections, section_points
 from .search import broad_pairs, element_spheres
-from .state import KeyLayout, check_state
+from .history import ContactHistory
+from .state import KeyLayout
 from . import adjust, conditioning, rules
 
 
@@ -67,20 +72,20 @@ SWITCH_TOL = 1e-12        # a step ending within this (relative) of active_from 
 TIMED = ("search", "rules", "projection", "params", "kernel", "blocks")   # parts of ``ContactSystem.timings``
 
 
-_numpy_oracle = False     # whether ``use_numpy_kernel`` switched to the oracle
+_default = {"kernel": kernel_jit}       # the kernel of contact systems made without one (``use_numpy_kernel``)
 
 
 def use_numpy_kernel(flag=True):
-    """Evaluate contact with the complex-step numpy kernel of ``reference`` (the test oracle, slow,
-    imported only here) instead of the compiled ``kernel_jit`` (default); returns the previous setting."""
-    global contact_kernel, kernel_and_tangent, _numpy_oracle
-    previous = _numpy_oracle
+    """Make contact systems created from now on without a ``kernel`` evaluate contact with the
+    complex-step numpy kernel of ``reference`` (the test oracle, slow, imported only here) instead of
+    the compiled ``kernel_jit`` (default); returns the previous setting.  Systems made before keep
+    theirs (``ContactSystem.kernel``)."""
+    previous = _default["kernel"] is not kernel_jit
     if flag:
-        from . import reference as mod
+        from . import reference
+        _default["kernel"] = reference
     else:
-        mod = kernel_jit
-    contact_kernel, kernel_and_tangent = mod.contact_kernel, mod.kernel_and_tangent
-    _numpy_oracle = bool(flag)
+        _default["kernel"] = kernel_jit
     return previous
 
 
@@ -116,8 +121,16 @@ class _Decl:
 
 
 class ContactSystem(Contribution):
-    def __init__(self, system):
+    """The contact of ``system`` (an ``assembly.System`` whose model has contact declarations) as a
+    contribution: the pipeline of the module docstring.  ``kernel``: the module evaluating the contact
+    points, ``contact_kernel(X, p, friction, law=)`` and ``kernel_and_tangent(X, p, friction, law=,
+    K=)`` (default the compiled ``kernel_jit``, or the oracle ``reference`` after
+    ``use_numpy_kernel(True)``); ``history``: what it carries between evaluations and steps
+    (``history.ContactHistory``)."""
+
+    def __init__(self, system, kernel=None):
         self.sys = system
+        self.kernel = _default["kernel"] if kernel is None else kernel
         model = system.model
         n_el = system.n_elements
         self.el_beam = np.empty(n_el, dtype=int)
@@ -141,8 +154,12 @@ class ContactSystem(Contribution):
         self._mu = np.array([d.mu for d in self.decls])
         self._switch = [(d.active_from, d.friction_from) for d in model.contacts]
         self._decl_on = np.ones(len(self.decls), dtype=bool)
+        self.max_gp = max(d.n_gp for d in self.decls)
+        layout = KeyLayout(n_el, self.max_gp, len(self.decls), self.el_beam, self.n_beams)
+        self.point_offset = layout.point_offset
+        self.history = ContactHistory(layout)
         self._switch_to(-np.inf)
-        self._mu_committed = self._decl_mu       # friction of the last committed step (None: unknown)
+        self.history.mu_committed = self._decl_mu       # friction of the last committed step
         table = declaration_table([d.options for d in self.decls])    # None as each option's kernel_none
         self._decl_slip_tol = np.array([d.slip_tolerance for d in self.decls])
         self._decl_smoothing, self._decl_tolerance = table["smoothing"], table["tolerance"]
@@ -150,28 +167,16 @@ class ContactSystem(Contribution):
         self._decl_exact = np.array([d.exact for d in self.decls])
         self._decl_eps_t = np.array([d.eps_t for d in self.decls])
         self._decl_stick_tol = np.array([d.stick_tolerance for d in self.decls])
-        # exact stick: nodal multipliers per (declaration, slave node, master beam) in the node's frame
-        self._tmult_committed = (np.zeros(0, dtype=np.int64), np.zeros((0, 3)))
-        self._tmult = self._tmult_committed
         # slave nodes whose every increment is fixed (``mortar.groups``' boundary modification)
         self._held = ~system.free.reshape(-1, 6)[system.rep].any(axis=1)
         self._node_len = np.bincount(system.enodes.ravel(), weights=np.repeat(0.5 * system.L, 2),
                                      minlength=len(system.poses0))
-        self.max_gp = max(d.n_gp for d in self.decls)
-        self.point_offset = np.int64(n_el) * self.max_gp * self.n_beams * len(self.decls)
-        self._history = self._empty_history()
-        self._mult_committed = (np.zeros(0, dtype=np.int64), np.zeros(0))
-        self._mult = self._mult_committed
-        self._tmult = self._tmult_committed
         self._augments = 0
-        self._prev_points = np.zeros(0, dtype=np.int64)
-        self._prev_owners = np.zeros(0, dtype=np.int64)   # Gauss-point key * n_elements + master element
         self._sweepable = {}       # per declaration: whether the last search found no crossing (``_candidates``)
-        self._forget_kinds()
         self._H_prev = None        # last converged poses (start of the step)
         self._geo = self._geo_prev = None    # (poses, element twists) of the last evaluation / of H_prev
         self._blocks = None        # (poses, local blocks) of the last evaluation, for the same state
-        self._K_pool = []          # tangent buffers of the compiled kernel (``_tangent_out``)
+        self._tangent_pool = BufferPool()     # tangent buffers of the compiled kernel (``_tangent_out``)
         self.timings = dict.fromkeys(TIMED, 0.0)
         self._clock = time.process_time()
         self._penalties = conditioning.penalty_ratios(model, system)
@@ -183,9 +188,9 @@ class ContactSystem(Contribution):
     def _reference_adjustment(self, H0):
         """``adjust.offsets`` of the pairs at the reference poses ``H0``; the search's memory
         (owners, point pairs, kinds) is left as it was."""
-        saved = (self._prev_points, self._prev_owners, self._kind_keys, self._kind_values)
+        saved = self.history.memory()
         P = self.pairs(H0)
-        self._prev_points, self._prev_owners, self._kind_keys, self._kind_values = saved
+        self.history.recall(saved)
         self.timings = dict.fromkeys(TIMED, 0.0)
         if P is None:
             return adjust.EMPTY
@@ -207,102 +212,19 @@ class ContactSystem(Contribution):
             return t0 is None or t > t0 + SWITCH_TOL * max(1.0, abs(t0))
         self._decl_on = np.array([on(a) for a, _ in self._switch], dtype=bool)
         self._decl_mu = np.where([on(f) for _, f in self._switch], self._mu, 0.0)
-        committed = getattr(self, "_mu_committed", None)       # None: at construction, or restarted
-        if committed is not None:
-            starts = (self._decl_mu > 0) & (committed == 0)
-            if starts.any():     # friction starts this step: as at first contact, from the step's start
-                self._history = {k: v[~starts[self._history_decl()]] for k, v in self._history.items()}
-
-    def _history_decl(self):
-        """Declaration of every row of the friction history (decoded from the point keys)."""
-        key, n_el = self._history["key"], np.int64(self.sys.n_elements)
-        gauss = key < self.point_offset
-        return np.where(gauss, key // np.maximum(n_el * self.max_gp * self.n_beams, 1),
-                        (key - self.point_offset) // (n_el * n_el)).astype(int)
+        self.history.start_friction(self._decl_mu)    # friction starting this step: as at first contact
 
     # ------------------------------------------------------------ history
     def get_state(self):
-        """Committed contact state as a flat dict of arrays (saved with a ``Solution``, restart).
-
-        ``history.<field>``: friction history per point key (material frames, ``xi``,
-        traction); ``mult_keys``/``mult_values``: augmented-Lagrangian multipliers;
-        ``tmult_keys``/``tmult_values``: exact stick's nodal tangential multipliers (``mortar.py``);
-        ``prev_points``/``prev_owners``: the point pairs and Gauss-point owners of the last
-        evaluation (the hysteresis of the ownership rules).  ``set_state`` restores it.
-        """
-        out = {f"history.{k}": np.array(v) for k, v in self._history.items()}
-        out["mult_keys"], out["mult_values"] = (np.array(a) for a in self._mult_committed)
-        out["tmult_keys"], out["tmult_values"] = (np.array(a) for a in self._tmult_committed)
-        out["prev_points"] = np.array(self._prev_points)
-        out["prev_owners"] = np.array(self._prev_owners)
-        return out
+        """Committed contact state as a flat dict of arrays (``ContactHistory.state``: saved with a
+        ``Solution``, restart); ``set_state`` restores it."""
+        return self.history.state()
 
     def set_state(self, state):
-        """Restore a state from ``get_state`` (missing parts: empty; older archives lack some), checked
-        first (``contact.state.check_state``: ``InputError`` naming a damaged or foreign entry)."""
-        layout = KeyLayout(self.sys.n_elements, self.max_gp, len(self.decls), self.el_beam, self.n_beams)
-        history, mult, prev = check_state(state, layout)
+        """Restore a state from ``get_state`` (``ContactHistory.restore``: missing parts empty, checked
+        first, ``InputError`` naming a damaged or foreign entry)."""
+        self.history.restore(state)
         self._blocks = None
-        hist = self._empty_history()
-        for k, v in (history or {}).items():
-            hist[k] = v.astype(hist[k].dtype)
-        n = {len(v) for v in hist.values()}
-        if len(n) > 1:
-            raise InputError(f"contact state: the history has {sorted(n)} rows in different entries "
-                             f"(given: {sorted(history or {})}; all of {sorted(hist)} are needed)")
-        self._history = hist
-        self._mu_committed = None          # a restart keeps its history also at a friction switch
-        if mult is not None:
-            self._mult_committed = mult
-        self._mult = self._mult_committed
-        if "tmult_keys" in state:
-            self._tmult_committed = (np.asarray(state["tmult_keys"], dtype=np.int64),
-                                     np.asarray(state["tmult_values"], dtype=float).reshape(-1, 3))
-        self._tmult = self._tmult_committed
-        for name, v in prev.items():
-            setattr(self, f"_{name}", np.sort(v))
-        self._forget_kinds()
-
-    def _forget_kinds(self):
-        """Empty the kinds of the step (``_step_kinds``): the next evaluation decides them."""
-        self._kind_keys, self._kind_values = np.zeros(0, dtype=np.int64), np.zeros(0, dtype=int)
-
-    def _step_kinds(self, d, e, m, kinds):
-        """Kinds of crossing element pairs kept within a step: a pair (declaration ``d``, slave
-        ``e``, master ``m``) that was a point or orthogonal pair at an earlier evaluation of the
-        step keeps that kind while it is a crossing; the others are remembered as decided now.
-
-        The choice (the reduced-Hessian ratio of the closest points, ``rules.extend_wrap``) is
-        not continuous: decided afresh at every iterate it may flip between two iterates, and
-        the contact force with it (a point pair at the crossing against Gauss points around
-        it), so that Newton cycles (docs/theory.md, kind of a crossing within a step)."""
-        n_el = np.int64(self.sys.n_elements)
-        cross = np.flatnonzero(kinds != LINE)
-        if not len(cross):
-            return kinds
-        keys = (np.int64(d.index) * n_el + e[cross]) * n_el + m[cross]
-        idx, found = self._lookup(self._kind_keys, keys)
-        kinds = kinds.copy()
-        kinds[cross[found]] = self._kind_values[idx[found]]
-        if not found.all():
-            k = np.concatenate([self._kind_keys, keys[~found]])
-            v = np.concatenate([self._kind_values, kinds[cross[~found]]])
-            order = np.argsort(k, kind="stable")
-            self._kind_keys, self._kind_values = k[order], v[order]
-        return kinds
-
-    @staticmethod
-    def _empty_history():
-        return dict(key=np.zeros(0, dtype=np.int64), H_CL=np.zeros((0, 4, 4)), H_FK=np.zeros((0, 4, 4)),
-                    H_LK=np.zeros((0, 4, 4)), e=np.zeros(0, dtype=int), m=np.zeros(0, dtype=int),
-                    xi1=np.zeros(0), xi2=np.zeros(0), lam_t=np.zeros((0, 3)))
-
-    @staticmethod
-    def _lookup(keys_sorted, keys):
-        if len(keys_sorted) == 0:
-            return np.zeros(len(keys), dtype=int), np.zeros(len(keys), dtype=bool)
-        idx = np.clip(np.searchsorted(keys_sorted, keys), 0, len(keys_sorted) - 1)
-        return idx, keys_sorted[idx] == keys
 
     def _lap(self, part=None):
         """Add the CPU time since the last lap to ``timings[part]`` (``None``: start a lap)."""
@@ -374,11 +296,12 @@ class ContactSystem(Contribution):
             out += [part, rec]
             chosen.append(ids)
             owners.append(own)
-        self._prev_points = np.sort(np.concatenate(chosen)) if chosen else np.zeros(0, dtype=np.int64)
+        hist = self.history
+        hist.prev_points = np.sort(np.concatenate(chosen)) if chosen else np.zeros(0, dtype=np.int64)
         # sorted as made: a declaration's owner ids are ascending (``gauss_owners``' key order, one
         # owner per key, ``key * n_el + m``, ``m < n_el``) and above the last declaration's (``key``
         # grows with ``decl``)
-        self._prev_owners = np.concatenate(owners) if owners else np.zeros(0, dtype=np.int64)
+        hist.prev_owners = np.concatenate(owners) if owners else np.zeros(0, dtype=np.int64)
         out = [p for p in out if p is not None and len(p)]
         P = (out[0] if len(out) == 1 else PairSet.concatenate(out)) if out else None
         if P is not None and len(self._adjusted[0]):
@@ -421,7 +344,7 @@ class ContactSystem(Contribution):
             kinds[b] = rules.point_or_orthogonal(ratio, d.point_ratio)
             xi1[b], xi2[b] = x1, x2
             kinds = rules.extend_wrap(en, self.el_beam[m], self.n_beams, e, m, kinds, xi1)
-            kinds = self._step_kinds(d, e, m, kinds)
+            kinds = self.history.step_kinds(d.index, e, m, kinds)
         self._lap("rules")
         return Candidates(e=e, m=m, kind=kinds, xi1=xi1, xi2=xi2, c2=c2, reach=reach, swept=swept)
 
@@ -448,7 +371,7 @@ class ContactSystem(Contribution):
         if len(pt) > 1:
             keep = rules.dedupe_points(self._points(H, e, x1), self._points(H, m, x2), x1, x2,
                                        self.el_radius[e] + self.el_radius[m], self.el_beam[e] * self.n_beams + self.el_beam[m],
-                                       _member(e * n_el + m, self._prev_points))
+                                       _member(e * n_el + m, self.history.prev_points))
         pt, e, m = pt[keep], e[keep], m[keep]
         key = self.point_offset + (np.int64(d.index) * n_el + e) * n_el + m
         rec = self._record(d, np.full(len(pt), POINT), e, m, c.xi1[pt], c.xi2[pt], self.sys.L[e], key,
@@ -478,7 +401,7 @@ class ContactSystem(Contribution):
                                             window=rules.XI_OVERHANG)
         self._lap("projection")
         s, key, tied = gauss_owners(d.index, len(en), self.max_gp, self.n_beams, e, m, g, xi2, dist, self.el_first,
-                                    self.el_last, self.el_beam, self.el_radius, self._prev_owners, pair=r, order=True)
+                                    self.el_last, self.el_beam, self.el_radius, self.history.prev_owners, pair=r, order=True)
         f, ids = gauss_record(s, key, r, g, xi2, e, m, kind, xg, wg, self.sys.L, en, self.el_radius)
         rec = PairSet(key=key, decl=np.full(len(s), d.index), **f)
         self._lap("rules")
@@ -501,23 +424,9 @@ class ContactSystem(Contribution):
         touch = touch_tolerance(_extent(H), p["R1"], p["R2"])
         p["touch"] = np.where(p["smoothing"] >= touch, 0.0, touch)
         key = P.key[sel]
-        mi, mf = self._lookup(self._mult[0], key)
-        p["multiplier"] = np.where(mf, self._mult[1][mi] if len(self._mult[1]) else 0.0, 0.0)
-        hist = self._history
-        hi, hf = self._lookup(hist["key"], key)
-        n = len(key)
-        if len(hist["key"]):
-            every = hf.all()        # (every pair with history, as in a step's later iterates: no masking)
-            for name, src in (("H_CL", "H_CL"), ("H_FK", "H_FK"), ("H_LK_prev", "H_LK")):
-                p[name] = hist[src][hi] if every else np.where(hf[:, None, None], hist[src][hi], np.eye(4))
-            # material points, re-expressed on the current elements (same beam, consecutive ids)
-            p["xi1_prev"] = np.where(hf, hist["xi1"][hi] + hist["e"][hi] - P.e[sel], p["xi1"])
-            p["xi2_prev"] = np.where(hf, hist["xi2"][hi] + hist["m"][hi] - P.m[sel], p["xi2"])
-            p["lam_t_prev"] = np.where(hf[:, None], hist["lam_t"][hi], 0.0)
-        else:
-            p.update(H_CL=np.tile(np.eye(4), (n, 1, 1)), H_FK=np.tile(np.eye(4), (n, 1, 1)),
-                     H_LK_prev=np.tile(np.eye(4), (n, 1, 1)), xi1_prev=p["xi1"].copy(),
-                     xi2_prev=p["xi2"].copy(), lam_t_prev=np.zeros((n, 3)))
+        p["multiplier"] = self.history.normal_multipliers(key)
+        hf = self.history.frictional(p, key, P.e[sel], P.m[sel])
+        hist = self.history.friction
         # a point pair whose crossing moved to a neighbouring element pair keeps the
         # history of the committed point pair of the same two beams next to it
         cand = np.flatnonzero(~hf & (p["kind"] == POINT) & (p["mu"] > 0))
@@ -545,7 +454,7 @@ class ContactSystem(Contribution):
         """Give the point pairs ``cand`` (no history of their own) the history of the nearest
         committed point pair ``hp`` of the same declaration and beams within ``R1 + R2``;
         material points are re-expressed on the new elements (same beam, consecutive ids)."""
-        hist = self._history
+        hist = self.history.friction
         en, nb = self.sys.enodes, self.n_beams
         e, m = P.e[sel][cand], P.m[sel][cand]
         x = self._points(H, e, p["xi1"][cand])
@@ -588,8 +497,7 @@ class ContactSystem(Contribution):
         xC, xF = self._centres(H, P) if centres is None else centres
         gap = np.linalg.norm(xF - xC, axis=1) - P.R1 - P.R2
         pen = self._decl_penalty[P.decl]
-        mi, mf = self._lookup(self._mult[0], P.key)
-        mult = np.where(mf, self._mult[1][mi] if len(self._mult[1]) else 0.0, 0.0)
+        mult = self.history.normal_multipliers(P.key)
         # the smoothing zone plus a small band keeps the projection-updated gap consistent
         band = self._smoothing(P, slice(None)) + 1e-3 * (P.R1 + P.R2) + touch_tolerance(_extent(H), P.R1, P.R2)
         return np.flatnonzero(mult - pen * gap > -pen * band)
@@ -658,7 +566,7 @@ class ContactSystem(Contribution):
         c = self._blocks
         if c is not None and np.array_equal(c[0], H) and (c[1] is None or c[1][4] is not None or not tangent):
             return c[1]
-        tangent = tangent or not _numpy_oracle
+        tangent = tangent or self.kernel is kernel_jit
         P = self.pairs(H)
         self._lap()
         sel = np.zeros(0, dtype=int)
@@ -718,9 +626,7 @@ class ContactSystem(Contribution):
                           P.nodes[sel[idx]], n_nodes, self.n_beams, self._held_slip(P.nodes[sel[idx]]))
         gdecl = G["key"] // (np.int64(n_nodes) * self.n_beams)
         R = H[G["node"], :3, :3]
-        mi, mf = self._lookup(self._tmult[0], G["key"])
-        Lam = np.zeros((len(G["key"]), 3))
-        Lam[mf] = self._tmult[1][mi[mf]]
+        Lam = self.history.tangential_multipliers(G["key"])
         eps, mu = self._decl_eps_t[gdecl], self._decl_mu[gdecl]
         laws = {id(self.decls[k].law): self.decls[k].law for k in np.unique(gdecl)}
         if len(laws) > 1:
@@ -780,23 +686,23 @@ class ContactSystem(Contribution):
         """The kernel of each declaration's law on the pairs with friction and on those without
         (``friction``: the friction branch for all): ``f``, ``K`` (or None), ``out``."""
         laws = [d.law for d in self.decls]
-        if any(law is not None for law in laws) and _numpy_oracle:
+        compiled = self.kernel is kernel_jit
+        if any(law is not None for law in laws) and not compiled:
             raise InputError("contact: the numpy oracle kernel (use_numpy_kernel) has only the default law; "
                              f"add_contact declared law={next(law for law in laws if law is not None)!r}")
         fric = p["mu"] > 0 if friction is None else np.broadcast_to(friction, (len(X),))
         group = np.unique([id(law) for law in laws], return_inverse=True)[1][decl] * 2 + fric
         kinds = np.unique(group)
         if len(kinds) == 1:                     # one kind: no masked copies of the (m, 24, 24) blocks
-            compiled = kernel_and_tangent is kernel_jit.kernel_and_tangent
             out = self._tangent_out(len(X)) if tangent and compiled else None
-            return _kernel(X, p, bool(kinds[0] % 2), laws[decl[0]], tangent, out)
+            return _kernel(self.kernel, X, p, bool(kinds[0] % 2), laws[decl[0]], tangent, out)
         f = np.zeros((len(X), 4, 6))
         K = np.zeros((len(X), 24, 24)) if tangent else None
         out = {}
         for g in kinds:
             mask = group == g
             pm = {k: (v[mask] if np.ndim(v) else v) for k, v in p.items()}
-            fm, Km, om = _kernel(X[mask], pm, bool(g % 2), laws[decl[np.argmax(mask)]], tangent)
+            fm, Km, om = _kernel(self.kernel, X[mask], pm, bool(g % 2), laws[decl[np.argmax(mask)]], tangent)
             if tangent:
                 K[mask] = Km
             f[mask] = fm
@@ -807,17 +713,11 @@ class ContactSystem(Contribution):
         return f, K, out
 
     def _tangent_out(self, m):
-        """An ``(m, 24, 24)`` array for the compiled kernel's tangent: a view of a kept buffer that
-        nothing else references (blocks of an earlier evaluation may still be in use, e.g. the
-        solver's last evaluation during a line search), else of a new buffer; at most two kept.
-        Reusing memory avoids the page faults of a fresh ``(m, 24, 24)`` array per evaluation."""
-        for b in self._K_pool if REUSE_BUFFERS else ():
-            if len(b) >= m and sys.getrefcount(b) <= 3:      # the pool, ``b`` and the call's argument
-                return b[:m]
-        # room for a few more pairs: an active set growing by one pair does not need fresh memory
-        b = np.empty((m + m // 8 if REUSE_BUFFERS else m, 24, 24))
-        self._K_pool = [b] + self._K_pool[:1]
-        return b[:m]
+        """An ``(m, 24, 24)`` array for the compiled kernel's tangent (``buffers.BufferPool``): a view of
+        a kept buffer that nothing else references (blocks of an earlier evaluation may still be in
+        use, e.g. the solver's last evaluation during a line search), else of a new buffer; at most
+        two kept.  Reusing memory avoids the page faults of a fresh array per evaluation."""
+        return self._tangent_pool.take((m, 24, 24))
 
     def evaluate(self, H, tangent=True):
         """Local blocks of the active pairs and point data: ``(blocks.Blocks, info)``.
@@ -842,13 +742,13 @@ class ContactSystem(Contribution):
 
     # ------------------------------------------------------------ per step
     def begin_step(self, H, t):
+        """A step from the converged poses ``H`` to time ``t`` starts (or starts again after a failure):
+        the declarations acting at ``t``, the trial history reset to the committed one."""
         self._switch_to(t)
         self._blocks = None
-        self._forget_kinds()
+        self.history.begin_step()
         self._H_prev = np.array(H, dtype=float)
         self._geo_prev = None
-        self._mult = self._mult_committed
-        self._tmult = self._tmult_committed
         self._augments = 0
 
     def _state(self, H):
@@ -923,37 +823,33 @@ class ContactSystem(Contribution):
         if self._augments >= MAX_AUGMENT:      # not met: the caller decides (error or warning)
             self.unmet_tolerance = ratio
             return False
-        self._mult = self._mult if mult is None else mult
-        self._tmult = self._tmult if tmult is None else tmult
+        self.history.update_multipliers(mult, tmult)
         self._augments += 1
         self._blocks = None
         return True
 
     def commit(self, H):
-        """Store friction history and multipliers of the converged state."""
+        """Store friction history and multipliers of the converged state (``ContactHistory.commit``)."""
         self._blocks = None
-        self._mult_committed = self._mult
-        self._mu_committed = self._decl_mu
         P, sel, po = self._state(H)
         if P is None or len(sel) == 0:
-            self._history = self._empty_history()
-            self._tmult_committed = self._tmult = (np.zeros(0, dtype=np.int64), np.zeros((0, 3)))
+            self.history.commit(self._decl_mu)
             self._last = None
             return
         p, out = po
         m = out.get("mortar")
-        self._tmult_committed = self._tmult = (np.zeros(0, dtype=np.int64), np.zeros((0, 3))) if m is None else \
-            (m["key"], np.einsum("gji,gj->gi", m["R"], m["lam"]))
+        tmult = None if m is None else (m["key"], np.einsum("gji,gj->gi", m["R"], m["lam"]))
         keys = P.key[sel]
         order = np.argsort(keys)
         HL, HK = _frames(out)
         HC, HF = self._pose_at(H, P.e[sel], out["xi1"]), self._pose_at(H, P.m[sel], out["xi2"])
         lam_t = out["lam_t"]
         lam_vec = lam_t[:, :1] * out["t1"] + lam_t[:, 1:] * out["t2"]
-        self._history = dict(key=keys[order], H_CL=se3.relative(HC, HL)[order],
-                             H_FK=se3.relative(HF, HK)[order], H_LK=se3.relative(HL, HK)[order],
-                             e=P.e[sel][order], m=P.m[sel][order], xi1=out["xi1"][order],
-                             xi2=out["xi2"][order], lam_t=lam_vec[order])
+        friction = dict(key=keys[order], H_CL=se3.relative(HC, HL)[order],
+                        H_FK=se3.relative(HF, HK)[order], H_LK=se3.relative(HL, HK)[order],
+                        e=P.e[sel][order], m=P.m[sel][order], xi1=out["xi1"][order],
+                        xi2=out["xi2"][order], lam_t=lam_vec[order])
+        self.history.commit(self._decl_mu, friction, tmult)
         self._last = (P, sel, p, out, (np.array(H), HC, HF))
 
     def results(self, H):
@@ -1025,13 +921,14 @@ def _with_mortar(nodes, f, K, m):
     return Blocks(nodes, np.concatenate([fa, m["f"]]), np.concatenate([Ka, m["K"]]))
 
 
-def _kernel(X, p, friction, law, tangent, K=None):
-    """``f``, ``K`` (None without ``tangent`` on the numpy path) and point data of one kernel call;
-    ``K``: the compiled kernel's output array for the tangent (None: a new one)."""
+def _kernel(kernel, X, p, friction, law, tangent, K=None):
+    """``f``, ``K`` (None without ``tangent`` on the numpy path) and point data of one call of
+    ``kernel`` (``ContactSystem.kernel``); ``K``: the compiled kernel's output array for the tangent
+    (None: a new one)."""
     if tangent:
         kw = ({} if law is None else dict(law=law)) | ({} if K is None else dict(K=K))
-        return kernel_and_tangent(X, p, friction=friction, **kw)
-    f, out = contact_kernel(X, p, friction=friction, **({} if law is None else dict(law=law)))
+        return kernel.kernel_and_tangent(X, p, friction=friction, **kw)
+    f, out = kernel.contact_kernel(X, p, friction=friction, **({} if law is None else dict(law=law)))
     return f, None, out
 
 

@@ -14,15 +14,11 @@ their nodes (``q = M z``, ``assembly.System.node_transforms``): ``T^T f`` and
 ``T^T K T`` with ``T = diag(M_1, ..., M_k)``; ``dofs`` numbers a block's rows in
 the ``6 n`` unknowns of the representative nodes.
 """
-import sys
 from dataclasses import dataclass
 
 import numpy as np
 
-# Buffers handed out as blocks are reused when ``sys.getrefcount`` shows nothing else holds them, a
-# count of the caller's own references that is an implementation detail (CPython 3.14 borrows
-# references on the stack): reuse only on the CPython versions where it was checked, else make anew.
-REUSE_BUFFERS = sys.implementation.name == "cpython" and sys.version_info < (3, 14)
+from .buffers import REUSE_BUFFERS     # noqa: F401  (its former home; buffers.BufferPool reuses blocks' memory)
 
 __all__ = ["Blocks", "Contribution", "transform", "dofs", "levels"]
 

@@ -196,11 +196,11 @@ def warm_up(model):
 
 def _scene(model, proc):
     """The warm-up of ``model`` in this process; ``proc``: the process compiling the kernel (or None)."""
-    from ..contact import system as contact_system
     from ..contact.projection import closest_points
     from .problem import Problem
     problem = Problem.from_model(model, check_rigid_modes=False)
-    compiled = contact_system.kernel_and_tangent
+    kernel = problem.contact.kernel        # the contact system's kernel module, its function wrapped for the evaluation
+    compiled = kernel.kernel_and_tangent
 
     def after_the_process(*args, **kw):
         if proc is not None and proc.poll() is None:
@@ -208,11 +208,11 @@ def _scene(model, proc):
         return compiled(*args, **kw)
 
     H = problem.system.poses0.copy()
-    contact_system.kernel_and_tangent = after_the_process
+    kernel.kernel_and_tangent = after_the_process
     try:
         ev = problem.evaluate(H, 0.0)
     finally:
-        contact_system.kernel_and_tangent = compiled
+        kernel.kernel_and_tangent = compiled
     problem.tangent(ev)
     problem.update(H, np.zeros((problem.system.n_nodes, 6)))
     c = problem.contact

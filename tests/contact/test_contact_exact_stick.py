@@ -81,8 +81,8 @@ def test_exact_stick_tangent_matches_finite_differences(regime):
     c.begin_step(H, 0.0)
     c.commit(H)                                 # history and nodal multipliers (zero) at H
     if regime == "turned":                      # multipliers in the nodes' frames, not zero
-        keys, lam = c._tmult
-        c._tmult = (keys, np.random.default_rng(3).normal(size=lam.shape) * 50.0)
+        keys, lam = c.history.tmult
+        c.history.update_multipliers(tmult=(keys, np.random.default_rng(3).normal(size=lam.shape) * 50.0))
     slide = {"stick": 1e-7, "slip": 2e-3, "turned": 1e-7}[regime] * R
     G = se3.exp(np.array([slide, slide, 0.0, slide, 0.0, 0.5 * slide]))
     H = _move(H, slave.nodes, G)

@@ -98,6 +98,41 @@ def _solve_both(build, steps):
     return out
 
 
+def test_the_kernel_is_each_contact_system_s_own():
+    """``ContactSystem(system, kernel=reference)`` evaluates with the oracle while the system next to
+    it keeps the compiled kernel (same blocks to round-off, no tangent buffer on the numpy path);
+    ``use_numpy_kernel`` sets the kernel of systems made afterwards only."""
+    import rolling
+    from beamsolver.contact.system import ContactSystem, use_numpy_kernel
+    from beamsolver.nonlinear.problem import Problem
+    model, slave, _ = rolling.build(mu=0.5, n_elements=3)
+    sol = bs.solve(model, steps=2)
+    H = sol.poses[-1].copy()
+    H[slave.nodes, 0, 3] += 1e-4                   # sliding a little: friction forces
+    state = {k[len("contact/"):]: v for k, v in sol.contact_state.items()}
+    compiled = Problem.from_model(model).contact
+    oracle = ContactSystem(compiled.sys, kernel=reference)
+    assert compiled.kernel is kernel_jit and oracle.kernel is reference
+    blocks = []
+    for c in (compiled, oracle):
+        c.set_state(state)
+        c.begin_step(sol.poses[-1], 1.0)
+        blocks.append(c.evaluate(H, tangent=True)[0])
+    (a, info), b = (blocks[0], None), blocks[1]
+    assert len(a.f) and np.abs(a.f).max() > 0
+    np.testing.assert_array_equal(a.nodes, b.nodes)
+    assert np.abs(a.f - b.f).max() <= 1e-10 * np.abs(a.f).max()
+    assert np.abs(a.K - b.K).max() <= 1e-8 * np.abs(a.K).max()
+    assert len(compiled._tangent_pool.buffers) == 1 and not oracle._tangent_pool.buffers
+    previous = use_numpy_kernel(True)
+    try:
+        made_after = Problem.from_model(model).contact
+    finally:
+        use_numpy_kernel(previous)
+    assert made_after.kernel is reference and compiled.kernel is kernel_jit
+    assert Problem.from_model(model).contact.kernel is kernel_jit
+
+
 @pytest.mark.parametrize("name", ["rolling_friction", "crossing_frictionless"])
 def test_solves_take_the_same_newton_iterations_as_with_the_oracle(name):
     import crossing_beams

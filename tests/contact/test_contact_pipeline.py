@@ -11,7 +11,7 @@ from beamsolver import se3
 from beamsolver.nonlinear.problem import Problem
 from beamsolver.contact import frames, kernel_jit, projection
 from beamsolver.contact.system import TIMED
-from beamsolver.contact import system as cs
+from beamsolver.model.buffers import REUSE_BUFFERS
 
 from helpers import kernel_pairs as _pairs
 
@@ -174,10 +174,10 @@ def test_tangent_buffer_is_reused_only_when_no_earlier_blocks_hold_it():
     assert not np.shares_memory(b1.K, b2.K)
     np.testing.assert_array_equal(b1.K, K1)
     np.testing.assert_array_equal(b2.K, system().evaluate(H2, tangent=True)[0].K)
-    kept = [id(b) for b in c._K_pool]
+    kept = [id(b) for b in c._tangent_pool.buffers]
     assert len(kept) == 2
     del b1, b2
     c.begin_step(sol.poses[-1], 1.0)
     b3, _ = c.evaluate(H1, tangent=True)            # nothing holds the buffers: one is reused
-    assert ([id(b) for b in c._K_pool] == kept) == cs.REUSE_BUFFERS
+    assert ([id(b) for b in c._tangent_pool.buffers] == kept) == REUSE_BUFFERS
     np.testing.assert_array_equal(b3.K, K1)

@@ -250,7 +250,7 @@ def test_the_swept_search_gives_the_pairs_in_the_distance_matrix_order(monkeypat
     monkeypatch.setattr(system.ContactSystem, "_candidates", spy)
     for poses in (H, swept.sys.poses0):
         _same_pairs(swept.pairs(poses), tree.pairs(poses))
-        np.testing.assert_array_equal(swept._prev_owners, tree._prev_owners)
+        np.testing.assert_array_equal(swept.history.prev_owners, tree.history.prev_owners)
     assert calls == [(True, True), (False, False)] * 2
     # an order-dependent choice of owners: the search is redone in the distance matrix's order
     owners = system.gauss_owners

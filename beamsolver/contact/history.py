@@ -1,0 +1,223 @@
+"""What a contact system carries from one evaluation or step to the next: ``ContactHistory``.
+
+Keyed by material contact point (``state.KeyLayout``: a Gauss point's key, or a point pair's
+``point_offset + (decl n_el + e) n_el + m``), sorted by key and looked up by binary search:
+
+- the friction history, one row per point of the last accepted step: material frames ``H_CL``,
+  ``H_FK``, ``H_LK`` ``(k, 4, 4)``, elements ``e``, ``m`` and sections ``xi1``, ``xi2`` ``(k,)``, the
+  tangential traction ``lam_t`` ``(k, 3)`` (``frictional`` gives it to the kernel's parameters);
+- the augmented-Lagrangian multipliers, normal ``mult`` ``(keys, (k,))`` per point and exact
+  stick's tangential ``tmult`` ``(keys, (k, 3))`` per (declaration, slave node, master beam)
+  (``mortar.py``), each as a committed copy (the last accepted step) and a trial one (the step being
+  solved: ``begin_step`` or ``rollback`` resets it, ``update_multipliers`` sets it, ``commit``
+  keeps it);
+- the friction coefficients of the last accepted step (``mu_committed``: a declaration whose
+  friction switches on starts its history afresh, ``start_friction``);
+- the kinds of crossing element pairs decided within the step (``step_kinds``);
+- the search's memory: ``prev_points`` (``e n_el + m``) and ``prev_owners`` (``key n_el + m``), the
+  point pairs and Gauss-point owners of the last evaluation (the hysteresis of the ownership rules).
+
+``state()`` gives the committed part as a flat dict of arrays (saved with a ``Solution``, restart),
+``restore(state)`` takes it back, checked first (``state.check_state``).
+"""
+import numpy as np
+
+from ..errors import InputError
+from .frames import LINE
+from .state import check_state
+
+__all__ = ["ContactHistory", "lookup", "empty_friction"]
+
+
+def lookup(keys_sorted, keys):
+    """``(index, found)`` of ``keys`` in the sorted ``keys_sorted`` (binary search)."""
+    if len(keys_sorted) == 0:
+        return np.zeros(len(keys), dtype=int), np.zeros(len(keys), dtype=bool)
+    idx = np.clip(np.searchsorted(keys_sorted, keys), 0, len(keys_sorted) - 1)
+    return idx, keys_sorted[idx] == keys
+
+
+def empty_friction():
+    """A friction history without rows (the fields of the module docstring)."""
+    return dict(key=np.zeros(0, dtype=np.int64), H_CL=np.zeros((0, 4, 4)), H_FK=np.zeros((0, 4, 4)),
+                H_LK=np.zeros((0, 4, 4)), e=np.zeros(0, dtype=int), m=np.zeros(0, dtype=int),
+                xi1=np.zeros(0), xi2=np.zeros(0), lam_t=np.zeros((0, 3)))
+
+
+def _no_mult():
+    return np.zeros(0, dtype=np.int64), np.zeros(0)
+
+
+def _no_tmult():
+    return np.zeros(0, dtype=np.int64), np.zeros((0, 3))
+
+
+class ContactHistory:
+    """The contact state of the module docstring over the key space ``layout`` (``state.KeyLayout``)."""
+
+    def __init__(self, layout):
+        self.layout = layout
+        self.friction = empty_friction()
+        self.mult_committed = self.mult = _no_mult()
+        self.tmult_committed = self.tmult = _no_tmult()
+        self.mu_committed = None        # friction per declaration of the last accepted step (None: unknown)
+        self.prev_points = np.zeros(0, dtype=np.int64)
+        self.prev_owners = np.zeros(0, dtype=np.int64)
+        self.forget_kinds()
+
+    # ------------------------------------------------------------ steps
+    def begin_step(self):
+        """A step starts (or starts again): the trial multipliers are the committed ones, the kinds
+        of the crossings are decided afresh."""
+        self.mult = self.mult_committed
+        self.tmult = self.tmult_committed
+        self.forget_kinds()
+
+    rollback = begin_step
+
+    def update_multipliers(self, mult=None, tmult=None):
+        """New trial multipliers (an augmented-Lagrangian update; ``None``: kept)."""
+        self.mult = self.mult if mult is None else mult
+        self.tmult = self.tmult if tmult is None else tmult
+
+    def commit(self, mu, friction=None, tmult=None):
+        """The step is accepted: its trial normal multipliers, friction coefficients ``mu`` per
+        declaration, friction history ``friction`` (dict of the module docstring's fields, sorted by
+        key; ``None``: no rows) and tangential multipliers ``tmult`` (``None``: none) are kept."""
+        self.mult_committed = self.mult
+        self.mu_committed = mu
+        self.friction = empty_friction() if friction is None else friction
+        self.tmult_committed = self.tmult = _no_tmult() if tmult is None else tmult
+
+    def start_friction(self, mu):
+        """Friction coefficients ``mu`` per declaration for the coming step: where friction starts
+        (``mu > 0``, none in the last accepted step) the history rows are dropped, so friction acts as
+        at first contact, from the step's start.  Not after a restart (``mu_committed`` unknown)."""
+        if self.mu_committed is None:
+            return
+        starts = (mu > 0) & (self.mu_committed == 0)
+        if starts.any():
+            self.friction = {k: v[~starts[self.friction_decl()]] for k, v in self.friction.items()}
+
+    def friction_decl(self):
+        """Declaration of every row of the friction history (decoded from the point keys)."""
+        lay = self.layout
+        key, n_el = self.friction["key"], np.int64(lay.n_el)
+        gauss = key < lay.point_offset
+        return np.where(gauss, key // np.maximum(n_el * lay.max_gp * lay.n_beams, 1),
+                        (key - lay.point_offset) // (n_el * n_el)).astype(int)
+
+    # ------------------------------------------------------------ look-ups
+    def normal_multipliers(self, keys):
+        """Trial normal multiplier ``(k,)`` of the points ``keys`` (0 where there is none)."""
+        mi, mf = lookup(self.mult[0], keys)
+        return np.where(mf, self.mult[1][mi] if len(self.mult[1]) else 0.0, 0.0)
+
+    def tangential_multipliers(self, keys):
+        """Trial tangential multiplier ``(k, 3)`` of the nodal groups ``keys`` (0 where there is none)."""
+        mi, mf = lookup(self.tmult[0], keys)
+        lam = np.zeros((len(keys), 3))
+        lam[mf] = self.tmult[1][mi[mf]]
+        return lam
+
+    def frictional(self, p, keys, e, m):
+        """Put the friction history of the points ``keys`` on elements ``e``, ``m`` into the kernel
+        parameters ``p`` (``H_CL``, ``H_FK``, ``H_LK_prev``, ``xi1_prev``, ``xi2_prev``, ``lam_t_prev``;
+        points without history: identities, their own ``xi1``, ``xi2``, zero traction); returns
+        ``found`` ``(k,)``, the points with history."""
+        hist = self.friction
+        hi, hf = lookup(hist["key"], keys)
+        n = len(keys)
+        if len(hist["key"]):
+            every = hf.all()        # (every pair with history, as in a step's later iterates: no masking)
+            for name, src in (("H_CL", "H_CL"), ("H_FK", "H_FK"), ("H_LK_prev", "H_LK")):
+                p[name] = hist[src][hi] if every else np.where(hf[:, None, None], hist[src][hi], np.eye(4))
+            # material points, re-expressed on the current elements (same beam, consecutive ids)
+            p["xi1_prev"] = np.where(hf, hist["xi1"][hi] + hist["e"][hi] - e, p["xi1"])
+            p["xi2_prev"] = np.where(hf, hist["xi2"][hi] + hist["m"][hi] - m, p["xi2"])
+            p["lam_t_prev"] = np.where(hf[:, None], hist["lam_t"][hi], 0.0)
+        else:
+            p.update(H_CL=np.tile(np.eye(4), (n, 1, 1)), H_FK=np.tile(np.eye(4), (n, 1, 1)),
+                     H_LK_prev=np.tile(np.eye(4), (n, 1, 1)), xi1_prev=p["xi1"].copy(),
+                     xi2_prev=p["xi2"].copy(), lam_t_prev=np.zeros((n, 3)))
+        return hf
+
+    # ------------------------------------------------------------ kinds of crossings
+    def forget_kinds(self):
+        """Empty the kinds of the step (``step_kinds``): the next evaluation decides them."""
+        self.kind_keys, self.kind_values = np.zeros(0, dtype=np.int64), np.zeros(0, dtype=int)
+
+    def step_kinds(self, decl, e, m, kinds):
+        """Kinds of crossing element pairs kept within a step: a pair (declaration ``decl``, slave
+        ``e``, master ``m``) that was a point or orthogonal pair at an earlier evaluation of the
+        step keeps that kind while it is a crossing; the others are remembered as decided now.
+
+        The choice (the reduced-Hessian ratio of the closest points, ``rules.extend_wrap``) is
+        not continuous: decided afresh at every iterate it may flip between two iterates, and
+        the contact force with it (a point pair at the crossing against Gauss points around
+        it), so that Newton cycles (docs/theory.md, kind of a crossing within a step)."""
+        n_el = np.int64(self.layout.n_el)
+        cross = np.flatnonzero(kinds != LINE)
+        if not len(cross):
+            return kinds
+        keys = (np.int64(decl) * n_el + e[cross]) * n_el + m[cross]
+        idx, found = lookup(self.kind_keys, keys)
+        kinds = kinds.copy()
+        kinds[cross[found]] = self.kind_values[idx[found]]
+        if not found.all():
+            k = np.concatenate([self.kind_keys, keys[~found]])
+            v = np.concatenate([self.kind_values, kinds[cross[~found]]])
+            order = np.argsort(k, kind="stable")
+            self.kind_keys, self.kind_values = k[order], v[order]
+        return kinds
+
+    # ------------------------------------------------------------ the search's memory
+    def memory(self):
+        """The search's memory (point pairs, owners, kinds of the step), for ``recall``."""
+        return self.prev_points, self.prev_owners, self.kind_keys, self.kind_values
+
+    def recall(self, memory):
+        """Put back the search's memory saved by ``memory``."""
+        self.prev_points, self.prev_owners, self.kind_keys, self.kind_values = memory
+
+    # ------------------------------------------------------------ restart
+    def state(self):
+        """Committed contact state as a flat dict of arrays (saved with a ``Solution``, restart).
+
+        ``history.<field>``: friction history per point key (material frames, ``xi``,
+        traction); ``mult_keys``/``mult_values``: augmented-Lagrangian multipliers;
+        ``tmult_keys``/``tmult_values``: exact stick's nodal tangential multipliers (``mortar.py``);
+        ``prev_points``/``prev_owners``: the point pairs and Gauss-point owners of the last
+        evaluation (the hysteresis of the ownership rules).  ``restore`` takes it back.
+        """
+        out = {f"history.{k}": np.array(v) for k, v in self.friction.items()}
+        out["mult_keys"], out["mult_values"] = (np.array(a) for a in self.mult_committed)
+        out["tmult_keys"], out["tmult_values"] = (np.array(a) for a in self.tmult_committed)
+        out["prev_points"] = np.array(self.prev_points)
+        out["prev_owners"] = np.array(self.prev_owners)
+        return out
+
+    def restore(self, state):
+        """Restore a state from ``state()`` (missing parts: empty; older archives lack some), checked
+        first (``state.check_state``: ``InputError`` naming a damaged or foreign entry).  The trial
+        multipliers are the restored ones, the kinds of crossings forgotten."""
+        history, mult, prev = check_state(state, self.layout)
+        hist = empty_friction()
+        for k, v in (history or {}).items():
+            hist[k] = v.astype(hist[k].dtype)
+        n = {len(v) for v in hist.values()}
+        if len(n) > 1:
+            raise InputError(f"contact state: the history has {sorted(n)} rows in different entries "
+                             f"(given: {sorted(history or {})}; all of {sorted(hist)} are needed)")
+        self.friction = hist
+        self.mu_committed = None          # a restart keeps its history also at a friction switch
+        if mult is not None:
+            self.mult_committed = mult
+        self.mult = self.mult_committed
+        if "tmult_keys" in state:
+            self.tmult_committed = (np.asarray(state["tmult_keys"], dtype=np.int64),
+                                    np.asarray(state["tmult_values"], dtype=float).reshape(-1, 3))
+        self.tmult = self.tmult_committed
+        for name, v in prev.items():
+            setattr(self, name, np.sort(v))
+        self.forget_kinds()

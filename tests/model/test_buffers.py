@@ -1,0 +1,53 @@
+"""``buffers.BufferPool``: a kept buffer is handed out again only when no array still uses it."""
+import numpy as np
+import pytest
+
+from beamsolver.model.buffers import REUSE_BUFFERS, BufferPool
+
+
+def _base(a):
+    return a if a.base is None else a.base
+
+
+@pytest.mark.skipif(not REUSE_BUFFERS, reason="buffers are not reused on this Python")
+def test_a_free_buffer_is_reused_a_held_one_never():
+    pool = BufferPool()
+    a = pool.take((8, 24, 24))
+    assert a.shape == (8, 24, 24) and _base(a).shape == (9, 24, 24)     # room for an eighth more
+    a[...] = 1.0
+    b = pool.take((9, 24, 24))                 # ``a`` held: a new buffer
+    assert not np.shares_memory(a, b)
+    np.testing.assert_array_equal(a, 1.0)
+    first = id(_base(a))                       # (an id: a reference would hold the buffer)
+    del a
+    c = pool.take((7, 24, 24))                 # the first buffer is free again (and long enough)
+    assert id(_base(c)) == first and c.shape == (7, 24, 24)
+    del b, c
+    d = pool.take((40, 24, 24))                # none long enough: a new one, the oldest dropped
+    assert len(pool.buffers) == 2 and _base(d) is pool.buffers[0] and first not in map(id, pool.buffers)
+
+
+@pytest.mark.skipif(not REUSE_BUFFERS, reason="buffers are not reused on this Python")
+def test_growing_along_another_axis_and_dtype():
+    pool = BufferPool(np.int32, axis=1)
+    a = pool.take((2, 100))
+    assert a.dtype == np.int32 and a.shape == (2, 100) and _base(a).shape == (2, 112)
+    rows = a[0, :50]                           # a view of the view still holds the buffer
+    del a
+    b = pool.take((2, 60))
+    assert not np.shares_memory(rows, b)
+    del rows, b
+    c = pool.take((2, 112))
+    assert _base(c).shape == (2, 112) and c.shape == (2, 112)
+
+
+def test_without_reuse_every_take_is_new(monkeypatch):
+    from beamsolver.model import buffers
+    monkeypatch.setattr(buffers, "REUSE_BUFFERS", False)
+    pool = BufferPool()
+    a = pool.take((5, 3))
+    address = a.__array_interface__["data"][0]
+    del a
+    b = pool.take((5, 3))
+    assert _base(b).shape == (5, 3)
+    assert len(pool.buffers) == 2 and pool.buffers[1].__array_interface__["data"][0] == address
