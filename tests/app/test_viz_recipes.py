@@ -1,4 +1,5 @@
 """Pictures a new user makes (issue 17): smooth tubes from the VTU files, one y axis per unit."""
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -24,7 +25,7 @@ def test_guide_pyvista_recipe_runs_as_written_without_warnings(pair_run):
     pv = pytest.importorskip("pyvista")
     import re
     import warnings
-    page = (Path(__file__).resolve().parents[1] / "docs" / "guide" / "output.md").read_text()
+    page = (Path(__file__).resolve().parents[2] / "docs" / "guide" / "output.md").read_text()
     recipe = re.search(r"\(pyvista: `(grid\.[^`]*)`", page).group(1)
     recipe = re.sub(r"\s*\n\s*", "", recipe)
     grid = pv.read(pair_run[1] / "beams_0002.vtu")
