@@ -1,0 +1,62 @@
+"""Exact stick on the bent 1+6 strand (examples/strand_bending.py): first slip, stick stiffness and moment
+against the mesh and the augmentation penalty (issue 26; table in docs/benchmarks.md, "Compiled point terms,
+strand bending").
+
+    python benchmarks/exact_stick_strand.py [--meshes 8 16 32] [--penalties 1 10] [--lays 2] [--upto 1.6]
+
+Virgin ramp ``0 -> upto kappa_b`` in steps of 0.05 kappa_b (``t`` in ``[1, 2]``, after the frictionless pull);
+first slip = the first step with a slipping point in the middle half (``status``); the penalty column is
+``penalty_t / E`` (``None``: the default, the normal penalty E).
+"""
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+
+import strand_bending as sb  # noqa: E402
+
+
+def row(elements_per_lay, factor, lays, upto):
+    orig = sb._contact_options
+    extra = {} if factor is None else dict(penalty_t=factor * sb.E)
+    sb._contact_options = lambda stick, tol: orig("exact", tol) | extra
+    try:
+        t0 = time.perf_counter()
+        res = sb.run(lays, elements_per_lay, amplitude=upto, steps=int(round(upto / 0.05)), t_end=2.0)
+        wall = time.perf_counter() - t0
+    finally:
+        sb._contact_options = orig
+    th = sb.theory(res["F"])
+    up = np.flatnonzero(res["times"] > 1.0)
+    hit = up[res["share"][up] > 0]
+    first = res["kappa"][hit[0]] / th["kappa_b"] if len(hit) else np.nan
+    return dict(el=elements_per_lay, penalty="E" if factor is None else f"{factor:g} E",
+                EI0=res["M"][up[0]] / res["kappa"][up[0]], first=first, M=res["M"][up[-1]],
+                Mth=float(np.ravel(sb.moment(res["kappa"][up[-1]], th))[0]), share=res["share"][up[-1]],
+                iterations=res["iterations"], wall=wall, EI_max=th["EI_max"])
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--meshes", type=int, nargs="+", default=[8, 16, 32])
+    ap.add_argument("--penalties", type=float, nargs="+", default=[1.0], help="penalty_t / E (1: the default)")
+    ap.add_argument("--lays", type=float, default=2.0)
+    ap.add_argument("--upto", type=float, default=1.6)
+    a = ap.parse_args()
+    print("| el/lay | augmentation penalty | EI initial [N m^2] | first slip / kappa_b | M(end) [N m] | theory [N m] "
+          "| slipping share | Newton it. | wall [s] |")
+    print("|---:|---|---:|---:|---:|---:|---:|---:|---:|")
+    for n in a.meshes:
+        for f in a.penalties:
+            r = row(n, None if f == 1.0 else f, a.lays, a.upto)
+            print(f"| {r['el']} | {r['penalty']} | {r['EI0']:.2f} | {r['first']:.3f} | {r['M']:.4f} | {r['Mth']:.4f} "
+                  f"| {r['share']:.3f} | {r['iterations']} | {r['wall']:.1f} |", flush=True)
+    print(f"EI_max (plane sections) {r['EI_max']:.1f} N m^2")
+
+
+if __name__ == "__main__":
+    main()
