@@ -240,23 +240,24 @@ def build_strand(layers, length, E, nu=0.3, elements_per_lay=24, min_elements=8,
                                    phase=layer.phase + 2.0 * np.pi * i / n_wires)
             layer_wires.append(model.add_beam(P, sec, name=f"layer {k} wire {i}"))
         wires.append(layer_wires)
-    contacts = []
-    if contact:
-        opts = dict(contact_options or {})
-        for k in range(1, len(wires)):
-            contacts.append(model.add_contact(wires[k], wires[k - 1], mu=mu, **opts))
-        for k, lw in enumerate(wires):
-            m = len(lw)
-            if m < 2:
-                continue
-            R = geo[k][3]
-            d = _neighbour_distance(model, lw[0], lw[1])
-            if d <= 2.0 * R * (1.0 + touch_tol):
-                pairs = [(i, (i + 1) % m) for i in range(m if m > 2 else 1)]
-                for i, j in pairs:
-                    contacts.append(model.add_contact(lw[i], lw[j], mu=mu, **opts))
+    contacts = _strand_contacts(model, wires, geo, mu, dict(contact_options or {}), touch_tol) if contact else []
     return Strand(model, layers, wires, [g[0] for g in geo], [g[1] for g in geo], lays, float(length), contacts,
                   [layer_clearance(r, R, n, beta) for (r, beta, _, R, n) in geo])
+
+
+def _strand_contacts(model, wires, geo, mu, opts, touch_tol):
+    """Contact declarations of one strand's layers ``wires`` (lists of beams, centre out; ``geo``: their
+    ``_geometry``): each layer against the one inside it, and neighbours within a layer whose centre
+    lines come within ``2 R (1 + touch_tol)``."""
+    contacts = []
+    for k in range(1, len(wires)):
+        contacts.append(model.add_contact(wires[k], wires[k - 1], mu=mu, **opts))
+    for k, lw in enumerate(wires):
+        m = len(lw)
+        if m >= 2 and _neighbour_distance(model, lw[0], lw[1]) <= 2.0 * geo[k][3] * (1.0 + touch_tol):
+            for i in range(m if m > 2 else 1):
+                contacts.append(model.add_contact(lw[i], lw[(i + 1) % m], mu=mu, **opts))
+    return contacts
 
 
 def _geometry(layers):
@@ -490,17 +491,7 @@ def build_rope(strand, length, E, nu=0.3, n_strands=6, lay_length=None, lay_angl
     geo = _geometry(layers)
     rho_s = geo[-1][0] + geo[-1][3]
     model = Model() if model is None else model
-    # the core
-    fibre = isinstance(core, Section)
-    if not fibre and not (isinstance(core, (list, tuple)) and core):
-        raise InputError(f"build_rope: core must be a list of cables.Layer (a wire strand core) or a Section "
-                         f"(a fibre core), got {core!r}")
-    if fibre:
-        rho_c, core_lays = float(core.radius), []
-    else:
-        cgeo = _geometry([_layer(layer, k) for k, layer in enumerate(core)])
-        rho_c = cgeo[-1][0] + cgeo[-1][3]
-        core_lays = [p for (_, _, p, _, _) in cgeo if np.isfinite(p)]
+    rho_c, core_geo = _rope_core_geometry(core)
     # the strands' helix
     envelope = Layer(wire_radius=rho_s, n_wires=n_strands, lay_length=lay_length, lay_angle=lay_angle)
     if (lay_length is None) == (lay_angle is None):
@@ -517,8 +508,9 @@ def build_rope(strand, length, E, nu=0.3, n_strands=6, lay_length=None, lay_angl
     clearance = layer_clearance(R_s, rho_s, n_strands, alpha)
     c = (1.0 if direction == "right" else -1.0) * P / (2.0 * np.pi)
     lays = [P] + [p * np.cos(alpha) for (_, _, p, _, _) in geo if np.isfinite(p)]
+    core_lays = [] if core_geo is None else [p for (_, _, p, _, _) in core_geo if np.isfinite(p)]
     n_core = max(min_elements, elements_per_lay, int(np.ceil(elements_per_lay * length / min(lays + core_lays))))
-    if fibre:
+    if core_geo is None:
         core_strand = None
         core_wires = [[model.add_beam(geometry.straight((0, 0, 0), (0, 0, length), n_core), core, name="core")]]
     else:
@@ -526,39 +518,13 @@ def build_rope(strand, length, E, nu=0.3, n_strands=6, lay_length=None, lay_angl
                                    mu=mu, contact=contact, touch_tol=touch_tol, model=model,
                                    contact_options=contact_options)
         core_wires = core_strand.wires
-    # the outer strands
-    strands = []
-    for j in range(n_strands):
-        th0 = 2.0 * np.pi * j / n_strands
-        sl = []
-        for k, (layer, (r, beta, p, R, n_w)) in enumerate(zip(layers, geo)):
-            sec = _section(layer, k, R, E, nu)
-            lay_z = min(P, p * np.cos(alpha)) if np.isfinite(p) else P
-            n_el = max(min_elements, int(np.ceil(elements_per_lay * length / lay_z)))
-            z = np.linspace(0.0, length, n_el + 1)
-            wires = []
-            for i in range(n_w):
-                name = f"strand {j} layer {k} wire {i}"
-                if r == 0.0:
-                    P_ = geometry.helix(radius=R_s, pitch=2.0 * np.pi * c, length=length, n_elements=n_el, phase=th0)
-                else:
-                    sign = 1.0 if layer.direction == "right" else -1.0
-                    P_ = geometry.double_helix(R_s, 2.0 * np.pi * c, r, sign * p, length, n_el,
-                                               phase=layer.phase + 2.0 * np.pi * i / n_w, strand_phase=th0)
-                wires.append(model.add_beam(P_, sec, name=name))
-            sl.append(wires)
-        strands.append(sl)
+    strands = [_rope_strand(model, layers, geo, j, n_strands, R_s, c, P, alpha, length, E, nu, elements_per_lay,
+                            min_elements) for j in range(n_strands)]
     contacts = list(core_strand.contacts) if core_strand is not None else []
     if contact:
         opts = dict(contact_options or {})
         for sl in strands:
-            for k in range(1, len(sl)):
-                contacts.append(model.add_contact(sl[k], sl[k - 1], mu=mu, **opts))
-            for k, lw in enumerate(sl):
-                m = len(lw)
-                if m >= 2 and _neighbour_distance(model, lw[0], lw[1]) <= 2.0 * geo[k][3] * (1.0 + touch_tol):
-                    for i in range(m if m > 2 else 1):
-                        contacts.append(model.add_contact(lw[i], lw[(i + 1) % m], mu=mu, **opts))
+            contacts += _strand_contacts(model, sl, geo, mu, opts, touch_tol)
         gap = 2.0 * geo[-1][3] * touch_tol
         if R_s - rho_s - rho_c <= gap:
             contacts.append(model.add_contact([w for sl in strands for w in sl[-1]], core_wires[-1], mu=mu, **opts))
@@ -567,3 +533,38 @@ def build_rope(strand, length, E, nu=0.3, n_strands=6, lay_length=None, lay_angl
                 contacts.append(model.add_contact(strands[j][-1], strands[(j + 1) % n_strands][-1], mu=mu, **opts))
     return Rope(model, core_wires, strands, core_strand, float(R_s), float(P), float(alpha), layers, geo,
                 float(rho_s), float(rho_c), float(length), contacts, clearance)
+
+
+def _rope_core_geometry(core):
+    """``(radius, layer geometry)`` of a rope's core: a ``Section`` (fibre core: geometry ``None``) or a
+    list of ``Layer`` (a wire strand core, ``_geometry``)."""
+    if isinstance(core, Section):
+        return float(core.radius), None
+    if not (isinstance(core, (list, tuple)) and core):
+        raise InputError(f"build_rope: core must be a list of cables.Layer (a wire strand core) or a Section "
+                         f"(a fibre core), got {core!r}")
+    cgeo = _geometry([_layer(layer, k) for k, layer in enumerate(core)])
+    return cgeo[-1][0] + cgeo[-1][3], cgeo
+
+
+def _rope_strand(model, layers, geo, j, n_strands, R_s, c, P, alpha, length, E, nu, elements_per_lay, min_elements):
+    """The wires of outer strand ``j`` (lists per layer, centre out) on the strands' helix (pitch radius
+    ``R_s``, ``c`` = axial advance per radian, lay ``P``, angle ``alpha``)."""
+    th0 = 2.0 * np.pi * j / n_strands
+    sl = []
+    for k, (layer, (r, beta, p, R, n_w)) in enumerate(zip(layers, geo)):
+        sec = _section(layer, k, R, E, nu)
+        lay_z = min(P, p * np.cos(alpha)) if np.isfinite(p) else P
+        n_el = max(min_elements, int(np.ceil(elements_per_lay * length / lay_z)))
+        wires = []
+        for i in range(n_w):
+            name = f"strand {j} layer {k} wire {i}"
+            if r == 0.0:
+                P_ = geometry.helix(radius=R_s, pitch=2.0 * np.pi * c, length=length, n_elements=n_el, phase=th0)
+            else:
+                sign = 1.0 if layer.direction == "right" else -1.0
+                P_ = geometry.double_helix(R_s, 2.0 * np.pi * c, r, sign * p, length, n_el,
+                                           phase=layer.phase + 2.0 * np.pi * i / n_w, strand_phase=th0)
+            wires.append(model.add_beam(P_, sec, name=name))
+        sl.append(wires)
+    return sl
