@@ -159,3 +159,29 @@ def kernel_scene(seed, friction, smoothing, multiplier, history, elastic_slip, a
                  lam_t_prev=rng.normal(size=(P, 3)) * 0.5,
                  has_history=np.full(P, history) | (np.arange(P) % 4 == 0))
     return X, p
+
+
+def contact_tangent_error(problem, H, eps=1e-7):
+    """Largest difference between the assembled tangent and central differences of the residual over the
+    free unknowns at poses ``H``, relative to the largest contact tangent entry (the whole tangent's where
+    no contact block is active); returns ``(error, evaluation)``."""
+    system = problem.system
+    ev = problem.evaluate(H, 0.0, tangent=True)
+    K = problem.full_tangent(ev).toarray()
+    free = system.free_dofs
+    n = system.n_nodes
+    ext = ev.extra
+    Kc = np.zeros_like(K)
+    if ext is not None and len(ext[2]):
+        np.add.at(Kc, (ext[0], ext[1]), ext[2])
+    scale = np.abs(Kc[np.ix_(free, free)]).max(initial=0.0)
+    if scale == 0.0:
+        scale = np.abs(K[np.ix_(free, free)]).max()
+    worst = 0.0
+    for d in free:
+        dz = np.zeros(6 * n)
+        dz[d] = eps
+        rp = problem.evaluate(problem.update(H, dz.reshape(n, 6)), 0.0, tangent=False).r
+        rm = problem.evaluate(problem.update(H, -dz.reshape(n, 6)), 0.0, tangent=False).r
+        worst = max(worst, np.abs((rp - rm)[free] / (2 * eps) - K[free, d]).max() / scale)
+    return worst, ev

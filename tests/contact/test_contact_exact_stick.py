@@ -12,6 +12,7 @@ import pytest
 import beamsolver as bs
 from beamsolver import se3
 from beamsolver.nonlinear.problem import Problem
+from helpers import contact_tangent_error
 
 import contact_patch
 import shear_lag
@@ -53,22 +54,7 @@ def _pressed(problem, slave, depth):
 def _fd_error(problem, H, eps=1e-7):
     """Largest difference between the assembled tangent and central differences of the residual
     over the free unknowns, relative to the largest contact tangent entry."""
-    system = problem.system
-    ev = problem.evaluate(H, 0.0, tangent=True)
-    K = problem.full_tangent(ev).toarray()
-    free = system.free_dofs
-    n = system.n_nodes
-    Kc = np.zeros_like(K)
-    np.add.at(Kc, (ev.extra[0], ev.extra[1]), ev.extra[2])
-    scale = np.abs(Kc[np.ix_(free, free)]).max()
-    worst = 0.0
-    for d in free:
-        dz = np.zeros(6 * n)
-        dz[d] = eps
-        rp = problem.evaluate(problem.update(H, dz.reshape(n, 6)), 0.0, tangent=False).r
-        rm = problem.evaluate(problem.update(H, -dz.reshape(n, 6)), 0.0, tangent=False).r
-        worst = max(worst, np.abs((rp - rm)[free] / (2 * eps) - K[free, d]).max() / scale)
-    return worst
+    return contact_tangent_error(problem, H, eps)[0]
 
 
 @pytest.mark.slow

@@ -14,6 +14,7 @@ import beamsolver as bs
 from beamsolver import se3
 from beamsolver.nonlinear.problem import Problem
 from beamsolver.contact.frames import LINE, ORTHOGONAL, POINT
+from helpers import contact_tangent_error
 
 R = 0.05
 SEC = bs.Section.circular(radius=R, E=1e7, nu=0.3)
@@ -82,26 +83,7 @@ def _towards_master(problem, H, slave, master, depth):
 
 
 def _fd_error(problem, H, eps=1e-7):
-    system = problem.system
-    ev = problem.evaluate(H, 0.0, tangent=True)
-    K = problem.full_tangent(ev).toarray()
-    free = system.free_dofs
-    n = system.n_nodes
-    ext = ev.extra
-    Kc = np.zeros_like(K)
-    if ext is not None and len(ext[2]):
-        np.add.at(Kc, (ext[0], ext[1]), ext[2])
-    scale = np.abs(Kc[np.ix_(free, free)]).max(initial=0.0)
-    if scale == 0.0:
-        scale = np.abs(K[np.ix_(free, free)]).max()
-    worst = 0.0
-    for d in free:
-        dz = np.zeros(6 * n)
-        dz[d] = eps
-        rp = problem.evaluate(problem.update(H, dz.reshape(n, 6)), 0.0, tangent=False).r
-        rm = problem.evaluate(problem.update(H, -dz.reshape(n, 6)), 0.0, tangent=False).r
-        col = (rp - rm) / (2 * eps)
-        worst = max(worst, np.abs(col[free] - K[free, d]).max() / scale)
+    worst, ev = contact_tangent_error(problem, H, eps)
     return worst, ev.details["contact"]
 
 
