@@ -41,6 +41,24 @@ def spd_matrix(rng, diag=(1e3, 4e2, 5e2, 20.0, 30.0, 40.0), coupling=0.3):
     return (d / s)[:, None] * S * (d / s)[None, :]
 
 
+def numpy_matmul_fuses():
+    """Whether numpy's ``@`` on 3x3 blocks rounds ``a0 b0 + a1 b1 + a2 b2`` as one fma chain (the BLAS of
+    this machine; ``lie.se3_twin`` reproduces that chain)."""
+    e = 2.0 ** -30
+    A = np.array([[[1.0 + e, 1.0, 1.0], [0.0] * 3, [0.0] * 3]])
+    B = np.array([[[1.0 - e, 0, 0], [-0.5, 0, 0], [-0.5, 0, 0]]])
+    return (A @ B)[0, 0, 0] == -e * e
+
+
+def assert_same_bits(a, b):
+    """``a`` and ``b`` equal bit for bit (NaN where NaN) where numpy's ``@`` fuses (``numpy_matmul_fuses``),
+    else to round-off."""
+    if numpy_matmul_fuses():
+        assert np.array_equal(a, b, equal_nan=True), f"{np.count_nonzero(a != b)} entries differ"
+    else:
+        np.testing.assert_allclose(a, b, rtol=1e-13, atol=1e-15)
+
+
 def rel_err(a, b):
     a, b = np.asarray(a), np.asarray(b)
     return float(np.abs(a - b).max() / max(np.abs(b).max(), 1e-300))

@@ -23,7 +23,7 @@ with the digest of every package module it imports.)  The sections are inlined
 """
 import numpy as np
 
-from ..lie import se3
+from ..lie import se3_twin
 from .._jit import jit, jit_callee
 from ..lie.se3_jit import _SERIES_TABLE, _SWITCH, A_, B_, C_, add, add_outer, cross, dot, mat, mm, mv, scale
 from .kernel_jit import _pose_of, _project, _section, _section_inline
@@ -33,10 +33,10 @@ __all__ = ["element_twists", "section_points", "spheres", "overlap", "closest_po
 
 
 def element_twists(H, enodes):
-    """Twists ``h = log(H_A^-1 H_B)`` ``(n, 6)`` of the elements ``enodes`` ``(n, 2)``: one batched
-    ``se3.log`` (the compiled ``se3_jit.log_relative`` differs in round-off, which changes the
-    Newton iteration counts of the contact examples: docs/benchmarks.md)."""
-    return se3.log(se3.relative(H[enodes[:, 0]], H[enodes[:, 1]]))
+    """Twists ``h = log(H_A^-1 H_B)`` ``(n, 6)`` of the elements ``enodes`` ``(n, 2)``: the bits of the
+    batched ``se3.log`` (``se3_twin.log_relative``; the compiled ``se3_jit.log_relative`` differs in
+    round-off, which changes the Newton iteration counts of the contact examples: docs/benchmarks.md)."""
+    return se3_twin.log_relative(H, enodes[:, 0], enodes[:, 1])
 
 
 @jit

@@ -56,7 +56,8 @@ from ..model.model import JOIN_TOL
 from .law import default_penalty
 from . import kernel_jit, mortar
 from .options import ADJUST, SMOOTHING, STICK_TOLERANCE, ContactOptions, declaration_table
-from .frames import LINE, NORMAL_TOL, POINT, material_frames, no_normal, touch_tolerance
+from .frames import LINE, NORMAL_TOL, POINT, no_normal, touch_tolerance
+from .frames_jit import material_frames
 from .record import OPEN, SLIP, STICK, Candidates, PairSet
 from .ownership import gauss_owners, gauss_record
 from .projection import closest_points, element_twists, gauss_projections, section_points
@@ -437,9 +438,8 @@ class ContactSystem(Contribution):
         # material frames are those of the pair there (same xi), its traction zero
         new = np.flatnonzero(~hf & (p["mu"] > 0))
         if len(new) and self._H_prev is not None:
-            X = self._H_prev[P.nodes[sel][new]]
             h = self._prev_twists()           # the element twists at the last converged poses
-            H_CL, H_FK, H_LK = material_frames(X, p["kind"][new], p["xi1"][new], p["xi2"][new],
+            H_CL, H_FK, H_LK = material_frames(self._H_prev, P.nodes[sel][new], p["xi1"][new], p["xi2"][new],
                                                p["R1"][new], p["R2"][new], h[P.e[sel][new]], h[P.m[sel][new]])
             ok = np.isfinite(H_LK).all(axis=(1, 2))
             new = new[ok]
