@@ -23,7 +23,7 @@ import scipy.sparse as sp
 from . import compiled as assembly_jit
 from ..model import contributions
 from ..elements import line_load
-from ..lie import se3
+from ..lie import se3, se3_twin
 from ..model import blocks as _blocks
 from ..model.buffers import REUSE_BUFFERS, BufferPool     # noqa: F401  (REUSE_BUFFERS: tests)
 from ..errors import InputError
@@ -256,10 +256,12 @@ class System:
         P = self.poses0
         self.members = np.flatnonzero(~is_rep)
         if len(self.members):
+            self._member_reps = rep[self.members]
             self.X = se3.relative(P[rep[self.members]], P[self.members])   # H_i = H_rep X_i
             self.Ad_Xinv = se3.adjoint(se3.inverse(self.X))
         else:
             self.X, self.Ad_Xinv = np.zeros((0, 4, 4)), np.zeros((0, 6, 6))
+            self._member_reps = np.zeros(0, dtype=np.intp)
         self.global_nodes = np.flatnonzero(kind == GLOBAL)
         # prescribed global translations of fixed components: (node, component, f)
         self.fix_values = []
@@ -417,11 +419,16 @@ class System:
 
     # ------------------------------------------------------------ transforms
     def node_transforms(self, H):
-        """``M_i`` for the transformed nodes: dict of arrays ``(n, 6, 6)`` (identity elsewhere)."""
+        """``M_i`` ``(n, 6, 6)`` for the transformed nodes (identity elsewhere), read-only, kept while the
+        global-type nodes' rotations stay."""
         if not self.any_transformed:
             return None
-        M = np.broadcast_to(np.eye(6), (self.n_nodes, 6, 6)).copy()
         g = self.global_nodes
+        key = H[g, :3, :3]          # M depends on the poses of the global-type nodes only
+        c = getattr(self, "_transforms", None)
+        if c is not None and np.array_equal(c[0], key):
+            return c[1]             # read-only: shared by the evaluations at these poses
+        M = np.broadcast_to(np.eye(6), (self.n_nodes, 6, 6)).copy()
         if len(g):
             Rt = np.swapaxes(H[g, :3, :3], 1, 2)
             M[g] = 0.0
@@ -429,6 +436,8 @@ class System:
             M[g, 3:, 3:] = Rt
         if len(self.members):
             M[self.members] = self.Ad_Xinv @ M[self.rep[self.members]]
+        M.flags.writeable = False
+        self._transforms = (key, M)
         return M
 
     def assemble_blocks(self, H, blocks):
@@ -704,9 +713,8 @@ class System:
         if chains and self.chains:
             assembly_jit.rechain(H0, H, dz, self.chain_index, self.chain_ptr)
         g = self.global_nodes
-        if len(g):
-            H[g, :3, 3] += dz[g, :3]
-            H[g, :3, :3] = se3.exp_so3(dz[g, 3:]) @ H[g, :3, :3]
+        if len(g):        # x += dz_u, R <- exp(dz_w) R (compiled, numpy's bits)
+            se3_twin.turn_global(H, g, dz)
         self.sync_members(H)
         return H
 
@@ -726,8 +734,9 @@ class System:
             H[b] = se3.compose(H[nodes[0]], P)
 
     def sync_members(self, H):
+        """``H[members] = H[rep] X`` in place (compiled, the bits of ``se3.compose``)."""
         if len(self.members):
-            H[self.members] = se3.compose(H[self.rep[self.members]], self.X)
+            se3_twin.compose_members(H, self.members, self._member_reps, self.X)
 
     def prescribed_poses(self, t):
         """Target poses ``G(t) H_0`` of the prescribed representatives ``(k, 4, 4)``; every

@@ -7,8 +7,7 @@ new pairs; the numpy version spent most of its time in Python calls.
 import numpy as np
 
 from .._jit import jit
-from ..lie.se3 import coefficients
-from ..lie.se3_twin import exp_angles, exp_compose_into, relative_into
+from ..lie.se3_twin import coefficient_table, exp_angles, exp_compose_into, relative_into
 from .frames import NORMAL_TOL
 
 __all__ = ["material_frames"]
@@ -57,8 +56,8 @@ def material_frames(H, nodes, xi1, xi2, R1, R2, h1, h2):
     m = len(nodes)
     f = lambda v: np.ascontiguousarray(v, dtype=float)      # noqa: E731
     xi1, xi2, R1, R2, h1, h2 = f(xi1), f(xi2), f(R1), f(R2), f(h1), f(h2)
-    c = coefficients(("a", "b", "c"), np.concatenate([exp_angles(h1, xi1), exp_angles(h2, xi2)]))
+    c = coefficient_table(("a", "b", "c"), np.concatenate([exp_angles(h1, xi1), exp_angles(h2, xi2)]))
     out = np.empty((3, m, 4, 4))
-    _frames(np.ascontiguousarray(H, dtype=float), np.ascontiguousarray(nodes), xi1, xi2, R1, R2, h1, h2,
-            np.stack([c["a"], c["b"], c["c"]]), out[0], out[1], out[2])
+    _frames(np.ascontiguousarray(H, dtype=float), np.ascontiguousarray(nodes), xi1, xi2, R1, R2, h1, h2, c,
+            out[0], out[1], out[2])
     return out[0], out[1], out[2]

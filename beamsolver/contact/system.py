@@ -691,8 +691,12 @@ class ContactSystem(Contribution):
             raise InputError("contact: the numpy oracle kernel (use_numpy_kernel) has only the default law; "
                              f"add_contact declared law={next(law for law in laws if law is not None)!r}")
         fric = p["mu"] > 0 if friction is None else np.broadcast_to(friction, (len(X),))
-        group = np.unique([id(law) for law in laws], return_inverse=True)[1][decl] * 2 + fric
-        kinds = np.unique(group)
+        if len(laws) == 1:          # one declaration: the friction flag is the group
+            group = fric.astype(np.int64)
+            kinds = np.flatnonzero([not fric.all(), fric.any()])
+        else:
+            group = np.unique([id(law) for law in laws], return_inverse=True)[1][decl] * 2 + fric
+            kinds = np.unique(group)
         if len(kinds) == 1:                     # one kind: no masked copies of the (m, 24, 24) blocks
             out = self._tangent_out(len(X)) if tangent and compiled else None
             return _kernel(self.kernel, X, p, bool(kinds[0] % 2), laws[decl[0]], tangent, out)

@@ -23,9 +23,12 @@ from numba import config, types as nb_types
 from numba.extending import intrinsic
 
 from .._jit import jit, jit_callee
-from .se3 import ATAN_SERIES_RATIO, SERIES, SWITCH, coefficients
+from .se3 import ATAN_SERIES_RATIO, COEFFICIENT_NAMES, SERIES, SWITCH, coefficient
 
-__all__ = ["fma", "log_relative", "exp_compose", "relative_into"]
+__all__ = ["fma", "coefficient_table", "log_relative", "exp_compose", "relative_into", "compose_into", "compose_members",
+           "turn_global"]
+
+_SERIES_TABLE = np.array([SERIES[k] for k in COEFFICIENT_NAMES])
 
 _D_SERIES = np.array(SERIES["d"])
 _D_SWITCH = SWITCH["d"]
@@ -63,6 +66,85 @@ def _mm_entry(A, i, B, j):
 def _mtm_entry(A, i, B, j):
     """Entry ``(i, j)`` of ``A^T @ B`` (``se3.relative``'s ``swapaxes(A) @ B``), numpy's order."""
     return fma(A[2, i], B[2, j], fma(A[1, i], B[1, j], A[0, i] * B[0, j]))
+
+
+@jit
+def _series(rows, t, out):
+    """``out[i, k]``: the nine-term series of coefficient ``rows[i]`` at ``t[k]`` (``se3.coefficient``'s Horner)."""
+    for k in range(len(t)):
+        t2 = t[k] * t[k]
+        for i in range(len(rows)):
+            row = _SERIES_TABLE[rows[i]]
+            v = row[8]
+            for j in range(7, -1, -1):
+                v = v * t2 + row[j]
+            out[i, k] = v
+
+
+def coefficient_table(names, t):
+    """``se3.coefficient(name, t)`` of each of ``names`` ``(len(names), n)``, the same bits: the series
+    compiled, the closed forms (numpy's trig) only at angles from the coefficient's switch point."""
+    t = np.ascontiguousarray(t, dtype=float)
+    out = np.empty((len(names), len(t)))
+    _series(np.array([COEFFICIENT_NAMES.index(k) for k in names]), t, out)
+    for i, name in enumerate(names):
+        big = t >= SWITCH[name]
+        if big.any():
+            out[i, big] = coefficient(name, t[big])
+    return out
+
+
+@jit_callee
+def compose_into(A, B, out):
+    """``out = se3.compose(A, B)`` for one pair of poses ``(4, 4)`` (``out`` not ``A`` nor ``B``)."""
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = _mm_entry(A, i, B, j)
+        out[i, 3] = ((A[i, 0] * B[0, 3] + A[i, 1] * B[1, 3]) + A[i, 2] * B[2, 3]) + A[i, 3]
+        out[3, i] = 0.0
+    out[3, 3] = 1.0
+
+
+@jit
+def _compose_members(H, members, reps, X):
+    for k in range(len(members)):
+        compose_into(H[reps[k]], X[k], H[members[k]])
+
+
+def compose_members(H, members, reps, X):
+    """``H[members] = se3.compose(H[reps], X)`` in place, the same bits (``members`` and ``reps`` disjoint)."""
+    _compose_members(H, np.ascontiguousarray(members), np.ascontiguousarray(reps), np.ascontiguousarray(X))
+
+
+@jit
+def _turn(H, g, dz, coef):
+    W, E, R = np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3))
+    for k in range(len(g)):
+        n = g[k]
+        w0, w1, w2 = dz[n, 3], dz[n, 4], dz[n, 5]
+        W[0, 0], W[0, 1], W[0, 2] = 0.0, -w2, w1
+        W[1, 0], W[1, 1], W[1, 2] = w2, 0.0, -w0
+        W[2, 0], W[2, 1], W[2, 2] = -w1, w0, 0.0
+        a, b = coef[0, k], coef[1, k]
+        for i in range(3):
+            for j in range(3):
+                E[i, j] = ((1.0 if i == j else 0.0) + a * W[i, j]) + b * _mm_entry(W, i, W, j)
+        for i in range(3):
+            H[n, i, 3] += dz[n, i]
+            for j in range(3):
+                R[i, j] = H[n, i, j]
+        for i in range(3):
+            for j in range(3):
+                H[n, i, j] = _mm_entry(E, i, R, j)
+
+
+def turn_global(H, g, dz):
+    """Global increments of the nodes ``g`` in place (``assembly.System.update``'s numpy form, its bits):
+    ``x += dz[:3]``, ``R <- se3.exp_so3(dz[3:]) @ R``; ``dz`` ``(n, 6)``."""
+    g = np.ascontiguousarray(g)
+    w = dz[g, 3:]
+    t = np.sqrt(w[:, 0] * w[:, 0] + w[:, 1] * w[:, 1] + w[:, 2] * w[:, 2])
+    _turn(H, g, np.ascontiguousarray(dz, dtype=float), coefficient_table(("a", "b"), t))
 
 
 @jit_callee
@@ -213,8 +295,7 @@ def exp_compose(H, a, h, xi):
     """``se3.compose(H[a], se3.exp(xi[:, None] * h))`` ``(n, 4, 4)`` (``se3.interpolate``), the same bits;
     ``a`` ``(n,)`` node indices into ``H`` ``(N, 4, 4)``, ``h`` ``(n, 6)``, ``xi`` ``(n,)``."""
     h, xi = np.ascontiguousarray(h, dtype=float), np.ascontiguousarray(xi, dtype=float)
-    c = coefficients(("a", "b", "c"), exp_angles(h, xi))
     out = np.empty((len(a), 4, 4))
     _exp_compose(np.ascontiguousarray(H, dtype=float), np.ascontiguousarray(a), h, xi,
-                 np.stack([c["a"], c["b"], c["c"]]), out)
+                 coefficient_table(("a", "b", "c"), exp_angles(h, xi)), out)
     return out

@@ -76,3 +76,33 @@ def test_relative_into_gives_the_bits_of_the_numpy_relative():
     for k in range(len(A)):
         se3_twin.relative_into(A[k], B[k], out[k])
     _same(out, se3.relative(A, B))
+
+
+def test_coefficient_table_gives_the_bits_of_each_coefficient():
+    rng = np.random.default_rng(4)
+    t = np.concatenate([[0.0, 1e-9], rng.uniform(0, 3.5, 500), [0.75, 1.0, 1.5, 2.0]])
+    names = ("a", "b", "c", "d", "q2", "q3")
+    table = se3_twin.coefficient_table(names, t)
+    for name, row in zip(names, table):
+        assert np.array_equal(row, se3.coefficient(name, t)), name
+
+
+def test_compose_members_and_turn_global_give_the_bits_of_numpy():
+    """``assembly.System``'s pose updates: members ``H_rep X`` and global increments ``exp(w) R``."""
+    rng = np.random.default_rng(5)
+    H = se3.exp(rng.standard_normal((40, 6)))
+    X = se3.exp(rng.standard_normal((10, 6)))
+    members, reps = np.arange(30, 40), rng.integers(0, 30, 10)
+    want = H.copy()
+    want[members] = se3.compose(H[reps], X)
+    got = H.copy()
+    se3_twin.compose_members(got, members, reps, X)
+    _same(got, want)
+    dz = np.concatenate([rng.standard_normal((40, 3)), _twists(rng, 5)[:40, 3:]], axis=1)
+    g = np.array([0, 3, 7, 12, 25])
+    want = H.copy()
+    want[g, :3, 3] += dz[g, :3]
+    want[g, :3, :3] = se3.exp_so3(dz[g, 3:]) @ H[g, :3, :3]
+    got = H.copy()
+    se3_twin.turn_global(got, g, dz)
+    _same(got, want)
