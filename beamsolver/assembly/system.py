@@ -450,17 +450,30 @@ class System:
         ``blocks.K``) and the largest transformed nodal force and moment.
         """
         nodes, f, K = blocks.nodes, blocks.f, blocks.K
+        which, Kw = (), None
         if self.transformed.any() and len(nodes):
             which = np.flatnonzero(self.transformed[nodes].any(axis=1))
-            f, K = _blocks.transform(self.node_transforms(H), nodes, f, K, which)
+            if len(which):
+                f, Kw = _blocks.transform_rows(self.node_transforms(H), nodes, f, K, which)
         d = _blocks.dofs(self.rep, nodes)
         r = np.bincount(d.ravel(), weights=f.ravel(), minlength=6 * self.n_nodes)
         coo = (np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0))
         if K is not None and len(nodes):
-            coo = self._block_coo(d) + (K.ravel(),)
+            rows, cols = self._block_coo(d)
             g = np.intersect1d(self.global_nodes, self.rep[nodes])
-            if len(g):
-                coo = self._concat_coo(coo, self._global_node_terms(r, g))
+            tail = self._global_node_terms(r, g) if len(g) else None
+            if tail is not None:
+                rows, cols = self._concat_index(rows, cols, tail[0], tail[1])
+            if Kw is None and tail is None:
+                vals = K.ravel()                   # the blocks themselves: no copy
+            else:                                  # one copy: the blocks, the transformed ones, the tail
+                vals = np.empty(len(rows))
+                vals[:K.size] = K.ravel()
+                if Kw is not None:
+                    vals[:K.size].reshape(K.shape)[which] = Kw
+                if tail is not None:
+                    vals[K.size:] = tail[2]
+            coo = (rows, cols, vals)
         return (r, coo) + _blocks.levels(f)
 
     def _block_coo(self, d):
@@ -485,16 +498,16 @@ class System:
         the 19-wire bundle's contact)."""
         return self._coo_pool.take((2, n))
 
-    def _concat_coo(self, a, b):
-        """``_concat(a, b)`` whose index arrays are kept (the same read-only arrays) while ``a``'s are the
-        same arrays (``_block_coo``) and ``b``'s equal."""
+    def _concat_index(self, a_rows, a_cols, b_rows, b_cols):
+        """The COO index arrays ``a`` followed by ``b``, kept (the same read-only arrays) while ``a``'s are
+        the same arrays (``_block_coo``) and ``b``'s equal."""
         c = getattr(self, "_coo_concat", None)
-        if c is None or c[0] is not a[0] or c[1] is not a[1] or not (
-                np.array_equal(c[2], b[0]) and np.array_equal(c[3], b[1])):
-            rows, cols = np.concatenate([a[0], b[0]]), np.concatenate([a[1], b[1]])
+        if c is None or c[0] is not a_rows or c[1] is not a_cols or not (
+                np.array_equal(c[2], b_rows) and np.array_equal(c[3], b_cols)):
+            rows, cols = np.concatenate([a_rows, b_rows]), np.concatenate([a_cols, b_cols])
             rows.flags.writeable = cols.flags.writeable = False
-            c = self._coo_concat = (a[0], a[1], np.array(b[0]), np.array(b[1]), rows, cols)
-        return c[4], c[5], np.concatenate([a[2], b[2]])
+            c = self._coo_concat = (a_rows, a_cols, np.array(b_rows), np.array(b_cols), rows, cols)
+        return c[4], c[5]
 
     @staticmethod
     def _global_node_terms(r, g):
@@ -654,7 +667,7 @@ class System:
     def _extra_pattern(self, extra):
         """The pattern of the COO entries ``extra`` (kept while it stays: the same active contact
         pairs): ``extra_pattern.BlockPattern`` of the block dofs when they are the index arrays of
-        ``_block_coo`` over whole nodes (possibly followed by ``_concat_coo``'s), else
+        ``_block_coo`` over whole nodes (possibly followed by ``_concat_index``'s), else
         ``extra_pattern.ExtraPattern``."""
         p = getattr(self, "_extra_cache", None)
         base = (self.red, self.indptr, self.indices)

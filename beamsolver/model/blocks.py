@@ -20,7 +20,7 @@ import numpy as np
 
 from .buffers import REUSE_BUFFERS     # noqa: F401  (its former home; buffers.BufferPool reuses blocks' memory)
 
-__all__ = ["Blocks", "Contribution", "transform", "dofs", "levels"]
+__all__ = ["Blocks", "Contribution", "transform", "transform_rows", "dofs", "levels"]
 
 
 @dataclass
@@ -49,19 +49,26 @@ def transform(M, nodes, f, K=None, which=None):
     returned as they are (their nodes have ``M = I``).
     """
     which = np.arange(len(nodes)) if which is None else which
-    f = f.copy()
+    f, Kw = transform_rows(M, nodes, f, K, which)
     K = None if K is None else K.copy()
+    if K is not None and len(which):
+        K[which] = Kw
+    return f, K
+
+
+def transform_rows(M, nodes, f, K, which):
+    """``transform`` without the copy of ``K``: ``f`` transformed (a copy) and the transformed blocks
+    ``K[which]`` alone ``(len(which), 6 k, 6 k)`` (``None`` without ``K``)."""
+    f = f.copy()
     if len(which) == 0:
-        return f, K
+        return f, (None if K is None else K[:0].copy())
     k = nodes.shape[1]
     T = np.zeros((len(which), 6 * k, 6 * k))
     for j in range(k):
         T[:, 6 * j:6 * j + 6, 6 * j:6 * j + 6] = M[nodes[which, j]]
     Tt = np.swapaxes(T, 1, 2)
     f[which] = np.einsum("nij,nj->ni", Tt, f[which])
-    if K is not None:
-        K[which] = Tt @ K[which] @ T
-    return f, K
+    return f, (None if K is None else Tt @ K[which] @ T)
 
 
 def dofs(rep, nodes):
