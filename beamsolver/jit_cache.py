@@ -24,16 +24,25 @@ only adds a dependency).  So
   code this process runs: a process still running old code that saves after the files changed
   stamps its entries with the old digest, which the next process refuses.
 
+Walking the syntax trees costs ~0.2 s of CPU per process (172 functions at ``import beamsolver``),
+so the digests are kept between processes (``_Store``): one file beside the numba cache
+(``jit_digests.<package>.json``), valid for the exact sources it was computed from (keyed by the
+SHA-256 of every source file of the package, read once, the same texts the digests are computed
+from); any edit computes them again.
+
 A function made from another's code object (``kernel_jit.make_kernel``'s per-law kernels) is
 stamped by the statement its code comes from.  The cache stays where numba would put it
 (``NUMBA_CACHE_DIR``, the in-tree ``__pycache__``, else the user-wide cache for read-only installs).
 """
 import ast
+import atexit
 import hashlib
+import json
+import os
 from functools import lru_cache
 from pathlib import Path
 
-__all__ = ["dependencies", "digest", "install", "function_digest"]
+__all__ = ["dependencies", "digest", "install", "function_digest", "forget"]
 
 _ROOTS = set()
 
@@ -44,7 +53,9 @@ class _Module:
     def __init__(self, path, root):
         self.path = path
         self.rel = path.relative_to(root).as_posix()
-        self.text = path.read_text()
+        self.text = _store(root).texts.get(path)
+        if self.text is None:
+            self.text = path.read_text()
         tree = ast.parse(self.text, str(path))
         self.defs = {}          # name -> [statement], in file order
         self.imports = {}       # name -> (module path, attribute or None for the module itself)
@@ -231,11 +242,68 @@ def digest(items):
     return h.hexdigest()
 
 
+class _Store:
+    """The package's sources as this process reads them (once) and the digests computed from them,
+    kept between processes in one JSON file keyed by the SHA-256 of those sources (module docstring)."""
+
+    def __init__(self, root):
+        self.texts = {p.resolve(): p.read_text() for p in sorted(root.rglob("*.py"))}
+        h = hashlib.sha256()
+        for path, text in self.texts.items():
+            h.update(path.relative_to(root).as_posix().encode() + b"\0" + text.encode() + b"\0")
+        self.key, self.entries, self.dirty = h.hexdigest(), {}, False
+        cache_dir = os.environ.get("NUMBA_CACHE_DIR")
+        self.path = (Path(cache_dir) if cache_dir else root / "__pycache__") / f"jit_digests.{root.name}.json"
+        try:
+            data = json.loads(self.path.read_text())
+            if data.get("sources") == self.key:
+                self.entries = data["digests"]
+        except (OSError, ValueError, KeyError, TypeError):
+            pass
+        atexit.register(self.save)
+
+    def get(self, key, compute):
+        if key not in self.entries:
+            self.entries[key], self.dirty = list(compute()), True
+        return tuple(self.entries[key])
+
+    def save(self):
+        """Write the digests (atomically; nothing if none is new or the folder is not writable)."""
+        if not self.dirty:
+            return
+        try:
+            self.path.parent.mkdir(exist_ok=True)
+            tmp = self.path.with_name(f"{self.path.name}.{os.getpid()}.tmp")
+            tmp.write_text(json.dumps(dict(sources=self.key, digests=self.entries)))
+            tmp.replace(self.path)
+            self.dirty = False
+        except OSError:
+            pass
+
+
+@lru_cache(maxsize=None)
+def _store(root):
+    return _Store(root)
+
+
+def forget():
+    """Read the sources again at the next digest, as a new process would (tests edit sources)."""
+    _module.cache_clear()
+    _store.cache_clear()
+
+
 def function_digest(py_func, py_file, root):
     """``(digest, rank)`` of a compiled function: the digest of its dependencies and its rank among
     the same-named definitions of its file (if its ``def`` is not found: the digest of every statement
-    of its file and their dependencies, and its first line)."""
+    of its file and their dependencies, and its first line); kept between processes (``_Store``)."""
     root = Path(root).resolve()
+    py_file = Path(py_file).resolve()
+    code = py_func.__code__
+    key = f"{py_file.relative_to(root).as_posix()}:{code.co_name}:{code.co_firstlineno}"
+    return _store(root).get(key, lambda: _function_digest(py_func, py_file, root))
+
+
+def _function_digest(py_func, py_file, root):
     mod = _module(Path(py_file).resolve(), root)
     node, rank = _function_node(mod, py_func)
     nodes = [n for defs in mod.defs.values() for n in defs] if node is None else [node]

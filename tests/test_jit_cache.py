@@ -129,7 +129,7 @@ def _stamp(pkg, module, name):
     src = (pkg / f"{module}.py").read_text()
     code = compile(src, str(pkg / f"{module}.py"), "exec")
     func = next(c for c in code.co_consts if getattr(c, "co_name", None) == name)
-    jit_cache._module.cache_clear()
+    jit_cache.forget()                   # as a new process: sources read again
     return jit_cache.function_digest(type("F", (), {"__code__": func})(), pkg / f"{module}.py", pkg)
 
 
@@ -177,3 +177,24 @@ def test_the_contact_kernel_depends_on_the_constants_it_freezes():
     frames = (root / "contact" / "frames.py").read_text().splitlines()
     used = {frames[line - 1].split(" = ")[0] for r, line in deps if r == "contact/frames.py"}
     assert used == {"LINE, ORTHOGONAL, POINT"}                    # not the numpy geometry beside them
+
+
+def test_digests_are_kept_between_processes_for_the_same_sources(tmp_path, monkeypatch):
+    """A new process reads the digests of unchanged sources from the store (no syntax trees walked);
+    any edit of the package's sources makes it compute them again."""
+    pkg = _package(tmp_path, True)
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "cache"))
+    before = _stamp(pkg, "caller", "g")
+    jit_cache._store(pkg.resolve()).save()
+    assert (tmp_path / "cache" / "jit_digests.pkg.json").is_file()
+    real = jit_cache._function_digest
+
+    def walked(*a):
+        raise AssertionError("computed again")
+    monkeypatch.setattr(jit_cache, "_function_digest", walked)
+    assert _stamp(pkg, "caller", "g") == before                    # read from the store
+    (pkg / "consts.py").write_text("K = 1.0\n")
+    with pytest.raises(AssertionError, match="computed again"):
+        _stamp(pkg, "caller", "g")
+    monkeypatch.setattr(jit_cache, "_function_digest", real)
+    assert _stamp(pkg, "caller", "g")[0] != before[0]

@@ -57,7 +57,6 @@ from dataclasses import dataclass, replace
 from typing import Optional
 
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar
 
 from . import geometry
 from .bending import BendingFixture, bending_fixture
@@ -300,6 +299,7 @@ def layer_clearance(r, R, n, beta):
     ``None`` for fewer than two wires or a straight layer (negative: they overlap)."""
     if n < 2 or r == 0.0 or beta == 0.0:
         return None
+    from scipy.optimize import minimize_scalar    # here: 0.1 s of every import otherwise
     delta = 2.0 * np.pi / n
     c = r / np.tan(beta)                   # axial advance per radian of the helix
 
@@ -317,6 +317,8 @@ def closing_radius(R, n, beta):
 
 def _closing_pitch_radius(layer, R, n):
     """The exact pitch radius closing a layer (root of ``layer_clearance``; lay angle or lay length kept)."""
+    from scipy.optimize import brentq
+
     def gap(r):
         return layer_clearance(r, R, n, _lay(layer, r)[0])
     if n == 2 or (layer.lay_angle is None and layer.lay_length is None):
