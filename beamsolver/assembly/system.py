@@ -460,7 +460,7 @@ class System:
         coo = (np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0))
         if K is not None and len(nodes):
             rows, cols = self._block_coo(d)
-            g = np.intersect1d(self.global_nodes, self.rep[nodes])
+            g = self._global_among(self.rep[nodes])
             tail = self._global_node_terms(r, g) if len(g) else None
             if tail is not None:
                 rows, cols = self._concat_index(rows, cols, tail[0], tail[1])
@@ -475,6 +475,16 @@ class System:
                     vals[K.size:] = tail[2]
             coo = (rows, cols, vals)
         return (r, coo) + _blocks.levels(f)
+
+    def _global_among(self, nodes):
+        """The global-type nodes among ``nodes`` (any shape), sorted (``np.intersect1d``'s result without
+        its sort of ``nodes``)."""
+        g = self.global_nodes
+        if not len(g):
+            return g
+        present = np.zeros(self.n_nodes, dtype=bool)
+        present[nodes.ravel()] = True
+        return g[present[g]]
 
     def _block_coo(self, d):
         """Rows and columns ``(m k^2,)`` of the COO entries of blocks over the dofs ``d`` ``(m, k)``; the
