@@ -18,9 +18,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._jit import jit
+from ..lie.se3_twin import fma
 from .buffers import REUSE_BUFFERS     # noqa: F401  (its former home; buffers.BufferPool reuses blocks' memory)
 
-__all__ = ["Blocks", "Contribution", "transform", "transform_rows", "dofs", "levels"]
+__all__ = ["Blocks", "Contribution", "transform", "transform_rows", "transform_rows_numpy", "dofs", "levels"]
 
 
 @dataclass
@@ -58,7 +60,59 @@ def transform(M, nodes, f, K=None, which=None):
 
 def transform_rows(M, nodes, f, K, which):
     """``transform`` without the copy of ``K``: ``f`` transformed (a copy) and the transformed blocks
-    ``K[which]`` alone ``(len(which), 6 k, 6 k)`` (``None`` without ``K``)."""
+    ``K[which]`` alone ``(len(which), 6 k, 6 k)`` (``None`` without ``K``).  Compiled, the bits of
+    ``transform_rows_numpy`` (its sums in numpy's order: ``einsum`` left to right, ``@`` one fused
+    multiply-add chain per entry, ``lie.se3_twin``)."""
+    f = np.array(f, dtype=float)
+    which = np.ascontiguousarray(which, dtype=np.int64)
+    n, m = len(which), f.shape[1]
+    Kw = np.empty((n, m, m)) if K is not None else None
+    if n:
+        _transform(np.ascontiguousarray(M, dtype=float), np.ascontiguousarray(nodes), which, f,
+                   np.ascontiguousarray(K, dtype=float) if K is not None else np.empty((0, m, m)),
+                   Kw if K is not None else np.empty((0, m, m)), K is not None)
+    return f, Kw
+
+
+@jit
+def _transform(M, nodes, which, f, K, Kw, tangent):
+    """``f[w] <- T^T f[w]`` (in place) and ``Kw[i] = (T^T K[w]) T``, ``w = which[i]``, ``T`` the block
+    diagonal of ``M[nodes[w]]``, every sum over all ``6 k`` terms in numpy's order."""
+    m = f.shape[1]
+    T, A, fw = np.zeros((m, m)), np.empty((m, m)), np.empty(m)
+    for i in range(len(which)):
+        w = which[i]
+        T[:] = 0.0
+        for j in range(nodes.shape[1]):
+            Mj = M[nodes[w, j]]
+            for a in range(6):
+                for b in range(6):
+                    T[6 * j + a, 6 * j + b] = Mj[a, b]
+        for r in range(m):
+            fw[r] = f[w, r]
+        for r in range(m):                  # einsum("ij,j->i", T^T, f)
+            acc = T[0, r] * fw[0]
+            for c in range(1, m):
+                acc = acc + T[c, r] * fw[c]
+            f[w, r] = acc
+        if not tangent:
+            continue
+        for r in range(m):                  # A = T^T @ K[w]
+            for c in range(m):
+                acc = T[0, r] * K[w, 0, c]
+                for q in range(1, m):
+                    acc = fma(T[q, r], K[w, q, c], acc)
+                A[r, c] = acc
+        for r in range(m):                  # Kw[i] = A @ T
+            for c in range(m):
+                acc = A[r, 0] * T[0, c]
+                for q in range(1, m):
+                    acc = fma(A[r, q], T[q, c], acc)
+                Kw[i, r, c] = acc
+
+
+def transform_rows_numpy(M, nodes, f, K, which):
+    """``transform_rows`` in numpy (its test oracle)."""
     f = f.copy()
     if len(which) == 0:
         return f, (None if K is None else K[:0].copy())
