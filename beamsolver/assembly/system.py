@@ -513,21 +513,25 @@ class System:
         the same arrays (``_block_coo``) and ``b``'s equal."""
         c = getattr(self, "_coo_concat", None)
         if c is None or c[0] is not a_rows or c[1] is not a_cols or not (
-                np.array_equal(c[2], b_rows) and np.array_equal(c[3], b_cols)):
+                (c[6] is b_rows and c[7] is b_cols) or (np.array_equal(c[2], b_rows) and np.array_equal(c[3], b_cols))):
             rows, cols = np.concatenate([a_rows, b_rows]), np.concatenate([a_cols, b_cols])
             rows.flags.writeable = cols.flags.writeable = False
-            c = self._coo_concat = (a_rows, a_cols, np.array(b_rows), np.array(b_cols), rows, cols)
+            c = self._coo_concat = (a_rows, a_cols, np.array(b_rows), np.array(b_cols), rows, cols, b_rows, b_cols)
         return c[4], c[5]
 
-    @staticmethod
-    def _global_node_terms(r, g):
+    def _global_node_terms(self, r, g):
         """COO of ``[[0, -hat(r_u)], [0, -hat(r_w)]]`` at global-type nodes ``g`` (the dependence of
-        ``M`` on ``R``, see the module docstring) for the residual ``r`` of one contribution."""
+        ``M`` on ``R``, see the module docstring) for the residual ``r`` of one contribution; the
+        index arrays are the same (read-only) arrays while ``g`` is."""
         rg = r.reshape(-1, 6)[g]
-        vals = -np.concatenate([skew(rg[:, :3]), skew(rg[:, 3:])], axis=1)          # (k, 6, 3)
-        rows = np.broadcast_to((6 * g)[:, None, None] + np.arange(6)[:, None], vals.shape)
-        cols = np.broadcast_to((6 * g)[:, None, None] + 3 + np.arange(3), vals.shape)
-        return rows.ravel(), cols.ravel(), vals.ravel()
+        vals = -np.concatenate([_hat(rg[:, :3]), _hat(rg[:, 3:])], axis=1)          # (k, 6, 3)
+        c = getattr(self, "_global_index", None)
+        if c is None or not np.array_equal(c[0], g):
+            rows = np.broadcast_to((6 * g)[:, None, None] + np.arange(6)[:, None], vals.shape).ravel()
+            cols = np.broadcast_to((6 * g)[:, None, None] + 3 + np.arange(3), vals.shape).ravel()
+            rows.flags.writeable = cols.flags.writeable = False
+            c = self._global_index = (np.array(g), rows, cols)
+        return c[1], c[2], vals.ravel()
 
     # ------------------------------------------------------------ evaluation
     def evaluate(self, H, load_factors, tangent=True):
@@ -559,8 +563,8 @@ class System:
             g = self.global_nodes
             rg = r.reshape(-1, 6)[g]
             where = np.searchsorted(self.block_nodes, g)
-            blocks[where, :3, 3:] -= skew(rg[:, :3])
-            blocks[where, 3:, 3:] -= skew(rg[:, 3:])
+            blocks[where, :3, 3:] -= _hat(rg[:, :3])
+            blocks[where, 3:, 3:] -= _hat(rg[:, 3:])
         info = dict(state=state, f_level=f_level, m_level=m_level)
         return r, kvals, info
 
@@ -841,6 +845,13 @@ def _line_table(model, enodes, L):
     fol = np.array([ld.follower for ld in lls])[which]
     return _LineTable(el, enodes[el], L[el], np.array([ld.q for ld in lls])[which],
                       np.array([ld.m for ld in lls])[which], which, np.flatnonzero(~fol), np.flatnonzero(fol))
+
+
+def _hat(v):
+    """``se3.skew(v)`` ``(k, 3, 3)`` of real 3-vectors ``(k, 3)``: the same values, one stack."""
+    z = np.zeros(len(v))
+    x, y, w = v[:, 0], v[:, 1], v[:, 2]
+    return np.stack([z, -w, y, w, z, -x, -y, x, z], axis=1).reshape(-1, 3, 3)
 
 
 def _concat(a, b):
