@@ -38,6 +38,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .._jit import jit, jit_callee
+from .csc import canonical_csc
 
 __all__ = ["ExtraPattern", "BlockPattern"]
 
@@ -453,14 +454,31 @@ class BlockPattern:
 
 
 def _csc(data, zeros, indices, indptr, col, n_free):
-    """The union-pattern CSC matrix of ``data``, without its exact zeros (``zeros``: some are)."""
+    """The union-pattern CSC matrix of ``data``, without its exact zeros (``zeros``: some are).  The
+    pattern is canonical (sorted, unique rows per column, as scipy's sum makes it): ``csc.canonical_csc``."""
     if zeros:
-        nz = data != 0.0
-        data, indices = data[nz], indices[nz]
-        indptr = np.concatenate([[0], np.cumsum(np.bincount(col[nz], minlength=n_free))]).astype(np.int32)
+        d, i, p = np.empty(len(data)), np.empty(len(data), dtype=np.int32), np.empty(n_free + 1, dtype=np.int32)
+        k = _drop_zeros(data, indices, col, d, i, p)
+        data, indices, indptr = d[:k], i[:k], p
     else:
         indices, indptr = indices.copy(), indptr.copy()
-    return sp.csc_matrix((data, indices, indptr), shape=(n_free, n_free))
+    return canonical_csc(data, indices, indptr, n_free)
+
+
+@jit
+def _drop_zeros(data, indices, col, d, i, ptr):
+    """Entries of ``data`` that are not exactly zero into ``d``, their rows into ``i`` (order kept) and
+    the column pointers into ``ptr``; returns their number (``data != 0``, ``bincount`` of ``col``)."""
+    ptr[:] = 0
+    k = 0
+    for s in range(len(data)):
+        if data[s] != 0.0:
+            d[k], i[k] = data[s], indices[s]
+            ptr[col[s] + 1] += 1
+            k += 1
+    for j in range(len(ptr) - 1):
+        ptr[j + 1] += ptr[j]
+    return k
 
 
 def _union_buffers(n_free, n_el, n_c):

@@ -27,6 +27,7 @@ from ..lie import se3, se3_twin
 from ..model import blocks as _blocks
 from ..model.buffers import REUSE_BUFFERS, BufferPool     # noqa: F401  (REUSE_BUFFERS: tests)
 from ..errors import InputError
+from .csc import canonical_csc
 from .extra_pattern import BlockPattern, ExtraPattern, whole_nodes
 from ..lie.se3 import skew
 from ..model.validation import check_pose
@@ -79,40 +80,6 @@ def unique_inverse(key, bound):
     return np.flatnonzero(present), (np.cumsum(present) - 1)[key]
 
 
-def _csc_by_constructor(data, indices, indptr, n):
-    return sp.csc_matrix((data, indices, indptr), shape=(n, n))
-
-
-def _csc_direct(data, indices, indptr, n):
-    K = sp.csc_matrix.__new__(sp.csc_matrix)
-    K.data, K.indices, K.indptr, K._shape, K.maxprint = data, indices, indptr, (n, n), _MAXPRINT
-    K._has_canonical_format = K._has_sorted_indices = True
-    return K
-
-
-def _pick_csc():
-    """``_csc_direct`` where it builds what scipy's constructor builds (the same attributes), else the
-    constructor: scipy's checks cost more than a small model's factorisation."""
-    args = (np.ones(2), np.array([0, 1], dtype=np.int32), np.array([0, 1, 2], dtype=np.int32), 2)
-    try:
-        ref, fast = _csc_by_constructor(*args), _csc_direct(*args)
-        same = set(vars(ref)) | {"_has_canonical_format", "_has_sorted_indices"} == set(vars(fast)) \
-            and (ref != fast).nnz == 0
-    except Exception:
-        same = False
-    return _csc_direct if same else _csc_by_constructor
-
-
-_MAXPRINT = _csc_by_constructor(np.ones(1), np.zeros(1, dtype=np.int32), np.array([0, 1], dtype=np.int32), 1).maxprint
-
-
-def canonical_csc(data, indices, indptr, n):
-    """Square ``(n, n)`` ``scipy.sparse.csc_matrix`` of a canonical pattern (sorted, unique row
-    indices per column, int32, as ``System._build_pattern`` makes it) and its ``data``; the arrays
-    are not copied."""
-    return _CSC(data, indices, indptr, n)
-
-
 def beams_anchored(model, kind):
     """The rigid-mode check's exact shortcut: without joins, contact or nodes outside beams the
     connected groups are the beams (a beam's elements chain all its nodes), and a beam with a
@@ -145,7 +112,6 @@ def _representatives(n, joins, cons, group_constraint):
     return np.array([_find(parent, i) for i in range(n)])
 
 
-_CSC = _pick_csc()
 
 
 class System:

@@ -13,8 +13,11 @@ def _scipy(el, rows, cols, vals, red):
 
 
 def _identical(a, b):
+    """The same CSC arrays, and ``a`` is canonical (sorted, unique rows per column) as it says it is."""
+    fresh = sp.csc_matrix((a.data, a.indices, a.indptr), shape=a.shape)      # flags computed, not copied
     return (np.array_equal(a.indptr, b.indptr) and np.array_equal(a.indices, b.indices)
-            and np.array_equal(a.data, b.data) and a.shape == b.shape)
+            and np.array_equal(a.data, b.data) and a.shape == b.shape
+            and a.has_canonical_format == fresh.has_canonical_format == b.has_canonical_format)
 
 
 def _element_matrix(rng, n, density):
