@@ -47,7 +47,7 @@ import time
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..lie import se3
+from ..lie import se3, se3_twin
 from ..model.blocks import Blocks, Contribution
 from ..model.buffers import BufferPool
 from ..errors import InputError
@@ -259,10 +259,10 @@ class ContactSystem(Contribution):
         return self._geo_prev[1]
 
     def _pose_at(self, H, e, xi):
-        """Section poses ``(k, 4, 4)`` ``H_A exp(xi h)`` of elements ``e`` at ``H`` (numpy, the twists kept
+        """Section poses ``(k, 4, 4)`` ``H_A exp(xi h)`` of elements ``e`` at ``H`` (compiled, the twists kept
         for these poses)."""
         Hc, h = self._twists(H)
-        return se3.interpolate(Hc[self.sys.enodes[e, 0]], h[e], xi)
+        return se3_twin.exp_compose(Hc, self.sys.enodes[e, 0], h[e], xi)       # se3.interpolate's bits
 
     def _points(self, H, e, xi, prev=False):
         """Centre points ``(k, 3)`` of the sections ``xi`` of elements ``e`` at ``H`` (``prev``: at the
@@ -849,8 +849,8 @@ class ContactSystem(Contribution):
         HC, HF = self._pose_at(H, P.e[sel], out["xi1"]), self._pose_at(H, P.m[sel], out["xi2"])
         lam_t = out["lam_t"]
         lam_vec = lam_t[:, :1] * out["t1"] + lam_t[:, 1:] * out["t2"]
-        friction = dict(key=keys[order], H_CL=se3.relative(HC, HL)[order],
-                        H_FK=se3.relative(HF, HK)[order], H_LK=se3.relative(HL, HK)[order],
+        friction = dict(key=keys[order], H_CL=se3_twin.relative(HC, HL)[order],
+                        H_FK=se3_twin.relative(HF, HK)[order], H_LK=se3_twin.relative(HL, HK)[order],
                         e=P.e[sel][order], m=P.m[sel][order], xi1=out["xi1"][order],
                         xi2=out["xi2"][order], lam_t=lam_vec[order])
         self.history.commit(self._decl_mu, friction, tmult)

@@ -25,8 +25,8 @@ from numba.extending import intrinsic
 from .._jit import jit, jit_callee
 from .se3 import ATAN_SERIES_RATIO, COEFFICIENT_NAMES, SERIES, SWITCH, coefficient
 
-__all__ = ["fma", "coefficient_table", "log_relative", "exp_compose", "relative_into", "compose_into", "compose_members",
-           "turn_global"]
+__all__ = ["fma", "coefficient_table", "log_relative", "exp_compose", "relative", "relative_into", "compose_into",
+           "compose_members", "turn_global"]
 
 _SERIES_TABLE = np.array([SERIES[k] for k in COEFFICIENT_NAMES])
 
@@ -157,6 +157,20 @@ def relative_into(A, B, out):
         out[i, 3] = A[0, i] * v0 + A[1, i] * v1 + A[2, i] * v2
         out[3, i] = 0.0
     out[3, 3] = 1.0
+
+
+@jit
+def _relative(A, B, out):
+    for k in range(len(A)):
+        relative_into(A[k], B[k], out[k])
+
+
+def relative(A, B):
+    """``se3.relative(A, B)`` ``(n, 4, 4)`` of poses ``(n, 4, 4)``, the same bits."""
+    A, B = np.ascontiguousarray(A, dtype=float), np.ascontiguousarray(B, dtype=float)
+    out = np.empty(A.shape)
+    _relative(A, B, out)
+    return out
 
 
 # ---------------------------------------------------------------- log(A^-1 B) of node pairs

@@ -76,6 +76,7 @@ def test_relative_into_gives_the_bits_of_the_numpy_relative():
     for k in range(len(A)):
         se3_twin.relative_into(A[k], B[k], out[k])
     _same(out, se3.relative(A, B))
+    _same(se3_twin.relative(A, B), se3.relative(A, B))
 
 
 def test_coefficient_table_gives_the_bits_of_each_coefficient():
