@@ -15,6 +15,7 @@ examples (docs/benchmarks.md).  The functions here run the numpy operations in t
 So a twin is checked against its numpy original bit for bit (``tests/lie/test_se3_twin.py``) on
 the machine it runs on; where the BLAS does not fuse (another CPU) the two agree to round-off.
 """
+import math
 from fractions import Fraction
 
 import numpy as np
@@ -50,7 +51,13 @@ def _fma_intrinsic(typingctx, a, b, c):
 
 def _fma_python(a, b, c):
     """``fma`` as plain Python (``NUMBA_DISABLE_JIT=1``): exact rationals, rounded once."""
-    return float(Fraction(a) * Fraction(b) + Fraction(c))
+    if not (math.isfinite(a) and math.isfinite(b) and math.isfinite(c)):
+        return a * b + c
+    exact = Fraction(a) * Fraction(b) + Fraction(c)
+    try:
+        return float(exact)
+    except OverflowError:
+        return math.inf if exact > 0 else -math.inf
 
 
 fma = _fma_python if config.DISABLE_JIT else _fma_intrinsic
