@@ -12,7 +12,8 @@ def _pairs(rng, m, scale):
     nodes = rng.permutation(4 * m).reshape(m, 4)
     h1 = se3.log(se3.relative(H[nodes[:, 0]], H[nodes[:, 1]]))
     h2 = se3.log(se3.relative(H[nodes[:, 2]], H[nodes[:, 3]]))
-    return H, nodes, h1, h2, rng.uniform(-1, 1, m), rng.uniform(-1, 1, m), rng.uniform(0.1, 1, m), rng.uniform(0.1, 1, m)
+    xi1, xi2 = rng.uniform(-1, 1, m), rng.uniform(-1, 1, m)
+    return H, nodes, h1, h2, xi1, xi2, rng.uniform(0.1, 1, m), rng.uniform(0.1, 1, m)
 
 
 def test_material_frames_give_the_bits_of_the_numpy_frames():
