@@ -81,7 +81,7 @@ def return_mapping(trial, cap):
     return lam, stick, C, c
 
 
-def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu, m, active=None):
+def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu, m, active=None, hold=None):
     """Nodal weighted slip, normal traction and multipliers of the groups ``G`` (``groups``).
 
     ``w`` ``(P,)`` point weights, ``S`` ``(P, 3)`` slips, ``lam_n`` ``(P,)``, ``n`` ``(P, 3)`` normals; per group:
@@ -111,6 +111,14 @@ def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu, m, active=None):
     # d trial = Pi dv + Q dnbar, Q = -((nu . v) Pi + nu (Pi v)^T) / |nbar|
     Q = -(np.sum(nu * v, axis=1)[:, None, None] * Pi + nu[:, :, None] * trial[:, None, :]) / size[:, None, None]
     lam, stick, C, c = return_mapping(trial, mu * np.maximum(lamN, 0.0))
+    if hold is not None:
+        # touching without normal traction (``hold`` (n,) > 0 where a point lies in the normal law's band):
+        # no traction and any slip solve the law, a mechanism Newton cannot factorise (a wire laid on a rod
+        # before its load).  Their tangent holds with the stiffness ``hold``, as the point law's stiffness
+        # floor does (``law.PENALTY_T_MIN``); the residual keeps their traction at zero.
+        weak = (hold > 0) & (lamN <= 0.0)
+        C = np.where(weak[:, None, None], (hold / eps)[:, None, None] * np.eye(3), C)
+        c = np.where(weak[:, None], 0.0, c)
     T = np.einsum("pa,pai->pi", G["phi"], lam[G["g"]])
     return dict(m=m, u=np.einsum("gij,gj->gi", Pi, u), lamN=lamN, trial=trial, lam=lam, stick=stick, C=C, c=c,
                 T=T, wphi=wphi, wn=wn, Pi=Pi, Q=Q)

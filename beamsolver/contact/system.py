@@ -53,7 +53,7 @@ from ..model.buffers import BufferPool
 from ..errors import InputError
 from ..failures import ContactTunnelling, NoContactNormal
 from ..model.model import JOIN_TOL
-from .law import default_penalty
+from .law import PENALTY_T_MIN, default_penalty
 from . import kernel_jit, mortar
 from .options import ADJUST, EXACT_C, SMOOTHING, STICK_TOLERANCE, ContactOptions, declaration_table
 from .frames import LINE, NORMAL_TOL, POINT, material_frames, no_normal, touch_tolerance
@@ -509,7 +509,7 @@ class ContactSystem(Contribution):
         if self.newton_multipliers and self._decl_exact.any():
             # exact stick: the nodal traction field acts over the whole overlap the search found (a point
             # that left the normal law keeps its share of the field: no jump in the residual)
-            on |= self._decl_exact[P.decl] & (P.kind != POINT) & (self._decl_mu[P.decl] > 0)
+            on |= self._decl_exact[P.decl] & (P.kind == LINE) & (self._decl_mu[P.decl] > 0)
         return np.flatnonzero(on)
 
     # ------------------------------------------------------------ refusals
@@ -591,7 +591,7 @@ class ContactSystem(Contribution):
         p = self._params(P, sel, H)
         self._lap("params")
         self._blocks = None        # its tangent buffer may be reused (``_tangent_out``)
-        mort = self._decl_exact[P.decl[sel]] & (p["kind"] != POINT) & (p["mu"] > 0)
+        mort = self._decl_exact[P.decl[sel]] & (p["kind"] == LINE) & (p["mu"] > 0)
         f, K, out = self._kernels(H[P.nodes[sel]], p, P.decl[sel], tangent,
                                   friction=(p["mu"] > 0) & ~mort if mort.any() else None)
         np.negative(f, out=f)
@@ -652,8 +652,11 @@ class ContactSystem(Contribution):
             merged % len(self.sys.L)], minlength=len(G["key"]))
         # the traction acts where the normal law does (the kernel applies it there): the slip is
         # integrated over the same points
+        hold = None
+        if ssn:      # groups without normal traction: the point law's stiffness floor (mortar.py)
+            hold = mu * PENALTY_T_MIN * self._decl_penalty[gdecl]
         st = mortar.nodal_state(G, pm["weight"], d["S"], d["lam_n"], d["n"], R, Lam, eps, mu, m,
-                                None if ssn else d["active"])
+                                None if ssn else d["active"], hold=hold)
         mult = None
         if ssn:       # the multiplier itself is the traction (its complementarity function is an equation)
             v = np.einsum("gij,gj->gi", R, Lam)
@@ -682,7 +685,7 @@ class ContactSystem(Contribution):
                 out[name] = np.tile(np.eye(4), (len(sel), 1, 1))
             out[name][idx] = d[name]
         if ssn:
-            mult = dict(mult or {}, C=np.einsum("gij,gj->gi", R, Lam) - st["lam"], m=m, members=G["members"],
+            mult = dict(mult or {}, C=np.einsum("gij,gj->gi", R, Lam) - st["lam"], m=m, members=G["members"], R=R, Lam=Lam,
                         key=G["key"], stick=st["stick"], u=st["u"], tol=self._decl_stick_tol[gdecl])
         return dict(members=G["members"], f=-f, K=None if K is None else -K, key=G["key"], decl=gdecl,
                     lam=np.einsum("gij,gj->gi", R, Lam) if ssn else st["lam"], u=st["u"], stick=st["stick"], R=R,

@@ -128,13 +128,13 @@ class ContactOptions:
         "(``ADJUST``); 0: no adjustment; the count and the largest overlap adjusted are in "
         "``Solution.stats[0][\"adjusted\"]``; docs/theory_adjust.md)", kernel_none=np.nan)
     stick: str = option(
-        "exact", _stick,
-        "``\"exact\"`` (default: line contact's tangential traction is a field of nodal multipliers on "
-        "the slave beam, Newton unknowns with their Coulomb complementarity functions; a sticking node's "
-        "weighted slip is below ``stick_tolerance``; docs/theory_mortar.md; point contact keeps the "
-        "penalty) or ``\"penalty\"`` (the tangential penalty above, per Gauss point: sticking points "
-        "slip elastically by ``lam_T / penalty_t``, by up to ``slip_tolerance`` element lengths; "
-        "cheaper, with that error in the answer)")
+        "penalty", _stick,
+        "``\"penalty\"`` (default: the tangential penalty above, per Gauss point: sticking points slip "
+        "elastically by ``lam_T / penalty_t``, up to ``slip_tolerance`` element lengths, an error in the "
+        "answer) or ``\"exact\"`` (line contact's tangential traction is a field of nodal multipliers on "
+        "the slave beam, Newton unknowns with their Coulomb complementarity functions: a sticking node's "
+        "weighted slip is below ``stick_tolerance``, whatever ``penalty_t``; point and orthogonal pairs "
+        "keep the point law; docs/theory_mortar.md)")
     stick_tolerance: Optional[float] = option(
         None, _real("stick_tolerance", above=0.0, none=True),
         "that slip, a length (default ``1e-8 (R1 + R2)`` (``STICK_TOLERANCE``) of the largest radii "

@@ -494,7 +494,9 @@ class Newton:
                 a_new = phi0 * alpha**2 / (phi - phi0 + 2.0 * alpha * phi0)
             else:
                 a_new = 0.1 * alpha
-            alpha = float(np.clip(a_new, 0.1 * alpha, 0.5 * alpha)) if ev0.mult is None else 0.5 * alpha
+            # semi-smooth (bordered) systems: halving (the merit is only piecewise smooth), a tenth after a failure
+            alpha = float(np.clip(a_new, 0.1 * alpha, 0.5 * alpha)) if ev0.mult is None or not np.isfinite(phi) \
+                else 0.5 * alpha
             problem.multiplier_trial(alpha)
             H1 = problem.update(H, alpha * dz)
         if not np.isfinite(best[0]):

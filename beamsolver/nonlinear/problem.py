@@ -188,7 +188,7 @@ class Problem:
                 Kql[which] = np.swapaxes(T, 1, 2) @ Kql[which]
                 Klq[which] = Klq[which] @ T
         from ..model import blocks as _blocks
-        out.update(Kql=Kql, Klq=Klq, Kll=m["Kll"], dofs=_blocks.dofs(s.rep, nodes))
+        out.update(Kql=Kql, Klq=Klq, Kll=m["Kll"], R=m["R"], Lam=m["Lam"], dofs=_blocks.dofs(s.rep, nodes))
         return out
 
     def bordered(self, ev, K, rhs, dz_c=None):
@@ -207,9 +207,22 @@ class Problem:
         cl = np.broadcast_to(red[mu["dofs"]][:, None, :], (g, 3, k6))
         keep = cl >= 0
         Blq = sp.csc_matrix((mu["Klq"][keep], (rl[keep], cl[keep])), shape=(3 * g, nf))
-        Bll = sp.csc_matrix((mu["Kll"].ravel(), (np.repeat(gi, 3, axis=1).ravel(),
-                                                 np.tile(gi, (1, 3)).ravel())), shape=(3 * g, 3 * g))
+        Kll = mu["Kll"]
         rc = -mu["C"].ravel()
+        # a multiplier direction no free unknown can slip in (supports hold it, e.g. a scene kept in a
+        # plane): its row and column are empty, the saddle-point matrix singular; its traction acts on held
+        # unknowns only, so it is set to zero there (row: the traction's component itself)
+        free_row = np.sqrt(np.asarray(Blq.multiply(Blq).sum(axis=1)).ravel())
+        own = np.linalg.norm(Kll, axis=2).ravel()
+        idle = (free_row <= 1e-12 * max(free_row.max(initial=0.0), 1e-300)) & \
+            (own <= 1e-12 * max(own.max(initial=0.0), 1e-300))
+        if idle.any():
+            gg, ii = np.divmod(np.flatnonzero(idle), 3)
+            Kll = Kll.copy()
+            Kll[gg, ii] = mu["R"][gg, ii]
+            rc[idle] = -np.einsum("gj,gj->g", mu["R"][gg, ii], mu["Lam"][gg])
+        Bll = sp.csc_matrix((Kll.ravel(), (np.repeat(gi, 3, axis=1).ravel(),
+                                           np.tile(gi, (1, 3)).ravel())), shape=(3 * g, 3 * g))
         if dz_c is not None:
             dzf = np.ravel(dz_c)[mu["dofs"]]                       # (g, 6 k): constrained increments only
             dzf = np.where(red[mu["dofs"]] < 0, dzf, 0.0)

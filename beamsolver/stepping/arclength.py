@@ -217,6 +217,7 @@ class ArcLengthRun(Run):
     ``options.path``: its ``ArcLength`` (``None``: the defaults)."""
     name = "arc-length"
     switch_advice = False      # it follows unstable branches: the warning on one gives no advice
+    multipliers_in_newton = False  # the bordered solves keep t fixed: exact stick by Uzawa updates
 
     def __init__(self, problem, newton, writer, grid, dt_min, verbose, options):
         super().__init__(problem, newton, writer, grid, dt_min, verbose, options)
