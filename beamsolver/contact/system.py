@@ -68,6 +68,8 @@ from . import adjust, conditioning, rules
 
 MAX_AUGMENT = 30
 OVERLAP_REPORT = 1e-4    # penetration / (R1 + R2) in the given poses that step 0 reports (100 x the smoothing)
+import os
+HOLD = os.environ.get('BS_HOLD', 'touch')
 SWITCH_TOL = 1e-12        # a step ending within this (relative) of active_from / friction_from ends before it
 TIMED = ("search", "rules", "projection", "params", "kernel", "blocks")   # parts of ``ContactSystem.timings``
 
@@ -653,8 +655,11 @@ class ContactSystem(Contribution):
         # the traction acts where the normal law does (the kernel applies it there): the slip is
         # integrated over the same points
         hold = None
-        if ssn:      # groups without normal traction: the point law's stiffness floor (mortar.py)
+        if ssn and HOLD == "all":      # groups without normal traction: the point law's stiffness floor (mortar.py)
             hold = mu * PENALTY_T_MIN * self._decl_penalty[gdecl]
+        elif ssn and HOLD == "touch":
+            touch = np.bincount(G["g"].ravel(), weights=np.repeat(d["active"].astype(float), 2), minlength=len(m))
+            hold = np.where(touch > 0, mu * PENALTY_T_MIN * self._decl_penalty[gdecl], 0.0)
         st = mortar.nodal_state(G, pm["weight"], d["S"], d["lam_n"], d["n"], R, Lam, eps, mu, m,
                                 None if ssn else d["active"], hold=hold)
         mult = None
