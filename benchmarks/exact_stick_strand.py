@@ -5,8 +5,8 @@ strand bending").
     python benchmarks/exact_stick_strand.py [--meshes 8 16 32] [--penalties 1 10] [--lays 2] [--upto 1.6]
 
 Virgin ramp ``0 -> upto kappa_b`` in steps of 0.05 kappa_b (``t`` in ``[1, 2]``, after the frictionless pull);
-first slip = the first step with a slipping point in the middle half (``status``); the penalty column is
-``penalty_t / E`` (``None``: the default, the normal penalty E).
+first slip = the first step with a slipping point in the middle half (``status``); the c column is
+``penalty_t / E`` (the default: ``EXACT_C`` = 1e-3 of the normal penalty E).
 """
 import argparse
 import sys
