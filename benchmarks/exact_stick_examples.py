@@ -83,8 +83,10 @@ def run(scene, stick, c=None):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenes", nargs="+", default=list(SCENES))
-    ap.add_argument("--c", type=float, nargs="+", default=[None], help="penalty_t / normal penalty of the exact runs")
+    ap.add_argument("--c", type=float, nargs="+", default=[0.0],
+                    help="penalty_t / normal penalty of the exact runs (0: the default, EXACT_C)")
     a = ap.parse_args()
+    a.c = [None if c is None or c <= 0 else c for c in a.c]      # 0: the default
     print("| scene | stick | c / penalty | Newton it. | cut-backs | wall [s] | end | ratio to penalty |")
     print("|---|---|---|---:|---:|---:|---|---:|")
     for scene in a.scenes:
