@@ -1,12 +1,12 @@
 """Exact stick on the bent 1+6 strand (examples/strand_bending.py): first slip, stick stiffness and moment
-against the mesh and the augmentation penalty (issue 26; table in docs/benchmarks.md, "Compiled point terms,
+against the mesh and the complementarity parameter c = ``penalty_t`` (issue 26; table in docs/benchmarks.md, "Compiled point terms,
 strand bending").
 
     python benchmarks/exact_stick_strand.py [--meshes 8 16 32] [--penalties 1 10] [--lays 2] [--upto 1.6]
 
 Virgin ramp ``0 -> upto kappa_b`` in steps of 0.05 kappa_b (``t`` in ``[1, 2]``, after the frictionless pull);
-first slip = the first step with a slipping point in the middle half (``status``); the penalty column is
-``penalty_t / E`` (``None``: the default, the normal penalty E).
+first slip = the first step with a slipping point in the middle half (``status``); the c column is
+``penalty_t / E`` (the default: ``EXACT_C`` = 1e-3 of the normal penalty E).
 """
 import argparse
 import sys
@@ -34,7 +34,7 @@ def row(elements_per_lay, factor, lays, upto):
     up = np.flatnonzero(res["times"] > 1.0)
     hit = up[res["share"][up] > 0]
     first = res["kappa"][hit[0]] / th["kappa_b"] if len(hit) else np.nan
-    return dict(el=elements_per_lay, penalty="E" if factor is None else f"{factor:g} E",
+    return dict(el=elements_per_lay, penalty="1e-3 E (default)" if factor is None else f"{factor:g} E",
                 EI0=res["M"][up[0]] / res["kappa"][up[0]], first=first, M=res["M"][up[-1]],
                 Mth=float(np.ravel(sb.moment(res["kappa"][up[-1]], th))[0]), share=res["share"][up[-1]],
                 iterations=res["iterations"], wall=wall, EI_max=th["EI_max"])
@@ -43,11 +43,12 @@ def row(elements_per_lay, factor, lays, upto):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--meshes", type=int, nargs="+", default=[8, 16, 32])
-    ap.add_argument("--penalties", type=float, nargs="+", default=[1.0], help="penalty_t / E (1: the default)")
+    ap.add_argument("--penalties", type=float, nargs="+", default=[1.0],
+                    help="penalty_t / E, the complementarity parameter c of the exact stick (1: the default, 1e-3 E)")
     ap.add_argument("--lays", type=float, default=2.0)
     ap.add_argument("--upto", type=float, default=1.6)
     a = ap.parse_args()
-    print("| el/lay | augmentation penalty | EI initial [N m^2] | first slip / kappa_b | M(end) [N m] | theory [N m] "
+    print("| el/lay | c (penalty_t) | EI initial [N m^2] | first slip / kappa_b | M(end) [N m] | theory [N m] "
           "| slipping share | Newton it. | wall [s] |")
     print("|---:|---|---:|---:|---:|---:|---:|---:|---:|")
     for n in a.meshes:

@@ -47,14 +47,18 @@ def axial_force(sol, wire, step=-1):
 
 
 def slip_zone(sol, wire, L=1.0, step=-1):
-    """Length from the pulled end of the zone holding slipping contact points (from the stick flags)."""
+    """Length of the zone of slipping contact points that reaches the pulled end (from the stick flags:
+    the points from the pulled end up to the first sticking one; a point slipping elsewhere, e.g. at the
+    free end under the pressing phase's self-equilibrated forces, is not part of it)."""
     c = sol.contact(step)
     on = c["normal_force"] > 0
-    slipping = on & ~c["stick"]
+    x, slipping = c["position"][on, 0], ~c["stick"][on]
+    order = np.argsort(-x)
+    held = np.flatnonzero(~slipping[order])
     if not slipping.any():
         return 0.0
-    x = c["position"][slipping, 0]
-    return L - x.min()
+    reach = order if not len(held) else order[:held[0]]
+    return L - x[reach].min() if len(reach) else 0.0
 
 
 def main(steps=4, **kw):

@@ -203,3 +203,39 @@ def contact_tangent_error(problem, H, eps=1e-7):
         rm = problem.evaluate(problem.update(H, -dz.reshape(n, 6)), 0.0, tangent=False).r
         worst = max(worst, np.abs((rp - rm)[free] / (2 * eps) - K[free, d]).max() / scale)
     return worst, ev
+
+
+def bordered_tangent_error(problem, H, t=0.0, eps=1e-7, dlam=1e-6):
+    """Largest difference between the bordered Newton matrix of exact stick (``Problem.bordered``: poses
+    and nodal multipliers as unknowns) and central differences of ``[r_free; C]`` at poses ``H`` and the
+    contact's trial multipliers, column by column (poses by ``eps``, multipliers by ``dlam``), relative
+    to the largest entry of each block row; returns ``(error_q_rows, error_C_rows, evaluation)``."""
+    system, c = problem.system, problem.contact
+    ev = problem.evaluate(H, t, tangent=True)
+    free = system.free_dofs
+    nf, n = len(free), system.n_nodes
+    A = problem.bordered(ev, problem.tangent(ev), -ev.r[free])[0].toarray()
+    keys = ev.mult["key"]
+    g = len(keys)
+
+    def res(Hs, step, s):
+        c.multiplier_step(keys, step)
+        c.multiplier_trial(s)
+        e = problem.evaluate(Hs, t, tangent=False)
+        assert np.array_equal(e.mult["key"], keys)
+        return np.concatenate([e.r[free], e.mult["C"].ravel()])
+
+    fd = np.zeros_like(A)
+    zero = np.zeros((g, 3))
+    for k, d in enumerate(free):
+        dz = np.zeros(6 * n)
+        dz[d] = eps
+        fd[:, k] = (res(problem.update(H, dz.reshape(n, 6)), zero, 0.0)
+                    - res(problem.update(H, -dz.reshape(n, 6)), zero, 0.0)) / (2 * eps)
+    for k in range(3 * g):
+        step = np.zeros(3 * g)
+        step[k] = 1.0
+        fd[:, nf + k] = (res(H, step, dlam) - res(H, step, -dlam)) / (2 * dlam)
+    c.multiplier_step(keys, zero)
+    err = np.abs(fd - A)
+    return (err[:nf].max() / np.abs(A[:nf]).max(), err[nf:].max() / np.abs(A[nf:]).max(), ev)

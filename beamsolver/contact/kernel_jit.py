@@ -966,7 +966,7 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
                 for k in range(24):
                     G[(G_DSLIP + a) * W + k] = 0.0
         lt, Dlt, stick = _friction(slip, lamp, t1, t2, lam, par, G)
-        if active:
+        if active or _EVERYWHERE:
             F = _add_friction_force(F, G, wgt, lt, Dlt, t1, t2)
         else:
             lt = (0.0, 0.0)
@@ -1017,6 +1017,11 @@ def _friction_given(slip, lamp, t1, t2, lam, par, G):
         G[dtr + k] = lamp[0] * G[dt1 + k] + lamp[1] * G[dt1 + W + k] + lamp[2] * G[dt1 + 2 * W + k]
         G[dtr + W + k] = lamp[0] * G[dt2 + k] + lamp[1] * G[dt2 + W + k] + lamp[2] * G[dt2 + 2 * W + k]
     return (dot(lamp, t1), dot(lamp, t2)), G[dtr:dtr + 2 * W].reshape((2, W)), True
+
+
+# the friction of a point acts only where its normal law does; the mortar kernel's traction (a field
+# interpolated from the slave nodes) acts at every point of the overlap (``make_kernel``)
+_EVERYWHERE = False
 
 
 # the gradient rows a mortar evaluation exports per point: n, t1, t2 (9), the slip (2), the normal traction (1)
@@ -1079,6 +1084,7 @@ def make_kernel(law, mortar=False):
         glb = dict(globals(), _normal_law=law.normal, _tangential_law=law.tangential)
         if mortar:
             glb["_friction"] = _friction_given
+            glb["_EVERYWHERE"] = True      # the nodal traction field acts over the whole projected overlap
         for name in _MORTAR_PATH if mortar else _LAW_PATH:
             t = _TEMPLATES[name]
             f = types.FunctionType(t.__code__, glb, f"{name}__{key}", t.__defaults__)

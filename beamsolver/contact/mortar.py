@@ -23,7 +23,7 @@ import numpy as np
 
 from ..lie import se3
 
-__all__ = ["groups", "return_mapping", "nodal_state", "blocks"]
+__all__ = ["groups", "return_mapping", "nodal_state", "blocks", "multiplier_blocks"]
 
 def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=None):
     """Nodal groups (one slave node against one master beam) of ``P`` points.
@@ -71,8 +71,8 @@ def return_mapping(trial, cap):
     Returns ``lam``, ``stick``, ``C`` ``(G, 3, 3)`` = d lam / d trial and ``c`` ``(G, 3)`` = d lam / d cap.
     """
     norm = np.linalg.norm(trial, axis=1)
-    stick = norm <= cap
-    safe = np.where(stick, 1.0, norm)
+    stick = (norm <= cap) & (cap > 0.0)        # no capacity: no traction (not a stick of zero width)
+    safe = np.where(stick | (norm == 0.0), 1.0, norm)
     t = trial / safe[:, None]
     C = np.where(stick[:, None, None], np.eye(3),
                  (cap / safe)[:, None, None] * (np.eye(3) - t[:, :, None] * t[:, None, :]))
@@ -81,7 +81,7 @@ def return_mapping(trial, cap):
     return lam, stick, C, c
 
 
-def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu, m, active=None):
+def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu, m, active=None, hold=None):
     """Nodal weighted slip, normal traction and multipliers of the groups ``G`` (``groups``).
 
     ``w`` ``(P,)`` point weights, ``S`` ``(P, 3)`` slips, ``lam_n`` ``(P,)``, ``n`` ``(P, 3)`` normals; per group:
@@ -111,9 +111,69 @@ def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu, m, active=None):
     # d trial = Pi dv + Q dnbar, Q = -((nu . v) Pi + nu (Pi v)^T) / |nbar|
     Q = -(np.sum(nu * v, axis=1)[:, None, None] * Pi + nu[:, :, None] * trial[:, None, :]) / size[:, None, None]
     lam, stick, C, c = return_mapping(trial, mu * np.maximum(lamN, 0.0))
+    if hold is not None:
+        # touching without normal traction (``hold`` (n,) > 0 where a point lies in the normal law's band):
+        # no traction and any slip solve the law, a mechanism Newton cannot factorise (a wire laid on a rod
+        # before its load).  Their tangent holds with the stiffness ``hold``, as the point law's stiffness
+        # floor does (``law.PENALTY_T_MIN``); the residual keeps their traction at zero.
+        weak = (hold > 0) & (lamN <= 0.0)
+        C = np.where(weak[:, None, None], (hold / eps)[:, None, None] * np.eye(3), C)
+        c = np.where(weak[:, None], 0.0, c)
     T = np.einsum("pa,pai->pi", G["phi"], lam[G["g"]])
     return dict(m=m, u=np.einsum("gij,gj->gi", Pi, u), lamN=lamN, trial=trial, lam=lam, stick=stick, C=C, c=c,
                 T=T, wphi=wphi, wn=wn, Pi=Pi, Q=Q)
+
+
+def _slots(G, a):
+    """Group of each point's node ``a`` (0: A, 1: B) and the point's 24 rows in that group's block."""
+    P = len(G["g"])
+    return G["g"][:, a], (6 * G["pos"][:, a, :, None] + np.arange(6)).reshape(P, 24)
+
+
+def _point_parts(G, d):
+    """Point forces and their derivatives at fixed traction on the groups of the points' node A:
+    ``f`` ``(n, 6 k)``, ``K`` ``(n, 6 k, 6 k)``; and ``A`` ``(n, 6 k, 3)`` = d f / d lam_g (the forces of
+    the interpolated tractions: ``A_g = sum_p Phi_j(p) df_p/dT``, rows over the group's slots)."""
+    n, k = G["members"].shape
+    gA, rowsA = _slots(G, 0)
+    f = np.zeros((n, 6 * k))
+    np.add.at(f, (gA[:, None], rowsA), d["f"])
+    K = np.zeros((n, 6 * k, 6 * k))
+    np.add.at(K, (gA[:, None, None], rowsA[:, :, None], rowsA[:, None, :]), d["dfdq"])
+    A = np.zeros((n, 6 * k, 3))
+    for a in range(2):
+        g, rows = _slots(G, a)
+        np.add.at(A, (g[:, None], rows), G["phi"][:, a, None, None] * d["G"])
+    return f, K, A
+
+
+def _trial_rows(G, d, st, eps, mu):
+    """``d lam_g / d q`` ``(n, 3, 6 k)`` through the points (slips, normals, normal tractions), without the
+    turn of the node's frame: ``C (Pi eps du + Q dnbar) + c mu dlamN``."""
+    n, k = G["members"].shape
+    B = np.zeros((n, 3, 6 * k))
+    for a in range(2):
+        g, rows = _slots(G, a)
+        wg, wgn = st["wphi"][:, a] / st["m"][g], st["wn"][:, a] / st["m"][g]
+        dtrial = (eps[g] * wg)[:, None, None] * np.einsum("pij,pjq->piq", st["Pi"][g], d["dS"]) + \
+            wgn[:, None, None] * np.einsum("pij,pjq->piq", st["Q"][g], d["dn"])
+        dlam = np.einsum("pij,pjq->piq", st["C"][g], dtrial) + \
+            (mu[g] * wg)[:, None, None] * st["c"][g][:, :, None] * d["dlam_n"][:, None, :]
+        np.add.at(B, (g[:, None, None], np.arange(3)[None, :, None], rows[:, None, :]), dlam)
+    return B
+
+
+def _turn(G, R, Lam):
+    """Columns ``(n, 3)`` of the node's rotation increment in each group's block and ``d(R Lam) / dtheta``
+    ``(n, 3, 3)`` = ``-R hat(Lam)`` (body increment of the node)."""
+    own = np.argmax(G["members"] == G["node"][:, None], axis=1)
+    return 6 * own[:, None] + np.arange(3, 6), -np.einsum("gij,gjk->gik", R, se3.skew(Lam))
+
+
+def _add_columns(M, cols, V):
+    """``M[g][:, cols[g]] += V[g]`` for ``M`` ``(n, r, c)``, ``cols`` ``(n, 3)``, ``V`` ``(n, r, 3)``."""
+    n, r = M.shape[:2]
+    np.add.at(M, (np.arange(n)[:, None, None], np.arange(r)[None, :, None], cols[:, None, :]), V)
 
 
 def blocks(G, d, st, R, Lam, eps, mu):
@@ -123,37 +183,36 @@ def blocks(G, d, st, R, Lam, eps, mu):
     Returns ``f`` ``(n, 6 k)`` and ``K`` ``(n, 6 k, 6 k)`` (``d f / d q``): the point forces and
     their derivatives at fixed traction go to the group of the point's node A; the traction's
     dependence on the slips, normal tractions and node rotation of a group couples every node of
-    it: ``K_g += A_g B_g``, ``A_g = sum_p Phi_j(p) df_p/dT`` (rows over the group's nodes, which hold
+    it: ``K_g += A_g B_g``, ``A_g = sum_p Phi_j(p) df_p/dT`` (rows over the group's slots, which hold
     every member point's nodes) and ``B_g = d lam_g / d q``.
     """
-    n, k = G["members"].shape
-    P = len(d["f"])
-    gA = G["g"][:, 0]
-    rowsA = (6 * G["pos"][:, 0, :, None] + np.arange(6)).reshape(P, 24)
-    f = np.zeros((n, 6 * k))
-    np.add.at(f, (gA[:, None], rowsA), d["f"])
-    K = np.zeros((n, 6 * k, 6 * k))
-    np.add.at(K, (gA[:, None, None], rowsA[:, :, None], rowsA[:, None, :]), d["dfdq"])
+    f, K, A = _point_parts(G, d)
     # d lam_g / d q = C (Pi (eps du + d(R Lam)) + Q dnbar) + c mu dlamN, rows over the group's slots
-    B = np.zeros((n, 3, 6 * k))
-    for a in range(2):
-        g, rows = G["g"][:, a], (6 * G["pos"][:, a, :, None] + np.arange(6)).reshape(P, 24)
-        wg, wgn = st["wphi"][:, a] / st["m"][g], st["wn"][:, a] / st["m"][g]
-        dtrial = (eps[g] * wg)[:, None, None] * np.einsum("pij,pjq->piq", st["Pi"][g], d["dS"]) + \
-            wgn[:, None, None] * np.einsum("pij,pjq->piq", st["Q"][g], d["dn"])
-        dlam = np.einsum("pij,pjq->piq", st["C"][g], dtrial) + \
-            (mu[g] * wg)[:, None, None] * st["c"][g][:, :, None] * d["dlam_n"][:, None, :]
-        np.add.at(B, (g[:, None, None], np.arange(3)[None, :, None], rows[:, None, :]), dlam)
-    # the multiplier turns with its node: d(R Lam) = -R hat(Lam) dtheta (body increment of the node)
-    own = np.argmax(G["members"] == G["node"][:, None], axis=1)
-    rot = 6 * own[:, None] + np.arange(3, 6)
-    dR = -np.einsum("gij,gjk->gik", R, se3.skew(Lam))
-    np.add.at(B, (np.arange(n)[:, None, None], np.arange(3)[None, :, None], rot[:, None, :]),
-              np.einsum("gij,gjk,gkl->gil", st["C"], st["Pi"], dR))
-    # forces of the interpolated tractions: A_g = sum_p Phi_j(p) G_p (rows over the group's slots)
-    A = np.zeros((n, 6 * k, 3))
-    for a in range(2):
-        g, rows = G["g"][:, a], (6 * G["pos"][:, a, :, None] + np.arange(6)).reshape(P, 24)
-        np.add.at(A, (g[:, None], rows), G["phi"][:, a, None, None] * d["G"])
+    B = _trial_rows(G, d, st, eps, mu)
+    rot, dR = _turn(G, R, Lam)
+    _add_columns(B, rot, np.einsum("gij,gjk,gkl->gil", st["C"], st["Pi"], dR))
     K += A @ B
     return f, K
+
+
+def multiplier_blocks(G, d, st, R, Lam, c, mu):
+    """Semi-smooth Newton blocks of the nodal multipliers ``Lam`` ``(n, 3)`` (section frame of the node; the
+    traction is ``v = R Lam``) with the complementarity function ``C = v - P(Pi (v + c u))`` (``P`` the
+    return mapping onto the disk ``mu lamN``; ``d``: point terms at the tractions ``T_p = sum Phi_j v_j``,
+    ``st``: ``nodal_state`` with ``eps = c``).
+
+    Returns ``f`` ``(n, 6 k)`` (contact forces), ``Kqq`` ``(n, 6 k, 6 k)`` = d f / d q at fixed ``Lam``,
+    ``Kql`` ``(n, 6 k, 3)`` = d f / d Lam, ``Klq`` ``(n, 3, 6 k)`` = d C / d q, ``Kll`` ``(n, 3, 3)`` = d C / d Lam
+    and ``C`` ``(n, 3)``.  Sticking: ``C = nu nu^T v - c Pi u`` (no slip, no normal part); sliding:
+    ``C = v - mu lamN t``.
+    """
+    f, Kqq, A = _point_parts(G, d)
+    rot, dv = _turn(G, R, Lam)
+    _add_columns(Kqq, rot, A @ dv)
+    Kql = A @ R
+    MP = np.einsum("gij,gjk->gik", st["C"], st["Pi"])                  # d P / d v
+    Klq = -_trial_rows(G, d, st, c, mu)
+    _add_columns(Klq, rot, dv - MP @ dv)
+    Kll = R - MP @ R
+    v = np.einsum("gij,gj->gi", R, Lam)
+    return f, Kqq, Kql, Klq, Kll, v - st["lam"]

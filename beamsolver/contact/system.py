@@ -53,9 +53,9 @@ from ..model.buffers import BufferPool
 from ..errors import InputError
 from ..failures import ContactTunnelling, NoContactNormal
 from ..model.model import JOIN_TOL
-from .law import default_penalty
+from .law import PENALTY_T_MIN, default_penalty
 from . import kernel_jit, mortar
-from .options import ADJUST, SMOOTHING, STICK_TOLERANCE, ContactOptions, declaration_table
+from .options import ADJUST, EXACT_C, SMOOTHING, STICK_TOLERANCE, ContactOptions, declaration_table
 from .frames import LINE, NORMAL_TOL, POINT, no_normal, touch_tolerance
 from .frames_jit import material_frames
 from .record import OPEN, SLIP, STICK, Candidates, PairSet
@@ -69,6 +69,8 @@ from . import adjust, conditioning, rules
 
 MAX_AUGMENT = 30
 OVERLAP_REPORT = 1e-4    # penetration / (R1 + R2) in the given poses that step 0 reports (100 x the smoothing)
+import os
+HOLD = os.environ.get('BS_HOLD', 'touch')
 SWITCH_TOL = 1e-12        # a step ending within this (relative) of active_from / friction_from ends before it
 TIMED = ("search", "rules", "projection", "params", "kernel", "blocks")   # parts of ``ContactSystem.timings``
 
@@ -115,8 +117,10 @@ class _Decl:
         self.smoothing = o.smoothing          # None: SMOOTHING * (R1 + R2) per pair
         self.law = o.law                      # None: the kernel's default law
         self.exact = o.stick == "exact" and decl.mu > 0
-        # exact stick: augmentation penalty (force / length^2) and slip tolerance (length)
-        self.eps_t = self.penalty if o.penalty_t is None else o.penalty_t
+        # exact stick: the complementarity parameter c (force / length^2) and the slip tolerance (length)
+        self.eps_t = EXACT_C * self.penalty if o.penalty_t is None else o.penalty_t
+        # ... and, where the multipliers are not Newton unknowns (arc length), the Uzawa updates' penalty
+        self.aug_t = self.penalty if o.penalty_t is None else o.penalty_t
         self.stick_tolerance = (STICK_TOLERANCE * 2.0 * max(s.radius for s in secs)
                                 if o.stick_tolerance is None else o.stick_tolerance)
 
@@ -167,12 +171,15 @@ class ContactSystem(Contribution):
         self._decl_adjust = table["adjust"]
         self._decl_exact = np.array([d.exact for d in self.decls])
         self._decl_eps_t = np.array([d.eps_t for d in self.decls])
+        self._decl_aug_t = np.array([d.aug_t for d in self.decls])
         self._decl_stick_tol = np.array([d.stick_tolerance for d in self.decls])
         # slave nodes whose every increment is fixed (``mortar.groups``' boundary modification)
         self._held = ~system.free.reshape(-1, 6)[system.rep].any(axis=1)
         self._node_len = np.bincount(system.enodes.ravel(), weights=np.repeat(0.5 * system.L, 2),
                                      minlength=len(system.poses0))
         self._augments = 0
+        self.newton_multipliers = True   # exact stick: multipliers are Newton unknowns (else Uzawa updates)
+        self._mstep, self._ms = None, 0.0     # the Newton step of the multipliers (keys, dLam) and its trial length
         self._sweepable = {}       # per declaration: whether the last search found no crossing (``_candidates``)
         self._H_prev = None        # last converged poses (start of the step)
         self._geo = self._geo_prev = None    # (poses, element twists) of the last evaluation / of H_prev
@@ -500,7 +507,12 @@ class ContactSystem(Contribution):
         mult = self.history.normal_multipliers(P.key)
         # the smoothing zone plus a small band keeps the projection-updated gap consistent
         band = self._smoothing(P, slice(None)) + 1e-3 * (P.R1 + P.R2) + touch_tolerance(_extent(H), P.R1, P.R2)
-        return np.flatnonzero(mult - pen * gap > -pen * band)
+        on = mult - pen * gap > -pen * band
+        if self.newton_multipliers and self._decl_exact.any():
+            # exact stick: the nodal traction field acts over the whole overlap the search found (a point
+            # that left the normal law keeps its share of the field: no jump in the residual)
+            on |= self._decl_exact[P.decl] & (P.kind == LINE) & (self._decl_mu[P.decl] > 0)
+        return np.flatnonzero(on)
 
     # ------------------------------------------------------------ refusals
     def element_label(self, e):
@@ -581,7 +593,7 @@ class ContactSystem(Contribution):
         p = self._params(P, sel, H)
         self._lap("params")
         self._blocks = None        # its tangent buffer may be reused (``_tangent_out``)
-        mort = self._decl_exact[P.decl[sel]] & (p["kind"] != POINT) & (p["mu"] > 0)
+        mort = self._decl_exact[P.decl[sel]] & (p["kind"] == LINE) & (p["mu"] > 0)
         f, K, out = self._kernels(H[P.nodes[sel]], p, P.decl[sel], tangent,
                                   friction=(p["mu"] > 0) & ~mort if mort.any() else None)
         np.negative(f, out=f)
@@ -626,8 +638,9 @@ class ContactSystem(Contribution):
                           P.nodes[sel[idx]], n_nodes, self.n_beams, self._held_slip(P.nodes[sel[idx]]))
         gdecl = G["key"] // (np.int64(n_nodes) * self.n_beams)
         R = H[G["node"], :3, :3]
-        Lam = self.history.tangential_multipliers(G["key"])
-        eps, mu = self._decl_eps_t[gdecl], self._decl_mu[gdecl]
+        ssn = self.newton_multipliers
+        Lam = self.iterate_multipliers(G["key"]) if ssn else self.history.tangential_multipliers(G["key"])
+        eps, mu = (self._decl_eps_t if ssn else self._decl_aug_t)[gdecl], self._decl_mu[gdecl]
         laws = {id(self.decls[k].law): self.decls[k].law for k in np.unique(gdecl)}
         if len(laws) > 1:
             raise InputError("contact: exact stick needs one contact law over the declarations of a scene, "
@@ -641,11 +654,26 @@ class ContactSystem(Contribution):
             merged % len(self.sys.L)], minlength=len(G["key"]))
         # the traction acts where the normal law does (the kernel applies it there): the slip is
         # integrated over the same points
-        st = mortar.nodal_state(G, pm["weight"], d["S"], d["lam_n"], d["n"], R, Lam, eps, mu, m, d["active"])
+        hold = None
+        if ssn and HOLD == "all":      # groups without normal traction: the point law's stiffness floor (mortar.py)
+            hold = mu * PENALTY_T_MIN * self._decl_penalty[gdecl]
+        elif ssn and HOLD == "touch":
+            touch = np.bincount(G["g"].ravel(), weights=np.repeat(d["active"].astype(float), 2), minlength=len(m))
+            hold = np.where(touch > 0, mu * PENALTY_T_MIN * self._decl_penalty[gdecl], 0.0)
+        st = mortar.nodal_state(G, pm["weight"], d["S"], d["lam_n"], d["n"], R, Lam, eps, mu, m,
+                                None if ssn else d["active"], hold=hold)
+        mult = None
+        if ssn:       # the multiplier itself is the traction (its complementarity function is an equation)
+            v = np.einsum("gij,gj->gi", R, Lam)
+            st["T"] = np.einsum("pa,pai->pi", G["phi"], v[G["g"]])
         d["f"] = np.einsum("pij,pj->pi", d["A"], st["T"])
         if tangent:
             d["G"], d["dfdq"] = d["A"], np.einsum("pk,pkij->pij", st["T"], d["dK"])
-            f, K = mortar.blocks(G, d, st, R, Lam, eps, mu)
+            if ssn:
+                f, K, Kql, Klq, Kll, C = mortar.multiplier_blocks(G, d, st, R, Lam, eps, mu)
+                mult = dict(Kql=-Kql, Klq=Klq, Kll=Kll)
+            else:
+                f, K = mortar.blocks(G, d, st, R, Lam, eps, mu)
         else:
             f = np.zeros((len(G["key"]), 6 * G["members"].shape[1]))
             rows = (6 * G["pos"][:, 0, :, None] + np.arange(6)).reshape(len(idx), 24)
@@ -661,8 +689,12 @@ class ContactSystem(Contribution):
             if name not in out:
                 out[name] = np.tile(np.eye(4), (len(sel), 1, 1))
             out[name][idx] = d[name]
+        if ssn:
+            mult = dict(mult or {}, C=np.einsum("gij,gj->gi", R, Lam) - st["lam"], m=m, members=G["members"], R=R, Lam=Lam,
+                        key=G["key"], stick=st["stick"], u=st["u"], tol=self._decl_stick_tol[gdecl])
         return dict(members=G["members"], f=-f, K=None if K is None else -K, key=G["key"], decl=gdecl,
-                    lam=st["lam"], u=st["u"], stick=st["stick"], R=R)
+                    lam=np.einsum("gij,gj->gi", R, Lam) if ssn else st["lam"], u=st["u"], stick=st["stick"], R=R,
+                    mult=mult)
 
     def _held_slip(self, nodes):
         """``(P, 2)``: slave nodes A, B of the pairs over ``nodes`` ``(P, 4)`` whose slip is prescribed:
@@ -737,12 +769,47 @@ class ContactSystem(Contribution):
         if blocks is None:
             return Blocks.empty(4, tangent), dict(n_active=0)
         P, sel, p, f, K, out = blocks
+        info = dict(n_active=len(sel))
         if "mortar" in out:
             b = _with_mortar(P.nodes[sel], f.reshape(-1, 24), K if tangent else None, out["mortar"])
+            if out["mortar"]["mult"] is not None:
+                info["multipliers"] = out["mortar"]["mult"]
         else:
             b = Blocks(P.nodes[sel], f.reshape(-1, 24), K if tangent else None)
         self._lap("blocks")
-        return b, dict(n_active=len(sel))
+        return b, info
+
+    # ------------------------------------------------------------ multipliers as Newton unknowns
+    def iterate_multipliers(self, keys):
+        """Nodal multipliers ``(k, 3)`` of the groups ``keys`` at the current iterate: the trial ones of the
+        step (``history``) plus the trial length times the last Newton step of the multipliers."""
+        Lam = self.history.tangential_multipliers(keys)
+        if self._mstep is not None and self._ms != 0.0:
+            i = np.searchsorted(self._mstep[0], keys).clip(max=max(len(self._mstep[0]) - 1, 0))
+            found = (self._mstep[0][i] == keys) if len(self._mstep[0]) else np.zeros(len(keys), dtype=bool)
+            Lam[found] += self._ms * self._mstep[1][i[found]]
+        return Lam
+
+    def multiplier_step(self, keys, dLam):
+        """The Newton step ``dLam`` ``(k, 3)`` of the multipliers of the groups ``keys`` (sorted); trial length 0."""
+        self._mstep, self._ms = (np.asarray(keys), np.asarray(dLam).reshape(-1, 3)), 0.0
+
+    def multiplier_trial(self, s):
+        """The iterate's multipliers are the step's plus ``s`` times the last Newton step."""
+        if s != self._ms and self._mstep is not None:
+            self._ms = s
+            self._blocks = None
+
+    def accept_multipliers(self):
+        """The trial multipliers become the step's (``history``): the next Newton step starts from them."""
+        if self._mstep is None or self._ms == 0.0:
+            self._mstep, self._ms = None, 0.0
+            return
+        old = self.history.tmult
+        keys = np.union1d(old[0], self._mstep[0])
+        vals = self.iterate_multipliers(keys)
+        self.history.update_multipliers(None, (keys, vals))
+        self._mstep, self._ms = None, 0.0
 
     # ------------------------------------------------------------ per step
     def begin_step(self, H, t):
@@ -754,6 +821,7 @@ class ContactSystem(Contribution):
         self._H_prev = np.array(H, dtype=float)
         self._geo_prev = None
         self._augments = 0
+        self._mstep, self._ms = None, 0.0
 
     def _state(self, H):
         if self._decl_exact.any():      # the mortar pass: through the evaluation (kept for these poses)
@@ -800,7 +868,7 @@ class ContactSystem(Contribution):
         (else ``None``)."""
         self.unmet_tolerance = None
         tol = [d.tolerance for d in self.decls]
-        if all(t is None for t in tol) and not self._decl_exact.any():
+        if all(t is None for t in tol) and not (self._decl_exact.any() and not self.newton_multipliers):
             return False
         P, sel, po = self._state(H)
         if P is None or len(sel) == 0:
@@ -816,7 +884,7 @@ class ContactSystem(Contribution):
             order = np.argsort(keys)
             mult = (keys[order], lam[order])
         m = out.get("mortar")
-        if m is not None:
+        if m is not None and not self.newton_multipliers:
             slip, stol = np.linalg.norm(m["u"], axis=1), self._decl_stick_tol[m["decl"]]
             bad = m["stick"] & (slip > stol)
             if bad.any():

@@ -17,10 +17,11 @@ from ..errors import InputError
 from .validation import count, real
 
 __all__ = ["ContactOptions", "check_contact_options", "describe", "SMOOTHING", "SLIP_TOLERANCE",
-           "STICK_TOLERANCE", "LINE_ANGLE", "ADJUST"]
+           "STICK_TOLERANCE", "LINE_ANGLE", "ADJUST", "EXACT_C"]
 
 SMOOTHING = 1e-6          # default smoothing gap of the normal law / (R1 + R2) (benchmarks/touching_defaults.py)
 SLIP_TOLERANCE = 0.005    # elastic slip at the onset of sliding / slave element length (Abaqus' default)
+EXACT_C = 1e-3            # stick="exact": default c of the complementarity function / the normal penalty
 STICK_TOLERANCE = 1e-8    # weighted slip of a sticking node / (R1 + R2) with stick="exact"
 LINE_ANGLE = float(np.deg2rad(20.0))   # below this crossing angle: line contact (search.py, rule 1)
 ADJUST = 1e-3             # default overclosure adjusted away at the reference poses / (R1 + R2)
@@ -91,9 +92,11 @@ class ContactOptions:
     gauss_points: int = option(5, _gauss_points, "integration points per slave element for line contact (5)")
     penalty_t: Optional[float] = option(
         None, _real("penalty_t", above=0.0, none=True),
-        "a fixed tangential penalty, force / length^3, instead of one from ``slip_tolerance`` (default "
-        "None); with ``stick=\"exact\"`` the augmentation penalty, force / length^2 (default the normal "
-        "penalty)", kernel_none=np.nan)
+        "with ``stick=\"penalty\"``: a fixed tangential penalty, force / length^3, instead of one from "
+        "``slip_tolerance`` (default None); with ``stick=\"exact\"``: the parameter ``c`` of the "
+        "complementarity function ``C = lam - P(lam + c u)`` the semi-smooth Newton solves, force / "
+        "length^2 (default ``1e-3`` (``EXACT_C``) times the normal penalty): it changes the path of the "
+        "iterations, not the answer", kernel_none=np.nan)
     slip_tolerance: float = option(
         SLIP_TOLERANCE, _real("slip_tolerance", above=0.0),
         "elastic slip at the onset of sliding, in slave element lengths (default 0.005, Abaqus' "
@@ -126,10 +129,12 @@ class ContactOptions:
         "``Solution.stats[0][\"adjusted\"]``; docs/theory_adjust.md)", kernel_none=np.nan)
     stick: str = option(
         "penalty", _stick,
-        "``\"penalty\"`` (default: the tangential penalty above, per Gauss point; sticking points "
-        "slip elastically by ``lam_T / penalty_t``) or ``\"exact\"`` (mortar nodal multipliers on "
-        "the slave beam, iterated until every sticking node's weighted slip is below "
-        "``stick_tolerance``; docs/theory_mortar.md)")
+        "``\"penalty\"`` (default: the tangential penalty above, per Gauss point: sticking points slip "
+        "elastically by ``lam_T / penalty_t``, up to ``slip_tolerance`` element lengths, an error in the "
+        "answer) or ``\"exact\"`` (line contact's tangential traction is a field of nodal multipliers on "
+        "the slave beam, Newton unknowns with their Coulomb complementarity functions: a sticking node's "
+        "weighted slip is below ``stick_tolerance``, whatever ``penalty_t``; point and orthogonal pairs "
+        "keep the point law; docs/theory_mortar.md)")
     stick_tolerance: Optional[float] = option(
         None, _real("stick_tolerance", above=0.0, none=True),
         "that slip, a length (default ``1e-8 (R1 + R2)`` (``STICK_TOLERANCE``) of the largest radii "

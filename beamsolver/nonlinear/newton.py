@@ -156,13 +156,27 @@ class Newton:
 
     def residual_ratio(self, ev, r=None):
         """Scaled residual (``Convergence.residual_ratio``) of the residual ``r`` ``(6 n,)`` (default
-        ``ev.r``) with the force scales of the evaluation ``ev``."""
-        return self._ratio(ev.r if r is None else r, self.conv.scales(ev, self.L_ref))
+        ``ev.r``) with the force scales of the evaluation ``ev``, and the multipliers' equations
+        (``_with_multipliers``)."""
+        scales = self.conv.scales(ev, self.L_ref)
+        return self._with_multipliers(ev, self._ratio(ev.r if r is None else r, scales), scales)
+
+    def _with_multipliers(self, ev, ratio, scales):
+        """The scaled residual ``ratio`` with the multipliers that are Newton unknowns (exact stick): their
+        complementarity residuals (``Problem.multiplier_ratio``, on the force scale) and a sticking group's
+        slip against its tolerance (a ratio of 1 counts as ``rtol``)."""
+        if ev.mult is None:
+            return ratio
+        r, stick = self.problem.multiplier_ratio(ev, scales[0])
+        if log.isEnabledFor(logging.DEBUG):
+            log.debug("   forces %.3e, multipliers' equations %.3e, %d of %d groups sticking, largest sticking "
+                      "slip / tolerance %.3g", ratio, r, ev.mult["stick"].sum(), len(ev.mult["stick"]), stick)
+        return max(ratio, r, self.conv.rtol * stick)
 
     def _measured(self, ev):
         """``ev`` with its residual scales and scaled residual (``_Measured``; no direction yet)."""
         scales = self.conv.scales(ev, self.L_ref)
-        return _Measured(ev, scales, self._ratio(ev.r, scales))
+        return _Measured(ev, scales, self._with_multipliers(ev, self._ratio(ev.r, scales), scales))
 
     def at_rest(self, ev, H, t):
         """Whether the given poses ``H`` (evaluated in ``ev`` at ``t``) are an equilibrium by
@@ -177,10 +191,13 @@ class Newton:
             return True
         return self._inc(dzf) <= max(self.conv.dtol, self.conv.floor(H, self.L_ref))
 
-    def _merit(self, r, scales):
-        rf = r[self.sys.free_dofs]
+    def _merit(self, ev, scales):
+        rf = ev.r[self.sys.free_dofs]
         F, M = scales
-        return float(np.sum((rf[self.fu] / F) ** 2) + np.sum((rf[self.fw] / M) ** 2))
+        phi = float(np.sum((rf[self.fu] / F) ** 2) + np.sum((rf[self.fw] / M) ** 2))
+        if ev.mult is not None:
+            phi += float(np.sum((np.linalg.norm(ev.mult["C"], axis=1) * ev.mult["m"] / F) ** 2))
+        return phi
 
     def check_continuity(self, H0, H1):
         """``RotationGuard.check_continuity``: refuse a step over which an element's relative rotation
@@ -204,6 +221,8 @@ class Newton:
         if dz_c is not None:
             rhs -= problem.coupling(ev, dz_c)
         K = problem.tangent(ev)
+        if ev.mult is not None:
+            K, rhs = problem.bordered(ev, K, rhs, dz_c)
         t1 = time.perf_counter()
         try:
             lu = linsolve.factorize_tangent(K, self.linsolver)
@@ -214,6 +233,10 @@ class Newton:
             self.timings["linear_solve"] += t2 - t1
         if not np.all(np.isfinite(dzf)):
             raise SingularTangent("the linear solve returned non-finite values")
+        if ev.mult is not None:
+            n = self.sys.n_free
+            problem.multiplier_step(ev, dzf[n:])
+            dzf = dzf[:n]
         return lu, dzf
 
     def evaluate(self, H, t, tangent=True):
@@ -310,6 +333,7 @@ class Newton:
         for it in range(conv.max_iter + 1):
             ev, scales, ratio, lu, dzf, nrm = self._measured(self.evaluate(H, t)) if ahead is None else ahead
             ahead = None
+            problem.accept_multipliers()        # those the iterate was evaluated with
             residuals.append(ratio)
             log.debug("t = %.6g  iteration %d  scaled residual %.3e", t, it, ratio)
             if self.callback is not None:
@@ -329,16 +353,20 @@ class Newton:
                 # the first tangent K(H_n, t_n+1): indefinite where a step may jump
                 sign = getattr(lu, "det_sign", None)
                 self.indefinite_seen = sign is None or sign() < 0
+            if ev.mult is not None:
+                problem.multiplier_trial(1.0)
             if constraint.moves:
                 H, t, last_inc = constraint.move(self, H, t, dzf)
                 continue
             dz = self.full(dzf)
             if not damping:
                 last_inc = conv.increment_ratio(dz, self.L_ref)
+                if ev.mult is not None and ratio > conv.rtol:
+                    last_inc = np.inf        # the multipliers move too: no convergence on a small dz alone
                 if not self.line_search or plain:
                     H = problem.update(H, dz)
                     continue
-                H, ahead = self._line_search(H, dz, ev.r, scales, t)
+                H, ahead = self._line_search(H, dz, ev, scales, t)
                 continue
             lam0 = min(1.0, 2.0 * lam)          # after a damped iteration, try twice its length
             inc = conv.increment_ratio(dz, self.L_ref)
@@ -430,7 +458,7 @@ class Newton:
                 raise DampingStalled(f"damped Newton stalled: no step length down to {DAMPING_MIN:g} of the "
                                      "Newton increment reduces the Newton correction")
 
-    def _line_search(self, H, dz, r0, scales, t):
+    def _line_search(self, H, dz, ev0, scales, t):
         """Backtracking on the scaled residual (problems that are not smooth; the others use the
         damped Newton of ``_damped``: a piecewise smooth residual made its natural-monotonicity
         test accept steps that later stalled, e.g. in the twisted pair).
@@ -439,36 +467,41 @@ class Newton:
         ``_Measured`` evaluation (with tangent: the next iteration's, computed once; ``None`` otherwise).
         The residual does not depend on whether the tangent is computed."""
         problem = self.problem
-        phi0 = self._merit(r0, scales)
+        phi0 = self._merit(ev0, scales)
         H1 = problem.update(H, dz)
         if phi0 <= (10.0 * self.conv.rtol) ** 2 * len(self.sys.free_dofs):
             return H1, None
         alpha = 1.0
-        best = (np.inf, H1)
+        best = (np.inf, H1, alpha)
         for _ in range(8):
             ev1 = None
             try:
                 # the full step is nearly always accepted: evaluated with the tangent the next
                 # iteration needs; the backtracked trials need the residual only
                 ev1 = self.evaluate(H1, t, tangent=alpha == 1.0)
-                phi = self._merit(ev1.r, scales)
+                phi = self._merit(ev1, scales)
             except StepFailed:
                 phi = np.inf
             if phi < best[0]:
-                best = (phi, H1)
+                best = (phi, H1, alpha)
             # Newton may raise the residual for a while: only a blow-up (factor
             # LS_GROWTH) triggers backtracking, which then asks for a decrease
-            if phi <= (LS_GROWTH * phi0 if alpha == 1.0 else (1.0 - 1e-4 * alpha) * phi0):
+            growth = LS_GROWTH if ev0.mult is None else 1.0 - 1e-4      # semi-smooth: Armijo from the full step
+            if phi <= (growth * phi0 if alpha == 1.0 else (1.0 - 1e-4 * alpha) * phi0):
                 return H1, (self._measured(ev1) if alpha == 1.0 else None)
             # minimiser of the quadratic through phi(0), phi'(0) = -2 phi0, phi(alpha)
             if np.isfinite(phi):
                 a_new = phi0 * alpha**2 / (phi - phi0 + 2.0 * alpha * phi0)
             else:
                 a_new = 0.1 * alpha
-            alpha = float(np.clip(a_new, 0.1 * alpha, 0.5 * alpha))
+            # semi-smooth (bordered) systems: halving (the merit is only piecewise smooth), a tenth after a failure
+            alpha = float(np.clip(a_new, 0.1 * alpha, 0.5 * alpha)) if ev0.mult is None or not np.isfinite(phi) \
+                else 0.5 * alpha
+            problem.multiplier_trial(alpha)
             H1 = problem.update(H, alpha * dz)
         if not np.isfinite(best[0]):
             raise NonFinite("line search found no finite residual along the Newton direction")
+        problem.multiplier_trial(best[2])
         return best[1], None
 
 

@@ -57,6 +57,7 @@ class Evaluation:
     extra: tuple = None
     timings: dict = field(default_factory=dict)
     details: dict = field(default_factory=dict)
+    mult: dict = None           # multipliers that are Newton unknowns (``Problem.multipliers``), or None
 
 
 class Problem:
@@ -144,6 +145,8 @@ class Problem:
             t0 = time.perf_counter()
             blocks, cinfo = c.evaluate(H, tangent)
             rc, cc, fl, ml = s.assemble_blocks(H, blocks)
+            if "multipliers" in cinfo:
+                ev.mult = self._multipliers(H, c, blocks, cinfo.pop("multipliers"))
             ev.timings[c.name] = time.perf_counter() - t0
             ev.details[c.name] = cinfo
             ev.r = ev.r + rc
@@ -159,6 +162,110 @@ class Problem:
     def tangent(self, ev):
         """Reduced tangent (free x free) as CSC, every contribution in it."""
         return self.system.matrix(ev.kvals, ev.extra)
+
+    # ------------------------------------------------------------ multipliers as Newton unknowns
+    def _multipliers(self, H, owner, blocks, m):
+        """The multiplier unknowns of contribution ``owner`` (``m``: its complementarity residual ``C``
+        ``(g, 3)``, weights ``m`` ``(g,)``, group ``key``, ``members`` ``(g, k)``, ``stick``, slips ``u``, slip
+        tolerances ``tol`` and, with the tangent, ``Kql`` ``(g, 6 k, 3)``, ``Klq`` ``(g, 3, 6 k)``, ``Kll``
+        ``(g, 3, 3)``) with their blocks carried to the unknowns ``z`` (``blocks.transform``) and numbered
+        (``dofs``: full ``z`` numbering)."""
+        s = self.system
+        nodes = m["members"]
+        out = dict(owner=owner, C=m["C"], m=m["m"], key=m["key"], stick=m["stick"], u=m["u"], tol=m["tol"])
+        if "Kql" not in m:
+            return out
+        Kql, Klq = m["Kql"], m["Klq"]
+        if s.transformed.any() and len(nodes):
+            which = np.flatnonzero(s.transformed[nodes].any(axis=1))
+            if len(which):
+                M = s.node_transforms(H)
+                k = nodes.shape[1]
+                T = np.zeros((len(which), 6 * k, 6 * k))
+                for j in range(k):
+                    T[:, 6 * j:6 * j + 6, 6 * j:6 * j + 6] = M[nodes[which, j]]
+                Kql, Klq = Kql.copy(), Klq.copy()
+                Kql[which] = np.swapaxes(T, 1, 2) @ Kql[which]
+                Klq[which] = Klq[which] @ T
+        from ..model import blocks as _blocks
+        out.update(Kql=Kql, Klq=Klq, Kll=m["Kll"], R=m["R"], Lam=m["Lam"], dofs=_blocks.dofs(s.rep, nodes))
+        return out
+
+    def bordered(self, ev, K, rhs, dz_c=None):
+        """The Newton system with the multiplier unknowns of ``ev`` appended: ``[[K, K_ql], [K_lq, K_ll]]``
+        (CSC) and ``[rhs; -C - K_lc dz_c]``."""
+        import scipy.sparse as sp
+        mu = ev.mult
+        red, nf = self.system.red, self.system.n_free
+        g, k6 = mu["dofs"].shape
+        gi = np.arange(3 * g).reshape(g, 3)
+        rows = np.broadcast_to(red[mu["dofs"]][:, :, None], (g, k6, 3))
+        cols = np.broadcast_to(gi[:, None, :], (g, k6, 3))
+        keep = rows >= 0
+        Bql = sp.csc_matrix((mu["Kql"][keep], (rows[keep], cols[keep])), shape=(nf, 3 * g))
+        rl = np.broadcast_to(gi[:, :, None], (g, 3, k6))
+        cl = np.broadcast_to(red[mu["dofs"]][:, None, :], (g, 3, k6))
+        keep = cl >= 0
+        Blq = sp.csc_matrix((mu["Klq"][keep], (rl[keep], cl[keep])), shape=(3 * g, nf))
+        Kll = mu["Kll"]
+        rc = -mu["C"].ravel()
+        # a multiplier direction no free unknown can slip in (supports hold it, e.g. a scene kept in a
+        # plane): its row and column are empty, the saddle-point matrix singular; its traction acts on held
+        # unknowns only, so it is set to zero there (row: the traction's component itself)
+        free_row = np.sqrt(np.asarray(Blq.multiply(Blq).sum(axis=1)).ravel())
+        own = np.linalg.norm(Kll, axis=2).ravel()
+        idle = (free_row <= 1e-12 * max(free_row.max(initial=0.0), 1e-300)) & \
+            (own <= 1e-12 * max(own.max(initial=0.0), 1e-300))
+        if idle.any():
+            gg, ii = np.divmod(np.flatnonzero(idle), 3)
+            Kll = Kll.copy()
+            Kll[gg, ii] = mu["R"][gg, ii]
+            rc[idle] = -np.einsum("gj,gj->g", mu["R"][gg, ii], mu["Lam"][gg])
+        Bll = sp.csc_matrix((Kll.ravel(), (np.repeat(gi, 3, axis=1).ravel(),
+                                           np.tile(gi, (1, 3)).ravel())), shape=(3 * g, 3 * g))
+        if dz_c is not None:
+            dzf = np.ravel(dz_c)[mu["dofs"]]                       # (g, 6 k): constrained increments only
+            dzf = np.where(red[mu["dofs"]] < 0, dzf, 0.0)
+            rc = rc - np.einsum("gij,gj->gi", mu["Klq"], dzf).ravel()
+        A = sp.bmat([[K, Bql], [Blq, Bll]], format="csc")
+        return A, np.concatenate([rhs, rc])
+
+    def multipliers_in_newton(self, flag):
+        """Whether multipliers may be Newton unknowns (exact stick); otherwise their owners update them
+        between Newton solves (augmented-Lagrangian outer iterations)."""
+        for c in self.contributions:
+            if hasattr(c, "newton_multipliers"):
+                c.newton_multipliers = bool(flag)
+
+    def multiplier_step(self, ev, x):
+        """Hand the Newton step ``x`` ``(3 g,)`` of the multipliers of ``ev`` to their owner (trial length 0)."""
+        ev.mult["owner"].multiplier_step(ev.mult["key"], x)
+
+    def multiplier_trial(self, s):
+        """The iterate's multipliers: the accepted ones plus ``s`` times the last Newton step."""
+        for c in self.contributions:
+            f = getattr(c, "multiplier_trial", None)
+            if f is not None:
+                f(s)
+
+    def accept_multipliers(self):
+        """The trial multipliers become the accepted ones (a new Newton iterate)."""
+        for c in self.contributions:
+            f = getattr(c, "accept_multipliers", None)
+            if f is not None:
+                f()
+
+    def multiplier_ratio(self, ev, F):
+        """How far the multipliers of ``ev`` are from their equations, on the scale of the residual ratio:
+        ``max |C_g| m_g / F`` and, for sticking groups, ``rtol``-free ``max |u_g| / tol_g`` (returned apart):
+        ``(ratio, stick_ratio)``; ``(0, 0)`` without multipliers."""
+        mu = ev.mult
+        if mu is None or not len(mu["m"]):
+            return 0.0, 0.0
+        r = float(np.max(np.linalg.norm(mu["C"], axis=1) * mu["m"])) / F if F > 0 else 0.0
+        st = mu["stick"]
+        s = float(np.max(np.linalg.norm(mu["u"][st], axis=1) / mu["tol"][st])) if st.any() else 0.0
+        return r, s
 
     def full_tangent(self, ev):
         """Tangent over all ``6 n`` unknowns as CSR."""

@@ -217,9 +217,11 @@ class ArcLengthRun(Run):
     ``options.path``: its ``ArcLength`` (``None``: the defaults)."""
     name = "arc-length"
     switch_advice = False      # it follows unstable branches: the warning on one gives no advice
+    multipliers_in_newton = False  # the bordered solves keep t fixed: exact stick by Uzawa updates
 
     def __init__(self, problem, newton, writer, grid, dt_min, verbose, options):
         super().__init__(problem, newton, writer, grid, dt_min, verbose, options)
+        problem.multipliers_in_newton(False)     # the bordered solves keep t fixed: Uzawa updates instead
         self.arc = self.opt.path if self.opt.path is not None else ArcLength()
         self.t_end = float(grid[-1])
         self.span = float(grid[-1] - grid[0])

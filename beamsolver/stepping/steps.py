@@ -104,6 +104,7 @@ class Run:
     ``start``, then ``loop``, then ``finish``; ``abort(exc)`` on any exception."""
     name = "load"
     switch_advice = True          # the warning on an unstable state says how to reach a stable one
+    multipliers_in_newton = True  # exact stick's multipliers are Newton unknowns (arc length: Uzawa updates)
 
     @staticmethod
     def path_options(value, restart, branch_switching=False, stabilize=None):
@@ -195,6 +196,8 @@ class Run:
             self.H, self.t = H0, None
             conv = self.newton.conv
             max_iter, conv.max_iter = conv.max_iter, STEP_ZERO_ITERATIONS * conv.max_iter
+            # no slip before t_start: friction's multipliers stay out of the Newton unknowns at step 0
+            problem.multipliers_in_newton(False)
             try:
                 H, ev0, stats = self.newton_step(t_start)
             except StepFailed as e:
@@ -211,6 +214,7 @@ class Run:
                 raise err from None
             finally:
                 self.t, conv.max_iter = t_start, max_iter
+                problem.multipliers_in_newton(self.multipliers_in_newton)
             stats.update(wall_time=time.perf_counter() - t0, dt=0.0, cutbacks=0)
             if overlap:
                 stats.setdefault("warnings", []).append(overlap)

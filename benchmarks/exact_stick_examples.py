@@ -1,0 +1,102 @@
+"""Exact stick (semi-smooth Newton, ``stick="exact"``) against the penalty stick on the contact examples:
+Newton iterations, cut-backs and wall time of each (issue 26: at most 1.5 times the penalty's iterations).
+
+    python benchmarks/exact_stick_examples.py [--c 1e-3 1] [--scenes twisted_pair three_wires ...]
+
+``--c``: ``penalty_t`` of the exact runs as a fraction of each declaration's normal penalty (default: the
+library's default, ``EXACT_C``).  Every ``add_contact`` of a scene gets the mode through a wrapper of
+``Model.add_contact``.  Rows print as they finish (markdown table).
+"""
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+
+import beamsolver as bs  # noqa: E402
+
+
+def _twisted_pair():
+    import twisted_pair
+    return bs.solve(twisted_pair.build()[0], steps=16)
+
+
+def _three_wires():
+    import three_wires
+    return three_wires.main()[0]
+
+
+def _shear_lag():
+    import shear_lag
+    return shear_lag.main(n_wire=20)[0]
+
+
+def _contact_patch():
+    import contact_patch
+    model = contact_patch.build()[0]
+    return bs.solve(model, **contact_patch.solve_options)
+
+
+def _rolling():
+    import rolling
+    return rolling.main()[-1]
+
+
+SCENES = dict(twisted_pair=_twisted_pair, three_wires=_three_wires, shear_lag=_shear_lag,
+              contact_patch=_contact_patch, rolling=_rolling)
+
+
+def run(scene, stick, c=None):
+    """``(iterations, cut-backs, wall s, message)`` of ``scene`` with every declaration's ``stick`` (and
+    ``penalty_t = c x`` its normal penalty when given)."""
+    orig = bs.Model.add_contact
+
+    def add_contact(self, slave, master, mu=0.0, penalty=None, **options):
+        options.setdefault("stick", stick)
+        if c is not None and stick == "exact":
+            from beamsolver.contact.law import default_penalty
+            secs = [b.section for b in (list(slave) if isinstance(slave, (list, tuple)) else [slave])
+                    + (list(master) if isinstance(master, (list, tuple)) else [master])]
+            pen = penalty if penalty is not None else min(default_penalty(a, b) for a in secs for b in secs)
+            options.setdefault("penalty_t", c * pen)
+        return orig(self, slave, master, mu=mu, penalty=penalty, **options)
+
+    bs.Model.add_contact = add_contact
+    t0 = time.perf_counter()
+    try:
+        sol = SCENES[scene]()
+        stats = sol.stats
+        its = int(sum(s["iterations"] for s in stats))
+        cuts = int(sum(s.get("cutbacks", 0) for s in stats))
+        return its, cuts, time.perf_counter() - t0, "t = %.3g" % sol.times[-1]
+    except bs.ConvergenceError as e:
+        sol = e.solution
+        its = int(sum(s["iterations"] for s in sol.stats)) if sol is not None else 0
+        return its, 0, time.perf_counter() - t0, "failed at t = %.3g" % (sol.times[-1] if sol is not None else np.nan)
+    finally:
+        bs.Model.add_contact = orig
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--scenes", nargs="+", default=list(SCENES))
+    ap.add_argument("--c", type=float, nargs="+", default=[0.0],
+                    help="penalty_t / normal penalty of the exact runs (0: the default, EXACT_C)")
+    a = ap.parse_args()
+    a.c = [None if c is None or c <= 0 else c for c in a.c]      # 0: the default
+    print("| scene | stick | c / penalty | Newton it. | cut-backs | wall [s] | end | ratio to penalty |")
+    print("|---|---|---|---:|---:|---:|---|---:|")
+    for scene in a.scenes:
+        ref = run(scene, "penalty")
+        print(f"| {scene} | penalty | | {ref[0]} | {ref[1]} | {ref[2]:.1f} | {ref[3]} | 1 |", flush=True)
+        for c in a.c:
+            r = run(scene, "exact", c)
+            print(f"| {scene} | exact | {'default' if c is None else f'{c:g}'} | {r[0]} | {r[1]} | {r[2]:.1f} | {r[3]} "
+                  f"| {r[0] / max(ref[0], 1):.2f} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
