@@ -683,10 +683,37 @@ class System:
                           minlength=self.n_free).astype(float)   # int when no element couples (empty)
         if extra is not None and len(extra[2]):
             rows, cols, vals = extra
+            n_b = self._block_entries(extra)
+            if n_b:                              # dense blocks first: only those reaching a moved node
+                d = self._coo_index[0]
+                out += self._block_coupling(d, vals[:n_b].reshape(len(d), d.shape[1], d.shape[1]), dz_full)
+                rows, cols, vals = rows[n_b:], cols[n_b:], vals[n_b:]
             rr = self.red[rows]
             keep = (rr >= 0) & (self.red[cols] < 0)
             out += np.bincount(rr[keep], weights=vals[keep] * dz_full[cols[keep]], minlength=self.n_free)
         return out
+
+    def _block_entries(self, extra):
+        """How many leading entries of the COO ``extra`` are ``_block_coo``'s blocks (its very index
+        arrays, maybe followed by ``_concat_coo``'s tail): 0 if they are not."""
+        c, cc = getattr(self, "_coo_index", None), getattr(self, "_coo_concat", None)
+        if c is None:
+            return 0
+        if extra[0] is c[1] and extra[1] is c[2]:
+            return len(c[1])
+        if cc is not None and extra[0] is cc[4] and extra[1] is cc[5] and cc[0] is c[1] and cc[1] is c[2]:
+            return len(c[1])
+        return 0
+
+    def _block_coupling(self, d, K, dz_full):
+        """``K_fc dz_c`` of dense blocks ``K`` ``(m, k, k)`` over the dofs ``d`` ``(m, k)``: only the
+        blocks with a constrained, moved column, no ``(m k^2,)`` temporaries."""
+        rd = self.red[d]
+        w = np.where(rd < 0, dz_full[d], 0.0)
+        hit = np.flatnonzero(w.any(axis=1))
+        y = np.einsum("bij,bj->bi", K[hit], w[hit])
+        keep = rd[hit] >= 0
+        return np.bincount(rd[hit][keep], weights=y[keep], minlength=self.n_free)
 
     # ------------------------------------------------------------ poses
     def update(self, H, dz, chains=True):

@@ -58,6 +58,11 @@ class Evaluation:
     timings: dict = field(default_factory=dict)
     details: dict = field(default_factory=dict)
 
+    def drop_tangent(self):
+        """Forget the tangent data (``kvals``, ``extra``) once it is factorised: the contributions'
+        buffers they hold (``contact.system``'s tangent pool) can then serve the next evaluation."""
+        self.kvals = self.extra = None
+
 
 class Problem:
     """Elements, loads and constraints of ``system`` plus ``contributions`` (``Problem.from_model``

@@ -342,3 +342,21 @@ def test_block_index_arrays_reused_only_when_free():
     assert np.array_equal(new[1], np.tile(d_new, (1, 24)).ravel())
     if REUSE_BUFFERS:                    # the second set's buffer is free again: reused
         assert address(new[0]) == second
+
+
+def test_prescribed_coupling_of_blocks_equals_the_entrywise_sum():
+    """``System.prescribed_coupling`` reads the contact blocks through their dofs (``_block_coupling``,
+    no per-entry temporaries): equal to the sum over the COO entries (copies of the index arrays,
+    which take the entry-wise path) to round-off, on the twisted pair (blocks and a tail of
+    global-node terms) with every constrained unknown moved."""
+    problem, s, ev, el = _twisted_pair_tangent()
+    rng = np.random.default_rng(8)
+    dz = np.where(s.red < 0, rng.standard_normal(len(s.red)), 0.0)
+    assert s._block_entries(ev.extra) > 0
+    rows, cols, vals = ev.extra
+    no_elements = np.zeros_like(ev.kvals)           # the contact's part alone
+    ours = s.prescribed_coupling(no_elements, dz, ev.extra)
+    ref = s.prescribed_coupling(no_elements, dz, (rows.copy(), cols.copy(), vals))
+    assert s._block_entries((rows.copy(), cols.copy(), vals)) == 0
+    scale = np.abs(ref).max()
+    assert scale > 0 and np.abs(ours - ref).max() <= 1e-13 * scale
