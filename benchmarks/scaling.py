@@ -285,6 +285,7 @@ def replicated_contact(system, wires, per_wire, unit=None):
             H = us.poses0.copy()
             up.contact.begin_step(H, 0.0)
             _, coo, _, _ = us.assemble_blocks(H, up.contact.evaluate(H, tangent=True)[0])
+            coo = (np.ravel(coo[0]), np.ravel(coo[1]), coo[2])
             if cache:
                 np.savez(cache, rows=coo[0], cols=coo[1], vals=coo[2])
         unit = (us, uw, coo)

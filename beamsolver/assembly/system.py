@@ -25,7 +25,6 @@ from ..model import contributions
 from ..elements import line_load
 from ..lie import se3
 from ..model import blocks as _blocks
-from ..model.buffers import REUSE_BUFFERS, BufferPool     # noqa: F401  (REUSE_BUFFERS: tests)
 from ..errors import InputError
 from .extra_pattern import BlockPattern, ExtraPattern, whole_nodes
 from ..lie.se3 import skew
@@ -162,7 +161,6 @@ class System:
         self.C = np.ascontiguousarray(self.C, dtype=float)
         self.C_diagonal = bool(not np.any(self.C[:, ~np.eye(6, dtype=bool)]))
         self.n_elements = len(self.L)
-        self._coo_pool = BufferPool(np.int32, axis=1)     # memory of the block COO index arrays
         self._build_rotation_pairs()
         self.poses0 = model.poses0
         self.length_scale = model.characteristic_length()
@@ -438,7 +436,8 @@ class System:
         Node transforms (joins, global-type nodes) are applied to the blocks touching a
         transformed node.  Returns ``(r, coo, f_level, m_level)``: the residual ``(6 n,)``,
         the tangent as COO ``(rows, cols, vals)`` in full ``z`` numbering (empty without
-        ``blocks.K``) and the largest transformed nodal force and moment.
+        ``blocks.K``; ``rows``, ``cols`` of the blocks are ``(m, k, k)`` views, ``_block_coo``:
+        ``np.ravel`` them for flat arrays) and the largest transformed nodal force and moment.
         """
         nodes, f, K = blocks.nodes, blocks.f, blocks.K
         if self.transformed.any() and len(nodes):
@@ -455,26 +454,20 @@ class System:
         return (r, coo) + _blocks.levels(f)
 
     def _block_coo(self, d):
-        """Rows and columns ``(m k^2,)`` of the COO entries of blocks over the dofs ``d`` ``(m, k)``; the
-        same (read-only) arrays while ``d`` stays the same, which ``matrix`` recognises at once."""
+        """Rows and columns of the COO entries of blocks over the dofs ``d`` ``(m, k)``: read-only
+        ``(m, k, k)`` broadcast views of (a copy of) ``d``, without memory of their own (``np.ravel``
+        gives the ``(m k^2,)`` arrays ``repeat(d, k)``, ``tile(d, k)``; the CSC path never needs them:
+        ``BlockPattern`` reads ``d``); the same arrays while ``d`` stays the same, which ``matrix``
+        recognises at once."""
         c = getattr(self, "_coo_index", None)
         if c is None or c[0].shape != d.shape or not np.array_equal(c[0], d):
-            self._coo_index = c = None           # its arrays may be reused once nothing else holds them
             m, k = d.shape
-            buf = self._coo_buffer(m * k * k)
-            rows, cols = buf[0, :m * k * k], buf[1, :m * k * k]     # int32: half the memory of int64
-            rows.reshape(m, k, k)[...] = d[:, :, None]
-            cols.reshape(m, k, k)[...] = d[:, None, :]
-            rows.flags.writeable = cols.flags.writeable = False
-            c = self._coo_index = (d.copy(), rows, cols, whole_nodes(d))
+            small = 6 * self.n_nodes <= np.iinfo(np.int32).max
+            dk = np.array(d, dtype=np.int32 if small else np.int64)      # int32: half the memory when raveled
+            rows = np.broadcast_to(dk[:, :, None], (m, k, k))
+            cols = np.broadcast_to(dk[:, None, :], (m, k, k))
+            c = self._coo_index = (dk, rows, cols, whole_nodes(d))
         return c[1], c[2]
-
-    def _coo_buffer(self, n):
-        """A ``(2, n)`` int32 array for ``_block_coo``'s index arrays (``buffers.BufferPool``): memory of
-        a kept buffer that no array handed out any more is a view of (an evaluation's ``extra`` may
-        outlive the pattern), else new; at most two kept.  Fresh memory costs page faults (66 MB for
-        the 19-wire bundle's contact)."""
-        return self._coo_pool.take((2, n))
 
     def _concat_coo(self, a, b):
         """``_concat(a, b)`` whose index arrays are kept (the same read-only arrays) while ``a``'s are the
@@ -482,7 +475,7 @@ class System:
         c = getattr(self, "_coo_concat", None)
         if c is None or c[0] is not a[0] or c[1] is not a[1] or not (
                 np.array_equal(c[2], b[0]) and np.array_equal(c[3], b[1])):
-            rows, cols = np.concatenate([a[0], b[0]]), np.concatenate([a[1], b[1]])
+            rows, cols = np.concatenate([np.ravel(a[0]), b[0]]), np.concatenate([np.ravel(a[1]), b[1]])
             rows.flags.writeable = cols.flags.writeable = False
             c = self._coo_concat = (a[0], a[1], np.array(b[0]), np.array(b[1]), rows, cols)
         return c[4], c[5], np.concatenate([a[2], b[2]])
@@ -661,9 +654,10 @@ class System:
             if not isinstance(p, BlockPattern) or not p.same(c[0], tail, base):
                 p = self._extra_cache = BlockPattern(c[0], self.red, self.n_free, self.indptr, self.indices, tail,
                                                      spare=p if isinstance(p, BlockPattern) else None)
-        elif not isinstance(p, ExtraPattern) or not p.same(extra[0], extra[1], base):
-            p = self._extra_cache = ExtraPattern(extra[0], extra[1], self.red, self.n_free, self.indptr,
-                                                 self.indices, spare=p if isinstance(p, ExtraPattern) else None)
+        elif not isinstance(p, ExtraPattern) or not p.same(np.ravel(extra[0]), np.ravel(extra[1]), base):
+            p = self._extra_cache = ExtraPattern(np.ravel(extra[0]), np.ravel(extra[1]), self.red, self.n_free,
+                                                 self.indptr, self.indices,
+                                                 spare=p if isinstance(p, ExtraPattern) else None)
         return p
 
     def full_matrix(self, kvals, extra=None):
@@ -671,8 +665,8 @@ class System:
         ndof = 6 * self.n_nodes
         rows, cols = self.coo_rows, self.coo_cols
         if extra is not None and len(extra[2]):
-            rows = np.concatenate([rows, extra[0]])
-            cols = np.concatenate([cols, extra[1]])
+            rows = np.concatenate([rows, np.ravel(extra[0])])
+            cols = np.concatenate([cols, np.ravel(extra[1])])
             kvals = np.concatenate([kvals, extra[2]])
         return sp.coo_matrix((kvals, (rows, cols)), shape=(ndof, ndof)).tocsr()
 
@@ -687,7 +681,10 @@ class System:
             if n_b:                              # dense blocks first: only those reaching a moved node
                 d = self._coo_index[0]
                 out += self._block_coupling(d, vals[:n_b].reshape(len(d), d.shape[1], d.shape[1]), dz_full)
+                if n_b == len(vals):
+                    return out
                 rows, cols, vals = rows[n_b:], cols[n_b:], vals[n_b:]
+            rows, cols = np.ravel(rows), np.ravel(cols)
             rr = self.red[rows]
             keep = (rr >= 0) & (self.red[cols] < 0)
             out += np.bincount(rr[keep], weights=vals[keep] * dz_full[cols[keep]], minlength=self.n_free)
@@ -700,9 +697,9 @@ class System:
         if c is None:
             return 0
         if extra[0] is c[1] and extra[1] is c[2]:
-            return len(c[1])
+            return c[1].size
         if cc is not None and extra[0] is cc[4] and extra[1] is cc[5] and cc[0] is c[1] and cc[1] is c[2]:
-            return len(c[1])
+            return c[1].size
         return 0
 
     def _block_coupling(self, d, K, dz_full):
