@@ -23,6 +23,8 @@ Each scene runs in its own child process (``scaling.py --child scene NAME``) and
   (the loop's own iterations, line search included);
 - peak memory: ``ru_maxrss`` of the child (MB).
 
+``SCALING_NO_STEP=rope-600,...`` (environment): scenes whose loaded step is not run (one iteration only).
+
 The bundles are those of ``scaling.bundle_model`` at ``PER_WIRE`` = 158 elements per wire (the
 issue's 3002 / 5846 / 9638 elements).  The rope (``cables.build_rope``): ``ROPE_STRAND`` strands
 (1+6+12, wires 0.55 / 0.5 mm) six times around a 1+6+12 wire strand core (0.6 / 0.55 mm), 133
@@ -32,6 +34,7 @@ shorter pieces of the same rope are run (``rope-<length in mm>``) and the cost p
 extrapolated (the rope is long and thin: fill, flops and contact points per element settle once the
 piece is longer than a few elements, so time and memory grow linearly with the length).
 """
+import os
 import time
 
 import numpy as np
@@ -150,6 +153,10 @@ def measure_scene(name, rss_mb):
     out["analyses"] = solver.stats["analyses"]
     solver.close()
     del problem, system
+    out["rss_mb"] = rss_mb()
+    if name in os.environ.get("SCALING_NO_STEP", "").split(","):
+        out.update(step_iterations=0, step_status="not run", step_s=float("nan"), step_it_s=float("nan"))
+        return out
     # a loaded step: stretch by STRAIN (the bundles: their overlap-free twins, ``strand_model``)
     if not name.startswith("rope"):
         m, wires, length = strand_model(name)
@@ -194,7 +201,7 @@ def report(rows, base_mb, table):
                        g(r.get("step_it_s", np.nan)), f"{r['rss_it2_mb']:.0f}", f"{r['rss_mb']:.0f}"])
     lines = [table(head, body)]
     ropes = [r for r in rows if r["scene"].startswith("rope") and "error" not in r]
-    if len(ropes) >= 2:
+    if len(ropes) >= 2 and ropes[-1]["length_m"] < ROPE_FULL - 1e-9:     # (else the full rope is in the table)
         n = np.array([r["elements"] for r in ropes], float)
         full = ROPE_FULL / ropes[-1]["length_m"] * n[-1]
 
