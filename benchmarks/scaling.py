@@ -285,6 +285,7 @@ def replicated_contact(system, wires, per_wire, unit=None):
             H = us.poses0.copy()
             up.contact.begin_step(H, 0.0)
             _, coo, _, _ = us.assemble_blocks(H, up.contact.evaluate(H, tangent=True)[0])
+            coo = (np.ravel(coo[0]), np.ravel(coo[1]), coo[2])
             if cache:
                 np.savez(cache, rows=coo[0], cols=coo[1], vals=coo[2])
         unit = (us, uw, coo)
@@ -684,10 +685,14 @@ def scenes(names):
     text = (f"`python benchmarks/scaling.py --scenes {','.join(names)}` ({machine()}; one thread; whole run "
             f"{wall:.0f} s). The scenes of issue 30 (`benchmarks/scaling_scenes.py`): one Newton iteration at the "
             "reference poses by parts, CPU s, on the same pattern as the iteration before (`iteration (1st)`: "
-            "the first, with the pattern's analysis); solver: the default `linsolve.Solver` (`auto`); fill: "
+            "the first, with the pattern's analysis); `iteration` = element + contact + assembly + solve + update, "
+            "what `Newton.iterate` pays (an accepted full step is evaluated once, with its tangent); `residual "
+            "(trial)`: a residual-only evaluation, what a backtracked line-search trial adds; solver: the default "
+            "`linsolve.Solver` (`auto`); fill: "
             "factor entries; flops of the factorisation (PARDISO's report, or counted from SuperLU's factors); "
             f"loaded step: `bs.solve(steps=1)` stretching by {scaling_scenes.STRAIN:g}, CPU s (Newton "
-            f"iterations); peak MB: `ru_maxrss` of the child after the two iterations and after the loaded step "
+            f"iterations; `s per iteration, step`: median CPU s between its Newton iterations); peak MB: "
+            f"`ru_maxrss` of the child after the two iterations and after the loaded step "
             f"too (import baseline {base['rss_mb']:.0f} MB).\n\n"
             + scaling_scenes.report(rows, base["rss_mb"], table))
     print(text)

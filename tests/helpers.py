@@ -191,7 +191,7 @@ def contact_tangent_error(problem, H, eps=1e-7):
     ext = ev.extra
     Kc = np.zeros_like(K)
     if ext is not None and len(ext[2]):
-        np.add.at(Kc, (ext[0], ext[1]), ext[2])
+        np.add.at(Kc, (np.ravel(ext[0]), np.ravel(ext[1])), ext[2])
     scale = np.abs(Kc[np.ix_(free, free)]).max(initial=0.0)
     if scale == 0.0:
         scale = np.abs(K[np.ix_(free, free)]).max()

@@ -376,7 +376,8 @@ class BlockPattern:
     ``K_el + csc_matrix((vals, (red[rows], red[cols])))`` of scipy bit for bit, ``vals`` the blocks
     ``(m, 6 k, 6 k)`` raveled, then the tail's values.  A dof column with tail entries (special)
     is sorted on its own; the others read their node's column.  ``spare``: the ``BlockPattern`` it
-    replaces, whose buffers (12 bytes per entry of a node column) are reused when large enough.
+    replaces, whose buffers (8 bytes per entry of a node column while its numbers fit in int32, else 12)
+    are reused when large enough.
     """
 
     def __init__(self, d, red, n_free, el_indptr, el_indices, tail=None, spare=None):
@@ -411,9 +412,12 @@ class BlockPattern:
         n_src = n_nodes + len(spec_dofs)
         ptr = np.empty(n_src + 1, dtype=np.int64)
         n_kept = _count_nodes(node, drow, kept, spec_ptr, t_row, t_src, ptr)
-        if spare is None or spare.buffers is None or len(spare.buffers[0]) < n_kept:
+        # entry numbers and their runs in int32 while they fit (half the memory of int64)
+        idx = np.int32 if len(node) * drow.shape[1] ** 2 + len(t_src) < np.iinfo(np.int32).max else np.int64
+        if (spare is None or spare.buffers is None or len(spare.buffers[0]) < n_kept
+                or spare.buffers[0].dtype != idx):
             extra = n_kept + n_kept // 8           # room for a few more pairs next time
-            self.buffers = np.empty(extra, dtype=np.int64), np.empty(extra, dtype=np.int32)
+            self.buffers = np.empty(extra, dtype=idx), np.empty(extra, dtype=np.int32)
         else:
             self.buffers = spare.buffers
             spare.order = spare.buffers = None     # the old pattern is not used any more
@@ -424,12 +428,13 @@ class BlockPattern:
         tmp.sort_indices()
         c_row = tmp.indices
         self.order = tmp.data
-        start = np.empty(n_kept + 1, dtype=np.int64)
+        start = np.empty(n_kept + 1, dtype=idx)
         self.run_ptr = np.empty(n_src + 1, dtype=np.int64)
         n_runs = _node_runs(c_row, ptr, start, self.run_ptr)
         self.start = start[:n_runs + 1].copy()
         n_c = int((self.run_ptr[src + 1] - self.run_ptr[src]).sum())
-        u_ptr, u_row, u_col, self.el_pos, self.c_pos = _union_buffers(n_free, len(el_indices), n_c)
+        pos = np.int32 if len(el_indices) + n_c < np.iinfo(np.int32).max else np.int64
+        u_ptr, u_row, u_col, self.el_pos, self.c_pos = _union_buffers(n_free, len(el_indices), n_c, pos)
         n = _merge_nodes(np.asarray(el_indptr, dtype=np.int64), el_indices, src, self.run_ptr, c_row,
                          self.start, u_ptr, u_row, u_col, self.el_pos, self.c_pos)
         self.indices, self.col, self.indptr = u_row[:n].copy(), u_col[:n].copy(), u_ptr.astype(np.int32)
@@ -481,10 +486,10 @@ def _drop_zeros(data, indices, col, d, i, ptr):
     return k
 
 
-def _union_buffers(n_free, n_el, n_c):
+def _union_buffers(n_free, n_el, n_c, pos=np.int64):
     """Output buffers of a union-pattern merge (``_merge``, ``_merge_nodes``): column pointers
     ``(n_free + 1,)``, rows and columns ``(n_el + n_c,)`` (room for no overlap) and the union
-    positions of the ``n_el`` element entries and of the ``n_c`` contact runs."""
+    positions (dtype ``pos``) of the ``n_el`` element entries and of the ``n_c`` contact runs."""
     size = n_el + n_c
     return (np.empty(n_free + 1, dtype=np.int64), np.empty(size, dtype=np.int32), np.empty(size, dtype=np.int32),
-            np.empty(n_el, dtype=np.int64), np.empty(n_c, dtype=np.int64))
+            np.empty(n_el, dtype=pos), np.empty(n_c, dtype=pos))

@@ -25,7 +25,6 @@ from ..model import contributions
 from ..elements import line_load
 from ..lie import se3, se3_twin
 from ..model import blocks as _blocks
-from ..model.buffers import REUSE_BUFFERS, BufferPool     # noqa: F401  (REUSE_BUFFERS: tests)
 from ..errors import InputError
 from .csc import canonical_csc
 from .extra_pattern import BlockPattern, ExtraPattern, whole_nodes
@@ -128,7 +127,6 @@ class System:
         self.C = np.ascontiguousarray(self.C, dtype=float)
         self.C_diagonal = bool(not np.any(self.C[:, ~np.eye(6, dtype=bool)]))
         self.n_elements = len(self.L)
-        self._coo_pool = BufferPool(np.int32, axis=1)     # memory of the block COO index arrays
         self._build_rotation_pairs()
         self.poses0 = model.poses0
         self.length_scale = model.characteristic_length()
@@ -413,7 +411,8 @@ class System:
         Node transforms (joins, global-type nodes) are applied to the blocks touching a
         transformed node.  Returns ``(r, coo, f_level, m_level)``: the residual ``(6 n,)``,
         the tangent as COO ``(rows, cols, vals)`` in full ``z`` numbering (empty without
-        ``blocks.K``) and the largest transformed nodal force and moment.
+        ``blocks.K``; ``rows``, ``cols`` of the blocks are ``(m, k, k)`` views, ``_block_coo``:
+        ``np.ravel`` them for flat arrays) and the largest transformed nodal force and moment.
         """
         nodes, f, K = blocks.nodes, blocks.f, blocks.K
         which, Kw = (), None
@@ -433,7 +432,7 @@ class System:
             if Kw is None and tail is None:
                 vals = K.ravel()                   # the blocks themselves: no copy
             else:                                  # one copy: the blocks, the transformed ones, the tail
-                vals = np.empty(len(rows))
+                vals = np.empty(K.size + (0 if tail is None else len(tail[2])))
                 vals[:K.size] = K.ravel()
                 if Kw is not None:
                     vals[:K.size].reshape(K.shape)[which] = Kw
@@ -453,34 +452,28 @@ class System:
         return g[present[g]]
 
     def _block_coo(self, d):
-        """Rows and columns ``(m k^2,)`` of the COO entries of blocks over the dofs ``d`` ``(m, k)``; the
-        same (read-only) arrays while ``d`` stays the same, which ``matrix`` recognises at once."""
+        """Rows and columns of the COO entries of blocks over the dofs ``d`` ``(m, k)``: read-only
+        ``(m, k, k)`` broadcast views of (a copy of) ``d``, without memory of their own (``np.ravel``
+        gives the ``(m k^2,)`` arrays ``repeat(d, k)``, ``tile(d, k)``; the CSC path never needs them:
+        ``BlockPattern`` reads ``d``); the same arrays while ``d`` stays the same, which ``matrix``
+        recognises at once."""
         c = getattr(self, "_coo_index", None)
         if c is None or c[0].shape != d.shape or not np.array_equal(c[0], d):
-            self._coo_index = c = None           # its arrays may be reused once nothing else holds them
             m, k = d.shape
-            buf = self._coo_buffer(m * k * k)
-            rows, cols = buf[0, :m * k * k], buf[1, :m * k * k]     # int32: half the memory of int64
-            rows.reshape(m, k, k)[...] = d[:, :, None]
-            cols.reshape(m, k, k)[...] = d[:, None, :]
-            rows.flags.writeable = cols.flags.writeable = False
-            c = self._coo_index = (d.copy(), rows, cols, whole_nodes(d))
+            small = 6 * self.n_nodes <= np.iinfo(np.int32).max
+            dk = np.array(d, dtype=np.int32 if small else np.int64)      # int32: half the memory when raveled
+            rows = np.broadcast_to(dk[:, :, None], (m, k, k))
+            cols = np.broadcast_to(dk[:, None, :], (m, k, k))
+            c = self._coo_index = (dk, rows, cols, whole_nodes(d))
         return c[1], c[2]
 
-    def _coo_buffer(self, n):
-        """A ``(2, n)`` int32 array for ``_block_coo``'s index arrays (``buffers.BufferPool``): memory of
-        a kept buffer that no array handed out any more is a view of (an evaluation's ``extra`` may
-        outlive the pattern), else new; at most two kept.  Fresh memory costs page faults (66 MB for
-        the 19-wire bundle's contact)."""
-        return self._coo_pool.take((2, n))
-
     def _concat_index(self, a_rows, a_cols, b_rows, b_cols):
-        """The COO index arrays ``a`` followed by ``b``, kept (the same read-only arrays) while ``a``'s are
-        the same arrays (``_block_coo``) and ``b``'s equal."""
+        """The COO index arrays ``a`` (``_block_coo``'s views, raveled) followed by ``b``, kept (the same
+        read-only arrays) while ``a``'s are the same arrays and ``b``'s equal."""
         c = getattr(self, "_coo_concat", None)
         if c is None or c[0] is not a_rows or c[1] is not a_cols or not (
                 (c[6] is b_rows and c[7] is b_cols) or (np.array_equal(c[2], b_rows) and np.array_equal(c[3], b_cols))):
-            rows, cols = np.concatenate([a_rows, b_rows]), np.concatenate([a_cols, b_cols])
+            rows, cols = np.concatenate([np.ravel(a_rows), b_rows]), np.concatenate([np.ravel(a_cols), b_cols])
             rows.flags.writeable = cols.flags.writeable = False
             c = self._coo_concat = (a_rows, a_cols, np.array(b_rows), np.array(b_cols), rows, cols, b_rows, b_cols)
         return c[4], c[5]
@@ -663,9 +656,10 @@ class System:
             if not isinstance(p, BlockPattern) or not p.same(c[0], tail, base):
                 p = self._extra_cache = BlockPattern(c[0], self.red, self.n_free, self.indptr, self.indices, tail,
                                                      spare=p if isinstance(p, BlockPattern) else None)
-        elif not isinstance(p, ExtraPattern) or not p.same(extra[0], extra[1], base):
-            p = self._extra_cache = ExtraPattern(extra[0], extra[1], self.red, self.n_free, self.indptr,
-                                                 self.indices, spare=p if isinstance(p, ExtraPattern) else None)
+        elif not isinstance(p, ExtraPattern) or not p.same(np.ravel(extra[0]), np.ravel(extra[1]), base):
+            p = self._extra_cache = ExtraPattern(np.ravel(extra[0]), np.ravel(extra[1]), self.red, self.n_free,
+                                                 self.indptr, self.indices,
+                                                 spare=p if isinstance(p, ExtraPattern) else None)
         return p
 
     def full_matrix(self, kvals, extra=None):
@@ -673,8 +667,8 @@ class System:
         ndof = 6 * self.n_nodes
         rows, cols = self.coo_rows, self.coo_cols
         if extra is not None and len(extra[2]):
-            rows = np.concatenate([rows, extra[0]])
-            cols = np.concatenate([cols, extra[1]])
+            rows = np.concatenate([rows, np.ravel(extra[0])])
+            cols = np.concatenate([cols, np.ravel(extra[1])])
             kvals = np.concatenate([kvals, extra[2]])
         return sp.coo_matrix((kvals, (rows, cols)), shape=(ndof, ndof)).tocsr()
 
@@ -685,10 +679,40 @@ class System:
                           minlength=self.n_free).astype(float)   # int when no element couples (empty)
         if extra is not None and len(extra[2]):
             rows, cols, vals = extra
+            n_b = self._block_entries(extra)
+            if n_b:                              # dense blocks first: only those reaching a moved node
+                d = self._coo_index[0]
+                out += self._block_coupling(d, vals[:n_b].reshape(len(d), d.shape[1], d.shape[1]), dz_full)
+                if n_b == len(vals):
+                    return out
+                rows, cols, vals = rows[n_b:], cols[n_b:], vals[n_b:]
+            rows, cols = np.ravel(rows), np.ravel(cols)
             rr = self.red[rows]
             keep = (rr >= 0) & (self.red[cols] < 0)
             out += np.bincount(rr[keep], weights=vals[keep] * dz_full[cols[keep]], minlength=self.n_free)
         return out
+
+    def _block_entries(self, extra):
+        """How many leading entries of the COO ``extra`` are ``_block_coo``'s blocks (its very index
+        arrays, maybe followed by ``_concat_index``'s tail): 0 if they are not."""
+        c, cc = getattr(self, "_coo_index", None), getattr(self, "_coo_concat", None)
+        if c is None:
+            return 0
+        if extra[0] is c[1] and extra[1] is c[2]:
+            return c[1].size
+        if cc is not None and extra[0] is cc[4] and extra[1] is cc[5] and cc[0] is c[1] and cc[1] is c[2]:
+            return c[1].size
+        return 0
+
+    def _block_coupling(self, d, K, dz_full):
+        """``K_fc dz_c`` of dense blocks ``K`` ``(m, k, k)`` over the dofs ``d`` ``(m, k)``: only the
+        blocks with a constrained, moved column, no ``(m k^2,)`` temporaries."""
+        rd = self.red[d]
+        w = np.where(rd < 0, dz_full[d], 0.0)
+        hit = np.flatnonzero(w.any(axis=1))
+        y = np.einsum("bij,bj->bi", K[hit], w[hit])
+        keep = rd[hit] >= 0
+        return np.bincount(rd[hit][keep], weights=y[keep], minlength=self.n_free)
 
     # ------------------------------------------------------------ poses
     def update(self, H, dz, chains=True):

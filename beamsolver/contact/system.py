@@ -578,6 +578,7 @@ class ContactSystem(Contribution):
         c = self._blocks
         if c is not None and np.array_equal(c[0], H) and (c[1] is None or c[1][4] is not None or not tangent):
             return c[1]
+        c = None                   # (its tangent buffer may serve this evaluation: ``_tangent_out``)
         tangent = tangent or self.kernel is kernel_jit
         P = self.pairs(H)
         self._lap()

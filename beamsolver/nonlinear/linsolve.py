@@ -42,6 +42,7 @@ one sparse product, see ``_poor``, and re-analyses once before giving up).
 Threads: PARDISO uses MKL's OpenMP threads (``MKL_NUM_THREADS``), SuperLU one.
 """
 import copy
+import weakref
 
 import numpy as np
 import scipy.sparse as sp
@@ -410,6 +411,12 @@ def _backward_error(K, x, b):
     return r / scale if scale > 0 else r
 
 
+
+def _NONE():
+    """A dead weak reference's call: ``None``."""
+    return None
+
+
 class _Pardiso:
     """One PARDISO handle (``pypardiso.PyPardisoSolver``), driven phase by phase.
 
@@ -424,7 +431,9 @@ class _Pardiso:
         self.ps = _pardiso_handle(pypardiso)
         self._phased = all(hasattr(self.ps, a) for a in ("_check_A", "_check_b", "_call_pardiso", "set_phase"))
         self.pattern = None           # (indptr, indices) of the analysed matrix
-        self.current = None           # the factorisation whose values PARDISO holds
+        # the factorisation whose values PARDISO holds, as a weak reference: the caller's last factor
+        # (and its matrix) is freed as soon as the caller drops it, before the next tangent is built
+        self.current = _NONE
         self.flops = float("nan")     # of the numerical factorisation, from the last analysis
 
     def factorize(self, K, stats):
@@ -456,7 +465,7 @@ class _Pardiso:
                 self.flops = 1e6 * float(ps.iparm[18])
             self.pattern = (K.indptr.copy(), K.indices.copy(), K.format)
             f.reused = same
-        self.current = f
+        self.current = weakref.ref(f)
         iparm = ps.iparm
         f.perturbed = int(iparm[13])
         f.factor_nnz = int(iparm[17])
@@ -464,7 +473,7 @@ class _Pardiso:
         f.flops = self.flops
 
     def solve(self, f, b):
-        if self.current is not f:             # another matrix was factorised since: redo this one
+        if self.current() is not f:           # another matrix was factorised since: redo this one
             self._factor(f)
         b = np.asarray(b, dtype=float)
         x = self._solve(f, b)
@@ -494,7 +503,7 @@ class _Pardiso:
             self.ps.free_memory(everything=True)
         except Exception:    # noqa: BLE001  (interpreter shutdown: the library may be gone)
             pass
-        self.pattern = self.current = None
+        self.pattern, self.current = None, _NONE
 
     def __del__(self):
         self.release()

@@ -353,6 +353,9 @@ class Newton:
                 # the first tangent K(H_n, t_n+1): indefinite where a step may jump
                 sign = getattr(lu, "det_sign", None)
                 self.indefinite_seen = sign is None or sign() < 0
+            # the tangent of ``ev`` is factorised: its values (the contact's (m, 24, 24) blocks) are not
+            # needed any more, and freeing them lets the next evaluation reuse their memory
+            ev.drop_tangent()
             if ev.mult is not None:
                 problem.multiplier_trial(1.0)
             if constraint.moves:

@@ -47,7 +47,8 @@ SEP = "/"                        # between a contribution's name and its own key
 class Evaluation:
     """One evaluation at poses ``H``: ``r`` ``(6 n,)``, ``f_level``, ``m_level``, element ``state``;
     ``kvals`` (COO values on the System's fixed pattern, ``None`` without tangent), ``extra``
-    (COO ``(rows, cols, vals)`` of the contributions' blocks), ``timings`` (seconds per
+    (COO ``(rows, cols, vals)`` of the contributions' blocks; ``rows``, ``cols`` may be broadcast views
+    ``(m, k, k)``: ``np.ravel`` them), ``timings`` (seconds per
     contribution name, part of the evaluation), ``details`` (info per contribution name)."""
     r: np.ndarray
     f_level: float
@@ -58,6 +59,11 @@ class Evaluation:
     timings: dict = field(default_factory=dict)
     details: dict = field(default_factory=dict)
     mult: dict = None           # multipliers that are Newton unknowns (``Problem.multipliers``), or None
+
+    def drop_tangent(self):
+        """Forget the tangent data (``kvals``, ``extra``) once it is factorised: the contributions'
+        buffers they hold (``contact.system``'s tangent pool) can then serve the next evaluation."""
+        self.kvals = self.extra = None
 
 
 class Problem:
@@ -156,7 +162,7 @@ class Problem:
         if len(coo) == 1:
             ev.extra = coo[0]
         elif coo:
-            ev.extra = tuple(np.concatenate(a) for a in zip(*coo))
+            ev.extra = tuple(np.concatenate([np.ravel(x) for x in a]) for a in zip(*coo))
         return ev
 
     def tangent(self, ev):

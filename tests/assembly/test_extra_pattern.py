@@ -7,7 +7,7 @@ from beamsolver.assembly.extra_pattern import ExtraPattern
 
 
 def _scipy(el, rows, cols, vals, red):
-    rr, rc = red[rows], red[cols]
+    rr, rc = red[np.ravel(rows)], red[np.ravel(cols)]
     keep = (rr >= 0) & (rc >= 0)
     return el + sp.csc_matrix((vals[keep], (rr[keep], rc[keep])), shape=el.shape)
 
@@ -309,39 +309,48 @@ def test_contact_scene_with_global_nodes_takes_the_block_path():
     assert isinstance(s.extra_pattern, BlockPattern) and s.extra_pattern.tail is not None
 
 
-def test_block_index_arrays_reused_only_when_free():
-    """The COO index arrays of a new block set reuse the memory of earlier ones only once no array
-    handed out is a view of it: arrays still held (an evaluation's ``extra``) keep their values."""
+def test_block_index_arrays_are_views_of_the_block_dofs():
+    """The COO index arrays of blocks are broadcast views of the block dofs (no ``m k^2`` memory of
+    their own): raveled they are ``repeat(d, k)`` and ``tile(d, k)``; read-only; the same arrays
+    while the dofs stay the same, new ones (over new dofs) when they change, the old ones untouched."""
     import twisted_pair_extreme as twisted_pair
-    from beamsolver.assembly.system import REUSE_BUFFERS, System
-    from beamsolver.blocks import Blocks
+    from beamsolver.assembly.system import System
+    from beamsolver.model.blocks import Blocks
 
     model, _, _ = twisted_pair.build(n_elements=12, turns=0.5)
     s = System(model)
     rng = np.random.default_rng(4)
     plain = np.flatnonzero(~s.transformed & s.is_rep)     # no transform, no global-node terms
-    sets = [rng.choice(plain, size=(m, 4)) for m in (50, 40, 45, 30)]
+    sets = [rng.choice(plain, size=(m, 4)) for m in (50, 40)]
 
     def index(nodes):
         d = ((6 * s.rep[nodes])[:, :, None] + np.arange(6)).reshape(len(nodes), 24)
         blocks = Blocks(nodes, np.zeros((len(nodes), 24)), np.zeros((len(nodes), 24, 24)))
         return d, s.assemble_blocks(s.poses0, blocks)[1][:2]
 
-    def address(a):
-        return a.__array_interface__["data"][0]
+    d0, (rows0, cols0) = index(sets[0])
+    for d, (rows, cols) in ((d0, (rows0, cols0)), index(sets[1])):
+        assert np.array_equal(np.ravel(rows), np.repeat(d, 24, axis=1).ravel())
+        assert np.array_equal(np.ravel(cols), np.tile(d, (1, 24)).ravel())
+        assert not rows.flags.writeable and not cols.flags.writeable
+        assert rows.strides[2] == 0 and cols.strides[1] == 0 and rows.base.size == d.size
+    assert index(sets[1])[1][0] is index(sets[1])[1][0]            # the same dofs: the same arrays
+    assert np.array_equal(np.ravel(rows0), np.repeat(d0, 24, axis=1).ravel())
 
-    held = [index(nodes) for nodes in sets[:3]]          # all three held: three buffers
-    for d, (rows, cols) in held:
-        assert np.array_equal(rows, np.repeat(d, 24, axis=1).ravel())
-        assert np.array_equal(cols, np.tile(d, (1, 24)).ravel())
-        assert not rows.flags.writeable
-    assert len({address(h[1][0]) for h in held}) == 3
-    second = address(held[1][1][0])
-    d_kept, kept = held[2]
-    del held, d, rows, cols
-    d_new, new = index(sets[3])
-    assert np.array_equal(kept[0], np.repeat(d_kept, 24, axis=1).ravel())
-    assert np.array_equal(new[0], np.repeat(d_new, 24, axis=1).ravel())
-    assert np.array_equal(new[1], np.tile(d_new, (1, 24)).ravel())
-    if REUSE_BUFFERS:                    # the second set's buffer is free again: reused
-        assert address(new[0]) == second
+
+def test_prescribed_coupling_of_blocks_equals_the_entrywise_sum():
+    """``System.prescribed_coupling`` reads the contact blocks through their dofs (``_block_coupling``,
+    no per-entry temporaries): equal to the sum over the COO entries (copies of the index arrays,
+    which take the entry-wise path) to round-off, on the twisted pair (blocks and a tail of
+    global-node terms) with every constrained unknown moved."""
+    problem, s, ev, el = _twisted_pair_tangent()
+    rng = np.random.default_rng(8)
+    dz = np.where(s.red < 0, rng.standard_normal(len(s.red)), 0.0)
+    assert s._block_entries(ev.extra) > 0
+    rows, cols, vals = ev.extra
+    no_elements = np.zeros_like(ev.kvals)           # the contact's part alone
+    ours = s.prescribed_coupling(no_elements, dz, ev.extra)
+    ref = s.prescribed_coupling(no_elements, dz, (rows.copy(), cols.copy(), vals))
+    assert s._block_entries((rows.copy(), cols.copy(), vals)) == 0
+    scale = np.abs(ref).max()
+    assert scale > 0 and np.abs(ours - ref).max() <= 1e-13 * scale

@@ -245,3 +245,25 @@ def test_saddle_point_auto_coupled():
     ref2 = linsolve.factorize(A2, "splu").solve(b)
     np.testing.assert_allclose(s.factorize(A2).solve(b), ref2, rtol=1e-9, atol=1e-12 * np.abs(ref2).max())
     s.close()
+
+
+@pytest.mark.skipif(not HAVE_PARDISO, reason="pypardiso not installed")
+def test_pardiso_solver_keeps_no_factor_the_caller_dropped():
+    """A ``Solver`` remembers which factor PARDISO holds without keeping it (a weak reference): the
+    caller's last factor and its matrix are freed as soon as the caller drops them (before the next
+    tangent is assembled); a factor still held is re-factorised if another one came since."""
+    import gc
+    import weakref
+    s = linsolve.Solver("pardiso")
+    A, B = nonsymmetric_matrix(seed=1), nonsymmetric_matrix(seed=3)
+    b = np.random.default_rng(2).standard_normal(A.shape[0])
+    f = s.factorize(A.copy())                  # the factor's matrix: held by nobody else
+    f.solve(b)
+    gone, matrix_gone = weakref.ref(f), weakref.ref(f.K)
+    del f
+    gc.collect()
+    assert gone() is None and matrix_gone() is None
+    fa, fb = s.factorize(A), s.factorize(B)
+    np.testing.assert_allclose(fa.solve(b), np.linalg.solve(A.toarray(), b), rtol=1e-10)
+    np.testing.assert_allclose(fb.solve(b), np.linalg.solve(B.toarray(), b), rtol=1e-10)
+    s.close()

@@ -175,3 +175,38 @@ def test_check_fails_without_the_load_stiffness(monkeypatch):
     r, _ = last_step_residuals(model, max_iter=60)  # ... converges linearly without the load stiffness ...
     assert len(r) > 15
     assert _fails_quadratic_check(model)           # ... and fails the check
+
+
+def test_factorised_tangent_memory_serves_the_next_evaluation():
+    """Once an iterate's tangent is factorised its contact blocks are dropped
+    (``Evaluation.drop_tangent``): the trial evaluation of the next iterate, which computes the next
+    tangent, takes the same memory from the contact's tangent pool.  A 1+6 strand stretched in one
+    step (clamped ends, no transformed nodes: the blocks reach ``extra`` as views of the pool's
+    memory): the step's Newton iterations on one buffer, besides the start's (held by its
+    converged evaluation)."""
+    from beamsolver.driver import Convergence, Newton
+    from beamsolver.nonlinear.problem import Problem
+    from beamsolver.stepping.steps import Run
+
+    L = bs.cables.Layer
+    st = bs.cables.build_strand([L(1e-3), L(1e-3, 6, lay_length=0.1)], 0.1, E=2e11, elements_per_lay=8, mu=0.3,
+                                fit_core=True)
+    st.clamp("bottom")
+    for w in st.all_wires:
+        st.model.prescribe(w.last, bs.motion.translation(lambda t: (0.0, 0.0, 1e-4 * t)))
+    problem = Problem.from_model(st.model)
+    pool = problem.contributions[0]._tangent_pool
+    bases, take = set(), pool.take
+
+    def counted(shape):
+        view = take(shape)
+        bases.add(id(view.base))
+        return view
+    pool.take = counted
+    newton = Newton(problem, Convergence(), True, None)
+    run = Run(problem, newton, None, np.linspace(0.0, 1.0, 2), 1e-3, False, dict(advice=lambda *a: ""))
+    run.start(None, None)
+    run.loop()
+    sol = run.finish()
+    assert sol.n_steps == 1 and int(sol.iterations[1]) >= 3
+    assert len(bases) == 2

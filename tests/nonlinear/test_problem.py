@@ -139,7 +139,7 @@ def test_generic_assembler_equals_the_element_path():
     # both carry the global-node term -hat(r) of the elements' residual (assembly module docstring)
     import scipy.sparse as sp
     n = 6 * system.n_nodes
-    Kb = sp.coo_matrix((coo[2], (coo[0], coo[1])), shape=(n, n)).toarray()
+    Kb = sp.coo_matrix((coo[2], (np.ravel(coo[0]), np.ravel(coo[1]))), shape=(n, n)).toarray()
     Ke = system.full_matrix(kvals).toarray()
     free = system.free_dofs
     assert np.abs(Kb - Ke)[np.ix_(free, free)].max() <= 1e-12 * np.abs(Ke).max()

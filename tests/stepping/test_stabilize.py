@@ -27,7 +27,7 @@ def _assembled(system, stab, H, tangent=True):
     blocks, _ = stab.evaluate(H, tangent)
     r, (rows, cols, vals), _, _ = system.assemble_blocks(H, blocks)
     K = np.zeros((len(r), len(r)))
-    np.add.at(K, (rows, cols), vals)
+    np.add.at(K, (np.ravel(rows), np.ravel(cols)), vals)
     return r, K
 
 
