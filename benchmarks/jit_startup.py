@@ -301,7 +301,7 @@ Each run is a fresh process started from an empty numba cache (`NUMBA_CACHE_DIR`
 first run's); the job runs with a `logging` handler so the end of step 1 is seen. Seconds from the start to its first
 byte of output (the line `beamsolver: compiling the compiled kernels, first run only, ~N s`), to the end of step 1
 and to the end; longest silence: the longest time without a byte on stdout or stderr (the compile bar refreshes
-twice a second); CPU: user + system time of the job and its child processes (the second compiling process
+four times a second); CPU: user + system time of the job and its child processes (the second compiling process
 included). On a loaded machine wall times stretch with the load; the CPU column does not.
 
 {md}

@@ -130,3 +130,62 @@ def test_a_users_own_numba_function_is_not_announced():
     with event.install_listener("numba:compile", jit_warmup._Announcer(out)):
         h(1)
     assert out.getvalue() == ""
+
+
+STAND_IN = """
+import sys
+sys.path.insert(0, sys.argv[1])
+import beamsolver as bs
+from beamsolver.nonlinear import jit_warmup
+from twisted_pair import build
+import test_jit_warmup as t
+
+
+class Done:                     # a worker that has already compiled the kernel into the cache
+    def running(self):
+        return False
+
+    def wait(self):
+        return 0
+
+
+model = build()[0]
+jit_warmup._scene(model, Done())
+before = t._signatures()
+bs.solve(model, steps=16, verbose=False)
+after = t._signatures()
+print(sorted(name for i, (name, n) in after.items() if n > before.get(i, (name, 0))[1]))
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
+def test_the_kernels_stand_in_leaves_nothing_to_compile():
+    """With a second process compiling the kernel, this one evaluates the scene on a stand-in of the kernel
+    (``_stand_in``: plain Python, outputs of the kernel's types) and compiles what comes after it; then loads the
+    kernel.  In a fresh process (nothing held yet, the disk cache warm), the main job's solve after that loads
+    or compiles nothing: fails if the stand-in's outputs take other paths or types than the kernel's."""
+    jit_warmup._kernel_call()                          # the kernel in the cache, as the worker leaves it
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), str(ROOT / "examples"), str(Path(__file__).parent)]))
+    out = subprocess.run([sys.executable, "-c", STAND_IN, str(ROOT / "examples")], env=env, capture_output=True,
+                         text=True, cwd=Path(__file__).parent)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.strip().splitlines()[-1] == "[]"
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="fork only")
+def test_forked_worker_runs_its_target_silently(tmp_path, capfd):
+    """The second process is a fork running one function: its exit status says whether it ran (0) or raised
+    (1), and it writes nothing on this process's streams (not even the traceback of a failure)."""
+    flag = tmp_path / "ran"
+
+    def ok():
+        flag.write_text("yes")
+        print("noise")
+
+    def fails():
+        raise RuntimeError("no")
+
+    assert jit_warmup._Worker(ok).wait() == 0 and flag.read_text() == "yes"
+    assert jit_warmup._Worker(fails).wait() == 1
+    assert capfd.readouterr() == ("", "")
