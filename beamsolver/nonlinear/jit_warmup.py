@@ -38,9 +38,10 @@ from numba.core import event
 __all__ = ["estimate", "kernel_cached", "listen", "warm_up", "ESTIMATE"]
 
 # CPU seconds of the first run's compilation of the main job (examples/twisted_pair.py) on the project's
-# 2-core x86-64 machines: the contact kernel, the other contact functions, elements and assembly
-# (docs/benchmarks.md, jit_compile_functions; 36, 13 and 9 s before _jit.jit_callee)
-ESTIMATE = dict(kernel=18.0, contact=10.0, elements=9.0)
+# 2-core x86-64 machines: the contact kernel (13-14 s, with the element twists of the model's set-up before
+# the fork), the other contact functions (search, projections, owners: ~6.5 s), elements and assembly (~5.5 s)
+# (docs/benchmarks.md, jit_compile_functions; 36, 13 and 9 s before _jit.jit_callee, 18, 10, 9 s before the fork)
+ESTIMATE = dict(kernel=14.0, contact=6.5, elements=5.5)
 log = logging.getLogger("beamsolver")
 _REFRESH = 0.25         # seconds between refreshes of the bar
 _IDLE = 3.0             # seconds without compilation that close it (imports between two compilations)
