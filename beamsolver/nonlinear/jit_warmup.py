@@ -26,6 +26,7 @@ function being compiled (or the second process waited for), while compilations g
 """
 import logging
 import os
+import signal
 import subprocess
 import sys
 import threading
@@ -45,6 +46,7 @@ ESTIMATE = dict(kernel=14.0, contact=6.5, elements=5.5)
 log = logging.getLogger("beamsolver")
 _REFRESH = 0.25         # seconds between refreshes of the bar
 _IDLE = 3.0             # seconds without compilation that close it (imports between two compilations)
+WAIT_MAX = 600.0        # seconds this process waits for the second one at most (then kills it and compiles)
 
 
 def _disabled():
@@ -182,10 +184,12 @@ class _Worker:
 
     def __init__(self, target):
         self.proc = self.pid = None
-        if hasattr(os, "fork"):
-            self.pid = os.fork()
-            if self.pid == 0:
-                _child(target)              # never returns
+        if sys.platform.startswith("linux"):         # fork without exec: Linux only (as multiprocessing's default)
+            from numba.core.compiler_lock import global_compiler_lock
+            with global_compiler_lock:      # no other thread of this process is inside numba or LLVM at the fork
+                self.pid = os.fork()
+                if self.pid == 0:
+                    _child(target)          # never returns
         else:
             root = str(Path(__file__).resolve().parent.parent)
             env = dict(os.environ, PYTHONPATH=os.pathsep.join([root] + [p for p in [os.environ.get("PYTHONPATH")] if p]))
@@ -202,15 +206,28 @@ class _Worker:
             self.pid = None
         return not done
 
-    def wait(self):
-        """Wait for the process; its exit status (0: compiled; None: already reaped)."""
+    def wait(self, timeout=None):
+        """Wait for the process; its exit status (0: compiled; None: already reaped).  After ``timeout``
+        seconds (default ``WAIT_MAX``) it is killed: this process compiles what it did not."""
+        timeout = WAIT_MAX if timeout is None else timeout
         if self.proc is not None:
-            return self.proc.wait()
+            try:
+                return self.proc.wait(timeout)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                return self.proc.wait()
         if self.pid is None:
             return None
-        _, status = os.waitpid(self.pid, 0)
-        self.pid = None
-        return os.waitstatus_to_exitcode(status)
+        end = time.monotonic() + timeout
+        while True:
+            pid, status = os.waitpid(self.pid, os.WNOHANG)
+            if pid:
+                self.pid = None
+                return os.waitstatus_to_exitcode(status)
+            if time.monotonic() > end:
+                os.kill(self.pid, signal.SIGKILL)
+                end = float("inf")
+            time.sleep(0.02)
 
 
 def _child(target):

@@ -3,6 +3,7 @@ import io
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numba
@@ -95,12 +96,15 @@ def test_nothing_is_announced_without_compilation():
 
 
 @pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
-def test_kernel_process_runs():
-    """The second process (``python -m beamsolver.nonlinear.jit_warmup``) compiles or loads the kernel and exits 0."""
+def test_kernel_process_runs(monkeypatch):
+    """The second process where there is no fork (``python -m beamsolver.nonlinear.jit_warmup``) compiles or
+    loads the kernel and exits 0."""
     jit_warmup._kernel_call()          # this process's cache: the other process loads it
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    out = subprocess.run([sys.executable, "-m", "beamsolver.nonlinear.jit_warmup"], env=env, capture_output=True, text=True)
-    assert out.returncode == 0, out.stderr
+    monkeypatch.setenv("PYTHONPATH", str(ROOT))
+    monkeypatch.setattr(sys, "platform", "darwin")
+    worker = jit_warmup._Worker(jit_warmup._kernel_call)
+    assert worker.proc is not None and worker.pid is None
+    assert worker.wait() == 0
 
 
 def test_second_process_only_with_a_free_core(monkeypatch):
@@ -173,10 +177,11 @@ def test_the_kernels_stand_in_leaves_nothing_to_compile():
     assert out.stdout.strip().splitlines()[-1] == "[]"
 
 
-@pytest.mark.skipif(not hasattr(os, "fork"), reason="fork only")
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="fork on Linux only")
 def test_forked_worker_runs_its_target_silently(tmp_path, capfd):
     """The second process is a fork running one function: its exit status says whether it ran (0) or raised
-    (1), and it writes nothing on this process's streams (not even the traceback of a failure)."""
+    (1), and it writes nothing on this process's streams (not even the traceback of a failure); one that
+    does not finish in time is killed (this process then compiles what it would have)."""
     flag = tmp_path / "ran"
 
     def ok():
@@ -188,4 +193,5 @@ def test_forked_worker_runs_its_target_silently(tmp_path, capfd):
 
     assert jit_warmup._Worker(ok).wait() == 0 and flag.read_text() == "yes"
     assert jit_warmup._Worker(fails).wait() == 1
+    assert jit_warmup._Worker(lambda: time.sleep(60)).wait(timeout=0.3) == -9
     assert capfd.readouterr() == ("", "")
