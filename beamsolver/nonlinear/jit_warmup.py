@@ -95,6 +95,8 @@ class _Announcer(event.Listener):
         while True:
             time.sleep(_REFRESH)
             with self.lock:
+                if self.bar is not bar:             # closed by ``close``
+                    return
                 try:
                     if self.depth == 0 and not self.waiting and time.perf_counter() - self.idle > _IDLE:
                         bar.close()
@@ -106,6 +108,16 @@ class _Announcer(event.Listener):
                 except (ValueError, OSError):        # the stream was closed (a test's captured stderr)
                     self.bar = None
                     return
+
+    def close(self):
+        """Clear the bar now (the warm-up is done: nothing more compiles before the solve prints)."""
+        with self.lock:
+            if self.bar is not None and self.depth == 0:
+                try:
+                    self.bar.close()
+                except (ValueError, OSError):
+                    pass
+                self.bar = None
 
 
 _LISTENER = []
@@ -269,6 +281,8 @@ def warm_up(model):
     finally:
         if worker is not None and worker.running():
             _wait(worker)
+        for a in _LISTENER:
+            a.close()
 
 
 def _scene(model, worker):

@@ -195,3 +195,24 @@ def test_forked_worker_runs_its_target_silently(tmp_path, capfd):
     assert jit_warmup._Worker(fails).wait() == 1
     assert jit_warmup._Worker(lambda: time.sleep(60)).wait(timeout=0.3) == -9
     assert capfd.readouterr() == ("", "")
+
+
+@pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
+def test_the_bar_is_cleared_when_the_warm_up_ends():
+    """``close`` (run at the end of the warm-up) clears the bar at once, instead of ``_IDLE`` seconds after the last
+    compilation: the solve's first printed lines do not land behind a stale bar."""
+    out = io.StringIO()
+
+    @numba.njit
+    def f(x):
+        return x + 1
+
+    a = jit_warmup._Announcer(out, package=__name__)
+    with event.install_listener("numba:compile", a):
+        f(1)
+    assert a.bar is not None
+    a.close()
+    assert a.bar is None
+    n = len(out.getvalue())
+    time.sleep(3 * jit_warmup._REFRESH)
+    assert len(out.getvalue()) == n            # the refresh thread has stopped
