@@ -293,6 +293,9 @@ def _scene(model, worker):
     from ..contact import kernel_jit
     from ..contact.projection import closest_points
     from .problem import Problem
+    if worker is not None:          # the kernel's last callees, here: the worker loads them when it gets there
+        kernel_jit.share_of_the_kernel(np.zeros(kernel_jit.N_G * kernel_jit.W), np.zeros((2, kernel_jit.N_VEC, 6)),
+                                       np.zeros((4, 4, 4)))
     problem = Problem.from_model(model, check_rigid_modes=False)
     H = problem.system.poses0.copy()
     compiled = kernel_jit.evaluate

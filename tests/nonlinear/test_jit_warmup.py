@@ -216,3 +216,28 @@ def test_the_bar_is_cleared_when_the_warm_up_ends():
     n = len(out.getvalue())
     time.sleep(3 * jit_warmup._REFRESH)
     assert len(out.getvalue()) == n            # the refresh thread has stopped
+
+
+SHARE = """
+import numpy as np
+from beamsolver.contact import kernel_jit as kj
+from beamsolver.nonlinear import jit_warmup
+kj.share_of_the_kernel(np.zeros(kj.N_G * kj.W), np.zeros((2, kj.N_VEC, 6)), np.zeros((4, 4, 4)))
+names = ("_store_frames", "_moment_gradient", "_wrench")
+before = [len(getattr(kj, n).overloads) for n in names]
+jit_warmup._kernel_call()
+print(before, [len(getattr(kj, n).overloads) for n in names])
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
+def test_the_jobs_share_of_the_kernel_has_the_kernels_signatures(tmp_path):
+    """``kernel_jit.share_of_the_kernel`` (compiled by the job while the second process compiles the kernel) calls
+    ``_store_frames``, ``_moment_gradient`` and both ``_wrench`` with the types ``_point`` calls them with: in a
+    process with an empty cache, compiling the kernel after it adds no signature to them.  Fails when ``_point``
+    calls one of them with other types (the share would compile for nothing, the kernel compile them again)."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT), NUMBA_CACHE_DIR=str(tmp_path))
+    out = subprocess.run([sys.executable, "-c", SHARE], env=env, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.strip().splitlines()[-1] == "[1, 1, 2] [1, 1, 2]"
