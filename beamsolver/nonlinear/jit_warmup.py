@@ -178,15 +178,16 @@ def kernel_cached():
 
 def _two_processes():
     """Whether the kernel compiles in a second process: ``BEAMSOLVER_COMPILE_PROCESS`` ``1`` yes, ``0`` no,
-    unset: when a core is free (two or more cores, 1-minute load average at most their number less one;
-    on a machine kept busy by other jobs a second process gains no core and only adds its imports and
-    the callees both processes compile)."""
+    unset: when a core is free (two or more cores, 1-minute load average below their number less a half;
+    on a machine kept busy by other jobs a second process gains no core and only adds the callees both
+    processes compile).  Main job on 2 cores: at load 1.2-1.5 two processes 17.9 s against 30.4 s for one, at
+    load 3-4 54-72 s against 43-64 s (docs/benchmarks.md, jit_first_run_tradeoffs)."""
     flag = os.environ.get("BEAMSOLVER_COMPILE_PROCESS", "")
     if flag in ("0", "1"):
         return flag == "1"
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else 0.0
-    return cores >= 2 and load <= cores - 1
+    return cores >= 2 and load < cores - 0.5
 
 
 class _Worker:

@@ -119,6 +119,10 @@ def test_second_process_only_with_a_free_core(monkeypatch):
     assert not jit_warmup._two_processes()
     monkeypatch.setattr(os, "getloadavg", lambda: (0.3, 0.3, 0.3))
     assert jit_warmup._two_processes()
+    monkeypatch.setattr(os, "getloadavg", lambda: (1.4, 2.0, 2.0))       # one core busy part of the minute
+    assert jit_warmup._two_processes()
+    monkeypatch.setattr(os, "getloadavg", lambda: (1.6, 1.0, 1.0))
+    assert not jit_warmup._two_processes()
     monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0})
     assert not jit_warmup._two_processes()
 
