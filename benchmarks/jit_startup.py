@@ -27,7 +27,9 @@ least CPU seconds of ``bs.solve`` over 3 solves per process, in 4 processes alte
 
 ``--functions``: the compiled functions of the main job's first run (one process, empty cache) by
 the CPU time numba spends compiling each (numba's ``numba:compile`` events: inclusive of the
-functions it compiles on the way, and exclusive); section ``jit_compile_functions``.
+functions it compiles on the way, and exclusive); then the same run with two processes, each
+process's top-level compilations with their wall-clock times (what the job and its fork compile
+when); section ``jit_compile_functions``.
 """
 import argparse
 import os
@@ -107,40 +109,78 @@ def timeline(root, cache, cwd, env=None):
 
 
 COMPILE_PROFILE = """
-import atexit, json, runpy, sys, time
+import atexit, json, os, runpy, sys, time
 from numba.core import event
-rows, stack = [], []
+rows, stack, start = [], [], [time.time()]
 class Timer(event.Listener):
     def on_start(self, ev):
-        stack.append([time.process_time(), 0.0])
+        stack.append([time.process_time(), 0.0, time.time()])
     def on_end(self, ev):
-        t0, inner = stack.pop()
+        t0, inner, w0 = stack.pop()
         dt = time.process_time() - t0
         if stack:
             stack[-1][1] += dt
         f = ev.data["dispatcher"].py_func
-        rows.append((f.__module__ + "." + f.__qualname__.split("__")[0], dt, dt - inner, len(stack)))
+        rows.append((f.__module__ + "." + f.__qualname__.split("__")[0], dt, dt - inner, len(stack), w0, time.time()))
 event.register("numba:compile", Timer())
 path = sys.argv[2]
-atexit.register(lambda: open(path, "w").write(json.dumps(dict(rows=rows, cpu=time.process_time()))))
+def dump(suffix=""):
+    with open(path + suffix, "w") as fh:
+        fh.write(json.dumps(dict(rows=rows, cpu=time.process_time(), start=start[0], end=time.time())))
+atexit.register(dump)
+os.register_at_fork(after_in_child=lambda: (rows.clear(), start.__setitem__(0, time.time())))
+_exit = os._exit
+def traced_exit(code):                  # the forked compiling process leaves by os._exit
+    try:
+        dump(".fork")
+    finally:
+        _exit(code)
+os._exit = traced_exit
 sys.argv = [sys.argv[1]]
 runpy.run_path(sys.argv[0], run_name="__main__")
 """
+
+
+def compile_trace(processes, root=ROOT):
+    """The main job's first run with ``processes`` (1 or 2) compiling processes, from an empty cache: per
+    process, ``dict(rows=[(function, inclusive CPU, exclusive CPU, depth, wall start, wall end)], cpu, start,
+    end)``, wall times in seconds from the job's start."""
+    import json
+    with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as cwd:
+        out = Path(cwd) / "profile.json"
+        env = {**os.environ, "NUMBA_CACHE_DIR": cache, "PYTHONPATH": str(root),
+               "BEAMSOLVER_COMPILE_PROCESS": str(processes - 1)}
+        t0 = time.time()
+        subprocess.run([sys.executable, "-c", COMPILE_PROFILE, str(Path(root) / "examples" / "twisted_pair.py"),
+                        str(out)], cwd=cwd, env=env, check=True, capture_output=True)
+        procs = [json.loads(f.read_text()) for f in (out, Path(str(out) + ".fork")) if f.exists()]
+    for d in procs:
+        d["rows"] = [r[:4] + [r[4] - t0, r[5] - t0] for r in d["rows"]]
+        d["start"], d["end"] = d["start"] - t0, d["end"] - t0
+    return procs
+
+
+def trace_table(procs):
+    """Markdown table of the top-level compilations of each process (what it compiles when), and a summary line."""
+    from _report import table
+    rows = []
+    for k, d in enumerate(procs):
+        who = "job" if k == 0 else "fork"
+        for name, inc, exc, depth, w0, w1 in d["rows"]:
+            if depth == 0:
+                rows.append((who, name.replace("beamsolver.", ""), f"{w0:.1f}", f"{w1:.1f}", f"{inc:.2f}"))
+    head = "; ".join(f"{'job' if k == 0 else 'fork'}: {d['start']:.1f}-{d['end']:.1f} s, CPU {d['cpu']:.1f} s of which "
+                     f"compiling {sum(r[2] for r in d['rows']):.1f} s" for k, d in enumerate(procs))
+    return head, table(["process", "compiled function (top level)", "from [s]", "to [s]", "CPU, inclusive [s]"], rows)
 
 
 def compile_profile(top=15):
     """Table of the functions compiled by the main job's first run, by exclusive CPU seconds (section
     ``jit_compile_functions`` of ``docs/benchmarks.md``)."""
     from _report import table
-    with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as cwd:
-        out = Path(cwd) / "profile.json"
-        env = {**os.environ, "NUMBA_CACHE_DIR": cache, "PYTHONPATH": str(ROOT), "BEAMSOLVER_COMPILE_PROCESS": "0"}
-        subprocess.run([sys.executable, "-c", COMPILE_PROFILE, str(ROOT / "examples" / "twisted_pair.py"), str(out)],
-                       cwd=cwd, env=env, check=True, capture_output=True)
-        import json
-        data = json.loads(out.read_text())
+    data = compile_trace(1)[0]
     by = {}
-    for name, inc, exc, depth in data["rows"]:
+    for name, inc, exc, depth, _, _ in data["rows"]:
         b = by.setdefault(name, [0, 0.0, 0.0])
         b[0] += 1
         b[1] = max(b[1], inc) if depth else b[1] + inc
@@ -152,6 +192,9 @@ def compile_profile(top=15):
     head = f"compilation CPU {total:.1f} s of the process's {data['cpu']:.1f} s; the {top} costliest functions:"
     print(head)
     print(md)
+    two_head, two = trace_table(compile_trace(2))
+    print(two_head)
+    print(two)
     from _report import machine, write_section
     write_section("jit_compile_functions", f"""## What the first run compiles (issue 29)
 
@@ -163,6 +206,13 @@ integer argument, counts twice).
 {head}
 
 {md}
+
+The same job with two compiling processes (`BEAMSOLVER_COMPILE_PROCESS=1`: the job and the fork compiling the
+contact kernel, `nonlinear/jit_warmup.py`): each process's top-level compilations (a function with the ones it
+compiles on the way), wall seconds from the job's start and CPU seconds; the job waits for the fork before it
+loads the kernel, then solves.  {two_head}.
+
+{two}
 """)
     return by
 
@@ -301,7 +351,7 @@ Each run is a fresh process started from an empty numba cache (`NUMBA_CACHE_DIR`
 first run's); the job runs with a `logging` handler so the end of step 1 is seen. Seconds from the start to its first
 byte of output (the line `beamsolver: compiling the compiled kernels, first run only, ~N s`), to the end of step 1
 and to the end; longest silence: the longest time without a byte on stdout or stderr (the compile bar refreshes
-twice a second); CPU: user + system time of the job and its child processes (the second compiling process
+four times a second); CPU: user + system time of the job and its child processes (the second compiling process
 included). On a loaded machine wall times stretch with the load; the CPU column does not.
 
 {md}

@@ -93,6 +93,12 @@ def _scalars(poly, color_by, component):
     return "_color", title
 
 
+# the colour bar: vertical, at the right, in viewport coordinates (x0, y0, x1, y1); the drawing is fitted into
+# the part of the window left of it (``_fit``), so the bar never covers the beams
+BAR_BOX = (0.86, 0.1, 0.98, 0.9)
+SCENE_BOX = (0.02, 0.02, 0.84, 0.98)
+
+
 def render(solution, step=-1, path=None, color_by="displacement", component=None,
            window_size=(800, 600), refine=8, n_sides=24, view="auto", zoom=1.0, contacts=True,
            cmap="viridis", background="white", show_edges=False, scale=None):
@@ -107,8 +113,19 @@ def render(solution, step=-1, path=None, color_by="displacement", component=None
     ``"xy"``, ``"xz"``, ``"yz"`` or ``"iso"``; ``zoom`` > 1 magnifies.
     ``contacts``: draw the active contact points as red spheres.  ``scale``: factors
     ``(sx, sy, sz)`` stretching the drawing along x, y, z (e.g. ``(1, 1, 0.04)`` to see the lay of a
-    long thin cable; say so in the caption), default none.
+    long thin cable; say so in the caption), default none.  The colour bar stands at the right
+    (``BAR_BOX``), the beams are drawn left of it (``SCENE_BOX``).
     """
+    plotter = _plotter(solution, step, path, color_by, component, window_size, refine, n_sides, view, zoom,
+                       contacts, cmap, background, show_edges, scale)
+    img = plotter.screenshot(str(path) if path is not None else None, return_img=True)
+    plotter.close()
+    return img
+
+
+def _plotter(solution, step, path, color_by, component, window_size, refine, n_sides, view, zoom, contacts,
+             cmap, background, show_edges, scale):
+    """The off-screen plotter ``render`` takes its picture of (arguments of ``render``)."""
     _folder_for(path, "render")
     if scale is not None:
         scale = np.asarray(scale, dtype=float)
@@ -143,9 +160,10 @@ def render(solution, step=-1, path=None, color_by="displacement", component=None
             plotter.add_mesh(tubes, color="lightsteelblue", **kw)
         else:
             plotter.add_mesh(tubes, show_scalar_bar=j == 0,
-                             scalar_bar_args=dict(title=title, color="black", vertical=False, n_labels=3,
+                             scalar_bar_args=dict(title=title, color="black", vertical=True, n_labels=3,
                                                   fmt="%.3g", label_font_size=14, title_font_size=16,
-                                                  position_x=0.25, position_y=0.02, width=0.5, height=0.1),
+                                                  position_x=BAR_BOX[0], position_y=BAR_BOX[1],
+                                                  width=BAR_BOX[2] - BAR_BOX[0], height=BAR_BOX[3] - BAR_BOX[1]),
                              **kw)
         table = solution.contacts[k] if contacts else {}
         active = np.asarray(table.get("normal_force", np.zeros(0))) > 0
@@ -154,11 +172,41 @@ def render(solution, step=-1, path=None, color_by="displacement", component=None
             r = float(np.min(solution.description["beam_radius"]))
             plotter.add_mesh(pts.glyph(geom=pv.Sphere(radius=r), scale=False, orient=False), color="red")
     _set_view(plotter, np.concatenate([p.points for p in polys]) * (1.0 if scale is None else scale), view)
+    if scalars is not None:
+        _fit(plotter, drawn_points(plotter), SCENE_BOX)
     if zoom != 1.0:
         plotter.camera.zoom(zoom)
-    img = plotter.screenshot(str(path) if path is not None else None, return_img=True)
-    plotter.close()
-    return img
+    return plotter
+
+
+def drawn_points(plotter):
+    """World coordinates ``(n, 3)`` of the points of every mesh drawn (tubes, contact glyphs)."""
+    meshes = [getattr(a, "mapper", None) for a in plotter.renderer.actors.values()]
+    return np.concatenate([np.asarray(m.dataset.points) for m in meshes if m is not None and m.dataset is not None])
+
+
+def viewport_bounds(plotter, points):
+    """``(x0, y0, x1, y1)``: the bounds of world ``points`` ``(n, 3)`` as the plotter's camera projects
+    them, in viewport coordinates (0..1 across the window)."""
+    w, h = plotter.window_size
+    M = np.array([[plotter.camera.GetCompositeProjectionTransformMatrix(w / h, -1, 1).GetElement(i, j)
+                   for j in range(4)] for i in range(4)])
+    q = np.c_[points, np.ones(len(points))] @ M.T
+    ndc = q[:, :2] / q[:, 3:]
+    (x0, y0), (x1, y1) = ndc.min(axis=0), ndc.max(axis=0)
+    return 0.5 * (x0 + 1), 0.5 * (y0 + 1), 0.5 * (x1 + 1), 0.5 * (y1 + 1)
+
+
+def _fit(plotter, points, box):
+    """Zoom the camera out (never in) and shift the picture so that ``points`` fall into ``box``
+    ``(x0, y0, x1, y1)`` of the viewport."""
+    x0, y0, x1, y1 = viewport_bounds(plotter, points)
+    s = min(1.0, (box[2] - box[0]) / max(x1 - x0, 1e-12), (box[3] - box[1]) / max(y1 - y0, 1e-12))
+    plotter.camera.zoom(s)
+    x0, y0, x1, y1 = viewport_bounds(plotter, points)
+    cx, cy = plotter.camera.GetWindowCenter()
+    # the window centre is in -1..1 coordinates; the picture moves opposite to it
+    plotter.camera.SetWindowCenter(cx + (x0 + x1) - (box[0] + box[2]), cy + (y0 + y1) - (box[1] + box[3]))
 
 
 def _set_view(plotter, points, view):

@@ -984,6 +984,23 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
     flags[0], flags[1] = active, stick
 
 
+@jit
+def share_of_the_kernel(G, v, frames):
+    """Compiles the last callees the kernel's ``_point`` types (``_store_frames``, ``_moment_gradient``, both
+    ``_wrench``), called with the types ``_point`` gives them (``G``, ``v``: ``_scratch``'s, ``frames`` ``(4, 4, 4)``),
+    into the cache: ``jit_warmup`` runs it in the job while a second process compiles the kernel, which then
+    loads them instead of compiling them last.  Writes only into its arguments."""
+    n = (1.0, 0.0, 0.0)
+    R = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    F = scale(-1.0, n)
+    R1 = v[0, 0, 0] * 0.0 + 1.0                 # a float64 as ``par[R1_]``
+    _store_frames(frames, n, n, n, R, n, R, n, R1, R1)
+    mF = cross(n, F)
+    _moment_gradient(n, F, G)
+    _wrench(R, F, False, scale(R1, mF), R1, G, G_VC, G_DWC, v[0, V_WR])
+    _wrench(R, scale(-1.0, F), True, scale(R1, mF), R1, G, G_VF, G_DWF, v[1, V_WR])
+
+
 @jit_callee
 def _scratch():
     """Scratch arrays of one evaluation, reused by every point (the kernel allocates nothing per point); the

@@ -97,6 +97,42 @@ def _pairs_apart(i, j, c_s, r_s, c_m, r_m, t_s, t_m, slave_el, master_el, enodes
     return n, least
 
 
+@jit_callee
+def _argsort(key):
+    """``np.argsort(key, kind="stable")`` of a 1-d float array without NaN: a bottom-up merge sort (numba's
+    ``np.argsort`` compiles its generic quicksort, about a second of the first run)."""
+    n = len(key)
+    a, b = np.arange(n), np.empty(n, dtype=np.int64)
+    width = 1
+    while width < n:
+        for lo in range(0, n, 2 * width):
+            mid, hi = min(lo + width, n), min(lo + 2 * width, n)
+            i, j = lo, mid
+            for k in range(lo, hi):
+                if i < mid and (j >= hi or key[a[i]] <= key[a[j]]):
+                    b[k] = a[i]
+                    i += 1
+                else:
+                    b[k] = a[j]
+                    j += 1
+        a, b = b, a
+        width *= 2
+    return a
+
+
+@jit_callee
+def _bisect(key, v, right):
+    """``np.searchsorted(key, v, side="right" if right else "left")`` in a sorted float array."""
+    lo, hi = 0, len(key)
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if key[mid] < v or (right and key[mid] == v):
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
 SWEEP_MARGIN = 1e-9     # sweep: relative widening of its windows and of the distance-matrix radius checked
 SWEEP_BUDGET = 32       # sweep: masters in the windows per slave element, at most (else the tree)
 
@@ -125,9 +161,10 @@ def _sweep(c_s, r_s, c_m, r_m, R, budget, i, j):
             lo, hi = min(lo, c_m[b, x]), max(hi, c_m[b, x])
         if hi - lo > spread:
             ax, spread = x, hi - lo
-    key = c_m[:, ax].copy()
-    order = np.argsort(key)
-    key = key[order]
+    order = _argsort(c_m[:, ax])
+    key = np.empty(len(order))
+    for q in range(len(order)):
+        key[q] = c_m[order[q], ax]
     r_max = 0.0
     for b in range(len(r_m)):
         r_max = max(r_max, r_m[b])
@@ -136,8 +173,8 @@ def _sweep(c_s, r_s, c_m, r_m, R, budget, i, j):
     for a in range(len(r_s)):
         # |x_a - x_b| <= |c_a - c_b| <= r_a + r_b: the masters in a window of the sorted coordinate
         w = (r_s[a] + r_max) * (1.0 + SWEEP_MARGIN) + 1e-12 * abs(c_s[a, ax])     # round-off of x_a -+ w
-        lo = np.searchsorted(key, c_s[a, ax] - w)
-        hi = np.searchsorted(key, c_s[a, ax] + w, side="right")
+        lo = _bisect(key, c_s[a, ax] - w, False)
+        hi = _bisect(key, c_s[a, ax] + w, True)
         seen += hi - lo
         if seen > budget:
             return n, True

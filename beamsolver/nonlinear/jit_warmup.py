@@ -6,24 +6,27 @@ the contact kernel (``contact.kernel_jit``).  ``warm_up(model)``, run by ``solve
 
 - does nothing when the contact kernel is in the cache (the cached runs: one index lookup) or
   without contact, or under ``NUMBA_DISABLE_JIT``;
-- else starts a second process compiling the default law's contact kernel into the cache
-  (``python -m beamsolver.nonlinear.jit_warmup``; when a core is free, or as the environment variable
-  ``BEAMSOLVER_COMPILE_PROCESS`` (``1``/``0``) says) while this process compiles the
-  rest: one evaluation of residual and tangent of a throwaway ``Problem`` of the model at its
-  initial poses (the signatures step 0 uses), a pose update, and the two functions that are
-  otherwise compiled in the middle of a solve, on the first crossing of two wires
-  (``search._pairs_apart`` for the distance matrix's pair arrays, ``projection._closest``).
-  The throwaway evaluation waits for the second process before it calls the contact kernel,
-  which it then loads from the cache.
+- else starts a second process compiling the default law's contact kernel into the cache (a fork of
+  this one: nothing to import again, and what this process has compiled so far is not compiled
+  twice; ``python -m beamsolver.nonlinear.jit_warmup`` where there is no fork), when a core is free
+  or as the environment variable ``BEAMSOLVER_COMPILE_PROCESS`` (``1``/``0``) says, while this process
+  compiles the rest: one evaluation of residual and tangent of a throwaway ``Problem`` of the model at
+  its initial poses (the signatures step 0 uses) on a plain-Python stand-in of the kernel
+  (``_stand_in``: outputs of its types, so the assembly and history code after the kernel compiles
+  here too), a pose update, and the two functions that are otherwise compiled in the middle of a
+  solve, on the first crossing of two wires (``search._pairs_apart`` for the distance matrix's pair
+  arrays, ``projection._closest``); then it waits for the second process and loads the kernel from
+  the cache.  With one process, the same evaluation on the compiled kernel.
 
 ``listen()`` (run at ``import beamsolver``): the first compilation of the process (a cache
 miss, numba's ``numba:compile`` event; loading from the cache is silent) prints one line on
 stderr, ``beamsolver: compiling the compiled kernels, first run only, ~N s`` (``estimate``), then
-a tqdm bar of the elapsed seconds against that estimate, refreshed twice a second and naming the
+a tqdm bar of the elapsed seconds against that estimate, refreshed four times a second and naming the
 function being compiled (or the second process waited for), while compilations go on.
 """
 import logging
 import os
+import signal
 import subprocess
 import sys
 import threading
@@ -36,12 +39,14 @@ from numba.core import event
 __all__ = ["estimate", "kernel_cached", "listen", "warm_up", "ESTIMATE"]
 
 # CPU seconds of the first run's compilation of the main job (examples/twisted_pair.py) on the project's
-# 2-core x86-64 machines: the contact kernel, the other contact functions, elements and assembly
-# (docs/benchmarks.md, jit_compile_functions; 36, 13 and 9 s before _jit.jit_callee)
-ESTIMATE = dict(kernel=18.0, contact=10.0, elements=9.0)
+# 2-core x86-64 machines: the contact kernel (13-14 s, with the element twists of the model's set-up before
+# the fork), the other contact functions (search, projections, owners: ~6.5 s), elements and assembly (~5.5 s)
+# (docs/benchmarks.md, jit_compile_functions; 36, 13 and 9 s before _jit.jit_callee, 18, 10, 9 s before the fork)
+ESTIMATE = dict(kernel=14.0, contact=6.5, elements=5.5)
 log = logging.getLogger("beamsolver")
-_REFRESH = 0.5          # seconds between refreshes of the bar
+_REFRESH = 0.25         # seconds between refreshes of the bar
 _IDLE = 3.0             # seconds without compilation that close it (imports between two compilations)
+WAIT_MAX = 600.0        # seconds this process waits for the second one at most (then kills it and compiles)
 
 
 def _disabled():
@@ -90,6 +95,8 @@ class _Announcer(event.Listener):
         while True:
             time.sleep(_REFRESH)
             with self.lock:
+                if self.bar is not bar:             # closed by ``close``
+                    return
                 try:
                     if self.depth == 0 and not self.waiting and time.perf_counter() - self.idle > _IDLE:
                         bar.close()
@@ -101,6 +108,16 @@ class _Announcer(event.Listener):
                 except (ValueError, OSError):        # the stream was closed (a test's captured stderr)
                     self.bar = None
                     return
+
+    def close(self):
+        """Clear the bar now (the warm-up is done: nothing more compiles before the solve prints)."""
+        with self.lock:
+            if self.bar is not None and self.depth == 0:
+                try:
+                    self.bar.close()
+                except (ValueError, OSError):
+                    pass
+                self.bar = None
 
 
 _LISTENER = []
@@ -161,25 +178,95 @@ def kernel_cached():
 
 def _two_processes():
     """Whether the kernel compiles in a second process: ``BEAMSOLVER_COMPILE_PROCESS`` ``1`` yes, ``0`` no,
-    unset: when a core is free (two or more cores, 1-minute load average at most their number less one;
-    on a machine kept busy by other jobs a second process gains no core and only adds its imports and
-    the callees both processes compile)."""
+    unset: when a core is free (two or more cores, 1-minute load average below their number less a half;
+    on a machine kept busy by other jobs a second process gains no core and only adds the callees both
+    processes compile).  Main job on 2 cores: at load 1.2-1.5 two processes 17.9 s against 30.4 s for one, at
+    load 3-4 54-72 s against 43-64 s (docs/benchmarks.md, jit_first_run_tradeoffs)."""
     flag = os.environ.get("BEAMSOLVER_COMPILE_PROCESS", "")
     if flag in ("0", "1"):
         return flag == "1"
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else 0.0
-    return cores >= 2 and load <= cores - 1
+    return cores >= 2 and load < cores - 0.5
+
+
+class _Worker:
+    """The second compiling process: a fork of this one (no imports to repeat, and the compiled functions
+    this process already holds, e.g. the element twists of the model's set-up, are not compiled again),
+    or ``python -m beamsolver.nonlinear.jit_warmup`` where there is no ``fork``."""
+
+    def __init__(self, target):
+        self.proc = self.pid = None
+        if sys.platform.startswith("linux"):         # fork without exec: Linux only (as multiprocessing's default)
+            from numba.core.compiler_lock import global_compiler_lock
+            with global_compiler_lock:      # no other thread of this process is inside numba or LLVM at the fork
+                self.pid = os.fork()
+                if self.pid == 0:
+                    _child(target)          # never returns
+        else:
+            root = str(Path(__file__).resolve().parent.parent)
+            env = dict(os.environ, PYTHONPATH=os.pathsep.join([root] + [p for p in [os.environ.get("PYTHONPATH")] if p]))
+            self.proc = subprocess.Popen([sys.executable, "-m", "beamsolver.nonlinear.jit_warmup"], env=env,
+                                         stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+    def running(self):
+        if self.proc is not None:
+            return self.proc.poll() is None
+        if self.pid is None:
+            return False
+        done, _ = os.waitpid(self.pid, os.WNOHANG)
+        if done:
+            self.pid = None
+        return not done
+
+    def wait(self, timeout=None):
+        """Wait for the process; its exit status (0: compiled; None: already reaped).  After ``timeout``
+        seconds (default ``WAIT_MAX``) it is killed: this process compiles what it did not."""
+        timeout = WAIT_MAX if timeout is None else timeout
+        if self.proc is not None:
+            try:
+                return self.proc.wait(timeout)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                return self.proc.wait()
+        if self.pid is None:
+            return None
+        end = time.monotonic() + timeout
+        while True:
+            pid, status = os.waitpid(self.pid, os.WNOHANG)
+            if pid:
+                self.pid = None
+                return os.waitstatus_to_exitcode(status)
+            if time.monotonic() > end:
+                os.kill(self.pid, signal.SIGKILL)
+                end = float("inf")
+            time.sleep(0.02)
+
+
+def _child(target):
+    """The forked process: compile ``target()`` into the cache and leave, silently (the parent's progress
+    bar thread may have held a lock of the streams or of the bar at the fork: nothing here touches them)."""
+    code = 1
+    try:
+        for a in _LISTENER:
+            event.unregister("numba:compile", a)
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, 1)
+        os.dup2(devnull, 2)
+        sys.stdout = sys.stderr = open(devnull, "w", closefd=False)       # new objects: no lock held
+        target()
+        code = 0
+    except BaseException:           # the parent compiles what is missing
+        pass
+    finally:
+        os._exit(code)
 
 
 def _start_kernel_process():
     """A process compiling the contact kernel into the cache (None unless ``_two_processes()``)."""
     if not _two_processes():
         return None
-    root = str(Path(__file__).resolve().parent.parent)
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([root] + [p for p in [os.environ.get("PYTHONPATH")] if p]))
-    return subprocess.Popen([sys.executable, "-m", "beamsolver.nonlinear.jit_warmup"], env=env, stdin=subprocess.DEVNULL,
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    return _Worker(_kernel_call)
 
 
 # ---------------------------------------------------------------- a scene's kernels
@@ -187,51 +274,70 @@ def warm_up(model):
     """Compile what solving ``model`` needs before its first step, on a first run (see the module)."""
     if _disabled() or not model.contacts or kernel_cached() is not False:
         return
-    proc = _start_kernel_process()
+    worker = _start_kernel_process()
     try:
-        _scene(model, proc)
+        _scene(model, worker)
     except Exception as exc:          # the solve compiles what is left, as it goes
         log.info("compilation before step 0 stopped early: %r", exc)
+    finally:
+        if worker is not None and worker.running():
+            _wait(worker)
+        for a in _LISTENER:
+            a.close()
 
 
-def _scene(model, proc):
-    """The warm-up of ``model`` in this process; ``proc``: the process compiling the kernel (or None)."""
+def _scene(model, worker):
+    """The warm-up of ``model`` in this process; ``worker``: the process compiling the kernel (or None:
+    compiled here).  With a worker, the throwaway evaluation runs on a stand-in of the kernel (``_stand_in``)
+    so that what comes after the kernel (assembly of the contact blocks, history updates) compiles here
+    while the worker compiles the kernel, which is loaded from the cache after."""
+    from ..contact import kernel_jit
     from ..contact.projection import closest_points
     from .problem import Problem
+    if worker is not None:          # the kernel's last callees, here: the worker loads them when it gets there
+        kernel_jit.share_of_the_kernel(np.zeros(kernel_jit.N_G * kernel_jit.W), np.zeros((2, kernel_jit.N_VEC, 6)),
+                                       np.zeros((4, 4, 4)))
     problem = Problem.from_model(model, check_rigid_modes=False)
-    kernel = problem.contact.kernel        # the contact system's kernel module, its function wrapped for the evaluation
-    compiled = kernel.kernel_and_tangent
-
-    def after_the_process(*args, **kw):
-        if proc is not None and proc.poll() is None:
-            _wait(proc)
-        return compiled(*args, **kw)
-
     H = problem.system.poses0.copy()
-    kernel.kernel_and_tangent = after_the_process
+    compiled = kernel_jit.evaluate
+    if worker is not None:
+        kernel_jit.evaluate = _stand_in
     try:
         ev = problem.evaluate(H, 0.0)
+        problem.tangent(ev)
+        problem.update(H, np.zeros((problem.system.n_nodes, 6)))
     finally:
-        kernel.kernel_and_tangent = compiled
-    problem.tangent(ev)
-    problem.update(H, np.zeros((problem.system.n_nodes, 6)))
+        kernel_jit.evaluate = compiled
     c = problem.contact
     geo = c._twists(H)
     for d in c.decls:
         c._candidates(d, geo, sweep=False)
     en = problem.system.enodes
     closest_points(H, en[:0, 0], np.zeros((0, 6)), en[:0, 0], np.zeros((0, 6)))
-    if proc is not None and proc.poll() is None:      # no contact point at the initial poses
-        _wait(proc)
+    if worker is not None and worker.running():
+        _wait(worker)
     _kernel_call()
 
 
-def _wait(proc):
+def _stand_in(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames):
+    """Plain-Python stand-in of the compiled kernel ``kernel_jit.evaluate`` (its arguments; nothing compiled):
+    outputs of the kernel's types and shapes, every point touching, the even ones sticking, the odd ones
+    sliding, so the code after the kernel takes the paths of a solve."""
+    from ..contact.kernel_jit import XI1, XI2
+    f[:], K[:], two[:], vec[:] = 0.0, 0.0, 0.0, 0.0
+    sc[:, 0], sc[:, 1], sc[:, 2], sc[:, 3] = -1e-9, 1.0, par[:, XI1], par[:, XI2]
+    vec[:, 0, 0] = vec[:, 1, 1] = vec[:, 2, 2] = 1.0
+    vec[:, 3], vec[:, 4] = X[:, 0, :3, 3], X[:, 2, :3, 3]
+    flags[:, 0], flags[:, 1] = True, np.arange(len(flags)) % 2 == 0
+    frames[:] = np.eye(4)
+
+
+def _wait(worker):
     a = _LISTENER[0] if _LISTENER else None
     if a is not None:
         a.waiting, a.name = True, "the contact kernel, in a second process"
     try:
-        proc.wait()
+        worker.wait()
     finally:
         if a is not None:
             a.waiting, a.idle = False, time.perf_counter()

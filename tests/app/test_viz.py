@@ -80,3 +80,52 @@ def test_render_by_utilisation_with_a_stretched_axis(roll_up):
     assert aspect(viz.render(sol, scale=(1, 0.1, 1), **kw)) < 0.3
     with pytest.raises(ValueError, match="scale"):
         viz.render(sol, scale=(1, 0, 1), **kw)
+
+
+def _bar_and_beams(sol, step, **kw):
+    """The colour bar's rectangle and the drawn meshes' bounds, in viewport coordinates, as ``render`` draws."""
+    from beamsolver.app import viz
+    args = dict(path=None, color_by="displacement", component=None, window_size=(800, 600), refine=8, n_sides=24,
+                view="auto", zoom=1.0, contacts=True, cmap="viridis", background="white", show_edges=False,
+                scale=None)
+    args.update(kw)
+    plotter = viz._plotter(sol, step, **args)
+    try:
+        bars = list(plotter.scalar_bars.values())
+        assert len(bars) == 1
+        x0, y0 = bars[0].GetPositionCoordinate().GetValue()[:2]
+        w, h = bars[0].GetPosition2Coordinate().GetValue()[:2]
+        return (x0, y0, x0 + w, y0 + h), viz.viewport_bounds(plotter, viz.drawn_points(plotter))
+    finally:
+        plotter.close()
+
+
+def _apart(a, b):
+    return a[2] <= b[0] or b[2] <= a[0] or a[3] <= b[1] or b[3] <= a[1]
+
+
+@pytest.mark.parametrize("scene", ["upright pair", "long cantilever"])
+def test_colour_bar_leaves_the_beams_free(scene):
+    """``render``'s colour bar does not cover the beams (issue 29: a horizontal bar at the bottom covered the
+    main job's upright wires at step 0; a bar at the right must not cover a long beam drawn across the window):
+    the bar's rectangle and the drawn tubes' screen bounds do not overlap, and the beams stay inside the window."""
+    pytest.importorskip("pyvista")
+    m = bs.Model()
+    if scene == "upright pair":                   # the main job's wires at step 0, without the contact
+        sec = bs.Section.circular(radius=0.5e-3, E=200e9, nu=0.3)
+        for x in (0.5e-3, -0.5e-3):
+            b = m.add_beam(bs.geometry.straight((x, 0, 0), (x, 0, 1.0), 8), sec)
+            m.clamp(b.first)
+            m.add_load(b.last, force=(0, 0, 100.0))
+    else:
+        sec = bs.Section(EA=1e4, GA2=1e4, GA3=1e4, GJ=1e2, EI2=1e2, EI3=1e2, radius=0.2)
+        b = m.add_beam(bs.geometry.straight((0, 0, 0), (10, 0, 0), 4), sec)
+        m.clamp(b.first)
+        m.add_load(b.last, force=(0, 0, -0.1))
+    sol = bs.solve(m, steps=1, verbose=False)
+    for step in (0, 1):
+        for view in ("auto", "iso", "xz"):
+            bar, beams = _bar_and_beams(sol, step, view=view)
+            assert _apart(bar, beams), (step, view, bar, beams)
+            assert 0.0 <= beams[0] and beams[2] <= 1.0 and 0.0 <= beams[1] and beams[3] <= 1.0, (step, view, beams)
+            assert beams[3] - beams[1] > 0.5 or beams[2] - beams[0] > 0.5, "the drawing was shrunk too far"

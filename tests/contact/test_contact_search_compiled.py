@@ -303,3 +303,18 @@ def test_broad_pairs_are_the_broad_phase_and_apart_in_one_pass(sweep):
     for a, b in zip(got[:5], (e, m, cos, cm[j], rm[j] + radius[e])):
         assert a.dtype == b.dtype and a.tobytes() == b.tobytes()
     assert got[5] == np.abs(cos).min()
+
+
+@pytest.mark.parametrize("ties", [False, True])
+def test_sweep_sort_and_bisection_equal_numpy(ties):
+    """The sweep's own sort (``search._argsort``: stable merge sort, instead of numba's ``np.argsort``, whose
+    generic quicksort cost about a second of the first run's compilation) and bisection (``_bisect``) give
+    ``np.argsort(kind="stable")`` and ``np.searchsorted`` (left and right), ties and ends included."""
+    rng = np.random.default_rng(7)
+    for n in (0, 1, 2, 3, 5, 64, 1000, 1025):
+        key = rng.integers(0, 4, size=n).astype(float) if ties else rng.normal(size=n)
+        np.testing.assert_array_equal(search._argsort(key), np.argsort(key, kind="stable"))
+        s = np.sort(key)
+        for v in list(s[:4]) + list(s[-2:]) + [-9.0, 9.0, 0.25]:
+            for side in ("left", "right"):
+                assert search._bisect(s, v, side == "right") == np.searchsorted(s, v, side=side), (n, v, side)

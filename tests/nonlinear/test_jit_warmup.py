@@ -3,6 +3,7 @@ import io
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numba
@@ -95,12 +96,15 @@ def test_nothing_is_announced_without_compilation():
 
 
 @pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
-def test_kernel_process_runs():
-    """The second process (``python -m beamsolver.nonlinear.jit_warmup``) compiles or loads the kernel and exits 0."""
+def test_kernel_process_runs(monkeypatch):
+    """The second process where there is no fork (``python -m beamsolver.nonlinear.jit_warmup``) compiles or
+    loads the kernel and exits 0."""
     jit_warmup._kernel_call()          # this process's cache: the other process loads it
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    out = subprocess.run([sys.executable, "-m", "beamsolver.nonlinear.jit_warmup"], env=env, capture_output=True, text=True)
-    assert out.returncode == 0, out.stderr
+    monkeypatch.setenv("PYTHONPATH", str(ROOT))
+    monkeypatch.setattr(sys, "platform", "darwin")
+    worker = jit_warmup._Worker(jit_warmup._kernel_call)
+    assert worker.proc is not None and worker.pid is None
+    assert worker.wait() == 0
 
 
 def test_second_process_only_with_a_free_core(monkeypatch):
@@ -115,6 +119,10 @@ def test_second_process_only_with_a_free_core(monkeypatch):
     assert not jit_warmup._two_processes()
     monkeypatch.setattr(os, "getloadavg", lambda: (0.3, 0.3, 0.3))
     assert jit_warmup._two_processes()
+    monkeypatch.setattr(os, "getloadavg", lambda: (1.4, 2.0, 2.0))       # one core busy part of the minute
+    assert jit_warmup._two_processes()
+    monkeypatch.setattr(os, "getloadavg", lambda: (1.6, 1.0, 1.0))
+    assert not jit_warmup._two_processes()
     monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0})
     assert not jit_warmup._two_processes()
 
@@ -130,3 +138,110 @@ def test_a_users_own_numba_function_is_not_announced():
     with event.install_listener("numba:compile", jit_warmup._Announcer(out)):
         h(1)
     assert out.getvalue() == ""
+
+
+STAND_IN = """
+import sys
+sys.path.insert(0, sys.argv[1])
+import beamsolver as bs
+from beamsolver.nonlinear import jit_warmup
+from twisted_pair import build
+import test_jit_warmup as t
+
+
+class Done:                     # a worker that has already compiled the kernel into the cache
+    def running(self):
+        return False
+
+    def wait(self):
+        return 0
+
+
+model = build()[0]
+jit_warmup._scene(model, Done())
+before = t._signatures()
+bs.solve(model, steps=16, verbose=False)
+after = t._signatures()
+print(sorted(name for i, (name, n) in after.items() if n > before.get(i, (name, 0))[1]))
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
+def test_the_kernels_stand_in_leaves_nothing_to_compile():
+    """With a second process compiling the kernel, this one evaluates the scene on a stand-in of the kernel
+    (``_stand_in``: plain Python, outputs of the kernel's types) and compiles what comes after it; then loads the
+    kernel.  In a fresh process (nothing held yet, the disk cache warm), the main job's solve after that loads
+    or compiles nothing: fails if the stand-in's outputs take other paths or types than the kernel's."""
+    jit_warmup._kernel_call()                          # the kernel in the cache, as the worker leaves it
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), str(ROOT / "examples"), str(Path(__file__).parent)]))
+    out = subprocess.run([sys.executable, "-c", STAND_IN, str(ROOT / "examples")], env=env, capture_output=True,
+                         text=True, cwd=Path(__file__).parent)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.strip().splitlines()[-1] == "[]"
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="fork on Linux only")
+def test_forked_worker_runs_its_target_silently(tmp_path, capfd):
+    """The second process is a fork running one function: its exit status says whether it ran (0) or raised
+    (1), and it writes nothing on this process's streams (not even the traceback of a failure); one that
+    does not finish in time is killed (this process then compiles what it would have)."""
+    flag = tmp_path / "ran"
+
+    def ok():
+        flag.write_text("yes")
+        print("noise")
+
+    def fails():
+        raise RuntimeError("no")
+
+    assert jit_warmup._Worker(ok).wait() == 0 and flag.read_text() == "yes"
+    assert jit_warmup._Worker(fails).wait() == 1
+    assert jit_warmup._Worker(lambda: time.sleep(60)).wait(timeout=0.3) == -9
+    assert capfd.readouterr() == ("", "")
+
+
+@pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
+def test_the_bar_is_cleared_when_the_warm_up_ends():
+    """``close`` (run at the end of the warm-up) clears the bar at once, instead of ``_IDLE`` seconds after the last
+    compilation: the solve's first printed lines do not land behind a stale bar."""
+    out = io.StringIO()
+
+    @numba.njit
+    def f(x):
+        return x + 1
+
+    a = jit_warmup._Announcer(out, package=__name__)
+    with event.install_listener("numba:compile", a):
+        f(1)
+    assert a.bar is not None
+    a.close()
+    assert a.bar is None
+    n = len(out.getvalue())
+    time.sleep(3 * jit_warmup._REFRESH)
+    assert len(out.getvalue()) == n            # the refresh thread has stopped
+
+
+SHARE = """
+import numpy as np
+from beamsolver.contact import kernel_jit as kj
+from beamsolver.nonlinear import jit_warmup
+kj.share_of_the_kernel(np.zeros(kj.N_G * kj.W), np.zeros((2, kj.N_VEC, 6)), np.zeros((4, 4, 4)))
+names = ("_store_frames", "_moment_gradient", "_wrench")
+before = [len(getattr(kj, n).overloads) for n in names]
+jit_warmup._kernel_call()
+print(before, [len(getattr(kj, n).overloads) for n in names])
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
+def test_the_jobs_share_of_the_kernel_has_the_kernels_signatures(tmp_path):
+    """``kernel_jit.share_of_the_kernel`` (compiled by the job while the second process compiles the kernel) calls
+    ``_store_frames``, ``_moment_gradient`` and both ``_wrench`` with the types ``_point`` calls them with: in a
+    process with an empty cache, compiling the kernel after it adds no signature to them.  Fails when ``_point``
+    calls one of them with other types (the share would compile for nothing, the kernel compile them again)."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT), NUMBA_CACHE_DIR=str(tmp_path))
+    out = subprocess.run([sys.executable, "-c", SHARE], env=env, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.strip().splitlines()[-1] == "[1, 1, 2] [1, 1, 2]"
