@@ -48,6 +48,21 @@ def table(header, rows, fmt=None):
     return "\n".join(lines)
 
 
+def write_csv(name, rows, keys=None, cell=None):
+    """``benchmarks/results/<name>.csv`` of the dicts ``rows``: columns ``keys`` (default every key, in the
+    order first seen), cells by ``cell(value)`` (default ``str`` with commas made semicolons)."""
+    if keys is None:
+        keys = []
+        for r in rows:
+            keys += [k for k in r if k not in keys]
+    cell = cell or (lambda v: str(v).replace(",", ";"))
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    with open(RESULTS / f"{name}.csv", "w") as f:
+        f.write(",".join(keys) + "\n")
+        for r in rows:
+            f.write(",".join(cell(r.get(k, "")) for k in keys) + "\n")
+
+
 def write_section(name, text, doc=DOC):
     """Replace (or append) the section ``name`` of ``docs/benchmarks.md`` by ``text``."""
     begin, end = f"<!-- BEGIN {name} -->", f"<!-- END {name} -->"

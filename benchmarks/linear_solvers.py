@@ -38,7 +38,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _report import RESULTS, machine, single_thread, table, write_section  # noqa: E402
+from _report import machine, single_thread, table, write_csv, write_section  # noqa: E402
 
 single_thread()
 
@@ -323,13 +323,8 @@ def main(argv):
     lines.append("\nNot run: " + "; ".join(f"**{k}**: {v}" for k, v in NOT_RUN.items()) + ".")
     text = "\n".join(lines)
     print(text)
-    RESULTS.mkdir(parents=True, exist_ok=True)
-    keys = ["wires", "candidate", "analyse", "factor", "refactor", "solve", "fill", "flops", "peak_mb", "residual",
-            "missing"]
-    with open(RESULTS / "linear_solvers.csv", "w") as f:
-        f.write(",".join(keys) + "\n")
-        for r in rows:
-            f.write(",".join(str(r.get(k, "")).replace(",", ";") for k in keys) + "\n")
+    write_csv("linear_solvers", rows, keys=["wires", "candidate", "analyse", "factor", "refactor", "solve", "fill",
+                                            "flops", "peak_mb", "residual", "missing"])
     write_section("linear_solvers", "## Linear solvers on the bundles' tangents (issue 30)\n\n" + text)
     return rows
 

@@ -41,7 +41,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _report import RESULTS, machine, single_thread, table, write_section  # noqa: E402
+from _report import machine, single_thread, table, write_csv, write_section  # noqa: E402
 
 single_thread()
 
@@ -225,14 +225,7 @@ def main(argv):
             + table(["wires", "choice", "analyse", "factor", "refactor", "solve", "fill (1e6)", "flops (1e9)",
                      "peak MB", "residual", "perturbed", "refinement"], body))
     print(text)
-    RESULTS.mkdir(parents=True, exist_ok=True)
-    keys = []
-    for r in rows:
-        keys += [k for k in r if k not in keys]
-    with open(RESULTS / "pardiso_options.csv", "w") as f:
-        f.write(",".join(keys) + "\n")
-        for r in rows:
-            f.write(",".join(str(r.get(k, "")).replace(",", ";") for k in keys) + "\n")
+    write_csv("pardiso_options", rows)
     write_section("pardiso_options", "## PARDISO's options on the bundles (issue 30)\n\n" + text)
     return rows
 

@@ -67,7 +67,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _report import RESULTS, machine, single_thread, table, write_section  # noqa: E402
+from _report import machine, single_thread, table, write_csv, write_section  # noqa: E402
 
 single_thread()
 
@@ -658,14 +658,7 @@ def main(argv):
     wall = time.perf_counter() - t_start
     text = report(rows, base, nothing, max_elements, cap, wall)
     print(text)
-    RESULTS.mkdir(parents=True, exist_ok=True)
-    keys = []
-    for r in rows:
-        keys += [k for k in r if k not in keys]
-    with open(RESULTS / "scaling.csv", "w") as f:
-        f.write(",".join(keys) + "\n")
-        for r in rows:
-            f.write(",".join(_csv(r.get(k, "")) for k in keys) + "\n")
+    write_csv("scaling", rows, cell=_csv)
     write_section("scaling", "## Scaling of a Newton iteration (issue 6)\n\n" + text)
     return rows
 
@@ -696,14 +689,7 @@ def scenes(names):
             f"too (import baseline {base['rss_mb']:.0f} MB).\n\n"
             + scaling_scenes.report(rows, base["rss_mb"], table))
     print(text)
-    RESULTS.mkdir(parents=True, exist_ok=True)
-    keys = []
-    for r in rows:
-        keys += [k for k in r if k not in keys]
-    with open(RESULTS / "scaling_scenes.csv", "w") as f:
-        f.write(",".join(keys) + "\n")
-        for r in rows:
-            f.write(",".join(_csv(r.get(k, "")) for k in keys) + "\n")
+    write_csv("scaling_scenes", rows, cell=_csv)
     write_section("scaling_scenes", "## Bundles of 19, 37, 61 wires and a rope (issue 30)\n\n" + text)
     return rows
 
