@@ -303,9 +303,11 @@ def _scene(model, worker):
     if worker is not None:
         kernel_jit.evaluate = _stand_in
     try:
+        problem.begin_step(H, 0.0)
         ev = problem.evaluate(H, 0.0)
         problem.tangent(ev)
-        problem.update(H, np.zeros((problem.system.n_nodes, 6)))
+        problem.update(H, np.full((problem.system.n_nodes, 6), 1e-12))    # the compiled pose updates
+        problem.commit(H)                 # the friction history's frames (contact.frames_jit, lie.se3_twin)
     finally:
         kernel_jit.evaluate = compiled
     c = problem.contact
