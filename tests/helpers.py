@@ -239,3 +239,37 @@ def bordered_tangent_error(problem, H, t=0.0, eps=1e-7, dlam=1e-6):
     c.multiplier_step(keys, zero)
     err = np.abs(fd - A)
     return (err[:nf].max() / np.abs(A[:nf]).max(), err[nf:].max() / np.abs(A[nf:]).max(), ev)
+
+
+def crossing_at_nodes(r=0.05, n=8, **contact_options):
+    """Two clamped beams of ``n`` elements crossing at right angles exactly at their middle nodes, touching
+    (radius ``r``), the upper one pushed down there by 50; ``contact_options`` go to ``add_contact``.
+    Returns ``(model, upper, lower, section)``."""
+    import beamsolver as bs
+    sec = bs.Section.circular(radius=r, E=1e7, nu=0.3)
+    m = bs.Model()
+    lower = m.add_beam(bs.geometry.straight((0, -1, 0), (0, 1, 0), n), sec)
+    upper = m.add_beam(bs.geometry.straight((-1, 0, 2 * r), (1, 0, 2 * r), n), sec)
+    for node in (lower.first, lower.last, upper.first, upper.last):
+        m.clamp(node)
+    m.add_load(upper.nodes[n // 2], force=(0.0, 0.0, -50.0))
+    m.add_contact(upper, lower, **contact_options)
+    return m, upper, lower, sec
+
+
+def placed_crossing(G=np.eye(4), lam=1.0, steps=2, swap=False):
+    """Two crossing beams (crossing inside elements), all ends clamped, the upper one pushed down
+    by 50 N at its node 3; contact declared upper-on-lower, or the other way with ``swap``; the scene
+    placed by the pose ``G`` and scaled by ``lam``.  Returns the solution, the upper middle node and the lower
+    first node."""
+    import beamsolver as bs
+    r = 0.05 * lam
+    sec = bs.Section.circular(radius=r, E=1e7 / lam**2, nu=0.3)
+    m = bs.Model()
+    lower = m.add_beam(G @ bs.geometry.straight((0, -lam, 0), (0, lam, 0), 7), sec)
+    upper = m.add_beam(G @ bs.geometry.straight((-lam, 0, 2 * r), (lam, 0, 2 * r), 7), sec)
+    for node in (lower.first, lower.last, upper.first, upper.last):
+        m.clamp(node)
+    m.add_load(upper.nodes[3], force=G[:3, :3] @ np.array([0.0, 0.0, -50.0]))
+    m.add_contact(*((lower, upper) if swap else (upper, lower)))
+    return bs.solve(m, steps=steps, verbose=False), upper.nodes[3], lower.first

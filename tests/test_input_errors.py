@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
+from helpers import placed_crossing
 
 
 # ------------------------------------------------------------------ motions
@@ -149,17 +150,9 @@ def test_projection_branches_not_taken_never_overflow():
     hypothesis found in tests/test_invariance_property.py): the LINE step of the crossing
     pairs divides by ``x2' . e1`` ~ 1e-303, a value ``where`` then throws away.  It must not
     warn (overflow), and the answer is that of the unrotated scene."""
-    def crossing(G, lam=0.01):
-        r = 0.05 * lam
-        sec = bs.Section.circular(radius=r, E=1e7 / lam**2, nu=0.3)
-        m = bs.Model()
-        lower = m.add_beam(G @ bs.geometry.straight((0, -lam, 0), (0, lam, 0), 7), sec)
-        upper = m.add_beam(G @ bs.geometry.straight((-lam, 0, 2 * r), (lam, 0, 2 * r), 7), sec)
-        for node in (lower.first, lower.last, upper.first, upper.last):
-            m.clamp(node)
-        m.add_load(upper.nodes[3], force=G[:3, :3] @ np.array([0.0, 0.0, -50.0]))
-        m.add_contact(lower, upper)
-        return bs.solve(m, steps=1, verbose=False), upper.nodes[3]
+    def crossing(G):
+        sol, node, _ = placed_crossing(G, lam=0.01, steps=1, swap=True)
+        return sol, node
     G = np.eye(4)
     G[:3, 3] = (0.0, 0.0, -1.0)
     ref, node = crossing(G)

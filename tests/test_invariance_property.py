@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 
 import beamsolver as bs
 from beamsolver import se3
+from helpers import placed_crossing as crossing
 
 RTOL = 1e-7          # solver rtol 1e-8 (residual), so answers agree to about this
 
@@ -40,21 +41,6 @@ def cantilever(G=np.eye(4), lam=1.0, steps=4):
     R = G[:3, :3]
     m.add_load(b.last, force=R @ np.array([0.0, 3.0, 2.0]), moment=R @ np.array([0.0, 0.0, 5.0 * lam]))
     return bs.solve(m, steps=steps, verbose=False), b.last, b.first
-
-
-def crossing(G=np.eye(4), lam=1.0, steps=2, swap=False):
-    """Two crossing beams (crossing inside elements), all ends clamped, the upper one pushed down
-    by 50 N at its node 3; contact declared upper-on-lower, or the other way with ``swap``."""
-    r = 0.05 * lam
-    sec = bs.Section.circular(radius=r, E=1e7 / lam**2, nu=0.3)
-    m = bs.Model()
-    lower = m.add_beam(G @ bs.geometry.straight((0, -lam, 0), (0, lam, 0), 7), sec)
-    upper = m.add_beam(G @ bs.geometry.straight((-lam, 0, 2 * r), (lam, 0, 2 * r), 7), sec)
-    for node in (lower.first, lower.last, upper.first, upper.last):
-        m.clamp(node)
-    m.add_load(upper.nodes[3], force=G[:3, :3] @ np.array([0.0, 0.0, -50.0]))
-    m.add_contact(*((lower, upper) if swap else (upper, lower)))
-    return bs.solve(m, steps=steps, verbose=False), upper.nodes[3], lower.first
 
 
 @functools.lru_cache(maxsize=None)

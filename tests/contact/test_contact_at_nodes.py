@@ -12,18 +12,12 @@ import numpy as np
 
 import beamsolver as bs
 from beamsolver.nonlinear.problem import Problem
+from helpers import crossing_at_nodes
 
 
 def test_crossing_at_a_kink_node_keeps_its_contact_point():
     r, n = 0.05, 8
-    sec = bs.Section.circular(radius=r, E=1e7, nu=0.3)
-    m = bs.Model()
-    lower = m.add_beam(bs.geometry.straight((0, -1, 0), (0, 1, 0), n), sec)
-    upper = m.add_beam(bs.geometry.straight((-1, 0, 2 * r), (1, 0, 2 * r), n), sec)
-    for node in (lower.first, lower.last, upper.first, upper.last):
-        m.clamp(node)
-    m.add_load(upper.nodes[n // 2], force=(0.0, 0.0, -50.0))
-    m.add_contact(upper, lower)
+    m, upper, lower, _ = crossing_at_nodes(r, n)
     sol = bs.solve(m, steps=2, verbose=False)
     gap = sol.position(upper.nodes[n // 2])[2] - sol.position(lower.nodes[n // 2])[2] - 2 * r
     assert gap > -0.1 * r                                        # was -0.036, 72 % of a radius

@@ -15,7 +15,7 @@ from beamsolver.contact import kernel_jit
 from beamsolver.contact.law import (PENALTY_COULOMB, ContactLaw, coulomb, coulomb_return_mapping, normal_force,
                                     penalty_normal)
 
-from helpers import kernel_scene as _scene
+from helpers import crossing_at_nodes, kernel_scene as _scene
 
 STIFFENING = 0.05     # length over which the stiffening law doubles its stiffness
 
@@ -100,16 +100,7 @@ def test_the_default_law_kernel_is_the_module_kernel():
 
 
 def _crossing(law):
-    import beamsolver as bs
-    r, n = 0.05, 8
-    sec = bs.Section.circular(radius=r, E=1e7, nu=0.3)
-    m = bs.Model()
-    lower = m.add_beam(bs.geometry.straight((0, -1, 0), (0, 1, 0), n), sec)
-    upper = m.add_beam(bs.geometry.straight((-1, 0, 2 * r), (1, 0, 2 * r), n), sec)
-    for node in (lower.first, lower.last, upper.first, upper.last):
-        m.clamp(node)
-    m.add_load(upper.nodes[n // 2], force=(0.0, 0.0, -50.0))
-    m.add_contact(upper, lower, **({} if law is None else dict(law=law)))
+    m, _, _, sec = crossing_at_nodes(**({} if law is None else dict(law=law)))
     return m, sec
 
 
