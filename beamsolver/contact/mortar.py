@@ -23,7 +23,7 @@ import numpy as np
 
 from ..lie import se3
 
-__all__ = ["groups", "return_mapping", "nodal_state", "blocks", "multiplier_blocks"]
+__all__ = ["groups", "return_mapping", "nodal_state", "group_forces", "blocks", "multiplier_blocks"]
 
 def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=None):
     """Nodal groups (one slave node against one master beam) of ``P`` points.
@@ -130,14 +130,22 @@ def _slots(G, a):
     return G["g"][:, a], (6 * G["pos"][:, a, :, None] + np.arange(6)).reshape(P, 24)
 
 
+def group_forces(G, f_points):
+    """The points' forces ``(P, 24)`` on the groups of their node A, ``(n, 6 k)`` (rows over the group's slots)."""
+    n, k = G["members"].shape
+    gA, rowsA = _slots(G, 0)
+    f = np.zeros((n, 6 * k))
+    np.add.at(f, (gA[:, None], rowsA), f_points)
+    return f
+
+
 def _point_parts(G, d):
     """Point forces and their derivatives at fixed traction on the groups of the points' node A:
     ``f`` ``(n, 6 k)``, ``K`` ``(n, 6 k, 6 k)``; and ``A`` ``(n, 6 k, 3)`` = d f / d lam_g (the forces of
     the interpolated tractions: ``A_g = sum_p Phi_j(p) df_p/dT``, rows over the group's slots)."""
     n, k = G["members"].shape
     gA, rowsA = _slots(G, 0)
-    f = np.zeros((n, 6 * k))
-    np.add.at(f, (gA[:, None], rowsA), d["f"])
+    f = group_forces(G, d["f"])
     K = np.zeros((n, 6 * k, 6 * k))
     np.add.at(K, (gA[:, None, None], rowsA[:, :, None], rowsA[:, None, :]), d["dfdq"])
     A = np.zeros((n, 6 * k, 3))

@@ -69,8 +69,6 @@ from . import adjust, conditioning, rules
 
 MAX_AUGMENT = 30
 OVERLAP_REPORT = 1e-4    # penetration / (R1 + R2) in the given poses that step 0 reports (100 x the smoothing)
-import os
-HOLD = os.environ.get('BS_HOLD', 'touch')
 SWITCH_TOL = 1e-12        # a step ending within this (relative) of active_from / friction_from ends before it
 TIMED = ("search", "rules", "projection", "params", "kernel", "blocks")   # parts of ``ContactSystem.timings``
 
@@ -653,19 +651,18 @@ class ContactSystem(Contribution):
                            + e[G["g"][:, 0] == G["g"][:, 1]])
         m = self._node_len[G["node"]] + np.bincount(merged // len(self.sys.L), weights=0.5 * self.sys.L[
             merged % len(self.sys.L)], minlength=len(G["key"]))
-        # the traction acts where the normal law does (the kernel applies it there): the slip is
-        # integrated over the same points
-        hold = None
-        if ssn and HOLD == "all":      # groups without normal traction: the point law's stiffness floor (mortar.py)
-            hold = mu * PENALTY_T_MIN * self._decl_penalty[gdecl]
-        elif ssn and HOLD == "touch":
+        hold = v = None
+        if ssn:
+            # groups with a point in the normal law's band: the point law's stiffness floor (mortar.py)
             touch = np.bincount(G["g"].ravel(), weights=np.repeat(d["active"].astype(float), 2), minlength=len(m))
             hold = np.where(touch > 0, mu * PENALTY_T_MIN * self._decl_penalty[gdecl], 0.0)
+            v = np.einsum("gij,gj->gi", R, Lam)
+        # with the updates, the slip is integrated where the normal law acts (the kernel applies the traction
+        # there); as Newton unknowns the traction field acts on every point of the overlap
         st = mortar.nodal_state(G, pm["weight"], d["S"], d["lam_n"], d["n"], R, Lam, eps, mu, m,
                                 None if ssn else d["active"], hold=hold)
         mult = None
         if ssn:       # the multiplier itself is the traction (its complementarity function is an equation)
-            v = np.einsum("gij,gj->gi", R, Lam)
             st["T"] = np.einsum("pa,pai->pi", G["phi"], v[G["g"]])
         d["f"] = np.einsum("pij,pj->pi", d["A"], st["T"])
         if tangent:
@@ -676,10 +673,7 @@ class ContactSystem(Contribution):
             else:
                 f, K = mortar.blocks(G, d, st, R, Lam, eps, mu)
         else:
-            f = np.zeros((len(G["key"]), 6 * G["members"].shape[1]))
-            rows = (6 * G["pos"][:, 0, :, None] + np.arange(6)).reshape(len(idx), 24)
-            np.add.at(f, (G["g"][:, 0][:, None], rows), d["f"])
-            K = None
+            f, K = mortar.group_forces(G, d["f"]), None
         n, t1, t2 = d["n"], d["t1"], d["t2"]
         Tt = st["T"] - np.sum(st["T"] * n, axis=1)[:, None] * n
         out["lam_t"][idx] = np.stack([np.sum(Tt * t1, axis=1), np.sum(Tt * t2, axis=1)], axis=1)
@@ -691,10 +685,10 @@ class ContactSystem(Contribution):
                 out[name] = np.tile(np.eye(4), (len(sel), 1, 1))
             out[name][idx] = d[name]
         if ssn:
-            mult = dict(mult or {}, C=np.einsum("gij,gj->gi", R, Lam) - st["lam"], m=m, members=G["members"], R=R, Lam=Lam,
+            mult = dict(mult or {}, C=v - st["lam"], m=m, members=G["members"], R=R, Lam=Lam,
                         key=G["key"], stick=st["stick"], u=st["u"], tol=self._decl_stick_tol[gdecl])
         return dict(members=G["members"], f=-f, K=None if K is None else -K, key=G["key"], decl=gdecl,
-                    lam=np.einsum("gij,gj->gi", R, Lam) if ssn else st["lam"], u=st["u"], stick=st["stick"], R=R,
+                    lam=v if ssn else st["lam"], u=st["u"], stick=st["stick"], R=R,
                     mult=mult)
 
     def _held_slip(self, nodes):
