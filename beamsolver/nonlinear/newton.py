@@ -340,19 +340,15 @@ class Newton:
                 self.callback(dict(t=t, iteration=it, residual=ratio, poses=H))
             verdict = conv.decide(ratio, last_inc, it, floor, final=constraint.final)
             if verdict is CONVERGED:
-                constraint.accept(self, H)
                 if damped_its:
                     stats_extra["damped"] = damped_its
-                self.last_evaluation = ev     # of the converged state (its tangent: stability check)
-                return H, t, ev, dict(iterations=it, residuals=residuals, **stats_extra, **constraint.stats())
+                return self._converged(H, t, ev, constraint, dict(iterations=it, residuals=residuals, **stats_extra))
             if verdict is not CONTINUE:
                 raise self._failure(verdict, ratio)
             if dzf is None:
                 lu, dzf = constraint.direction(self, ev, H, t)
             if it == 0 and self.watch_sign and constraint.watch_sign:
-                # the first tangent K(H_n, t_n+1): indefinite where a step may jump
-                sign = getattr(lu, "det_sign", None)
-                self.indefinite_seen = sign is None or sign() < 0
+                self._watch_first_tangent(lu)
             # the tangent of ``ev`` is factorised: its values (the contact's (m, 24, 24) blocks) are not
             # needed any more, and freeing them lets the next evaluation reuse their memory
             ev.drop_tangent()
@@ -363,13 +359,7 @@ class Newton:
                 continue
             dz = self.full(dzf)
             if not damping:
-                last_inc = conv.increment_ratio(dz, self.L_ref)
-                if ev.mult is not None and ratio > conv.rtol:
-                    last_inc = np.inf        # the multipliers move too: no convergence on a small dz alone
-                if not self.line_search or plain:
-                    H = problem.update(H, dz)
-                    continue
-                H, ahead = self._line_search(H, dz, ev, scales, t)
+                H, ahead, last_inc = self._undamped(H, dz, ev, scales, ratio, t, plain)
                 continue
             lam0 = min(1.0, 2.0 * lam)          # after a damped iteration, try twice its length
             inc = conv.increment_ratio(dz, self.L_ref)
@@ -396,6 +386,31 @@ class Newton:
                 raise rotation
             last_inc = inc if lam == 1.0 else np.inf
         raise AssertionError("unreachable: decide() returns MAX_ITER at iteration max_iter")
+
+    def _converged(self, H, t, ev, constraint, stats):
+        """The return of ``iterate`` at the converged iterate ``(H, t)`` evaluated in ``ev``."""
+        constraint.accept(self, H)
+        self.last_evaluation = ev     # of the converged state (its tangent: stability check)
+        return H, t, ev, dict(stats, **constraint.stats())
+
+    def _watch_first_tangent(self, lu):
+        """``indefinite_seen`` from the factorised first tangent ``K(H_n, t_n+1)``: indefinite where a step
+        may jump (a back-end that cannot tell counts as indefinite)."""
+        sign = getattr(lu, "det_sign", None)
+        self.indefinite_seen = sign is None or sign() < 0
+
+    def _undamped(self, H, dz, ev, scales, ratio, t, plain):
+        """A Newton update without damping: the full step (``plain``, or no line search) or the residual line
+        search's.  Returns ``(H, ahead, increment ratio)`` (``ahead``: the trial's ``_Measured`` evaluation
+        or ``None``; the ratio is ``inf`` while multipliers that are unknowns move, ``ratio > rtol``)."""
+        conv = self.conv
+        inc = conv.increment_ratio(dz, self.L_ref)
+        if ev.mult is not None and ratio > conv.rtol:
+            inc = np.inf                 # the multipliers move too: no convergence on a small dz alone
+        if not self.line_search or plain:
+            return self.problem.update(H, dz), None, inc
+        H, ahead = self._line_search(H, dz, ev, scales, t)
+        return H, ahead, inc
 
     def _failure(self, verdict, ratio):
         """The typed failure of a ``Convergence.decide`` verdict other than converged / continue."""

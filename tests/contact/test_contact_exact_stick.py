@@ -151,6 +151,20 @@ def test_nodal_return_mapping_derivatives():
     np.testing.assert_allclose(np.linalg.norm(lam[~stick], axis=1), cap[~stick])
 
 
+def test_return_mapping_without_capacity_gives_no_traction_and_no_stiffness():
+    """A group without normal traction (capacity 0) carries nothing whatever its trial, even a zero one, and
+    its traction does not move with the trial (it was a zero-width "stick" with the full trial's stiffness:
+    the multiplier column of the bordered matrix then failed its finite-difference check by 65 %)."""
+    from beamsolver.contact.mortar import return_mapping
+    trial = np.array([[0.0, 0.0, 0.0], [1.0, -2.0, 0.5]])
+    lam, stick, C, c = return_mapping(trial, np.zeros(2))
+    assert not stick.any()
+    np.testing.assert_array_equal(lam, 0.0)
+    np.testing.assert_array_equal(C, 0.0)
+    np.testing.assert_allclose(c[1], trial[1] / np.linalg.norm(trial[1]))     # d lam / d cap: along the trial
+    np.testing.assert_array_equal(c[0], 0.0)
+
+
 def test_groups_move_a_held_node_to_its_neighbour():
     """``mortar.groups``: a held slave node has no group; the points of its element count wholly
     for the neighbour (boundary modification), the others are split by the hats."""
