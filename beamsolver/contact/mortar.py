@@ -119,9 +119,11 @@ def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu, m, active=None, hold=None):
         weak = (hold > 0) & (lamN <= 0.0)
         C = np.where(weak[:, None, None], (hold / eps)[:, None, None] * np.eye(3), C)
         c = np.where(weak[:, None], 0.0, c)
+    else:
+        weak = np.zeros(k, dtype=bool)
     T = np.einsum("pa,pai->pi", G["phi"], lam[G["g"]])
     return dict(m=m, u=np.einsum("gij,gj->gi", Pi, u), lamN=lamN, trial=trial, lam=lam, stick=stick, C=C, c=c,
-                T=T, wphi=wphi, wn=wn, Pi=Pi, Q=Q)
+                T=T, wphi=wphi, wn=wn, Pi=Pi, Q=Q, weak=weak)
 
 
 def _slots(G, a):
@@ -218,8 +220,16 @@ def multiplier_blocks(G, d, st, R, Lam, c, mu):
     rot, dv = _turn(G, R, Lam)
     _add_columns(Kqq, rot, A @ dv)
     Kql = A @ R
+    weak = st["weak"]
     MP = np.einsum("gij,gjk->gik", st["C"], st["Pi"])                  # d P / d v
-    Klq = -_trial_rows(G, d, st, c, mu)
+    B = _trial_rows(G, d, st, c, mu)
+    # a touching group without normal traction: C = v exactly (its traction goes to zero in one step); the
+    # hold stiffness acts on its slip in the displacement rows only, a tangent-only term like the point law's
+    # floor (putting it in d C / d v made the multiplier overshoot and the residual stall: twisted pair)
+    Kqq[weak] += A[weak] @ B[weak]
+    B[weak] = 0.0
+    MP[weak] = 0.0
+    Klq = -B
     _add_columns(Klq, rot, dv - MP @ dv)
     Kll = R - MP @ R
     v = np.einsum("gij,gj->gi", R, Lam)

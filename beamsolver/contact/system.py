@@ -90,6 +90,14 @@ def use_numpy_kernel(flag=True):
     return previous
 
 
+def exact_c(EI, L):
+    """Default ``c`` of exact stick (force / length^2): ``EXACT_C EI / L_e^4``, the slave's bending stiffness
+    against a nodal displacement per unit length (``EI`` its smaller bending stiffness, ``L_e`` the median of
+    its element lengths ``L``).  ``c`` weighs slip against traction in the stick/slip decision of an iterate:
+    the scenes' best values follow the slave's stiffness, not the normal penalty (docs/theory_mortar.md 3b)."""
+    return float(EXACT_C * EI / np.median(L) ** 4)
+
+
 class _Decl:
     """One declaration's element sets and parameters (options from ``ContactOptions``)."""
 
@@ -116,7 +124,9 @@ class _Decl:
         self.law = o.law                      # None: the kernel's default law
         self.exact = o.stick == "exact" and decl.mu > 0
         # exact stick: the complementarity parameter c (force / length^2) and the slip tolerance (length)
-        self.eps_t = EXACT_C * self.penalty if o.penalty_t is None else o.penalty_t
+        # default: EXACT_C EI / L_e^4 of the slave (set by ContactSystem, which knows the element lengths)
+        self.eps_t = o.penalty_t
+        self.slave_bending = min(min(b.section.C[4, 4], b.section.C[5, 5]) for b in decl.slave)
         # ... and, where the multipliers are not Newton unknowns (arc length), the Uzawa updates' penalty
         self.aug_t = self.penalty if o.penalty_t is None else o.penalty_t
         self.stick_tolerance = (STICK_TOLERANCE * 2.0 * max(s.radius for s in secs)
@@ -168,6 +178,9 @@ class ContactSystem(Contribution):
         self._decl_smoothing, self._decl_tolerance = table["smoothing"], table["tolerance"]
         self._decl_adjust = table["adjust"]
         self._decl_exact = np.array([d.exact for d in self.decls])
+        for d in self.decls:
+            if d.eps_t is None:
+                d.eps_t = exact_c(d.slave_bending, system.L[d.slave_el])
         self._decl_eps_t = np.array([d.eps_t for d in self.decls])
         self._decl_aug_t = np.array([d.aug_t for d in self.decls])
         self._decl_stick_tol = np.array([d.stick_tolerance for d in self.decls])
@@ -786,8 +799,16 @@ class ContactSystem(Contribution):
         return Lam
 
     def multiplier_step(self, keys, dLam):
-        """The Newton step ``dLam`` ``(k, 3)`` of the multipliers of the groups ``keys`` (sorted); trial length 0."""
-        self._mstep, self._ms = (np.asarray(keys), np.asarray(dLam).reshape(-1, 3)), 0.0
+        """The Newton step ``dLam`` ``(k, 3)`` of the multipliers of the groups ``keys`` (sorted); trial length 0.
+        The multipliers of groups the step's iterate did not have (no contact point: they acted nowhere there)
+        are set to zero: a group coming back starts without traction, not with a value Newton never saw (on the
+        twisted pair such stale tractions at the contact zone's ends kept the multipliers' residual at 1e-6)."""
+        keys = np.asarray(keys)
+        old_keys, old = self.history.tmult
+        gone = ~np.isin(old_keys, keys)
+        if gone.any() and np.any(old[gone]):
+            self.history.update_multipliers(None, (old_keys, np.where(gone[:, None], 0.0, old)))
+        self._mstep, self._ms = (keys, np.asarray(dLam).reshape(-1, 3)), 0.0
 
     def multiplier_trial(self, s):
         """The iterate's multipliers are the step's plus ``s`` times the last Newton step."""

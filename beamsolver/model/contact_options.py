@@ -21,7 +21,7 @@ __all__ = ["ContactOptions", "check_contact_options", "describe", "SMOOTHING", "
 
 SMOOTHING = 1e-6          # default smoothing gap of the normal law / (R1 + R2) (benchmarks/touching_defaults.py)
 SLIP_TOLERANCE = 0.005    # elastic slip at the onset of sliding / slave element length (Abaqus' default)
-EXACT_C = 1e-3            # stick="exact": default c of the complementarity function / the normal penalty
+EXACT_C = 24.0            # stick="exact": default c of the complementarity function / (EI / L_e^4) of the slave
 STICK_TOLERANCE = 1e-8    # weighted slip of a sticking node / (R1 + R2) with stick="exact"
 LINE_ANGLE = float(np.deg2rad(20.0))   # below this crossing angle: line contact (search.py, rule 1)
 ADJUST = 1e-3             # default overclosure adjusted away at the reference poses / (R1 + R2)
@@ -95,8 +95,9 @@ class ContactOptions:
         "with ``stick=\"penalty\"``: a fixed tangential penalty, force / length^3, instead of one from "
         "``slip_tolerance`` (default None); with ``stick=\"exact\"``: the parameter ``c`` of the "
         "complementarity function ``C = lam - P(lam + c u)`` the semi-smooth Newton solves, force / "
-        "length^2 (default ``1e-3`` (``EXACT_C``) times the normal penalty): it changes the path of the "
-        "iterations, not the answer", kernel_none=np.nan)
+        "length^2 (default ``24 EI / L_e^4`` (``EXACT_C``), the slave's bending stiffness against a "
+        "nodal displacement per unit length: ``EI`` its smaller bending stiffness, ``L_e`` its median "
+        "element length): it changes the path of the iterations, not the answer", kernel_none=np.nan)
     slip_tolerance: float = option(
         SLIP_TOLERANCE, _real("slip_tolerance", above=0.0),
         "elastic slip at the onset of sliding, in slave element lengths (default 0.005, Abaqus' "

@@ -238,3 +238,46 @@ def test_exact_stick_newton_converges_superlinearly():
                 assert np.log(r1) / np.log(r0) >= 1.4, s["residuals"]
                 pairs += 1
     assert pairs >= 4
+
+
+def test_touching_group_without_pressure_sheds_its_traction_exactly():
+    """Touching without normal traction (a sharp law at zero gap, where the law's band holds the group):
+    the group carries nothing, so its complementarity function is ``C = v`` and its rows of the bordered
+    matrix are exact, ``dC/dLam = R`` and no slip columns, and one Newton step takes its traction to zero.
+    The holding stiffness of such groups acts on the displacement rows only (a tangent-only floor).
+    (It was ``dC/dLam = (I - mu Pi) R`` and slip columns: the multiplier overshot and the twisted pair's
+    residual stalled.)"""
+    model = bs.Model()
+    master = model.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 5), SEC)
+    slave = model.add_beam(bs.geometry.straight((0.1, 0, 2 * R), (0.9, 0, 2 * R), 4), SEC)
+    for b in (master, slave):
+        model.clamp(b.first)
+    model.clamp(master.last)
+    model.add_contact(slave, master, mu=0.5, stick="exact", smoothing=0.0)
+    problem = Problem.from_model(model, check_rigid_modes=False)
+    c = problem.contact
+    H = problem.system.poses0.copy()
+    c.begin_step(H, 0.0)
+    c.commit(H)
+    keys, lam = c.history.tmult
+    c.history.update_multipliers(tmult=(keys, np.random.default_rng(5).normal(size=lam.shape) * 50.0))
+    ev = problem.evaluate(H, 0.0, tangent=True)
+    m = ev.mult
+    v = np.einsum("gij,gj->gi", m["R"], m["Lam"])
+    assert len(v) and not m["stick"].any() and np.allclose(m["C"], v)      # no capacity: C = v
+    np.testing.assert_allclose(m["Kll"], m["R"], atol=1e-12)
+    # d C / d q: only the turn of the node's own frame (three columns), no slip
+    assert (np.count_nonzero(np.abs(m["Klq"]).max(axis=1), axis=1) <= 3).all()
+
+
+def test_a_group_the_iterate_lacks_comes_back_without_traction():
+    """A Newton step of the multipliers sets those of groups its iterate did not have to zero: they acted
+    nowhere there, and a group coming back must not bring a traction Newton never saw."""
+    model, slave, master = _parallel(0.5)
+    problem = Problem.from_model(model, check_rigid_modes=False)
+    c = problem.contact
+    keys = np.array([3, 7, 11], dtype=np.int64)
+    c.history.update_multipliers(tmult=(keys, np.ones((3, 3))))
+    c.multiplier_step(keys[[0, 2]], np.full((2, 3), 0.5))
+    c.multiplier_trial(1.0)
+    np.testing.assert_array_equal(c.iterate_multipliers(keys), [[1.5] * 3, [0.0] * 3, [1.5] * 3])
