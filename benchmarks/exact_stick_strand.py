@@ -6,7 +6,7 @@ strand bending").
 
 Virgin ramp ``0 -> upto kappa_b`` in steps of 0.05 kappa_b (``t`` in ``[1, 2]``, after the frictionless pull);
 first slip = the first step with a slipping point in the middle half (``status``); the c column is
-``penalty_t / E`` (the default: ``EXACT_C`` = 1e-3 of the normal penalty E).
+``penalty_t / E`` (the default: ``EXACT_C EI / L_e^4`` of the slave wire, 24 EI / L_e^4).
 """
 import argparse
 import sys
@@ -34,7 +34,7 @@ def row(elements_per_lay, factor, lays, upto):
     up = np.flatnonzero(res["times"] > 1.0)
     hit = up[res["share"][up] > 0]
     first = res["kappa"][hit[0]] / th["kappa_b"] if len(hit) else np.nan
-    return dict(el=elements_per_lay, penalty="1e-3 E (default)" if factor is None else f"{factor:g} E",
+    return dict(el=elements_per_lay, penalty="default (24 EI / L_e^4)" if factor is None else f"{factor:g} E",
                 EI0=res["M"][up[0]] / res["kappa"][up[0]], first=first, M=res["M"][up[-1]],
                 Mth=float(np.ravel(sb.moment(res["kappa"][up[-1]], th))[0]), share=res["share"][up[-1]],
                 iterations=res["iterations"], wall=wall, EI_max=th["EI_max"])
