@@ -35,12 +35,11 @@ def build(n_slave=7, n_master=10, L=1.0, r=0.01, E=1e9, q=100.0, tau=15.0, mu=0.
     model.fix(master.nodes[n_master // 2], dofs=("uy", "uz", "rx", "rz"))
     press = lambda t: min(2.0 * t, 1.0)      # noqa: E731
     pull = lambda t: max(2.0 * t - 1.0, 0.0)     # noqa: E731
-    for beam, n, sign in ((slave, n_slave, -1.0), (master, n_master, 1.0)):
-        le = L / n
-        for k, node in enumerate(beam.nodes):
-            share = le * (0.5 if k in (0, n) else 1.0)
-            model.add_load(node, force=(0, 0, sign * q * share), scale=press)
-            model.add_load(node, force=(-sign * tau * share, 0, 0), scale=pull)
+    for beam, sign in ((slave, -1.0), (master, 1.0)):
+        model.add_line_load(beam, force_per_length=(0, 0, sign * q), scale=press)
+        # the traction acts at the contact line, a radius off the centre line: its moment per length with it
+        model.add_line_load(beam, force_per_length=(-sign * tau, 0, 0), moment_per_length=(0, -r * tau, 0),
+                            scale=pull)
     model.add_contact(slave, master, mu=mu, **contact_options)
     return model, slave, master
 

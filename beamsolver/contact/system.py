@@ -60,7 +60,7 @@ from .frames import LINE, NORMAL_TOL, POINT, no_normal, touch_tolerance
 from .frames_jit import material_frames
 from .record import OPEN, SLIP, STICK, Candidates, PairSet
 from .ownership import gauss_owners, gauss_record
-from .projection import closest_points, element_twists, gauss_projections, section_points
+from .projection import closest_points, element_twists, gauss_projections, section_points, segment_bounds
 from .search import broad_pairs, element_spheres
 from .history import ContactHistory
 from .state import KeyLayout
@@ -109,6 +109,12 @@ class _Decl:
         self.n_gp = o.gauss_points
         xg, wg = np.polynomial.legendre.leggauss(self.n_gp)
         self.gauss = 0.5 * (xg + 1.0), 0.5 * wg        # Gauss points and weights on [0, 1]
+        self.segments = o.integration == "segments"   # line pairs integrated over segments
+        # the Gauss rules of 1..n_gp points on [0, 1] (row k: k points), for segments
+        self.rules = np.zeros((self.n_gp + 1, self.n_gp)), np.zeros((self.n_gp + 1, self.n_gp))
+        for k in range(1, self.n_gp + 1):
+            x, w = np.polynomial.legendre.leggauss(k)
+            self.rules[0][k, :k], self.rules[1][k, :k] = 0.5 * (x + 1.0), 0.5 * w
         self.line_angle = o.line_angle
         self.point_ratio = o.point_ratio
         self.margin = 2.0 * max(s.radius for s in secs) if o.margin is None else o.margin
@@ -158,7 +164,12 @@ class ContactSystem(Contribution):
         self._switch = [(d.active_from, d.friction_from) for d in model.contacts]
         self._decl_on = np.ones(len(self.decls), dtype=bool)
         self.max_gp = max(d.n_gp for d in self.decls)
-        layout = KeyLayout(n_el, self.max_gp, len(self.decls), self.el_beam, self.n_beams)
+        # segments: a slave point's key names its segment, ``n_gp * slot + g``, slot ``m mod n_slots`` for a
+        # line segment against master element ``m`` (the masters overlapping one slave element are consecutive
+        # and fewer than ``n_slots``), ``n_slots`` for the points of whole elements (other kinds)
+        self.n_slots = self._segment_slots(system) if any(d.segments for d in self.decls) else 0
+        self.key_gp = self.max_gp * (self.n_slots + 1)
+        layout = KeyLayout(n_el, self.key_gp, len(self.decls), self.el_beam, self.n_beams)
         self.point_offset = layout.point_offset
         self.history = ContactHistory(layout)
         self._switch_to(-np.inf)
@@ -190,6 +201,16 @@ class ContactSystem(Contribution):
         self._adjusted = adjust.EMPTY
         self._adjusted = self._reference_adjustment(system.poses0)
         self.adjusted = adjust.summary(self._adjusted)    # count and largest overlap adjusted away
+
+    def _segment_slots(self, system):
+        """Key slots of line segments per slave element: more than the master elements one slave element
+        of a segmenting declaration can overlap (its length over the shortest master's, plus 2, and a
+        stretch of 2 between them)."""
+        n = 1
+        for d in self.decls:
+            if d.segments:
+                n = max(n, int(np.ceil(2.0 * system.L[d.slave_el].max() / system.L[d.master_el].min())) + 2)
+        return n
 
     def _reference_adjustment(self, H0):
         """``adjust.offsets`` of the pairs at the reference poses ``H0``; the search's memory
@@ -403,15 +424,37 @@ class ContactSystem(Contribution):
         # get finer); the others from the projection on the master chord, 8 Newton iterations
         # (compiled, projection.py; the kernel polishes the point with 2 more and needs it converged
         # for an exact tangent)
+        segments = slot = None
+        if d.segments:
+            seg, slot = self._segments(e, m, kind)
+            lo, hi = segment_bounds(H, en, h, e, m, seg)
+            # points on a segment: gauss_points times its share of the element, at least 2 (the products of
+            # the linear shape functions exactly), at most gauss_points
+            n = len(xg)
+            cnt = np.where(seg, np.clip(np.ceil(n * (hi - lo)), min(2, n), n), 0).astype(np.int64)
+            segments = (seg, lo, hi, cnt, d.rules[0])
         r, g, xi2, dist = gauss_projections(H, en, h, e, m, xg, kind, c2, reach, iterations=8,
-                                            window=rules.XI_OVERHANG)
+                                            window=rules.XI_OVERHANG, segments=segments)
         self._lap("projection")
-        s, key, tied = gauss_owners(d.index, len(en), self.max_gp, self.n_beams, e, m, g, xi2, dist, self.el_first,
+        gk = g if slot is None else g + len(xg) * slot[r]
+        s, key, tied = gauss_owners(d.index, len(en), self.key_gp, self.n_beams, e, m, gk, xi2, dist, self.el_first,
                                     self.el_last, self.el_beam, self.el_radius, self.history.prev_owners, pair=r, order=True)
-        f, ids = gauss_record(s, key, r, g, xi2, e, m, kind, xg, wg, self.sys.L, en, self.el_radius)
+        f, ids = gauss_record(s, key, r, g, xi2, e, m, kind, xg, wg, self.sys.L, en, self.el_radius,
+                              None if segments is None else segments[1:4] + d.rules)
         rec = PairSet(key=key, decl=np.full(len(s), d.index), **f)
         self._lap("rules")
         return rec, ids, tied
+
+    def _segments(self, e, m, kind):
+        """Which element pairs are integrated over segments and the key slot of each pair
+        (``__init__``): the line pairs, unless their slave element meets the same master beam in an
+        orthogonal pair too (a wrap's end: the points of the whole element, one owner each, as without
+        segments, so nothing is counted twice)."""
+        line = kind == LINE
+        group = e.astype(np.int64) * self.n_beams + self.el_beam[m]
+        mixed = _member(group, np.unique(group[~line])) if not line.all() else np.zeros(len(e), dtype=bool)
+        seg = line & ~mixed
+        return seg, np.where(seg, m % self.n_slots, self.n_slots)
 
     def _xi_range(self, el):
         """Accepted projections ``[lo, hi]`` on elements ``el`` (``rules.xi_range``)."""

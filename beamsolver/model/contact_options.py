@@ -52,6 +52,12 @@ def _compiled(f):
     return isinstance(f, Dispatcher) or bool(config.DISABLE_JIT)
 
 
+def _integration(v, owner):
+    if v in ("points", "segments"):
+        return v
+    raise InputError(f"{owner}: integration must be 'points' or 'segments', got {v!r}")
+
+
 def _contact_law(v, owner):
     """A ``contact.law.ContactLaw`` (checked by its fields: ``name``, compiled ``normal`` and
     ``tangential``) or None."""
@@ -89,7 +95,15 @@ class ContactOptions:
         "gap over which the normal law is made C1 (default None: ``1e-6 (R1 + R2)`` "
         "(``SMOOTHING``) for line contact, so touching, lightly loaded wires converge, and sharp "
         "for point and orthogonal pairs; 0: sharp everywhere)", kernel_none=np.nan)
-    gauss_points: int = option(5, _gauss_points, "integration points per slave element for line contact (5)")
+    gauss_points: int = option(5, _gauss_points, "integration points per slave element for line contact (5); "
+                                "with ``integration=\"segments\"`` per segment")
+    integration: str = option(
+        "points", _integration,
+        "line contact's integration: ``\"points\"`` (default: ``gauss_points`` fixed per slave element, each "
+        "projected on one master element; the master's shape functions, kinked inside the slave element, "
+        "are integrated inexactly) or ``\"segments\"`` (the slave element cut where its section planes pass "
+        "through the master's nodes, ``gauss_points`` on each piece: exact for straight beams, the contact "
+        "patch test passes to round-off; docs/theory_mortar.md)")
     penalty_t: Optional[float] = option(
         None, _real("penalty_t", above=0.0, none=True),
         "with ``stick=\"penalty\"``: a fixed tangential penalty, force / length^3, instead of one from "
