@@ -110,11 +110,6 @@ class _Decl:
         xg, wg = np.polynomial.legendre.leggauss(self.n_gp)
         self.gauss = 0.5 * (xg + 1.0), 0.5 * wg        # Gauss points and weights on [0, 1]
         self.segments = o.integration == "segments"   # line pairs integrated over segments
-        # the Gauss rules of 1..n_gp points on [0, 1] (row k: k points), for segments
-        self.rules = np.zeros((self.n_gp + 1, self.n_gp)), np.zeros((self.n_gp + 1, self.n_gp))
-        for k in range(1, self.n_gp + 1):
-            x, w = np.polynomial.legendre.leggauss(k)
-            self.rules[0][k, :k], self.rules[1][k, :k] = 0.5 * (x + 1.0), 0.5 * w
         self.line_angle = o.line_angle
         self.point_ratio = o.point_ratio
         self.margin = 2.0 * max(s.radius for s in secs) if o.margin is None else o.margin
@@ -427,12 +422,8 @@ class ContactSystem(Contribution):
         segments = slot = None
         if d.segments:
             seg, slot = self._segments(e, m, kind)
-            lo, hi = segment_bounds(H, en, h, e, m, seg)
-            # points on a segment: gauss_points times its share of the element, at least 2 (the products of
-            # the linear shape functions exactly), at most gauss_points
-            n = len(xg)
-            cnt = np.where(seg, np.clip(np.ceil(n * (hi - lo)), min(2, n), n), 0).astype(np.int64)
-            segments = (seg, lo, hi, cnt, d.rules[0])
+            # gauss_points on every segment (a count depending on its length would make the forces jump)
+            segments = (seg,) + segment_bounds(H, en, h, e, m, seg)
         r, g, xi2, dist = gauss_projections(H, en, h, e, m, xg, kind, c2, reach, iterations=8,
                                             window=rules.XI_OVERHANG, segments=segments)
         self._lap("projection")
@@ -440,7 +431,7 @@ class ContactSystem(Contribution):
         s, key, tied = gauss_owners(d.index, len(en), self.key_gp, self.n_beams, e, m, gk, xi2, dist, self.el_first,
                                     self.el_last, self.el_beam, self.el_radius, self.history.prev_owners, pair=r, order=True)
         f, ids = gauss_record(s, key, r, g, xi2, e, m, kind, xg, wg, self.sys.L, en, self.el_radius,
-                              None if segments is None else segments[1:4] + d.rules)
+                              segments)
         rec = PairSet(key=key, decl=np.full(len(s), d.index), **f)
         self._lap("rules")
         return rec, ids, tied
