@@ -55,7 +55,8 @@ from ..failures import ContactTunnelling, NoContactNormal
 from ..model.model import JOIN_TOL
 from .law import PENALTY_T_MIN, default_penalty
 from . import kernel_jit, mortar
-from .options import ADJUST, EXACT_C, SMOOTHING, STICK_TOLERANCE, ContactOptions, declaration_table
+from .options import (ADJUST, EXACT_C, GAUSS_POINTS, SEGMENT_POINTS, SMOOTHING, STICK_TOLERANCE, ContactOptions,
+                      declaration_table)
 from .frames import LINE, NORMAL_TOL, POINT, no_normal, touch_tolerance
 from .frames_jit import material_frames
 from .record import OPEN, SLIP, STICK, Candidates, PairSet
@@ -106,10 +107,10 @@ class _Decl:
         self.slip_tolerance = o.slip_tolerance
         self.mu = decl.mu
         self.tolerance = o.tolerance
-        self.n_gp = o.gauss_points
+        self.segments = o.integration == "segments"   # line pairs integrated over segments
+        self.n_gp = o.gauss_points if o.gauss_points is not None else SEGMENT_POINTS if self.segments else GAUSS_POINTS
         xg, wg = np.polynomial.legendre.leggauss(self.n_gp)
         self.gauss = 0.5 * (xg + 1.0), 0.5 * wg        # Gauss points and weights on [0, 1]
-        self.segments = o.integration == "segments"   # line pairs integrated over segments
         self.line_angle = o.line_angle
         self.point_ratio = o.point_ratio
         self.margin = 2.0 * max(s.radius for s in secs) if o.margin is None else o.margin

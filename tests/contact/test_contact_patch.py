@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import beamsolver as bs
+from beamsolver.contact.options import SEGMENT_POINTS
 from beamsolver.contact.projection import element_twists, segment_bounds
 from beamsolver.nonlinear.problem import Problem
 
@@ -28,7 +29,7 @@ def _solve(n_slave, n_master, steps=4, t_end=1.0, tau=TAU, **kw):
 def test_frictionless_pressure_is_uniform_to_round_off_with_segments(n_slave, n_master):
     sol, slave, master = _solve(n_slave, n_master, steps=2, t_end=0.5, mu=0.0, tau=0.0, integration="segments")
     p, _, _ = cp.tractions(sol)
-    assert len(p) == 5 * (n_slave + n_master - 1)          # one segment per (slave, master) overlap
+    assert len(p) == SEGMENT_POINTS * (n_slave + n_master - 1)     # one segment per (slave, master) overlap
     assert abs(p.mean() - Q) <= 1e-9 * Q
     assert np.ptp(p) <= 1e-8 * Q
     for beam in (slave, master):
