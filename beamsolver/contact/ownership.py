@@ -130,8 +130,8 @@ def gauss_owners(decl, n_el, max_gp, n_beams, e, m, g, xi2, dist, first, last, b
 
 
 @jit
-def _fill(s, r, g, xi2, e, m, kind, xg, wg, length, enodes, radius, key, n_el, seg, lo, hi, o_kind, o_e, o_m, o_xi1,
-          o_xi2, o_weight, o_gp, o_nodes, o_R1, o_R2, o_ids):
+def _fill(s, r, g, xi2, e, m, kind, xg, wg, length, enodes, radius, key, n_el, seg, lo, hi, xs, ws, o_kind, o_e, o_m,
+          o_xi1, o_xi2, o_weight, o_gp, o_nodes, o_R1, o_R2, o_ids):
     for k in range(len(s)):
         row = s[k]
         c = r[row]
@@ -141,8 +141,8 @@ def _fill(s, r, g, xi2, e, m, kind, xg, wg, length, enodes, radius, key, n_el, s
             o_xi1[k], o_xi2[k] = xg[gk], xi2[row]
             o_weight[k] = wg[gk] * length[ek]
         elif seg[c]:        # a segment's points (``projection.segment_bounds``)
-            o_xi1[k], o_xi2[k] = lo[c] + (hi[c] - lo[c]) * xg[gk], xi2[row]
-            o_weight[k] = ((hi[c] - lo[c]) * wg[gk]) * length[ek]
+            o_xi1[k], o_xi2[k] = lo[c] + (hi[c] - lo[c]) * xs[gk], xi2[row]
+            o_weight[k] = ((hi[c] - lo[c]) * ws[gk]) * length[ek]
         else:
             o_xi1[k], o_xi2[k] = xg[gk], xi2[row]
             o_weight[k] = wg[gk] * length[ek]
@@ -157,16 +157,16 @@ def gauss_record(s, key, r, g, xi2, e, m, kind, xg, wg, length, enodes, radius, 
     ``key * n_el + m``; element pairs' slave and master elements ``e``, ``m`` and ``kind``, Gauss points and
     weights ``xg``, ``wg`` on ``[0, 1]``, element ``length``, end nodes ``enodes``, section ``radius``.
     ``xi1 = xg[g]``, ``weight = wg[g] * length[e]``, ``nodes`` ``(P, 4)``: A1, B1, A2, B2.  ``segments``:
-    ``(seg, lo, hi)`` per element pair (``projection.segment_bounds``): where ``seg``, ``xi1 = lo + (hi - lo)
-    xg[g]``, ``weight = (hi - lo) wg[g] length[e]``."""
+    ``(seg, lo, hi, xs, ws)``: per element pair (``projection.segment_bounds``) and the segments' Gauss points
+    and weights: where ``seg``, ``xi1 = lo + (hi - lo) xs[g]``, ``weight = (hi - lo) ws[g] length[e]``."""
     n = len(s)
     f = dict(kind=np.empty(n, dtype=kind.dtype), e=np.empty(n, dtype=e.dtype), m=np.empty(n, dtype=m.dtype),
              xi1=np.empty(n), xi2=np.empty(n), weight=np.empty(n), gp=np.empty(n, dtype=g.dtype),
              nodes=np.empty((n, 4), dtype=enodes.dtype), R1=np.empty(n), R2=np.empty(n))
     ids = np.empty(n, dtype=np.int64)
-    seg = lo = hi = None
+    seg = lo = hi = xs = ws = None
     if segments is not None:
-        seg, lo, hi = (np.ascontiguousarray(a) for a in segments)
-    _fill(s, r, g, xi2, e, m, kind, xg, wg, length, enodes, radius, key, np.int64(len(enodes)), seg, lo, hi,
+        seg, lo, hi, xs, ws = (np.ascontiguousarray(a) for a in segments)
+    _fill(s, r, g, xi2, e, m, kind, xg, wg, length, enodes, radius, key, np.int64(len(enodes)), seg, lo, hi, xs, ws,
           f["kind"], f["e"], f["m"], f["xi1"], f["xi2"], f["weight"], f["gp"], f["nodes"], f["R1"], f["R2"], ids)
     return f, ids

@@ -256,13 +256,13 @@ def _misses(xc, e1, xA2, xB2, lo, hi, bow):
 
 
 @jit
-def _gauss_project(H, enodes, h, e, m, xg, line, c2, reach, iterations, overhang, seg, lo_seg, hi_seg, row, gp, out2,
-                   dist):
+def _gauss_project(H, enodes, h, e, m, xg, line, c2, reach, iterations, overhang, seg, lo_seg, hi_seg, xs, row, gp,
+                   out2, dist):
     """Slave Gauss points ``xg`` of element pairs ``k`` (slave ``e[k]``, master ``m[k]``) within ``reach[k]``
     of ``c2[k]``, projected on the master; rows in the order ``(k, g)``, returns their number.  A slave
     element's sections are computed once.  ``overhang >= 0``: ``LINE`` rows whose plane misses the master
     on ``[-overhang, 1 + overhang]`` (``_misses``) are culled.  ``seg[k]``: the points of pair ``k`` are
-    ``lo_seg[k] + (hi_seg[k] - lo_seg[k]) xg`` (its segment; none if empty), their sections its own."""
+    ``lo_seg[k] + (hi_seg[k] - lo_seg[k]) xs`` (its segment; none if empty), their sections its own."""
     cull = overhang >= 0.0
     lo, hi = -overhang - CULL_PAD, 1.0 + overhang + CULL_PAD
     # |x(xi) - chord(xi)| <= |x''| |xi (xi - 1)| / 2 for xi in and beyond [0, 1]; |x''| = |w x u|
@@ -272,19 +272,20 @@ def _gauss_project(H, enodes, h, e, m, xg, line, c2, reach, iterations, overhang
     ln = np.empty(LANES, dtype=np.bool_)
     lane_row = np.empty(LANES, dtype=np.int64)
     slot = np.full(len(enodes), -1, dtype=np.int64)
-    sec = np.empty((len(e) + 1, len(xg), 6))   # per slave element: centre and first axis of each Gauss point
+    sec = np.empty((len(e) + 1, max(len(xg), len(xs)), 6))   # per slave element: centre and axis of each point
     n_sec = 0                                  # (the last row: a segment's points)
     n, l = 0, 0
     for k in range(len(e)):
         s = slot[e[k]]
+        ng = len(xg)
         if seg[k]:
             if not hi_seg[k] > lo_seg[k]:
                 continue
-            s = len(e)
+            s, ng = len(e), len(xs)
             RA1, xA1 = _pose_of(H, enodes[e[k], 0])
             u1, w1 = (h[e[k], 0], h[e[k], 1], h[e[k], 2]), (h[e[k], 3], h[e[k], 4], h[e[k], 5])
-            for g in range(len(xg)):
-                R1, xc, _, _ = _section_inline(RA1, xA1, u1, w1, lo_seg[k] + (hi_seg[k] - lo_seg[k]) * xg[g])
+            for g in range(ng):
+                R1, xc, _, _ = _section_inline(RA1, xA1, u1, w1, lo_seg[k] + (hi_seg[k] - lo_seg[k]) * xs[g])
                 for i in range(3):
                     sec[s, g, i], sec[s, g, 3 + i] = xc[i], R1[i][0]
         elif s < 0:
@@ -303,7 +304,7 @@ def _gauss_project(H, enodes, h, e, m, xg, line, c2, reach, iterations, overhang
         if cull and line[k]:
             wxu = cross((h[m[k], 3], h[m[k], 4], h[m[k], 5]), (h[m[k], 0], h[m[k], 1], h[m[k], 2]))
             bow = quad * np.sqrt(dot(wxu, wxu))
-        for g in range(len(xg)):
+        for g in range(ng):
             xc = (sec[s, g, 0], sec[s, g, 1], sec[s, g, 2])
             d0, d1, d2 = xc[0] - c2[k, 0], xc[1] - c2[k, 1], xc[2] - c2[k, 2]
             if not (d0 * d0 + d1 * d1) + d2 * d2 <= r2:
@@ -347,20 +348,20 @@ def gauss_projections(H, enodes, h, e, m, xg, kind, c2, reach, iterations=8, win
     would be rejected.  Without it the rows within ``reach`` grow like ``1 + 7 R / L`` per slave
     point as the elements get shorter than the radii; with it about one or two.
 
-    ``segments``: ``(seg, lo, hi)`` ``(n,)`` (``segment_bounds``): the points of a pair with ``seg`` are
-    ``lo + (hi - lo) xg`` (none where ``hi <= lo``); the others' are ``xg``.
+    ``segments``: ``(seg, lo, hi)`` ``(n,)`` (``segment_bounds``) and ``xs`` ``(s,)``: the points of a pair
+    with ``seg`` are ``lo + (hi - lo) xs`` (none where ``hi <= lo``); the others' are ``xg``.
     """
     c = np.ascontiguousarray
-    n = len(e) * len(xg)
+    n = len(e) * (len(xg) if segments is None else max(len(xg), len(segments[3])))
     row, gp = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
     out2, dist = np.empty(n), np.empty(n)
     if segments is None:
-        seg, lo, hi = np.zeros(len(e), dtype=np.bool_), np.zeros(len(e)), np.ones(len(e))
+        seg, lo, hi, xs = np.zeros(len(e), dtype=np.bool_), np.zeros(len(e)), np.ones(len(e)), c(xg, dtype=float)
     else:
-        seg, lo, hi = (c(a) for a in segments)
+        seg, lo, hi, xs = (c(a) for a in segments)
     k = _gauss_project(H, enodes, c(h, dtype=float), c(e), c(m), c(xg, dtype=float), c(np.asarray(kind) == LINE),
                        c(c2, dtype=float), c(reach, dtype=float), int(iterations),
-                       -1.0 if window is None else float(window), seg, lo, hi, row, gp, out2, dist)
+                       -1.0 if window is None else float(window), seg, lo, hi, xs, row, gp, out2, dist)
     return row[:k], gp[:k], out2[:k], dist[:k]
 
 

@@ -108,9 +108,12 @@ class _Decl:
         self.mu = decl.mu
         self.tolerance = o.tolerance
         self.segments = o.integration == "segments"   # line pairs integrated over segments
-        self.n_gp = o.gauss_points if o.gauss_points is not None else SEGMENT_POINTS if self.segments else GAUSS_POINTS
+        self.n_gp = GAUSS_POINTS if o.gauss_points is None else o.gauss_points        # per whole slave element
         xg, wg = np.polynomial.legendre.leggauss(self.n_gp)
         self.gauss = 0.5 * (xg + 1.0), 0.5 * wg        # Gauss points and weights on [0, 1]
+        self.n_seg = SEGMENT_POINTS if o.gauss_points is None else o.gauss_points      # per segment
+        xs, ws = np.polynomial.legendre.leggauss(self.n_seg)
+        self.seg_gauss = 0.5 * (xs + 1.0), 0.5 * ws
         self.line_angle = o.line_angle
         self.point_ratio = o.point_ratio
         self.margin = 2.0 * max(s.radius for s in secs) if o.margin is None else o.margin
@@ -159,8 +162,8 @@ class ContactSystem(Contribution):
         self._mu = np.array([d.mu for d in self.decls])
         self._switch = [(d.active_from, d.friction_from) for d in model.contacts]
         self._decl_on = np.ones(len(self.decls), dtype=bool)
-        self.max_gp = max(d.n_gp for d in self.decls)
-        # segments: a slave point's key names its segment, ``n_gp * slot + g``, slot ``m mod n_slots`` for a
+        self.max_gp = max(max(d.n_gp, d.n_seg if d.segments else 0) for d in self.decls)
+        # segments: a slave point's key names its segment, ``max_gp * slot + g``, slot ``m mod n_slots`` for a
         # line segment against master element ``m`` (the masters overlapping one slave element are consecutive
         # and fewer than ``n_slots``), ``n_slots`` for the points of whole elements (other kinds)
         self.n_slots = self._segment_slots(system) if any(d.segments for d in self.decls) else 0
@@ -423,12 +426,12 @@ class ContactSystem(Contribution):
         segments = slot = None
         if d.segments:
             seg, slot = self._segments(e, m, kind)
-            # gauss_points on every segment (a count depending on its length would make the forces jump)
-            segments = (seg,) + segment_bounds(H, en, h, e, m, seg)
+            # n_seg points on every segment (a count depending on its length would make the forces jump)
+            segments = (seg,) + segment_bounds(H, en, h, e, m, seg) + d.seg_gauss
         r, g, xi2, dist = gauss_projections(H, en, h, e, m, xg, kind, c2, reach, iterations=8,
-                                            window=rules.XI_OVERHANG, segments=segments)
+                                            window=rules.XI_OVERHANG, segments=None if segments is None else segments[:4])
         self._lap("projection")
-        gk = g if slot is None else g + len(xg) * slot[r]
+        gk = g if slot is None else g + self.max_gp * slot[r]
         s, key, tied = gauss_owners(d.index, len(en), self.key_gp, self.n_beams, e, m, gk, xi2, dist, self.el_first,
                                     self.el_last, self.el_beam, self.el_radius, self.history.prev_owners, pair=r, order=True)
         f, ids = gauss_record(s, key, r, g, xi2, e, m, kind, xg, wg, self.sys.L, en, self.el_radius,

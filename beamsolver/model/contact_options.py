@@ -101,7 +101,8 @@ class ContactOptions:
         "for point and orthogonal pairs; 0: sharp everywhere)", kernel_none=np.nan)
     gauss_points: Optional[int] = option(
         None, _gauss_points, "integration points of line contact per segment (``integration=\"segments\"``, "
-        "default 3, ``SEGMENT_POINTS``) or per slave element (``\"points\"``, default 5, ``GAUSS_POINTS``)")
+        "default 3, ``SEGMENT_POINTS``) or per slave element (``\"points\"`` and orthogonal pairs, default 5, "
+        "``GAUSS_POINTS``)")
     integration: str = option(
         "points", _integration,
         "line contact's integration: ``\"points\"`` (default: ``gauss_points`` fixed per slave element, each "
