@@ -123,3 +123,47 @@ def test_integration_option_is_checked():
     b = model.add_beam(bs.geometry.straight((0, 0, 0.02), (1, 0, 0.02), 2), sec)
     with pytest.raises(bs.InputError, match="integration"):
         model.add_contact(a, b, integration="mortar")
+
+
+class _Stop(Exception):
+    pass
+
+
+def test_segment_keys_restart_exactly():
+    """The friction history of segment points (keys with the segment's slot) is checked and given back by
+    a restart: the restarted run ends as the uninterrupted one (shear lag, 20 wire / 13 rod elements)."""
+    import shear_lag
+
+    def stop(info):
+        if info["t"] > 0.6:
+            raise _Stop
+
+    model, wire, _ = shear_lag.build(integration="segments")
+    full = bs.solve(model, steps=4, verbose=False)
+    model, _, _ = shear_lag.build(integration="segments")
+    with pytest.raises(_Stop) as e:
+        bs.solve(model, steps=4, callback=stop, verbose=False)
+    part = e.value.solution
+    assert len(part.contact_state["contact/history.key"]) > 0
+    model, _, _ = shear_lag.build(integration="segments")
+    rest = bs.solve(model, steps=4, restart=part, verbose=False)
+    np.testing.assert_array_equal(rest.contact()["tangential_force"], full.contact()["tangential_force"])
+    assert not full.contact()["stick"].all()          # the pull slides part of the wire: the history matters
+
+
+def test_a_wrap_end_keeps_whole_element_points():
+    """A slave element meeting the same master beam in an orthogonal pair too is not segmented (its
+    points keep one owner each: nothing counted twice); line pairs elsewhere are, each with its slot."""
+    from beamsolver.contact.frames import LINE, ORTHOGONAL
+    model = bs.Model()
+    sec = bs.Section.circular(radius=0.01, E=1e9, nu=0.3)
+    a = model.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 4), sec)
+    b = model.add_beam(bs.geometry.straight((0, 0, 0.02), (1, 0, 0.02), 3), sec)
+    model.add_contact(b, a, integration="segments")
+    cs = Problem.from_model(model, check_rigid_modes=False).contact
+    e = np.array([4, 4, 5, 5, 6])
+    m = np.array([0, 1, 1, 2, 3])
+    seg, slot = cs._segments(e, m, np.array([LINE, ORTHOGONAL, LINE, LINE, LINE]))
+    assert seg.tolist() == [False, False, True, True, True]
+    assert slot.tolist() == [cs.n_slots, cs.n_slots, 1 % cs.n_slots, 2 % cs.n_slots, 3 % cs.n_slots]
+    assert cs.n_slots >= 3                   # masters one slave element can overlap (1/3 over 1/4, stretch 2)
