@@ -54,7 +54,7 @@ from ..errors import InputError
 from ..failures import ContactTunnelling, NoContactNormal
 from ..model.model import JOIN_TOL
 from .law import PENALTY_T_MIN, default_penalty
-from . import kernel_jit, mortar
+from . import kernel_jit, mortar, segment_tangent
 from .options import (ADJUST, EXACT_C, GAUSS_POINTS, SEGMENT_POINTS, SMOOTHING, STICK_TOLERANCE, ContactOptions,
                       declaration_table)
 from .frames import LINE, NORMAL_TOL, POINT, no_normal, touch_tolerance
@@ -615,7 +615,7 @@ class ContactSystem(Contribution):
         if c is not None and np.array_equal(c[0], H) and (c[1] is None or c[1][4] is not None or not tangent):
             return c[1]
         c = None                   # (its tangent buffer may serve this evaluation: ``_tangent_out``)
-        tangent = tangent or self.kernel is kernel_jit
+        asked, tangent = tangent, tangent or self.kernel is kernel_jit
         P = self.pairs(H)
         self._lap()
         sel = np.zeros(0, dtype=int)
@@ -636,6 +636,11 @@ class ContactSystem(Contribution):
         np.negative(f, out=f)
         if K is not None:
             np.negative(K, out=K)
+        if K is not None and self.n_slots:
+            # the segment ends' tangent terms: now if the tangent is asked for, else when it is (``evaluate``)
+            out["segment_ends"] = (p["mu"] > 0) & ~mort
+            if asked:
+                self._segment_ends(H, P, sel, p, f, K, out.pop("segment_ends"))
         if mort.any():
             out["mortar"] = self._mortar(H, P, sel, p, np.flatnonzero(mort), out, tangent)
         self._lap("kernel")
@@ -644,6 +649,31 @@ class ContactSystem(Contribution):
             self._cache = (H.copy(), P, sel, p, out)
         self._blocks = (np.array(H), (P, sel, p, f, K, out))
         return self._blocks[1]
+
+    def _segment_ends(self, H, P, sel, p, f, K, friction):
+        """Add the tangent terms of the moving segment ends (``segment_tangent``) to the blocks ``K`` of the
+        segment points among the active pairs ``sel`` (``f``: their forces, residual signs; ``friction``: the
+        kernel's friction flags).  The exact-stick multipliers' terms (``_mortar``) are not included."""
+        key = P.key[sel]
+        gk = (key // self.n_beams) % self.key_gp
+        seg = (key < self.point_offset) & (p["kind"] == LINE) & (gk // self.max_gp < self.n_slots)
+        for d in self.decls:
+            idx = np.flatnonzero(seg & (P.decl[sel] == d.index))
+            if not d.segments or not len(idx):
+                continue
+            g = gk[idx] % self.max_gp
+            X = H[P.nodes[sel[idx]]]
+            pm = {k: (v[idx] if np.ndim(v) else v) for k, v in p.items()}
+
+            def forces(rows, xi):
+                q = {k: (v[rows] if np.ndim(v) else v) for k, v in pm.items()}
+                q["xi1"] = xi
+                fk = self._kernels(X[rows], q, P.decl[sel[idx[rows]]], False, friction=friction[idx[rows]])[0]
+                return -fk.reshape(len(rows), 24)
+
+            rows, terms = segment_tangent.end_terms(X, pm["xi1"], pm["weight"], d.seg_gauss[0][g], d.seg_gauss[1][g],
+                                                    self.sys.L[P.e[sel[idx]]], f[idx].reshape(len(idx), 24), forces)
+            K[idx[rows]] += terms
 
     def overlap(self, H):
         """Initial overlaps at poses ``H``: ``None`` when no pair penetrates by more than
@@ -802,6 +832,8 @@ class ContactSystem(Contribution):
         if blocks is None:
             return Blocks.empty(4, tangent), dict(n_active=0)
         P, sel, p, f, K, out = blocks
+        if tangent and K is not None and "segment_ends" in out:
+            self._segment_ends(H, P, sel, p, f, K, out.pop("segment_ends"))
         info = dict(n_active=len(sel))
         if "mortar" in out:
             b = _with_mortar(P.nodes[sel], f.reshape(-1, 24), K if tangent else None, out["mortar"])

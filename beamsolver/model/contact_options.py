@@ -109,8 +109,8 @@ class ContactOptions:
         "projected on one master element: the master's shape functions, kinked inside the slave element, "
         "are integrated inexactly) or ``\"segments\"`` (each slave element cut where its section planes "
         "pass through the master's nodes, ``gauss_points`` on every piece: the products of slave and master "
-        "shape functions exact on straight beams, the contact patch test passes to round-off; its tangent "
-        "leaves out the motion of the segments' ends; docs/theory_mortar.md section 7)")
+        "shape functions exact on straight beams, the contact patch test passes to round-off; "
+        "docs/theory_mortar.md section 7)")
     penalty_t: Optional[float] = option(
         None, _real("penalty_t", above=0.0, none=True),
         "with ``stick=\"penalty\"``: a fixed tangential penalty, force / length^3, instead of one from "
