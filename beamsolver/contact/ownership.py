@@ -130,31 +130,43 @@ def gauss_owners(decl, n_el, max_gp, n_beams, e, m, g, xi2, dist, first, last, b
 
 
 @jit
-def _fill(s, r, g, xi2, e, m, kind, xg, wg, length, enodes, radius, key, n_el, o_kind, o_e, o_m, o_xi1, o_xi2,
-          o_weight, o_gp, o_nodes, o_R1, o_R2, o_ids):
+def _fill(s, r, g, xi2, e, m, kind, xg, wg, length, enodes, radius, key, n_el, seg, lo, hi, xs, ws, o_kind, o_e, o_m,
+          o_xi1, o_xi2, o_weight, o_gp, o_nodes, o_R1, o_R2, o_ids):
     for k in range(len(s)):
         row = s[k]
         c = r[row]
         ek, mk, gk = e[c], m[c], g[row]
         o_kind[k], o_e[k], o_m[k], o_gp[k] = kind[c], ek, mk, gk
-        o_xi1[k], o_xi2[k] = xg[gk], xi2[row]
-        o_weight[k] = wg[gk] * length[ek]
+        if seg is None:
+            o_xi1[k], o_xi2[k] = xg[gk], xi2[row]
+            o_weight[k] = wg[gk] * length[ek]
+        elif seg[c]:        # a segment's points (``projection.segment_bounds``)
+            o_xi1[k], o_xi2[k] = lo[c] + (hi[c] - lo[c]) * xs[gk], xi2[row]
+            o_weight[k] = ((hi[c] - lo[c]) * ws[gk]) * length[ek]
+        else:
+            o_xi1[k], o_xi2[k] = xg[gk], xi2[row]
+            o_weight[k] = wg[gk] * length[ek]
         o_nodes[k, 0], o_nodes[k, 1], o_nodes[k, 2], o_nodes[k, 3] = enodes[ek, 0], enodes[ek, 1], enodes[mk, 0], enodes[mk, 1]
         o_R1[k], o_R2[k] = radius[ek], radius[mk]
         o_ids[k] = key[k] * n_el + mk
 
 
-def gauss_record(s, key, r, g, xi2, e, m, kind, xg, wg, length, enodes, radius):
+def gauss_record(s, key, r, g, xi2, e, m, kind, xg, wg, length, enodes, radius, segments=None):
     """The fields of ``record.PairSet`` (but ``decl``) of the owners ``s`` (keys ``key``) among the projected
     rows ``r`` (element pair of each row), ``g``, ``xi2``, in one compiled pass, and the owner ids
     ``key * n_el + m``; element pairs' slave and master elements ``e``, ``m`` and ``kind``, Gauss points and
     weights ``xg``, ``wg`` on ``[0, 1]``, element ``length``, end nodes ``enodes``, section ``radius``.
-    ``xi1 = xg[g]``, ``weight = wg[g] * length[e]``, ``nodes`` ``(P, 4)``: A1, B1, A2, B2."""
+    ``xi1 = xg[g]``, ``weight = wg[g] * length[e]``, ``nodes`` ``(P, 4)``: A1, B1, A2, B2.  ``segments``:
+    ``(seg, lo, hi, xs, ws)``: per element pair (``projection.segment_bounds``) and the segments' Gauss points
+    and weights: where ``seg``, ``xi1 = lo + (hi - lo) xs[g]``, ``weight = (hi - lo) ws[g] length[e]``."""
     n = len(s)
     f = dict(kind=np.empty(n, dtype=kind.dtype), e=np.empty(n, dtype=e.dtype), m=np.empty(n, dtype=m.dtype),
              xi1=np.empty(n), xi2=np.empty(n), weight=np.empty(n), gp=np.empty(n, dtype=g.dtype),
              nodes=np.empty((n, 4), dtype=enodes.dtype), R1=np.empty(n), R2=np.empty(n))
     ids = np.empty(n, dtype=np.int64)
-    _fill(s, r, g, xi2, e, m, kind, xg, wg, length, enodes, radius, key, np.int64(len(enodes)), f["kind"], f["e"],
-          f["m"], f["xi1"], f["xi2"], f["weight"], f["gp"], f["nodes"], f["R1"], f["R2"], ids)
+    seg = lo = hi = xs = ws = None
+    if segments is not None:
+        seg, lo, hi, xs, ws = (np.ascontiguousarray(a) for a in segments)
+    _fill(s, r, g, xi2, e, m, kind, xg, wg, length, enodes, radius, key, np.int64(len(enodes)), seg, lo, hi, xs, ws,
+          f["kind"], f["e"], f["m"], f["xi1"], f["xi2"], f["weight"], f["gp"], f["nodes"], f["R1"], f["R2"], ids)
     return f, ids

@@ -29,7 +29,8 @@ from ..lie.se3_jit import _SERIES_TABLE, _SWITCH, A_, B_, C_, add, add_outer, cr
 from .kernel_jit import _pose_of, _project, _section, _section_inline
 from .frames import LINE, POINT
 
-__all__ = ["element_twists", "section_points", "spheres", "overlap", "closest_points", "project_points", "gauss_projections"]
+__all__ = ["element_twists", "section_points", "spheres", "overlap", "closest_points", "project_points", "gauss_projections",
+           "segment_bounds"]
 
 
 def element_twists(H, enodes):
@@ -255,11 +256,13 @@ def _misses(xc, e1, xA2, xB2, lo, hi, bow):
 
 
 @jit
-def _gauss_project(H, enodes, h, e, m, xg, line, c2, reach, iterations, overhang, row, gp, out2, dist):
+def _gauss_project(H, enodes, h, e, m, xg, line, c2, reach, iterations, overhang, seg, lo_seg, hi_seg, xs, row, gp,
+                   out2, dist):
     """Slave Gauss points ``xg`` of element pairs ``k`` (slave ``e[k]``, master ``m[k]``) within ``reach[k]``
     of ``c2[k]``, projected on the master; rows in the order ``(k, g)``, returns their number.  A slave
     element's sections are computed once.  ``overhang >= 0``: ``LINE`` rows whose plane misses the master
-    on ``[-overhang, 1 + overhang]`` (``_misses``) are culled."""
+    on ``[-overhang, 1 + overhang]`` (``_misses``) are culled.  ``seg[k]``: the points of pair ``k`` are
+    ``lo_seg[k] + (hi_seg[k] - lo_seg[k]) xs`` (its segment; none if empty), their sections its own."""
     cull = overhang >= 0.0
     lo, hi = -overhang - CULL_PAD, 1.0 + overhang + CULL_PAD
     # |x(xi) - chord(xi)| <= |x''| |xi (xi - 1)| / 2 for xi in and beyond [0, 1]; |x''| = |w x u|
@@ -269,12 +272,23 @@ def _gauss_project(H, enodes, h, e, m, xg, line, c2, reach, iterations, overhang
     ln = np.empty(LANES, dtype=np.bool_)
     lane_row = np.empty(LANES, dtype=np.int64)
     slot = np.full(len(enodes), -1, dtype=np.int64)
-    sec = np.empty((len(e), len(xg), 6))       # per slave element: centre and first axis of each Gauss point
-    n_sec = 0
+    sec = np.empty((len(e) + 1, max(len(xg), len(xs)), 6))   # per slave element: centre and axis of each point
+    n_sec = 0                                  # (the last row: a segment's points)
     n, l = 0, 0
     for k in range(len(e)):
         s = slot[e[k]]
-        if s < 0:
+        ng = len(xg)
+        if seg[k]:
+            if not hi_seg[k] > lo_seg[k]:
+                continue
+            s, ng = len(e), len(xs)
+            RA1, xA1 = _pose_of(H, enodes[e[k], 0])
+            u1, w1 = (h[e[k], 0], h[e[k], 1], h[e[k], 2]), (h[e[k], 3], h[e[k], 4], h[e[k], 5])
+            for g in range(ng):
+                R1, xc, _, _ = _section_inline(RA1, xA1, u1, w1, lo_seg[k] + (hi_seg[k] - lo_seg[k]) * xs[g])
+                for i in range(3):
+                    sec[s, g, i], sec[s, g, 3 + i] = xc[i], R1[i][0]
+        elif s < 0:
             s = slot[e[k]] = n_sec
             n_sec += 1
             RA1, xA1 = _pose_of(H, enodes[e[k], 0])
@@ -290,7 +304,7 @@ def _gauss_project(H, enodes, h, e, m, xg, line, c2, reach, iterations, overhang
         if cull and line[k]:
             wxu = cross((h[m[k], 3], h[m[k], 4], h[m[k], 5]), (h[m[k], 0], h[m[k], 1], h[m[k], 2]))
             bow = quad * np.sqrt(dot(wxu, wxu))
-        for g in range(len(xg)):
+        for g in range(ng):
             xc = (sec[s, g, 0], sec[s, g, 1], sec[s, g, 2])
             d0, d1, d2 = xc[0] - c2[k, 0], xc[1] - c2[k, 1], xc[2] - c2[k, 2]
             if not (d0 * d0 + d1 * d1) + d2 * d2 <= r2:
@@ -316,7 +330,7 @@ def _gauss_project(H, enodes, h, e, m, xg, line, c2, reach, iterations, overhang
     return n
 
 
-def gauss_projections(H, enodes, h, e, m, xg, kind, c2, reach, iterations=8, window=None):
+def gauss_projections(H, enodes, h, e, m, xg, kind, c2, reach, iterations=8, window=None, segments=None):
     """Slave Gauss points ``xg`` ``(g,)`` of element pairs ``(n,)`` projected on their master elements.
 
     Pair ``k``: slave element ``e[k]`` (its sections are computed once), master element ``m[k]``,
@@ -333,15 +347,70 @@ def gauss_projections(H, enodes, h, e, m, xg, kind, c2, reach, iterations=8, win
     signed distance and the bound of the line's bow) is not projected: its converged projection
     would be rejected.  Without it the rows within ``reach`` grow like ``1 + 7 R / L`` per slave
     point as the elements get shorter than the radii; with it about one or two.
+
+    ``segments``: ``(seg, lo, hi)`` ``(n,)`` (``segment_bounds``) and ``xs`` ``(s,)``: the points of a pair
+    with ``seg`` are ``lo + (hi - lo) xs`` (none where ``hi <= lo``); the others' are ``xg``.
     """
     c = np.ascontiguousarray
-    n = len(e) * len(xg)
+    n = len(e) * (len(xg) if segments is None else max(len(xg), len(segments[3])))
     row, gp = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
     out2, dist = np.empty(n), np.empty(n)
+    if segments is None:
+        seg, lo, hi, xs = np.zeros(len(e), dtype=np.bool_), np.zeros(len(e)), np.ones(len(e)), c(xg, dtype=float)
+    else:
+        seg, lo, hi, xs = (c(a) for a in segments)
     k = _gauss_project(H, enodes, c(h, dtype=float), c(e), c(m), c(xg, dtype=float), c(np.asarray(kind) == LINE),
                        c(c2, dtype=float), c(reach, dtype=float), int(iterations),
-                       -1.0 if window is None else float(window), row, gp, out2, dist)
+                       -1.0 if window is None else float(window), seg, lo, hi, xs, row, gp, out2, dist)
     return row[:k], gp[:k], out2[:k], dist[:k]
+
+
+@jit_callee
+def _plane_through(RA, xA, u, w, xB, xN, iterations):
+    """Slave parameter ``xi`` whose section plane passes through the point ``xN`` (``(xN - x(xi)) . e1(xi) = 0``),
+    Newton from the projection of ``xN`` on the chord ``xA xB`` (kept within ``[-1, 2]``); ``u``, ``w``: the
+    element's twist.  ``d/dxi (x, e1) = (R u, R (w x E1))``."""
+    xi = _chord_start(xN, xA, xB)
+    for _ in range(iterations):
+        R, x, xp, _ = _section_inline(RA, xA, u, w, xi)
+        d = (xN[0] - x[0], xN[1] - x[1], xN[2] - x[2])
+        e1 = (R[0][0], R[1][0], R[2][0])
+        e1p = mv(R, (0.0, w[2], -w[1]))
+        f = dot(d, e1)
+        j = dot(d, e1p) - dot(xp, e1)
+        xi = min(max(xi - f / (j if j != 0.0 else 1.0), -1.0), 2.0)
+    return xi
+
+
+@jit
+def _segment_bounds(H, enodes, h, e, m, seg, iterations, lo, hi):
+    for k in range(len(e)):
+        lo[k], hi[k] = 0.0, 1.0
+        if not seg[k]:
+            continue
+        RA1, xA1 = _pose_of(H, enodes[e[k], 0])
+        _, xB1 = _pose_of(H, enodes[e[k], 1])
+        u1, w1 = (h[e[k], 0], h[e[k], 1], h[e[k], 2]), (h[e[k], 3], h[e[k], 4], h[e[k], 5])
+        _, xA2 = _pose_of(H, enodes[m[k], 0])
+        _, xB2 = _pose_of(H, enodes[m[k], 1])
+        a = _plane_through(RA1, xA1, u1, w1, xB1, xA2, iterations)
+        b = _plane_through(RA1, xA1, u1, w1, xB1, xB2, iterations)
+        lo[k] = min(max(min(a, b), 0.0), 1.0)
+        hi[k] = min(max(max(a, b), 0.0), 1.0)
+
+
+def segment_bounds(H, enodes, h, e, m, seg, iterations=8):
+    """Segments ``[lo, hi]`` ``(n,)`` of the slave elements ``e`` against the master elements ``m`` (pairs ``seg``;
+    the others ``[0, 1]``): the slave parameters whose section planes pass through the master's end nodes
+    (``LINE`` projection inverted, ``_plane_through``), sorted and clipped to ``[0, 1]``; ``hi <= lo``: no
+    overlap.  Slave points of ``[lo, hi]`` project into the master element (``[0, 1]``); the segments of
+    one slave element against consecutive master elements meet where the plane passes through their
+    shared node, so they tile the slave element's overlap with the master beam."""
+    c = np.ascontiguousarray
+    n = len(e)
+    lo, hi = np.empty(n), np.empty(n)
+    _segment_bounds(H, enodes, c(h, dtype=float), c(e), c(m), c(seg, dtype=np.bool_), int(iterations), lo, hi)
+    return lo, hi
 
 
 @jit

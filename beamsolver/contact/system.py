@@ -54,13 +54,14 @@ from ..errors import InputError
 from ..failures import ContactTunnelling, NoContactNormal
 from ..model.model import JOIN_TOL
 from .law import PENALTY_T_MIN, default_penalty
-from . import kernel_jit, mortar
-from .options import ADJUST, EXACT_C, SMOOTHING, STICK_TOLERANCE, ContactOptions, declaration_table
+from . import kernel_jit, mortar, segment_tangent
+from .options import (ADJUST, EXACT_C, GAUSS_POINTS, SEGMENT_POINTS, SMOOTHING, STICK_TOLERANCE, ContactOptions,
+                      declaration_table)
 from .frames import LINE, NORMAL_TOL, POINT, no_normal, touch_tolerance
 from .frames_jit import material_frames
 from .record import OPEN, SLIP, STICK, Candidates, PairSet
 from .ownership import gauss_owners, gauss_record
-from .projection import closest_points, element_twists, gauss_projections, section_points
+from .projection import closest_points, element_twists, gauss_projections, section_points, segment_bounds
 from .search import broad_pairs, element_spheres
 from .history import ContactHistory
 from .state import KeyLayout
@@ -114,9 +115,13 @@ class _Decl:
         self.slip_tolerance = o.slip_tolerance
         self.mu = decl.mu
         self.tolerance = o.tolerance
-        self.n_gp = o.gauss_points
+        self.segments = o.integration == "segments"   # line pairs integrated over segments
+        self.n_gp = GAUSS_POINTS if o.gauss_points is None else o.gauss_points        # per whole slave element
         xg, wg = np.polynomial.legendre.leggauss(self.n_gp)
         self.gauss = 0.5 * (xg + 1.0), 0.5 * wg        # Gauss points and weights on [0, 1]
+        self.n_seg = SEGMENT_POINTS if o.gauss_points is None else o.gauss_points      # per segment
+        xs, ws = np.polynomial.legendre.leggauss(self.n_seg)
+        self.seg_gauss = 0.5 * (xs + 1.0), 0.5 * ws
         self.line_angle = o.line_angle
         self.point_ratio = o.point_ratio
         self.margin = 2.0 * max(s.radius for s in secs) if o.margin is None else o.margin
@@ -167,8 +172,13 @@ class ContactSystem(Contribution):
         self._mu = np.array([d.mu for d in self.decls])
         self._switch = [(d.active_from, d.friction_from) for d in model.contacts]
         self._decl_on = np.ones(len(self.decls), dtype=bool)
-        self.max_gp = max(d.n_gp for d in self.decls)
-        layout = KeyLayout(n_el, self.max_gp, len(self.decls), self.el_beam, self.n_beams)
+        self.max_gp = max(max(d.n_gp, d.n_seg if d.segments else 0) for d in self.decls)
+        # segments: a slave point's key names its segment, ``max_gp * slot + g``, slot ``m mod n_slots`` for a
+        # line segment against master element ``m`` (the masters overlapping one slave element are consecutive
+        # and fewer than ``n_slots``), ``n_slots`` for the points of whole elements (other kinds)
+        self.n_slots = self._segment_slots(system) if any(d.segments for d in self.decls) else 0
+        self.key_gp = self.max_gp * (self.n_slots + 1)
+        layout = KeyLayout(n_el, self.key_gp, len(self.decls), self.el_beam, self.n_beams)
         self.point_offset = layout.point_offset
         self.history = ContactHistory(layout)
         self._switch_to(-np.inf)
@@ -203,6 +213,16 @@ class ContactSystem(Contribution):
         self._adjusted = adjust.EMPTY
         self._adjusted = self._reference_adjustment(system.poses0)
         self.adjusted = adjust.summary(self._adjusted)    # count and largest overlap adjusted away
+
+    def _segment_slots(self, system):
+        """Key slots of line segments per slave element: more than the master elements one slave element
+        of a segmenting declaration can overlap (its length over the shortest master's, plus 2, and a
+        stretch of 2 between them)."""
+        n = 1
+        for d in self.decls:
+            if d.segments:
+                n = max(n, int(np.ceil(2.0 * system.L[d.slave_el].max() / system.L[d.master_el].min())) + 2)
+        return n
 
     def _reference_adjustment(self, H0):
         """``adjust.offsets`` of the pairs at the reference poses ``H0``; the search's memory
@@ -416,15 +436,33 @@ class ContactSystem(Contribution):
         # get finer); the others from the projection on the master chord, 8 Newton iterations
         # (compiled, projection.py; the kernel polishes the point with 2 more and needs it converged
         # for an exact tangent)
+        segments = slot = None
+        if d.segments:
+            seg, slot = self._segments(e, m, kind)
+            # n_seg points on every segment (a count depending on its length would make the forces jump)
+            segments = (seg,) + segment_bounds(H, en, h, e, m, seg) + d.seg_gauss
         r, g, xi2, dist = gauss_projections(H, en, h, e, m, xg, kind, c2, reach, iterations=8,
-                                            window=rules.XI_OVERHANG)
+                                            window=rules.XI_OVERHANG, segments=None if segments is None else segments[:4])
         self._lap("projection")
-        s, key, tied = gauss_owners(d.index, len(en), self.max_gp, self.n_beams, e, m, g, xi2, dist, self.el_first,
+        gk = g if slot is None else g + self.max_gp * slot[r]
+        s, key, tied = gauss_owners(d.index, len(en), self.key_gp, self.n_beams, e, m, gk, xi2, dist, self.el_first,
                                     self.el_last, self.el_beam, self.el_radius, self.history.prev_owners, pair=r, order=True)
-        f, ids = gauss_record(s, key, r, g, xi2, e, m, kind, xg, wg, self.sys.L, en, self.el_radius)
+        f, ids = gauss_record(s, key, r, g, xi2, e, m, kind, xg, wg, self.sys.L, en, self.el_radius,
+                              segments)
         rec = PairSet(key=key, decl=np.full(len(s), d.index), **f)
         self._lap("rules")
         return rec, ids, tied
+
+    def _segments(self, e, m, kind):
+        """Which element pairs are integrated over segments and the key slot of each pair
+        (``__init__``): the line pairs, unless their slave element meets the same master beam in an
+        orthogonal pair too (a wrap's end: the points of the whole element, one owner each, as without
+        segments, so nothing is counted twice)."""
+        line = kind == LINE
+        group = e.astype(np.int64) * self.n_beams + self.el_beam[m]
+        mixed = _member(group, np.unique(group[~line])) if not line.all() else np.zeros(len(e), dtype=bool)
+        seg = line & ~mixed
+        return seg, np.where(seg, m % self.n_slots, self.n_slots)
 
     def _xi_range(self, el):
         """Accepted projections ``[lo, hi]`` on elements ``el`` (``rules.xi_range``)."""
@@ -590,7 +628,7 @@ class ContactSystem(Contribution):
         if c is not None and np.array_equal(c[0], H) and (c[1] is None or c[1][4] is not None or not tangent):
             return c[1]
         c = None                   # (its tangent buffer may serve this evaluation: ``_tangent_out``)
-        tangent = tangent or self.kernel is kernel_jit
+        asked, tangent = tangent, tangent or self.kernel is kernel_jit
         P = self.pairs(H)
         self._lap()
         sel = np.zeros(0, dtype=int)
@@ -611,6 +649,11 @@ class ContactSystem(Contribution):
         np.negative(f, out=f)
         if K is not None:
             np.negative(K, out=K)
+        if K is not None and self.n_slots:
+            # the segment ends' tangent terms: now if the tangent is asked for, else when it is (``evaluate``)
+            out["segment_ends"] = (p["mu"] > 0) & ~mort
+            if asked:
+                self._segment_ends(H, P, sel, p, f, K, out.pop("segment_ends"))
         if mort.any():
             out["mortar"] = self._mortar(H, P, sel, p, np.flatnonzero(mort), out, tangent)
         self._lap("kernel")
@@ -619,6 +662,31 @@ class ContactSystem(Contribution):
             self._cache = (H.copy(), P, sel, p, out)
         self._blocks = (np.array(H), (P, sel, p, f, K, out))
         return self._blocks[1]
+
+    def _segment_ends(self, H, P, sel, p, f, K, friction):
+        """Add the tangent terms of the moving segment ends (``segment_tangent``) to the blocks ``K`` of the
+        segment points among the active pairs ``sel`` (``f``: their forces, residual signs; ``friction``: the
+        kernel's friction flags).  The exact-stick multipliers' terms (``_mortar``) are not included."""
+        key = P.key[sel]
+        gk = (key // self.n_beams) % self.key_gp
+        seg = (key < self.point_offset) & (p["kind"] == LINE) & (gk // self.max_gp < self.n_slots)
+        for d in self.decls:
+            idx = np.flatnonzero(seg & (P.decl[sel] == d.index))
+            if not d.segments or not len(idx):
+                continue
+            g = gk[idx] % self.max_gp
+            X = H[P.nodes[sel[idx]]]
+            pm = {k: (v[idx] if np.ndim(v) else v) for k, v in p.items()}
+
+            def forces(rows, xi):
+                q = {k: (v[rows] if np.ndim(v) else v) for k, v in pm.items()}
+                q["xi1"] = xi
+                fk = self._kernels(X[rows], q, P.decl[sel[idx[rows]]], False, friction=friction[idx[rows]])[0]
+                return -fk.reshape(len(rows), 24)
+
+            rows, terms = segment_tangent.end_terms(X, pm["xi1"], pm["weight"], d.seg_gauss[0][g], d.seg_gauss[1][g],
+                                                    self.sys.L[P.e[sel[idx]]], f[idx].reshape(len(idx), 24), forces)
+            K[idx[rows]] += terms
 
     def overlap(self, H):
         """Initial overlaps at poses ``H``: ``None`` when no pair penetrates by more than
@@ -777,6 +845,8 @@ class ContactSystem(Contribution):
         if blocks is None:
             return Blocks.empty(4, tangent), dict(n_active=0)
         P, sel, p, f, K, out = blocks
+        if tangent and K is not None and "segment_ends" in out:
+            self._segment_ends(H, P, sel, p, f, K, out.pop("segment_ends"))
         info = dict(n_active=len(sel))
         if "mortar" in out:
             b = _with_mortar(P.nodes[sel], f.reshape(-1, 24), K if tangent else None, out["mortar"])

@@ -16,7 +16,8 @@ import numpy as np
 from ..errors import InputError
 from .validation import count, real
 
-__all__ = ["ContactOptions", "check_contact_options", "describe", "SMOOTHING", "SLIP_TOLERANCE",
+__all__ = ["ContactOptions", "check_contact_options", "describe", "SMOOTHING", "SLIP_TOLERANCE", "GAUSS_POINTS",
+           "SEGMENT_POINTS",
            "STICK_TOLERANCE", "LINE_ANGLE", "ADJUST", "EXACT_C"]
 
 SMOOTHING = 1e-6          # default smoothing gap of the normal law / (R1 + R2) (benchmarks/touching_defaults.py)
@@ -24,12 +25,15 @@ SLIP_TOLERANCE = 0.005    # elastic slip at the onset of sliding / slave element
 EXACT_C = 24.0            # stick="exact": default c of the complementarity function / (EI / L_e^4) of the slave
 STICK_TOLERANCE = 1e-8    # weighted slip of a sticking node / (R1 + R2) with stick="exact"
 LINE_ANGLE = float(np.deg2rad(20.0))   # below this crossing angle: line contact (search.py, rule 1)
+GAUSS_POINTS = 5          # integration="points": Gauss points per slave element
+SEGMENT_POINTS = 3        # integration="segments": Gauss points per segment (2 integrate the patch test exactly;
+                          # 3 keep the contact examples' iterations: docs/benchmarks.md, segment-to-segment)
 ADJUST = 1e-3             # default overclosure adjusted away at the reference poses / (R1 + R2)
                           # (chords of a polyline on a post: 1.1e-4 at R1 + R2 = 1.02; docs/theory_adjust.md)
 
 
 def _gauss_points(v, owner):
-    return count(v, "gauss_points", owner, maximum=64)
+    return None if v is None else count(v, "gauss_points", owner, maximum=64)
 
 
 def _line_angle(v, owner):
@@ -50,6 +54,12 @@ def _compiled(f):
     from numba.core import config
     from numba.core.dispatcher import Dispatcher
     return isinstance(f, Dispatcher) or bool(config.DISABLE_JIT)
+
+
+def _integration(v, owner):
+    if v in ("points", "segments"):
+        return v
+    raise InputError(f"{owner}: integration must be 'points' or 'segments', got {v!r}")
 
 
 def _contact_law(v, owner):
@@ -89,7 +99,18 @@ class ContactOptions:
         "gap over which the normal law is made C1 (default None: ``1e-6 (R1 + R2)`` "
         "(``SMOOTHING``) for line contact, so touching, lightly loaded wires converge, and sharp "
         "for point and orthogonal pairs; 0: sharp everywhere)", kernel_none=np.nan)
-    gauss_points: int = option(5, _gauss_points, "integration points per slave element for line contact (5)")
+    gauss_points: Optional[int] = option(
+        None, _gauss_points, "integration points of line contact per segment (``integration=\"segments\"``, "
+        "default 3, ``SEGMENT_POINTS``) or per slave element (``\"points\"`` and orthogonal pairs, default 5, "
+        "``GAUSS_POINTS``)")
+    integration: str = option(
+        "points", _integration,
+        "line contact's integration: ``\"points\"`` (default: ``gauss_points`` fixed per slave element, each "
+        "projected on one master element: the master's shape functions, kinked inside the slave element, "
+        "are integrated inexactly) or ``\"segments\"`` (each slave element cut where its section planes "
+        "pass through the master's nodes, ``gauss_points`` on every piece: the products of slave and master "
+        "shape functions exact on straight beams, the contact patch test passes to round-off; "
+        "docs/theory_mortar.md section 7)")
     penalty_t: Optional[float] = option(
         None, _real("penalty_t", above=0.0, none=True),
         "with ``stick=\"penalty\"``: a fixed tangential penalty, force / length^3, instead of one from "

@@ -6,15 +6,30 @@ import pytest
 
 import beamsolver as bs
 from beamsolver.nonlinear.problem import Problem
-from beamsolver.contact.options import SLIP_TOLERANCE, SMOOTHING, ContactOptions
+from beamsolver.contact.options import GAUSS_POINTS, SEGMENT_POINTS, SLIP_TOLERANCE, SMOOTHING, ContactOptions
 
 
 def test_defaults_live_in_one_place():
     o = ContactOptions.from_dict({})
     assert o == ContactOptions()
-    assert o.slip_tolerance == SLIP_TOLERANCE and o.smoothing is None and o.gauss_points == 5
+    assert o.slip_tolerance == SLIP_TOLERANCE and o.smoothing is None and o.gauss_points is None
+    assert o.integration == "points" and (GAUSS_POINTS, SEGMENT_POINTS) == (5, 3)
     assert o.line_angle == pytest.approx(np.deg2rad(20.0)) and o.margin is None
     assert SMOOTHING >= 0.0
+
+
+@pytest.mark.parametrize("options, n", [({}, (5, 3)), (dict(integration="segments"), (5, 3)),
+                                        (dict(integration="segments", gauss_points=4), (4, 4))])
+def test_gauss_points_default_per_integration(options, n):
+    """``gauss_points=None``: 5 per whole slave element (points; with segments, the orthogonal pairs), 3 per
+    segment."""
+    m = bs.Model()
+    a = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 2), bs.Section.circular(radius=0.01, E=1e9, nu=0.3))
+    b = m.add_beam(bs.geometry.straight((0, 0, 0.02), (1, 0, 0.02), 3), bs.Section.circular(radius=0.01, E=1e9, nu=0.3))
+    m.add_contact(b, a, **options)
+    contact = Problem.from_model(m, check_rigid_modes=False).contact
+    d = contact.decls[0]
+    assert (d.n_gp, d.n_seg) == n and (len(d.gauss[0]), len(d.seg_gauss[0])) == n
 
 
 def test_given_values_are_kept_and_typed():
