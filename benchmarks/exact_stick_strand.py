@@ -37,24 +37,27 @@ def row(elements_per_lay, factor, lays, upto):
     return dict(el=elements_per_lay, penalty="default (24 EI / L_e^4)" if factor is None else f"{factor:g} E",
                 EI0=res["M"][up[0]] / res["kappa"][up[0]], first=first, M=res["M"][up[-1]],
                 Mth=float(np.ravel(sb.moment(res["kappa"][up[-1]], th))[0]), share=res["share"][up[-1]],
-                iterations=res["iterations"], wall=wall, EI_max=th["EI_max"])
+                iterations=res["iterations"], wall=wall, EI_max=th["EI_max"], EI_min=th["EI_min"])
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--meshes", type=int, nargs="+", default=[8, 16, 32])
     ap.add_argument("--penalties", type=float, nargs="+", default=[1.0],
-                    help="penalty_t / E, the complementarity parameter c of the exact stick (1: the default, 1e-3 E)")
+                    help="penalty_t / E, the complementarity parameter c of the exact stick (1: the default, 24 EI / L_e^4)")
     ap.add_argument("--lays", type=float, default=2.0)
     ap.add_argument("--upto", type=float, default=1.6)
     a = ap.parse_args()
-    print("| el/lay | c (penalty_t) | EI initial [N m^2] | first slip / kappa_b | M(end) [N m] | theory [N m] "
-          "| slipping share | Newton it. | wall [s] |")
-    print("|---:|---|---:|---:|---:|---:|---:|---:|---:|")
+    print("| el/lay | c (penalty_t) | EI initial [N m^2] | first slip / kappa_b | first slip / kappa_b of the model "
+          "| M(end) [N m] | theory [N m] | slipping share | Newton it. | wall [s] |")
+    print("|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     for n in a.meshes:
         for f in a.penalties:
             r = row(n, None if f == 1.0 else f, a.lays, a.upto)
-            print(f"| {r['el']} | {r['penalty']} | {r['EI0']:.2f} | {r['first']:.3f} | {r['M']:.4f} | {r['Mth']:.4f} "
+            # the plane-section onset scaled by the model's own stick stiffness: the wires' force gradient at
+            # the neutral axis grows like (EI_stick - EI_min) (docs/theory_strand_bending.md, section 5)
+            own = r["first"] * (r["EI0"] - r["EI_min"]) / (r["EI_max"] - r["EI_min"])
+            print(f"| {r['el']} | {r['penalty']} | {r['EI0']:.2f} | {r['first']:.3f} | {own:.3f} | {r['M']:.4f} | {r['Mth']:.4f} "
                   f"| {r['share']:.3f} | {r['iterations']} | {r['wall']:.1f} |", flush=True)
     print(f"EI_max (plane sections) {r['EI_max']:.1f} N m^2")
 
