@@ -45,8 +45,13 @@ def _rolling():
     return rolling.main()[-1]
 
 
+def _capstan():
+    import capstan
+    return capstan.main()[-1]
+
+
 SCENES = dict(twisted_pair=_twisted_pair, three_wires=_three_wires, shear_lag=_shear_lag,
-              contact_patch=_contact_patch, rolling=_rolling)
+              contact_patch=_contact_patch, rolling=_rolling, capstan=_capstan)
 
 
 def run(scene, stick, c=None):
