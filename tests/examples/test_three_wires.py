@@ -35,3 +35,16 @@ def test_wires_stay_in_touch_and_carry_the_torsion(run):
     on = c["normal_force"] > 0
     assert on.sum() >= 20
     assert np.all(c["gap"][on] > -1e-3 * R) and np.all(c["gap"][on] < 1e-2 * R)
+
+
+def test_exact_stick_needs_no_more_than_half_again_the_penalty_iterations(run):
+    """``stick="exact"`` with its default ``c`` (``24 EI / L_e^4`` of the slave: 22 Newton iterations here;
+    ``1e-3`` of the normal penalty, the previous default, took 52) against the penalty stick's 21."""
+    sol, _ = run
+    exact, _ = three_wires.main(turns=TURNS, steps=2, n_elements=8, length=L, stick="exact")
+    n_pen = sum(s["iterations"] for s in sol.stats)
+    n_exact = sum(s["iterations"] for s in exact.stats)
+    assert exact.converged and n_exact <= 1.5 * n_pen, (n_exact, n_pen)
+    # the same torque: the friction state differs (no elastic slip), the wires' torsion dominates
+    _, plate, _ = three_wires.build(n_elements=8, length=L, turns=TURNS)
+    assert exact.reaction(plate)[5] == pytest.approx(sol.reaction(plate)[5], rel=1e-2)
