@@ -23,14 +23,14 @@ first slip ``kappa_b = mu F sin b / (E A_w cos^2 b r)``; slipping share ``2 psi 
 
 Stick: by default the Gauss-point penalty with ``slip_tolerance`` 5e-6 element lengths (with the
 default 0.005 the strand does not stick at all); ``--stick exact`` (``run(stick="exact")``) uses the
-mortar nodal multipliers (docs/theory_mortar.md), whose full-stick branch does not depend on a
-penalty: initial stiffness 91.0-93.3 N m^2 at 8-32 el/lay, the same to four digits with a ten times
-stiffer augmentation penalty, about 12 % below the plane-section ``EI_max`` (the wires stick at their
-surface, a lever arm ``R_w`` from their axes, and bend under the friction's moment; tying the axes
-rigidly to the core gives ``EI_max``), first slip at 1.05-1.15 ``kappa_b``.  It is not the default
-yet: its augmented-Lagrangian updates do not meet the stick tolerance in 30 updates on the cyclic
-run's 1.25 ``kappa_b`` steps (docs/theory_mortar.md, section 5).  The full-slip quantities (``M_f``,
-the Masing branch at the end of a half cycle, the loop energy) need only Coulomb's limit.
+mortar nodal multipliers as Newton unknowns (docs/theory_mortar.md), whose stick state does not depend
+on a penalty: initial stiffness 90.9-91.1 N m^2 at 24-48 el/lay, about 12 % below the plane-section
+``EI_max`` (the wires stick at their surface, a lever arm ``R_w`` from their axes, and turn under the
+friction's moment; tying the axes rigidly to the core gives ``EI_max``), first slip at 1.15
+``kappa_b``, which is where the model's own stick stiffness puts it (docs/theory_strand_bending.md,
+section 5); beyond 2 ``kappa_b`` the moment is within 2.1 % of the theory at 16 el/lay, 1.4 % at 24.  At this
+script's default 8 el/lay the linear nodal tractions smear the friction's reversal at the neutral axis
+over an element (``M_f`` 6 % low), so exact stick wants 16 el/lay or more.
 ``tied=True`` ties the wires rigidly to the core (no contact) to measure the beam model's own
 full-stick stiffness (shear and torsion of the wires included) against ``EI_max``.
 
