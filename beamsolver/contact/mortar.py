@@ -22,8 +22,21 @@ point terms come from the compiled kernel (``kernel_jit.mortar_terms``); the com
 import numpy as np
 
 from ..lie import se3
+from . import mortar_jit
 
 __all__ = ["groups", "return_mapping", "nodal_state", "group_forces", "blocks", "multiplier_blocks"]
+
+# the scatters of the points' rows into their groups: compiled (``mortar_jit``), or their numpy oracle
+_COMPILED = dict(rows=mortar_jit.scatter_rows, block=mortar_jit.scatter_block, columns=mortar_jit.scatter_columns)
+_NUMPY = dict(rows=mortar_jit.scatter_rows_numpy, block=mortar_jit.scatter_block_numpy,
+              columns=mortar_jit.scatter_columns_numpy)
+_SCATTER = dict(_COMPILED)
+
+
+def use_numpy_scatter(flag=True):
+    """The numpy oracle of the scatters (``np.add.at``) instead of the compiled ones (tests, benchmarks)."""
+    _SCATTER.update(_NUMPY if flag else _COMPILED)
+
 
 def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=None):
     """Nodal groups (one slave node against one master beam) of ``P`` points.
@@ -136,9 +149,7 @@ def group_forces(G, f_points):
     """The points' forces ``(P, 24)`` on the groups of their node A, ``(n, 6 k)`` (rows over the group's slots)."""
     n, k = G["members"].shape
     gA, rowsA = _slots(G, 0)
-    f = np.zeros((n, 6 * k))
-    np.add.at(f, (gA[:, None], rowsA), f_points)
-    return f
+    return _SCATTER["rows"](np.zeros((n, 6 * k)), gA, rowsA, f_points)
 
 
 def _point_parts(G, d):
@@ -148,12 +159,11 @@ def _point_parts(G, d):
     n, k = G["members"].shape
     gA, rowsA = _slots(G, 0)
     f = group_forces(G, d["f"])
-    K = np.zeros((n, 6 * k, 6 * k))
-    np.add.at(K, (gA[:, None, None], rowsA[:, :, None], rowsA[:, None, :]), d["dfdq"])
+    K = _SCATTER["block"](np.zeros((n, 6 * k, 6 * k)), gA, rowsA, d["dfdq"])
     A = np.zeros((n, 6 * k, 3))
     for a in range(2):
         g, rows = _slots(G, a)
-        np.add.at(A, (g[:, None], rows), G["phi"][:, a, None, None] * d["G"])
+        _SCATTER["rows"](A, g, rows, d["G"], G["phi"][:, a])
     return f, K, A
 
 
@@ -169,7 +179,7 @@ def _trial_rows(G, d, st, eps, mu):
             wgn[:, None, None] * np.einsum("pij,pjq->piq", st["Q"][g], d["dn"])
         dlam = np.einsum("pij,pjq->piq", st["C"][g], dtrial) + \
             (mu[g] * wg)[:, None, None] * st["c"][g][:, :, None] * d["dlam_n"][:, None, :]
-        np.add.at(B, (g[:, None, None], np.arange(3)[None, :, None], rows[:, None, :]), dlam)
+        _SCATTER["columns"](B, g, rows, dlam)
     return B
 
 
@@ -182,8 +192,7 @@ def _turn(G, R, Lam):
 
 def _add_columns(M, cols, V):
     """``M[g][:, cols[g]] += V[g]`` for ``M`` ``(n, r, c)``, ``cols`` ``(n, 3)``, ``V`` ``(n, r, 3)``."""
-    n, r = M.shape[:2]
-    np.add.at(M, (np.arange(n)[:, None, None], np.arange(r)[None, :, None], cols[:, None, :]), V)
+    _SCATTER["columns"](M, np.arange(len(M)), cols, V)
 
 
 def blocks(G, d, st, R, Lam, eps, mu):
