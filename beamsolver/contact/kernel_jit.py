@@ -1069,7 +1069,8 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
     """``_point`` of the mortar kernel at the four given tractions ``T = 0, e_x, e_y, e_z`` (``mortar_terms``):
     the geometry, projection, slip and their gradients once, then per traction what depends on it (the
     friction force, wrenches and nodal rows), each the same operations as a ``_point`` call with that
-    traction; ``f[q, p]`` ``(4, 6)``, ``K[q, p]`` ``(24, 24)`` (``q``: the traction); the point data as the last call left them;
+    traction; ``f[q, p]`` ``(4, 6)``, ``K[q, p]`` ``(24, 24)`` (``q``: the traction; ``q`` = 1, 2, 3 less those
+    of ``q`` = 0 at the end, ``mortar_terms``' differences); the point data as the last call left them;
     ``rows`` ``(N_ROWS, 24)``: the gradient rows (``_evaluate_rows``).  A template (``make_kernel``)."""
     S, v, G, cache = ws
     side1, side2 = _element_side(Xp, 0, S[0], cache[0]), _element_side(Xp, 2, S[1], cache[1])
@@ -1122,11 +1123,19 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
             vec[0, i], vec[1, i], vec[2, i], vec[3, i], vec[4, i], vec[5, i] = n[i], t1[i], t2[i], xC[i], xF[i], F[i]
         two[0, 0], two[0, 1], two[1, 0], two[1, 1] = lt[0], lt[1], slip[0], slip[1]
         flags[0], flags[1] = active, stick
+    for q in range(1, 4):               # the differences to T = 0: the friction's parts (``mortar_terms``)
+        fq, Kq, f0, K0 = f[q, p], K[q, p], f[0, p], K[0, p]
+        for i in range(4):
+            for j in range(6):
+                fq[i, j] -= f0[i, j]
+        for i in range(24):
+            for j in range(24):
+                Kq[i, j] -= K0[i, j]
 
 
 def _evaluate_mortar(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows):
-    """``_point_mortar`` over all pairs: ``f`` ``(4, P, 4, 6)``, ``K`` ``(4, P, 24, 24)`` at the four
-    tractions, the point data and the gradient rows ``(P, N_ROWS, 24)``.  A template of the mortar kernel
+    """``_point_mortar`` over all pairs: ``f`` ``(4, P, 4, 6)``, ``K`` ``(4, P, 24, 24)`` at ``T = 0`` and the
+    differences to it at the three others, the point data and the gradient rows ``(P, N_ROWS, 24)``.  A template of the mortar kernel
     (``make_kernel(law, mortar=True)``)."""
     own = _scratch()
     ws = (_borrowed(own[0]), _borrowed(own[1]), _borrowed(own[2]), _borrowed(own[3]))
@@ -1301,7 +1310,7 @@ def mortar_terms(X, p, law=None):
     sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
     flags, frames, rows = np.empty((P, 2), dtype=np.bool_), np.empty((P, 4, 4, 4)), np.empty((P, N_ROWS, 24))
     kern(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows)
-    return _mortar_terms(P, f, K, sc, vec, two, flags, frames, rows)
+    return _mortar_terms(P, f[1:], K[1:], sc, vec, two, flags, frames, rows)
 
 
 def mortar_terms_four(X, p, law=None):
@@ -1329,14 +1338,14 @@ def mortar_terms_four(X, p, law=None):
             lamp[:, k - 1] = 1.0
         kern(X, kind, par, has, HCL, HFK, HLKp, lamp, True, f[k], K[k], sc, vec, two, flags, frames,
              rows if k == 0 else junk)
-    return _mortar_terms(P, f, K, sc, vec, two, flags, frames, rows)
+    return _mortar_terms(P, f[1:] - f[0], K[1:] - K[0], sc, vec, two, flags, frames, rows)
 
 
-def _mortar_terms(P, f, K, sc, vec, two, flags, frames, rows):
-    """``mortar_terms``' dict from the forces ``f`` ``(4, P, 4, 6)`` and tangents ``K`` ``(4, P, 24, 24)`` at the
-    four tractions and the kernel's point data."""
-    A = np.transpose(f[1:] - f[0], (1, 2, 3, 0)).reshape(P, 24, 3)
-    dK = np.transpose(K[1:] - K[0], (1, 0, 2, 3))
+def _mortar_terms(P, df, dK, sc, vec, two, flags, frames, rows):
+    """``mortar_terms``' dict from the differences of the forces ``df`` ``(3, P, 4, 6)`` and tangents ``dK``
+    ``(3, P, 24, 24)`` at ``T = e_x, e_y, e_z`` to those at ``T = 0`` and the kernel's point data."""
+    A = np.transpose(df, (1, 2, 3, 0)).reshape(P, 24, 3)
+    dK = np.transpose(dK, (1, 0, 2, 3))
     n, t1, t2, s = vec[:, 0], vec[:, 1], vec[:, 2], two[:, 1]
     dn, dt1, dt2 = rows[:, 0:3], rows[:, 3:6], rows[:, 6:9]
     S = s[:, :1] * t1 + s[:, 1:] * t2
