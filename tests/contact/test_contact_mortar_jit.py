@@ -66,3 +66,31 @@ def test_the_mortar_blocks_are_those_of_the_numpy_scatters():
     out = mortar.multiplier_blocks(*args), mortar.blocks(*args)
     for a, b in zip(ref[0] + ref[1], out[0] + out[1]):
         assert np.array_equal(a, b)
+
+
+def test_groups_are_kept_while_the_pairs_nodes_hold():
+    """``mortar.Groups``: the groups of ``mortar.groups`` for new ``xi1`` on the same pairs (one build), built
+    again when a pair's nodes or its held flags change."""
+    from beamsolver.contact import mortar
+    rng = np.random.default_rng(2)
+    P, n_nodes = 30, 10
+    slave = np.sort(rng.choice(n_nodes, (P, 2)), axis=1)
+    nodes = np.concatenate([slave, rng.integers(0, n_nodes, (P, 2))], axis=1)
+    beam, decl, held = rng.integers(0, 2, P), np.zeros(P, int), rng.random((P, 2)) < 0.2
+    keep = mortar.Groups()
+
+    def check(*args):
+        ref, out = mortar.groups(*args), keep(*args)
+        assert set(ref) == set(out)
+        for k in ref:
+            assert np.array_equal(ref[k], out[k]), k
+    for _ in range(3):
+        check(slave, rng.uniform(0, 1, P), beam, decl, nodes, n_nodes, 2, held)
+    assert keep.builds == 1
+    nodes = nodes.copy()
+    nodes[0, 3] = (nodes[0, 3] + 1) % n_nodes
+    check(slave, rng.uniform(0, 1, P), beam, decl, nodes, n_nodes, 2, held)
+    held = held.copy()
+    held[1] = ~held[1]
+    check(slave, rng.uniform(0, 1, P), beam, decl, nodes, n_nodes, 2, held)
+    assert keep.builds == 3
