@@ -1,7 +1,8 @@
 """Exact stick's cost per Newton iteration against the penalty stick (issue 26, speed): the main job
 (``examples/twisted_pair.py``, 16 steps: Newton iterations, warm solve CPU time, ms per iteration) and one Newton
 iteration of the 19-wire bundle (``scaling.bundle_model`` at ``scaling_scenes.PER_WIRE``, its reference poses:
-evaluation, tangent (bordered with the multipliers for exact stick), factorisation and solve, CPU s).
+evaluation, tangent (bordered with the multipliers for exact stick), factorisation and solve, CPU s, and
+these parts).
 
     python benchmarks/exact_stick_speed.py [--scenes twisted_pair bundle19] [--repeat 3] [--profile]
 
@@ -64,9 +65,12 @@ def twisted_pair():
     return int(sum(s["iterations"] for s in sol.stats)), time.process_time() - t0
 
 
+PARTS = {}       # the last bundle19 iteration by parts (CPU s)
+
+
 def bundle19():
-    """``(1, CPU s)`` of one Newton iteration of the 19-wire bundle at its reference poses (second of two:
-    patterns and the solver's analysis in place)."""
+    """``(1, CPU s)`` of one Newton iteration of the 19-wire bundle at its reference poses (the best of three:
+    patterns and the solver's analysis in place); its parts in ``PARTS``."""
     import scaling_scenes
     from scaling import bundle_model
     m, _ = bundle_model(scaling_scenes.PER_WIRE, n_layers=2)
@@ -77,14 +81,20 @@ def bundle19():
     best = np.inf
     for _ in range(3):
         problem.begin_step(H, 0.0)
-        t0 = time.process_time()
+        t = [time.process_time()]
         ev = problem.evaluate(H, 1.0, tangent=True)
+        t.append(time.process_time())
         K = problem.tangent(ev)
         rhs = -ev.r[system.free_dofs]
         if ev.mult is not None:
             K, rhs = problem.bordered(ev, K, rhs)
-        solver.factorize(K).solve(rhs)
-        best = min(best, time.process_time() - t0)
+        t.append(time.process_time())
+        linsolve.factorize_tangent(K, solver, saddle=ev.mult is not None).solve(rhs)
+        t.append(time.process_time())
+        if t[-1] - t[0] < best:
+            best = t[-1] - t[0]
+            PARTS.update(evaluate=t[1] - t[0], matrix=t[2] - t[1], solve=t[3] - t[2], unknowns=K.shape[0],
+                         nnz=K.nnz)
     solver.close()
     return 1, best
 
@@ -110,7 +120,10 @@ def main():
             its, t = runs[0][0], min(r[1] for r in runs)
             ms = 1e3 * t / max(its, 1)
             ref = ms if ref is None else ref
-            print(f"| {scene} | {name} | {its} | {t:.3f} | {ms:.2f} | {ms / ref:.2f} |", flush=True)
+            parts = "" if scene != "bundle19" else (
+                f" (evaluation {PARTS['evaluate']:.3f}, matrix {PARTS['matrix']:.3f}, factorisation and solve "
+                f"{PARTS['solve']:.3f}; {PARTS['unknowns']} unknowns, {PARTS['nnz']} non-zeros)")
+            print(f"| {scene} | {name} | {its} | {t:.3f}{parts} | {ms:.2f} | {ms / ref:.2f} |", flush=True)
         if a.profile:
             with mode("exact"):
                 pr = cProfile.Profile()

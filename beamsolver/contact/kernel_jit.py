@@ -55,6 +55,7 @@ from numba.extending import intrinsic
 
 from .._jit import jit, jit_callee
 from ..errors import InputError
+from ..model.buffers import BufferPool
 from ..elements.element_jit import _dq_du, _dq_dw
 from ..lie.se3_jit import madd, mscale
 from ..lie.se3_jit import A_, B_, C_, CP_, D_, Q2P_, Q2_, Q3P_, Q3_, add, add_outer, coefficient, cross, dot, log_relative, mat, mm, mv, q_matrix, scale, ti_matrix, transpose
@@ -1291,6 +1292,9 @@ def contact_kernel(X, p, friction=True, law=None):
     return f, out
 
 
+_MORTAR_POOL = BufferPool()      # ``mortar_terms``' tangent buffers (free again once its results are dropped)
+
+
 def mortar_terms(X, p, law=None):
     """Point terms of the mortar friction (``mortar.py``) from the compiled mortar kernel.
 
@@ -1306,7 +1310,9 @@ def mortar_terms(X, p, law=None):
     P = X.shape[0]
     kind, par, has, (HCL, HFK, HLKp), _ = _table(X, p)
     kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar=True)
-    f, K = np.empty((4, P, 4, 6)), np.empty((4, P, 24, 24))
+    # the tangents into kept memory (4.6 kB a point and traction; fresh memory's page faults cost about as much
+    # as the kernel on the 19-wire bundle), a contiguous (4, P, 24, 24) prefix as ``np.empty`` would give
+    f, K = np.empty((4, P, 4, 6)), _MORTAR_POOL.take((4 * P * 576,)).reshape(4, P, 24, 24)
     sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
     flags, frames, rows = np.empty((P, 2), dtype=np.bool_), np.empty((P, 4, 4, 4)), np.empty((P, N_ROWS, 24))
     kern(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows)

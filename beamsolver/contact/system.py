@@ -197,6 +197,7 @@ class ContactSystem(Contribution):
         self._geo = self._geo_prev = None    # (poses, element twists) of the last evaluation / of H_prev
         self._blocks = None        # (poses, local blocks) of the last evaluation, for the same state
         self._tangent_pool = BufferPool()     # tangent buffers of the compiled kernel (``_tangent_out``)
+        self._mortar_pool = BufferPool()      # tangent blocks of pairs and mortar groups (``_with_mortar``)
         self.timings = dict.fromkeys(TIMED, 0.0)
         self._clock = time.process_time()
         self._penalties = conditioning.penalty_ratios(model, system)
@@ -780,7 +781,8 @@ class ContactSystem(Contribution):
         P, sel, p, f, K, out = blocks
         info = dict(n_active=len(sel))
         if "mortar" in out:
-            b = _with_mortar(P.nodes[sel], f.reshape(-1, 24), K if tangent else None, out["mortar"])
+            b = _with_mortar(P.nodes[sel], f.reshape(-1, 24), K if tangent else None, out["mortar"],
+                             self._mortar_pool)
             if out["mortar"]["mult"] is not None:
                 info["multipliers"] = out["mortar"]["mult"]
         else:
@@ -995,9 +997,11 @@ def _extent(H):
     """Largest node coordinate of the poses ``H`` (``frames.touch_tolerance``)."""
     return float(np.abs(H[..., :3, 3]).max(initial=0.0))
 
-def _with_mortar(nodes, f, K, m):
+def _with_mortar(nodes, f, K, m, pool=None):
     """The pairs' 4-node blocks and the mortar groups' blocks (``ContactSystem._mortar``) as one
-    ``Blocks`` over the groups' ``k`` nodes: the pair blocks padded with their first node (zero rows)."""
+    ``Blocks`` over the groups' ``k`` nodes: the pair blocks padded with their first node (zero rows).
+    ``pool``: a ``BufferPool`` the tangent blocks go to (kept memory: on the 19-wire bundle the fresh
+    ``(m, 6 k, 6 k)`` array's page faults cost 2.5 s an evaluation), else a new array."""
     k = m["members"].shape[1]
     n = len(nodes)
     nodes = np.concatenate([np.concatenate([nodes, np.repeat(nodes[:, :1], k - 4, axis=1)], axis=1), m["members"]])
@@ -1005,9 +1009,12 @@ def _with_mortar(nodes, f, K, m):
     fa[:, :24] = f
     if K is None:
         return Blocks(nodes, np.concatenate([fa, m["f"]]))
-    Ka = np.zeros((n, 6 * k, 6 * k))
-    Ka[:, :24, :24] = K
-    return Blocks(nodes, np.concatenate([fa, m["f"]]), np.concatenate([Ka, m["K"]]))
+    shape = (n + len(m["K"]), 6 * k, 6 * k)
+    Ka = np.empty(shape) if pool is None else pool.take(shape)
+    Ka[:n] = 0.0
+    Ka[:n, :24, :24] = K
+    Ka[n:] = m["K"]
+    return Blocks(nodes, np.concatenate([fa, m["f"]]), Ka)
 
 
 def _kernel(kernel, X, p, friction, law, tangent, K=None):
