@@ -17,7 +17,9 @@ against one master beam; with the linear slave shape functions ``Phi_j`` (``1 - 
 Augmented-Lagrangian updates ``Lam_g <- R_j^T lam_g`` repeat the step until every sticking group's
 ``|u_g|`` is below the tolerance (``ContactSystem.augment``).  All functions are batched numpy; the
 point terms come from the compiled kernel (``kernel_jit.mortar_terms``); the complex-step numpy forms
-(``reference.mortar_point_friction``, ``mortar_point_derivatives``) are their oracle.
+(``reference.mortar_point_friction``, ``mortar_point_derivatives``) are their oracle.  The points' rows go
+to their groups by compiled scatters (``mortar_jit``; ``use_numpy_scatter``: their ``np.add.at`` oracle);
+``Groups`` keeps the groups while a Newton step's pairs hold.
 """
 import numpy as np
 
