@@ -10,7 +10,7 @@ from beamsolver import _jit
 from beamsolver.lie import se3_jit
 
 PACKAGE = Path(_jit.__file__).resolve().parent
-TEMPLATES = {"_friction", "_point", "_evaluate", "_evaluate_rows"}   # kernel_jit's templates, compiled by make_kernel
+TEMPLATES = {"_friction", "_point", "_evaluate", "_evaluate_rows", "_point_mortar", "_evaluate_mortar"}   # kernel_jit's templates, compiled by make_kernel
 
 
 def _module(p):

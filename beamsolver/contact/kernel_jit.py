@@ -55,6 +55,7 @@ from numba.extending import intrinsic
 
 from .._jit import jit, jit_callee
 from ..errors import InputError
+from ..model.buffers import BufferPool
 from ..elements.element_jit import _dq_du, _dq_dw
 from ..lie.se3_jit import madd, mscale
 from ..lie.se3_jit import A_, B_, C_, CP_, D_, Q2P_, Q2_, Q3P_, Q3_, add, add_outer, coefficient, cross, dot, log_relative, mat, mm, mv, q_matrix, scale, ti_matrix, transpose
@@ -1065,10 +1066,91 @@ def _evaluate_rows(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, 
     own[0][0, 0, 0, 0] = 0.0
 
 
+def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, flags, frames, ws, rows):
+    """``_point`` of the mortar kernel at the four given tractions ``T = 0, e_x, e_y, e_z`` (``mortar_terms``):
+    the geometry, projection, slip and their gradients once, then per traction what depends on it (the
+    friction force, wrenches and nodal rows), each the same operations as a ``_point`` call with that
+    traction; ``f[q, p]`` ``(4, 6)``, ``K[q, p]`` ``(24, 24)`` (``q``: the traction; ``q`` = 1, 2, 3 less those
+    of ``q`` = 0 at the end, ``mortar_terms``' differences); the point data as the last call left them;
+    ``rows`` ``(N_ROWS, 24)``: the gradient rows (``_evaluate_rows``).  A template (``make_kernel``)."""
+    S, v, G, cache = ws
+    side1, side2 = _element_side(Xp, 0, S[0], cache[0]), _element_side(Xp, 2, S[1], cache[1])
+    RA1, xA1, u1, w1 = side1
+    RA2, xA2, u2, w2 = side2
+    xi1, xi2 = _project(kind, RA1, xA1, u1, w1, par[XI1], RA2, xA2, u2, w2, par[XI2])
+    co1, co2 = _coefficients(scale(xi1, w1)), _coefficients(scale(xi2, w2))
+    RC, xC, _, _ = _section_co(RA1, xA1, u1, w1, xi1, co1[0], co1[1])
+    RF, xF, _, _ = _section_co(RA2, xA2, u2, w2, xi2, co2[0], co2[1])
+    S1, S2 = S[0], S[1]
+    _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, G)
+    n, t1, t2, dist = _axes(RC, xC, RF, xF, G)
+    R1, R2, wgt = par[R1_], par[R2_], par[WEIGHT]
+    gap = dist - R1 - R2
+    touching = 0.0 < gap <= par[TOUCH]          # round-off of a touching pair's gap: touching (reference.touching_gap)
+    lam, dlam, active = _normal_law(0.0 if touching else gap, par[PENALTY], par[MULT], par[SMOOTH])  # make_kernel
+    for k in range(24):
+        G[G_DLAM * W + k] = dlam * G[G_DDIST * W + k]
+    slip = (0.0, 0.0)
+    if has:         # writes all 24 columns of the slip gradient
+        slip = _slip(side1, side2, S1, S2, (xi1, RC, xC), (xi2, RF, xF), par[XI1P], par[XI2P], HCL, HFK, HLKp,
+                     G[G_DSLIP * W:(G_DSLIP + 2) * W].reshape((2, W)))
+    else:
+        for a in range(2):
+            for k in range(24):
+                G[(G_DSLIP + a) * W + k] = 0.0
+    for k in range(24):
+        for i in range(9):
+            rows[i, k] = G[(G_DN + i) * W + k]
+        rows[9, k] = G[G_DSLIP * W + k]
+        rows[10, k] = G[(G_DSLIP + 1) * W + k]
+        rows[11, k] = G[G_DLAM * W + k]
+    for q in range(4):
+        lamp = (1.0 if q == 1 else 0.0, 1.0 if q == 2 else 0.0, 1.0 if q == 3 else 0.0)
+        F = scale(-wgt * lam, n)
+        for k in range(24):
+            for i in range(3):
+                G[(G_DF + i) * W + k] = -wgt * (n[i] * G[G_DLAM * W + k] + lam * G[(G_DN + i) * W + k])
+        lt, Dlt, stick = _friction_given(slip, lamp, t1, t2, lam, par, G)
+        F = _add_friction_force(F, G, wgt, lt, Dlt, t1, t2)
+        _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2)
+        mF = cross(n, F)
+        _moment_gradient(n, F, G)
+        _wrench(RC, F, False, scale(R1, mF), R1, G, G_VC, G_DWC, v[0, V_WR])
+        _wrench(RF, scale(-1.0, F), True, scale(R2, mF), R2, G, G_VF, G_DWF, v[1, V_WR])
+        _nodal(u1, w1, xi1, co1[0], co1[1], S1, v[0], cache[0], G, G_DWC, G_DH1, G_DXI1, f[q, p], K[q, p], 0)
+        _nodal(u2, w2, xi2, co2[0], co2[1], S2, v[1], cache[1], G, G_DWF, G_DH2, G_DXI2, f[q, p], K[q, p], 2)
+        sc[0], sc[1], sc[2], sc[3] = gap, lam, xi1, xi2
+        for i in range(3):
+            vec[0, i], vec[1, i], vec[2, i], vec[3, i], vec[4, i], vec[5, i] = n[i], t1[i], t2[i], xC[i], xF[i], F[i]
+        two[0, 0], two[0, 1], two[1, 0], two[1, 1] = lt[0], lt[1], slip[0], slip[1]
+        flags[0], flags[1] = active, stick
+    for q in range(1, 4):               # the differences to T = 0: the friction's parts (``mortar_terms``)
+        fq, Kq, f0, K0 = f[q, p], K[q, p], f[0, p], K[0, p]
+        for i in range(4):
+            for j in range(6):
+                fq[i, j] -= f0[i, j]
+        for i in range(24):
+            for j in range(24):
+                Kq[i, j] -= K0[i, j]
+
+
+def _evaluate_mortar(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows):
+    """``_point_mortar`` over all pairs: ``f`` ``(4, P, 4, 6)``, ``K`` ``(4, P, 24, 24)`` at ``T = 0`` and the
+    differences to it at the three others, the point data and the gradient rows ``(P, N_ROWS, 24)``.  A template of the mortar kernel
+    (``make_kernel(law, mortar=True)``)."""
+    own = _scratch()
+    ws = (_borrowed(own[0]), _borrowed(own[1]), _borrowed(own[2]), _borrowed(own[3]))
+    for p in range(X.shape[0]):
+        _point_mortar(X[p], kind[p], par[p], has[p], HCL[p], HFK[p], HLKp[p], f, K, p, sc[p], vec[p], two[p],
+                      flags[p], frames[p], ws, rows[p])
+    own[0][0, 0, 0, 0] = 0.0
+
+
 # ---------------------------------------------------------------- the kernel of a contact law
 _LAW_PATH = ("_friction", "_point", "_evaluate")      # the templates on the call path to the law, callee first
-_MORTAR_PATH = ("_point", "_evaluate_rows")          # the mortar kernel's (``_friction`` is ``_friction_given``)
-_TEMPLATES = {name: globals()[name] for name in _LAW_PATH + _MORTAR_PATH[1:]}
+_MORTAR_PATH = ("_point", "_evaluate_rows")          # the four-call mortar kernel's (``_friction`` is ``_friction_given``)
+_MORTAR_ONCE_PATH = ("_point_mortar", "_evaluate_mortar")   # the mortar kernel's: the geometry once per point
+_TEMPLATES = {name: globals()[name] for name in _LAW_PATH + _MORTAR_PATH[1:] + _MORTAR_ONCE_PATH}
 _KERNELS = {}
 
 
@@ -1094,21 +1176,24 @@ def make_kernel(law, mortar=False):
     the name ``<template>__<law name>_<code digest>``: numba's disk cache (``cache=True``) keys
     on that name and the template's source file, so each law's kernel compiles once per machine
     and loads from the cache afterwards (closures or functions passed as arguments are
-    recompiled in every process with numba 0.68).
+    recompiled in every process with numba 0.68).  ``mortar``: the mortar kernel (``_evaluate_mortar``, the
+    geometry once per point for the four tractions of ``mortar_terms``), ``"four"``: its former form, one
+    ``_evaluate_rows`` call per traction (``mortar_terms_four``, the oracle).
     """
     key = f"{'mortar_' if mortar else ''}{law.name}_{_digest(law)}"
-    if key not in _KERNELS:
+    path = _LAW_PATH if not mortar else _MORTAR_PATH if mortar == "four" else _MORTAR_ONCE_PATH
+    if (key, path) not in _KERNELS:
         glb = dict(globals(), _normal_law=law.normal, _tangential_law=law.tangential)
         if mortar:
             glb["_friction"] = _friction_given
             glb["_EVERYWHERE"] = True      # the nodal traction field acts over the whole projected overlap
-        for name in _MORTAR_PATH if mortar else _LAW_PATH:
+        for name in path:
             t = _TEMPLATES[name]
             f = types.FunctionType(t.__code__, glb, f"{name}__{key}", t.__defaults__)
             f.__qualname__, f.__doc__ = f.__name__, t.__doc__
-            glb[name] = jit(f) if name in ("_evaluate", "_evaluate_rows") else jit_callee(f)
-        _KERNELS[key] = glb["_evaluate_rows" if mortar else "_evaluate"]
-    return _KERNELS[key]
+            glb[name] = jit(f) if name == path[-1] else jit_callee(f)
+        _KERNELS[key, path] = glb[path[-1]]
+    return _KERNELS[key, path]
 
 
 evaluate = make_kernel(PENALTY_COULOMB)
@@ -1207,8 +1292,35 @@ def contact_kernel(X, p, friction=True, law=None):
     return f, out
 
 
+_MORTAR_POOL = BufferPool()      # ``mortar_terms``' tangent buffers (free again once its results are dropped)
+
+
 def mortar_terms(X, p, law=None):
     """Point terms of the mortar friction (``mortar.py``) from the compiled mortar kernel.
+
+    A point's friction force is linear in the global traction ``T`` (force per length) it is given:
+    ``f = A T`` and, at fixed ``T``, ``df/dq = sum_k T_k dK_k``.  Four tractions (``T = 0, e_x, e_y,
+    e_z``; the normal part cancels in the differences; one compiled pass, the geometry once per point) give ``A`` ``(P, 24, 3)`` and ``dK``
+    ``(P, 3, 24, 24)``; the first also gives the slip ``S = s1 t1 + s2 t2`` ``(P, 3)`` (global) and
+    ``dS`` ``(P, 3, 24)``, ``lam_n`` ``(P,)``, ``dlam_n`` ``(P, 24)``, ``n``, ``t1``, ``t2`` ``(P, 3)``, ``dn``
+    ``(P, 3, 24)``, ``slip`` ``(P, 2)``, ``HL``, ``HK`` ``(P, 4, 4)``, ``active`` ``(P,)``.  Columns as in
+    ``kernel_and_tangent`` (body increments of the nodes A1, B1, A2, B2).
+    """
+    X = np.ascontiguousarray(X, dtype=float)
+    P = X.shape[0]
+    kind, par, has, (HCL, HFK, HLKp), _ = _table(X, p)
+    kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar=True)
+    # the tangents into kept memory (4.6 kB a point and traction; fresh memory's page faults cost about as much
+    # as the kernel on the 19-wire bundle), a contiguous (4, P, 24, 24) prefix as ``np.empty`` would give
+    f, K = np.empty((4, P, 4, 6)), _MORTAR_POOL.take((4 * P * 576,)).reshape(4, P, 24, 24)
+    sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
+    flags, frames, rows = np.empty((P, 2), dtype=np.bool_), np.empty((P, 4, 4, 4)), np.empty((P, N_ROWS, 24))
+    kern(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows)
+    return _mortar_terms(P, f[1:], K[1:], sc, vec, two, flags, frames, rows)
+
+
+def mortar_terms_four(X, p, law=None):
+    """``mortar_terms`` by four calls of the point kernel (``make_kernel(law, mortar="four")``): its oracle.
 
     A point's friction force is linear in the global traction ``T`` (force per length) it is given:
     ``f = A T`` and, at fixed ``T``, ``df/dq = sum_k T_k dK_k``.  Four evaluations (``T = 0, e_x, e_y,
@@ -1221,7 +1333,7 @@ def mortar_terms(X, p, law=None):
     X = np.ascontiguousarray(X, dtype=float)
     P = X.shape[0]
     kind, par, has, (HCL, HFK, HLKp), _ = _table(X, p)
-    kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar=True)
+    kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar="four")
     f, K = np.empty((4, P, 4, 6)), np.empty((4, P, 24, 24))
     sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
     flags, frames, rows = np.empty((P, 2), dtype=np.bool_), np.empty((P, 4, 4, 4)), np.empty((P, N_ROWS, 24))
@@ -1232,8 +1344,14 @@ def mortar_terms(X, p, law=None):
             lamp[:, k - 1] = 1.0
         kern(X, kind, par, has, HCL, HFK, HLKp, lamp, True, f[k], K[k], sc, vec, two, flags, frames,
              rows if k == 0 else junk)
-    A = np.transpose(f[1:] - f[0], (1, 2, 3, 0)).reshape(P, 24, 3)
-    dK = np.transpose(K[1:] - K[0], (1, 0, 2, 3))
+    return _mortar_terms(P, f[1:] - f[0], K[1:] - K[0], sc, vec, two, flags, frames, rows)
+
+
+def _mortar_terms(P, df, dK, sc, vec, two, flags, frames, rows):
+    """``mortar_terms``' dict from the differences of the forces ``df`` ``(3, P, 4, 6)`` and tangents ``dK``
+    ``(3, P, 24, 24)`` at ``T = e_x, e_y, e_z`` to those at ``T = 0`` and the kernel's point data."""
+    A = np.transpose(df, (1, 2, 3, 0)).reshape(P, 24, 3)
+    dK = np.transpose(dK, (1, 0, 2, 3))
     n, t1, t2, s = vec[:, 0], vec[:, 1], vec[:, 2], two[:, 1]
     dn, dt1, dt2 = rows[:, 0:3], rows[:, 3:6], rows[:, 6:9]
     S = s[:, :1] * t1 + s[:, 1:] * t2

@@ -17,13 +17,28 @@ against one master beam; with the linear slave shape functions ``Phi_j`` (``1 - 
 Augmented-Lagrangian updates ``Lam_g <- R_j^T lam_g`` repeat the step until every sticking group's
 ``|u_g|`` is below the tolerance (``ContactSystem.augment``).  All functions are batched numpy; the
 point terms come from the compiled kernel (``kernel_jit.mortar_terms``); the complex-step numpy forms
-(``reference.mortar_point_friction``, ``mortar_point_derivatives``) are their oracle.
+(``reference.mortar_point_friction``, ``mortar_point_derivatives``) are their oracle.  The points' rows go
+to their groups by compiled scatters (``mortar_jit``; ``use_numpy_scatter``: their ``np.add.at`` oracle);
+``Groups`` keeps the groups while a Newton step's pairs hold.
 """
 import numpy as np
 
 from ..lie import se3
+from . import mortar_jit
 
-__all__ = ["groups", "return_mapping", "nodal_state", "group_forces", "blocks", "multiplier_blocks"]
+__all__ = ["groups", "Groups", "return_mapping", "nodal_state", "group_forces", "blocks", "multiplier_blocks"]
+
+# the scatters of the points' rows into their groups: compiled (``mortar_jit``), or their numpy oracle
+_COMPILED = dict(rows=mortar_jit.scatter_rows, block=mortar_jit.scatter_block, columns=mortar_jit.scatter_columns)
+_NUMPY = dict(rows=mortar_jit.scatter_rows_numpy, block=mortar_jit.scatter_block_numpy,
+              columns=mortar_jit.scatter_columns_numpy)
+_SCATTER = dict(_COMPILED)
+
+
+def use_numpy_scatter(flag=True):
+    """The numpy oracle of the scatters (``np.add.at``) instead of the compiled ones (tests, benchmarks)."""
+    _SCATTER.update(_NUMPY if flag else _COMPILED)
+
 
 def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=None):
     """Nodal groups (one slave node against one master beam) of ``P`` points.
@@ -63,6 +78,29 @@ def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=No
     members[ug, slot] = u % n_nodes
     return dict(key=ukey, node=node, g=g, phi=np.stack([1.0 - xi1, xi1], axis=1), members=members,
                 pos=slot[inv].reshape(P, 2, 4))
+
+
+class Groups:
+    """``groups`` kept between evaluations while the points' nodes, master beams, declarations and held flags
+    are those of the last call (the pairs of a Newton step): then only the shape functions ``phi`` follow
+    ``xi1`` (two ``np.unique`` and a sort less per evaluation).  The arrays returned are shared between
+    the calls that reuse them: read them only."""
+
+    def __init__(self):
+        self._last = None
+        self.builds = 0          # ``groups`` calls (tests)
+
+    def __call__(self, slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=None):
+        args = (slave_nodes, master_beam, decl, nodes, held)
+        last = self._last
+        if last is not None and last[0] == (n_nodes, n_beams) and all(
+                (a is None and b is None) or (a is not None and b is not None and np.array_equal(a, b))
+                for a, b in zip(last[1], args)):
+            return dict(last[2], phi=np.stack([1.0 - xi1, xi1], axis=1))
+        G = groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held)
+        self._last = ((n_nodes, n_beams), tuple(None if a is None else np.array(a) for a in args), G)
+        self.builds += 1
+        return G
 
 
 def return_mapping(trial, cap):
@@ -136,9 +174,7 @@ def group_forces(G, f_points):
     """The points' forces ``(P, 24)`` on the groups of their node A, ``(n, 6 k)`` (rows over the group's slots)."""
     n, k = G["members"].shape
     gA, rowsA = _slots(G, 0)
-    f = np.zeros((n, 6 * k))
-    np.add.at(f, (gA[:, None], rowsA), f_points)
-    return f
+    return _SCATTER["rows"](np.zeros((n, 6 * k)), gA, rowsA, f_points)
 
 
 def _point_parts(G, d):
@@ -148,12 +184,11 @@ def _point_parts(G, d):
     n, k = G["members"].shape
     gA, rowsA = _slots(G, 0)
     f = group_forces(G, d["f"])
-    K = np.zeros((n, 6 * k, 6 * k))
-    np.add.at(K, (gA[:, None, None], rowsA[:, :, None], rowsA[:, None, :]), d["dfdq"])
+    K = _SCATTER["block"](np.zeros((n, 6 * k, 6 * k)), gA, rowsA, d["dfdq"])
     A = np.zeros((n, 6 * k, 3))
     for a in range(2):
         g, rows = _slots(G, a)
-        np.add.at(A, (g[:, None], rows), G["phi"][:, a, None, None] * d["G"])
+        _SCATTER["rows"](A, g, rows, d["G"], G["phi"][:, a])
     return f, K, A
 
 
@@ -169,7 +204,7 @@ def _trial_rows(G, d, st, eps, mu):
             wgn[:, None, None] * np.einsum("pij,pjq->piq", st["Q"][g], d["dn"])
         dlam = np.einsum("pij,pjq->piq", st["C"][g], dtrial) + \
             (mu[g] * wg)[:, None, None] * st["c"][g][:, :, None] * d["dlam_n"][:, None, :]
-        np.add.at(B, (g[:, None, None], np.arange(3)[None, :, None], rows[:, None, :]), dlam)
+        _SCATTER["columns"](B, g, rows, dlam)
     return B
 
 
@@ -182,8 +217,7 @@ def _turn(G, R, Lam):
 
 def _add_columns(M, cols, V):
     """``M[g][:, cols[g]] += V[g]`` for ``M`` ``(n, r, c)``, ``cols`` ``(n, 3)``, ``V`` ``(n, r, 3)``."""
-    n, r = M.shape[:2]
-    np.add.at(M, (np.arange(n)[:, None, None], np.arange(r)[None, :, None], cols[:, None, :]), V)
+    _SCATTER["columns"](M, np.arange(len(M)), cols, V)
 
 
 def blocks(G, d, st, R, Lam, eps, mu):

@@ -200,12 +200,14 @@ class ContactSystem(Contribution):
                                      minlength=len(system.poses0))
         self._augments = 0
         self.newton_multipliers = True   # exact stick: multipliers are Newton unknowns (else Uzawa updates)
+        self._groups = mortar.Groups()   # the mortar groups, kept while the pairs' nodes hold
         self._mstep, self._ms = None, 0.0     # the Newton step of the multipliers (keys, dLam) and its trial length
         self._sweepable = {}       # per declaration: whether the last search found no crossing (``_candidates``)
         self._H_prev = None        # last converged poses (start of the step)
         self._geo = self._geo_prev = None    # (poses, element twists) of the last evaluation / of H_prev
         self._blocks = None        # (poses, local blocks) of the last evaluation, for the same state
         self._tangent_pool = BufferPool()     # tangent buffers of the compiled kernel (``_tangent_out``)
+        self._mortar_pool = BufferPool()      # tangent blocks of pairs and mortar groups (``_with_mortar``)
         self.timings = dict.fromkeys(TIMED, 0.0)
         self._clock = time.process_time()
         self._penalties = conditioning.penalty_ratios(model, system)
@@ -714,7 +716,7 @@ class ContactSystem(Contribution):
         n_nodes = len(H)
         X = H[P.nodes[sel[idx]]]
         pm = {k: (v[idx] if np.ndim(v) else v) for k, v in p.items()}
-        G = mortar.groups(P.nodes[sel[idx], :2], pm["xi1"], self.el_beam[P.m[sel[idx]]], P.decl[sel[idx]],
+        G = self._groups(P.nodes[sel[idx], :2], pm["xi1"], self.el_beam[P.m[sel[idx]]], P.decl[sel[idx]],
                           P.nodes[sel[idx]], n_nodes, self.n_beams, self._held_slip(P.nodes[sel[idx]]))
         gdecl = G["key"] // (np.int64(n_nodes) * self.n_beams)
         R = H[G["node"], :3, :3]
@@ -849,7 +851,8 @@ class ContactSystem(Contribution):
             self._segment_ends(H, P, sel, p, f, K, out.pop("segment_ends"))
         info = dict(n_active=len(sel))
         if "mortar" in out:
-            b = _with_mortar(P.nodes[sel], f.reshape(-1, 24), K if tangent else None, out["mortar"])
+            b = _with_mortar(P.nodes[sel], f.reshape(-1, 24), K if tangent else None, out["mortar"],
+                             self._mortar_pool)
             if out["mortar"]["mult"] is not None:
                 info["multipliers"] = out["mortar"]["mult"]
         else:
@@ -1064,9 +1067,11 @@ def _extent(H):
     """Largest node coordinate of the poses ``H`` (``frames.touch_tolerance``)."""
     return float(np.abs(H[..., :3, 3]).max(initial=0.0))
 
-def _with_mortar(nodes, f, K, m):
+def _with_mortar(nodes, f, K, m, pool=None):
     """The pairs' 4-node blocks and the mortar groups' blocks (``ContactSystem._mortar``) as one
-    ``Blocks`` over the groups' ``k`` nodes: the pair blocks padded with their first node (zero rows)."""
+    ``Blocks`` over the groups' ``k`` nodes: the pair blocks padded with their first node (zero rows).
+    ``pool``: a ``BufferPool`` the tangent blocks go to (kept memory: on the 19-wire bundle the fresh
+    ``(m, 6 k, 6 k)`` array's page faults cost 2.5 s an evaluation), else a new array."""
     k = m["members"].shape[1]
     n = len(nodes)
     nodes = np.concatenate([np.concatenate([nodes, np.repeat(nodes[:, :1], k - 4, axis=1)], axis=1), m["members"]])
@@ -1074,9 +1079,12 @@ def _with_mortar(nodes, f, K, m):
     fa[:, :24] = f
     if K is None:
         return Blocks(nodes, np.concatenate([fa, m["f"]]))
-    Ka = np.zeros((n, 6 * k, 6 * k))
-    Ka[:, :24, :24] = K
-    return Blocks(nodes, np.concatenate([fa, m["f"]]), np.concatenate([Ka, m["K"]]))
+    shape = (n + len(m["K"]), 6 * k, 6 * k)
+    Ka = np.empty(shape) if pool is None else pool.take(shape)
+    Ka[:n] = 0.0
+    Ka[:n, :24, :24] = K
+    Ka[n:] = m["K"]
+    return Blocks(nodes, np.concatenate([fa, m["f"]]), Ka)
 
 
 def _kernel(kernel, X, p, friction, law, tangent, K=None):

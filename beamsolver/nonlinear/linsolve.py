@@ -57,6 +57,8 @@ __all__ = ["factorize", "factorize_tangent", "Solver", "SingularMatrixError", "a
 
 BACKENDS = ("splu", "splu-rcm", "pardiso", "auto")
 DEFAULT = "auto"          # splu for beams and small scenes; pardiso (else splu-rcm) for coupled ones
+SADDLE_PERTURB = 8        # PARDISO on saddle-point systems: pivots perturbed to 1e-8 |K| (iparm(10))
+SADDLE_REFINE = 20        # ... and up to 20 steps of iterative refinement (iparm(8)); ``Solver.factorize``
 AUTO_MIN_UNKNOWNS = 1_500      # "auto": below this size the default splu is as fast as any
 AUTO_COUPLED_NNZ = 24.0        # "auto": non-zeros per column above which contact couples the beams
 BACKWARD_ERROR = 1e-9          # pardiso, splu-rcm: |K x - b| / (|K| |x| + |b|) above this -> re-analyse / pivot fully
@@ -108,14 +110,14 @@ def factorize(K, backend=None):
     return Solver(backend).factorize(K)
 
 
-def factorize_tangent(K, solver=None, what="singular tangent"):
+def factorize_tangent(K, solver=None, what="singular tangent", saddle=False):
     """``solver.factorize(K)`` (default a fresh ``Solver()``) as a factor whose singularity, found
     by the factorisation or by a solve (pardiso), is the typed step failure
     ``failures.SingularTangent(f"{what} ({error})")``: the one wrapper of the Newton loop, the
     arc-length solves and the branch switch.  The factor keeps the back-end's ``det_sign`` and
-    ``factor_nnz`` where it has them."""
+    ``factor_nnz`` where it has them.  ``saddle``: ``K`` is a saddle-point system (``Solver.factorize``)."""
     try:
-        return _Typed((solver if solver is not None else Solver()).factorize(K), what)
+        return _Typed((solver if solver is not None else Solver()).factorize(K, saddle=saddle), what)
     except SingularMatrixError as e:
         raise SingularTangent(f"{what} ({e})") from None
 
@@ -168,7 +170,12 @@ class Solver:
             return "pardiso" if _pypardiso() is not None else "splu-rcm"
         return "splu"
 
-    def factorize(self, K):
+    def factorize(self, K, saddle=False):
+        """The factor of ``K`` by ``backend_for(K)``.  ``saddle``: ``K`` is a saddle-point system (multiplier
+        unknowns, ``Problem.bordered``): PARDISO perturbs tiny pivots to ``SADDLE_PERTURB`` (not 1e-13) and
+        refines the solution up to ``SADDLE_REFINE`` steps, which its static pivoting needs there (19-wire bundle,
+        exact stick, 55 000 unknowns: 709 perturbed pivots, a residual 7.6e3 |b| with the defaults, 2.4e-9 |b|
+        so); SuperLU pivots by rows itself."""
         if K.shape[0] != K.shape[1]:
             raise InputError(f"linsolve: the matrix must be square, got shape {K.shape}")
         self.stats["factorizations"] += 1
@@ -179,7 +186,7 @@ class Solver:
             return _SpluRcmFactor(K)
         if self._pardiso is None:
             self._pardiso = _Pardiso(_pypardiso())
-        return self._pardiso.factorize(K, self.stats)
+        return self._pardiso.factorize(K, self.stats, saddle)
 
     def close(self):
         """Release PARDISO's memory now (it is also released when the ``Solver`` is collected)."""
@@ -435,19 +442,22 @@ class _Pardiso:
         # (and its matrix) is freed as soon as the caller drops it, before the next tangent is built
         self.current = _NONE
         self.flops = float("nan")     # of the numerical factorisation, from the last analysis
+        self._defaults = None         # iparm(8), iparm(10) of the handle (refinement steps, pivot perturbation)
 
-    def factorize(self, K, stats):
+    def factorize(self, K, stats, saddle=False):
         K = K.tocsr() if K.format not in ("csr", "csc") else K
         if K.dtype != np.float64:
             K = K.astype(np.float64)
         if K.shape[0] and not np.diff(K.indptr).all():
             raise SingularMatrixError("the matrix has an empty row or column")
         f = _PardisoFactor(self, K)
+        f.saddle = bool(saddle)
         self._factor(f, stats)
         return f
 
     def _factor(self, f, stats=None, fresh=False):
         K, ps = f.K, self.ps
+        set_ = self._saddle(f.saddle)
         if not self._phased:
             ps.factorize(K)
             f.reused = False
@@ -463,6 +473,9 @@ class _Pardiso:
             ps._call_pardiso(K, np.zeros((K.shape[0], 1)))
             if not same:
                 self.flops = 1e6 * float(ps.iparm[18])
+            if f.saddle and not set_ and self._saddle(True):     # MKL's defaults were filled in by that call
+                ps.set_phase(22)
+                ps._call_pardiso(K, np.zeros((K.shape[0], 1)))
             self.pattern = (K.indptr.copy(), K.indices.copy(), K.format)
             f.reused = same
         self.current = weakref.ref(f)
@@ -471,6 +484,18 @@ class _Pardiso:
         f.factor_nnz = int(iparm[17])
         f.peak_kb = int(max(iparm[14], iparm[15] + iparm[16]))
         f.flops = self.flops
+
+    def _saddle(self, saddle):
+        """Set the pivot perturbation and refinement steps for a saddle-point system (``Solver.factorize``) or
+        back to the handle's own; False while MKL's defaults are not filled in (before the first call,
+        ``iparm(1) = 0``: MKL ignores the other entries then)."""
+        ps = self.ps
+        if ps.iparm[0] == 0:
+            return False
+        if self._defaults is None:
+            self._defaults = (int(ps.iparm[7]), int(ps.iparm[9]))
+        ps.iparm[7], ps.iparm[9] = (SADDLE_REFINE, SADDLE_PERTURB) if saddle else self._defaults
+        return True
 
     def solve(self, f, b):
         if self.current() is not f:           # another matrix was factorised since: redo this one
@@ -537,6 +562,7 @@ class _PardisoFactor:
         self._owner = owner
         self.K = K
         self.perturbed = 0
+        self.saddle = False        # a saddle-point system (``Solver.factorize``)
         self.reused = False
         self.norm = None           # |K|_inf, computed on the first check
         self.factor_nnz = 0

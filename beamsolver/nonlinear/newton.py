@@ -225,7 +225,7 @@ class Newton:
             K, rhs = problem.bordered(ev, K, rhs, dz_c)
         t1 = time.perf_counter()
         try:
-            lu = linsolve.factorize_tangent(K, self.linsolver)
+            lu = linsolve.factorize_tangent(K, self.linsolver, saddle=ev.mult is not None)
             dzf = lu.solve(rhs)
         finally:
             t2 = time.perf_counter()

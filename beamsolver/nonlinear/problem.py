@@ -36,6 +36,7 @@ import numpy as np
 from ..model import contributions
 from ..assembly.system import System
 from ..errors import InputError
+from .bordered import Bordered
 
 __all__ = ["Problem", "Evaluation"]
 
@@ -74,6 +75,7 @@ class Problem:
         self.system = system
         self.contributions = list(contributions)
         self._lf = (None, np.zeros(0))
+        self._bordered = Bordered()      # the bordered matrix's pattern, kept across Newton iterations
 
     @classmethod
     def from_model(cls, model, check_rigid_modes=True):
@@ -199,41 +201,18 @@ class Problem:
 
     def bordered(self, ev, K, rhs, dz_c=None):
         """The Newton system with the multiplier unknowns of ``ev`` appended: ``[[K, K_ql], [K_lq, K_ll]]``
-        (CSC) and ``[rhs; -C - K_lc dz_c]``."""
-        import scipy.sparse as sp
+        (CSC, ``bordered.Bordered``: its pattern kept while the tangent's and the groups' hold) and
+        ``[rhs; -C - K_lc dz_c]``.  A multiplier direction no free unknown can slip in (supports hold it, e.g.
+        a scene kept in a plane) has an empty row and column: its traction acts on held unknowns only, so it
+        is set to zero there (row: the traction's component itself)."""
         mu = ev.mult
-        red, nf = self.system.red, self.system.n_free
-        g, k6 = mu["dofs"].shape
-        gi = np.arange(3 * g).reshape(g, 3)
-        rows = np.broadcast_to(red[mu["dofs"]][:, :, None], (g, k6, 3))
-        cols = np.broadcast_to(gi[:, None, :], (g, k6, 3))
-        keep = rows >= 0
-        Bql = sp.csc_matrix((mu["Kql"][keep], (rows[keep], cols[keep])), shape=(nf, 3 * g))
-        rl = np.broadcast_to(gi[:, :, None], (g, 3, k6))
-        cl = np.broadcast_to(red[mu["dofs"]][:, None, :], (g, 3, k6))
-        keep = cl >= 0
-        Blq = sp.csc_matrix((mu["Klq"][keep], (rl[keep], cl[keep])), shape=(3 * g, nf))
-        Kll = mu["Kll"]
-        rc = -mu["C"].ravel()
-        # a multiplier direction no free unknown can slip in (supports hold it, e.g. a scene kept in a
-        # plane): its row and column are empty, the saddle-point matrix singular; its traction acts on held
-        # unknowns only, so it is set to zero there (row: the traction's component itself)
-        free_row = np.sqrt(np.asarray(Blq.multiply(Blq).sum(axis=1)).ravel())
-        own = np.linalg.norm(Kll, axis=2).ravel()
-        idle = (free_row <= 1e-12 * max(free_row.max(initial=0.0), 1e-300)) & \
-            (own <= 1e-12 * max(own.max(initial=0.0), 1e-300))
-        if idle.any():
-            gg, ii = np.divmod(np.flatnonzero(idle), 3)
-            Kll = Kll.copy()
-            Kll[gg, ii] = mu["R"][gg, ii]
-            rc[idle] = -np.einsum("gj,gj->g", mu["R"][gg, ii], mu["Lam"][gg])
-        Bll = sp.csc_matrix((Kll.ravel(), (np.repeat(gi, 3, axis=1).ravel(),
-                                           np.tile(gi, (1, 3)).ravel())), shape=(3 * g, 3 * g))
+        red = self.system.red
+        rows_red = red[mu["dofs"]]
+        A, rc = self._bordered.matrix(K, rows_red, mu["Kql"], mu["Klq"], mu["Kll"], mu["R"], mu["Lam"], mu["C"])
         if dz_c is not None:
             dzf = np.ravel(dz_c)[mu["dofs"]]                       # (g, 6 k): constrained increments only
-            dzf = np.where(red[mu["dofs"]] < 0, dzf, 0.0)
+            dzf = np.where(rows_red < 0, dzf, 0.0)
             rc = rc - np.einsum("gij,gj->gi", mu["Klq"], dzf).ravel()
-        A = sp.bmat([[K, Bql], [Blq, Bll]], format="csc")
         return A, np.concatenate([rhs, rc])
 
     def multipliers_in_newton(self, flag):

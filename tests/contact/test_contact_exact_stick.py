@@ -281,3 +281,34 @@ def test_a_group_the_iterate_lacks_comes_back_without_traction():
     c.multiplier_step(keys[[0, 2]], np.full((2, 3), 0.5))
     c.multiplier_trial(1.0)
     np.testing.assert_array_equal(c.iterate_multipliers(keys), [[1.5] * 3, [0.0] * 3, [1.5] * 3])
+
+
+def test_the_one_pass_mortar_kernel_gives_the_bits_of_four_kernel_calls(monkeypatch):
+    """``kernel_jit.mortar_terms`` (one compiled pass, the geometry once per point for the four tractions)
+    against ``mortar_terms_four`` (one call of the point kernel per traction, its oracle): every term the
+    same bits, on pressed and slid pairs with friction history."""
+    from beamsolver.contact import kernel_jit
+    captured = {}
+    compiled = kernel_jit.mortar_terms
+
+    def spy(X, pm, law=None):
+        captured.update(X=X, pm=pm)
+        return compiled(X, pm, law)
+
+    monkeypatch.setattr(kernel_jit, "mortar_terms", spy)
+    model, slave, master = _parallel(0.5)
+    problem = Problem.from_model(model, check_rigid_modes=False)
+    c = problem.contact
+    H = _pressed(problem, slave, 2e-3 * R)
+    c.begin_step(H, 0.0)
+    c.commit(H)
+    slide = 1e-4 * R
+    H = _move(H, slave.nodes, se3.exp(np.array([slide, slide, 0.0, slide, 0.0, 0.5 * slide])))
+    c._local_blocks(H, True)
+    X, pm = captured["X"], captured["pm"]
+    assert len(X) > 4 and np.any(pm["has_history"])
+    one, four = compiled(X, pm), kernel_jit.mortar_terms_four(X, pm)
+    assert set(one) == set(four)
+    for k in one:
+        assert np.array_equal(one[k], four[k]), k
+    assert np.abs(one["A"]).max() > 0 and np.abs(one["dK"]).max() > 0 and np.abs(one["dS"]).max() > 0

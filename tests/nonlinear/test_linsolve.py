@@ -267,3 +267,30 @@ def test_pardiso_solver_keeps_no_factor_the_caller_dropped():
     np.testing.assert_allclose(fa.solve(b), np.linalg.solve(A.toarray(), b), rtol=1e-10)
     np.testing.assert_allclose(fb.solve(b), np.linalg.solve(B.toarray(), b), rtol=1e-10)
     s.close()
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_saddle_point_systems_solve_on_every_backend(backend):
+    """``factorize(K, saddle=True)``: a saddle-point matrix ``[[K, B], [B^T, 0]]`` (multiplier unknowns with a
+    zero diagonal block, badly scaled against ``K`` as exact stick's) is solved to round-off by every back-end;
+    PARDISO's pivot perturbation and refinement steps are those of ``SADDLE_*`` for it and the handle's own
+    again for the next plain matrix."""
+    rng = np.random.default_rng(3)
+    n, m = 60, 15
+    A = sp.random(n, n, density=0.1, random_state=rng) * 1e9
+    K = sp.csr_matrix(A @ A.T + 1e9 * sp.eye(n))
+    B = sp.random(n, m, density=0.2, random_state=rng) * 1e-3 + sp.eye(n, m) * 1e-3
+    S = sp.csc_matrix(sp.bmat([[K, B], [B.T, None]]))
+    b = rng.standard_normal(n + m)
+    solver = linsolve.Solver(backend)
+    x = solver.factorize(S, saddle=True).solve(b)
+
+    def backward(M, x, b):
+        return np.abs(M @ x - b).max() / (abs(M).sum(axis=1).max() * np.abs(x).max() + np.abs(b).max())
+    assert backward(S, x, b) <= 1e-14
+    if backend == "pardiso":
+        ps = solver._pardiso.ps
+        assert (ps.iparm[7], ps.iparm[9]) == (linsolve.SADDLE_REFINE, linsolve.SADDLE_PERTURB)
+        y = solver.factorize(sp.csc_matrix(K)).solve(b[:n])
+        assert (ps.iparm[7], ps.iparm[9]) != (linsolve.SADDLE_REFINE, linsolve.SADDLE_PERTURB)
+        assert backward(K, y, b[:n]) <= 1e-14

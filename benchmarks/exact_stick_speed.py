@@ -1,0 +1,137 @@
+"""Exact stick's cost per Newton iteration against the penalty stick (issue 26, speed): the main job
+(``examples/twisted_pair.py``, 16 steps: Newton iterations, warm solve CPU time, ms per iteration) and one Newton
+iteration of the 19-wire bundle (``scaling.bundle_model`` at ``scaling_scenes.PER_WIRE``, its reference poses:
+evaluation, tangent (bordered with the multipliers for exact stick), factorisation and solve, CPU s, and
+these parts).
+
+    python benchmarks/exact_stick_speed.py [--scenes twisted_pair bundle19] [--repeat 3] [--profile]
+
+Three modes: ``penalty``; ``exact (before)``, the exact path on the numpy/scipy oracles that were its code
+before the compiled parts (``mortar.use_numpy_scatter``: ``np.add.at`` scatters; ``kernel_jit.mortar_terms_four``:
+four point-kernel calls; ``bordered.use_bmat``: COO/CSC constructors and ``sp.bmat`` every iteration); and
+``exact``, the current path.  Each mode runs once to warm up (compilation, caches), then ``--repeat`` times:
+the best CPU time (``time.process_time``: the machine is shared) is reported.  ``--profile``: a cProfile table of one warm exact run per scene (tottime).
+"""
+import argparse
+import cProfile
+import contextlib
+import pstats
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(HERE.parents[0] / "examples"))
+
+import beamsolver as bs  # noqa: E402
+from beamsolver.contact import kernel_jit, mortar  # noqa: E402
+from beamsolver.nonlinear import bordered, linsolve  # noqa: E402
+from beamsolver.nonlinear.problem import Problem  # noqa: E402
+
+
+@contextlib.contextmanager
+def mode(name):
+    """Every ``add_contact`` with the stick of ``name``; ``exact (before)``: the oracles' code paths."""
+    stick = "penalty" if name == "penalty" else "exact"
+    orig, terms = bs.Model.add_contact, kernel_jit.mortar_terms
+
+    def add_contact(self, *a, **options):
+        options.setdefault("stick", stick)
+        return orig(self, *a, **options)
+
+    bs.Model.add_contact = add_contact
+    before = name == "exact (before)"
+    mortar.use_numpy_scatter(before)
+    bordered.use_bmat(before)
+    if before:
+        kernel_jit.mortar_terms = kernel_jit.mortar_terms_four
+    try:
+        yield
+    finally:
+        bs.Model.add_contact, kernel_jit.mortar_terms = orig, terms
+        mortar.use_numpy_scatter(False)
+        bordered.use_bmat(False)
+
+
+def twisted_pair():
+    """``(Newton iterations, CPU s)`` of the main job's solve."""
+    import twisted_pair as tp
+    model = tp.build()[0]
+    t0 = time.process_time()
+    sol = bs.solve(model, steps=16)
+    return int(sum(s["iterations"] for s in sol.stats)), time.process_time() - t0
+
+
+PARTS = {}       # the last bundle19 iteration by parts (CPU s)
+
+
+def bundle19():
+    """``(1, CPU s)`` of one Newton iteration of the 19-wire bundle at its reference poses (the best of three:
+    patterns and the solver's analysis in place); its parts in ``PARTS``."""
+    import scaling_scenes
+    from scaling import bundle_model
+    m, _ = bundle_model(scaling_scenes.PER_WIRE, n_layers=2)
+    problem = Problem.from_model(m)
+    system = problem.system
+    H = system.poses0.copy()
+    solver = linsolve.Solver()
+    best = np.inf
+    for _ in range(3):
+        problem.begin_step(H, 0.0)
+        t = [time.process_time()]
+        ev = problem.evaluate(H, 1.0, tangent=True)
+        t.append(time.process_time())
+        K = problem.tangent(ev)
+        rhs = -ev.r[system.free_dofs]
+        if ev.mult is not None:
+            K, rhs = problem.bordered(ev, K, rhs)
+        t.append(time.process_time())
+        linsolve.factorize_tangent(K, solver, saddle=ev.mult is not None).solve(rhs)
+        t.append(time.process_time())
+        if t[-1] - t[0] < best:
+            best = t[-1] - t[0]
+            PARTS.update(evaluate=t[1] - t[0], matrix=t[2] - t[1], solve=t[3] - t[2], unknowns=K.shape[0],
+                         nnz=K.nnz)
+    solver.close()
+    return 1, best
+
+
+SCENES = dict(twisted_pair=twisted_pair, bundle19=bundle19)
+MODES = ("penalty", "exact (before)", "exact")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--scenes", nargs="+", default=list(SCENES))
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--profile", action="store_true")
+    a = ap.parse_args()
+    print("| scene | stick | Newton it. | time [s] | ms per iteration | ratio to penalty |")
+    print("|---|---|---:|---:|---:|---:|")
+    for scene in a.scenes:
+        ref = None
+        for name in MODES:
+            with mode(name):
+                SCENES[scene]()                             # warm-up
+                runs = [SCENES[scene]() for _ in range(a.repeat)]
+            its, t = runs[0][0], min(r[1] for r in runs)
+            ms = 1e3 * t / max(its, 1)
+            ref = ms if ref is None else ref
+            parts = "" if scene != "bundle19" else (
+                f" (evaluation {PARTS['evaluate']:.3f}, matrix {PARTS['matrix']:.3f}, factorisation and solve "
+                f"{PARTS['solve']:.3f}; {PARTS['unknowns']} unknowns, {PARTS['nnz']} non-zeros)")
+            print(f"| {scene} | {name} | {its} | {t:.3f}{parts} | {ms:.2f} | {ms / ref:.2f} |", flush=True)
+        if a.profile:
+            with mode("exact"):
+                pr = cProfile.Profile()
+                pr.enable()
+                SCENES[scene]()
+                pr.disable()
+            pstats.Stats(pr, stream=sys.stdout).sort_stats("tottime").print_stats(25)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,96 @@
+"""The compiled scatters of the mortar groups (contact/mortar_jit.py) against their numpy oracle (``np.add.at``):
+the same bits, repeated rows within a point and points of one group included."""
+import numpy as np
+import pytest
+
+from beamsolver.contact import mortar_jit
+
+
+def _case(seed, P=60, n=7, r=30, m=24):
+    rng = np.random.default_rng(seed)
+    g = rng.integers(0, n, P)
+    rows = rng.integers(0, r, (P, m))           # repeats within a point and across points of a group
+    return rng, g, rows, n, r, m
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_scatter_rows_gives_the_bits_of_add_at(seed):
+    rng, g, rows, n, r, m = _case(seed)
+    vals, scale = rng.standard_normal((len(g), m, 3)), rng.standard_normal(len(g))
+    start = rng.standard_normal((n, r, 3))
+    for s in (None, scale):
+        a = mortar_jit.scatter_rows_numpy(start.copy(), g, rows, vals, s)
+        b = mortar_jit.scatter_rows(start.copy(), g, rows, vals, s)
+        assert np.array_equal(a, b) and not np.array_equal(a, start)
+    flat = rng.standard_normal((len(g), m))
+    a = mortar_jit.scatter_rows_numpy(np.zeros((n, r)), g, rows, flat)
+    b = mortar_jit.scatter_rows(np.zeros((n, r)), g, rows, flat)
+    assert np.array_equal(a, b) and np.any(a)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_scatter_block_and_columns_give_the_bits_of_add_at(seed):
+    rng, g, rows, n, r, m = _case(seed)
+    vals = rng.standard_normal((len(g), m, m))
+    a = mortar_jit.scatter_block_numpy(np.zeros((n, r, r)), g, rows, vals)
+    b = mortar_jit.scatter_block(np.zeros((n, r, r)), g, rows, vals)
+    assert np.array_equal(a, b) and np.any(a)
+    cv = rng.standard_normal((len(g), 3, m))
+    a = mortar_jit.scatter_columns_numpy(np.zeros((n, 3, r)), g, rows, cv)
+    b = mortar_jit.scatter_columns(np.zeros((n, 3, r)), g, rows, cv)
+    assert np.array_equal(a, b) and np.any(a)
+
+
+def test_the_mortar_blocks_are_those_of_the_numpy_scatters():
+    """``mortar.multiplier_blocks`` on a random group set: the compiled scatters give the oracle's bits."""
+    from beamsolver.contact import mortar
+    rng = np.random.default_rng(5)
+    P, n_nodes = 40, 12
+    slave = np.sort(rng.choice(n_nodes, (P, 2), replace=True), axis=1)
+    nodes = np.concatenate([slave, rng.integers(0, n_nodes, (P, 2))], axis=1)
+    G = mortar.groups(slave, rng.uniform(0, 1, P), rng.integers(0, 2, P), np.zeros(P, int), nodes, n_nodes, 2)
+    k = len(G["key"])
+    d = dict(G=rng.standard_normal((P, 24, 3)), dfdq=rng.standard_normal((P, 24, 24)),
+             f=rng.standard_normal((P, 24)), dS=rng.standard_normal((P, 3, 24)), dn=rng.standard_normal((P, 3, 24)),
+             dlam_n=rng.standard_normal((P, 24)))
+    R = np.linalg.qr(rng.standard_normal((k, 3, 3)))[0]
+    st = mortar.nodal_state(G, rng.uniform(0.1, 1, P), rng.standard_normal((P, 3)), rng.uniform(0, 1, P),
+                            rng.standard_normal((P, 3)), R, rng.standard_normal((k, 3)), np.ones(k), 0.3 * np.ones(k),
+                            rng.uniform(1, 2, k))
+    args = (G, d, st, R, rng.standard_normal((k, 3)), np.ones(k), 0.3 * np.ones(k))
+    try:
+        mortar.use_numpy_scatter(True)
+        ref = mortar.multiplier_blocks(*args), mortar.blocks(*args)
+    finally:
+        mortar.use_numpy_scatter(False)
+    out = mortar.multiplier_blocks(*args), mortar.blocks(*args)
+    for a, b in zip(ref[0] + ref[1], out[0] + out[1]):
+        assert np.array_equal(a, b)
+
+
+def test_groups_are_kept_while_the_pairs_nodes_hold():
+    """``mortar.Groups``: the groups of ``mortar.groups`` for new ``xi1`` on the same pairs (one build), built
+    again when a pair's nodes or its held flags change."""
+    from beamsolver.contact import mortar
+    rng = np.random.default_rng(2)
+    P, n_nodes = 30, 10
+    slave = np.sort(rng.choice(n_nodes, (P, 2)), axis=1)
+    nodes = np.concatenate([slave, rng.integers(0, n_nodes, (P, 2))], axis=1)
+    beam, decl, held = rng.integers(0, 2, P), np.zeros(P, int), rng.random((P, 2)) < 0.2
+    keep = mortar.Groups()
+
+    def check(*args):
+        ref, out = mortar.groups(*args), keep(*args)
+        assert set(ref) == set(out)
+        for k in ref:
+            assert np.array_equal(ref[k], out[k]), k
+    for _ in range(3):
+        check(slave, rng.uniform(0, 1, P), beam, decl, nodes, n_nodes, 2, held)
+    assert keep.builds == 1
+    nodes = nodes.copy()
+    nodes[0, 3] = (nodes[0, 3] + 1) % n_nodes
+    check(slave, rng.uniform(0, 1, P), beam, decl, nodes, n_nodes, 2, held)
+    held = held.copy()
+    held[1] = ~held[1]
+    check(slave, rng.uniform(0, 1, P), beam, decl, nodes, n_nodes, 2, held)
+    assert keep.builds == 3
