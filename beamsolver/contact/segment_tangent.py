@@ -138,7 +138,7 @@ def mortar_shifted(X, p, T, law=None):
     r = X.shape[0]
     kind, par, has, (HCL, HFK, HLKp), _ = _table(X, p)
     kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar=True)
-    f, K = np.empty((2, r, 4, 6)), np.empty((r, 24, 24))
+    f, K = np.empty((2, r, 4, 6)), np.empty((r, 0, 0))           # an empty K: forces only
     sc, vec, two = np.empty((r, 4)), np.empty((r, 6, 3)), np.empty((r, 2, 2))
     flags, frames, rows = np.empty((r, 2), dtype=np.bool_), np.empty((r, 4, 4, 4)), np.empty((r, N_ROWS, 24))
     for k, lamp in enumerate((np.zeros((r, 3)), np.ascontiguousarray(T, dtype=float))):
