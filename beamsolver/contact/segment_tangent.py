@@ -115,18 +115,30 @@ def end_derivatives(X, xi, weight, x_g, w_g, length):
     return moving, dxi, dW
 
 
-def end_terms(X, xi, weight, x_g, w_g, length, f, forces):
-    """The tangent terms ``(k, 24, 24)`` of segment points: poses ``X`` ``(k, 4, 4, 4)``, parameters ``xi`` and
-    weights ``weight`` ``(k,)``, their Gauss point ``x_g`` and weight ``w_g`` on ``[0, 1]``, slave element
-    ``length``, the points' forces ``f`` ``(k, 24)`` (residual signs) and ``forces(rows, xi)``: the forces
-    ``(r, 24)`` of the points ``rows`` moved to ``xi``.  Returns the rows with a moving end and their terms
-    ``(r, 24, 24)``."""
+@jit
+def _add_terms(K, at, dfdxi, dxi, per_length, dW):
+    """``K[at[r]] += dfdxi[r] (x) dxi[r] + per_length[r] (x) dW[r]`` in place (no ``(r, 24, 24)`` temporaries)."""
+    for r in range(len(at)):
+        Kr = K[at[r]]
+        for i in range(24):
+            a, c = dfdxi[r, i], per_length[r, i]
+            for j in range(24):
+                Kr[i, j] += a * dxi[r, j] + c * dW[r, j]
+
+
+def end_terms(X, xi, weight, x_g, w_g, length, f, forces, K, at):
+    """Add the tangent terms of segment points to their blocks ``K[at]`` ``(k, 24, 24)`` (in place): poses ``X``
+    ``(k, 4, 4, 4)``, parameters ``xi`` and weights ``weight`` ``(k,)``, their Gauss point ``x_g`` and weight
+    ``w_g`` on ``[0, 1]``, slave element ``length``, the points' forces ``f`` ``(k, 24)`` (residual signs) and
+    ``forces(rows, xi)``: the forces ``(r, 24)`` of the points ``rows`` moved to ``xi``.  Returns the rows with
+    a moving end."""
     moving, dxi, dW = end_derivatives(X, xi, weight, x_g, w_g, length)
     if not len(moving):
-        return moving, np.zeros((0, 24, 24))
+        return moving
     dfdxi = (forces(moving, xi[moving] + STEP) - f[moving]) / STEP
     per_length = f[moving] / np.where(weight[moving] == 0.0, 1.0, weight[moving])[:, None]
-    return moving, dfdxi[:, :, None] * dxi[:, None, :] + per_length[:, :, None] * dW[:, None, :]
+    _add_terms(K, np.ascontiguousarray(at[moving], dtype=np.int64), dfdxi, dxi, per_length, dW)
+    return moving
 
 
 def mortar_shifted(X, p, T, law=None):

@@ -666,7 +666,7 @@ class ContactSystem(Contribution):
     def _segment_ends(self, H, P, sel, p, f, K, friction):
         """Add the tangent terms of the moving segment ends (``segment_tangent``) to the blocks ``K`` of the
         segment points among the active pairs ``sel`` (``f``: their forces, residual signs; ``friction``: the
-        kernel's friction flags).  The exact-stick multipliers' terms (``_mortar``) are not included."""
+        kernel's friction flags).  The exact-stick multipliers' terms: ``_mortar_ends``."""
         key = P.key[sel]
         gk = (key // self.n_beams) % self.key_gp
         seg = (key < self.point_offset) & (p["kind"] == LINE) & (gk // self.max_gp < self.n_slots)
@@ -676,17 +676,16 @@ class ContactSystem(Contribution):
                 continue
             g = gk[idx] % self.max_gp
             X = H[P.nodes[sel[idx]]]
-            pm = {k: (v[idx] if np.ndim(v) else v) for k, v in p.items()}
 
             def forces(rows, xi):
-                q = {k: (v[rows] if np.ndim(v) else v) for k, v in pm.items()}
+                at = idx[rows]
+                q = {k: (v[at] if np.ndim(v) else v) for k, v in p.items()}
                 q["xi1"] = xi
-                fk = self._kernels(X[rows], q, P.decl[sel[idx[rows]]], False, friction=friction[idx[rows]])[0]
+                fk = self._kernels(X[rows], q, P.decl[sel[at]], False, friction=friction[at])[0]
                 return -fk.reshape(len(rows), 24)
 
-            rows, terms = segment_tangent.end_terms(X, pm["xi1"], pm["weight"], d.seg_gauss[0][g], d.seg_gauss[1][g],
-                                                    self.sys.L[P.e[sel[idx]]], f[idx].reshape(len(idx), 24), forces)
-            K[idx[rows]] += terms
+            segment_tangent.end_terms(X, p["xi1"][idx], p["weight"][idx], d.seg_gauss[0][g], d.seg_gauss[1][g],
+                                      self.sys.L[P.e[sel[idx]]], f[idx].reshape(len(idx), 24), forces, K, idx)
 
     def overlap(self, H):
         """Initial overlaps at poses ``H``: ``None`` when no pair penetrates by more than
