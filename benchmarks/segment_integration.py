@@ -5,7 +5,7 @@
 - the contact patch test (``examples/contact_patch.py``, 7 against 10 elements): pressure and
   traction spreads, slip and Newton iterations of each integration and stick;
 - the contact examples (main job ``twisted_pair``, ``three_wires``, ``shear_lag``, ``rolling``,
-  ``capstan``) with ``integration="points"`` (5 per slave element), ``"segments"`` (3 per segment, the
+  ``capstan``, ``crossing_beams``) with ``integration="points"`` (5 per slave element), ``"segments"`` (3 per segment, the
   default count) and ``"segments"`` with 5 per segment: Newton iterations, warm solve CPU (least of
   two solves after a first one; the runs of one example alternate between the integrations) and
   contact points per slave element in contact (mean over the evaluations).
@@ -22,7 +22,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _report import machine, single_thread, table, write_section  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
-EXAMPLES = ("twisted_pair", "three_wires", "shear_lag", "rolling", "capstan")
+EXAMPLES = ("twisted_pair", "three_wires", "shear_lag", "rolling", "capstan", "crossing_beams")
 VARIANTS = (("points", {}), ("segments", {"integration": "segments"}),
             ("segments, 5 per segment", {"integration": "segments", "gauss_points": 5}))
 
