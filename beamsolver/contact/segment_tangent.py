@@ -131,8 +131,11 @@ def end_terms(X, xi, weight, x_g, w_g, length, f, forces, K, at):
     ``(k, 4, 4, 4)``, parameters ``xi`` and weights ``weight`` ``(k,)``, their Gauss point ``x_g`` and weight
     ``w_g`` on ``[0, 1]``, slave element ``length``, the points' forces ``f`` ``(k, 24)`` (residual signs) and
     ``forces(rows, xi)``: the forces ``(r, 24)`` of the points ``rows`` moved to ``xi``.  Returns the rows with
-    a moving end."""
-    moving, dxi, dW = end_derivatives(X, xi, weight, x_g, w_g, length)
+    a moving end.  Points without force (the normal law off: no friction either) have no terms."""
+    loaded = np.flatnonzero(f.any(axis=1))
+    moving, dxi, dW = end_derivatives(X[loaded], xi[loaded], weight[loaded], x_g[loaded], w_g[loaded],
+                                      length[loaded])
+    moving = loaded[moving]
     if not len(moving):
         return moving
     dfdxi = (forces(moving, xi[moving] + STEP) - f[moving]) / STEP
