@@ -158,7 +158,7 @@ def main():
                 "step iterations"], bundle, fmt={2: ".3f", 3: ".3f", 5: ".2f"}) if bundle else "(not run)"), "",
         "Segments are an option, not the default: with 3 points per segment the Newton iterations of the "
         "contact examples are equal or lower with the penalty stick and the main job's solve is about 1.3x, "
-        "but the 19-wire bundle's iteration is about 1.45x and its loaded step about 1.6x, and with exact "
+        "but the 19-wire bundle's iteration is 1.4-1.5x and its loaded step 1.5-1.6x (over runs), and with exact "
         "stick the three wires take 476 Newton iterations against 232 "
         "(`benchmarks/exact_stick_examples.py --integration points segments`; docs/theory_mortar.md section 7).", ""])
     print(text)
