@@ -159,7 +159,7 @@ def main():
         "Segments are an option, not the default: with 3 points per segment the Newton iterations of the "
         "contact examples are equal or lower with the penalty stick and the main job's solve is about 1.3x, "
         "but the 19-wire bundle's iteration is 1.4-1.5x and its loaded step 1.5-1.6x (over runs), and with exact "
-        "stick the three wires take 476 Newton iterations against 232 "
+        "stick the three wires take 407-476 Newton iterations against 232 "
         "(`benchmarks/exact_stick_examples.py --integration points segments`; docs/theory_mortar.md section 7).", ""])
     print(text)
     if not args.no_write:
