@@ -2,10 +2,11 @@
 Newton iterations, cut-backs and wall time of each (issue 26: at most 1.5 times the penalty's iterations).
 
     python benchmarks/exact_stick_examples.py [--c 1e-3 1] [--scenes twisted_pair three_wires ...]
+        [--integration points segments]
 
 ``--c``: ``penalty_t`` of the exact runs as a fraction of each declaration's normal penalty (default: the
 library's default, ``EXACT_C``).  Every ``add_contact`` of a scene gets the mode through a wrapper of
-``Model.add_contact``.  Rows print as they finish (markdown table).
+``Model.add_contact``, as does ``--integration`` (line contact's, each scene run with each).  Rows print as they finish (markdown table).
 """
 import argparse
 import sys
@@ -54,13 +55,15 @@ SCENES = dict(twisted_pair=_twisted_pair, three_wires=_three_wires, shear_lag=_s
               contact_patch=_contact_patch, rolling=_rolling, capstan=_capstan)
 
 
-def run(scene, stick, c=None):
+def run(scene, stick, c=None, integration=None):
     """``(iterations, cut-backs, wall s, message)`` of ``scene`` with every declaration's ``stick`` (and
     ``penalty_t = c x`` its normal penalty when given)."""
     orig = bs.Model.add_contact
 
     def add_contact(self, slave, master, mu=0.0, penalty=None, **options):
         options.setdefault("stick", stick)
+        if integration is not None:
+            options.setdefault("integration", integration)
         if c is not None and stick == "exact":
             from beamsolver.contact.law import default_penalty
             secs = [b.section for b in (list(slave) if isinstance(slave, (list, tuple)) else [slave])
@@ -90,17 +93,21 @@ def main():
     ap.add_argument("--scenes", nargs="+", default=list(SCENES))
     ap.add_argument("--c", type=float, nargs="+", default=[0.0],
                     help="penalty_t / normal penalty of the exact runs (0: the default, EXACT_C)")
+    ap.add_argument("--integration", nargs="+", default=[None], choices=["points", "segments"],
+                    help="add_contact(integration=...) of every declaration (default: the library's)")
     a = ap.parse_args()
     a.c = [None if c is None or c <= 0 else c for c in a.c]      # 0: the default
-    print("| scene | stick | c / penalty | Newton it. | cut-backs | wall [s] | end | ratio to penalty |")
-    print("|---|---|---|---:|---:|---:|---|---:|")
+    print("| scene | integration | stick | c / penalty | Newton it. | cut-backs | wall [s] | end | ratio to penalty |")
+    print("|---|---|---|---|---:|---:|---:|---|---:|")
     for scene in a.scenes:
-        ref = run(scene, "penalty")
-        print(f"| {scene} | penalty | | {ref[0]} | {ref[1]} | {ref[2]:.1f} | {ref[3]} | 1 |", flush=True)
-        for c in a.c:
-            r = run(scene, "exact", c)
-            print(f"| {scene} | exact | {'default' if c is None else f'{c:g}'} | {r[0]} | {r[1]} | {r[2]:.1f} | {r[3]} "
-                  f"| {r[0] / max(ref[0], 1):.2f} |", flush=True)
+        for integ in a.integration:
+            label = integ or "default"
+            ref = run(scene, "penalty", integration=integ)
+            print(f"| {scene} | {label} | penalty | | {ref[0]} | {ref[1]} | {ref[2]:.1f} | {ref[3]} | 1 |", flush=True)
+            for c in a.c:
+                r = run(scene, "exact", c, integration=integ)
+                print(f"| {scene} | {label} | exact | {'default' if c is None else f'{c:g}'} | {r[0]} | {r[1]} | "
+                      f"{r[2]:.1f} | {r[3]} | {r[0] / max(ref[0], 1):.2f} |", flush=True)
 
 
 if __name__ == "__main__":

@@ -824,9 +824,18 @@ def _wrench(R, F, neg, m, sm, G, V, DW, w):
 def _nodal(u, w, xi, t2, co, S, v, c, G, DW, DH, DXI, f, K, j0):
     """``f_j = J_j^T wr`` (``wr = v[V_WR]``) for the two nodes of one side and their rows of the tangent:
     ``J^T dwr + d(J^T wr)/dh dh + d(J^T wr)/dxi dxi`` (rows ``DW``, ``DH``, ``DXI`` of ``G``; ``dh`` is zero
-    outside the side's columns)."""
-    _jacobian_derivatives(u, w, xi, t2, co, S, v, c)
+    outside the side's columns); forces only for an empty ``K`` (``contact_kernel``)."""
     wr = v[V_WR]
+    if K.shape[1] == 0:
+        for s in range(2):
+            J = S[S_JA] if s == 0 else S[S_JB]
+            for i in range(6):
+                acc = 0.0
+                for l in range(6):
+                    acc += J[l, i] * wr[l]
+                f[j0 + s, i] = acc
+        return
+    _jacobian_derivatives(u, w, xi, t2, co, S, v, c)
     for s in range(2):
         J, D, dd = (S[S_JA], S[S_DA], v[V_DA]) if s == 0 else (S[S_JB], S[S_DB], v[V_DB])
         r0 = 6 * (j0 + s)
@@ -945,7 +954,11 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
     RC, xC, _, _ = _section_co(RA1, xA1, u1, w1, xi1, co1[0], co1[1])
     RF, xF, _, _ = _section_co(RA2, xA2, u2, w2, xi2, co2[0], co2[1])
     S1, S2 = S[0], S[1]
-    _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, G)
+    if K.shape[1] > 0:
+        _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, G)
+    else:       # forces only (``contact_kernel``: an empty ``K``): the Jacobians, no variations (their rows stay 0)
+        _jacobians(u1, w1, xi1, co1[0], co1[1], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB], S1[S_TMP])
+        _jacobians(u2, w2, xi2, co2[0], co2[1], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB], S2[S_TMP])
     n, t1, t2, dist = _axes(RC, xC, RF, xF, G)
     R1, R2, wgt = par[R1_], par[R2_], par[WEIGHT]
     gap = dist - R1 - R2
@@ -1287,8 +1300,22 @@ def kernel_and_tangent(X, p, friction=True, law=None, K=None):
 
 
 def contact_kernel(X, p, friction=True, law=None):
-    """Wrenches ``(P, 4, 6)`` and point data (``reference.contact_kernel``, for batches ``(P, 4, 4, 4)``)."""
-    f, _, out = kernel_and_tangent(X, p, friction, law)
+    """Wrenches ``(P, 4, 6)`` and point data (``reference.contact_kernel``, for batches ``(P, 4, 4, 4)``):
+    the kernel without its tangent (an empty ``K``: no variations, no tangent rows; the segment ends'
+    forward difference, ``segment_tangent``)."""
+    X = np.ascontiguousarray(X, dtype=float)
+    P = X.shape[0]
+    kind, par, has, (HCL, HFK, HLKp), lamp = _table(X, p)
+    f = np.empty((P, 4, 6))
+    sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
+    flags, frames = np.empty((P, 2), dtype=np.bool_), np.empty((P, 4, 4, 4))
+    kern = evaluate if law is None else make_kernel(law)
+    kern(X, kind, par, has, HCL, HFK, HLKp, lamp, bool(friction), f, np.empty((P, 0, 0)), sc, vec, two, flags, frames)
+    out = dict(gap=sc[:, 0], lam_n=sc[:, 1], active=flags[:, 0], n=vec[:, 0], t1=vec[:, 1], t2=vec[:, 2],
+               xC=vec[:, 3], xF=vec[:, 4], xi1=sc[:, 2], xi2=sc[:, 3], lam_t=two[:, 0], stick=flags[:, 1],
+               slip=two[:, 1], F_slave=vec[:, 5])
+    if friction:
+        out.update(HL=frames[:, 0], HK=frames[:, 1], HC=frames[:, 2], HF=frames[:, 3])
     return f, out
 
 

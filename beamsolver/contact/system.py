@@ -668,7 +668,7 @@ class ContactSystem(Contribution):
     def _segment_ends(self, H, P, sel, p, f, K, friction):
         """Add the tangent terms of the moving segment ends (``segment_tangent``) to the blocks ``K`` of the
         segment points among the active pairs ``sel`` (``f``: their forces, residual signs; ``friction``: the
-        kernel's friction flags).  The exact-stick multipliers' terms (``_mortar``) are not included."""
+        kernel's friction flags).  The exact-stick multipliers' terms: ``_mortar_ends``."""
         key = P.key[sel]
         gk = (key // self.n_beams) % self.key_gp
         seg = (key < self.point_offset) & (p["kind"] == LINE) & (gk // self.max_gp < self.n_slots)
@@ -678,17 +678,16 @@ class ContactSystem(Contribution):
                 continue
             g = gk[idx] % self.max_gp
             X = H[P.nodes[sel[idx]]]
-            pm = {k: (v[idx] if np.ndim(v) else v) for k, v in p.items()}
 
             def forces(rows, xi):
-                q = {k: (v[rows] if np.ndim(v) else v) for k, v in pm.items()}
+                at = idx[rows]
+                q = {k: (v[at] if np.ndim(v) else v) for k, v in p.items()}
                 q["xi1"] = xi
-                fk = self._kernels(X[rows], q, P.decl[sel[idx[rows]]], False, friction=friction[idx[rows]])[0]
+                fk = self._kernels(X[rows], q, P.decl[sel[at]], False, friction=friction[at])[0]
                 return -fk.reshape(len(rows), 24)
 
-            rows, terms = segment_tangent.end_terms(X, pm["xi1"], pm["weight"], d.seg_gauss[0][g], d.seg_gauss[1][g],
-                                                    self.sys.L[P.e[sel[idx]]], f[idx].reshape(len(idx), 24), forces)
-            K[idx[rows]] += terms
+            segment_tangent.end_terms(X, p["xi1"][idx], p["weight"][idx], d.seg_gauss[0][g], d.seg_gauss[1][g],
+                                      self.sys.L[P.e[sel[idx]]], f[idx].reshape(len(idx), 24), forces, K, idx)
 
     def overlap(self, H):
         """Initial overlaps at poses ``H``: ``None`` when no pair penetrates by more than
@@ -755,6 +754,18 @@ class ContactSystem(Contribution):
                 mult = dict(Kql=-Kql, Klq=Klq, Kll=Kll)
             else:
                 f, K = mortar.blocks(G, d, st, R, Lam, eps, mu)
+            if self.n_slots:
+                ends = self._mortar_ends(P, sel, idx, X, pm, G, d, st, v if ssn else st["lam"], eps, mu,
+                                         next(iter(laws.values())), None if ssn else d["active"])
+                if ends is not None:
+                    F, B = ends
+                    weak = st["weak"] if ssn else np.ones(len(m), dtype=bool)
+                    A = np.einsum("gij,gkj->gik", Kql, R) if ssn else mortar._point_parts(G, d)[2]
+                    K += F
+                    K[weak] += A[weak] @ B[weak]
+                    if ssn:
+                        B[weak] = 0.0
+                        Klq -= B
         else:
             f, K = mortar.group_forces(G, d["f"]), None
         n, t1, t2 = d["n"], d["t1"], d["t2"]
@@ -773,6 +784,32 @@ class ContactSystem(Contribution):
         return dict(members=G["members"], f=-f, K=None if K is None else -K, key=G["key"], decl=gdecl,
                     lam=v if ssn else st["lam"], u=st["u"], stick=st["stick"], R=R,
                     mult=mult)
+
+    def _mortar_ends(self, P, sel, idx, X, pm, G, d, st, vals, eps, mu, law, active):
+        """The exact-stick terms of the moving segment ends (``segment_tangent.mortar_end_terms``) of the
+        mortar points ``sel[idx]`` (``_mortar``'s data): ``(F, B)``, or None without such points."""
+        key = P.key[sel[idx]]
+        gk = (key // self.n_beams) % self.key_gp
+        seg = (key < self.point_offset) & (pm["kind"] == LINE) & (gk // self.max_gp < self.n_slots)
+        x_g, w_g = np.full(len(idx), 0.5), np.ones(len(idx))
+        on = np.zeros(len(idx), dtype=bool)
+        for dc in self.decls:
+            k = seg & (P.decl[sel[idx]] == dc.index)
+            if dc.segments and k.any():
+                g = gk[k] % self.max_gp
+                x_g[k], w_g[k], on[k] = dc.seg_gauss[0][g], dc.seg_gauss[1][g], True
+        pts = np.flatnonzero(on)
+        if not len(pts):
+            return None
+        rows, dxi, dW = segment_tangent.end_derivatives(X[pts], pm["xi1"][pts], pm["weight"][pts], x_g[pts],
+                                                        w_g[pts], self.sys.L[P.e[sel[idx[pts]]]])
+        if not len(rows):
+            return None
+        rows = pts[rows]
+        q = {k: (v[rows] if np.ndim(v) else v) for k, v in pm.items()}
+        q["xi1"] = pm["xi1"][rows] + segment_tangent.STEP
+        shifted = segment_tangent.mortar_shifted(X[rows], q, st["T"][rows], law)
+        return segment_tangent.mortar_end_terms(G, d, st, vals, eps, mu, rows, dxi, dW, pm["weight"], shifted, active)
 
     def _held_slip(self, nodes):
         """``(P, 2)``: slave nodes A, B of the pairs over ``nodes`` ``(P, 4)`` whose slip is prescribed:
