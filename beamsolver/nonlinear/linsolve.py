@@ -51,6 +51,7 @@ import scipy.sparse.linalg as spla
 from .._jit import jit
 from ..errors import InputError
 from ..failures import SingularTangent
+from .lagged import LaggedFactor
 
 __all__ = ["factorize", "factorize_tangent", "Solver", "SingularMatrixError", "available", "permutation_sign",
            "BACKENDS", "DEFAULT"]
@@ -62,6 +63,12 @@ AUTO_COUPLED_NNZ = 24.0        # "auto": non-zeros per column above which contac
 BACKWARD_ERROR = 1e-9          # pardiso, splu-rcm: |K x - b| / (|K| |x| + |b|) above this -> re-analyse / pivot fully
 RCM_PIVOT_THRESHOLD = 1e-3     # splu-rcm: keep the diagonal pivot unless below this fraction of the column's largest
 SINGULAR_RESIDUAL = 1e-6       # pardiso, with perturbed pivots: |K x - b| / |b| above this -> singular
+LAGGED = "auto"                # Solver(lagged=None): the previous factor as GMRES preconditioner where it pays
+LAG_MAX_ITERATIONS = 30        # GMRES iterations of a lagged solve at most
+LAG_MIN_ITERATIONS = 4         # "auto": no lagging where the budget is smaller (cheap factorisations)
+LAG_COST_SHARE = 0.5           # "auto": a lagged solve may cost this share of a re-factorisation
+LAG_FLOPS_PER_ENTRY = 20.0     # "auto": one GMRES iteration costs a re-factorisation's time for this many flops per factor entry
+LAG_REFRESH_SHARE = 0.5        # a lagged solve over this share of its budget: the next tangent is factorised afresh
 
 
 class SingularMatrixError(RuntimeError):
@@ -141,10 +148,17 @@ class _Typed:
 class Solver:
     """A linear-solver back-end kept across Newton iterations (``factorize(K)`` per iteration)."""
 
-    def __init__(self, backend=None):
+    def __init__(self, backend=None, lagged=None):
         self.requested = _check(backend)
+        self.lagged = LAGGED if lagged is None else lagged
+        if self.lagged not in ("auto", True, False):
+            raise InputError(f"linsolve: lagged must be 'auto', True or False, got {self.lagged!r}")
         self._pardiso = None            # _Pardiso handle, created on first use
-        self.stats = dict(factorizations=0, analyses=0)
+        self._base = None               # the last fresh factor, the lagged solves' preconditioner
+        self._base_shape = None
+        self._budget = 0                # GMRES iterations a lagged solve may take (``lag_budget``)
+        self._refresh = False           # the next factorize is a fresh one
+        self.stats = dict(factorizations=0, analyses=0, lagged=0, krylov_iterations=0, lag_failures=0)
 
     def backend_for(self, K):
         """The back-end ``factorize`` uses for ``K`` (resolves ``"auto"``).
@@ -168,9 +182,61 @@ class Solver:
             return "pardiso" if _pypardiso() is not None else "splu-rcm"
         return "splu"
 
+    def lag_budget(self, f):
+        """GMRES iterations a lagged solve preconditioned by the fresh factor ``f`` may take (0: no lagging).
+
+        ``lagged=True``: ``LAG_MAX_ITERATIONS``.  ``"auto"``: an iteration (a triangular solve
+        with the factor, one product with the matrix) against a re-factorisation, from the
+        factor's flops and entries (PARDISO reports both; other back-ends: no lagging):
+        ``LAG_COST_SHARE * flops / (LAG_FLOPS_PER_ENTRY * fill)`` iterations, the share of a
+        factorisation a lagged solve may cost, at most ``LAG_MAX_ITERATIONS``, none below
+        ``LAG_MIN_ITERATIONS`` (a cheap factorisation: small scenes, beams).  Measured on the
+        bundles (docs/benchmarks.md, issue 30): an iteration costs the time of ~``LAG_FLOPS_PER_ENTRY``
+        flops per factor entry of the re-factorisation (16-21 on the 37- and 61-wire tangents).
+        """
+        if self.lagged is False:
+            return 0
+        if self.lagged is True:
+            return LAG_MAX_ITERATIONS
+        flops, fill = float(getattr(f, "flops", np.nan)), float(getattr(f, "factor_nnz", 0))
+        if not (np.isfinite(flops) and fill > 0):
+            return 0
+        its = int(min(LAG_COST_SHARE * flops / (LAG_FLOPS_PER_ENTRY * fill), LAG_MAX_ITERATIONS))
+        return its if its >= LAG_MIN_ITERATIONS else 0
+
     def factorize(self, K):
+        """A factor of ``K`` with ``solve(b)``: fresh, or lagged (``lagged.LaggedFactor``: GMRES
+        preconditioned by the last fresh factor, while ``lag_budget`` allows, the shape holds and
+        the previous lagged solve took at most ``LAG_REFRESH_SHARE`` of its budget)."""
         if K.shape[0] != K.shape[1]:
             raise InputError(f"linsolve: the matrix must be square, got shape {K.shape}")
+        base = self._base
+        if (base is not None and not self._refresh and self._budget > 0 and self._base_shape == K.shape
+                and self.backend_for(K) == base.backend):
+            self.stats["lagged"] += 1
+            return LaggedFactor(self, K)
+        return self.fresh(K)
+
+    def fresh(self, K):
+        """A new factorisation of ``K`` (``factorize`` without lagging); it becomes the preconditioner
+        of the next lagged solves if ``lag_budget`` allows."""
+        self._base = None                       # (its matrix freed before the new factorisation)
+        f = self._factorize(K)
+        self._budget = self.lag_budget(f) if self.lagged is not False else 0
+        self._base = f if self._budget > 0 else None
+        self._base_shape = K.shape
+        self._refresh = False
+        return f
+
+    def lagged_done(self, iterations, converged):
+        """Bookkeeping of a lagged solve (``LaggedFactor``): its GMRES ``iterations``; the next
+        ``factorize`` is fresh if it took more than ``LAG_REFRESH_SHARE`` of the budget."""
+        self.stats["krylov_iterations"] += iterations
+        if not converged:
+            self.stats["lag_failures"] += 1
+        self._refresh = iterations > LAG_REFRESH_SHARE * self._budget
+
+    def _factorize(self, K):
         self.stats["factorizations"] += 1
         backend = self.backend_for(K)
         if backend == "splu":
@@ -183,6 +249,7 @@ class Solver:
 
     def close(self):
         """Release PARDISO's memory now (it is also released when the ``Solver`` is collected)."""
+        self._base = None
         if self._pardiso is not None:
             self._pardiso.release()
             self._pardiso = None
@@ -205,6 +272,8 @@ class _SpluFactor:
 
     def solve(self, b):
         return self._lu.solve(np.asarray(b, dtype=float))
+
+    apply = solve          # as a preconditioner (``lagged``): the same solve
 
     def det_sign(self):
         """Sign of ``det(K)`` (1, -1; 0 for a zero pivot): SuperLU factors ``Pr K Pc = L U`` with a
@@ -275,6 +344,10 @@ class _SpluRcmFactor:
         x = np.empty_like(y)
         x[self.perm] = y
         return x
+
+    def apply(self, b):
+        """The solve without its accuracy check (as a preconditioner, ``lagged``)."""
+        return self._solve(np.asarray(b, dtype=float))
 
     def solve(self, b):
         b = np.asarray(b, dtype=float)
@@ -489,6 +562,19 @@ class _Pardiso:
             raise SingularMatrixError(f"pardiso: singular matrix ({bad}, {f.perturbed} perturbed pivots)")
         return x
 
+    def apply(self, f, b):
+        """``solve`` without the check (``_poor``) and without PARDISO's iterative refinement (two
+        steps by default, ``iparm(8)``: three triangular solves and two products): a
+        preconditioner's solve, a third of the time."""
+        if self.current() is not f:
+            self._factor(f)
+        steps = self.ps.iparm[7]
+        self.ps.iparm[7] = 0
+        try:
+            return self._solve(f, np.asarray(b, dtype=float))
+        finally:
+            self.ps.iparm[7] = steps
+
     def _solve(self, f, b):
         ps, K = self.ps, f.K
         if not self._phased:
@@ -545,6 +631,10 @@ class _PardisoFactor:
 
     def solve(self, b):
         return self._owner.solve(self, b)
+
+    def apply(self, b):
+        """The solve without its accuracy check (as a preconditioner, ``lagged``)."""
+        return self._owner.apply(self, b)
 
 
 def _poor(f, x, b):
