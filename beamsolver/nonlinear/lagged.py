@@ -16,7 +16,7 @@ __all__ = ["gmres", "LaggedFactor", "LAG_RTOL"]
 
 LAG_RTOL = 1e-10        # |K x - b| / |b| a lagged solve must reach (a direct solve: 1e-15 .. 1e-10)
 GIVE_UP_AFTER = 3       # GMRES iterations after which a hopeless solve stops (``_hopeless``)
-GIVE_UP_FACTOR = 2.0    # hopeless: the mean rate so far needs this many times the budget
+GIVE_UP_FACTOR = 1.0    # hopeless: the mean rate so far needs this many times the budget
 
 
 def _hopeless(reduction, k, rtol, m):
@@ -90,7 +90,7 @@ def gmres(matvec, precondition, b, rtol, max_iterations):
 
 class LaggedFactor:
     """``K`` solved by ``gmres`` preconditioned by the last fresh factor of ``solver``
-    (``linsolve.Solver``), within ``solver``'s budget; otherwise (or for ``det_sign``) by a fresh
+    (``linsolve.Solver``), within ``budget`` iterations (``Solver.lag_budget``); otherwise (or for ``det_sign``) by a fresh
     factorisation of ``K`` (``Solver.fresh``), which becomes the next preconditioner.
 
     ``backend``, ``flops``, ``factor_nnz``: those of the preconditioner; ``iterations``: GMRES
@@ -98,8 +98,8 @@ class LaggedFactor:
 
     lagged = True
 
-    def __init__(self, solver, K):
-        self.solver, self.K = solver, K
+    def __init__(self, solver, K, budget):
+        self.solver, self.K, self.budget = solver, K, budget
         base = solver._base
         self.backend, self.factor_nnz = base.backend, getattr(base, "factor_nnz", 0)
         self.flops = getattr(base, "flops", float("nan"))
@@ -112,9 +112,9 @@ class LaggedFactor:
         solver = self.solver
         base = solver._base
         if base is not None:
-            x, its, ok = gmres(self.K.__matmul__, base.apply, b, LAG_RTOL, solver._budget)
+            x, its, ok = gmres(self.K.__matmul__, base.apply, b, LAG_RTOL, self.budget)
             self.iterations = its
-            solver.lagged_done(its, ok)
+            solver.lagged_done(its, self.budget, ok)
             if ok:
                 return x
         self.direct = solver.fresh(self.K)
@@ -122,7 +122,7 @@ class LaggedFactor:
 
     def __getattr__(self, name):
         """``det_sign`` (and any other attribute of a factor): from a fresh factorisation of ``K``."""
-        if name in ("direct", "solver", "K") or name.startswith("__"):
+        if name in ("direct", "solver", "K", "budget") or name.startswith("__"):
             raise AttributeError(name)
         if self.direct is None:
             base = self.solver._base

@@ -68,6 +68,7 @@ LAG_MAX_ITERATIONS = 30        # GMRES iterations of a lagged solve at most
 LAG_MIN_ITERATIONS = 4         # "auto": no lagging where the budget is smaller (cheap factorisations)
 LAG_COST_SHARE = 0.5           # "auto": a lagged solve may cost this share of a re-factorisation
 LAG_FLOPS_PER_ENTRY = 20.0     # "auto": one GMRES iteration costs a re-factorisation's time for this many flops per factor entry
+LAG_ANALYSIS_ITERATIONS = 16   # "auto": PARDISO's symbolic analysis costs this many GMRES iterations
 LAG_REFRESH_SHARE = 0.5        # a lagged solve over this share of its budget: the next tangent is factorised afresh
 
 
@@ -156,7 +157,6 @@ class Solver:
         self._pardiso = None            # _Pardiso handle, created on first use
         self._base = None               # the last fresh factor, the lagged solves' preconditioner
         self._base_shape = None
-        self._budget = 0                # GMRES iterations a lagged solve may take (``lag_budget``)
         self._refresh = False           # the next factorize is a fresh one
         self.stats = dict(factorizations=0, analyses=0, lagged=0, krylov_iterations=0, lag_failures=0)
 
@@ -182,17 +182,19 @@ class Solver:
             return "pardiso" if _pypardiso() is not None else "splu-rcm"
         return "splu"
 
-    def lag_budget(self, f):
-        """GMRES iterations a lagged solve preconditioned by the fresh factor ``f`` may take (0: no lagging).
+    def lag_budget(self, f, analysis=False):
+        """GMRES iterations a lagged solve preconditioned by the fresh factor ``f`` may take (0: no
+        lagging); ``analysis``: whether a fresh factorisation of the new matrix would redo the
+        symbolic analysis (its pattern differs from ``f``'s).
 
-        ``lagged=True``: ``LAG_MAX_ITERATIONS``.  ``"auto"``: an iteration (a triangular solve
-        with the factor, one product with the matrix) against a re-factorisation, from the
-        factor's flops and entries (PARDISO reports both; other back-ends: no lagging):
-        ``LAG_COST_SHARE * flops / (LAG_FLOPS_PER_ENTRY * fill)`` iterations, the share of a
-        factorisation a lagged solve may cost, at most ``LAG_MAX_ITERATIONS``, none below
-        ``LAG_MIN_ITERATIONS`` (a cheap factorisation: small scenes, beams).  Measured on the
-        bundles (docs/benchmarks.md, issue 30): an iteration costs the time of ~``LAG_FLOPS_PER_ENTRY``
-        flops per factor entry of the re-factorisation (16-21 on the 37- and 61-wire tangents).
+        ``lagged=True``: ``LAG_MAX_ITERATIONS``.  ``"auto"``: ``LAG_COST_SHARE`` of a fresh
+        factorisation counted in GMRES iterations (one triangular solve with ``f``, one product with
+        the matrix), at most ``LAG_MAX_ITERATIONS``, none below ``LAG_MIN_ITERATIONS`` (cheap
+        factorisations: small scenes, beams).  Measured with PARDISO on bundles, strands and their
+        loaded steps of 19..61 wires (docs/benchmarks.md, issue 30): a re-factorisation costs
+        ``flops / (LAG_FLOPS_PER_ENTRY fill)`` iterations (PARDISO reports both; 18-22 flops per
+        factor entry measured), an analysis ``LAG_ANALYSIS_ITERATIONS`` more (14-18 measured);
+        back-ends without flops: no lagging.
         """
         if self.lagged is False:
             return 0
@@ -201,7 +203,8 @@ class Solver:
         flops, fill = float(getattr(f, "flops", np.nan)), float(getattr(f, "factor_nnz", 0))
         if not (np.isfinite(flops) and fill > 0):
             return 0
-        its = int(min(LAG_COST_SHARE * flops / (LAG_FLOPS_PER_ENTRY * fill), LAG_MAX_ITERATIONS))
+        fresh = flops / (LAG_FLOPS_PER_ENTRY * fill) + (LAG_ANALYSIS_ITERATIONS if analysis else 0.0)
+        its = int(min(LAG_COST_SHARE * fresh, LAG_MAX_ITERATIONS))
         return its if its >= LAG_MIN_ITERATIONS else 0
 
     def factorize(self, K):
@@ -211,30 +214,31 @@ class Solver:
         if K.shape[0] != K.shape[1]:
             raise InputError(f"linsolve: the matrix must be square, got shape {K.shape}")
         base = self._base
-        if (base is not None and not self._refresh and self._budget > 0 and self._base_shape == K.shape
+        if (base is not None and not self._refresh and self._base_shape == K.shape
                 and self.backend_for(K) == base.backend):
-            self.stats["lagged"] += 1
-            return LaggedFactor(self, K)
+            budget = self.lag_budget(base, analysis=not _same_pattern(base, K))
+            if budget > 0:
+                self.stats["lagged"] += 1
+                return LaggedFactor(self, K, budget)
         return self.fresh(K)
 
     def fresh(self, K):
-        """A new factorisation of ``K`` (``factorize`` without lagging); it becomes the preconditioner
-        of the next lagged solves if ``lag_budget`` allows."""
+        """A new factorisation of ``K`` (``factorize`` without lagging); it preconditions the next
+        lagged solves if ``lag_budget`` may allow them."""
         self._base = None                       # (its matrix freed before the new factorisation)
         f = self._factorize(K)
-        self._budget = self.lag_budget(f) if self.lagged is not False else 0
-        self._base = f if self._budget > 0 else None
+        self._base = f if self.lag_budget(f, analysis=True) > 0 else None
         self._base_shape = K.shape
         self._refresh = False
         return f
 
-    def lagged_done(self, iterations, converged):
-        """Bookkeeping of a lagged solve (``LaggedFactor``): its GMRES ``iterations``; the next
-        ``factorize`` is fresh if it took more than ``LAG_REFRESH_SHARE`` of the budget."""
+    def lagged_done(self, iterations, budget, converged):
+        """Bookkeeping of a lagged solve (``LaggedFactor``): its GMRES ``iterations`` of ``budget``;
+        the next ``factorize`` is fresh if it took more than ``LAG_REFRESH_SHARE`` of the budget."""
         self.stats["krylov_iterations"] += iterations
         if not converged:
             self.stats["lag_failures"] += 1
-        self._refresh = iterations > LAG_REFRESH_SHARE * self._budget
+        self._refresh = iterations > LAG_REFRESH_SHARE * budget
 
     def _factorize(self, K):
         self.stats["factorizations"] += 1
@@ -281,6 +285,13 @@ class _SpluFactor:
         two permutations."""
         d = self._lu.U.diagonal()
         return int(np.prod(np.sign(d))) * permutation_sign(self._lu.perm_r) * permutation_sign(self._lu.perm_c)
+
+
+def _same_pattern(f, K):
+    """Whether ``K`` has the pattern of the matrix of the factor ``f`` (if ``f`` keeps it)."""
+    A = getattr(f, "K", None)
+    return (A is not None and A.format == K.format and A.shape == K.shape and A.nnz == K.nnz
+            and np.array_equal(A.indptr, K.indptr) and np.array_equal(A.indices, K.indices))
 
 
 def permutation_sign(p):

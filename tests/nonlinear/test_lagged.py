@@ -127,11 +127,10 @@ def test_auto_lags_only_expensive_factorisations():
 
     class F:
         flops, factor_nnz = 48.2e9, 48.5e6          # the 61-wire bundle's tangent (docs/benchmarks.md)
-    assert s.lag_budget(F) == 24
-    F.flops = 1.47e9 * 4.88e6 / 4.88e6 / 10.0      # flops per entry 30: below the minimum budget
-    F.factor_nnz = 4.88e6
-    assert s.lag_budget(F) == 0
-    assert linsolve.Solver("splu", lagged=False).lag_budget(F) == 0
+    assert s.lag_budget(F) == 24 and s.lag_budget(F, analysis=True) == 30
+    F.flops, F.factor_nnz = 0.816e9, 5.89e6         # the 61-wire strand's: a cheap re-factorisation
+    assert s.lag_budget(F) == 0 and s.lag_budget(F, analysis=True) == 11
+    assert linsolve.Solver("splu", lagged=False).lag_budget(F, analysis=True) == 0
 
 
 def test_bad_lagged_option():
@@ -145,9 +144,9 @@ def rolled_lagged():
     counts = []
     orig = linsolve.Solver.lagged_done
 
-    def spy(self, iterations, converged):
+    def spy(self, iterations, budget, converged):
         counts.append((iterations, converged))
-        return orig(self, iterations, converged)
+        return orig(self, iterations, budget, converged)
     mp = pytest.MonkeyPatch()
     mp.setattr(linsolve, "LAGGED", True)
     mp.setattr(linsolve.Solver, "lagged_done", spy)
