@@ -10,6 +10,8 @@ that does not reach the tolerance within its budget falls back to a fresh factor
 same matrix, so a lagged solve is as accurate as a direct one (the true residual
 ``|K x - b| <= LAG_RTOL |b|`` is checked after the iterations) and never wrong, at worst slower.
 """
+import weakref
+
 import numpy as np
 
 __all__ = ["gmres", "LaggedFactor", "LAG_RTOL"]
@@ -101,8 +103,8 @@ class LaggedFactor:
     def __init__(self, solver, K, budget):
         self.solver, self.K, self.budget = solver, K, budget
         base = solver._base
-        self.backend, self.factor_nnz = base.backend, getattr(base, "factor_nnz", 0)
-        self.flops = getattr(base, "flops", float("nan"))
+        self._preconditioner = weakref.ref(base)      # (for ``factor_nnz``; not kept alive)
+        self.backend, self.flops = base.backend, getattr(base, "flops", float("nan"))
         self.direct = None            # the fresh factor of ``K``, once needed
         self.iterations = 0
 
@@ -120,9 +122,15 @@ class LaggedFactor:
         self.direct = solver.fresh(self.K)
         return self.direct.solve(b)
 
+    @property
+    def factor_nnz(self):
+        """Entries of the preconditioner's factor (0 once it is gone)."""
+        base = self._preconditioner()
+        return base.factor_nnz if base is not None else 0
+
     def __getattr__(self, name):
         """``det_sign`` (and any other attribute of a factor): from a fresh factorisation of ``K``."""
-        if name in ("direct", "solver", "K", "budget") or name.startswith("__"):
+        if name in ("direct", "solver", "K", "budget", "_preconditioner") or name.startswith("__"):
             raise AttributeError(name)
         if self.direct is None:
             base = self.solver._base

@@ -66,6 +66,7 @@ SINGULAR_RESIDUAL = 1e-6       # pardiso, with perturbed pivots: |K x - b| / |b|
 LAGGED = "auto"                # Solver(lagged=None): the previous factor as GMRES preconditioner where it pays
 LAG_MAX_ITERATIONS = 30        # GMRES iterations of a lagged solve at most
 LAG_MIN_ITERATIONS = 4         # "auto": no lagging where the budget is smaller (cheap factorisations)
+LAG_MIN_FLOPS = 1e8            # "auto": no lagging below (a factorisation of ~10 ms or less: GMRES' Python overheads weigh)
 LAG_COST_SHARE = 0.5           # "auto": a lagged solve may cost this share of a re-factorisation
 LAG_FLOPS_PER_ENTRY = 20.0     # "auto": one GMRES iteration costs a re-factorisation's time for this many flops per factor entry
 LAG_ANALYSIS_ITERATIONS = 16   # "auto": PARDISO's symbolic analysis costs this many GMRES iterations
@@ -194,14 +195,18 @@ class Solver:
         loaded steps of 19..61 wires (docs/benchmarks.md, issue 30): a re-factorisation costs
         ``flops / (LAG_FLOPS_PER_ENTRY fill)`` iterations (PARDISO reports both; 18-22 flops per
         factor entry measured), an analysis ``LAG_ANALYSIS_ITERATIONS`` more (14-18 measured);
-        back-ends without flops: no lagging.
+        back-ends without flops and factorisations under ``LAG_MIN_FLOPS`` (the twisted pair of
+        128 elements per wire with PARDISO: 10 % slower per Newton iteration when lagged): no lagging.
         """
         if self.lagged is False:
             return 0
         if self.lagged is True:
             return LAG_MAX_ITERATIONS
-        flops, fill = float(getattr(f, "flops", np.nan)), float(getattr(f, "factor_nnz", 0))
-        if not (np.isfinite(flops) and fill > 0):
+        flops = float(getattr(f, "flops", np.nan))
+        if not (np.isfinite(flops) and flops >= LAG_MIN_FLOPS):     # (before ``factor_nnz``: SuperLU's builds L, U)
+            return 0
+        fill = float(f.factor_nnz)
+        if fill <= 0:
             return 0
         fresh = flops / (LAG_FLOPS_PER_ENTRY * fill) + (LAG_ANALYSIS_ITERATIONS if analysis else 0.0)
         its = int(min(LAG_COST_SHARE * fresh, LAG_MAX_ITERATIONS))

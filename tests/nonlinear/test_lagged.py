@@ -131,6 +131,8 @@ def test_auto_lags_only_expensive_factorisations():
     F.flops, F.factor_nnz = 0.816e9, 5.89e6         # the 61-wire strand's: a cheap re-factorisation
     assert s.lag_budget(F) == 0 and s.lag_budget(F, analysis=True) == 11
     assert linsolve.Solver("splu", lagged=False).lag_budget(F, analysis=True) == 0
+    F.flops, F.factor_nnz = 0.5 * linsolve.LAG_MIN_FLOPS, 1e4     # expensive per entry, cheap in all
+    assert s.lag_budget(F, analysis=True) == 0
 
 
 def test_bad_lagged_option():
