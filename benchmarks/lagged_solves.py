@@ -14,7 +14,8 @@ Two measurements, one thread, CPU seconds, each scene in its own child process:
     sequence a user of these scenes pays); ``strand-37``, ``strand-61``: the whole loaded step of their
     overlap-free twins (``scaling_scenes.strand_model``).  Reported: the sum of the solves, the
     fresh factorisations, lagged solves, GMRES iterations, lagged solves that fell back to a
-    factorisation, and the largest difference of a solution from the direct one (relative, 2-norm) and relative residual;
+    factorisation, and the largest difference of a solution from the direct one (relative, 2-norm)
+    and relative residual;
 (b) **the loaded step** of the strands (``scaling_scenes``: ``bs.solve(steps=1)``), lagged off and on
     (``linsolve.LAGGED``), alternately: CPU s, Newton iterations, median CPU s between iterations.
 
@@ -165,7 +166,8 @@ def main(argv):
     for name in scenes:
         r = run_child("sequence", name, a.rounds, a.tangents)
         print(r, flush=True)
-        seq_rows.append([r["scene"], r["unknowns"], r["tangents"], f"{r['direct_s']:.3g}", f"{r['lagged_s']:.3g}",
+        seq_rows.append([r["scene"], r["unknowns"], r["tangents"], f"{r['direct_s']:.3g}",
+                         f"{r['lagged_s']:.3g}",
                          f"{r['direct_s'] / r['tangents']:.3g}", f"{r['lagged_s'] / r['tangents']:.3g}",
                          r["factorizations"], r["lagged"], r["krylov"], r["failures"], f"{r['diff']:.1e}",
                          f"{r['residual']:.1e}"])
@@ -182,15 +184,15 @@ def main(argv):
             r = best[lagged]
             step_rows.append([name, lagged, f"{r['step_s']:.3g}", r["iterations"], f"{r['it_s']:.3g}",
                               " ".join(f"{x:.1e}" for x in r["residuals"])])
+    about = " ".join(__doc__.split("Two measurements, ", 1)[1].split("Markdown on stdout")[0].split())
+    about = about.replace("``", "`").replace(": (a)", ".\n\n(a)").replace("; (b)", ".\n\n(b)")
     text = (f"## Lagged factorisations: the previous factor as a preconditioner (issue 30)\n\n"
             f"`python benchmarks/lagged_solves.py --scenes {a.scenes} --rounds {a.rounds} --tangents {a.tangents}` "
-            f"({machine()}; one thread; whole run {time.time() - t_start:.0f} s).  "
-            + "Two measurements, " + " ".join(__doc__.split("Two measurements, ", 1)[1].split("Markdown on stdout")[0].split())
-            .replace("``", "`").replace(": (a)", ".\n\n(a)").replace("; (b)", ".\n\n(b)")
-            + "\n\n"
+            f"({machine()}; one thread; whole run {time.time() - t_start:.0f} s).  Two measurements, {about}\n\n"
             + table(["scene", "unknowns", "tangents", "solves, direct (s)", "solves, lagged (s)",
                      "per tangent, direct", "per tangent, lagged", "factorisations (lagged run)", "lagged solves",
-                     "GMRES iterations", "fell back", "largest relative difference from direct", "largest relative residual"], seq_rows))
+                     "GMRES iterations", "fell back", "largest relative difference from direct",
+                     "largest relative residual"], seq_rows))
     if step_rows:
         text += "\n\n" + table(["scene", "lagged", "loaded step (s)", "Newton iterations", "s per iteration",
                                 "residuals"], step_rows)

@@ -1,14 +1,15 @@
 """The previous factorisation as a preconditioner (a lagged factorisation, Newton-Krylov).
 
 While Newton converges the tangent changes less and less from one iteration to the next
-(relative change ~0.5, 0.25, 0.1, 2e-2, 1e-3, 1e-6 on the bundles' loaded steps,
+(relative change ~0.5, 0.25, 0.1, 2e-2, 1e-3, 1e-6 on the 61-wire strand's loaded step,
 docs/benchmarks.md), and the factorisation of the last one is an excellent preconditioner of the
 next: right-preconditioned GMRES (``gmres``) then reaches the Newton step to ``LAG_RTOL`` of the
 right-hand side in a few iterations, each one triangular solve and one product with the new matrix,
 instead of a new factorisation.  ``linsolve.Solver`` decides when (``Solver.lag_budget``); a solve
 that does not reach the tolerance within its budget falls back to a fresh factorisation of the
-same matrix, so a lagged solve is as accurate as a direct one (the true residual
-``|K x - b| <= LAG_RTOL |b|`` is checked after the iterations) and never wrong, at worst slower.
+same matrix: the true residual ``|K x - b| <= LAG_RTOL |b|`` is checked after the iterations, so a
+lagged Newton step is as good as a direct one for Newton's rate (solutions within ~1e-8 of the
+direct ones on the bundles), at worst slower.
 """
 import weakref
 
@@ -23,9 +24,10 @@ GIVE_UP_FACTOR = 1.0    # hopeless: the mean rate so far needs this many times t
 
 def _hopeless(reduction, k, rtol, m):
     """Whether ``k`` iterations that reduced the residual by ``reduction`` in all, at that mean rate,
-    would need more than ``GIVE_UP_FACTOR`` times the ``m`` iterations allowed to reach ``rtol``
-    (GMRES speeds up as it goes, hence the margin): a preconditioner from a tangent too far away
-    (a new load step, a changed contact set) costs ``GIVE_UP_AFTER`` iterations, not the budget."""
+    would need more than ``GIVE_UP_FACTOR`` times the ``m`` iterations allowed to reach ``rtol``: a
+    preconditioner from a tangent too far away (a new load step, a changed contact set) costs
+    ``GIVE_UP_AFTER`` iterations, not the budget (GMRES may speed up later: 2.0 gave up later and
+    saved nothing on the recorded sequences of docs/benchmarks.md)."""
     if reduction <= 0.0:
         return False
     if reduction >= 1.0:
@@ -92,8 +94,8 @@ def gmres(matvec, precondition, b, rtol, max_iterations):
 
 class LaggedFactor:
     """``K`` solved by ``gmres`` preconditioned by the last fresh factor of ``solver``
-    (``linsolve.Solver``), within ``budget`` iterations (``Solver.lag_budget``); otherwise (or for ``det_sign``) by a fresh
-    factorisation of ``K`` (``Solver.fresh``), which becomes the next preconditioner.
+    (``linsolve.Solver``), within ``budget`` iterations (``Solver.lag_budget``); otherwise (or for
+    ``det_sign``) by a fresh factorisation of ``K`` (``Solver.fresh``), the next preconditioner.
 
     ``backend``, ``flops``, ``factor_nnz``: those of the preconditioner; ``iterations``: GMRES
     iterations of the last lagged solve (also when it fell back to a fresh factorisation)."""

@@ -34,6 +34,12 @@ equilibrium, contact).  Saddle-point systems (multiplier contact: a zero diagona
 the same unsymmetric back-ends, which pivot (SuperLU: threshold partial pivoting; PARDISO:
 weighted matching and pivot perturbation, its solutions checked by ``_poor``).
 
+Lagged solves (``Solver(lagged="auto")``, the default; ``lagged.py``): while a factorisation is
+expensive (``Solver.lag_budget``), ``Solver.factorize`` returns a factor that solves the new matrix
+by GMRES preconditioned by the last fresh factorisation, to ``lagged.LAG_RTOL`` of the right-hand
+side, and factorises afresh when that does not get there within its budget (docs/benchmarks.md:
+8-13 % less CPU per Newton iteration on the strands' loaded steps; no lagging for small scenes).
+
 A singular matrix raises ``SingularMatrixError`` (a ``RuntimeError``), from
 ``factorize`` (splu: exactly zero pivot) or from ``solve`` (pardiso perturbs
 tiny pivots instead of failing, so its ``solve`` checks the solution with
@@ -66,9 +72,9 @@ SINGULAR_RESIDUAL = 1e-6       # pardiso, with perturbed pivots: |K x - b| / |b|
 LAGGED = "auto"                # Solver(lagged=None): the previous factor as GMRES preconditioner where it pays
 LAG_MAX_ITERATIONS = 30        # GMRES iterations of a lagged solve at most
 LAG_MIN_ITERATIONS = 4         # "auto": no lagging where the budget is smaller (cheap factorisations)
-LAG_MIN_FLOPS = 1e8            # "auto": no lagging below (a factorisation of ~10 ms or less: GMRES' Python overheads weigh)
+LAG_MIN_FLOPS = 1e8            # "auto": no lagging below (factorisations of ~10 ms: GMRES' Python overheads weigh)
 LAG_COST_SHARE = 0.5           # "auto": a lagged solve may cost this share of a re-factorisation
-LAG_FLOPS_PER_ENTRY = 20.0     # "auto": one GMRES iteration costs a re-factorisation's time for this many flops per factor entry
+LAG_FLOPS_PER_ENTRY = 20.0     # "auto": a GMRES iteration costs a re-factorisation's time at this many flops/entry
 LAG_ANALYSIS_ITERATIONS = 16   # "auto": PARDISO's symbolic analysis costs this many GMRES iterations
 LAG_REFRESH_SHARE = 0.5        # a lagged solve over this share of its budget: the next tangent is factorised afresh
 
