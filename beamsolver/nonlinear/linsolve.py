@@ -76,6 +76,7 @@ LAG_MIN_FLOPS = 1e8            # "auto": no lagging below (factorisations of ~10
 LAG_COST_SHARE = 0.5           # "auto": a lagged solve may cost this share of a re-factorisation
 LAG_FLOPS_PER_ENTRY = 20.0     # "auto": a GMRES iteration costs a re-factorisation's time at this many flops/entry
 LAG_ANALYSIS_ITERATIONS = 16   # "auto": PARDISO's symbolic analysis costs this many GMRES iterations
+LAG_MAX_BACKOFF = 8            # failed lagged solves in a row: 0, 1, 2, 4, .. this many fresh factorisations between tries
 LAG_REFRESH_SHARE = 0.5        # a lagged solve over this share of its budget: the next tangent is factorised afresh
 
 
@@ -165,6 +166,8 @@ class Solver:
         self._base = None               # the last fresh factor, the lagged solves' preconditioner
         self._base_shape = None
         self._refresh = False           # the next factorize is a fresh one
+        self._skip = 0                  # fresh factorisations before the next lagged try (``lagged_done``)
+        self._backoff = 0               # the skip after the next failed lagged solve
         self.stats = dict(factorizations=0, analyses=0, lagged=0, krylov_iterations=0, lag_failures=0)
 
     def backend_for(self, K):
@@ -225,7 +228,9 @@ class Solver:
         if K.shape[0] != K.shape[1]:
             raise InputError(f"linsolve: the matrix must be square, got shape {K.shape}")
         base = self._base
-        if (base is not None and not self._refresh and self._base_shape == K.shape
+        if self._skip > 0:
+            self._skip -= 1
+        elif (base is not None and not self._refresh and self._base_shape == K.shape
                 and self.backend_for(K) == base.backend):
             budget = self.lag_budget(base, analysis=not _same_pattern(base, K))
             if budget > 0:
@@ -247,8 +252,11 @@ class Solver:
         """Bookkeeping of a lagged solve (``LaggedFactor``): its GMRES ``iterations`` of ``budget``;
         the next ``factorize`` is fresh if it took more than ``LAG_REFRESH_SHARE`` of the budget."""
         self.stats["krylov_iterations"] += iterations
-        if not converged:
+        if converged:
+            self._backoff = 0
+        else:
             self.stats["lag_failures"] += 1
+            self._skip, self._backoff = self._backoff, min(max(2 * self._backoff, 1), LAG_MAX_BACKOFF)
         self._refresh = iterations > LAG_REFRESH_SHARE * budget
 
     def _factorize(self, K):

@@ -93,6 +93,29 @@ def test_a_far_matrix_is_factorised_afresh(backend):
     s.close()
 
 
+def test_failed_lagged_solves_back_off():
+    """Lagged solves failing in a row: 0, 1, 2 fresh factorisations before the next try; a success resets."""
+    s = linsolve.Solver("splu", lagged=True)
+    b = np.ones(300)
+    s.factorize(matrix(seed=0))
+    kinds = []
+    for seed in range(1, 8):                                  # every matrix far from the one before
+        f = s.factorize(matrix(seed=seed))
+        f.solve(b)
+        kinds.append(isinstance(f, lagged.LaggedFactor))
+    assert kinds == [True, True, False, True, False, False, True], kinds
+    near = perturbed(matrix(seed=7), 1e-6)
+    kinds = [isinstance(s.factorize(near), lagged.LaggedFactor) for _ in range(4)]
+    assert kinds == [False] * 4                                               # four skipped after 4 failures
+    f = s.factorize(perturbed(near, 1e-6))
+    f.solve(b)
+    assert isinstance(f, lagged.LaggedFactor) and f.direct is None          # a success ...
+    f = s.factorize(matrix(seed=8))
+    f.solve(b)
+    assert f.direct is not None
+    assert isinstance(s.factorize(matrix(seed=9)), lagged.LaggedFactor)     # ... and the back-off starts over
+
+
 def test_slow_lagged_solve_refreshes_the_next_factor():
     """A lagged solve that took more than ``LAG_REFRESH_SHARE`` of its budget: the next tangent is factorised."""
     A = matrix()
