@@ -38,7 +38,7 @@ Lagged solves (``Solver(lagged="auto")``, the default; ``lagged.py``): while a f
 expensive (``Solver.lag_budget``), ``Solver.factorize`` returns a factor that solves the new matrix
 by GMRES preconditioned by the last fresh factorisation, to ``lagged.LAG_RTOL`` of the right-hand
 side, and factorises afresh when that does not get there within its budget (docs/benchmarks.md:
-2-13 % less CPU per Newton iteration on the strands' loaded steps; no lagging for small scenes).
+2-19 % less CPU per Newton iteration on the strands' loaded steps; no lagging for small scenes).
 
 A singular matrix raises ``SingularMatrixError`` (a ``RuntimeError``), from
 ``factorize`` (splu: exactly zero pivot) or from ``solve`` (pardiso perturbs
