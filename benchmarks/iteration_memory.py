@@ -5,7 +5,8 @@
 Builds the scene of ``scaling_scenes.scene_model`` (``19``, ``37``, ``61``, ``rope-<mm>``) and runs
 ``--iterations`` Newton iterations at the reference poses as ``Newton.iterate`` does them:
 ``Problem.begin_step``, the evaluation with tangent, ``Problem.tangent`` (CSC), the factorisation and
-solve with the default ``linsolve.Solver``, ``Evaluation.drop_tangent``, then a residual-only
+solve with the default ``linsolve.Solver`` (``--lagged off``: without lagged solves; the iterations
+share their poses, so the lagged ones take one GMRES iteration), ``Evaluation.drop_tangent``, then a residual-only
 evaluation at slightly moved poses (a line-search trial).  After each stage it reads
 ``/proc/self/status``: the resident memory ``VmRSS`` and the peak since the previous stage
 (``VmHWM``, reset by writing ``5`` to ``/proc/self/clear_refs``), in MB.  One thread (MKL pinned).
@@ -41,6 +42,8 @@ def main(argv):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scene", default="61")
     ap.add_argument("--iterations", type=int, default=3)
+    ap.add_argument("--lagged", default="auto", choices=("auto", "off"),
+                    help="linsolve.Solver(lagged=): the default, or a factorisation per iteration")
     a = ap.parse_args(argv)
     import scaling_scenes
     from scaling import warm_up
@@ -64,7 +67,7 @@ def main(argv):
     system = problem.system
     mark("model and problem built")
     H = system.poses0.copy()
-    solver = linsolve.Solver()
+    solver = linsolve.Solver(lagged=a.lagged if a.lagged == "auto" else False)
     rng = np.random.default_rng(1)
     for it in range(a.iterations):
         problem.begin_step(H, 0.0)
@@ -80,7 +83,8 @@ def main(argv):
         mark(f"{it}: residual (trial)")
         del ev, K, f
     solver.close()
-    print(f"`python benchmarks/iteration_memory.py --scene {a.scene} --iterations {a.iterations}` ({machine()}; "
+    print(f"`python benchmarks/iteration_memory.py --scene {a.scene} --iterations {a.iterations} --lagged {a.lagged}` "
+          f"({machine()}; "
           f"{system.n_elements} elements, {system.n_free} unknowns): MB after each stage\n")
     print(table(["stage", "resident (VmRSS)", "peak during the stage (VmHWM)"], rows))
 

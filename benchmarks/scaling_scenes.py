@@ -6,7 +6,7 @@ Each scene runs in its own child process (``scaling.py --child scene NAME``) and
 - one Newton iteration at the reference poses by parts (CPU s): ``element`` (``System.evaluate``),
   ``contact`` (the rest of ``Problem.evaluate``: search, kernels, blocks, their assembly into the
   residual and COO), ``assembly`` (``Problem.tangent``, CSC), ``solve`` (the default
-  ``linsolve.Solver``: factorisation + solve; its back-end, fill and flops, the flops reported by
+  ``linsolve.Solver`` without lagging: a factorisation + solve; its back-end, fill and flops, the flops reported by
   PARDISO or counted from SuperLU's factors) and ``update``: their sum is ``iteration``, what
   ``Newton.iterate`` pays per iteration (an accepted full step is evaluated once, with the tangent:
   the next iteration's evaluation); the first iteration (a new pattern: PARDISO's analysis, the maps
@@ -111,7 +111,10 @@ def measure_scene(name, rss_mb):
     out = dict(scene=name, build_s=clock() - t0, elements=system.n_elements, unknowns=system.n_free,
                length_m=length)
     H = system.poses0.copy()
-    solver = linsolve.Solver()
+    # a factorisation per iteration: the second tangent, at the same poses, equals the first, and a lagged
+    # solve (the default ``Solver``'s, preconditioned by the first factor) would take one GMRES iteration, not
+    # what a Newton iteration pays; lagged solves over real Newton sequences: ``lagged_solves.py``
+    solver = linsolve.Solver(lagged=False)
     for it in (1, 2):
         t = {}
         problem.begin_step(H, 0.0)

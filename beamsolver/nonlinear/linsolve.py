@@ -34,6 +34,12 @@ equilibrium, contact).  Saddle-point systems (multiplier contact: a zero diagona
 the same unsymmetric back-ends, which pivot (SuperLU: threshold partial pivoting; PARDISO:
 weighted matching and pivot perturbation, its solutions checked by ``_poor``).
 
+Lagged solves (``Solver(lagged="auto")``, the default; ``lagged.py``): while a factorisation is
+expensive (``Solver.lag_budget``), ``Solver.factorize`` returns a factor that solves the new matrix
+by GMRES preconditioned by the last fresh factorisation, to ``lagged.LAG_RTOL`` of the right-hand
+side, and factorises afresh when that does not get there within its budget (docs/benchmarks.md:
+2-19 % less CPU per Newton iteration on the strands' loaded steps; no lagging for small scenes).
+
 A singular matrix raises ``SingularMatrixError`` (a ``RuntimeError``), from
 ``factorize`` (splu: exactly zero pivot) or from ``solve`` (pardiso perturbs
 tiny pivots instead of failing, so its ``solve`` checks the solution with
@@ -51,6 +57,7 @@ import scipy.sparse.linalg as spla
 from .._jit import jit
 from ..errors import InputError
 from ..failures import SingularTangent
+from .lagged import LaggedFactor
 
 __all__ = ["factorize", "factorize_tangent", "Solver", "SingularMatrixError", "available", "permutation_sign",
            "BACKENDS", "DEFAULT"]
@@ -64,6 +71,15 @@ AUTO_COUPLED_NNZ = 24.0        # "auto": non-zeros per column above which contac
 BACKWARD_ERROR = 1e-9          # pardiso, splu-rcm: |K x - b| / (|K| |x| + |b|) above this -> re-analyse / pivot fully
 RCM_PIVOT_THRESHOLD = 1e-3     # splu-rcm: keep the diagonal pivot unless below this fraction of the column's largest
 SINGULAR_RESIDUAL = 1e-6       # pardiso, with perturbed pivots: |K x - b| / |b| above this -> singular
+LAGGED = "auto"                # Solver(lagged=None): the previous factor as GMRES preconditioner where it pays
+LAG_MAX_ITERATIONS = 30        # GMRES iterations of a lagged solve at most
+LAG_MIN_ITERATIONS = 4         # "auto": no lagging where the budget is smaller (cheap factorisations)
+LAG_MIN_FLOPS = 1e8            # "auto": no lagging below (factorisations of ~10 ms: GMRES' Python overheads weigh)
+LAG_COST_SHARE = 0.5           # "auto": a lagged solve may cost this share of a re-factorisation
+LAG_FLOPS_PER_ENTRY = 20.0     # "auto": a GMRES iteration costs a re-factorisation's time at this many flops/entry
+LAG_ANALYSIS_ITERATIONS = 16   # "auto": PARDISO's symbolic analysis costs this many GMRES iterations
+LAG_MAX_BACKOFF = 8            # failed lagged solves in a row: 0, 1, 2, 4, .. this many fresh factorisations between tries
+LAG_REFRESH_SHARE = 0.5        # a lagged solve over this share of its budget: the next tangent is factorised afresh
 
 
 class SingularMatrixError(RuntimeError):
@@ -143,10 +159,18 @@ class _Typed:
 class Solver:
     """A linear-solver back-end kept across Newton iterations (``factorize(K)`` per iteration)."""
 
-    def __init__(self, backend=None):
+    def __init__(self, backend=None, lagged=None):
         self.requested = _check(backend)
+        self.lagged = LAGGED if lagged is None else lagged
+        if self.lagged not in ("auto", True, False):
+            raise InputError(f"linsolve: lagged must be 'auto', True or False, got {self.lagged!r}")
         self._pardiso = None            # _Pardiso handle, created on first use
-        self.stats = dict(factorizations=0, analyses=0)
+        self._base = None               # the last fresh factor, the lagged solves' preconditioner
+        self._base_shape = None
+        self._refresh = False           # the next factorize is a fresh one
+        self._skip = 0                  # fresh factorisations before the next lagged try (``lagged_done``)
+        self._backoff = 0               # the skip after the next failed lagged solve
+        self.stats = dict(factorizations=0, analyses=0, lagged=0, krylov_iterations=0, lag_failures=0)
 
     def backend_for(self, K):
         """The back-end ``factorize`` uses for ``K`` (resolves ``"auto"``).
@@ -170,14 +194,81 @@ class Solver:
             return "pardiso" if _pypardiso() is not None else "splu-rcm"
         return "splu"
 
+    def lag_budget(self, f, analysis=False):
+        """GMRES iterations a lagged solve preconditioned by the fresh factor ``f`` may take (0: no
+        lagging); ``analysis``: whether a fresh factorisation of the new matrix would redo the
+        symbolic analysis (its pattern differs from ``f``'s).
+
+        ``lagged=True``: ``LAG_MAX_ITERATIONS``.  ``"auto"``: ``LAG_COST_SHARE`` of a fresh
+        factorisation counted in GMRES iterations (one triangular solve with ``f``, one product with
+        the matrix), at most ``LAG_MAX_ITERATIONS``, none below ``LAG_MIN_ITERATIONS`` (cheap
+        factorisations: small scenes, beams).  Measured with PARDISO on bundles, strands and their
+        loaded steps of 19..61 wires (docs/benchmarks.md, issue 30): a re-factorisation costs
+        ``flops / (LAG_FLOPS_PER_ENTRY fill)`` iterations (PARDISO reports both; 18-22 flops per
+        factor entry measured), an analysis ``LAG_ANALYSIS_ITERATIONS`` more (14-18 measured);
+        back-ends without flops and factorisations under ``LAG_MIN_FLOPS`` (the twisted pair of
+        128 elements per wire with PARDISO: 10 % slower per Newton iteration when lagged): no lagging.
+        """
+        if self.lagged is False:
+            return 0
+        if self.lagged is True:
+            return LAG_MAX_ITERATIONS
+        flops = float(getattr(f, "flops", np.nan))
+        if not (np.isfinite(flops) and flops >= LAG_MIN_FLOPS):     # (before ``factor_nnz``: SuperLU's builds L, U)
+            return 0
+        fill = float(f.factor_nnz)
+        if fill <= 0:
+            return 0
+        fresh = flops / (LAG_FLOPS_PER_ENTRY * fill) + (LAG_ANALYSIS_ITERATIONS if analysis else 0.0)
+        its = int(min(LAG_COST_SHARE * fresh, LAG_MAX_ITERATIONS))
+        return its if its >= LAG_MIN_ITERATIONS else 0
+
     def factorize(self, K, saddle=False):
-        """The factor of ``K`` by ``backend_for(K)``.  ``saddle``: ``K`` is a saddle-point system (multiplier
-        unknowns, ``Problem.bordered``): PARDISO perturbs tiny pivots to ``SADDLE_PERTURB`` (not 1e-13) and
-        refines the solution up to ``SADDLE_REFINE`` steps, which its static pivoting needs there (19-wire bundle,
-        exact stick, 55 000 unknowns: 709 perturbed pivots, a residual 7.6e3 |b| with the defaults, 2.4e-9 |b|
-        so); SuperLU pivots by rows itself."""
+        """A factor of ``K`` with ``solve(b)``: fresh, or lagged (``lagged.LaggedFactor``: GMRES
+        preconditioned by the last fresh factor, while ``lag_budget`` allows, the shape holds and
+        the previous lagged solve took at most ``LAG_REFRESH_SHARE`` of its budget).  ``saddle``: ``K`` is
+        a saddle-point system (multiplier unknowns, ``Problem.bordered``), always factorised afresh: PARDISO
+        perturbs tiny pivots to ``SADDLE_PERTURB`` (not 1e-13) and refines the solution up to
+        ``SADDLE_REFINE`` steps, which its static pivoting needs there (19-wire bundle, exact stick, 55 000
+        unknowns: 709 perturbed pivots, a residual 7.6e3 |b| with the defaults, 2.4e-9 |b| so); SuperLU
+        pivots by rows itself."""
         if K.shape[0] != K.shape[1]:
             raise InputError(f"linsolve: the matrix must be square, got shape {K.shape}")
+        if saddle:
+            return self.fresh(K, saddle=True)
+        base = self._base
+        if self._skip > 0:
+            self._skip -= 1
+        elif (base is not None and not self._refresh and self._base_shape == K.shape
+                and self.backend_for(K) == base.backend):
+            budget = self.lag_budget(base, analysis=not _same_pattern(base, K))
+            if budget > 0:
+                self.stats["lagged"] += 1
+                return LaggedFactor(self, K, budget)
+        return self.fresh(K)
+
+    def fresh(self, K, saddle=False):
+        """A new factorisation of ``K`` (``factorize`` without lagging); it preconditions the next
+        lagged solves if ``lag_budget`` may allow them (not for saddle-point systems)."""
+        self._base = None                       # (its matrix freed before the new factorisation)
+        f = self._factorize(K, saddle)
+        self._base = f if not saddle and self.lag_budget(f, analysis=True) > 0 else None
+        self._base_shape = K.shape
+        self._refresh = False
+        return f
+
+    def lagged_done(self, iterations, budget, converged):
+        """Bookkeeping of a lagged solve (``LaggedFactor``): its GMRES ``iterations`` of ``budget``;
+        the next ``factorize`` is fresh if it took more than ``LAG_REFRESH_SHARE`` of the budget."""
+        self.stats["krylov_iterations"] += iterations
+        if converged:
+            self._backoff = 0
+        else:
+            self.stats["lag_failures"] += 1
+            self._skip, self._backoff = self._backoff, min(max(2 * self._backoff, 1), LAG_MAX_BACKOFF)
+        self._refresh = iterations > LAG_REFRESH_SHARE * budget
+
+    def _factorize(self, K, saddle=False):
         self.stats["factorizations"] += 1
         backend = self.backend_for(K)
         if backend == "splu":
@@ -190,6 +281,7 @@ class Solver:
 
     def close(self):
         """Release PARDISO's memory now (it is also released when the ``Solver`` is collected)."""
+        self._base = None
         if self._pardiso is not None:
             self._pardiso.release()
             self._pardiso = None
@@ -213,12 +305,21 @@ class _SpluFactor:
     def solve(self, b):
         return self._lu.solve(np.asarray(b, dtype=float))
 
+    apply = solve          # as a preconditioner (``lagged``): the same solve
+
     def det_sign(self):
         """Sign of ``det(K)`` (1, -1; 0 for a zero pivot): SuperLU factors ``Pr K Pc = L U`` with a
         unit diagonal in ``L``, so it is the sign of ``prod diag(U)`` times the parities of the
         two permutations."""
         d = self._lu.U.diagonal()
         return int(np.prod(np.sign(d))) * permutation_sign(self._lu.perm_r) * permutation_sign(self._lu.perm_c)
+
+
+def _same_pattern(f, K):
+    """Whether ``K`` has the pattern of the matrix of the factor ``f`` (if ``f`` keeps it)."""
+    A = getattr(f, "K", None)
+    return (A is not None and A.format == K.format and A.shape == K.shape and A.nnz == K.nnz
+            and np.array_equal(A.indptr, K.indptr) and np.array_equal(A.indices, K.indices))
 
 
 def permutation_sign(p):
@@ -282,6 +383,10 @@ class _SpluRcmFactor:
         x = np.empty_like(y)
         x[self.perm] = y
         return x
+
+    def apply(self, b):
+        """The solve without its accuracy check (as a preconditioner, ``lagged``)."""
+        return self._solve(np.asarray(b, dtype=float))
 
     def solve(self, b):
         b = np.asarray(b, dtype=float)
@@ -514,6 +619,19 @@ class _Pardiso:
             raise SingularMatrixError(f"pardiso: singular matrix ({bad}, {f.perturbed} perturbed pivots)")
         return x
 
+    def apply(self, f, b):
+        """``solve`` without the check (``_poor``) and without PARDISO's iterative refinement (two
+        steps by default, ``iparm(8)``: three triangular solves and two products): a
+        preconditioner's solve, a third of the time."""
+        if self.current() is not f:
+            self._factor(f)
+        steps = self.ps.iparm[7]
+        self.ps.iparm[7] = 0
+        try:
+            return self._solve(f, np.asarray(b, dtype=float))
+        finally:
+            self.ps.iparm[7] = steps
+
     def _solve(self, f, b):
         ps, K = self.ps, f.K
         if not self._phased:
@@ -571,6 +689,10 @@ class _PardisoFactor:
 
     def solve(self, b):
         return self._owner.solve(self, b)
+
+    def apply(self, b):
+        """The solve without its accuracy check (as a preconditioner, ``lagged``)."""
+        return self._owner.apply(self, b)
 
 
 def _poor(f, x, b):

@@ -251,10 +251,11 @@ def test_saddle_point_auto_coupled():
 def test_pardiso_solver_keeps_no_factor_the_caller_dropped():
     """A ``Solver`` remembers which factor PARDISO holds without keeping it (a weak reference): the
     caller's last factor and its matrix are freed as soon as the caller drops them (before the next
-    tangent is assembled); a factor still held is re-factorised if another one came since."""
+    tangent is assembled); a factor still held is re-factorised if another one came since.  (Without
+    lagging: a lagged ``Solver`` keeps its last fresh factor as the preconditioner, test_lagged.py.)"""
     import gc
     import weakref
-    s = linsolve.Solver("pardiso")
+    s = linsolve.Solver("pardiso", lagged=False)
     A, B = nonsymmetric_matrix(seed=1), nonsymmetric_matrix(seed=3)
     b = np.random.default_rng(2).standard_normal(A.shape[0])
     f = s.factorize(A.copy())                  # the factor's matrix: held by nobody else
