@@ -152,7 +152,8 @@ def mortar_shifted(X, p, T, law=None):
     X = np.ascontiguousarray(X, dtype=float)
     r = X.shape[0]
     kind, par, has, (HCL, HFK, HLKp), _ = _table(X, p)
-    kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar=True)
+    # one traction per call (the kernel's per-traction form, ``mortar="four"``), forces only
+    kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar="four")
     f, K = np.empty((2, r, 4, 6)), np.empty((r, 0, 0))           # an empty K: forces only
     sc, vec, two = np.empty((r, 4)), np.empty((r, 6, 3)), np.empty((r, 2, 2))
     flags, frames, rows = np.empty((r, 2), dtype=np.bool_), np.empty((r, 4, 4, 4)), np.empty((r, N_ROWS, 24))
