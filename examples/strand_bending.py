@@ -21,16 +21,16 @@ first slip ``kappa_b = mu F sin b / (E A_w cos^2 b r)``; slipping share ``2 psi 
 ``sin(psi) / psi = kappa_b / kappa`` up to ``kappa_t = (pi / 2) kappa_b``; saturated friction moment
 ``M_f = (2 n / pi) mu F r sin b cos b``; reversals by Masing's rule; loop energy from it.
 
-Stick: by default the Gauss-point penalty with ``slip_tolerance`` 5e-6 element lengths (with the
-default 0.005 the strand does not stick at all); ``--stick exact`` (``run(stick="exact")``) uses the
-mortar nodal multipliers as Newton unknowns (docs/theory_mortar.md), whose stick state does not depend
-on a penalty: initial stiffness 90.9-91.1 N m^2 at 24-48 el/lay, about 12 % below the plane-section
-``EI_max`` (the wires stick at their surface, a lever arm ``R_w`` from their axes, and turn under the
-friction's moment; tying the axes rigidly to the core gives ``EI_max``), first slip at 1.15
-``kappa_b``, which is where the model's own stick stiffness puts it (docs/theory_strand_bending.md,
-section 5); beyond 2 ``kappa_b`` the moment is within 2.1 % of the theory at 16 el/lay, 1.4 % at 24.  At this
-script's default 8 el/lay the linear nodal tractions smear the friction's reversal at the neutral axis
-over an element (``M_f`` 6 % low), so exact stick wants 16 el/lay or more.
+Stick: by default exact (``stick="exact"``: the mortar nodal multipliers as Newton unknowns,
+docs/theory_mortar.md), whose stick state does not depend on a penalty: initial stiffness 90.6-91.1
+N m^2 at 16-48 el/lay, about 12 % below the plane-section ``EI_max`` (the wires stick at their surface,
+a lever arm ``R_w`` from their axes, and turn under the friction's moment; tying the axes rigidly to
+the core gives ``EI_max``), first slip at 1.15 ``kappa_b``, which is where the model's own stick
+stiffness puts it (docs/theory_strand_bending.md, section 5); beyond 2 ``kappa_b`` the moment is within
+2.1 % of the theory at 16 el/lay, 1.4 % at 24.  Exact stick wants 16 el/lay or more: at 8 the linear
+nodal tractions smear the friction's reversal at the neutral axis over an element (``M_f`` 6 % low).
+``--stick penalty`` uses the Gauss-point penalty with ``slip_tolerance`` 5e-6 element lengths (with the
+library's default 0.005 the strand does not stick at all: initial stiffness 15 N m^2).
 ``tied=True`` ties the wires rigidly to the core (no contact) to measure the beam model's own
 full-stick stiffness (shear and torsion of the wires included) against ``EI_max``.
 
@@ -49,7 +49,7 @@ E, NU, MU = 200e9, 0.3, 0.3
 RC, RW, LAY, N = 1.97e-3, 1.865e-3, 114.6e-3, 6
 STRAIN = 1e-3                     # axial strain of the strand under the pull
 
-LAYS, ELEMENTS, AMPLITUDE, STEPS = 2, 8, 5.0, 4   # default size: about 30 s of CPU (2 lays: the cut in the middle)
+LAYS, ELEMENTS, AMPLITUDE, STEPS = 2, 16, 5.0, 4   # default size: about 40 s of CPU (2 lays: the cut in the middle)
 solve_options = dict(steps=6 * STEPS, t_end=6.0)   # for `beamsolver run examples/strand_bending.py`
 
 
@@ -110,7 +110,7 @@ def loop_energy(kappa_a, th):
 
 
 # ---------------------------------------------------------------- model
-STICK = "penalty"                # the Gauss-point penalty; "exact": mortar nodal multipliers (docs/theory_mortar.md)
+STICK = "exact"                  # mortar nodal multipliers (docs/theory_mortar.md); "penalty": the Gauss-point penalty
 SLIP_TOLERANCE = 5e-6            # with stick="penalty": its elastic slip / element length (default 0.005: see above)
 
 

@@ -1,8 +1,9 @@
 """examples/strand_bending.py: the closed-form strand-bending theory is self-consistent, and the beam
-model meets what today's (penalty-stick) friction can: EI_min with frictionless contact, EI_max with
-the wires tied to the core, and in the cyclic run the saturated friction moment, the Masing branch at
-the end of a half cycle and the loop energy.  EI_max and the first slip with friction are not asserted:
-the penalty stick's elastic slip makes them off (docs/theory_strand_bending.md section 5)."""
+model meets it: EI_min with frictionless contact, EI_max with the wires tied to the core, and in the
+cyclic run with exact stick (the example's default) the saturated friction moment, the Masing branch at
+the end of a half cycle and the loop energy.  The full-stick stiffness and the first slip with friction
+are not asserted against plane sections: stuck at their surface the wires are 12 % softer than plane
+sections (docs/theory_strand_bending.md section 5)."""
 
 import numpy as np
 import pytest
@@ -52,12 +53,15 @@ def test_full_slip_and_full_stick_stiffness_of_the_beam_model():
 
 @pytest.mark.slow
 def test_cyclic_bending_meets_the_full_slip_theory():
-    res = sb.run(lays=2, elements_per_lay=8, amplitude=5.0, steps=4)
+    """Issue 27's answer quality on the example's defaults (exact stick, 16 el/lay): measured M_f -0.95 %,
+    the Masing branch at -k 0.16 % of M_f, the loop energy -9.5 %, no cut-back."""
+    res = sb.run(lays=2, elements_per_lay=16, amplitude=5.0, steps=4)
     th, rows = sb.compare(res)
     got = {name: (a, b, e) for name, a, b, e in rows}
     assert abs(got["M_f [N m]"][2]) < 0.03
-    assert got["Masing branch at -k: |M - M_Masing| / M_f"][1] < 0.02
-    assert abs(got["loop energy [J/m]"][2]) < 0.15
+    assert got["Masing branch at -k: |M - M_Masing| / M_f"][1] < 0.01
+    assert abs(got["loop energy [J/m]"][2]) < 0.10
+    assert res["cutbacks"] == 0
     assert res["share"][-1] > 0.9                                        # at +5 kappa_b nearly all slip
 
 
