@@ -51,6 +51,30 @@ def _pressed(problem, slave, depth):
     return H
 
 
+def _mortar_inputs(monkeypatch):
+    """``(kernel_jit.mortar_terms, X, pm)``: the compiled mortar terms and the inputs ``_mortar`` gives them on
+    pressed, slid pairs (with friction history) of ``_parallel``."""
+    from beamsolver.contact import kernel_jit
+    captured = {}
+    compiled = kernel_jit.mortar_terms
+
+    def spy(X, pm, law=None):
+        captured.update(X=X, pm=pm)
+        return compiled(X, pm, law)
+
+    monkeypatch.setattr(kernel_jit, "mortar_terms", spy)
+    model, slave, master = _parallel(0.5)
+    problem = Problem.from_model(model, check_rigid_modes=False)
+    c = problem.contact
+    H = _pressed(problem, slave, 2e-3 * R)
+    c.begin_step(H, 0.0)
+    c.commit(H)
+    slide = 1e-4 * R
+    H = _move(H, slave.nodes, se3.exp(np.array([slide, slide, 0.0, slide, 0.0, 0.5 * slide])))
+    c._local_blocks(H, True)
+    return compiled, captured["X"], captured["pm"]
+
+
 def _fd_error(problem, H, eps=1e-7):
     """Largest difference between the assembled tangent and central differences of the residual
     over the free unknowns, relative to the largest contact tangent entry."""
@@ -210,25 +234,8 @@ def test_compiled_mortar_terms_match_the_complex_step_oracle(monkeypatch):
     against ``reference.mortar_point_derivatives`` (numpy complex steps) on pressed, slid pairs at a random
     traction: forces, ``df/dT``, the tangent at fixed traction, the slip and its derivative, the normal
     traction and the normal's derivative."""
-    from beamsolver.contact import kernel_jit, reference
-    captured = {}
-    compiled = kernel_jit.mortar_terms
-
-    def spy(X, pm, law=None):
-        captured.update(X=X, pm=pm)
-        return compiled(X, pm, law)
-
-    monkeypatch.setattr(kernel_jit, "mortar_terms", spy)
-    model, slave, master = _parallel(0.5)
-    problem = Problem.from_model(model, check_rigid_modes=False)
-    c = problem.contact
-    H = _pressed(problem, slave, 2e-3 * R)
-    c.begin_step(H, 0.0)
-    c.commit(H)
-    slide = 1e-4 * R
-    H = _move(H, slave.nodes, se3.exp(np.array([slide, slide, 0.0, slide, 0.0, 0.5 * slide])))
-    c._local_blocks(H, True)
-    X, pm = captured["X"], captured["pm"]
+    from beamsolver.contact import reference
+    compiled, X, pm = _mortar_inputs(monkeypatch)
     assert len(X) > 4
     T = np.random.default_rng(0).normal(size=(len(X), 3)) * 100.0
     d = reference.mortar_point_derivatives(X, pm, T)
@@ -310,24 +317,7 @@ def test_the_one_pass_mortar_kernel_gives_the_bits_of_four_kernel_calls(monkeypa
     against ``mortar_terms_four`` (one call of the point kernel per traction, its oracle): every term the
     same bits, on pressed and slid pairs with friction history."""
     from beamsolver.contact import kernel_jit
-    captured = {}
-    compiled = kernel_jit.mortar_terms
-
-    def spy(X, pm, law=None):
-        captured.update(X=X, pm=pm)
-        return compiled(X, pm, law)
-
-    monkeypatch.setattr(kernel_jit, "mortar_terms", spy)
-    model, slave, master = _parallel(0.5)
-    problem = Problem.from_model(model, check_rigid_modes=False)
-    c = problem.contact
-    H = _pressed(problem, slave, 2e-3 * R)
-    c.begin_step(H, 0.0)
-    c.commit(H)
-    slide = 1e-4 * R
-    H = _move(H, slave.nodes, se3.exp(np.array([slide, slide, 0.0, slide, 0.0, 0.5 * slide])))
-    c._local_blocks(H, True)
-    X, pm = captured["X"], captured["pm"]
+    compiled, X, pm = _mortar_inputs(monkeypatch)
     assert len(X) > 4 and np.any(pm["has_history"])
     one, four = compiled(X, pm), kernel_jit.mortar_terms_four(X, pm)
     assert set(one) == set(four)
