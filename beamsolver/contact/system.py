@@ -200,6 +200,7 @@ class ContactSystem(Contribution):
                                      minlength=len(system.poses0))
         self._augments = 0
         self.newton_multipliers = True   # exact stick: multipliers are Newton unknowns (else Uzawa updates)
+        self.exact_friction = True       # exact stick's friction acts (off at step 0: ``Problem.exact_friction``)
         self._groups = mortar.Groups()   # the mortar groups, kept while the pairs' nodes hold
         self._mstep, self._ms = None, 0.0     # the Newton step of the multipliers (keys, dLam) and its trial length
         self._sweepable = {}       # per declaration: whether the last search found no crossing (``_candidates``)
@@ -246,6 +247,10 @@ class ContactSystem(Contribution):
         (``conditioning.stiff_penalty_hint``), else ``""``."""
         return conditioning.stiff_penalty_hint(self._penalties)
 
+    def has_exact_friction(self):
+        """Whether a declaration has exact stick with friction (``Problem.exact_friction``)."""
+        return bool(self._decl_exact.any())
+
     def _switch_to(self, t):
         """Declarations and friction acting in a step ending at ``t`` (``add_contact``'s
         ``active_from``, ``friction_from``: on for ``t`` after them); before any step, off."""
@@ -253,6 +258,8 @@ class ContactSystem(Contribution):
             return t0 is None or t > t0 + SWITCH_TOL * max(1.0, abs(t0))
         self._decl_on = np.array([on(a) for a, _ in self._switch], dtype=bool)
         self._decl_mu = np.where([on(f) for _, f in self._switch], self._mu, 0.0)
+        if not getattr(self, "exact_friction", True):
+            self._decl_mu = np.where(self._decl_exact, 0.0, self._decl_mu)
         self.history.start_friction(self._decl_mu)    # friction starting this step: as at first contact
 
     # ------------------------------------------------------------ history

@@ -222,6 +222,17 @@ class Problem:
             if hasattr(c, "newton_multipliers"):
                 c.newton_multipliers = bool(flag)
 
+    def exact_friction(self, flag):
+        """Whether exact stick's friction acts (``Run``'s step 0 turns it off when the equilibrium at ``t_start``
+        is not found with it: friction then starts from zero traction at the state found).  Returns whether a
+        contribution has such friction."""
+        found = False
+        for c in self.contributions:
+            if hasattr(c, "exact_friction"):
+                c.exact_friction = bool(flag)
+                found = found or bool(np.any(c.has_exact_friction()))
+        return found
+
     def multiplier_step(self, ev, x):
         """Hand the Newton step ``x`` ``(3 g,)`` of the multipliers of ``ev`` to their owner (trial length 0)."""
         ev.mult["owner"].multiplier_step(ev.mult["key"], x)

@@ -199,7 +199,19 @@ class Run:
             # no slip before t_start: friction's multipliers stay out of the Newton unknowns at step 0
             problem.multipliers_in_newton(False)
             try:
-                H, ev0, stats = self.newton_step(t_start)
+                try:
+                    H, ev0, stats = self.newton_step(t_start)
+                except StepFailed as e:
+                    # exact stick's friction has no history at t_start: if the equilibrium is not found with it,
+                    # it is found without it and friction starts from zero traction there (the touching wires of
+                    # a 1+6+12 strand under their contact pre-stress: docs/theory_mortar.md 3b)
+                    if not problem.exact_friction(False):
+                        raise
+                    H, ev0, stats = self.newton_step(t_start)
+                    note = (f"step 0 (t = {t_start:.6g}): no equilibrium with exact stick's friction ({e}); found "
+                            "without it, friction starts from zero traction at that state")
+                    log.warning(note)
+                    stats.setdefault("warnings", []).append(note)
             except StepFailed as e:
                 self.sol.converged, self.sol.message = False, str(e)
                 if pushed:
@@ -215,6 +227,7 @@ class Run:
             finally:
                 self.t, conv.max_iter = t_start, max_iter
                 problem.multipliers_in_newton(self.multipliers_in_newton)
+                problem.exact_friction(True)
             stats.update(wall_time=time.perf_counter() - t0, dt=0.0, cutbacks=0)
             if overlap:
                 stats.setdefault("warnings", []).append(overlap)

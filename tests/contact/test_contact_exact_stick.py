@@ -324,3 +324,24 @@ def test_the_one_pass_mortar_kernel_gives_the_bits_of_four_kernel_calls(monkeypa
     for k in one:
         assert np.array_equal(one[k], four[k]), k
     assert np.abs(one["A"]).max() > 0 and np.abs(one["dK"]).max() > 0 and np.abs(one["dS"]).max() > 0
+
+
+@pytest.mark.slow
+def test_pre_stressed_strand_starts_without_exact_friction_when_it_must():
+    """A 1+6+12 strand whose touching layers carry contact forces at t_start: with exact stick's friction
+    step 0 finds no equilibrium (120 iterations, the residual stays near 1); the solve then finds it without
+    that friction, says so, and the stretched step converges with friction (it raised ConvergenceError)."""
+    L = bs.cables.Layer
+    r, lay = 1e-3, 0.1
+    st = bs.cables.build_strand([L(r)] + [L(r, 6 * k, lay_length=lay) for k in (1, 2)], lay, E=2e11,
+                                elements_per_lay=24, mu=0.3, contact_options=dict(stick="exact"), fit_core=True,
+                                touch_tol=-0.5)
+    st.clamp("bottom")
+    for w in st.all_wires:
+        st.model.prescribe(w.last, bs.motion.translation(lambda t: (0.0, 0.0, 1e-4 * st.length * t)))
+    sol = bs.solve(st.model, steps=1)
+    assert sol.converged and sol.times[-1] == pytest.approx(1.0)
+    assert any("exact stick's friction" in w for w in sol.stats[0].get("warnings", []))
+    assert sol.stats[-1]["iterations"] <= 8
+    c = sol.contact()
+    assert (c["normal_force"] > 0).sum() > 100 and (c["stick"][c["normal_force"] > 0]).any()
