@@ -181,6 +181,7 @@ class ContactSystem(Contribution):
         layout = KeyLayout(n_el, self.key_gp, len(self.decls), self.el_beam, self.n_beams)
         self.point_offset = layout.point_offset
         self.history = ContactHistory(layout)
+        self.exact_friction = True       # exact stick's friction acts (off at step 0: ``Problem.exact_friction``)
         self._switch_to(-np.inf)
         self.history.mu_committed = self._decl_mu       # friction of the last committed step
         table = declaration_table([d.options for d in self.decls])    # None as each option's kernel_none
@@ -200,7 +201,6 @@ class ContactSystem(Contribution):
                                      minlength=len(system.poses0))
         self._augments = 0
         self.newton_multipliers = True   # exact stick: multipliers are Newton unknowns (else Uzawa updates)
-        self.exact_friction = True       # exact stick's friction acts (off at step 0: ``Problem.exact_friction``)
         self._groups = mortar.Groups()   # the mortar groups, kept while the pairs' nodes hold
         self._mstep, self._ms = None, 0.0     # the Newton step of the multipliers (keys, dLam) and its trial length
         self._sweepable = {}       # per declaration: whether the last search found no crossing (``_candidates``)
@@ -258,7 +258,7 @@ class ContactSystem(Contribution):
             return t0 is None or t > t0 + SWITCH_TOL * max(1.0, abs(t0))
         self._decl_on = np.array([on(a) for a, _ in self._switch], dtype=bool)
         self._decl_mu = np.where([on(f) for _, f in self._switch], self._mu, 0.0)
-        if not getattr(self, "exact_friction", True):
+        if not self.exact_friction:
             self._decl_mu = np.where(self._decl_exact, 0.0, self._decl_mu)
         self.history.start_friction(self._decl_mu)    # friction starting this step: as at first contact
 

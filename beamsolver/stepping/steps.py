@@ -199,31 +199,9 @@ class Run:
             # no slip before t_start: friction's multipliers stay out of the Newton unknowns at step 0
             problem.multipliers_in_newton(False)
             try:
-                try:
-                    H, ev0, stats = self.newton_step(t_start)
-                except StepFailed as e:
-                    # exact stick's friction has no history at t_start: if the equilibrium is not found with it,
-                    # it is found without it and friction starts from zero traction there (the touching wires of
-                    # a 1+6+12 strand under their contact pre-stress: docs/theory_mortar.md 3b)
-                    if not problem.exact_friction(False):
-                        raise
-                    H, ev0, stats = self.newton_step(t_start)
-                    note = (f"step 0 (t = {t_start:.6g}): no equilibrium with exact stick's friction ({e}); found "
-                            "without it, friction starts from zero traction at that state")
-                    log.warning(note)
-                    stats.setdefault("warnings", []).append(note)
+                H, ev0, stats = self._solve_start(t_start)
             except StepFailed as e:
-                self.sol.converged, self.sol.message = False, str(e)
-                if pushed:
-                    why = (f"contact forces already act ({diagnosis.pushing_point(problem, H)}): {e}; "
-                           "separate the beams by a small gap, let add_contact(adjust=) cover the overlap "
-                           "(strain-free adjustment) or raise max_iter")
-                else:
-                    why = f"loads or motions already act: {e}; start the loads from zero or use more steps"
-                why += self.opt.penalty_hint
-                err = ConvergenceError(f"solve: no equilibrium at t_start = {t_start:.6g}, where {why}", self.sol)
-                err.failure = e
-                raise err from None
+                raise self._start_failure(e, pushed, H, t_start) from None
             finally:
                 self.t, conv.max_iter = t_start, max_iter
                 problem.multipliers_in_newton(self.multipliers_in_newton)
@@ -247,6 +225,38 @@ class Run:
         self.H = H
         if self.writer is not None:
             self.writer.write(self.sol, 0)
+
+    def _solve_start(self, t_start):
+        """Newton at ``t_start`` (step 0): ``(H, ev, stats)``.  Exact stick's friction has no history at
+        ``t_start``: if the equilibrium is not found with it, it is found without it and friction starts from zero
+        traction there, with a warning in the stats (the touching wires of a 1+6+12 strand under their contact
+        pre-stress: docs/theory_mortar.md 3b)."""
+        try:
+            return self.newton_step(t_start)
+        except StepFailed as e:
+            if not self.problem.exact_friction(False):
+                raise
+            H, ev0, stats = self.newton_step(t_start)
+            note = (f"step 0 (t = {t_start:.6g}): no equilibrium with exact stick's friction ({e}); found "
+                    "without it, friction starts from zero traction at that state")
+            log.warning(note)
+            stats.setdefault("warnings", []).append(note)
+            return H, ev0, stats
+
+    def _start_failure(self, e, pushed, H, t_start):
+        """The ``ConvergenceError`` of a step 0 that failed with ``e`` (``pushed``: contact pushes the given
+        poses ``H``, nothing else acts)."""
+        self.sol.converged, self.sol.message = False, str(e)
+        if pushed:
+            why = (f"contact forces already act ({diagnosis.pushing_point(self.problem, H)}): {e}; "
+                   "separate the beams by a small gap, let add_contact(adjust=) cover the overlap "
+                   "(strain-free adjustment) or raise max_iter")
+        else:
+            why = f"loads or motions already act: {e}; start the loads from zero or use more steps"
+        why += self.opt.penalty_hint
+        err = ConvergenceError(f"solve: no equilibrium at t_start = {t_start:.6g}, where {why}", self.sol)
+        err.failure = e
+        return err
 
     def _name_nonfinite(self, t):
         """A non-finite residual from the user's input (a load scale or motion at ``t``): InputError."""
