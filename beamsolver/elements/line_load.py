@@ -25,12 +25,29 @@ import numpy as np
 
 from ..lie import se3
 
-__all__ = ["GAUSS_POINTS", "nodal_loads", "nodal_loads_and_tangent"]
+__all__ = ["GAUSS_POINTS", "nodal_loads", "nodal_loads_and_tangent", "use_numpy"]
 
 GAUSS_POINTS = 3                 # per element; exact for a straight element, error O(|h_w|^6) when curved
 COMPLEX_STEP = 1e-30             # imaginary step of the complex-step derivative
 _XG, _WG = np.polynomial.legendre.leggauss(GAUSS_POINTS)
 XI, WEIGHTS = 0.5 * (_XG + 1.0), 0.5 * _WG
+_NUMPY = [False]
+
+
+def use_numpy(flag=True):
+    """Evaluate with the numpy form below (the oracle of ``line_load_jit``) instead of the compiled kernel."""
+    _NUMPY[0] = bool(flag)
+
+
+def _compiled(H_A, H_B, L, q, m, follower, tangent):
+    from .line_load_jit import line_loads
+    n = len(L)
+    f = np.empty((n, 12))
+    K = np.empty((n, 12, 12)) if tangent else np.empty((0, 12, 12))
+    c = np.ascontiguousarray
+    line_loads(c(H_A, dtype=float), c(H_B, dtype=float), c(L, dtype=float), c(q, dtype=float),
+               c(m, dtype=float), bool(follower), bool(tangent), f, K)
+    return (f, K) if tangent else f
 
 
 def _loads(H_A, h, L, q, m, follower, rotation=False):
@@ -67,6 +84,8 @@ def nodal_loads(H_A, H_B, L, q, m, follower=False):
     """Consistent nodal loads ``f_ext`` ``(n, 12)`` (node A then B, body components) of loads per
     unit reference length ``q``, ``m`` ``(n, 3)`` on elements ``H_A, H_B`` ``(n, 4, 4)`` of length ``L``
     ``(n,)``; dead (global ``q, m``) or ``follower`` (section-frame ``q, m``)."""
+    if not _NUMPY[0]:
+        return _compiled(H_A, H_B, L, q, m, follower, False)
     return _loads(H_A, se3.log(se3.relative(H_A, H_B)), L, q, m, follower)
 
 
@@ -74,7 +93,10 @@ def nodal_loads_and_tangent(H_A, H_B, L, q, m, follower=False):
     """``(f_ext (n, 12), K (n, 12, 12))`` with ``K = d f_ext / d(dq_A, dq_B)``; arguments as
     ``nodal_loads``.  ``D = d f_ext / d h`` by complex steps in ``h`` (6 directions), then
     ``K_B = D T(h)^-1``, ``K_A = -D T(-h)^-1`` plus, for dead loads, the rigid turn of the element
-    by ``dw_A`` at fixed ``h`` (``_loads(..., rotation=True)``)."""
+    by ``dw_A`` at fixed ``h`` (``_loads(..., rotation=True)``).  Compiled (``line_load_jit``, the same
+    formulas and complex steps) unless ``use_numpy``."""
+    if not _NUMPY[0]:
+        return _compiled(H_A, H_B, L, q, m, follower, True)
     h = se3.log(se3.relative(H_A, H_B))
     if follower:
         f, G = _loads(H_A, h, L, q, m, True), None

@@ -147,3 +147,27 @@ def test_line_loads_drive_arc_length_and_step_zero():
     model.line_loads[0].scale = lambda t: 1.0           # acting already at t_start: step 0 is solved
     sol = bs.solve(model, steps=1)
     assert sol.stats[0]["iterations"] > 0 and sol.position(beam.last, step=0)[2] < -1e-6
+
+
+@pytest.mark.parametrize("follower", [False, True])
+@pytest.mark.parametrize("scale", [0.0, 1e-7, 0.6, 2.9])
+def test_compiled_loads_and_stiffness_are_the_numpy_forms_to_round_off(scale, follower):
+    """``line_load_jit`` (the default) against the numpy form: same formulas, the same complex steps; element
+    twists from zero (series of every coefficient) to near pi (closed forms)."""
+    rng = np.random.default_rng(7)
+    n = 40
+    HA = se3.exp(rng.normal(size=(n, 6)))
+    w = rng.normal(size=(n, 6))
+    w[:, 3:] *= (scale / np.linalg.norm(w[:, 3:], axis=1))[:, None]
+    HB = HA @ se3.exp(np.where(scale > 0, 1.0, 0.0) * w)
+    L, q, m = rng.uniform(0.5, 2.0, n), rng.normal(size=(n, 3)), rng.normal(size=(n, 3))
+    f, K = line_load.nodal_loads_and_tangent(HA, HB, L, q, m, follower)
+    f1 = line_load.nodal_loads(HA, HB, L, q, m, follower)
+    line_load.use_numpy(True)
+    try:
+        f0, K0 = line_load.nodal_loads_and_tangent(HA, HB, L, q, m, follower)
+    finally:
+        line_load.use_numpy(False)
+    assert np.abs(f - f0).max() <= 1e-14 * np.abs(f0).max()
+    assert np.abs(f1 - f0).max() <= 1e-14 * np.abs(f0).max()
+    assert np.abs(K - K0).max() <= 1e-13 * np.abs(K0).max()

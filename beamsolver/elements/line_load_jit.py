@@ -1,0 +1,256 @@
+"""Compiled consistent nodal loads of line loads and their stiffness (``line_load``'s formulas).
+
+One element per pass of a loop, small arrays written in place (no allocation per element).  The
+derivative in the element twist ``h`` is the same complex step as the numpy form: every SE(3)
+function here takes complex twists (the coefficients switch from series to closed form on the real
+part of the angle, as ``se3.coefficient``), so both forms agree to round-off
+(``tests/elements/test_line_load.py``).  Conventions: ``line_load`` and docs/theory_line_loads.md.
+"""
+import numpy as np
+
+from .._jit import jit, jit_callee
+from ..lie.se3_jit import (A_, B_, C_, D_, Q2_, Q3_, _SERIES_TABLE, _SWITCH, _closed, cross, dot, log_relative,
+                           pose, q_matrix)
+from .line_load import COMPLEX_STEP, WEIGHTS, XI
+
+__all__ = ["line_loads"]
+
+
+@jit_callee
+def _coef(k, t):
+    """Coefficient ``k`` of ``se3`` at a complex angle ``t`` (series below the switch point of its real part)."""
+    if t.real >= _SWITCH[k]:
+        return _closed(k, t)
+    row = _SERIES_TABLE[k]
+    t2 = t * t
+    v = row[8] + 0.0 * t2
+    for j in range(7, -1, -1):
+        v = v * t2 + row[j]
+    return v
+
+
+@jit_callee
+def _skew(w, S):
+    S[0, 0], S[0, 1], S[0, 2] = 0.0, -w[2], w[1]
+    S[1, 0], S[1, 1], S[1, 2] = w[2], 0.0, -w[0]
+    S[2, 0], S[2, 1], S[2, 2] = -w[1], w[0], 0.0
+
+
+@jit_callee
+def _mm(A, B, C):
+    """``C = A B`` (square blocks of equal size)."""
+    n = A.shape[0]
+    for i in range(n):
+        for j in range(n):
+            s = 0.0 * A[0, 0]
+            for k in range(n):
+                s += A[i, k] * B[k, j]
+            C[i, j] = s
+
+
+@jit_callee
+def _so3(w, k1, sign, k2, M, W, WW):
+    """``M = I + sign k1(t) W + k2(t) W^2``, ``W = hat(w)``, ``t = |w|`` (complex; ``k1 < 0``: ``k1(t) = 1/2``);
+    returns ``t``."""
+    t = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+    c1 = sign * (0.5 + 0.0 * t if k1 < 0 else _coef(k1, t))
+    c2 = _coef(k2, t)
+    _skew(w, W)
+    _mm(W, W, WW)
+    for i in range(3):
+        for j in range(3):
+            M[i, j] = c1 * W[i, j] + c2 * WW[i, j] + (1.0 if i == j else 0.0)
+    return t
+
+
+@jit_callee
+def _tangents(h, inverse, Dg, Of, s):
+    """Right tangent of SE(3) (``inverse``: its inverse) at the twist ``h`` (6,): ``[[Dg, Of], [0, Dg]]``,
+    written into the 3x3 blocks ``Dg``, ``Of`` (``se3.tangent``, ``se3.tangent_inv``)."""
+    u, w = h[:3], h[3:]
+    if inverse:
+        t = _so3(w, -1, 1.0, D_, Dg, s[0], s[1])
+    else:
+        t = _so3(w, B_, -1.0, C_, Dg, s[0], s[1])
+    nu, nw = (-u[0], -u[1], -u[2]), (-w[0], -w[1], -w[2])
+    Q = q_matrix(nu, nw, dot(nw, nu), cross(nw, nu), t * t, _coef(C_, t), _coef(Q2_, t), _coef(Q3_, t))
+    for i in range(3):
+        for j in range(3):
+            s[8][i, j] = Q[i][j]
+    if inverse:
+        _mm(Dg, s[8], s[0])
+        _mm(s[0], Dg, Of)
+        for i in range(3):
+            for j in range(3):
+                Of[i, j] = -Of[i, j]
+    else:
+        Of[:, :] = s[8]
+
+
+@jit_callee
+def _inverse_adjoint(h, Et, Of, s):
+    """``Ad(exp(h)^-1) = [[Et, Of], [0, Et]]``: ``Et`` the transposed rotation of ``exp(h)``."""
+    u, w = h[:3], h[3:]
+    R = s[7]
+    t = _so3(w, A_, 1.0, B_, R, s[0], s[1])
+    b, c = _coef(B_, t), _coef(C_, t)
+    wxu = s[9][0]
+    wxu[0], wxu[1], wxu[2] = w[1] * u[2] - w[2] * u[1], w[2] * u[0] - w[0] * u[2], w[0] * u[1] - w[1] * u[0]
+    x = s[9][1]
+    x[0] = u[0] + b * wxu[0] + c * (w[1] * wxu[2] - w[2] * wxu[1])
+    x[1] = u[1] + b * wxu[1] + c * (w[2] * wxu[0] - w[0] * wxu[2])
+    x[2] = u[2] + b * wxu[2] + c * (w[0] * wxu[1] - w[1] * wxu[0])
+    p = s[9][2]
+    for i in range(3):
+        p[i] = 0.0
+        for j in range(3):
+            Et[i, j] = R[j, i]
+            p[i] -= R[j, i] * x[j]                       # position of the inverse: -R^T x
+    _skew(p, s[0])
+    _mm(s[0], Et, Of)
+
+
+@jit_callee
+def _product(D1, O1, D2, O2, D, O, tmp):
+    """``[[D, O], [0, D]] = [[D1, O1], [0, D1]] [[D2, O2], [0, D2]]``."""
+    _mm(D1, D2, D)
+    _mm(D1, O2, O)
+    _mm(O1, D2, tmp)
+    for i in range(3):
+        for j in range(3):
+            O[i, j] += tmp[i, j]
+
+
+@jit_callee
+def _tmv(D, O, pu, pw, out, k, wg):
+    """``out[k:k+6] += wg [[D, O], [0, D]]^T (pu, pw)``."""
+    for i in range(3):
+        a, b = 0.0 * pu[0], 0.0 * pu[0]
+        for j in range(3):
+            a += D[j, i] * pu[j]
+            b += O[j, i] * pu[j] + D[j, i] * pw[j]
+        out[k + i] += wg * a
+        out[k + 3 + i] += wg * b
+
+
+@jit_callee
+def _element(vq, vm, h, L, q, m, follower, rotation, f, G, w6):
+    """``f`` (12,) = ``line_load._loads`` of one element (complex twist ``h``; ``vq, vm`` the load in node A's
+    frame, ``q, m`` as given); with ``rotation`` also ``G`` (12, 3), d f / d w_A at fixed ``h`` (real ``h``).
+    Every 6x6 operator here is block upper triangular with equal diagonal blocks, kept as two 3x3 blocks."""
+    b, s, hx, pu, pw = w6
+    Dp, Op, Dm, Om, Dx, Ox, Da, Oa, DA, OA, DB, OB, X = b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7], b[8], \
+        b[9], b[10], b[11], b[12]
+    _tangents(h, True, Dp, Op, s)
+    for i in range(6):
+        hx[i] = -h[i]
+    _tangents(hx, True, Dm, Om, s)
+    f[:] = 0.0
+    if rotation:
+        G[:, :] = 0.0
+    for g in range(XI.shape[0]):
+        x, wg = XI[g], WEIGHTS[g]
+        for i in range(6):
+            hx[i] = x * h[i]
+        _inverse_adjoint(hx, Da, Oa, s)
+        _tangents(hx, False, Dx, Ox, s)
+        for i in range(3):
+            for j in range(3):
+                Dx[i, j] *= x
+                Ox[i, j] *= x
+        _product(Dx, Ox, Dm, Om, DA, OA, X)              # Phi_A = Ad(E^-1) - x T(x h) T(-h)^-1
+        for i in range(3):
+            for j in range(3):
+                DA[i, j] = Da[i, j] - DA[i, j]
+                OA[i, j] = Oa[i, j] - OA[i, j]
+        _product(Dx, Ox, Dp, Op, DB, OB, X)              # Phi_B = x T(x h) T(h)^-1
+        for i in range(3):
+            if follower:
+                pu[i], pw[i] = q[i], m[i]
+            else:
+                pu[i] = Da[i, 0] * vq[0] + Da[i, 1] * vq[1] + Da[i, 2] * vq[2]
+                pw[i] = Da[i, 0] * vm[0] + Da[i, 1] * vm[1] + Da[i, 2] * vm[2]
+        _tmv(DA, OA, pu, pw, f, 0, wg)
+        _tmv(DB, OB, pu, pw, f, 6, wg)
+        if rotation:
+            # dp = (E^T hat(vq), E^T hat(vm)) (6, 3): the rigid turn of the element by dw_A
+            Xq, Xm = s[0], s[1]
+            _skew(vq, X)
+            _mm(Da, X, Xq)
+            _skew(vm, X)
+            _mm(Da, X, Xm)
+            for j in range(3):
+                for i in range(3):
+                    a0, a1, b0, b1 = 0.0, 0.0, 0.0, 0.0
+                    for k in range(3):
+                        a0 += (DA[k, i] * Xq[k, j]).real
+                        a1 += (OA[k, i] * Xq[k, j] + DA[k, i] * Xm[k, j]).real
+                        b0 += (DB[k, i] * Xq[k, j]).real
+                        b1 += (OB[k, i] * Xq[k, j] + DB[k, i] * Xm[k, j]).real
+                    G[i, j] += wg * a0
+                    G[3 + i, j] += wg * a1
+                    G[6 + i, j] += wg * b0
+                    G[9 + i, j] += wg * b1
+    for i in range(12):
+        f[i] *= L
+    if rotation:
+        for i in range(12):
+            for j in range(3):
+                G[i, j] *= L
+
+
+@jit
+def line_loads(HA, HB, L, q, m, follower, tangent, f, K):
+    """Consistent nodal loads ``f`` (n, 12) and, with ``tangent``, their derivative ``K`` (n, 12, 12) in the
+    nodes' body increments (``line_load.nodal_loads_and_tangent``); poses ``HA, HB`` (n, 4, 4), lengths
+    ``L`` (n,), loads per unit reference length ``q, m`` (n, 3), dead or ``follower``."""
+    c = np.complex128
+    w6 = (np.zeros((13, 3, 3), c), np.zeros((10, 3, 3), c), np.zeros(6, c), np.zeros(3, c), np.zeros(3, c))
+    h, hh, fe, fk = np.zeros(6, c), np.zeros(6, c), np.zeros(12, c), np.zeros(12, c)
+    vq, vm = np.zeros(3, c), np.zeros(3, c)
+    G, D = np.zeros((12, 3)), np.zeros((12, 6))
+    Tp, Tm = np.zeros((6, 6)), np.zeros((6, 6))
+    b, s, hx = w6[0], w6[1], w6[2]
+    for e in range(HA.shape[0]):
+        RA, xA = pose(HA, e)
+        RB, xB = pose(HB, e)
+        u, w, t, d = log_relative(RA, xA, RB, xB)
+        for i in range(3):
+            h[i], h[3 + i] = u[i], w[i]
+            vq[i] = RA[0][i] * q[e, 0] + RA[1][i] * q[e, 1] + RA[2][i] * q[e, 2]
+            vm[i] = RA[0][i] * m[e, 0] + RA[1][i] * m[e, 1] + RA[2][i] * m[e, 2]
+        rotation = tangent and not follower
+        _element(vq, vm, h, L[e], q[e], m[e], follower, rotation, fe, G, w6)
+        for i in range(12):
+            f[e, i] = fe[i].real
+        if not tangent:
+            continue
+        for k in range(6):
+            for i in range(6):
+                hh[i] = h[i]
+            hh[k] += 1j * COMPLEX_STEP
+            _element(vq, vm, hh, L[e], q[e], m[e], follower, False, fk, G, w6)
+            for i in range(12):
+                D[i, k] = fk[i].imag / COMPLEX_STEP
+        # K_A = -D T(-h)^-1 (+ the rigid turn G), K_B = D T(h)^-1
+        _tangents(h, True, b[0], b[1], s)
+        for i in range(6):
+            hx[i] = -h[i]
+        _tangents(hx, True, b[2], b[3], s)
+        for i in range(3):
+            for j in range(3):
+                Tp[i, j] = Tp[3 + i, 3 + j] = b[0][i, j].real
+                Tp[i, 3 + j] = b[1][i, j].real
+                Tm[i, j] = Tm[3 + i, 3 + j] = b[2][i, j].real
+                Tm[i, 3 + j] = b[3][i, j].real
+        for i in range(12):
+            for j in range(6):
+                a, bb = 0.0, 0.0
+                for k in range(6):
+                    a += D[i, k] * Tm[k, j]
+                    bb += D[i, k] * Tp[k, j]
+                K[e, i, j] = -a
+                K[e, i, 6 + j] = bb
+            if rotation:
+                for j in range(3):
+                    K[e, i, 3 + j] += G[i, j]
