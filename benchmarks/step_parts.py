@@ -24,6 +24,7 @@ loop); CPU seconds (``time.process_time``) with one thread; with two threads CPU
 wall seconds (``time.perf_counter``) are reported beside them (a shared machine: wall times are noisier).
 ``first``: the step's first iteration; ``later``: the median of the later ones.  Peak memory: ``ru_maxrss``.
 """
+import os
 import time
 
 import numpy as np
@@ -91,6 +92,9 @@ def measure(name, hold, threads, rss_mb):
     from scaling import warm_up
     warm_up()
     system_mod.HOLD_PATTERN = {"True": True, "False": False, "auto": "auto"}[hold]
+    if os.environ.get("HELD_RESET_SHARE"):          # (a knob of the held pattern's growth rule, for its tuning)
+        from beamsolver.assembly import held_pattern
+        held_pattern.RESET_SHARE = float(os.environ["HELD_RESET_SHARE"])
     linsolve.LAGGED = False
     strand = name.startswith("strand")
     m, wires, length = ss.strand_model(name.split("-")[1]) if strand else ss.scene_model(name)

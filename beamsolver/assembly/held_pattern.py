@@ -82,10 +82,20 @@ def _element_positions(el_indptr, el_indices, node_of, first, nptr, nrow, eoff, 
     return missing
 
 
+@jit_callee
+def _zero_block(vals, blk, s, t):
+    """Whether the 6 x 6 block of slots ``(s, t)`` of block ``blk`` of ``vals`` ``(m, 6 k, 6 k)`` is all zero."""
+    for p in range(6):
+        for q in range(6):
+            if vals[blk, 6 * s + p, 6 * t + q] != 0.0:
+                return False
+    return True
+
+
 @jit
-def _uncovered(node, nfree, nptr, nrow):
-    """Number of slot pairs of the blocks ``node`` ``(m, k)`` whose node pair (both with free dofs) is
-    not in the node graph."""
+def _uncovered(node, vals, nfree, nptr, nrow):
+    """Number of slot pairs of the blocks ``vals`` over ``node`` ``(m, k)`` whose node pair (both with free
+    dofs, a 6 x 6 block not all zero) is not in the node graph."""
     n = 0
     for blk in range(node.shape[0]):
         for t in range(node.shape[1]):
@@ -94,7 +104,7 @@ def _uncovered(node, nfree, nptr, nrow):
                 continue
             for s in range(node.shape[1]):
                 a = node[blk, s]
-                if nfree[a] > 0 and _find(nptr, nrow, a, b) < 0:
+                if nfree[a] > 0 and _find(nptr, nrow, a, b) < 0 and not _zero_block(vals, blk, s, t):
                     n += 1
     return n
 
@@ -115,9 +125,9 @@ def _values(el_data, el_pos, node, vals, red, nfree, indptr, eoff, nptr, nrow, t
                 a = node[blk, s]
                 e = _find(nptr, nrow, a, b)
                 if e < 0:
-                    if nfree[a] > 0 and nfree[b] > 0:
+                    if nfree[a] > 0 and nfree[b] > 0 and not _zero_block(vals, blk, s, t):
                         return False
-                    continue                     # a or b without free dofs
+                    continue                     # a or b without free dofs, or a zero block
                 for q in range(6):
                     j = red[6 * b + q]
                     if j < 0:
@@ -143,13 +153,14 @@ def _values(el_data, el_pos, node, vals, red, nfree, indptr, eoff, nptr, nrow, t
     return True
 
 
-def _pair_keys(node, nfree, n):
-    """Sorted unique keys ``b n + a`` of the node pairs of the blocks ``node`` ``(m, k)`` whose both nodes
-    have free dofs."""
+def _pair_keys(node, vals, nfree, n):
+    """Sorted unique keys ``b n + a`` of the node pairs of the blocks ``vals`` ``(m, 6 k, 6 k)`` over ``node``
+    ``(m, k)`` whose both nodes have free dofs and whose 6 x 6 block is not all zero."""
     m, k = node.shape
     a = np.repeat(node, k, axis=1).ravel()
     b = np.tile(node, (1, k)).ravel()
-    keep = (nfree[a] > 0) & (nfree[b] > 0)
+    nonzero = (vals.reshape(m, k, 6, k, 6) != 0.0).any(axis=(2, 4)).ravel()
+    keep = (nfree[a] > 0) & (nfree[b] > 0) & nonzero
     return np.unique(b[keep].astype(np.int64) * n + a[keep])
 
 
@@ -196,14 +207,16 @@ class HeldPattern:
         """Whether it was built on these arrays ``(red, el_indptr, el_indices)`` (the same objects)."""
         return all(a is b for a, b in zip(base, self.base))
 
-    def covers(self, node):
-        """Whether every node pair of the blocks ``node`` ``(m, k)`` is in the pattern."""
-        return _uncovered(node, self.nfree, self.nptr, self.nrow) == 0
+    def covers(self, node, vals):
+        """Whether the pattern holds the blocks ``vals`` ``(m, 6 k, 6 k)`` over ``node`` ``(m, k)``: every node
+        pair of theirs, except those whose 6 x 6 block is all zero (a contact point without stiffness)."""
+        return _uncovered(node, vals, self.nfree, self.nptr, self.nrow) == 0
 
-    def grown(self, node):
-        """The pattern holding the node pairs of ``node`` too: this reserve plus them, or them alone when
-        fewer than ``RESET_SHARE`` of the reserve's pairs are among them (a rarely used reserve is dropped)."""
-        new = _pair_keys(node, self.nfree, self.n_nodes)
+    def grown(self, node, vals):
+        """The pattern holding the node pairs of the blocks ``vals`` over ``node`` too (``covers``): this reserve
+        plus theirs, or theirs alone when fewer than ``RESET_SHARE`` of the reserve's pairs are among them (a
+        stale reserve is dropped)."""
+        new = _pair_keys(node, vals, self.nfree, self.n_nodes)
         used = np.isin(self.keys, new, assume_unique=True).sum() if len(self.keys) else 0
         keys = np.union1d(self.keys, new) if used >= RESET_SHARE * len(self.keys) else new
         return HeldPattern(self.base[0], self.n_free, self.base[1], self.base[2], keys=keys)

@@ -629,7 +629,11 @@ class System:
         """Reduced tangent (free x free) as CSC from the COO values.
 
         ``extra``: optional ``(rows, cols, vals)`` COO entries in full ``z``
-        numbering (``assemble_blocks``), whose pattern may change between iterations.
+        numbering (``assemble_blocks``), whose pattern may change between iterations.  Where
+        ``holds_pattern()`` (large models), whole-node blocks go on the held pattern
+        (``held_pattern.HeldPattern``: explicit zeros for reserved contact node pairs, the same
+        ``indptr``/``indices`` from one Newton iteration to the next while the blocks stay inside it),
+        else on the exact one (``extra_pattern``: exact zeros dropped, as scipy's sum).
         """
         data = np.empty(self.nnz + 1)
         assembly_jit.scatter(self.pos, kvals, data)
@@ -681,13 +685,15 @@ class System:
         base = (self.red, self.indptr, self.indices)
         if p is None or not p.same_base(base):
             p = HeldPattern(self.red, self.n_free, self.indptr, self.indices)
-        if node is not None and not p.covers(node):
-            p = p.grown(node)
-        self._held_cache = p
         if node is None:
+            self._held_cache = p
             return p.matrix(el_data)
         k = node.shape[1]
-        return p.matrix(el_data, node, extra[2][:n_b].reshape(-1, 6 * k, 6 * k), tail)
+        vals = extra[2][:n_b].reshape(-1, 6 * k, 6 * k)
+        if not p.covers(node, vals):
+            p = p.grown(node, vals)
+        self._held_cache = p
+        return p.matrix(el_data, node, vals, tail)
 
     def _block_nodes(self, d):
         """The nodes ``(m, k)`` of whole-node block dofs ``d`` ``(m, 6 k)`` (kept while ``d`` is the same array)."""

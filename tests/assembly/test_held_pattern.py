@@ -38,10 +38,9 @@ def test_values_are_the_exact_patterns_to_round_off():
         g = rng.choice(n_nodes, 4, replace=False)
         t_rows = np.repeat(6 * g, 18) + np.tile(np.repeat(np.arange(6), 3), len(g))
         t_cols = np.repeat(6 * g, 18) + 3 + np.tile(np.arange(3), 6 * len(g))
-        p = HeldPattern(red, n, el.indptr, el.indices)
-        p = p.grown(_nodes(d))
-        p = p.grown(np.repeat(g, 2).reshape(-1, 2)) if not p.covers(np.repeat(g, 2).reshape(-1, 2)) else p
-        assert p.covers(_nodes(d))
+        ones = np.ones((len(d), 24, 24))
+        p = HeldPattern(red, n, el.indptr, el.indices).grown(_nodes(d), ones)
+        assert p.covers(_nodes(d), ones)
         for _ in range(2):
             vals = rng.standard_normal(len(d) * 24 * 24) * 10.0 ** rng.integers(-6, 6, size=len(d) * 576)
             vals[::9] = 0.0
@@ -54,21 +53,32 @@ def test_values_are_the_exact_patterns_to_round_off():
 
 
 def test_blocks_outside_grow_the_pattern_and_a_stale_reserve_is_dropped():
+    """A block over a node pair outside the pattern is not covered (unless its 6 x 6 part is zero: a contact
+    point without stiffness), and grows it; a reserve mostly unused at a growth is rebuilt from the blocks."""
     rng = np.random.default_rng(5)
     n_nodes = 80
     red, n = _reduction(rng, n_nodes, 3, 2)
     el = _element_matrix(rng, n, 0.01)
     a = _nodes(_node_blocks(rng, n_nodes, 40, 4))
     b = _nodes(_node_blocks(rng, n_nodes, 40, 4))
-    p = HeldPattern(red, n, el.indptr, el.indices).grown(a)
-    assert p.covers(a) and p.covers(a[::3]) and not p.covers(b)
-    q = p.grown(np.concatenate([a[5:], b]))        # most of the reserve in use: it is kept, b added
-    assert q.covers(a) and q.covers(b) and q.nnz > p.nnz
-    assert q.matrix(el.data).nnz == q.nnz            # element values alone on the held pattern
-    small = np.concatenate([a[:2], b[:1] + 1])       # few of the reserve's pairs in use: rebuilt from them
-    assert np.isin(q.keys, HeldPattern(red, n, el.indptr, el.indices).grown(small).keys).mean() < RESET_SHARE
-    r = q.grown(small)
-    assert r.covers(small) and not r.covers(a) and len(r.keys) < len(q.keys) and r.nnz < q.nnz
+
+    def ones(x):
+        return np.ones((len(x), 24, 24))
+    p = HeldPattern(red, n, el.indptr, el.indices).grown(a, ones(a))
+    assert p.covers(a, ones(a)) and p.covers(a[::3], ones(a[::3])) and not p.covers(b, ones(b))
+    assert p.covers(b, np.zeros((len(b), 24, 24)))          # zero blocks need no place
+    with pytest.raises(ValueError, match="outside the pattern"):
+        p.matrix(el.data, b, ones(b))
+    ab = np.concatenate([a[5:], b])
+    q = p.grown(ab, ones(ab))                             # most of the reserve in use: it is kept, b added
+    assert q.covers(a, ones(a)) and q.covers(b, ones(b)) and q.nnz > p.nnz
+    assert q.matrix(el.data).nnz == q.nnz                 # element values alone on the held pattern
+    small = np.concatenate([a[:2], b[:1] + 1])            # few of the reserve's pairs in use: rebuilt from them
+    assert np.isin(q.keys, HeldPattern(red, n, el.indptr, el.indices).grown(small, ones(small)).keys).mean() \
+        < RESET_SHARE
+    r = q.grown(small, ones(small))
+    assert r.covers(small, ones(small)) and not r.covers(a, ones(a)) and len(r.keys) < len(q.keys) \
+        and r.nnz < q.nnz
 
 
 def _twisted_pair_system(hold):
