@@ -725,7 +725,8 @@ def step_parts_rows(names, threads, holds):
     text = (f"`python benchmarks/scaling.py --step-parts {','.join(names)} --threads {','.join(threads)}` "
             f"({machine()}; whole run {wall:.0f} s). Newton iterations of a real loaded step by parts "
             "(`benchmarks/step_parts.py`): CPU s per iteration with one thread; with two threads (PARDISO/MKL) "
-            "the parts and `total wall` are wall s, `total` CPU s of both threads.\n\n"
+            "the parts are wall s (CPU s of both threads in brackets), `total` CPU s, `total wall` wall s; "
+            f"load average at the end {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores.\n\n"
             + step_parts.report(rows, table))
     print(text)
     write_csv("scaling_step_parts", [{k: v for k, v in r.items() if not isinstance(v, dict)} for r in rows],

@@ -21,7 +21,8 @@ Parts per Newton iteration: ``evaluation`` (``Problem.evaluate``: elements, cont
 trials included), ``assembly`` (``Problem.tangent``, ``coupling``, ``bordered``), ``analysis`` (PARDISO phase
 11), ``factorisation`` (phase 22), ``solve`` (phase 33 and its check), ``update`` and ``other`` (the rest of the
 loop); CPU seconds (``time.process_time``) with one thread; with two threads CPU seconds count both threads, so
-wall seconds (``time.perf_counter``) are reported beside them (a shared machine: wall times are noisier).
+the parts are wall seconds (``time.perf_counter``) with CPU seconds in brackets (a shared machine: wall times
+are noisier, and longer than the CPU time of one thread whenever the other core is busy).
 ``first``: the step's first iteration; ``later``: the median of the later ones.  Peak memory: ``ru_maxrss``.
 """
 import os
@@ -174,8 +175,8 @@ def report(rows, table):
             it = r[which]
             if not it:
                 continue
-            wall = r["threads"] > 1
-            parts = [g(it[p + "_wall"] if wall else it[p]) for p in PARTS + ("other",)]
+            wall = r["threads"] > 1        # wall s (CPU s of both threads)
+            parts = [f"{g(it[p + '_wall'])} ({g(it[p])})" if wall else g(it[p]) for p in PARTS + ("other",)]
             body.append([r["scene"], r["threads"], r["hold"], f"{r['status']} ({r['iterations']})",
                          f"{r['analyses']} / {r['factorisations']}", which if which == "first" else
                          f"later (median of {r['n_timed'] - 1})"] + parts

@@ -170,7 +170,7 @@ class HeldPattern:
     (``b n + a``, sorted) as one CSC pattern kept while the contact blocks stay inside it (see the
     module).  ``matrix`` gives the tangent with explicit zeros; ``covers`` tells whether blocks fit."""
 
-    def __init__(self, red, n_free, el_indptr, el_indices, keys=None):
+    def __init__(self, red, n_free, el_indptr, el_indices, keys=None, el_keys=None):
         self.base = (red, el_indptr, el_indices)
         red = np.ascontiguousarray(red, dtype=np.int64)
         n = len(red) // 6
@@ -180,8 +180,10 @@ class HeldPattern:
         self.nfree = np.bincount(node_of, minlength=n).astype(np.int64)
         first = np.zeros(n, dtype=np.int64)
         first[node_of[::-1]] = np.arange(n_free)[::-1]          # the first free dof of each node
-        el_col = np.repeat(np.arange(n_free), np.diff(el_indptr))
-        el_keys = np.unique(node_of[el_col] * n + node_of[el_indices])
+        if el_keys is None:            # the element pattern's node pairs (kept: ``grown`` passes them on)
+            el_col = np.repeat(np.arange(n_free), np.diff(el_indptr))
+            el_keys = np.unique(node_of[el_col] * n + node_of[el_indices])
+        self.el_keys = el_keys
         self.keys = np.zeros(0, dtype=np.int64) if keys is None else np.setdiff1d(keys, el_keys)
         allk = np.union1d(el_keys, self.keys)
         self.nptr = np.searchsorted(allk // n, np.arange(n + 1)).astype(np.int64)
@@ -219,7 +221,7 @@ class HeldPattern:
         new = _pair_keys(node, vals, self.nfree, self.n_nodes)
         used = np.isin(self.keys, new, assume_unique=True).sum() if len(self.keys) else 0
         keys = np.union1d(self.keys, new) if used >= RESET_SHARE * len(self.keys) else new
-        return HeldPattern(self.base[0], self.n_free, self.base[1], self.base[2], keys=keys)
+        return HeldPattern(self.base[0], self.n_free, self.base[1], self.base[2], keys=keys, el_keys=self.el_keys)
 
     def matrix(self, el_data, node=None, vals=None, tail=None):
         """CSC ``(n_free, n_free)`` of the element values ``el_data`` (element pattern order) plus the blocks
