@@ -68,11 +68,14 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _report import machine, single_thread, table, write_csv, write_section  # noqa: E402
+import os  # noqa: E402
 
 single_thread()
+if os.environ.get("SCALING_THREADS"):          # --step-parts --threads: a child with more MKL/OpenMP threads
+    for _var in ("OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ[_var] = os.environ["SCALING_THREADS"]
 
 import json  # noqa: E402
-import os  # noqa: E402
 import resource  # noqa: E402
 import subprocess  # noqa: E402
 import tempfile  # noqa: E402
@@ -435,6 +438,9 @@ def child(argv):
         out = measure_bundle(int(argv[1]), int(argv[2]), float(argv[3]), argv[4].split(","))
     elif kind == "nothing":
         out = measure_pays_nothing(int(argv[1]))
+    elif kind == "step-parts":
+        import step_parts
+        out = step_parts.measure(argv[1], argv[2], argv[3], _maxrss_mb)
     elif kind == "scene":
         import scaling_scenes
         out = scaling_scenes.measure_scene(argv[1], _maxrss_mb)
@@ -443,10 +449,10 @@ def child(argv):
     print("JSON " + json.dumps(out, default=float))
 
 
-def run_child(*args, timeout=900):
+def run_child(*args, timeout=900, env=None):
     t0 = time.perf_counter()
     p = subprocess.run([sys.executable, __file__, "--child", *map(str, args)], capture_output=True, text=True,
-                       timeout=timeout)
+                       timeout=timeout, env=None if env is None else {**os.environ, **env})
     lines = [ln for ln in p.stdout.splitlines() if ln.startswith("JSON ")]
     if p.returncode != 0 or not lines:
         raise RuntimeError(f"child {args} failed (status {p.returncode}):\n{p.stderr[-3000:]}")
@@ -626,7 +632,14 @@ def main(argv):
                     help="largest bundle (elements) run through the contact code")
     ap.add_argument("--scenes", default=None,
                     help="instead: the scenes of issue 30, e.g. 19,37,61,rope-20,rope-40 (scaling_scenes.py)")
+    ap.add_argument("--step-parts", default=None,
+                    help="instead: Newton iterations of a loaded step by parts, held pattern off/on, e.g. "
+                         "19,37,61,strand-61 (step_parts.py)")
+    ap.add_argument("--threads", default="1", help="with --step-parts: PARDISO/MKL threads, e.g. 1,2")
+    ap.add_argument("--hold", default="False,True", help="with --step-parts: System.hold_pattern values")
     a = ap.parse_args(argv)
+    if a.step_parts:
+        return step_parts_rows(a.step_parts.split(","), a.threads.split(","), a.hold.split(","))
     if a.scenes:
         return scenes(a.scenes.split(","))
     max_elements, cap = int(a.max_elements), int(a.bundle_cap)
@@ -691,6 +704,35 @@ def scenes(names):
     print(text)
     write_csv("scaling_scenes", rows, cell=_csv)
     write_section("scaling_scenes", "## Bundles of 19, 37, 61 wires and a rope (issue 30)\n\n" + text)
+    return rows
+
+
+def step_parts_rows(names, threads, holds):
+    """``--step-parts``: Newton iterations of a loaded step by parts (``step_parts``), one child per row."""
+    import step_parts
+    t_start = time.perf_counter()
+    rows = []
+    for name in names:
+        for th in threads:
+            for hold in holds:
+                try:
+                    rows.append(run_child("step-parts", name, hold, th, timeout=3000,
+                                          env=dict(SCALING_THREADS=th)))
+                except (RuntimeError, subprocess.TimeoutExpired) as e:
+                    rows.append(dict(scene=name, hold=hold, threads=th,
+                                     error=str(e).splitlines()[-1][:100] if str(e) else type(e).__name__))
+    wall = time.perf_counter() - t_start
+    text = (f"`python benchmarks/scaling.py --step-parts {','.join(names)} --threads {','.join(threads)}` "
+            f"({machine()}; whole run {wall:.0f} s). Newton iterations of a real loaded step by parts "
+            "(`benchmarks/step_parts.py`): CPU s per iteration with one thread; with two threads (PARDISO/MKL) "
+            "the parts are wall s (CPU s of both threads in brackets), `total` CPU s, `total wall` wall s; "
+            f"load average at the end {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores.\n\n"
+            + step_parts.report(rows, table))
+    print(text)
+    write_csv("scaling_step_parts", [{k: v for k, v in r.items() if not isinstance(v, dict)} for r in rows],
+              cell=_csv)
+    write_section("scaling_step_parts", "## Newton iterations of a loaded step by parts, held pattern (issue 30)\n\n"
+                  + text)
     return rows
 
 

@@ -73,9 +73,9 @@ def child(root, sizes):
     timed(kernel_jit, "evaluate")
     factorize = linsolve.Solver.factorize
 
-    def factorized(solver, K):
+    def factorized(solver, K, *a, **k):
         t = clock()
-        lu = factorize(solver, K)
+        lu = factorize(solver, K, *a, **k)
         floor[0] += clock() - t
         solve = lu.solve
 

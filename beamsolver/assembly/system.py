@@ -28,12 +28,15 @@ from ..model import blocks as _blocks
 from ..errors import InputError
 from .csc import canonical_csc
 from .extra_pattern import BlockPattern, ExtraPattern, whole_nodes
+from .held_pattern import HeldPattern
 from ..lie.se3 import skew
 from ..model.validation import check_pose
 
 __all__ = ["System", "FREE", "GLOBAL", "CLAMPED", "PRESCRIBED"]
 
 FREE, GLOBAL, CLAMPED, PRESCRIBED = 0, 1, 2, 3
+HOLD_PATTERN = "auto"        # System.hold_pattern's default: True, False or "auto" (``HOLD_MIN_UNKNOWNS``)
+HOLD_MIN_UNKNOWNS = 1_500    # "auto": a held pattern from this size (linsolve's PARDISO size: its analysis reused)
 # rank tolerance of the rigid-mode check: the constraint rows mix unit rotations with lever arms
 # in units of the group's size (``_rigid_mode_rank``), so entries are O(1)
 RIGID_MODE_TOL = 1e-9
@@ -120,6 +123,7 @@ class System:
         if not model.beams:
             raise InputError("Model: no beams were added")
         self.model = model
+        self.hold_pattern = HOLD_PATTERN
         n = model.n_nodes
         self.n_nodes = n
         self.groups = model.element_groups()          # one per element type (model.ElementGroup)
@@ -625,13 +629,78 @@ class System:
         """Reduced tangent (free x free) as CSC from the COO values.
 
         ``extra``: optional ``(rows, cols, vals)`` COO entries in full ``z``
-        numbering (``assemble_blocks``), whose pattern may change between iterations.
+        numbering (``assemble_blocks``), whose pattern may change between iterations.  Where
+        ``holds_pattern()`` (large models), whole-node blocks go on the held pattern
+        (``held_pattern.HeldPattern``: explicit zeros for reserved contact node pairs, the same
+        ``indptr``/``indices`` from one Newton iteration to the next while the blocks stay inside it),
+        else on the exact one (``extra_pattern``: exact zeros dropped, as scipy's sum).
         """
         data = np.empty(self.nnz + 1)
         assembly_jit.scatter(self.pos, kvals, data)
-        if extra is not None and len(extra[2]):
+        has_extra = extra is not None and len(extra[2])
+        held = self._held(data[:self.nnz], extra if has_extra else None)
+        if held is not None:
+            return held
+        if has_extra:
             return self._extra_pattern(extra).matrix(data[:self.nnz], extra[2])
         return canonical_csc(data[:self.nnz], self.indices, self.indptr, self.n_free)
+
+    def holds_pattern(self):
+        """Whether ``matrix`` keeps a held pattern (``held_pattern.HeldPattern``): ``hold_pattern`` True, or
+        ``"auto"`` with at least ``HOLD_MIN_UNKNOWNS`` free unknowns (where PARDISO is the back-end and
+        reuses its analysis while the pattern holds; small scenes keep the exact pattern)."""
+        h = self.hold_pattern
+        if h not in (True, False, "auto"):
+            raise InputError(f"System.hold_pattern must be True, False or 'auto', got {h!r}")
+        return h is True or (h == "auto" and self.n_free >= HOLD_MIN_UNKNOWNS)
+
+    @property
+    def held_pattern(self):
+        """The ``held_pattern.HeldPattern`` of the last ``matrix`` call (``None`` if none): a new object
+        whenever the reserve grew (a contact block outside it)."""
+        return getattr(self, "_held_cache", None)
+
+    def _held(self, el_data, extra):
+        """The tangent on the held pattern (``matrix``) for the element values ``el_data`` and the
+        contributions' COO ``extra`` (``None``: none), or ``None`` where no pattern is held: not
+        ``holds_pattern``, or entries that are not whole-node blocks (``_block_coo``'s, maybe with
+        ``_concat_index``'s tail)."""
+        if not self.holds_pattern():
+            self._held_cache = None
+            return None
+        node = tail = None
+        if extra is not None:
+            c, cc = getattr(self, "_coo_index", None), getattr(self, "_coo_concat", None)
+            if c is None or not c[3]:
+                return None
+            n_b = c[1].size
+            if extra[0] is c[1] and extra[1] is c[2]:
+                pass
+            elif cc is not None and extra[0] is cc[4] and extra[1] is cc[5] and cc[0] is c[1] and cc[1] is c[2]:
+                tail = (cc[2], cc[3], extra[2][n_b:])
+            else:
+                return None
+            node = self._block_nodes(c[0])
+        p = getattr(self, "_held_cache", None)
+        base = (self.red, self.indptr, self.indices)
+        if p is None or not p.same_base(base):
+            p = HeldPattern(self.red, self.n_free, self.indptr, self.indices)
+        if node is None:
+            self._held_cache = p
+            return p.matrix(el_data)
+        k = node.shape[1]
+        vals = extra[2][:n_b].reshape(-1, 6 * k, 6 * k)
+        if not p.covers(node, vals):
+            p = p.grown(node, vals)
+        self._held_cache = p
+        return p.matrix(el_data, node, vals, tail)
+
+    def _block_nodes(self, d):
+        """The nodes ``(m, k)`` of whole-node block dofs ``d`` ``(m, 6 k)`` (kept while ``d`` is the same array)."""
+        c = getattr(self, "_block_nodes_cache", None)
+        if c is None or c[0] is not d:
+            c = self._block_nodes_cache = (d, np.ascontiguousarray(d[:, 0::6] // 6, dtype=np.int64))
+        return c[1]
 
     @property
     def extra_pattern(self):

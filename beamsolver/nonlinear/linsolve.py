@@ -570,17 +570,18 @@ class _Pardiso:
             ps._check_A(K)                     # sorts indices, sets the CSR/CSC (transposed) flag
             same = (not fresh and self.pattern is not None and self.pattern[2] == K.format
                     and np.array_equal(self.pattern[0], K.indptr) and np.array_equal(self.pattern[1], K.indices))
-            ps.set_phase(22 if same else 12)
-            if not same:
+            zero = np.zeros((K.shape[0], 1))
+            if not same:                       # ordering + symbolic analysis (phase 11), then phase 22 alone
                 ps.iparm[18] = -1              # report the factorisation's Mflops (MKL iparm(19))
                 if stats is not None:
                     stats["analyses"] += 1
-            ps._call_pardiso(K, np.zeros((K.shape[0], 1)))
-            if not same:
+                ps.set_phase(11)
+                ps._call_pardiso(K, zero)
                 self.flops = 1e6 * float(ps.iparm[18])
-            if f.saddle and not set_ and self._saddle(True):     # MKL's defaults were filled in by that call
-                ps.set_phase(22)
-                ps._call_pardiso(K, np.zeros((K.shape[0], 1)))
+                if f.saddle and not set_:
+                    self._saddle(True)         # MKL's defaults were filled in by that call
+            ps.set_phase(22)
+            ps._call_pardiso(K, zero)
             self.pattern = (K.indptr.copy(), K.indices.copy(), K.format)
             f.reused = same
         self.current = weakref.ref(f)

@@ -1,0 +1,239 @@
+"""A tangent pattern held across Newton iterations: the element pattern plus reserved contact node pairs.
+
+``extra_pattern.BlockPattern`` builds the exact union of the element pattern and the active contact
+blocks, without the entries that sum to exactly zero: a new pattern whenever a contact point enters or
+leaves an element pair, which on a loaded step of a bundle is every Newton iteration, and PARDISO then
+redoes its ordering and symbolic analysis (``linsolve._Pardiso``; ~0.5 s at 61 wires).  ``HeldPattern``
+stores explicit zeros instead: its pattern is the element pattern plus 6 x 6 node blocks for every
+*reserved* node pair, the union of the node pairs the contact blocks have used so far (grown when a
+block reaches a pair outside it, rebuilt from the current pairs alone when fewer than ``RESET_SHARE`` of
+the reserved pairs are still used then), so consecutive tangents have the same ``indptr``, ``indices``
+and PARDISO runs its numerical factorisation only (phase 22).  The values are those of
+``BlockPattern`` to round-off (the same entries summed, in another order; zeros kept).
+
+Node-level layout: the reserved node graph ``(nptr, nrow)`` (node column ``b``: sorted row nodes ``a``)
+covers the element pattern (every element couples whole nodes) and the reserved pairs; dof column ``j``
+of node ``b`` holds the free dofs of its row nodes in order, so the entry (row dof ``6 a + p``, column
+dof ``6 b + q``) sits at ``indptr[red[6 b + q]] + eoff[e] + prank[a, p]``, ``e`` the pair's place in the
+node graph, ``eoff[e]`` its offset in the node column (the same for the six columns of ``b``) and
+``prank[a, p]`` the rank of dof ``p`` among the free dofs of ``a``: memory per node pair, not per entry.
+"""
+import numpy as np
+
+from .._jit import jit, jit_callee
+from .csc import canonical_csc
+
+__all__ = ["HeldPattern", "RESET_SHARE"]
+
+RESET_SHARE = 0.8      # growth: keep the old reserve while at least this share of its contact pairs is in use
+
+
+@jit_callee
+def _find(nptr, nrow, a, b):
+    """Place of the node pair (row ``a``, column ``b``) in the node graph, ``-1`` if absent."""
+    lo, hi = nptr[b], nptr[b + 1]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if nrow[mid] < a:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo if lo < nptr[b + 1] and nrow[lo] == a else -1
+
+
+@jit
+def _expand(nptr, nrow, nfree, first, indptr, indices, eoff):
+    """The dof pattern of the node graph: column pointers ``indptr`` (``(n_free + 1,)``), rows
+    ``indices`` and each node pair's offset ``eoff`` within its node column; ``first[a]`` is the first
+    free (reduced) dof of node ``a``."""
+    indptr[0] = 0
+    j = 0
+    for b in range(len(nptr) - 1):
+        off = 0
+        for e in range(nptr[b], nptr[b + 1]):
+            eoff[e] = off
+            off += nfree[nrow[e]]
+        for q in range(nfree[b]):
+            s = indptr[j]
+            for e in range(nptr[b], nptr[b + 1]):
+                a = nrow[e]
+                for p in range(nfree[a]):
+                    indices[s] = first[a] + p
+                    s += 1
+            indptr[j + 1] = s
+            j += 1
+
+
+@jit
+def _element_positions(el_indptr, el_indices, node_of, first, nptr, nrow, eoff, indptr, out):
+    """Position of every element-pattern entry in the held pattern; returns how many are not in it."""
+    missing = 0
+    for j in range(len(el_indptr) - 1):
+        b = node_of[j]
+        for s in range(el_indptr[j], el_indptr[j + 1]):
+            i = el_indices[s]
+            a = node_of[i]
+            e = _find(nptr, nrow, a, b)
+            if e < 0:
+                missing += 1
+                out[s] = 0
+            else:
+                out[s] = indptr[j] + eoff[e] + (i - first[a])
+    return missing
+
+
+@jit_callee
+def _zero_block(vals, blk, s, t):
+    """Whether the 6 x 6 block of slots ``(s, t)`` of block ``blk`` of ``vals`` ``(m, 6 k, 6 k)`` is all zero."""
+    for p in range(6):
+        for q in range(6):
+            if vals[blk, 6 * s + p, 6 * t + q] != 0.0:
+                return False
+    return True
+
+
+@jit
+def _uncovered(node, vals, nfree, nptr, nrow):
+    """Number of slot pairs of the blocks ``vals`` over ``node`` ``(m, k)`` whose node pair (both with free
+    dofs, a 6 x 6 block not all zero) is not in the node graph."""
+    n = 0
+    for blk in range(node.shape[0]):
+        for t in range(node.shape[1]):
+            b = node[blk, t]
+            if nfree[b] == 0:
+                continue
+            for s in range(node.shape[1]):
+                a = node[blk, s]
+                if nfree[a] > 0 and _find(nptr, nrow, a, b) < 0 and not _zero_block(vals, blk, s, t):
+                    n += 1
+    return n
+
+
+@jit
+def _values(el_data, el_pos, node, vals, red, nfree, indptr, eoff, nptr, nrow, t_rows, t_cols, t_vals, out):
+    """Held-pattern values: element values, plus the blocks ``vals`` ``(m, 6 k, 6 k)`` over ``node``
+    ``(m, k)``, plus the tail entries (full numbering, dropped where held); explicit zeros kept.  Returns
+    False if an entry with a free row and column has no place in the pattern."""
+    out[:] = 0.0
+    for s in range(len(el_pos)):
+        out[el_pos[s]] += el_data[s]
+    k = node.shape[1]
+    for blk in range(node.shape[0]):
+        for t in range(k):
+            b = node[blk, t]
+            for s in range(k):
+                a = node[blk, s]
+                e = _find(nptr, nrow, a, b)
+                if e < 0:
+                    if nfree[a] > 0 and nfree[b] > 0 and not _zero_block(vals, blk, s, t):
+                        return False
+                    continue                     # a or b without free dofs, or a zero block
+                for q in range(6):
+                    j = red[6 * b + q]
+                    if j < 0:
+                        continue
+                    base = indptr[j] + eoff[e]
+                    r = 0
+                    for p in range(6):
+                        if red[6 * a + p] >= 0:
+                            out[base + r] += vals[blk, 6 * s + p, 6 * t + q]
+                            r += 1
+    for u in range(len(t_rows)):
+        j, i = red[t_cols[u]], red[t_rows[u]]
+        if i < 0 or j < 0:
+            continue
+        e = _find(nptr, nrow, t_rows[u] // 6, t_cols[u] // 6)
+        if e < 0:
+            return False
+        r = 0
+        for p in range(t_rows[u] % 6):
+            if red[t_rows[u] - t_rows[u] % 6 + p] >= 0:
+                r += 1
+        out[indptr[j] + eoff[e] + r] += t_vals[u]
+    return True
+
+
+def _pair_keys(node, vals, nfree, n):
+    """Sorted unique keys ``b n + a`` of the node pairs of the blocks ``vals`` ``(m, 6 k, 6 k)`` over ``node``
+    ``(m, k)`` whose both nodes have free dofs and whose 6 x 6 block is not all zero."""
+    m, k = node.shape
+    a = np.repeat(node, k, axis=1).ravel()
+    b = np.tile(node, (1, k)).ravel()
+    nonzero = (vals.reshape(m, k, 6, k, 6) != 0.0).any(axis=(2, 4)).ravel()
+    keep = (nfree[a] > 0) & (nfree[b] > 0) & nonzero
+    return np.unique(b[keep].astype(np.int64) * n + a[keep])
+
+
+class HeldPattern:
+    """The element pattern ``(el_indptr, el_indices)`` (reduced, ``n_free``; ``red`` ``(6 n,)`` the
+    reduction, ``-1`` for held unknowns) plus 6 x 6 blocks over the reserved node pairs ``keys``
+    (``b n + a``, sorted) as one CSC pattern kept while the contact blocks stay inside it (see the
+    module).  ``matrix`` gives the tangent with explicit zeros; ``covers`` tells whether blocks fit."""
+
+    def __init__(self, red, n_free, el_indptr, el_indices, keys=None, el_keys=None):
+        self.base = (red, el_indptr, el_indices)
+        red = np.ascontiguousarray(red, dtype=np.int64)
+        n = len(red) // 6
+        self.n_nodes, self.n_free, self.red = n, n_free, red
+        free_dofs = np.flatnonzero(red >= 0)
+        node_of = free_dofs // 6
+        self.nfree = np.bincount(node_of, minlength=n).astype(np.int64)
+        first = np.zeros(n, dtype=np.int64)
+        first[node_of[::-1]] = np.arange(n_free)[::-1]          # the first free dof of each node
+        if el_keys is None:            # the element pattern's node pairs (kept: ``grown`` passes them on)
+            el_col = np.repeat(np.arange(n_free), np.diff(el_indptr))
+            el_keys = np.unique(node_of[el_col] * n + node_of[el_indices])
+        self.el_keys = el_keys
+        self.keys = np.zeros(0, dtype=np.int64) if keys is None else np.setdiff1d(keys, el_keys)
+        allk = np.union1d(el_keys, self.keys)
+        self.nptr = np.searchsorted(allk // n, np.arange(n + 1)).astype(np.int64)
+        self.nrow = (allk % n).astype(np.int64)
+        self.eoff = np.empty(len(allk), dtype=np.int64)
+        col_len = np.bincount(allk // n, weights=self.nfree[self.nrow], minlength=n).astype(np.int64)
+        size = int((col_len * self.nfree).sum())
+        self.indptr = np.empty(n_free + 1, dtype=np.int64)
+        self.indices = np.empty(size, dtype=np.int32)
+        _expand(self.nptr, self.nrow, self.nfree, first, self.indptr, self.indices, self.eoff)
+        self.el_pos = np.empty(len(el_indices), dtype=np.int64)
+        missing = _element_positions(np.asarray(el_indptr, dtype=np.int64), el_indices, node_of, first, self.nptr,
+                                     self.nrow, self.eoff, self.indptr, self.el_pos)
+        if missing:
+            raise ValueError(f"HeldPattern: {missing} element entries outside whole node blocks")
+        self.indptr = self.indptr.astype(np.int32) if size < np.iinfo(np.int32).max else self.indptr
+
+    @property
+    def nnz(self):
+        return len(self.indices)
+
+    def same_base(self, base):
+        """Whether it was built on these arrays ``(red, el_indptr, el_indices)`` (the same objects)."""
+        return all(a is b for a, b in zip(base, self.base))
+
+    def covers(self, node, vals):
+        """Whether the pattern holds the blocks ``vals`` ``(m, 6 k, 6 k)`` over ``node`` ``(m, k)``: every node
+        pair of theirs, except those whose 6 x 6 block is all zero (a contact point without stiffness)."""
+        return _uncovered(node, vals, self.nfree, self.nptr, self.nrow) == 0
+
+    def grown(self, node, vals):
+        """The pattern holding the node pairs of the blocks ``vals`` over ``node`` too (``covers``): this reserve
+        plus theirs, or theirs alone when fewer than ``RESET_SHARE`` of the reserve's pairs are among them (a
+        stale reserve is dropped)."""
+        new = _pair_keys(node, vals, self.nfree, self.n_nodes)
+        used = np.isin(self.keys, new, assume_unique=True).sum() if len(self.keys) else 0
+        keys = np.union1d(self.keys, new) if used >= RESET_SHARE * len(self.keys) else new
+        return HeldPattern(self.base[0], self.n_free, self.base[1], self.base[2], keys=keys, el_keys=self.el_keys)
+
+    def matrix(self, el_data, node=None, vals=None, tail=None):
+        """CSC ``(n_free, n_free)`` of the element values ``el_data`` (element pattern order) plus the blocks
+        ``vals`` ``(m, 6 k, 6 k)`` over ``node`` ``(m, k)`` (``covers``) and the ``tail`` COO
+        ``(rows, cols, vals)`` (full numbering; node pairs in the pattern), explicit zeros kept."""
+        if node is None:
+            node, vals = np.zeros((0, 1), dtype=np.int64), np.zeros((0, 6, 6))
+        t = tail if tail is not None else (np.zeros(0, dtype=np.int64),) * 2 + (np.zeros(0),)
+        data = np.empty(self.nnz)
+        ok = _values(el_data, self.el_pos, node, vals, self.red, self.nfree, self.indptr, self.eoff, self.nptr, self.nrow,
+                     np.asarray(t[0], dtype=np.int64), np.asarray(t[1], dtype=np.int64),
+                     np.asarray(t[2], dtype=float), data)
+        if not ok:
+            raise ValueError("HeldPattern: a block or tail entry outside the pattern (see covers)")
+        return canonical_csc(data, self.indices.copy(), self.indptr.copy(), self.n_free)
