@@ -1085,7 +1085,8 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
     friction force, wrenches and nodal rows), each the same operations as a ``_point`` call with that
     traction; ``f[q, p]`` ``(4, 6)``, ``K[q, p]`` ``(24, 24)`` (``q``: the traction; ``q`` = 1, 2, 3 less those
     of ``q`` = 0 at the end, ``mortar_terms``' differences); the point data as the last call left them;
-    ``rows`` ``(N_ROWS, 24)``: the gradient rows (``_evaluate_rows``).  A template (``make_kernel``)."""
+    ``rows`` ``(N_ROWS, 24)``: the gradient rows (``_evaluate_rows``).  An empty ``K`` ``(4, P, 0, 0)``: forces only
+    (``mortar_forces``; ``rows`` untouched), the same bits as with the tangent.  A template (``make_kernel``)."""
     S, v, G, cache = ws
     side1, side2 = _element_side(Xp, 0, S[0], cache[0]), _element_side(Xp, 2, S[1], cache[1])
     RA1, xA1, u1, w1 = side1
@@ -1095,7 +1096,12 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
     RC, xC, _, _ = _section_co(RA1, xA1, u1, w1, xi1, co1[0], co1[1])
     RF, xF, _, _ = _section_co(RA2, xA2, u2, w2, xi2, co2[0], co2[1])
     S1, S2 = S[0], S[1]
-    _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, G)
+    tangent = K.shape[2] > 0
+    if tangent:
+        _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, G)
+    else:       # forces only (``mortar_forces``: an empty ``K``): the Jacobians, no variations, no gradient rows
+        _jacobians(u1, w1, xi1, co1[0], co1[1], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB], S1[S_TMP])
+        _jacobians(u2, w2, xi2, co2[0], co2[1], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB], S2[S_TMP])
     n, t1, t2, dist = _axes(RC, xC, RF, xF, G)
     R1, R2, wgt = par[R1_], par[R2_], par[WEIGHT]
     gap = dist - R1 - R2
@@ -1111,12 +1117,13 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
         for a in range(2):
             for k in range(24):
                 G[(G_DSLIP + a) * W + k] = 0.0
-    for k in range(24):
-        for i in range(9):
-            rows[i, k] = G[(G_DN + i) * W + k]
-        rows[9, k] = G[G_DSLIP * W + k]
-        rows[10, k] = G[(G_DSLIP + 1) * W + k]
-        rows[11, k] = G[G_DLAM * W + k]
+    if tangent:
+        for k in range(24):
+            for i in range(9):
+                rows[i, k] = G[(G_DN + i) * W + k]
+            rows[9, k] = G[G_DSLIP * W + k]
+            rows[10, k] = G[(G_DSLIP + 1) * W + k]
+            rows[11, k] = G[G_DLAM * W + k]
     for q in range(4):
         lamp = (1.0 if q == 1 else 0.0, 1.0 if q == 2 else 0.0, 1.0 if q == 3 else 0.0)
         F = scale(-wgt * lam, n)
@@ -1142,9 +1149,10 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
         for i in range(4):
             for j in range(6):
                 fq[i, j] -= f0[i, j]
-        for i in range(24):
-            for j in range(24):
-                Kq[i, j] -= K0[i, j]
+        if tangent:
+            for i in range(24):
+                for j in range(24):
+                    Kq[i, j] -= K0[i, j]
 
 
 def _evaluate_mortar(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows):
@@ -1344,6 +1352,25 @@ def mortar_terms(X, p, law=None):
     flags, frames, rows = np.empty((P, 2), dtype=np.bool_), np.empty((P, 4, 4, 4)), np.empty((P, N_ROWS, 24))
     kern(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows)
     return _mortar_terms(P, f[1:], K[1:], sc, vec, two, flags, frames, rows)
+
+
+def mortar_forces(X, p, law=None):
+    """``mortar_terms`` without the tangent's parts (a line-search trial needs the residuals only): ``A``, ``S``,
+    ``lam_n``, ``n``, ``t1``, ``t2``, ``slip``, ``HL``, ``HK``, ``active``, ``xi1``, ``xi2``, the same bits as
+    ``mortar_terms``' (the mortar kernel with an empty tangent: no frame variations, no gradient rows)."""
+    X = np.ascontiguousarray(X, dtype=float)
+    P = X.shape[0]
+    kind, par, has, (HCL, HFK, HLKp), _ = _table(X, p)
+    kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar=True)
+    f, K = np.empty((4, P, 4, 6)), np.empty((4, P, 0, 0))
+    sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
+    flags, frames, rows = np.empty((P, 2), dtype=np.bool_), np.empty((P, 4, 4, 4)), np.empty((P, 0, 0))
+    kern(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows)
+    A = np.transpose(f[1:], (1, 2, 3, 0)).reshape(P, 24, 3)
+    n, t1, t2, s = vec[:, 0], vec[:, 1], vec[:, 2], two[:, 1]
+    return dict(A=A, S=s[:, :1] * t1 + s[:, 1:] * t2, lam_n=sc[:, 1].copy(), n=n, t1=t1, t2=t2, slip=s.copy(),
+                HL=frames[:, 0].copy(), HK=frames[:, 1].copy(), active=flags[:, 0].copy(), xi1=sc[:, 2].copy(),
+                xi2=sc[:, 3].copy())
 
 
 def mortar_terms_four(X, p, law=None):

@@ -664,7 +664,11 @@ class ContactSystem(Contribution):
             if asked:
                 self._segment_ends(H, P, sel, p, f, K, out.pop("segment_ends"))
         if mort.any():
-            out["mortar"] = self._mortar(H, P, sel, p, np.flatnonzero(mort), out, tangent)
+            # exact stick's terms: forces and complementarity residuals only unless the tangent is asked for (a
+            # line-search trial); its blocks when it is (``evaluate``: ``mortar_pending``)
+            out["mortar"] = self._mortar(H, P, sel, p, np.flatnonzero(mort), out, asked)
+            if not asked:
+                out["mortar_pending"] = np.flatnonzero(mort)
         self._lap("kernel")
         # kept for commit/augment at the same poses (the converged iterate): no second pass
         if (p["mu"] > 0).all() or not (p["mu"] > 0).any() or mort.any():
@@ -733,7 +737,7 @@ class ContactSystem(Contribution):
         if len(laws) > 1:
             raise InputError("contact: exact stick needs one contact law over the declarations of a scene, "
                              f"got {len(laws)}")
-        d = kernel_jit.mortar_terms(X, pm, next(iter(laws.values())))
+        d = (kernel_jit.mortar_terms if tangent else kernel_jit.mortar_forces)(X, pm, next(iter(laws.values())))
         # nodal weights: half of each element at the node, the whole element beside a held node
         e = P.e[sel[idx]]
         merged = np.unique(G["g"][:, 0][G["g"][:, 0] == G["g"][:, 1]] * np.int64(len(self.sys.L))
@@ -893,6 +897,8 @@ class ContactSystem(Contribution):
         P, sel, p, f, K, out = blocks
         if tangent and K is not None and "segment_ends" in out:
             self._segment_ends(H, P, sel, p, f, K, out.pop("segment_ends"))
+        if tangent and K is not None and "mortar_pending" in out:
+            out["mortar"] = self._mortar(H, P, sel, p, out.pop("mortar_pending"), out, True)
         info = dict(n_active=len(sel))
         if "mortar" in out:
             b = _with_mortar(P.nodes[sel], f.reshape(-1, 24), K if tangent else None, out["mortar"],

@@ -495,8 +495,9 @@ class Newton:
             ev1 = None
             try:
                 # the full step is nearly always accepted: evaluated with the tangent the next
-                # iteration needs; the backtracked trials need the residual only
-                ev1 = self.evaluate(H1, t, tangent=alpha == 1.0)
+                # iteration needs; the backtracked trials need the residual only.  Semi-smooth (bordered)
+                # problems reject many full steps (Armijo): residuals only there too
+                ev1 = self.evaluate(H1, t, tangent=alpha == 1.0 and ev0.mult is None)
                 phi = self._merit(ev1, scales)
             except StepFailed:
                 phi = np.inf
@@ -506,7 +507,7 @@ class Newton:
             # LS_GROWTH) triggers backtracking, which then asks for a decrease
             growth = LS_GROWTH if ev0.mult is None else 1.0 - 1e-4      # semi-smooth: Armijo from the full step
             if phi <= (growth * phi0 if alpha == 1.0 else (1.0 - 1e-4 * alpha) * phi0):
-                return H1, (self._measured(ev1) if alpha == 1.0 else None)
+                return H1, (self._measured(ev1) if alpha == 1.0 and ev1.kvals is not None else None)
             # minimiser of the quadratic through phi(0), phi'(0) = -2 phi0, phi(alpha)
             if np.isfinite(phi):
                 a_new = phi0 * alpha**2 / (phi - phi0 + 2.0 * alpha * phi0)

@@ -345,3 +345,43 @@ def test_pre_stressed_strand_starts_without_exact_friction_when_it_must():
     assert sol.stats[-1]["iterations"] <= 8
     c = sol.contact()
     assert (c["normal_force"] > 0).sum() > 100 and (c["stick"][c["normal_force"] > 0]).any()
+
+
+def test_the_forces_only_mortar_kernel_gives_the_bits_of_the_full_one(monkeypatch):
+    """``kernel_jit.mortar_forces`` (a line-search trial's: no frame variations, no gradient rows, no tangent)
+    against ``mortar_terms``: every term it returns the same bits, on pressed and slid pairs with history."""
+    from beamsolver.contact import kernel_jit
+    compiled, X, pm = _mortar_inputs(monkeypatch)
+    full, forces = compiled(X, pm), kernel_jit.mortar_forces(X, pm)
+    assert set(forces) == set(full) - {"dK", "dS", "dlam_n", "dn"}
+    for k in forces:
+        assert np.array_equal(forces[k], full[k]), k
+    assert np.abs(forces["A"]).max() > 0 and np.abs(forces["S"]).max() > 0
+
+
+def test_a_residual_evaluation_computes_no_multiplier_blocks_until_they_are_asked_for(monkeypatch):
+    """A line-search trial (``tangent=False``) gets the forces and the complementarity residuals only; the
+    tangent asked for later at the same poses (an accepted trial) completes the blocks: residuals and blocks
+    equal to those of an evaluation with the tangent from the start."""
+    from beamsolver.contact import kernel_jit
+    calls = []
+    full = kernel_jit.mortar_terms
+    monkeypatch.setattr(kernel_jit, "mortar_terms", lambda *a, **k: calls.append(1) or full(*a, **k))
+    model, slave, master = _parallel(0.5)
+    problem = Problem.from_model(model, check_rigid_modes=False)
+    H = _pressed(problem, slave, 2e-3 * R)
+    problem.begin_step(H, 0.0)
+    problem.commit(H)
+    H = _move(H, slave.nodes, se3.exp(np.array([1e-4 * R, 0.0, 0.0, 0.0, 0.0, 0.0])))
+    problem.begin_step(problem.system.poses0, 1.0)
+    trial = problem.evaluate(H, 1.0, tangent=False)
+    assert not calls and "Kql" not in trial.mult and trial.kvals is None
+    later = problem.evaluate(H, 1.0, tangent=True)
+    assert len(calls) == 1
+    problem.contact._blocks = None
+    fresh = problem.evaluate(H, 1.0, tangent=True)
+    np.testing.assert_array_equal(trial.r, fresh.r)
+    np.testing.assert_array_equal(trial.mult["C"], fresh.mult["C"])
+    for k in ("Kql", "Klq", "Kll", "C"):
+        np.testing.assert_array_equal(later.mult[k], fresh.mult[k])
+    np.testing.assert_array_equal(later.extra[2], fresh.extra[2])
