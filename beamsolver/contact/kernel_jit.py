@@ -1185,8 +1185,13 @@ def _digest(law):
     """Identity of a law's code: a law edited in place gets a new compiled kernel (and cache entry).
     Only the two functions' own code counts: after editing a helper they call, clear the numba
     cache (``__pycache__``) or rename the law."""
-    code = [_code_bytes(getattr(f, "py_func", f).__code__) for f in (law.normal, law.tangential)]
-    return hashlib.sha1(b"".join(code)).hexdigest()[:10]
+    codes = tuple(getattr(f, "py_func", f).__code__ for f in (law.normal, law.tangential))
+    if codes not in _DIGESTS:      # (every evaluation asks: the bytes' hash cost 70 us a call on the main job)
+        _DIGESTS[codes] = hashlib.sha1(b"".join(_code_bytes(c) for c in codes)).hexdigest()[:10]
+    return _DIGESTS[codes]
+
+
+_DIGESTS = {}    # ``_digest`` by the laws' code objects (equal code objects: equal instructions, names, constants)
 
 
 def make_kernel(law, mortar=False):

@@ -26,7 +26,8 @@ import numpy as np
 from ..lie import se3
 from . import mortar_jit
 
-__all__ = ["groups", "Groups", "return_mapping", "nodal_state", "group_forces", "blocks", "multiplier_blocks"]
+__all__ = ["groups", "Groups", "return_mapping", "nodal_state", "multiplier_basis", "group_forces", "blocks",
+           "multiplier_blocks"]
 
 # the scatters of the points' rows into their groups: compiled (``mortar_jit``), or their numpy oracle
 _COMPILED = dict(rows=mortar_jit.scatter_rows, block=mortar_jit.scatter_block, columns=mortar_jit.scatter_columns)
@@ -161,7 +162,25 @@ def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu, m, active=None, hold=None):
         weak = np.zeros(k, dtype=bool)
     T = np.einsum("pa,pai->pi", G["phi"], lam[G["g"]])
     return dict(m=m, u=np.einsum("gij,gj->gi", Pi, u), lamN=lamN, trial=trial, lam=lam, stick=stick, C=C, c=c,
-                T=T, wphi=wphi, wn=wn, Pi=Pi, Q=Q, weak=weak)
+                T=T, wphi=wphi, wn=wn, Pi=Pi, Q=Q, weak=weak, nu=nu)
+
+
+def multiplier_basis(st):
+    """``(G, 3, 3)`` orthonormal columns ``[nu, e1, e2]`` per group (``st``: ``nodal_state``) in which the
+    complementarity function's derivative ``dC/dv = I - M_P Pi`` is diagonal (``nonlinear.condense``):
+    ``diag(1, 0, 0)`` sticking, ``diag(1, 1, 1 - mu lamN / |trial|)`` sliding with ``e1`` along the trial,
+    ``I`` without pressure.  Otherwise ``e1`` is the global axis least aligned with ``nu`` projected on the
+    tangent plane (a scene held in a plane keeps its normal axis as a component, whose row is idle)."""
+    nu = st["nu"]
+    a = np.argmin(np.abs(nu), axis=1)
+    e1 = -nu[np.arange(len(nu)), a][:, None] * nu
+    e1[np.arange(len(nu)), a] += 1.0
+    trial = st["trial"]
+    norm = np.linalg.norm(trial, axis=1)
+    slide = ~st["stick"] & ~st["weak"] & (norm > 0.0)
+    e1 = np.where(slide[:, None], trial, e1)
+    e1 /= np.linalg.norm(e1, axis=1)[:, None]
+    return np.stack([nu, e1, np.cross(nu, e1)], axis=2)
 
 
 def _slots(G, a):

@@ -72,6 +72,7 @@ MAX_AUGMENT = 30
 OVERLAP_REPORT = 1e-4    # penetration / (R1 + R2) in the given poses that step 0 reports (100 x the smoothing)
 SWITCH_TOL = 1e-12        # a step ending within this (relative) of active_from / friction_from ends before it
 TIMED = ("search", "rules", "projection", "params", "kernel", "blocks")   # parts of ``ContactSystem.timings``
+LAZY_MORTAR = True       # exact stick: the multiplier blocks only when the tangent is asked for (False: benchmarks, before)
 
 
 _default = {"kernel": kernel_jit}       # the kernel of contact systems made without one (``use_numpy_kernel``)
@@ -666,8 +667,9 @@ class ContactSystem(Contribution):
         if mort.any():
             # exact stick's terms: forces and complementarity residuals only unless the tangent is asked for (a
             # line-search trial); its blocks when it is (``evaluate``: ``mortar_pending``)
-            out["mortar"] = self._mortar(H, P, sel, p, np.flatnonzero(mort), out, asked)
-            if not asked:
+            lazy = LAZY_MORTAR and not asked
+            out["mortar"] = self._mortar(H, P, sel, p, np.flatnonzero(mort), out, not lazy)
+            if lazy:
                 out["mortar_pending"] = np.flatnonzero(mort)
         self._lap("kernel")
         # kept for commit/augment at the same poses (the converged iterate): no second pass
@@ -790,6 +792,8 @@ class ContactSystem(Contribution):
                 out[name] = np.tile(np.eye(4), (len(sel), 1, 1))
             out[name][idx] = d[name]
         if ssn:
+            if tangent:
+                mult["B"] = mortar.multiplier_basis(st)
             mult = dict(mult or {}, C=v - st["lam"], m=m, members=G["members"], R=R, Lam=Lam,
                         key=G["key"], stick=st["stick"], u=st["u"], tol=self._decl_stick_tol[gdecl])
         return dict(members=G["members"], f=-f, K=None if K is None else -K, key=G["key"], decl=gdecl,

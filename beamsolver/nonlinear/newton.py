@@ -40,6 +40,7 @@ log = logging.getLogger("beamsolver")
 LS_GROWTH = 10.0                     # full Newton steps are kept unless the merit grows this much
 DAMPING_MIN = 1.0 / 64.0             # shortest damped Newton step (smooth problems)
 STALL_RATIO = 1.5                    # undamped fallback if the shortest damped step grows the correction less
+FORCES_ONLY_TRIALS = True            # semi-smooth problems: the line search's full-step trial without tangent
 
 
 class Constraint(Protocol):
@@ -217,12 +218,7 @@ class Newton:
         unknowns ``(n_free,)`` (with the prescribed-motion coupling of ``dz_c`` ``(n, 6)``)."""
         problem = self.problem
         t0 = time.perf_counter()
-        rhs = -ev.r[self.sys.free_dofs]
-        if dz_c is not None:
-            rhs -= problem.coupling(ev, dz_c)
-        K = problem.tangent(ev)
-        if ev.mult is not None:
-            K, rhs = problem.bordered(ev, K, rhs, dz_c)
+        K, rhs = problem.linear_system(ev, dz_c)     # with multipliers: condensed and bordered
         t1 = time.perf_counter()
         try:
             lu = linsolve.factorize_tangent(K, self.linsolver, saddle=ev.mult is not None)
@@ -234,9 +230,8 @@ class Newton:
         if not np.all(np.isfinite(dzf)):
             raise SingularTangent("the linear solve returned non-finite values")
         if ev.mult is not None:
-            n = self.sys.n_free
-            problem.multiplier_step(ev, dzf[n:])
-            dzf = dzf[:n]
+            dzf, dlam = problem.split_solution(ev, dzf, dz_c)
+            problem.multiplier_step(ev, dlam)
         return lu, dzf
 
     def evaluate(self, H, t, tangent=True):
@@ -497,7 +492,7 @@ class Newton:
                 # the full step is nearly always accepted: evaluated with the tangent the next
                 # iteration needs; the backtracked trials need the residual only.  Semi-smooth (bordered)
                 # problems reject many full steps (Armijo): residuals only there too
-                ev1 = self.evaluate(H1, t, tangent=alpha == 1.0 and ev0.mult is None)
+                ev1 = self.evaluate(H1, t, tangent=alpha == 1.0 and (ev0.mult is None or not FORCES_ONLY_TRIALS))
                 phi = self._merit(ev1, scales)
             except StepFailed:
                 phi = np.inf
