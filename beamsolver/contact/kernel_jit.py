@@ -1089,7 +1089,7 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
     (``mortar_forces``; ``rows`` untouched), the same bits as with the tangent.  ``K`` ``(2, P, 24, 24)``: the
     tangents at ``T = 0`` and at the point's traction ``Tp`` less the first (``mortar_terms(T=)``: the tangent at
     fixed traction ``sum_k T_k dK_k`` by linearity, two tangents instead of four); the unit tractions' forces
-    then without tangent.  ``spare``: an empty ``(0, 0)`` and a ``(4, 6)`` scratch.  A template (``make_kernel``)."""
+    then without tangent.  ``K`` ``(1, P, 24, 24)``: the whole tangent at ``Tp`` (``mortar_terms(whole=True)``).  ``spare``: an empty ``(0, 0)`` and a ``(4, 6)`` scratch.  A template (``make_kernel``)."""
     S, v, G, cache = ws
     side1, side2 = _element_side(Xp, 0, S[0], cache[0]), _element_side(Xp, 2, S[1], cache[1])
     RA1, xA1, u1, w1 = side1
@@ -1127,7 +1127,7 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
             rows[9, k] = G[G_DSLIP * W + k]
             rows[10, k] = G[(G_DSLIP + 1) * W + k]
             rows[11, k] = G[G_DLAM * W + k]
-    contracted = tangent and K.shape[0] == 2
+    contracted = tangent and K.shape[0] < 4       # 2: at T = 0 and at Tp; 1: at Tp only
     for step in range(5 if contracted else 4):
         q = step if not contracted else (0, 4, 1, 2, 3)[step]         # the unit tractions last (the point data)
         lamp = (1.0 if q == 1 else 0.0, 1.0 if q == 2 else 0.0, 1.0 if q == 3 else 0.0) if q < 4 else \
@@ -1135,8 +1135,10 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
         fq = f[q, p] if q < 4 else spare[1]
         if not contracted:
             Kq = K[q, p]
-        elif q == 0 or q == 4:
-            Kq = K[q // 4, p]
+        elif q == 4:
+            Kq = K[K.shape[0] - 1, p]
+        elif q == 0 and K.shape[0] == 2:
+            Kq = K[0, p]
         else:
             Kq = spare[0]
         F = scale(-wgt * lam, n)
@@ -1162,7 +1164,7 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
         for i in range(4):
             for j in range(6):
                 fq[i, j] -= f0[i, j]
-        if tangent and (q == 1 or not contracted):
+        if tangent and ((q == 1 and K.shape[0] == 2) or not contracted):
             Kq, K0 = K[q, p], K[0, p]
             for i in range(24):
                 for j in range(24):
@@ -1351,12 +1353,13 @@ def contact_kernel(X, p, friction=True, law=None):
 _MORTAR_POOL = BufferPool()      # ``mortar_terms``' tangent buffers (free again once its results are dropped)
 
 
-def mortar_terms(X, p, law=None, T=None):
+def mortar_terms(X, p, law=None, T=None, whole=False):
     """Point terms of the mortar friction (``mortar.py``) from the compiled mortar kernel.
 
     ``T`` ``(P, 3)``: the points' tractions, known before the call (exact stick's multipliers): ``dfdq``
     ``(P, 24, 24)`` = ``sum_k T_k dK_k`` from two tangents (at ``T`` and at 0) instead of ``dK`` (equal to
-    round-off; half the kernel's tangent rows and memory).
+    round-off; half the kernel's tangent rows and memory).  ``whole``: ``dfdq`` is the whole tangent at ``T``
+    (the normal law's too, as the point kernel gives it without friction): one tangent.
 
     A point's friction force is linear in the global traction ``T`` (force per length) it is given:
     ``f = A T`` and, at fixed ``T``, ``df/dq = sum_k T_k dK_k``.  Four tractions (``T = 0, e_x, e_y,
@@ -1372,7 +1375,7 @@ def mortar_terms(X, p, law=None, T=None):
     kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar=True)
     # the tangents into kept memory (4.6 kB a point and traction; fresh memory's page faults cost about as much
     # as the kernel on the 19-wire bundle), a contiguous (4, P, 24, 24) prefix as ``np.empty`` would give
-    nK = 4 if T is None else 2
+    nK = 4 if T is None else 1 if whole else 2
     f, K = np.empty((4, P, 4, 6)), _MORTAR_POOL.take((nK * P * 576,)).reshape(nK, P, 24, 24)
     sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
     flags, frames, rows = np.empty((P, 2), dtype=np.bool_), np.empty((P, 4, 4, 4)), np.empty((P, N_ROWS, 24))
@@ -1381,7 +1384,7 @@ def mortar_terms(X, p, law=None, T=None):
     if T is None:
         return _mortar_terms(P, f[1:], K[1:], sc, vec, two, flags, frames, rows)
     d = _mortar_terms(P, f[1:], None, sc, vec, two, flags, frames, rows)
-    d["dfdq"] = K[1]
+    d["dfdq"] = K[-1]
     return d
 
 

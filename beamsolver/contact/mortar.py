@@ -224,9 +224,14 @@ def _point_parts(G, d):
 
 def _trial_rows(G, d, st, eps, mu):
     """``d lam_g / d q`` ``(n, 3, 6 k)`` through the points (slips, normals, normal tractions), without the
-    turn of the node's frame: ``C (Pi eps du + Q dnbar) + c mu dlamN``."""
+    turn of the node's frame: ``C (Pi eps du + Q dnbar) + c mu dlamN`` (compiled: ``mortar_jit.trial_rows``;
+    ``use_numpy_scatter``: the numpy form)."""
     n, k = G["members"].shape
     B = np.zeros((n, 3, 6 * k))
+    if _SCATTER["rows"] is mortar_jit.scatter_rows:
+        rows2 = (6 * G["pos"][:, :, :, None] + np.arange(6)).reshape(len(G["g"]), 2, 24)
+        return mortar_jit.trial_rows(B, G["g"], rows2, st["wphi"], st["wn"], st["m"], eps, mu, st["Pi"], st["Q"],
+                                     st["C"], st["c"], d["dS"], d["dn"], d["dlam_n"])
     for a in range(2):
         g, rows = _slots(G, a)
         wg, wgn = st["wphi"][:, a] / st["m"][g], st["wn"][:, a] / st["m"][g]

@@ -54,7 +54,7 @@ from ..errors import InputError
 from ..failures import ContactTunnelling, NoContactNormal
 from ..model.model import JOIN_TOL
 from .law import PENALTY_T_MIN, default_penalty
-from . import kernel_jit, mortar, segment_tangent
+from . import kernel_jit, mortar, mortar_jit, segment_tangent
 from .options import (ADJUST, EXACT_C, GAUSS_POINTS, SEGMENT_POINTS, SMOOTHING, STICK_TOLERANCE, ContactOptions,
                       declaration_table)
 from .frames import LINE, NORMAL_TOL, POINT, no_normal, touch_tolerance
@@ -745,8 +745,12 @@ class ContactSystem(Contribution):
         if not tangent:
             d = kernel_jit.mortar_forces(X, pm, law)
         elif ssn:         # the points' tractions are known (the multipliers): the tangent at them, two not four
+            # (one, the normal law's included, where the pairs' own tangent has no segment ends' terms to keep)
+            whole = K_pairs is not None and not self.n_slots
             d = kernel_jit.mortar_terms(X, pm, law, T=np.einsum("pa,pai->pi", G["phi"],
-                                                                np.einsum("gij,gj->gi", R, Lam)[G["g"]]))
+                                                                np.einsum("gij,gj->gi", R, Lam)[G["g"]]), whole=whole)
+            if whole:
+                K_pairs = None            # in ``dfdq``
         else:
             d = kernel_jit.mortar_terms(X, pm, law)
         # nodal weights: half of each element at the node, the whole element beside a held node
@@ -773,6 +777,8 @@ class ContactSystem(Contribution):
             d["G"] = d["A"]
             if d.get("dfdq") is None:
                 d["dfdq"] = np.einsum("pk,pkij->pij", st["T"], d["dK"])
+            if K_pairs is not None:      # the points' own (normal) blocks go to their groups with the friction's
+                mortar_jit.subtract_indexed(d["dfdq"], K_pairs, idx)
             if ssn:
                 f, K, Kql, Klq, Kll, C = mortar.multiplier_blocks(G, d, st, R, Lam, eps, mu)
                 mult = dict(Kql=-Kql, Klq=Klq, Kll=Kll)
@@ -807,11 +813,13 @@ class ContactSystem(Contribution):
                 mult["B"] = mortar.multiplier_basis(st)
             mult = dict(mult or {}, C=v - st["lam"], m=m, members=G["members"], R=R, Lam=Lam,
                         key=G["key"], stick=st["stick"], u=st["u"], tol=self._decl_stick_tol[gdecl])
-        f, K = -f, (None if K is None else -K)
+        np.negative(f, out=f)
+        if K is not None:
+            np.negative(K, out=K)
         folded, own = None, f
         if f_pairs is not None:
             own = f.copy()           # the groups' own forces (the force levels: ``_with_mortar``)
-            mortar.add_pairs(G, f, K, f_pairs.reshape(-1, 24)[idx], None if K is None else K_pairs[idx])
+            mortar.add_pairs(G, f, None, f_pairs.reshape(-1, 24)[idx], None)
             folded = idx
         return dict(members=G["members"], f=f, K=K, key=G["key"], decl=gdecl,
                     lam=v if ssn else st["lam"], u=st["u"], stick=st["stick"], R=R,
