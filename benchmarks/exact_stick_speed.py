@@ -27,8 +27,8 @@ sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parents[0] / "examples"))
 
 import beamsolver as bs  # noqa: E402
-from beamsolver.contact import kernel_jit, mortar  # noqa: E402
-from beamsolver.nonlinear import bordered, linsolve  # noqa: E402
+from beamsolver.contact import kernel_jit, mortar, system  # noqa: E402
+from beamsolver.nonlinear import bordered, condense, linsolve, newton  # noqa: E402
 from beamsolver.nonlinear.problem import Problem  # noqa: E402
 
 
@@ -48,12 +48,15 @@ def mode(name):
     bordered.use_bmat(before)
     if before:
         kernel_jit.mortar_terms = kernel_jit.mortar_terms_four
+    eager = name in ("exact (before)", "exact (main)")
+    newton.FORCES_ONLY_TRIALS = system.LAZY_MORTAR = condense.ENABLED = not eager
     try:
         yield
     finally:
         bs.Model.add_contact, kernel_jit.mortar_terms = orig, terms
         mortar.use_numpy_scatter(False)
         bordered.use_bmat(False)
+        newton.FORCES_ONLY_TRIALS = system.LAZY_MORTAR = condense.ENABLED = True
 
 
 def twisted_pair():
@@ -84,10 +87,7 @@ def bundle19():
         t = [time.process_time()]
         ev = problem.evaluate(H, 1.0, tangent=True)
         t.append(time.process_time())
-        K = problem.tangent(ev)
-        rhs = -ev.r[system.free_dofs]
-        if ev.mult is not None:
-            K, rhs = problem.bordered(ev, K, rhs)
+        K, rhs = problem.linear_system(ev)
         t.append(time.process_time())
         linsolve.factorize_tangent(K, solver, saddle=ev.mult is not None).solve(rhs)
         t.append(time.process_time())
@@ -100,7 +100,7 @@ def bundle19():
 
 
 SCENES = dict(twisted_pair=twisted_pair, bundle19=bundle19)
-MODES = ("penalty", "exact (before)", "exact")
+MODES = ("penalty", "exact (before)", "exact (main)", "exact")
 
 
 def main():

@@ -446,7 +446,16 @@ class System:
                 if tail is not None:
                     vals[K.size:] = tail[2]
             coo = (rows, cols, vals)
-        return (r, coo) + _blocks.levels(f)
+        if blocks.levels_of is None:
+            return (r, coo) + _blocks.levels(f)
+        fl, ml = 0.0, 0.0
+        for ln, lf in blocks.levels_of:
+            w = np.flatnonzero(self.transformed[ln].any(axis=1)) if self.transformed.any() and len(ln) else ()
+            if len(w):
+                lf = _blocks.transform_rows(self.node_transforms(H), ln, lf, None, w)[0]
+            a, b = _blocks.levels(lf)
+            fl, ml = max(fl, a), max(ml, b)
+        return (r, coo, fl, ml)
 
     def _global_among(self, nodes):
         """The global-type nodes among ``nodes`` (any shape), sorted (``np.intersect1d``'s result without

@@ -1079,13 +1079,17 @@ def _evaluate_rows(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, 
     own[0][0, 0, 0, 0] = 0.0
 
 
-def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, flags, frames, ws, rows):
+def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, flags, frames, ws, rows, Tp, spare):
     """``_point`` of the mortar kernel at the four given tractions ``T = 0, e_x, e_y, e_z`` (``mortar_terms``):
     the geometry, projection, slip and their gradients once, then per traction what depends on it (the
     friction force, wrenches and nodal rows), each the same operations as a ``_point`` call with that
     traction; ``f[q, p]`` ``(4, 6)``, ``K[q, p]`` ``(24, 24)`` (``q``: the traction; ``q`` = 1, 2, 3 less those
     of ``q`` = 0 at the end, ``mortar_terms``' differences); the point data as the last call left them;
-    ``rows`` ``(N_ROWS, 24)``: the gradient rows (``_evaluate_rows``).  A template (``make_kernel``)."""
+    ``rows`` ``(N_ROWS, 24)``: the gradient rows (``_evaluate_rows``).  An empty ``K`` ``(4, P, 0, 0)``: forces only
+    (``mortar_forces``; ``rows`` untouched), the same bits as with the tangent.  ``K`` ``(2, P, 24, 24)``: the
+    tangents at ``T = 0`` and at the point's traction ``Tp`` less the first (``mortar_terms(T=)``: the tangent at
+    fixed traction ``sum_k T_k dK_k`` by linearity, two tangents instead of four); the unit tractions' forces
+    then without tangent.  ``K`` ``(1, P, 24, 24)``: the whole tangent at ``Tp`` (``mortar_terms(whole=True)``).  ``spare``: an empty ``(0, 0)`` and a ``(4, 6)`` scratch.  A template (``make_kernel``)."""
     S, v, G, cache = ws
     side1, side2 = _element_side(Xp, 0, S[0], cache[0]), _element_side(Xp, 2, S[1], cache[1])
     RA1, xA1, u1, w1 = side1
@@ -1095,7 +1099,12 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
     RC, xC, _, _ = _section_co(RA1, xA1, u1, w1, xi1, co1[0], co1[1])
     RF, xF, _, _ = _section_co(RA2, xA2, u2, w2, xi2, co2[0], co2[1])
     S1, S2 = S[0], S[1]
-    _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, G)
+    tangent = K.shape[2] > 0
+    if tangent:
+        _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, G)
+    else:       # forces only (``mortar_forces``: an empty ``K``): the Jacobians, no variations, no gradient rows
+        _jacobians(u1, w1, xi1, co1[0], co1[1], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB], S1[S_TMP])
+        _jacobians(u2, w2, xi2, co2[0], co2[1], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB], S2[S_TMP])
     n, t1, t2, dist = _axes(RC, xC, RF, xF, G)
     R1, R2, wgt = par[R1_], par[R2_], par[WEIGHT]
     gap = dist - R1 - R2
@@ -1111,14 +1120,27 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
         for a in range(2):
             for k in range(24):
                 G[(G_DSLIP + a) * W + k] = 0.0
-    for k in range(24):
-        for i in range(9):
-            rows[i, k] = G[(G_DN + i) * W + k]
-        rows[9, k] = G[G_DSLIP * W + k]
-        rows[10, k] = G[(G_DSLIP + 1) * W + k]
-        rows[11, k] = G[G_DLAM * W + k]
-    for q in range(4):
-        lamp = (1.0 if q == 1 else 0.0, 1.0 if q == 2 else 0.0, 1.0 if q == 3 else 0.0)
+    if tangent:
+        for k in range(24):
+            for i in range(9):
+                rows[i, k] = G[(G_DN + i) * W + k]
+            rows[9, k] = G[G_DSLIP * W + k]
+            rows[10, k] = G[(G_DSLIP + 1) * W + k]
+            rows[11, k] = G[G_DLAM * W + k]
+    contracted = tangent and K.shape[0] < 4       # 2: at T = 0 and at Tp; 1: at Tp only
+    for step in range(5 if contracted else 4):
+        q = step if not contracted else (0, 4, 1, 2, 3)[step]         # the unit tractions last (the point data)
+        lamp = (1.0 if q == 1 else 0.0, 1.0 if q == 2 else 0.0, 1.0 if q == 3 else 0.0) if q < 4 else \
+            (Tp[0], Tp[1], Tp[2])
+        fq = f[q, p] if q < 4 else spare[1]
+        if not contracted:
+            Kq = K[q, p]
+        elif q == 4:
+            Kq = K[K.shape[0] - 1, p]
+        elif q == 0 and K.shape[0] == 2:
+            Kq = K[0, p]
+        else:
+            Kq = spare[0]
         F = scale(-wgt * lam, n)
         for k in range(24):
             for i in range(3):
@@ -1130,32 +1152,36 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
         _moment_gradient(n, F, G)
         _wrench(RC, F, False, scale(R1, mF), R1, G, G_VC, G_DWC, v[0, V_WR])
         _wrench(RF, scale(-1.0, F), True, scale(R2, mF), R2, G, G_VF, G_DWF, v[1, V_WR])
-        _nodal(u1, w1, xi1, co1[0], co1[1], S1, v[0], cache[0], G, G_DWC, G_DH1, G_DXI1, f[q, p], K[q, p], 0)
-        _nodal(u2, w2, xi2, co2[0], co2[1], S2, v[1], cache[1], G, G_DWF, G_DH2, G_DXI2, f[q, p], K[q, p], 2)
+        _nodal(u1, w1, xi1, co1[0], co1[1], S1, v[0], cache[0], G, G_DWC, G_DH1, G_DXI1, fq, Kq, 0)
+        _nodal(u2, w2, xi2, co2[0], co2[1], S2, v[1], cache[1], G, G_DWF, G_DH2, G_DXI2, fq, Kq, 2)
         sc[0], sc[1], sc[2], sc[3] = gap, lam, xi1, xi2
         for i in range(3):
             vec[0, i], vec[1, i], vec[2, i], vec[3, i], vec[4, i], vec[5, i] = n[i], t1[i], t2[i], xC[i], xF[i], F[i]
         two[0, 0], two[0, 1], two[1, 0], two[1, 1] = lt[0], lt[1], slip[0], slip[1]
         flags[0], flags[1] = active, stick
     for q in range(1, 4):               # the differences to T = 0: the friction's parts (``mortar_terms``)
-        fq, Kq, f0, K0 = f[q, p], K[q, p], f[0, p], K[0, p]
+        fq, f0 = f[q, p], f[0, p]
         for i in range(4):
             for j in range(6):
                 fq[i, j] -= f0[i, j]
-        for i in range(24):
-            for j in range(24):
-                Kq[i, j] -= K0[i, j]
+        if tangent and ((q == 1 and K.shape[0] == 2) or not contracted):
+            Kq, K0 = K[q, p], K[0, p]
+            for i in range(24):
+                for j in range(24):
+                    Kq[i, j] -= K0[i, j]
 
 
-def _evaluate_mortar(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows):
+def _evaluate_mortar(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows, T):
     """``_point_mortar`` over all pairs: ``f`` ``(4, P, 4, 6)``, ``K`` ``(4, P, 24, 24)`` at ``T = 0`` and the
-    differences to it at the three others, the point data and the gradient rows ``(P, N_ROWS, 24)``.  A template of the mortar kernel
+    differences to it at the three others (or ``(2, P, 24, 24)``: at ``T = 0`` and at the points' tractions ``T``
+    ``(P, 3)`` less it), the point data and the gradient rows ``(P, N_ROWS, 24)``.  A template of the mortar kernel
     (``make_kernel(law, mortar=True)``)."""
     own = _scratch()
     ws = (_borrowed(own[0]), _borrowed(own[1]), _borrowed(own[2]), _borrowed(own[3]))
+    spare = (np.empty((0, 0)), np.empty((4, 6)))
     for p in range(X.shape[0]):
         _point_mortar(X[p], kind[p], par[p], has[p], HCL[p], HFK[p], HLKp[p], f, K, p, sc[p], vec[p], two[p],
-                      flags[p], frames[p], ws, rows[p])
+                      flags[p], frames[p], ws, rows[p], T[p % T.shape[0]], spare)
     own[0][0, 0, 0, 0] = 0.0
 
 
@@ -1177,8 +1203,13 @@ def _digest(law):
     """Identity of a law's code: a law edited in place gets a new compiled kernel (and cache entry).
     Only the two functions' own code counts: after editing a helper they call, clear the numba
     cache (``__pycache__``) or rename the law."""
-    code = [_code_bytes(getattr(f, "py_func", f).__code__) for f in (law.normal, law.tangential)]
-    return hashlib.sha1(b"".join(code)).hexdigest()[:10]
+    codes = tuple(getattr(f, "py_func", f).__code__ for f in (law.normal, law.tangential))
+    if codes not in _DIGESTS:      # (every evaluation asks: the bytes' hash cost 70 us a call on the main job)
+        _DIGESTS[codes] = hashlib.sha1(b"".join(_code_bytes(c) for c in codes)).hexdigest()[:10]
+    return _DIGESTS[codes]
+
+
+_DIGESTS = {}    # ``_digest`` by the laws' code objects (equal code objects: equal instructions, names, constants)
 
 
 def make_kernel(law, mortar=False):
@@ -1322,8 +1353,13 @@ def contact_kernel(X, p, friction=True, law=None):
 _MORTAR_POOL = BufferPool()      # ``mortar_terms``' tangent buffers (free again once its results are dropped)
 
 
-def mortar_terms(X, p, law=None):
+def mortar_terms(X, p, law=None, T=None, whole=False):
     """Point terms of the mortar friction (``mortar.py``) from the compiled mortar kernel.
+
+    ``T`` ``(P, 3)``: the points' tractions, known before the call (exact stick's multipliers): ``dfdq``
+    ``(P, 24, 24)`` = ``sum_k T_k dK_k`` from two tangents (at ``T`` and at 0) instead of ``dK`` (equal to
+    round-off; half the kernel's tangent rows and memory).  ``whole``: ``dfdq`` is the whole tangent at ``T``
+    (the normal law's too, as the point kernel gives it without friction): one tangent.
 
     A point's friction force is linear in the global traction ``T`` (force per length) it is given:
     ``f = A T`` and, at fixed ``T``, ``df/dq = sum_k T_k dK_k``.  Four tractions (``T = 0, e_x, e_y,
@@ -1339,11 +1375,36 @@ def mortar_terms(X, p, law=None):
     kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar=True)
     # the tangents into kept memory (4.6 kB a point and traction; fresh memory's page faults cost about as much
     # as the kernel on the 19-wire bundle), a contiguous (4, P, 24, 24) prefix as ``np.empty`` would give
-    f, K = np.empty((4, P, 4, 6)), _MORTAR_POOL.take((4 * P * 576,)).reshape(4, P, 24, 24)
+    nK = 4 if T is None else 1 if whole else 2
+    f, K = np.empty((4, P, 4, 6)), _MORTAR_POOL.take((nK * P * 576,)).reshape(nK, P, 24, 24)
     sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
     flags, frames, rows = np.empty((P, 2), dtype=np.bool_), np.empty((P, 4, 4, 4)), np.empty((P, N_ROWS, 24))
-    kern(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows)
-    return _mortar_terms(P, f[1:], K[1:], sc, vec, two, flags, frames, rows)
+    Tc = np.zeros((1, 3)) if T is None else np.ascontiguousarray(T, dtype=float)
+    kern(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows, Tc)
+    if T is None:
+        return _mortar_terms(P, f[1:], K[1:], sc, vec, two, flags, frames, rows)
+    d = _mortar_terms(P, f[1:], None, sc, vec, two, flags, frames, rows)
+    d["dfdq"] = K[-1]
+    return d
+
+
+def mortar_forces(X, p, law=None):
+    """``mortar_terms`` without the tangent's parts (a line-search trial needs the residuals only): ``A``, ``S``,
+    ``lam_n``, ``n``, ``t1``, ``t2``, ``slip``, ``HL``, ``HK``, ``active``, ``xi1``, ``xi2``, the same bits as
+    ``mortar_terms``' (the mortar kernel with an empty tangent: no frame variations, no gradient rows)."""
+    X = np.ascontiguousarray(X, dtype=float)
+    P = X.shape[0]
+    kind, par, has, (HCL, HFK, HLKp), _ = _table(X, p)
+    kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar=True)
+    f, K = np.empty((4, P, 4, 6)), np.empty((4, P, 0, 0))
+    sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
+    flags, frames, rows = np.empty((P, 2), dtype=np.bool_), np.empty((P, 4, 4, 4)), np.empty((P, 0, 0))
+    kern(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows, np.zeros((1, 3)))
+    A = np.transpose(f[1:], (1, 2, 3, 0)).reshape(P, 24, 3)
+    n, t1, t2, s = vec[:, 0], vec[:, 1], vec[:, 2], two[:, 1]
+    return dict(A=A, S=s[:, :1] * t1 + s[:, 1:] * t2, lam_n=sc[:, 1].copy(), n=n, t1=t1, t2=t2, slip=s.copy(),
+                HL=frames[:, 0].copy(), HK=frames[:, 1].copy(), active=flags[:, 0].copy(), xi1=sc[:, 2].copy(),
+                xi2=sc[:, 3].copy())
 
 
 def mortar_terms_four(X, p, law=None):
@@ -1378,7 +1439,7 @@ def _mortar_terms(P, df, dK, sc, vec, two, flags, frames, rows):
     """``mortar_terms``' dict from the differences of the forces ``df`` ``(3, P, 4, 6)`` and tangents ``dK``
     ``(3, P, 24, 24)`` at ``T = e_x, e_y, e_z`` to those at ``T = 0`` and the kernel's point data."""
     A = np.transpose(df, (1, 2, 3, 0)).reshape(P, 24, 3)
-    dK = np.transpose(dK, (1, 0, 2, 3))
+    dK = None if dK is None else np.transpose(dK, (1, 0, 2, 3))
     n, t1, t2, s = vec[:, 0], vec[:, 1], vec[:, 2], two[:, 1]
     dn, dt1, dt2 = rows[:, 0:3], rows[:, 3:6], rows[:, 6:9]
     S = s[:, :1] * t1 + s[:, 1:] * t2

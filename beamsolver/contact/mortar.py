@@ -26,7 +26,8 @@ import numpy as np
 from ..lie import se3
 from . import mortar_jit
 
-__all__ = ["groups", "Groups", "return_mapping", "nodal_state", "group_forces", "blocks", "multiplier_blocks"]
+__all__ = ["groups", "Groups", "return_mapping", "nodal_state", "multiplier_basis", "group_forces", "blocks",
+           "multiplier_blocks"]
 
 # the scatters of the points' rows into their groups: compiled (``mortar_jit``), or their numpy oracle
 _COMPILED = dict(rows=mortar_jit.scatter_rows, block=mortar_jit.scatter_block, columns=mortar_jit.scatter_columns)
@@ -161,7 +162,25 @@ def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu, m, active=None, hold=None):
         weak = np.zeros(k, dtype=bool)
     T = np.einsum("pa,pai->pi", G["phi"], lam[G["g"]])
     return dict(m=m, u=np.einsum("gij,gj->gi", Pi, u), lamN=lamN, trial=trial, lam=lam, stick=stick, C=C, c=c,
-                T=T, wphi=wphi, wn=wn, Pi=Pi, Q=Q, weak=weak)
+                T=T, wphi=wphi, wn=wn, Pi=Pi, Q=Q, weak=weak, nu=nu)
+
+
+def multiplier_basis(st):
+    """``(G, 3, 3)`` orthonormal columns ``[nu, e1, e2]`` per group (``st``: ``nodal_state``) in which the
+    complementarity function's derivative ``dC/dv = I - M_P Pi`` is diagonal (``nonlinear.condense``):
+    ``diag(1, 0, 0)`` sticking, ``diag(1, 1, 1 - mu lamN / |trial|)`` sliding with ``e1`` along the trial,
+    ``I`` without pressure.  Otherwise ``e1`` is the global axis least aligned with ``nu`` projected on the
+    tangent plane (a scene held in a plane keeps its normal axis as a component, whose row is idle)."""
+    nu = st["nu"]
+    a = np.argmin(np.abs(nu), axis=1)
+    e1 = -nu[np.arange(len(nu)), a][:, None] * nu
+    e1[np.arange(len(nu)), a] += 1.0
+    trial = st["trial"]
+    norm = np.linalg.norm(trial, axis=1)
+    slide = ~st["stick"] & ~st["weak"] & (norm > 0.0)
+    e1 = np.where(slide[:, None], trial, e1)
+    e1 /= np.linalg.norm(e1, axis=1)[:, None]
+    return np.stack([nu, e1, np.cross(nu, e1)], axis=2)
 
 
 def _slots(G, a):
@@ -175,6 +194,17 @@ def group_forces(G, f_points):
     n, k = G["members"].shape
     gA, rowsA = _slots(G, 0)
     return _SCATTER["rows"](np.zeros((n, 6 * k)), gA, rowsA, f_points)
+
+
+def add_pairs(G, f, K, fp, Kp):
+    """Add the points' own blocks (``fp`` ``(P, 24)``, ``Kp`` ``(P, 24, 24)`` or None: the normal law's, residual
+    signs) to the groups of their node A (``f`` ``(n, 6 k)``, ``K`` ``(n, 6 k, 6 k)``, in place): one set of blocks
+    for both (the 19-wire bundle: the pairs' blocks, padded to the groups' ``6 k`` rows, cost 0.6 s to copy and
+    as much to assemble)."""
+    gA, rowsA = _slots(G, 0)
+    _SCATTER["rows"](f, gA, rowsA, fp)
+    if K is not None and Kp is not None:
+        _SCATTER["block"](K, gA, rowsA, Kp)
 
 
 def _point_parts(G, d):
@@ -194,9 +224,14 @@ def _point_parts(G, d):
 
 def _trial_rows(G, d, st, eps, mu):
     """``d lam_g / d q`` ``(n, 3, 6 k)`` through the points (slips, normals, normal tractions), without the
-    turn of the node's frame: ``C (Pi eps du + Q dnbar) + c mu dlamN``."""
+    turn of the node's frame: ``C (Pi eps du + Q dnbar) + c mu dlamN`` (compiled: ``mortar_jit.trial_rows``;
+    ``use_numpy_scatter``: the numpy form)."""
     n, k = G["members"].shape
     B = np.zeros((n, 3, 6 * k))
+    if _SCATTER["rows"] is mortar_jit.scatter_rows:
+        rows2 = (6 * G["pos"][:, :, :, None] + np.arange(6)).reshape(len(G["g"]), 2, 24)
+        return mortar_jit.trial_rows(B, G["g"], rows2, st["wphi"], st["wn"], st["m"], eps, mu, st["Pi"], st["Q"],
+                                     st["C"], st["c"], d["dS"], d["dn"], d["dlam_n"])
     for a in range(2):
         g, rows = _slots(G, a)
         wg, wgn = st["wphi"][:, a] / st["m"][g], st["wn"][:, a] / st["m"][g]

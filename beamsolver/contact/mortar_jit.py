@@ -9,7 +9,7 @@ import numpy as np
 from .._jit import jit
 
 __all__ = ["scatter_rows", "scatter_block", "scatter_columns", "scatter_rows_numpy", "scatter_block_numpy",
-           "scatter_columns_numpy"]
+           "scatter_columns_numpy", "trial_rows", "subtract_indexed"]
 
 
 @jit
@@ -49,6 +49,50 @@ def _columns(out, g, cols, vals):
         for i in range(vals.shape[1]):
             for j in range(cols.shape[1]):
                 o[i, cols[p, j]] += vals[p, i, j]
+
+
+@jit
+def _trial_rows(B, g2, rows2, wphi, wn, m, eps, mu, Pi, Q, C, c, dS, dn, dlam_n):
+    for p in range(g2.shape[0]):
+        for a in range(2):
+            g = g2[p, a]
+            wg, wgn = wphi[p, a] / m[g], wn[p, a] / m[g]
+            se, sm = eps[g] * wg, mu[g] * wg
+            o = B[g]
+            for k in range(24):
+                t0 = se * (Pi[g, 0, 0] * dS[p, 0, k] + Pi[g, 0, 1] * dS[p, 1, k] + Pi[g, 0, 2] * dS[p, 2, k]) + \
+                    wgn * (Q[g, 0, 0] * dn[p, 0, k] + Q[g, 0, 1] * dn[p, 1, k] + Q[g, 0, 2] * dn[p, 2, k])
+                t1 = se * (Pi[g, 1, 0] * dS[p, 0, k] + Pi[g, 1, 1] * dS[p, 1, k] + Pi[g, 1, 2] * dS[p, 2, k]) + \
+                    wgn * (Q[g, 1, 0] * dn[p, 0, k] + Q[g, 1, 1] * dn[p, 1, k] + Q[g, 1, 2] * dn[p, 2, k])
+                t2 = se * (Pi[g, 2, 0] * dS[p, 0, k] + Pi[g, 2, 1] * dS[p, 1, k] + Pi[g, 2, 2] * dS[p, 2, k]) + \
+                    wgn * (Q[g, 2, 0] * dn[p, 0, k] + Q[g, 2, 1] * dn[p, 1, k] + Q[g, 2, 2] * dn[p, 2, k])
+                r = rows2[p, a, k]
+                for i in range(3):
+                    o[i, r] += C[g, i, 0] * t0 + C[g, i, 1] * t1 + C[g, i, 2] * t2 + sm * c[g, i] * dlam_n[p, k]
+
+
+@jit
+def _sub_indexed(out, vals, idx):
+    for p in range(out.shape[0]):
+        o, v = out[p], vals[idx[p]]
+        for i in range(o.shape[0]):
+            for j in range(o.shape[1]):
+                o[i, j] -= v[i, j]
+
+
+def trial_rows(B, g2, rows2, wphi, wn, m, eps, mu, Pi, Q, C, c, dS, dn, dlam_n):
+    """``mortar._trial_rows`` compiled: ``B[g] (3, 6 k) += C (Pi eps w du + Q w dnbar) + c mu w dlamN`` over the
+    points' groups ``g2`` ``(P, 2)`` (of their nodes A, B) and slot rows ``rows2`` ``(P, 2, 24)``, in place; the
+    per-point products summed in registers (no ``(P, 3, 24)`` temporaries), equal to the numpy form to round-off."""
+    _trial_rows(B, _c(g2, np.int64), _c(rows2, np.int64), _c(wphi), _c(wn), _c(m), _c(eps), _c(mu), _c(Pi), _c(Q),
+                _c(C), _c(c), _c(dS), _c(dn), _c(dlam_n))
+    return B
+
+
+def subtract_indexed(out, vals, idx):
+    """``out[p] -= vals[idx[p]]`` in place (``out`` ``(P, r, c)``; no copy of ``vals[idx]``)."""
+    _sub_indexed(out, _c(vals), _c(idx, np.int64))
+    return out
 
 
 def _c(a, dtype=np.float64):

@@ -54,7 +54,7 @@ from ..errors import InputError
 from ..failures import ContactTunnelling, NoContactNormal
 from ..model.model import JOIN_TOL
 from .law import PENALTY_T_MIN, default_penalty
-from . import kernel_jit, mortar, segment_tangent
+from . import kernel_jit, mortar, mortar_jit, segment_tangent
 from .options import (ADJUST, EXACT_C, GAUSS_POINTS, SEGMENT_POINTS, SMOOTHING, STICK_TOLERANCE, ContactOptions,
                       declaration_table)
 from .frames import LINE, NORMAL_TOL, POINT, no_normal, touch_tolerance
@@ -72,6 +72,7 @@ MAX_AUGMENT = 30
 OVERLAP_REPORT = 1e-4    # penetration / (R1 + R2) in the given poses that step 0 reports (100 x the smoothing)
 SWITCH_TOL = 1e-12        # a step ending within this (relative) of active_from / friction_from ends before it
 TIMED = ("search", "rules", "projection", "params", "kernel", "blocks")   # parts of ``ContactSystem.timings``
+LAZY_MORTAR = True       # exact stick: the multiplier blocks only when the tangent is asked for (False: benchmarks, before)
 
 
 _default = {"kernel": kernel_jit}       # the kernel of contact systems made without one (``use_numpy_kernel``)
@@ -664,7 +665,12 @@ class ContactSystem(Contribution):
             if asked:
                 self._segment_ends(H, P, sel, p, f, K, out.pop("segment_ends"))
         if mort.any():
-            out["mortar"] = self._mortar(H, P, sel, p, np.flatnonzero(mort), out, tangent)
+            # exact stick's terms: forces and complementarity residuals only unless the tangent is asked for (a
+            # line-search trial); its blocks when it is (``evaluate``: ``mortar_pending``)
+            lazy = LAZY_MORTAR and not asked
+            out["mortar"] = self._mortar(H, P, sel, p, np.flatnonzero(mort), out, not lazy, f, K)
+            if lazy:
+                out["mortar_pending"] = np.flatnonzero(mort)
         self._lap("kernel")
         # kept for commit/augment at the same poses (the converged iterate): no second pass
         if (p["mu"] > 0).all() or not (p["mu"] > 0).any() or mort.any():
@@ -715,10 +721,12 @@ class ContactSystem(Contribution):
                 f"{self.element_label(P.m[sel][k])}): their normal force, {force:.4g} in all, pre-stresses "
                 "the model at t_start")
 
-    def _mortar(self, H, P, sel, p, idx, out, tangent=True):
+    def _mortar(self, H, P, sel, p, idx, out, tangent=True, f_pairs=None, K_pairs=None):
         """Exact stick (``mortar.py``) on the pairs ``sel[idx]``: nodal groups, multipliers and blocks
         (residual signs: minus the forces); the point data ``lam_t``, ``stick``, ``slip``, ``HL``,
-        ``HK`` of ``out`` are overwritten for these pairs."""
+        ``HK`` of ``out`` are overwritten for these pairs.  ``f_pairs`` ``(m, 4, 6)``, ``K_pairs`` ``(m, 24, 24)``:
+        the active pairs' blocks (residual signs), which these pairs' go to (``mortar.add_pairs``: the group of the
+        point's node A holds all of its nodes), so that ``_with_mortar`` leaves them out (``folded``)."""
         n_nodes = len(H)
         X = H[P.nodes[sel[idx]]]
         pm = {k: (v[idx] if np.ndim(v) else v) for k, v in p.items()}
@@ -733,7 +741,18 @@ class ContactSystem(Contribution):
         if len(laws) > 1:
             raise InputError("contact: exact stick needs one contact law over the declarations of a scene, "
                              f"got {len(laws)}")
-        d = kernel_jit.mortar_terms(X, pm, next(iter(laws.values())))
+        law = next(iter(laws.values()))
+        if not tangent:
+            d = kernel_jit.mortar_forces(X, pm, law)
+        elif ssn:         # the points' tractions are known (the multipliers): the tangent at them, two not four
+            # (one, the normal law's included, where the pairs' own tangent has no segment ends' terms to keep)
+            whole = K_pairs is not None and not self.n_slots
+            d = kernel_jit.mortar_terms(X, pm, law, T=np.einsum("pa,pai->pi", G["phi"],
+                                                                np.einsum("gij,gj->gi", R, Lam)[G["g"]]), whole=whole)
+            if whole:
+                K_pairs = None            # in ``dfdq``
+        else:
+            d = kernel_jit.mortar_terms(X, pm, law)
         # nodal weights: half of each element at the node, the whole element beside a held node
         e = P.e[sel[idx]]
         merged = np.unique(G["g"][:, 0][G["g"][:, 0] == G["g"][:, 1]] * np.int64(len(self.sys.L))
@@ -755,7 +774,11 @@ class ContactSystem(Contribution):
             st["T"] = np.einsum("pa,pai->pi", G["phi"], v[G["g"]])
         d["f"] = np.einsum("pij,pj->pi", d["A"], st["T"])
         if tangent:
-            d["G"], d["dfdq"] = d["A"], np.einsum("pk,pkij->pij", st["T"], d["dK"])
+            d["G"] = d["A"]
+            if d.get("dfdq") is None:
+                d["dfdq"] = np.einsum("pk,pkij->pij", st["T"], d["dK"])
+            if K_pairs is not None:      # the points' own (normal) blocks go to their groups with the friction's
+                mortar_jit.subtract_indexed(d["dfdq"], K_pairs, idx)
             if ssn:
                 f, K, Kql, Klq, Kll, C = mortar.multiplier_blocks(G, d, st, R, Lam, eps, mu)
                 mult = dict(Kql=-Kql, Klq=Klq, Kll=Kll)
@@ -786,11 +809,21 @@ class ContactSystem(Contribution):
                 out[name] = np.tile(np.eye(4), (len(sel), 1, 1))
             out[name][idx] = d[name]
         if ssn:
+            if tangent:
+                mult["B"] = mortar.multiplier_basis(st)
             mult = dict(mult or {}, C=v - st["lam"], m=m, members=G["members"], R=R, Lam=Lam,
                         key=G["key"], stick=st["stick"], u=st["u"], tol=self._decl_stick_tol[gdecl])
-        return dict(members=G["members"], f=-f, K=None if K is None else -K, key=G["key"], decl=gdecl,
+        np.negative(f, out=f)
+        if K is not None:
+            np.negative(K, out=K)
+        folded, own = None, f
+        if f_pairs is not None:
+            own = f.copy()           # the groups' own forces (the force levels: ``_with_mortar``)
+            mortar.add_pairs(G, f, None, f_pairs.reshape(-1, 24)[idx], None)
+            folded = idx
+        return dict(members=G["members"], f=f, K=K, key=G["key"], decl=gdecl,
                     lam=v if ssn else st["lam"], u=st["u"], stick=st["stick"], R=R,
-                    mult=mult)
+                    mult=mult, folded=folded, f_own=own)
 
     def _mortar_ends(self, P, sel, idx, X, pm, G, d, st, vals, eps, mu, law, active):
         """The exact-stick terms of the moving segment ends (``segment_tangent.mortar_end_terms``) of the
@@ -893,6 +926,8 @@ class ContactSystem(Contribution):
         P, sel, p, f, K, out = blocks
         if tangent and K is not None and "segment_ends" in out:
             self._segment_ends(H, P, sel, p, f, K, out.pop("segment_ends"))
+        if tangent and K is not None and "mortar_pending" in out:
+            out["mortar"] = self._mortar(H, P, sel, p, out.pop("mortar_pending"), out, True, f, K)
         info = dict(n_active=len(sel))
         if "mortar" in out:
             b = _with_mortar(P.nodes[sel], f.reshape(-1, 24), K if tangent else None, out["mortar"],
@@ -1113,22 +1148,30 @@ def _extent(H):
 
 def _with_mortar(nodes, f, K, m, pool=None):
     """The pairs' 4-node blocks and the mortar groups' blocks (``ContactSystem._mortar``) as one
-    ``Blocks`` over the groups' ``k`` nodes: the pair blocks padded with their first node (zero rows).
+    ``Blocks`` over the groups' ``k`` nodes: the pair blocks padded with their first node (zero rows); the
+    mortar pairs' own blocks are in their groups' (``m["folded"]``) and left out, the force levels those of the
+    parts (``Blocks.levels_of``).
     ``pool``: a ``BufferPool`` the tangent blocks go to (kept memory: on the 19-wire bundle the fresh
     ``(m, 6 k, 6 k)`` array's page faults cost 2.5 s an evaluation), else a new array."""
     k = m["members"].shape[1]
+    levels = None
+    if m.get("folded") is not None:          # the mortar pairs' blocks are in their groups' (``_mortar``)
+        levels = ((nodes, f), (m["members"], m["f_own"]))      # the force levels of the parts, as unfolded
+        keep = np.ones(len(nodes), dtype=bool)
+        keep[m["folded"]] = False
+        nodes, f, K = nodes[keep], f[keep], (None if K is None else K[keep])
     n = len(nodes)
     nodes = np.concatenate([np.concatenate([nodes, np.repeat(nodes[:, :1], k - 4, axis=1)], axis=1), m["members"]])
     fa = np.zeros((n, 6 * k))
     fa[:, :24] = f
     if K is None:
-        return Blocks(nodes, np.concatenate([fa, m["f"]]))
+        return Blocks(nodes, np.concatenate([fa, m["f"]]), levels_of=levels)
     shape = (n + len(m["K"]), 6 * k, 6 * k)
     Ka = np.empty(shape) if pool is None else pool.take(shape)
     Ka[:n] = 0.0
     Ka[:n, :24, :24] = K
     Ka[n:] = m["K"]
-    return Blocks(nodes, np.concatenate([fa, m["f"]]), Ka)
+    return Blocks(nodes, np.concatenate([fa, m["f"]]), Ka, levels_of=levels)
 
 
 def _kernel(kernel, X, p, friction, law, tangent, K=None):

@@ -31,6 +31,8 @@ class Blocks:
     nodes: np.ndarray
     f: np.ndarray
     K: np.ndarray = None
+    levels_of: tuple = None     # ``((nodes, f), ...)`` whose largest nodal force and moment are the levels
+                                # (blocks that sum the forces of several parts per node: their parts')
 
     def __post_init__(self):
         m, k = np.shape(self.nodes)

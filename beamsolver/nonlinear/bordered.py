@@ -16,19 +16,19 @@ __all__ = ["Bordered", "bmat", "use_bmat", "IDLE"]
 IDLE = 1e-12        # a multiplier row with no free coupling and no own entry below this share of the largest
 
 
-def _coo(rows_red, nf):
-    """COO rows, cols ``(e,)`` of the border blocks in the order ``K_ql`` ``(g, k6, 3)``, ``K_lq`` ``(g, 3, k6)``,
-    ``K_ll`` ``(g, 3, 3)`` (kept entries: free rows) and the flat indices of the kept entries of the first two."""
+def _coo(rows_red, nf, c=3):
+    """COO rows, cols ``(e,)`` of the border blocks in the order ``K_ql`` ``(g, k6, c)``, ``K_lq`` ``(g, c, k6)``,
+    ``K_ll`` ``(g, c, c)`` (kept entries: free rows) and the flat indices of the kept entries of the first two."""
     g, k6 = rows_red.shape
-    gi = nf + np.arange(3 * g).reshape(g, 3)
-    rq = np.broadcast_to(rows_red[:, :, None], (g, k6, 3)).ravel()
-    cq = np.broadcast_to(gi[:, None, :], (g, k6, 3)).ravel()
+    gi = nf + np.arange(c * g).reshape(g, c)
+    rq = np.broadcast_to(rows_red[:, :, None], (g, k6, c)).ravel()
+    cq = np.broadcast_to(gi[:, None, :], (g, k6, c)).ravel()
     iq = np.flatnonzero(rq >= 0)
-    rl = np.broadcast_to(gi[:, :, None], (g, 3, k6)).ravel()
-    cl = np.broadcast_to(rows_red[:, None, :], (g, 3, k6)).ravel()
+    rl = np.broadcast_to(gi[:, :, None], (g, c, k6)).ravel()
+    cl = np.broadcast_to(rows_red[:, None, :], (g, c, k6)).ravel()
     il = np.flatnonzero(cl >= 0)
-    rll = np.repeat(gi, 3, axis=1).ravel()
-    cll = np.tile(gi, (1, 3)).ravel()
+    rll = np.repeat(gi, c, axis=1).ravel()
+    cll = np.tile(gi, (1, c)).ravel()
     return (np.concatenate([rq[iq], rl[il], rll]), np.concatenate([cq[iq], cl[il], cll]), iq, il)
 
 
@@ -47,19 +47,19 @@ class Bordered:
         self._p = None
         self.builds = 0          # patterns built (tests, benchmarks)
 
-    def _same(self, K, rows_red, nf):
+    def _same(self, K, rows_red, nf, c):
         p = self._p
-        if p is None or p["nf"] != nf or p["rows_red"].shape != rows_red.shape:
+        if p is None or p["nf"] != nf or p["c"] != c or p["rows_red"].shape != rows_red.shape:
             return False
         for a, b in ((p["indptr"], K.indptr), (p["kindices"], K.indices), (p["rows_red"], rows_red)):
             if a is not b and not np.array_equal(a, b):
                 return False
         return True
 
-    def _build(self, K, rows_red, nf):
+    def _build(self, K, rows_red, nf, c):
         g = rows_red.shape[0]
-        N = nf + 3 * g
-        rb, cb, iq, il = _coo(rows_red, nf)
+        N = nf + c * g
+        rb, cb, iq, il = _coo(rows_red, nf, c)
         kc = np.repeat(np.arange(nf, dtype=np.int64), np.diff(K.indptr))
         rows = np.concatenate([K.indices.astype(np.int64), rb])
         cols = np.concatenate([kc, cb])
@@ -72,26 +72,27 @@ class Bordered:
         nlq = len(iq) + len(il)
         lq = inv.ravel()[len(iq):nlq]
         ulq, lq_inv = np.unique(lq, return_inverse=True)
-        self._p = dict(nf=nf, indptr_out=indptr, indices=(u % N).astype(np.int32), nnz=len(u), N=N,
+        self._p = dict(nf=nf, c=c, indptr_out=indptr, indices=(u % N).astype(np.int32), nnz=len(u), N=N,
                        posK=pos[:nk], border=ub, inv=inv.ravel(), iq=iq, il=il,
                        lq_rows=(u[ub[ulq]] % N) - nf, lq_entries=ub[ulq],
-                       ll=pos[nk + nlq:].reshape(g, 3, 3), n_border=nb,
+                       ll=pos[nk + nlq:].reshape(g, c, c), n_border=nb,
                        indptr=K.indptr, kindices=K.indices, rows_red=rows_red.copy())
         self.builds += 1
 
     def matrix(self, K, rows_red, Kql, Klq, Kll, R, Lam, C):
-        """``(A, rc)``: the bordered CSC ``A`` ``(nf + 3 g,)^2`` and the multipliers' right-hand side ``-C`` with
+        """``(A, rc)``: the bordered CSC ``A`` ``(nf + c g,)^2`` and the multipliers' right-hand side ``-C`` with
         the idle rows (``bmat``) set; ``K`` canonical CSC ``(nf, nf)``, ``rows_red`` ``(g, k6)`` the free row of
-        each group slot (``-1``: held), ``Kql`` ``(g, k6, 3)``, ``Klq`` ``(g, 3, k6)``, ``Kll``, ``R`` ``(g, 3, 3)``,
-        ``Lam``, ``C`` ``(g, 3)``."""
+        each group slot (``-1``: held), ``Kql`` ``(g, k6, c)``, ``Klq`` ``(g, c, k6)``, ``Kll``, ``R`` ``(g, c, c)``,
+        ``Lam``, ``C`` ``(g, c)`` (``c`` = 3: every component; 1: the kept ones of ``condense``, one per row)."""
         if _ORACLE[0]:
             return bmat(K, rows_red, Kql, Klq, Kll, R, Lam, C)
         nf = K.shape[0]
         rows_red = np.asarray(rows_red)
         K = K if K.has_canonical_format else K.copy()
         K.sum_duplicates()
-        if not self._same(K, rows_red, nf):
-            self._build(K, rows_red, nf)
+        c = Kll.shape[1]
+        if not self._same(K, rows_red, nf, c):
+            self._build(K, rows_red, nf, c)
         p = self._p
         data = np.empty(p["nnz"])
         data[p["posK"]] = K.data
@@ -100,12 +101,12 @@ class Bordered:
         rc = -np.ravel(C).copy()
         # a multiplier direction no free unknown can slip in: its row is the traction's component itself (bmat)
         g = len(rows_red)
-        free_row = np.sqrt(np.bincount(p["lq_rows"], weights=data[p["lq_entries"]] ** 2, minlength=3 * g))
+        free_row = np.sqrt(np.bincount(p["lq_rows"], weights=data[p["lq_entries"]] ** 2, minlength=c * g))
         own = np.linalg.norm(Kll, axis=2).ravel()
         idle = (free_row <= IDLE * max(free_row.max(initial=0.0), 1e-300)) & \
             (own <= IDLE * max(own.max(initial=0.0), 1e-300))
         if idle.any():
-            gg, ii = np.divmod(np.flatnonzero(idle), 3)
+            gg, ii = np.divmod(np.flatnonzero(idle), c)
             data[p["ll"][gg, ii]] = R[gg, ii]
             rc[idle] = -np.einsum("gj,gj->g", R[gg, ii], Lam[gg])
         return canonical_csc(data, p["indices"], p["indptr_out"], p["N"]), rc
@@ -115,25 +116,26 @@ def bmat(K, rows_red, Kql, Klq, Kll, R, Lam, C):
     """``Bordered.matrix`` by scipy's COO/CSC constructors and ``sp.bmat`` (the oracle)."""
     nf = K.shape[0]
     g, k6 = rows_red.shape
-    gi = np.arange(3 * g).reshape(g, 3)
-    rows = np.broadcast_to(rows_red[:, :, None], (g, k6, 3))
-    cols = np.broadcast_to(gi[:, None, :], (g, k6, 3))
+    c = Kll.shape[1]
+    gi = np.arange(c * g).reshape(g, c)
+    rows = np.broadcast_to(rows_red[:, :, None], (g, k6, c))
+    cols = np.broadcast_to(gi[:, None, :], (g, k6, c))
     keep = rows >= 0
-    Bql = sp.csc_matrix((Kql[keep], (rows[keep], cols[keep])), shape=(nf, 3 * g))
-    rl = np.broadcast_to(gi[:, :, None], (g, 3, k6))
-    cl = np.broadcast_to(rows_red[:, None, :], (g, 3, k6))
+    Bql = sp.csc_matrix((Kql[keep], (rows[keep], cols[keep])), shape=(nf, c * g))
+    rl = np.broadcast_to(gi[:, :, None], (g, c, k6))
+    cl = np.broadcast_to(rows_red[:, None, :], (g, c, k6))
     keep = cl >= 0
-    Blq = sp.csc_matrix((Klq[keep], (rl[keep], cl[keep])), shape=(3 * g, nf))
+    Blq = sp.csc_matrix((Klq[keep], (rl[keep], cl[keep])), shape=(c * g, nf))
     rc = -C.ravel()
     free_row = np.sqrt(np.asarray(Blq.multiply(Blq).sum(axis=1)).ravel())
     own = np.linalg.norm(Kll, axis=2).ravel()
     idle = (free_row <= IDLE * max(free_row.max(initial=0.0), 1e-300)) & \
         (own <= IDLE * max(own.max(initial=0.0), 1e-300))
     if idle.any():
-        gg, ii = np.divmod(np.flatnonzero(idle), 3)
+        gg, ii = np.divmod(np.flatnonzero(idle), c)
         Kll = Kll.copy()
         Kll[gg, ii] = R[gg, ii]
         rc[idle] = -np.einsum("gj,gj->g", R[gg, ii], Lam[gg])
-    Bll = sp.csc_matrix((Kll.ravel(), (np.repeat(gi, 3, axis=1).ravel(), np.tile(gi, (1, 3)).ravel())),
-                        shape=(3 * g, 3 * g))
+    Bll = sp.csc_matrix((Kll.ravel(), (np.repeat(gi, c, axis=1).ravel(), np.tile(gi, (1, c)).ravel())),
+                        shape=(c * g, c * g))
     return sp.bmat([[K, Bql], [Blq, Bll]], format="csc"), rc

@@ -40,6 +40,7 @@ log = logging.getLogger("beamsolver")
 LS_GROWTH = 10.0                     # full Newton steps are kept unless the merit grows this much
 DAMPING_MIN = 1.0 / 64.0             # shortest damped Newton step (smooth problems)
 STALL_RATIO = 1.5                    # undamped fallback if the shortest damped step grows the correction less
+FORCES_ONLY_TRIALS = True            # semi-smooth problems: the line search's full-step trial without tangent
 
 
 class Constraint(Protocol):
@@ -217,12 +218,7 @@ class Newton:
         unknowns ``(n_free,)`` (with the prescribed-motion coupling of ``dz_c`` ``(n, 6)``)."""
         problem = self.problem
         t0 = time.perf_counter()
-        rhs = -ev.r[self.sys.free_dofs]
-        if dz_c is not None:
-            rhs -= problem.coupling(ev, dz_c)
-        K = problem.tangent(ev)
-        if ev.mult is not None:
-            K, rhs = problem.bordered(ev, K, rhs, dz_c)
+        K, rhs = problem.linear_system(ev, dz_c)     # with multipliers: condensed and bordered
         t1 = time.perf_counter()
         try:
             lu = linsolve.factorize_tangent(K, self.linsolver, saddle=ev.mult is not None)
@@ -234,9 +230,8 @@ class Newton:
         if not np.all(np.isfinite(dzf)):
             raise SingularTangent("the linear solve returned non-finite values")
         if ev.mult is not None:
-            n = self.sys.n_free
-            problem.multiplier_step(ev, dzf[n:])
-            dzf = dzf[:n]
+            dzf, dlam = problem.split_solution(ev, dzf, dz_c)
+            problem.multiplier_step(ev, dlam)
         return lu, dzf
 
     def evaluate(self, H, t, tangent=True):
@@ -495,8 +490,9 @@ class Newton:
             ev1 = None
             try:
                 # the full step is nearly always accepted: evaluated with the tangent the next
-                # iteration needs; the backtracked trials need the residual only
-                ev1 = self.evaluate(H1, t, tangent=alpha == 1.0)
+                # iteration needs; the backtracked trials need the residual only.  Semi-smooth (bordered)
+                # problems reject many full steps (Armijo): residuals only there too
+                ev1 = self.evaluate(H1, t, tangent=alpha == 1.0 and (ev0.mult is None or not FORCES_ONLY_TRIALS))
                 phi = self._merit(ev1, scales)
             except StepFailed:
                 phi = np.inf
@@ -506,7 +502,7 @@ class Newton:
             # LS_GROWTH) triggers backtracking, which then asks for a decrease
             growth = LS_GROWTH if ev0.mult is None else 1.0 - 1e-4      # semi-smooth: Armijo from the full step
             if phi <= (growth * phi0 if alpha == 1.0 else (1.0 - 1e-4 * alpha) * phi0):
-                return H1, (self._measured(ev1) if alpha == 1.0 else None)
+                return H1, (self._measured(ev1) if alpha == 1.0 and ev1.kvals is not None else None)
             # minimiser of the quadratic through phi(0), phi'(0) = -2 phi0, phi(alpha)
             if np.isfinite(phi):
                 a_new = phi0 * alpha**2 / (phi - phi0 + 2.0 * alpha * phi0)

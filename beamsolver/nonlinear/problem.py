@@ -36,6 +36,7 @@ import numpy as np
 from ..model import contributions
 from ..assembly.system import System
 from ..errors import InputError
+from . import bordered as bordered_, condense as condense_
 from .bordered import Bordered
 
 __all__ = ["Problem", "Evaluation"]
@@ -155,6 +156,9 @@ class Problem:
             rc, cc, fl, ml = s.assemble_blocks(H, blocks)
             if "multipliers" in cinfo:
                 ev.mult = self._multipliers(H, c, blocks, cinfo.pop("multipliers"))
+                if blocks.K is not None:     # where the groups' blocks (the last ones) sit in ``ev.extra``'s values
+                    k6 = blocks.K.shape[1]
+                    ev.mult["offset"] = sum(len(x[2]) for x in coo) + (len(blocks.K) - len(ev.mult["C"])) * k6 * k6
             ev.timings[c.name] = time.perf_counter() - t0
             ev.details[c.name] = cinfo
             ev.r = ev.r + rc
@@ -196,7 +200,8 @@ class Problem:
                 Kql[which] = np.swapaxes(T, 1, 2) @ Kql[which]
                 Klq[which] = Klq[which] @ T
         from ..model import blocks as _blocks
-        out.update(Kql=Kql, Klq=Klq, Kll=m["Kll"], R=m["R"], Lam=m["Lam"], dofs=_blocks.dofs(s.rep, nodes))
+        out.update(Kql=Kql, Klq=Klq, Kll=m["Kll"], R=m["R"], Lam=m["Lam"], B=m.get("B"),
+                   dofs=_blocks.dofs(s.rep, nodes))
         return out
 
     def bordered(self, ev, K, rhs, dz_c=None):
@@ -214,6 +219,64 @@ class Problem:
             dzf = np.where(rows_red < 0, dzf, 0.0)
             rc = rc - np.einsum("gij,gj->gi", mu["Klq"], dzf).ravel()
         return A, np.concatenate([rhs, rc])
+
+    def linear_system(self, ev, dz_c=None, condense=True):
+        """``(A, rhs)``: the Newton system of ``ev`` (CSC, free unknowns first; ``dz_c`` ``(n, 6)`` prescribed
+        increments).  With multipliers, those components their owner's basis makes eliminable are eliminated
+        exactly (``condense``: their Schur terms go into ``ev``'s tangent values, in place, once) and the others
+        border the tangent (``Bordered``, one row each); ``condense=False``: the full ``bordered`` system.
+        ``split_solution`` gives the increments and the multipliers' step from its solution."""
+        s = self.system
+        mu = ev.mult
+        if mu is not None and condense and condense_.ENABLED and mu.get("B") is not None and "offset" in mu:
+            if "split" not in mu:
+                mu["split"] = condense_.split(mu["Kql"], mu["Klq"], mu["Kll"], mu["R"], mu["Lam"], mu["C"], mu["B"])
+                condense_.add_schur(ev.extra[2], mu["offset"], mu["split"])
+            sp = mu["split"]
+        else:
+            sp = None
+        rhs = -ev.r[s.free_dofs]
+        if dz_c is not None:
+            rhs -= self.coupling(ev, dz_c)
+        K = self.tangent(ev)
+        if mu is None:
+            return K, rhs
+        if sp is None:
+            return self.bordered(ev, K, rhs, dz_c)
+        rows_red = s.red[mu["dofs"]]
+        corr = condense_.rhs_terms(sp)
+        free = rows_red >= 0
+        rhs += np.bincount(rows_red[free], weights=corr[free], minlength=len(rhs))
+        g, j = sp.kept[:, 0], sp.kept[:, 1]
+        d = sp.d[g, j]
+        d = np.where(np.abs(d) < bordered_.IDLE, 0.0, d)       # a sticking group's tangential components: zero
+        A, rc = self._bordered.matrix(K, rows_red[g], sp.Kql[g, :, j][:, :, None], sp.Klq[g, j][:, None, :],
+                                      d[:, None, None], np.ones((len(g), 1, 1)), sp.b[g, j][:, None],
+                                      sp.C[g, j][:, None])
+        if dz_c is not None:
+            rc = rc - np.einsum("ua,ua->u", sp.Klq[g, j], self._prescribed_slots(mu, dz_c)[g])
+        return A, np.concatenate([rhs, rc])
+
+    def _prescribed_slots(self, mu, dz_c):
+        """``(g, k6)``: the prescribed increments ``dz_c`` on the groups' held slots (zero on free ones)."""
+        dz = np.ravel(dz_c)[mu["dofs"]]
+        return np.where(self.system.red[mu["dofs"]] < 0, dz, 0.0)
+
+    def split_solution(self, ev, x, dz_c=None):
+        """``(dzf, dLam)``: the free increments ``(n_free,)`` and the multipliers' Newton step ``(g, 3)`` (``None``
+        without multipliers) from the solution ``x`` of ``linear_system``."""
+        n = self.system.n_free
+        mu = ev.mult
+        if mu is None:
+            return x, None
+        sp = mu.get("split")
+        if sp is None:
+            return x[:n], x[n:].reshape(-1, 3)
+        rows_red = self.system.red[mu["dofs"]]
+        dz = np.where(rows_red >= 0, x[:n][rows_red], 0.0)
+        if dz_c is not None:
+            dz = dz + self._prescribed_slots(mu, dz_c)
+        return x[:n], condense_.recover(sp, x[n:], dz)
 
     def multipliers_in_newton(self, flag):
         """Whether multipliers may be Newton unknowns (exact stick); otherwise their owners update them

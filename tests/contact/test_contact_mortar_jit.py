@@ -42,7 +42,8 @@ def test_scatter_block_and_columns_give_the_bits_of_add_at(seed):
 
 
 def test_the_mortar_blocks_are_those_of_the_numpy_scatters():
-    """``mortar.multiplier_blocks`` on a random group set: the compiled scatters give the oracle's bits."""
+    """``mortar.multiplier_blocks`` on a random group set: the compiled scatters give the oracle's bits, the compiled
+    trial rows (``mortar_jit.trial_rows``, products summed in another order) its values to round-off."""
     from beamsolver.contact import mortar
     rng = np.random.default_rng(5)
     P, n_nodes = 40, 12
@@ -64,8 +65,12 @@ def test_the_mortar_blocks_are_those_of_the_numpy_scatters():
     finally:
         mortar.use_numpy_scatter(False)
     out = mortar.multiplier_blocks(*args), mortar.blocks(*args)
-    for a, b in zip(ref[0] + ref[1], out[0] + out[1]):
-        assert np.array_equal(a, b)
+    exact = {0, 2, 4, 5, 6}             # f, Kql, Kll, C, the updates' f: no trial rows in them
+    for i, (a, b) in enumerate(zip(ref[0] + ref[1], out[0] + out[1])):
+        if i in exact:
+            assert np.array_equal(a, b), i
+        else:
+            assert np.abs(a - b).max() <= 1e-14 * np.abs(a).max() and np.any(a != 0), i
 
 
 def test_groups_are_kept_while_the_pairs_nodes_hold():

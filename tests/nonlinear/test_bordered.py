@@ -53,3 +53,16 @@ def test_the_pattern_is_kept_while_the_blocks_pattern_holds_and_rebuilt_when_it_
     K2 = sp.csc_matrix(K + sp.eye(K.shape[0], k=5, format="csc"))
     _same(*b.matrix(K2, rows, *vals), *bordered.bmat(K2, rows, *vals))
     assert b.builds == 3
+
+
+def test_one_component_groups_are_the_bmat_of_their_blocks():
+    """The kept components of ``condense`` border the tangent one row each (``c`` = 1), idle rows included."""
+    rng = np.random.default_rng(2)
+    K, rows, Kql, Klq, Kll, R, Lam, C = _case(rng, g=7)
+    rows[3] = -1                                  # no free unknown moves unit 3, and its diagonal is zero
+    args = (K, rows, Kql[:, :, :1], Klq[:, :1], np.abs(Kll[:, :1, :1]), np.ones((7, 1, 1)), Lam[:, :1], C[:, :1])
+    args[4][3] = 0.0
+    A, rc = bordered.Bordered().matrix(*args)
+    B, rc0 = bordered.bmat(*args)
+    _same(A, rc, B, rc0)
+    assert A.shape[0] == K.shape[0] + 7 and rc[3] == -Lam[3, 0]
