@@ -38,6 +38,8 @@ __all__ = ["Newton", "Constraint", "FixedTime", "Convergence", "Verdict", "Rotat
 log = logging.getLogger("beamsolver")
 
 LS_GROWTH = 10.0                     # full Newton steps are kept unless the merit grows this much
+LS_CRAWL = 3                         # backtracked iterations in a row after which the next full step ...
+LS_WATCHDOG = 1e4                    # ... is kept unless the merit grows this much (``Newton._line_search``)
 DAMPING_MIN = 1.0 / 64.0             # shortest damped Newton step (smooth problems)
 STALL_RATIO = 1.5                    # undamped fallback if the shortest damped step grows the correction less
 
@@ -143,6 +145,7 @@ class Newton:
         self.linsolver = linsolve.Solver()    # solve(linear_solver=...) replaces it
         self.stall_ratio = np.inf             # correction growth of the shortest damped trial
         self.indefinite_seen = False          # the step's first tangent had det < 0 (or a back-end that cannot tell)
+        self.crawl = 0                        # backtracked line searches in a row (``_line_search``)
         self.watch_sign = False               # whether to look (stepping.Run: conservative problems)
         self.t_evaluated = None               # t of the last evaluation (failure messages)
         self.last_evaluation = None           # of the last converged state
@@ -319,6 +322,7 @@ class Newton:
         """
         conv, problem = self.conv, self.problem
         residuals = []
+        self.crawl = 0
         if constraint.watch_sign:
             self.indefinite_seen = False
         damped_its = 0
@@ -491,6 +495,13 @@ class Newton:
             return H1, None
         alpha = 1.0
         best = (np.inf, H1, alpha)
+        # Newton may raise the residual for a while: only a blow-up (factor LS_GROWTH) triggers
+        # backtracking, which then asks for a decrease; after LS_CRAWL backtracked iterations in a
+        # row, a growth up to LS_WATCHDOG (a non-monotone watchdog step: thousands of contact points
+        # crossing the kinks of the normal and friction laws at once, the 40 mm rope's loaded step,
+        # where backtracked steps of 0.1 .. 0.01 crawled for 25 iterations)
+        growth = (LS_GROWTH if self.crawl < LS_CRAWL else LS_WATCHDOG) if ev0.mult is None \
+            else 1.0 - 1e-4      # semi-smooth with multipliers: Armijo from the full step
         for _ in range(8):
             ev1 = None
             try:
@@ -502,10 +513,8 @@ class Newton:
                 phi = np.inf
             if phi < best[0]:
                 best = (phi, H1, alpha)
-            # Newton may raise the residual for a while: only a blow-up (factor
-            # LS_GROWTH) triggers backtracking, which then asks for a decrease
-            growth = LS_GROWTH if ev0.mult is None else 1.0 - 1e-4      # semi-smooth: Armijo from the full step
-            if phi <= (growth * phi0 if alpha == 1.0 else (1.0 - 1e-4 * alpha) * phi0):
+            if np.isfinite(phi) and phi <= (growth * phi0 if alpha == 1.0 else (1.0 - 1e-4 * alpha) * phi0):
+                self.crawl = 0 if alpha == 1.0 else self.crawl + 1
                 return H1, (self._measured(ev1) if alpha == 1.0 else None)
             # minimiser of the quadratic through phi(0), phi'(0) = -2 phi0, phi(alpha)
             if np.isfinite(phi):
@@ -519,6 +528,7 @@ class Newton:
             H1 = problem.update(H, alpha * dz)
         if not np.isfinite(best[0]):
             raise NonFinite("line search found no finite residual along the Newton direction")
+        self.crawl += 1
         problem.multiplier_trial(best[2])
         return best[1], None
 
