@@ -1,0 +1,35 @@
+"""Past ``max_iter`` Newton goes on while it converges fast (``Newton._converging``: ``GRACE_RATE``,
+``GRACE_ITER``), and only then: a semi-smooth Newton whose contact active set settles late (the rope's loaded
+step, ``test_rope_loaded_step``) is not stopped two iterations before its quadratic end."""
+import pytest
+
+import beamsolver as bs
+from beamsolver.nonlinear import newton as nw
+
+import bend45
+
+
+def test_fast_convergence_at_the_budget_goes_on():
+    """bend45 in one step: scaled residuals 1, 0.66, 0.40, 0.077, 2.4e-3, 3.4e-8, 1.5e-11 (converged at
+    iteration 6); with ``max_iter = 5`` the iterate at the budget is in the quadratic phase."""
+    model, _ = bend45.build(8)
+    sol = bs.solve(model, steps=1, max_iter=5, min_step_ratio=1.0, verbose=False)
+    assert sol.stats[-1]["iterations"] == 6 and sol.stats[-1]["cutbacks"] == 0
+
+
+def test_slow_convergence_at_the_budget_stops():
+    """With ``max_iter = 3`` the last residuals (0.66, 0.40, 0.077) are no quadratic tail: a cut-back."""
+    model, _ = bend45.build(8)
+    with pytest.raises(bs.ConvergenceError):
+        bs.solve(model, steps=1, max_iter=3, min_step_ratio=1.0, verbose=False)
+
+
+@pytest.mark.parametrize("residuals, extra, expected", [
+    ([1e-2, 1e-3, 1e-4], 0, True),
+    ([1e-2, 1e-3, 1e-4], nw.GRACE_ITER, False),               # at most GRACE_ITER more
+    ([1e-2, 9e-3, 8e-3], 0, False),                           # a crawl
+    ([1e-2, 1e-4, 5e-4], 0, False),                           # the last one rose
+    ([1e-3, 1e-4], 0, False),                                 # too short a history
+])
+def test_converging_rule(residuals, extra, expected):
+    assert nw.Newton._converging(residuals, extra) is expected
