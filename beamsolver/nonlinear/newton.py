@@ -7,7 +7,9 @@ tangent; ``evaluate`` checks it is finite and that no element turns past
 one factorisation of the tangent, ``linsolve.factorize_tangent``) and, where it moves the
 constrained nodes or the pseudo-time, the next iterate (``move``).  Otherwise the correction
 is damped on the size of the Newton correction for a smooth problem (``Newton._damped``) or
-by a backtracking line search on the scaled residual (``Newton._line_search``).
+by a backtracking line search on the scaled residual (``Newton._line_search``; after ``LS_CRAWL``
+backtracked iterations in a row, a watchdog full step).  Past ``max_iter`` the iterations go on while
+they converge fast (``Newton._converging``: ``GRACE_RATE``, at most ``GRACE_ITER`` more).
 
 Constraints (the ``Constraint`` protocol):
 
@@ -531,7 +533,6 @@ class Newton:
                 best = (phi, H1, alpha)
             if np.isfinite(phi) and phi <= (growth * phi0 if alpha == 1.0 else (1.0 - 1e-4 * alpha) * phi0):
                 self.crawl = 0 if alpha == 1.0 else self.crawl + 1
-                self.ls_alpha = alpha
                 return H1, (self._measured(ev1) if alpha == 1.0 else None)
             # minimiser of the quadratic through phi(0), phi'(0) = -2 phi0, phi(alpha)
             if np.isfinite(phi):
@@ -546,7 +547,6 @@ class Newton:
         if not np.isfinite(best[0]):
             raise NonFinite("line search found no finite residual along the Newton direction")
         self.crawl += 1
-        self.ls_alpha = best[2]
         problem.multiplier_trial(best[2])
         return best[1], None
 
