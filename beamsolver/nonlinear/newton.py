@@ -9,7 +9,8 @@ constrained nodes or the pseudo-time, the next iterate (``move``).  Otherwise th
 is damped on the size of the Newton correction for a smooth problem (``Newton._damped``) or
 by a backtracking line search on the scaled residual (``Newton._line_search``; after ``LS_CRAWL``
 backtracked iterations in a row, a watchdog full step).  Past ``max_iter`` the iterations go on while
-they converge fast (``Newton._converging``: ``GRACE_RATE``, at most ``GRACE_ITER`` more).
+a non-smooth problem's converge fast (``Newton._converging``: ``GRACE_RATE``, at most ``GRACE_ITER``
+more; contact's semi-smooth Newton, whose active set may settle late); for a smooth one it is a hard cap.
 
 Constraints (the ``Constraint`` protocol):
 
@@ -347,7 +348,7 @@ class Newton:
             if self.callback is not None:
                 self.callback(dict(t=t, iteration=it, residual=ratio, poses=H))
             verdict = conv.decide(ratio, last_inc, it, floor, final=constraint.final)
-            if verdict is MAX_ITER and self._converging(residuals, it - conv.max_iter):
+            if verdict is MAX_ITER and not problem.smooth and self._converging(residuals, it - conv.max_iter):
                 verdict = CONTINUE
             if verdict is CONVERGED:
                 if damped_its:
@@ -400,7 +401,8 @@ class Newton:
 
     @staticmethod
     def _converging(residuals, extra):
-        """Whether an iteration past ``max_iter`` (the ``extra``-th) may go on: at most ``GRACE_ITER`` of them,
+        """Whether an iteration past ``max_iter`` (the ``extra``-th) of a problem that is not smooth
+        (``Problem.smooth``; a smooth one stops at ``max_iter``) may go on: at most ``GRACE_ITER`` of them,
         each after iterations that cut the scaled residual by ``GRACE_RATE`` at least, twice running
         (a semi-smooth Newton whose contact active set has just settled, e.g. the 40 mm rope's loaded step:
         6.7e-4, 1.8e-4 at iteration 30, then 1.5e-5, 1.9e-7, 3.5e-10), not one stalled or oscillating."""
