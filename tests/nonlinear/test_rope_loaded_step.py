@@ -1,0 +1,38 @@
+"""The loaded step of a rope piece converges in one step (issue 30; ``Newton._line_search``'s watchdog and
+``Newton._converging``).
+
+The 40 mm piece of the scaling benchmark's rope (``benchmarks/scaling_scenes.py``: six 1+6+12 strands
+around a 1+6+12 wire strand core, 133 wires, 6597 elements, mu = 0.3) stretched by a strain of 1e-4 in one
+step: ~18 000 Gauss points of the outer strands' layer-on-layer contacts carry tractions of the order of
+the smoothed normal law's ``penalty x smoothing`` and cross its kinks (and the friction law's) by thousands
+per iteration.  Before the watchdog the residual line search crawled (steps of 0.1 .. 0.01 for 20
+iterations) and the step failed at ``max_iter`` (scaled residual 1.4e-2; three halvings, 134 iterations
+in all).
+"""
+import pytest
+
+import beamsolver as bs
+
+L = bs.cables.Layer
+STRAIN = 1e-4
+
+
+def _rope(length):
+    core = [L(0.6e-3), L(0.55e-3, 6, lay_length=0.05), L(0.55e-3, 12, lay_length=0.05)]
+    strand = [L(0.55e-3), L(0.5e-3, 6, lay_length=0.04, direction="left"),
+              L(0.5e-3, 12, lay_length=0.04, direction="left")]
+    rope = bs.cables.build_rope(strand, length=length, E=2e11, lay_length=0.1, core=core, elements_per_lay=48,
+                                mu=0.3, contact_options=dict(gauss_points=5))
+    for w in rope.all_wires:
+        rope.model.clamp(w.first)
+        rope.model.prescribe(w.last, bs.motion.translation(lambda t: (0.0, 0.0, STRAIN * length * t)))
+    return rope.model
+
+
+@pytest.mark.slow
+def test_rope_piece_loaded_step_converges_without_cut_back():
+    sol = bs.solve(_rope(0.04), steps=1, min_step_ratio=1.0, verbose=False)
+    st = sol.stats[-1]
+    assert st["cutbacks"] == 0
+    assert st["iterations"] <= 40
+    assert st["residuals"][-1] <= 1e-8
