@@ -97,6 +97,13 @@ def measure(name, hold, threads, rss_mb):
         from beamsolver.assembly import held_pattern
         held_pattern.RESET_SHARE = float(os.environ["HELD_RESET_SHARE"])
     linsolve.LAGGED = False
+    if os.environ.get("STEP_PARTS_STICK"):          # e.g. "exact": every declaration's stick (saddle-point systems)
+        add_contact = bs.Model.add_contact
+
+        def with_stick(self, *a, **options):
+            options.setdefault("stick", os.environ["STEP_PARTS_STICK"])
+            return add_contact(self, *a, **options)
+        bs.Model.add_contact = with_stick
     strand = name.startswith("strand")
     m, wires, length = ss.strand_model(name.split("-")[1]) if strand else ss.scene_model(name)
     for w in wires:
