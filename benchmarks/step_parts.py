@@ -24,6 +24,9 @@ loop); CPU seconds (``time.process_time``) with one thread; with two threads CPU
 the parts are wall seconds (``time.perf_counter``) with CPU seconds in brackets (a shared machine: wall times
 are noisier, and longer than the CPU time of one thread whenever the other core is busy).
 ``first``: the step's first iteration; ``later``: the median of the later ones.  Peak memory: ``ru_maxrss``.
+
+Environment knobs of a child: ``STEP_PARTS_STICK=exact`` (every contact declaration's ``stick``: saddle-point
+systems), ``HELD_RESET_SHARE`` (``held_pattern.RESET_SHARE``, for its tuning).
 """
 import os
 import time
