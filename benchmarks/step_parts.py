@@ -24,6 +24,9 @@ loop); CPU seconds (``time.process_time``) with one thread; with two threads CPU
 the parts are wall seconds (``time.perf_counter``) with CPU seconds in brackets (a shared machine: wall times
 are noisier, and longer than the CPU time of one thread whenever the other core is busy).
 ``first``: the step's first iteration; ``later``: the median of the later ones.  Peak memory: ``ru_maxrss``.
+
+Environment knobs of a child: ``STEP_PARTS_STICK=exact`` (every contact declaration's ``stick``: saddle-point
+systems), ``HELD_RESET_SHARE`` (``held_pattern.RESET_SHARE``, for its tuning).
 """
 import os
 import time
@@ -97,6 +100,13 @@ def measure(name, hold, threads, rss_mb):
         from beamsolver.assembly import held_pattern
         held_pattern.RESET_SHARE = float(os.environ["HELD_RESET_SHARE"])
     linsolve.LAGGED = False
+    if os.environ.get("STEP_PARTS_STICK"):          # e.g. "exact": every declaration's stick (saddle-point systems)
+        add_contact = bs.Model.add_contact
+
+        def with_stick(self, *a, **options):
+            options.setdefault("stick", os.environ["STEP_PARTS_STICK"])
+            return add_contact(self, *a, **options)
+        bs.Model.add_contact = with_stick
     strand = name.startswith("strand")
     m, wires, length = ss.strand_model(name.split("-")[1]) if strand else ss.scene_model(name)
     for w in wires:

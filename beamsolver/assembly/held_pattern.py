@@ -199,7 +199,8 @@ class HeldPattern:
                                      self.nrow, self.eoff, self.indptr, self.el_pos)
         if missing:
             raise ValueError(f"HeldPattern: {missing} element entries outside whole node blocks")
-        self.indptr = self.indptr.astype(np.int32) if size < np.iinfo(np.int32).max else self.indptr
+        if size < np.iinfo(np.int32).max:          # int32 while they fit (half the memory)
+            self.indptr, self.el_pos = self.indptr.astype(np.int32), self.el_pos.astype(np.int32)
 
     @property
     def nnz(self):
@@ -231,8 +232,8 @@ class HeldPattern:
             node, vals = np.zeros((0, 1), dtype=np.int64), np.zeros((0, 6, 6))
         t = tail if tail is not None else (np.zeros(0, dtype=np.int64),) * 2 + (np.zeros(0),)
         data = np.empty(self.nnz)
-        ok = _values(el_data, self.el_pos, node, vals, self.red, self.nfree, self.indptr, self.eoff, self.nptr, self.nrow,
-                     np.asarray(t[0], dtype=np.int64), np.asarray(t[1], dtype=np.int64),
+        ok = _values(el_data, self.el_pos, node, vals, self.red, self.nfree, self.indptr, self.eoff, self.nptr,
+                     self.nrow, np.asarray(t[0], dtype=np.int64), np.asarray(t[1], dtype=np.int64),
                      np.asarray(t[2], dtype=float), data)
         if not ok:
             raise ValueError("HeldPattern: a block or tail entry outside the pattern (see covers)")
