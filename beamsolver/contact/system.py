@@ -749,7 +749,7 @@ class ContactSystem(Contribution):
             whole = K_pairs is not None and not self.n_slots
             d = kernel_jit.mortar_terms(X, pm, law, T=np.einsum("pa,pai->pi", G["phi"],
                                                                 np.einsum("gij,gj->gi", R, Lam)[G["g"]]), whole=whole)
-            if whole:
+            if whole and d.get("dfdq") is not None:
                 K_pairs = None            # in ``dfdq``
         else:
             d = kernel_jit.mortar_terms(X, pm, law)
