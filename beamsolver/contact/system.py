@@ -654,8 +654,13 @@ class ContactSystem(Contribution):
         self._lap("params")
         self._blocks = None        # its tangent buffer may be reused (``_tangent_out``)
         mort = self._decl_exact[P.decl[sel]] & (p["kind"] == LINE) & (p["mu"] > 0)
-        f, K, out = self._kernels(H[P.nodes[sel]], p, P.decl[sel], tangent,
+        # every pair a mortar pair whose whole tangent the mortar kernel gives (``_mortar``: points integration,
+        # multipliers as unknowns): the pairs' kernel without tangent (its forces: the same bits)
+        whole = tangent and self.kernel is kernel_jit and self.newton_multipliers and not self.n_slots and mort.all()
+        f, K, out = self._kernels(H[P.nodes[sel]], p, P.decl[sel], tangent and not whole,
                                   friction=(p["mu"] > 0) & ~mort if mort.any() else None)
+        if whole:
+            K = np.empty((0, 24, 24))       # (``_mortar``, ``_with_mortar``: every pair's blocks in its group's)
         np.negative(f, out=f)
         if K is not None:
             np.negative(K, out=K)
@@ -1159,7 +1164,8 @@ def _with_mortar(nodes, f, K, m, pool=None):
         levels = ((nodes, f), (m["members"], m["f_own"]))      # the force levels of the parts, as unfolded
         keep = np.ones(len(nodes), dtype=bool)
         keep[m["folded"]] = False
-        nodes, f, K = nodes[keep], f[keep], (None if K is None else K[keep])
+        # (an empty ``K``: every pair folded, its tangent never computed, ``_local_blocks``)
+        nodes, f, K = nodes[keep], f[keep], (None if K is None else K[keep] if len(K) else K)
     n = len(nodes)
     nodes = np.concatenate([np.concatenate([nodes, np.repeat(nodes[:, :1], k - 4, axis=1)], axis=1), m["members"]])
     fa = np.zeros((n, 6 * k))
