@@ -937,6 +937,11 @@ class ContactSystem(Contribution):
         if "mortar" in out:
             b = _with_mortar(P.nodes[sel], f.reshape(-1, 24), K if tangent else None, out["mortar"],
                              self._mortar_pool)
+            if b.K is not None and b.K is out["mortar"]["K"]:
+                # handed over (the Newton system adds to them in place, ``Problem.linear_system``): a second
+                # evaluation of these poses computes them again
+                out["mortar"]["K"] = None
+                out["mortar_pending"] = out["mortar"]["folded"]
             if out["mortar"]["mult"] is not None:
                 info["multipliers"] = out["mortar"]["mult"]
         else:
@@ -1167,6 +1172,8 @@ def _with_mortar(nodes, f, K, m, pool=None):
         # (an empty ``K``: every pair folded, its tangent never computed, ``_local_blocks``)
         nodes, f, K = nodes[keep], f[keep], (None if K is None else K[keep] if len(K) else K)
     n = len(nodes)
+    if n == 0:           # every pair in its group: the groups' blocks themselves (no copy; ``evaluate``)
+        return Blocks(m["members"], m["f"], K if K is None else m["K"], levels_of=levels)
     nodes = np.concatenate([np.concatenate([nodes, np.repeat(nodes[:, :1], k - 4, axis=1)], axis=1), m["members"]])
     fa = np.zeros((n, 6 * k))
     fa[:, :24] = f
