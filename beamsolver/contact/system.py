@@ -783,7 +783,11 @@ class ContactSystem(Contribution):
             if d.get("dfdq") is None:
                 d["dfdq"] = np.einsum("pk,pkij->pij", st["T"], d["dK"])
             if K_pairs is not None:      # the points' own (normal) blocks go to their groups with the friction's
-                mortar_jit.subtract_indexed(d["dfdq"], K_pairs, idx)
+                rows = idx
+                if len(K_pairs) < len(sel):     # left out by ``_local_blocks`` (a kernel without ``whole``: oracles)
+                    K_pairs = -self._kernels(X, pm, P.decl[sel[idx]], True, friction=False)[1]
+                    rows = np.arange(len(idx))
+                mortar_jit.subtract_indexed(d["dfdq"], K_pairs, rows)
             if ssn:
                 f, K, Kql, Klq, Kll, C = mortar.multiplier_blocks(G, d, st, R, Lam, eps, mu)
                 mult = dict(Kql=-Kql, Klq=Klq, Kll=Kll)
