@@ -1,16 +1,22 @@
 """Exact stick's cost per Newton iteration against the penalty stick (issue 26, speed): the main job
-(``examples/twisted_pair.py``, 16 steps: Newton iterations, warm solve CPU time, ms per iteration) and one Newton
-iteration of the 19-wire bundle (``scaling.bundle_model`` at ``scaling_scenes.PER_WIRE``, its reference poses:
-evaluation, tangent (bordered with the multipliers for exact stick), factorisation and solve, CPU s, and
-these parts).
+(``examples/twisted_pair.py``, 16 steps: Newton iterations, linear solves (every Newton iteration, those of failed
+attempts too), warm solve CPU time, ms per linear solve) and one Newton iteration of the 19-wire bundle
+(``scaling.bundle_model`` at ``scaling_scenes.PER_WIRE``, its reference poses: evaluation, Newton system (bordered
+with the multipliers for exact stick), factorisation and solve, CPU s, and these parts).
 
     python benchmarks/exact_stick_speed.py [--scenes twisted_pair bundle19] [--repeat 3] [--profile]
 
-Three modes: ``penalty``; ``exact (before)``, the exact path on the numpy/scipy oracles that were its code
-before the compiled parts (``mortar.use_numpy_scatter``: ``np.add.at`` scatters; ``kernel_jit.mortar_terms_four``:
-four point-kernel calls; ``bordered.use_bmat``: COO/CSC constructors and ``sp.bmat`` every iteration); and
-``exact``, the current path.  Each mode runs once to warm up (compilation, caches), then ``--repeat`` times:
-the best CPU time (``time.process_time``: the machine is shared) is reported.  ``--profile``: a cProfile table of one warm exact run per scene (tottime).
+Four modes: ``penalty``; ``exact (before)``, the exact path on the numpy/scipy oracles that were its code
+before the compiled parts (``mortar.use_numpy_scatter``: ``np.add.at`` scatters and the numpy trial rows;
+``kernel_jit.mortar_terms_four``: four point-kernel calls; ``bordered.use_bmat``: COO/CSC constructors and ``sp.bmat``
+every iteration) and without the three switches below; ``exact (eager, full)``, the current code with the switches
+off
+(``newton.FORCES_ONLY_TRIALS``: the line search's full-step trial with its tangent; ``system.LAZY_MORTAR``: the
+multiplier blocks at every trial; ``condense.ENABLED``: the full bordered system, 3 unknowns a group); and ``exact``,
+the current path.  Each mode runs once to warm up (compilation, caches), then ``--repeat`` times: the best CPU time
+(``time.process_time``: the machine is shared) is reported.  The twisted pair's Newton iterations move with round-off
+(224-314 over variants that differ at round-off only, docs/benchmarks.md): compare the ms per linear solve.
+``--profile``: a cProfile table of one warm exact run per scene (tottime).
 """
 import argparse
 import cProfile
@@ -47,8 +53,8 @@ def mode(name):
     mortar.use_numpy_scatter(before)
     bordered.use_bmat(before)
     if before:
-        kernel_jit.mortar_terms = kernel_jit.mortar_terms_four
-    eager = name in ("exact (before)", "exact (main)")
+        kernel_jit.mortar_terms = lambda X, p, law=None, **_: kernel_jit.mortar_terms_four(X, p, law)
+    eager = name in ("exact (before)", "exact (eager, full)")
     newton.FORCES_ONLY_TRIALS = system.LAZY_MORTAR = condense.ENABLED = not eager
     try:
         yield
@@ -59,13 +65,25 @@ def mode(name):
         newton.FORCES_ONLY_TRIALS = system.LAZY_MORTAR = condense.ENABLED = True
 
 
+SOLVES = [0]     # linear solves (``Newton.direction`` calls) of the last run
+
+
 def twisted_pair():
-    """``(Newton iterations, CPU s)`` of the main job's solve."""
+    """``(Newton iterations, CPU s)`` of the main job's solve; its linear solves in ``SOLVES``."""
     import twisted_pair as tp
     model = tp.build()[0]
-    t0 = time.process_time()
-    sol = bs.solve(model, steps=16)
-    return int(sum(s["iterations"] for s in sol.stats)), time.process_time() - t0
+    direction = newton.Newton.direction
+
+    def counted(self, *a, **k):
+        SOLVES[0] += 1
+        return direction(self, *a, **k)
+    newton.Newton.direction, SOLVES[0] = counted, 0
+    try:
+        t0 = time.process_time()
+        sol = bs.solve(model, steps=16)
+        return int(sum(s["iterations"] for s in sol.stats)), time.process_time() - t0
+    finally:
+        newton.Newton.direction = direction
 
 
 PARTS = {}       # the last bundle19 iteration by parts (CPU s)
@@ -100,7 +118,7 @@ def bundle19():
 
 
 SCENES = dict(twisted_pair=twisted_pair, bundle19=bundle19)
-MODES = ("penalty", "exact (before)", "exact (main)", "exact")
+MODES = ("penalty", "exact (before)", "exact (eager, full)", "exact")
 
 
 def main():
@@ -109,21 +127,29 @@ def main():
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--profile", action="store_true")
     a = ap.parse_args()
-    print("| scene | stick | Newton it. | time [s] | ms per iteration | ratio to penalty |")
-    print("|---|---|---:|---:|---:|---:|")
+    print("| scene | stick | Newton it. | linear solves | time [s] | ms per linear solve | ratio to penalty |")
+    print("|---|---|---:|---:|---:|---:|---:|")
     for scene in a.scenes:
         ref = None
         for name in MODES:
-            with mode(name):
-                SCENES[scene]()                             # warm-up
-                runs = [SCENES[scene]() for _ in range(a.repeat)]
-            its, t = runs[0][0], min(r[1] for r in runs)
-            ms = 1e3 * t / max(its, 1)
+            try:
+                with mode(name):
+                    SCENES[scene]()                             # warm-up
+                    runs = []
+                    for _ in range(a.repeat):
+                        runs.append(SCENES[scene]() + (SOLVES[0] if scene == "twisted_pair" else 1, dict(PARTS)))
+            except Exception as e:      # noqa: BLE001  (a singular bordered matrix: a row of the table)
+                print(f"| {scene} | {name} | failed: {type(e).__name__}: {e} | | | | |", flush=True)
+                continue
+            best = min(runs, key=lambda r: r[1])
+            its, solves, t = runs[0][0], runs[0][2], best[1]
+            PARTS.update(best[3])
+            ms = 1e3 * t / max(solves, 1)
             ref = ms if ref is None else ref
             parts = "" if scene != "bundle19" else (
-                f" (evaluation {PARTS['evaluate']:.3f}, matrix {PARTS['matrix']:.3f}, factorisation and solve "
-                f"{PARTS['solve']:.3f}; {PARTS['unknowns']} unknowns, {PARTS['nnz']} non-zeros)")
-            print(f"| {scene} | {name} | {its} | {t:.3f}{parts} | {ms:.2f} | {ms / ref:.2f} |", flush=True)
+                f" (evaluation {PARTS['evaluate']:.3f}, Newton system {PARTS['matrix']:.3f}, factorisation and "
+                f"solve {PARTS['solve']:.3f}; {PARTS['unknowns']} unknowns, {PARTS['nnz']} non-zeros)")
+            print(f"| {scene} | {name} | {its} | {solves} | {t:.3f}{parts} | {ms:.2f} | {ms / ref:.2f} |", flush=True)
         if a.profile:
             with mode("exact"):
                 pr = cProfile.Profile()

@@ -754,6 +754,26 @@ def _slip(side1, side2, S1, S2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp, D):
     return (dyu[1], dyu[2])
 
 
+@jit_callee
+def _slip_value(side1, side2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp):
+    """``_slip``'s value alone (the same operations, no gradient)."""
+    RA1, xA1, u1, w1 = side1
+    RA2, xA2, u2, w2 = side2
+    xi1, RC, xC = sec1
+    xi2, RF, xF = sec2
+    prev1 = _section_prev(RA1, xA1, u1, w1, xi1, RC, xC, xi1p)
+    prev2 = _section_prev(RA2, xA2, u2, w2, xi2, RF, xF, xi2p)
+    RCL, xCL = _pose4(HCL)
+    RFK, xFK = _pose4(HFK)
+    RL, xL = _compose(prev1[1], prev1[2], RCL, xCL)
+    RK, xK = _compose(prev2[1], prev2[2], RFK, xFK)
+    RLt = transpose(RL)
+    RLK, xLK = mm(RLt, RK), mv(RLt, add(xK, scale(-1.0, xL)))
+    RP, xP = _pose4(HLKp)
+    dyu, dyw, _, _ = log_relative(RP, xP, RLK, xLK)
+    return (dyu[1], dyu[2])
+
+
 def _friction(slip, lamp, t1, t2, lam, par, G):
     """Transported stored traction, tangential penalty, trial traction and the law's tangential part
     (``_tangential_law``, bound by ``make_kernel``); ``lam_t``, its gradient ``(2, 24)``, ``stick``.
@@ -801,6 +821,15 @@ def _friction(slip, lamp, t1, t2, lam, par, G):
 
 
 # ---------------------------------------------------------------- one contact point
+@jit_callee
+def _wrench_value(R, F, m, w):
+    """``_wrench``'s value alone: ``w = (R^T F, R^T m)`` (the same operations)."""
+    Rt = transpose(R)
+    bF, bm = mv(Rt, F), mv(Rt, m)
+    for i in range(3):
+        w[i], w[3 + i] = bF[i], bm[i]
+
+
 @jit_callee
 def _wrench(R, F, neg, m, sm, G, V, DW, w):
     """Body wrench ``w = (R^T F, R^T m)`` and its gradient (rows ``DW`` of ``G``, 6) from ``dF = -dF_slave``
@@ -1089,7 +1118,8 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
     (``mortar_forces``; ``rows`` untouched), the same bits as with the tangent.  ``K`` ``(2, P, 24, 24)``: the
     tangents at ``T = 0`` and at the point's traction ``Tp`` less the first (``mortar_terms(T=)``: the tangent at
     fixed traction ``sum_k T_k dK_k`` by linearity, two tangents instead of four); the unit tractions' forces
-    then without tangent.  ``K`` ``(1, P, 24, 24)``: the whole tangent at ``Tp`` (``mortar_terms(whole=True)``).  ``spare``: an empty ``(0, 0)`` and a ``(4, 6)`` scratch.  A template (``make_kernel``)."""
+    then without tangent.  ``K`` ``(1, P, 24, 24)``: the whole tangent at ``Tp`` (``mortar_terms(whole=True)``).
+    ``spare``: an empty ``(0, 0)`` and a ``(4, 6)`` scratch.  A template (``make_kernel``)."""
     S, v, G, cache = ws
     side1, side2 = _element_side(Xp, 0, S[0], cache[0]), _element_side(Xp, 2, S[1], cache[1])
     RA1, xA1, u1, w1 = side1
@@ -1113,7 +1143,9 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
     for k in range(24):
         G[G_DLAM * W + k] = dlam * G[G_DDIST * W + k]
     slip = (0.0, 0.0)
-    if has:         # writes all 24 columns of the slip gradient
+    if has and not tangent:
+        slip = _slip_value(side1, side2, (xi1, RC, xC), (xi2, RF, xF), par[XI1P], par[XI2P], HCL, HFK, HLKp)
+    elif has:         # writes all 24 columns of the slip gradient
         slip = _slip(side1, side2, S1, S2, (xi1, RC, xC), (xi2, RF, xF), par[XI1P], par[XI2P], HCL, HFK, HLKp,
                      G[G_DSLIP * W:(G_DSLIP + 2) * W].reshape((2, W)))
     else:
@@ -1141,17 +1173,25 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
             Kq = K[0, p]
         else:
             Kq = spare[0]
-        F = scale(-wgt * lam, n)
-        for k in range(24):
-            for i in range(3):
-                G[(G_DF + i) * W + k] = -wgt * (n[i] * G[G_DLAM * W + k] + lam * G[(G_DN + i) * W + k])
-        lt, Dlt, stick = _friction_given(slip, lamp, t1, t2, lam, par, G)
-        F = _add_friction_force(F, G, wgt, lt, Dlt, t1, t2)
-        _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2)
-        mF = cross(n, F)
-        _moment_gradient(n, F, G)
-        _wrench(RC, F, False, scale(R1, mF), R1, G, G_VC, G_DWC, v[0, V_WR])
-        _wrench(RF, scale(-1.0, F), True, scale(R2, mF), R2, G, G_VF, G_DWF, v[1, V_WR])
+        if Kq.shape[1] == 0:        # forces only: the values of the lines below, no gradient rows
+            lt, stick = (dot(lamp, t1), dot(lamp, t2)), True
+            F = add(scale(-wgt * lam, n), add(scale(wgt * lt[0], t1), scale(wgt * lt[1], t2)))
+            _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2)
+            mF = cross(n, F)
+            _wrench_value(RC, F, scale(R1, mF), v[0, V_WR])
+            _wrench_value(RF, scale(-1.0, F), scale(R2, mF), v[1, V_WR])
+        else:
+            F = scale(-wgt * lam, n)
+            for k in range(24):
+                for i in range(3):
+                    G[(G_DF + i) * W + k] = -wgt * (n[i] * G[G_DLAM * W + k] + lam * G[(G_DN + i) * W + k])
+            lt, Dlt, stick = _friction_given(slip, lamp, t1, t2, lam, par, G)
+            F = _add_friction_force(F, G, wgt, lt, Dlt, t1, t2)
+            _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2)
+            mF = cross(n, F)
+            _moment_gradient(n, F, G)
+            _wrench(RC, F, False, scale(R1, mF), R1, G, G_VC, G_DWC, v[0, V_WR])
+            _wrench(RF, scale(-1.0, F), True, scale(R2, mF), R2, G, G_VF, G_DWF, v[1, V_WR])
         _nodal(u1, w1, xi1, co1[0], co1[1], S1, v[0], cache[0], G, G_DWC, G_DH1, G_DXI1, fq, Kq, 0)
         _nodal(u2, w2, xi2, co2[0], co2[1], S2, v[1], cache[1], G, G_DWF, G_DH2, G_DXI2, fq, Kq, 2)
         sc[0], sc[1], sc[2], sc[3] = gap, lam, xi1, xi2

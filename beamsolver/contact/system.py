@@ -72,7 +72,7 @@ MAX_AUGMENT = 30
 OVERLAP_REPORT = 1e-4    # penetration / (R1 + R2) in the given poses that step 0 reports (100 x the smoothing)
 SWITCH_TOL = 1e-12        # a step ending within this (relative) of active_from / friction_from ends before it
 TIMED = ("search", "rules", "projection", "params", "kernel", "blocks")   # parts of ``ContactSystem.timings``
-LAZY_MORTAR = True       # exact stick: the multiplier blocks only when the tangent is asked for (False: benchmarks, before)
+LAZY_MORTAR = True       # exact stick: the multiplier blocks only when the tangent is asked for (False: benchmarks)
 
 
 _default = {"kernel": kernel_jit}       # the kernel of contact systems made without one (``use_numpy_kernel``)
@@ -654,8 +654,13 @@ class ContactSystem(Contribution):
         self._lap("params")
         self._blocks = None        # its tangent buffer may be reused (``_tangent_out``)
         mort = self._decl_exact[P.decl[sel]] & (p["kind"] == LINE) & (p["mu"] > 0)
-        f, K, out = self._kernels(H[P.nodes[sel]], p, P.decl[sel], tangent,
+        # every pair a mortar pair whose whole tangent the mortar kernel gives (``_mortar``: points integration,
+        # multipliers as unknowns): the pairs' kernel without tangent (its forces: the same bits)
+        whole = tangent and self.kernel is kernel_jit and self.newton_multipliers and not self.n_slots and mort.all()
+        f, K, out = self._kernels(H[P.nodes[sel]], p, P.decl[sel], tangent and not whole,
                                   friction=(p["mu"] > 0) & ~mort if mort.any() else None)
+        if whole:
+            K = np.empty((0, 24, 24))       # (``_mortar``, ``_with_mortar``: every pair's blocks in its group's)
         np.negative(f, out=f)
         if K is not None:
             np.negative(K, out=K)
@@ -749,7 +754,7 @@ class ContactSystem(Contribution):
             whole = K_pairs is not None and not self.n_slots
             d = kernel_jit.mortar_terms(X, pm, law, T=np.einsum("pa,pai->pi", G["phi"],
                                                                 np.einsum("gij,gj->gi", R, Lam)[G["g"]]), whole=whole)
-            if whole:
+            if whole and d.get("dfdq") is not None:
                 K_pairs = None            # in ``dfdq``
         else:
             d = kernel_jit.mortar_terms(X, pm, law)
@@ -778,7 +783,11 @@ class ContactSystem(Contribution):
             if d.get("dfdq") is None:
                 d["dfdq"] = np.einsum("pk,pkij->pij", st["T"], d["dK"])
             if K_pairs is not None:      # the points' own (normal) blocks go to their groups with the friction's
-                mortar_jit.subtract_indexed(d["dfdq"], K_pairs, idx)
+                rows = idx
+                if len(K_pairs) < len(sel):     # left out by ``_local_blocks`` (a kernel without ``whole``: oracles)
+                    K_pairs = -self._kernels(X, pm, P.decl[sel[idx]], True, friction=False)[1]
+                    rows = np.arange(len(idx))
+                mortar_jit.subtract_indexed(d["dfdq"], K_pairs, rows)
             if ssn:
                 f, K, Kql, Klq, Kll, C = mortar.multiplier_blocks(G, d, st, R, Lam, eps, mu)
                 mult = dict(Kql=-Kql, Klq=Klq, Kll=Kll)
@@ -932,6 +941,11 @@ class ContactSystem(Contribution):
         if "mortar" in out:
             b = _with_mortar(P.nodes[sel], f.reshape(-1, 24), K if tangent else None, out["mortar"],
                              self._mortar_pool)
+            if b.K is not None and b.K is out["mortar"]["K"]:
+                # handed over (the Newton system adds to them in place, ``Problem.linear_system``): a second
+                # evaluation of these poses computes them again
+                out["mortar"]["K"] = None
+                out["mortar_pending"] = out["mortar"]["folded"]
             if out["mortar"]["mult"] is not None:
                 info["multipliers"] = out["mortar"]["mult"]
         else:
@@ -1159,8 +1173,11 @@ def _with_mortar(nodes, f, K, m, pool=None):
         levels = ((nodes, f), (m["members"], m["f_own"]))      # the force levels of the parts, as unfolded
         keep = np.ones(len(nodes), dtype=bool)
         keep[m["folded"]] = False
-        nodes, f, K = nodes[keep], f[keep], (None if K is None else K[keep])
+        # (an empty ``K``: every pair folded, its tangent never computed, ``_local_blocks``)
+        nodes, f, K = nodes[keep], f[keep], (None if K is None else K[keep] if len(K) else K)
     n = len(nodes)
+    if n == 0:           # every pair in its group: the groups' blocks themselves (no copy; ``evaluate``)
+        return Blocks(m["members"], m["f"], K if K is None else m["K"], levels_of=levels)
     nodes = np.concatenate([np.concatenate([nodes, np.repeat(nodes[:, :1], k - 4, axis=1)], axis=1), m["members"]])
     fa = np.zeros((n, 6 * k))
     fa[:, :24] = f

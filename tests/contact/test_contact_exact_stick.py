@@ -440,3 +440,24 @@ def test_the_tangent_at_the_points_tractions_is_the_contraction_of_the_four(monk
     assert err_two < 1e-10 and err_two <= err_four       # measured 1.8e-12 and 2.4e-10 (the four's differences)
     for k in set(four) - {"dK"}:
         assert np.array_equal(two[k], four[k]), k
+
+
+def test_a_second_evaluation_of_the_same_poses_has_the_tangent_without_the_schur_terms():
+    """The groups' blocks go to the evaluation without a copy and the condensed Newton system adds its Schur terms
+    to them in place: evaluated again at the same poses (a step's start after ``at_rest``), the contact computes
+    them again; the tangent and the Newton system are those of a fresh evaluation."""
+    model, slave, master = _parallel(0.5)
+    problem = Problem.from_model(model, check_rigid_modes=False)
+    H = _pressed(problem, slave, 2e-3 * R)
+    problem.begin_step(H, 0.0)
+    problem.commit(H)
+    H = _move(H, slave.nodes, se3.exp(np.array([1e-7 * R, 1e-7 * R, 0.0, 1e-7 * R, 0.0, 0.0])))
+    first = problem.evaluate(H, 0.0, tangent=True)
+    A1, b1 = problem.linear_system(first)
+    assert len(first.mult["split"].kept) < 3 * len(first.mult["C"])
+    again = problem.evaluate(H, 0.0, tangent=True)
+    problem.contact._blocks = None
+    fresh = problem.evaluate(H, 0.0, tangent=True)
+    np.testing.assert_array_equal(again.extra[2], fresh.extra[2])
+    A2, b2 = problem.linear_system(again)
+    assert np.array_equal(A1.toarray(), A2.toarray()) and np.array_equal(b1, b2)
