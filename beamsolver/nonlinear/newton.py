@@ -8,9 +8,10 @@ one factorisation of the tangent, ``linsolve.factorize_tangent``) and, where it 
 constrained nodes or the pseudo-time, the next iterate (``move``).  Otherwise the correction
 is damped on the size of the Newton correction for a smooth problem (``Newton._damped``) or
 by a backtracking line search on the scaled residual (``Newton._line_search``; after ``LS_CRAWL``
-backtracked iterations in a row, a watchdog full step).  Past ``max_iter`` the iterations go on while
-a non-smooth problem's converge fast (``Newton._converging``: ``GRACE_RATE``, at most ``GRACE_ITER``
-more; contact's semi-smooth Newton, whose active set may settle late); for a smooth one it is a hard cap.
+backtracked iterations in a row near the solution, a watchdog full step).  Past ``max_iter`` the
+iterations go on while a non-smooth problem's converge fast (``Newton._converging``: ``GRACE_RATE``,
+at most ``GRACE_ITER`` more; contact's semi-smooth Newton, whose active set may settle late); for a
+smooth one it is a hard cap.
 
 Constraints (the ``Constraint`` protocol):
 
@@ -41,8 +42,9 @@ __all__ = ["Newton", "Constraint", "FixedTime", "Convergence", "Verdict", "Rotat
 log = logging.getLogger("beamsolver")
 
 LS_GROWTH = 10.0                     # full Newton steps are kept unless the merit grows this much
-LS_CRAWL = 12                        # backtracked iterations in a row after which the next full step ...
-LS_WATCHDOG = 1e4                    # ... is kept unless the merit grows this much (``Newton._line_search``)
+LS_CRAWL = 3                         # backtracked iterations in a row after which the next full step ...
+LS_WATCHDOG = 1e4                    # ... is kept unless the merit grows this much (``Newton._line_search``) ...
+LS_NEAR = 5e-3                       # ... once the scaled residual is below this times the step's largest
 GRACE_RATE = 3.0                     # past max_iter, iterations go on while each cuts the residual this much ...
 GRACE_ITER = 10                      # ... at most this many more (``Newton.iterate``)
 DAMPING_MIN = 1.0 / 64.0             # shortest damped Newton step (smooth problems)
@@ -152,6 +154,7 @@ class Newton:
         self.stall_ratio = np.inf             # correction growth of the shortest damped trial
         self.indefinite_seen = False          # the step's first tangent had det < 0 (or a back-end that cannot tell)
         self.crawl = 0                        # backtracked line searches in a row (``_line_search``)
+        self.near = False                     # the iterate's residual below LS_NEAR x the step's largest
         self.watch_sign = False               # whether to look (stepping.Run: conservative problems)
         self.t_evaluated = None               # t of the last evaluation (failure messages)
         self.last_evaluation = None           # of the last converged state
@@ -339,6 +342,7 @@ class Newton:
             ahead = None
             problem.accept_multipliers()        # those the iterate was evaluated with
             residuals.append(ratio)
+            self.near = ratio <= LS_NEAR * max(residuals)
             log.debug("t = %.6g  iteration %d  scaled residual %.3e", t, it, ratio)
             if self.callback is not None:
                 self.callback(dict(t=t, iteration=it, residual=ratio, poses=H))
@@ -512,10 +516,13 @@ class Newton:
         best = (np.inf, H1, alpha)
         # Newton may raise the residual for a while: only a blow-up (factor LS_GROWTH) triggers
         # backtracking, which then asks for a decrease; after LS_CRAWL backtracked iterations in a
-        # row, a growth up to LS_WATCHDOG (a non-monotone watchdog step: thousands of contact points
-        # crossing the kinks of the normal and friction laws at once, the 40 mm rope's loaded step,
-        # where backtracked steps of 0.1 .. 0.01 crawled for 25 iterations)
-        growth = (LS_GROWTH if self.crawl < LS_CRAWL else LS_WATCHDOG) if ev0.mult is None \
+        # row near the solution (``near``: the residual cut LS_NEAR-fold from the step's largest), a
+        # growth up to LS_WATCHDOG (a non-monotone watchdog step: thousands of contact points crossing
+        # the kinks of the normal and friction laws at once, the 40 mm rope's loaded step, where
+        # backtracked steps of 0.1 .. 0.01 crawled for 25 iterations; far from it, at the start of a
+        # step, the backtracking guards the contact examples' iterations)
+        watchdog = self.crawl >= LS_CRAWL and self.near
+        growth = (LS_WATCHDOG if watchdog else LS_GROWTH) if ev0.mult is None \
             else 1.0 - 1e-4      # semi-smooth with multipliers: Armijo from the full step
         for _ in range(8):
             ev1 = None

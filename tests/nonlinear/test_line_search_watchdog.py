@@ -1,9 +1,11 @@
 """The residual line search's watchdog (``Newton._line_search``, ``LS_CRAWL``, ``LS_WATCHDOG``).
 
 A full Newton step that raises the merit more than ``LS_GROWTH`` is backtracked; after ``LS_CRAWL``
-backtracked iterations in a row the next full step is kept unless the merit grows more than
-``LS_WATCHDOG`` (thousands of contact points crossing the kinks of the contact laws at once: the rope's
-loaded step, ``test_rope_loaded_step``).  A trial whose merit is not finite is never kept.  On a stub
+backtracked iterations in a row near the solution (``Newton.near``: the scaled residual ``LS_NEAR`` times
+the step's largest) the next full step is kept unless the merit grows more than ``LS_WATCHDOG``
+(thousands of contact points crossing the kinks of the contact laws at once: the rope's loaded step,
+``test_rope_loaded_step``); far from it (a step's first iterations) the backtracking goes on.  A trial
+whose merit is not finite is never kept.  On a stub
 Newton whose iterate is a point on a line and whose merit is a given function of it.
 """
 import types
@@ -19,7 +21,7 @@ class _Stub(nw.Newton):
     """``_line_search`` over ``x`` (the 'poses', a float array): merit ``phi(x)``; ``inf`` raises a step failure."""
 
     def __init__(self, phi):
-        self.phi, self.crawl = phi, 0
+        self.phi, self.crawl, self.near = phi, 0, True
         self.conv = types.SimpleNamespace(rtol=1e-8)
         self.sys = types.SimpleNamespace(free_dofs=np.arange(1))
         self.problem = types.SimpleNamespace(update=lambda H, dz: H + dz, multiplier_trial=lambda s: None)
@@ -55,6 +57,12 @@ def test_full_step_kept_after_a_crawl():
     assert _search(newton, growth) == 1.0            # the watchdog's full step
     assert newton.crawl == 0
     assert _search(newton, growth) < 1.0             # and the ordinary rule again
+
+
+def test_no_watchdog_far_from_the_solution():
+    newton = _Stub(None)
+    newton.crawl, newton.near = nw.LS_CRAWL, False
+    assert _search(newton, 100.0) < 1.0
 
 
 def test_watchdog_still_refuses_a_blow_up():
