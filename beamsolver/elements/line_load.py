@@ -46,7 +46,7 @@ def _compiled(H_A, H_B, L, q, m, follower, tangent):
     K = np.empty((n, 12, 12)) if tangent else np.empty((0, 12, 12))
     c = np.ascontiguousarray
     line_loads(c(H_A, dtype=float), c(H_B, dtype=float), c(L, dtype=float), c(q, dtype=float),
-               c(m, dtype=float), bool(follower), bool(tangent), f, K)
+               c(m, dtype=float), bool(follower), bool(tangent), f, K, XI, WEIGHTS, COMPLEX_STEP)
     return (f, K) if tangent else f
 
 

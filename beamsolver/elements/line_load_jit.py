@@ -11,7 +11,6 @@ import numpy as np
 from .._jit import jit, jit_callee
 from ..lie.se3_jit import (A_, B_, C_, D_, Q2_, Q3_, _SERIES_TABLE, _SWITCH, _closed, cross, dot, log_relative,
                            pose, q_matrix)
-from .line_load import COMPLEX_STEP, WEIGHTS, XI
 
 __all__ = ["line_loads"]
 
@@ -134,7 +133,7 @@ def _tmv(D, O, pu, pw, out, k, wg):
 
 
 @jit_callee
-def _element(vq, vm, h, L, q, m, follower, rotation, f, G, w6):
+def _element(vq, vm, h, L, q, m, follower, rotation, f, G, w6, XI, WEIGHTS):
     """``f`` (12,) = ``line_load._loads`` of one element (complex twist ``h``; ``vq, vm`` the load in node A's
     frame, ``q, m`` as given); with ``rotation`` also ``G`` (12, 3), d f / d w_A at fixed ``h`` (real ``h``).
     Every 6x6 operator here is block upper triangular with equal diagonal blocks, kept as two 3x3 blocks."""
@@ -200,10 +199,11 @@ def _element(vq, vm, h, L, q, m, follower, rotation, f, G, w6):
 
 
 @jit
-def line_loads(HA, HB, L, q, m, follower, tangent, f, K):
+def line_loads(HA, HB, L, q, m, follower, tangent, f, K, XI, WEIGHTS, COMPLEX_STEP):
     """Consistent nodal loads ``f`` (n, 12) and, with ``tangent``, their derivative ``K`` (n, 12, 12) in the
     nodes' body increments (``line_load.nodal_loads_and_tangent``); poses ``HA, HB`` (n, 4, 4), lengths
-    ``L`` (n,), loads per unit reference length ``q, m`` (n, 3), dead or ``follower``."""
+    ``L`` (n,), loads per unit reference length ``q, m`` (n, 3), dead or ``follower``; Gauss points ``XI``,
+    weights ``WEIGHTS`` on ``[0, 1]`` and the imaginary step ``COMPLEX_STEP`` (``line_load``'s)."""
     c = np.complex128
     w6 = (np.zeros((13, 3, 3), c), np.zeros((10, 3, 3), c), np.zeros(6, c), np.zeros(3, c), np.zeros(3, c))
     h, hh, fe, fk = np.zeros(6, c), np.zeros(6, c), np.zeros(12, c), np.zeros(12, c)
@@ -220,7 +220,7 @@ def line_loads(HA, HB, L, q, m, follower, tangent, f, K):
             vq[i] = RA[0][i] * q[e, 0] + RA[1][i] * q[e, 1] + RA[2][i] * q[e, 2]
             vm[i] = RA[0][i] * m[e, 0] + RA[1][i] * m[e, 1] + RA[2][i] * m[e, 2]
         rotation = tangent and not follower
-        _element(vq, vm, h, L[e], q[e], m[e], follower, rotation, fe, G, w6)
+        _element(vq, vm, h, L[e], q[e], m[e], follower, rotation, fe, G, w6, XI, WEIGHTS)
         for i in range(12):
             f[e, i] = fe[i].real
         if not tangent:
@@ -229,7 +229,7 @@ def line_loads(HA, HB, L, q, m, follower, tangent, f, K):
             for i in range(6):
                 hh[i] = h[i]
             hh[k] += 1j * COMPLEX_STEP
-            _element(vq, vm, hh, L[e], q[e], m[e], follower, False, fk, G, w6)
+            _element(vq, vm, hh, L[e], q[e], m[e], follower, False, fk, G, w6, XI, WEIGHTS)
             for i in range(12):
                 D[i, k] = fk[i].imag / COMPLEX_STEP
         # K_A = -D T(-h)^-1 (+ the rigid turn G), K_B = D T(h)^-1

@@ -29,7 +29,7 @@ class _Stub(nw.Newton):
     def evaluate(self, H, t, tangent=True):
         if not np.isfinite(self.phi(H[0])):
             raise StepFailed("refused")
-        return types.SimpleNamespace(x=H[0], mult=None)
+        return types.SimpleNamespace(x=H[0], mult=None, kvals=None if not tangent else np.zeros(1))
 
     def _merit(self, ev, scales):
         return self.phi(ev.x)
