@@ -726,13 +726,9 @@ def _slip_rows(row1, row2, R, xt, sign, prev, xip, S, D, c0):
 
 
 @jit_callee
-def _slip(side1, side2, S1, S2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp, D):
-    """Slip ``log(H_LK_prev^-1 H_LK)[1:3]`` of the material frames (``kinematics.slip_increment``)
-    and its gradient into ``D`` ``(2, 24)``; ``sec1``, ``sec2``: ``(xi, R, x)`` of the sections at the
-    point.  With ``dy = log(H_LK_prev^-1 H_LK)`` and the section variations ``dq = J_A dq_A + J_B dq_B`` at
-    ``xi_prev`` (fixed): ``d(dy) = T(dy)^-1 (-Ad((H_CL H_LK)^-1) dq_C + Ad(H_FK^-1) dq_F)``; only its rows 1, 2
-    are formed, as rows times the factors of ``J`` (``_slip_rows``).  Where ``xi_prev`` is ``xi`` (bit for
-    bit) the section and the Jacobians at ``xi`` are reused."""
+def _slip_frames(side1, side2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp):
+    """The material frames of ``_slip``: the sections at ``xi_prev`` (``prev1``, ``prev2``), ``H_CL``, ``H_FK``,
+    ``H_LK`` now and ``dy = log(H_LK_prev^-1 H_LK)`` (its ``u``, ``w``)."""
     RA1, xA1, u1, w1 = side1
     RA2, xA2, u2, w2 = side2
     xi1, RC, xC = sec1
@@ -747,6 +743,19 @@ def _slip(side1, side2, S1, S2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp, D):
     RLK, xLK = mm(RLt, RK), mv(RLt, add(xK, scale(-1.0, xL)))
     RP, xP = _pose4(HLKp)
     dyu, dyw, _, _ = log_relative(RP, xP, RLK, xLK)
+    return prev1, prev2, RCL, xCL, RFK, xFK, RLK, xLK, dyu, dyw
+
+
+@jit_callee
+def _slip(side1, side2, S1, S2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp, D):
+    """Slip ``log(H_LK_prev^-1 H_LK)[1:3]`` of the material frames (``kinematics.slip_increment``)
+    and its gradient into ``D`` ``(2, 24)``; ``sec1``, ``sec2``: ``(xi, R, x)`` of the sections at the
+    point.  With ``dy = log(H_LK_prev^-1 H_LK)`` and the section variations ``dq = J_A dq_A + J_B dq_B`` at
+    ``xi_prev`` (fixed): ``d(dy) = T(dy)^-1 (-Ad((H_CL H_LK)^-1) dq_C + Ad(H_FK^-1) dq_F)``; only its rows 1, 2
+    are formed, as rows times the factors of ``J`` (``_slip_rows``).  Where ``xi_prev`` is ``xi`` (bit for
+    bit) the section and the Jacobians at ``xi`` are reused."""
+    prev1, prev2, RCL, xCL, RFK, xFK, RLK, xLK, dyu, dyw = _slip_frames(side1, side2, sec1, sec2, xi1p, xi2p,
+                                                                        HCL, HFK, HLKp)
     row1, row2 = _tangent_inv_rows(dyu, dyw)
     Rm, xm = _compose(RCL, xCL, RLK, xLK)
     _slip_rows(row1, row2, Rm, scale(-1.0, mv(transpose(Rm), xm)), -1.0, prev1, xi1p, S1, D, 0)
@@ -757,20 +766,7 @@ def _slip(side1, side2, S1, S2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp, D):
 @jit_callee
 def _slip_value(side1, side2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp):
     """``_slip``'s value alone (the same operations, no gradient)."""
-    RA1, xA1, u1, w1 = side1
-    RA2, xA2, u2, w2 = side2
-    xi1, RC, xC = sec1
-    xi2, RF, xF = sec2
-    prev1 = _section_prev(RA1, xA1, u1, w1, xi1, RC, xC, xi1p)
-    prev2 = _section_prev(RA2, xA2, u2, w2, xi2, RF, xF, xi2p)
-    RCL, xCL = _pose4(HCL)
-    RFK, xFK = _pose4(HFK)
-    RL, xL = _compose(prev1[1], prev1[2], RCL, xCL)
-    RK, xK = _compose(prev2[1], prev2[2], RFK, xFK)
-    RLt = transpose(RL)
-    RLK, xLK = mm(RLt, RK), mv(RLt, add(xK, scale(-1.0, xL)))
-    RP, xP = _pose4(HLKp)
-    dyu, dyw, _, _ = log_relative(RP, xP, RLK, xLK)
+    dyu = _slip_frames(side1, side2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp)[8]
     return (dyu[1], dyu[2])
 
 
