@@ -7,9 +7,9 @@ tangent; ``evaluate`` checks it is finite and that no element turns past
 one factorisation of the tangent, ``linsolve.factorize_tangent``) and, where it moves the
 constrained nodes or the pseudo-time, the next iterate (``move``).  Otherwise the correction
 is damped on the size of the Newton correction for a smooth problem (``Newton._damped``) or
-by a backtracking line search on the scaled residual (``Newton._line_search``; after ``LS_CRAWL``
+by a backtracking line search on the scaled residual (``Newton.backtrack``; after ``LS_CRAWL``
 backtracked iterations in a row near the solution, a watchdog full step).  Past ``max_iter`` the
-iterations go on while a non-smooth problem's converge fast (``Newton._converging``: ``GRACE_RATE``,
+iterations go on while a non-smooth problem's converge fast (``Newton.converging``: ``GRACE_RATE``,
 at most ``GRACE_ITER`` more; contact's semi-smooth Newton, whose active set may settle late); for a
 smooth one it is a hard cap.
 
@@ -43,7 +43,7 @@ log = logging.getLogger("beamsolver")
 
 LS_GROWTH = 10.0                     # full Newton steps are kept unless the merit grows this much
 LS_CRAWL = 3                         # backtracked iterations in a row after which the next full step ...
-LS_WATCHDOG = 1e4                    # ... is kept unless the merit grows this much (``Newton._line_search``) ...
+LS_WATCHDOG = 1e4                    # ... is kept unless the merit grows this much (``Newton.backtrack``) ...
 LS_NEAR = 5e-3                       # ... once the scaled residual is below this times the step's largest
 GRACE_RATE = 3.0                     # past max_iter, iterations go on while each cuts the residual this much ...
 GRACE_ITER = 10                      # ... at most this many more (``Newton.iterate``)
@@ -153,7 +153,7 @@ class Newton:
         self.linsolver = linsolve.Solver()    # solve(linear_solver=...) replaces it
         self.stall_ratio = np.inf             # correction growth of the shortest damped trial
         self.indefinite_seen = False          # the step's first tangent had det < 0 (or a back-end that cannot tell)
-        self.crawl = 0                        # backtracked line searches in a row (``_line_search``)
+        self.crawl = 0                        # backtracked line searches in a row (``backtrack``)
         self.near = False                     # the iterate's residual below LS_NEAR x the step's largest
         self.watch_sign = False               # whether to look (stepping.Run: conservative problems)
         self.t_evaluated = None               # t of the last evaluation (failure messages)
@@ -321,7 +321,7 @@ class Newton:
 
         With ``line_search``, the Newton step of a smooth problem (``Problem.smooth``) is damped
         on the Newton correction (``_damped``); otherwise the residual line search
-        ``_line_search`` is used (only where the constraint lets the loop update the iterate).
+        ``backtrack`` is used (only where the constraint lets the loop update the iterate).
         """
         conv, problem = self.conv, self.problem
         residuals = []
@@ -347,7 +347,7 @@ class Newton:
             if self.callback is not None:
                 self.callback(dict(t=t, iteration=it, residual=ratio, poses=H))
             verdict = conv.decide(ratio, last_inc, it, floor, final=constraint.final)
-            if verdict is MAX_ITER and not problem.smooth and self._converging(residuals, it - conv.max_iter):
+            if verdict is MAX_ITER and not problem.smooth and self.converging(residuals, it - conv.max_iter):
                 verdict = CONTINUE
             if verdict is CONVERGED:
                 if damped_its:
@@ -395,11 +395,11 @@ class Newton:
             if rotation_streak >= 2:
                 raise rotation
             last_inc = inc if lam == 1.0 else np.inf
-        raise AssertionError("unreachable: decide() returns MAX_ITER from max_iter on, _converging is False "
+        raise AssertionError("unreachable: decide() returns MAX_ITER from max_iter on, converging is False "
                              "after GRACE_ITER more")
 
     @staticmethod
-    def _converging(residuals, extra):
+    def converging(residuals, extra):
         """Whether an iteration past ``max_iter`` (the ``extra``-th) of a problem that is not smooth
         (``Problem.smooth``; a smooth one stops at ``max_iter``) may go on: at most ``GRACE_ITER`` of them,
         each after iterations that cut the scaled residual by ``GRACE_RATE`` at least, twice running
@@ -432,7 +432,7 @@ class Newton:
             inc = np.inf                 # the multipliers move too: no convergence on a small dz alone
         if not self.line_search or plain:
             return self.problem.update(H, dz), None, inc
-        H, ahead = self._line_search(H, dz, ev, scales, t)
+        H, ahead = self.backtrack(H, dz, ev, scales, t)
         return H, ahead, inc
 
     def _failure(self, verdict, ratio):
@@ -499,7 +499,7 @@ class Newton:
                 raise DampingStalled(f"damped Newton stalled: no step length down to {DAMPING_MIN:g} of the "
                                      "Newton increment reduces the Newton correction")
 
-    def _line_search(self, H, dz, ev0, scales, t):
+    def backtrack(self, H, dz, ev0, scales, t):
         """Backtracking on the scaled residual (problems that are not smooth; the others use the
         damped Newton of ``_damped``: a piecewise smooth residual made its natural-monotonicity
         test accept steps that later stalled, e.g. in the twisted pair).

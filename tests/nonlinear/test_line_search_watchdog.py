@@ -1,4 +1,4 @@
-"""The residual line search's watchdog (``Newton._line_search``, ``LS_CRAWL``, ``LS_WATCHDOG``).
+"""The residual line search's watchdog (``Newton.backtrack``, ``LS_CRAWL``, ``LS_WATCHDOG``).
 
 A full Newton step that raises the merit more than ``LS_GROWTH`` is backtracked; after ``LS_CRAWL``
 backtracked iterations in a row near the solution (``Newton.near``: the scaled residual ``LS_NEAR`` times
@@ -18,7 +18,7 @@ from beamsolver.nonlinear import newton as nw
 
 
 class _Stub(nw.Newton):
-    """``_line_search`` over ``x`` (the 'poses', a float array): merit ``phi(x)``; ``inf`` raises a step failure."""
+    """``backtrack`` over ``x`` (the 'poses', a float array): merit ``phi(x)``; ``inf`` raises a step failure."""
 
     def __init__(self, phi):
         self.phi, self.crawl, self.near = phi, 0, True
@@ -43,7 +43,7 @@ def _search(newton, growth):
     def phi(x):
         return growth if x == 1.0 else 1.0 - 0.5 * x
     newton.phi = phi
-    H, _ = newton._line_search(np.zeros(1), np.ones(1), types.SimpleNamespace(x=0.0, mult=None), None, 0.0)
+    H, _ = newton.backtrack(np.zeros(1), np.ones(1), types.SimpleNamespace(x=0.0, mult=None), None, 0.0)
     return H[0]
 
 
@@ -75,5 +75,5 @@ def test_a_refused_trial_is_never_kept():
     newton = _Stub(None)
     newton.crawl = nw.LS_CRAWL
     newton.phi = lambda x: np.inf if x > 0.3 else 1.0 - x
-    H, ahead = newton._line_search(np.zeros(1), np.ones(1), types.SimpleNamespace(x=0.0, mult=None), None, 0.0)
+    H, ahead = newton.backtrack(np.zeros(1), np.ones(1), types.SimpleNamespace(x=0.0, mult=None), None, 0.0)
     assert 0.0 < H[0] <= 0.3 and ahead is None

@@ -1,4 +1,4 @@
-"""Past ``max_iter`` Newton goes on while a non-smooth (contact) problem converges fast (``Newton._converging``:
+"""Past ``max_iter`` Newton goes on while a non-smooth (contact) problem converges fast (``Newton.converging``:
 ``GRACE_RATE``, ``GRACE_ITER``), and only then: a semi-smooth Newton whose contact active set settles late (the
 rope's loaded step, ``test_rope_loaded_step``) is not stopped two iterations before its quadratic end; for a
 smooth problem ``max_iter`` stays a hard cap."""
@@ -41,4 +41,4 @@ def test_smooth_problem_stops_at_the_budget():
     ([1e-3, 1e-4], 0, False),                                 # too short a history
 ])
 def test_converging_rule(residuals, extra, expected):
-    assert nw.Newton._converging(residuals, extra) is expected
+    assert nw.Newton.converging(residuals, extra) is expected

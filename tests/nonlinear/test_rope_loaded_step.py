@@ -1,5 +1,5 @@
-"""The loaded step of a rope piece converges in one step (issue 30; ``Newton._line_search``'s watchdog and
-``Newton._converging``).
+"""The loaded step of a rope piece converges in one step (issue 30; ``Newton.backtrack``'s watchdog and
+``Newton.converging``).
 
 The 40 mm piece of the scaling benchmark's rope (``benchmarks/scaling_scenes.py``: six 1+6+12 strands
 around a 1+6+12 wire strand core, 133 wires, 6597 elements, mu = 0.3) stretched by a strain of 1e-4 in one
