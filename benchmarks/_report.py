@@ -63,6 +63,18 @@ def write_csv(name, rows, keys=None, cell=None):
             f.write(",".join(cell(r.get(k, "")) for k in keys) + "\n")
 
 
+def section_rows(name, doc=DOC):
+    """First cells of the table rows in the section ``name`` of ``docs/benchmarks.md`` (``[]`` without it):
+    what a partial rerun would drop if it replaced the section."""
+    begin, end = f"<!-- BEGIN {name} -->", f"<!-- END {name} -->"
+    old = Path(doc).read_text() if Path(doc).exists() else ""
+    if begin not in old or end not in old:
+        return []
+    body = old.split(begin, 1)[1].split(end, 1)[0]
+    cells = [ln.split("|")[1].strip() for ln in body.splitlines() if ln.startswith("|") and ln.count("|") > 2]
+    return [c for c in cells if c and set(c) - set("-: ")][1:]         # without the header and rule rows
+
+
 def write_section(name, text, doc=DOC):
     """Replace (or append) the section ``name`` of ``docs/benchmarks.md`` by ``text``."""
     begin, end = f"<!-- BEGIN {name} -->", f"<!-- END {name} -->"

@@ -67,7 +67,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _report import machine, single_thread, table, write_csv, write_section  # noqa: E402
+from _report import machine, section_rows, single_thread, table, write_csv, write_section  # noqa: E402
 import os  # noqa: E402
 
 single_thread()
@@ -632,6 +632,8 @@ def main(argv):
                     help="largest bundle (elements) run through the contact code")
     ap.add_argument("--scenes", default=None,
                     help="instead: the scenes of issue 30, e.g. 19,37,61,rope-20,rope-40 (scaling_scenes.py)")
+    ap.add_argument("--write-docs", action="store_true",
+                    help="with --scenes: replace the docs section even if rows of other scenes are dropped")
     ap.add_argument("--step-parts", default=None,
                     help="instead: Newton iterations of a loaded step by parts, held pattern off/on, e.g. "
                          "19,37,61,strand-61 (step_parts.py)")
@@ -641,7 +643,7 @@ def main(argv):
     if a.step_parts:
         return step_parts_rows(a.step_parts.split(","), a.threads.split(","), a.hold.split(","))
     if a.scenes:
-        return scenes(a.scenes.split(","))
+        return scenes(a.scenes.split(","), a.write_docs)
     max_elements, cap = int(a.max_elements), int(a.bundle_cap)
     t_start = time.perf_counter()
     tmp = tempfile.TemporaryDirectory()
@@ -676,8 +678,9 @@ def main(argv):
     return rows
 
 
-def scenes(names):
-    """``--scenes``: one Newton iteration by parts and a loaded step per scene (``scaling_scenes``)."""
+def scenes(names, write_docs=False):
+    """``--scenes``: one Newton iteration by parts and a loaded step per scene (``scaling_scenes``).  The docs
+    section is replaced only if no scene of its table is left out (``_dropped_rows``), or with ``write_docs``."""
     import scaling_scenes
     t_start = time.perf_counter()
     base = run_child("baseline")
@@ -703,8 +706,18 @@ def scenes(names):
             + scaling_scenes.report(rows, base["rss_mb"], table))
     print(text)
     write_csv("scaling_scenes", rows, cell=_csv)
-    write_section("scaling_scenes", "## Bundles of 19, 37, 61 wires and a rope (issue 30)\n\n" + text)
+    dropped = _dropped_rows(names)
+    if dropped and not write_docs:
+        print(f"docs/benchmarks.md: section scaling_scenes kept (its rows {', '.join(dropped)} were not run; "
+              "--write-docs replaces it)")
+    else:
+        write_section("scaling_scenes", "## Bundles of 19, 37, 61 wires and a rope (issue 30)\n\n" + text)
     return rows
+
+
+def _dropped_rows(names):
+    """Scenes of the docs section's table that a run of ``names`` would drop."""
+    return [c for c in section_rows("scaling_scenes") if c not in names]
 
 
 def step_parts_rows(names, threads, holds):
