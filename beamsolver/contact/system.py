@@ -139,6 +139,22 @@ class _Decl:
                                 if o.stick_tolerance is None else o.stick_tolerance)
 
 
+def _point_data(out, idx, n_sel, G, d, st):
+    """Exact stick's point data of the pairs ``idx`` into ``out`` (of ``n_sel`` active pairs): the tangential
+    traction ``lam_t`` in the point's ``t1, t2``, ``stick`` (every node of the point sticking), ``slip`` and
+    the contact frames ``HL``, ``HK``."""
+    n, t1, t2 = d["n"], d["t1"], d["t2"]
+    Tt = st["T"] - np.sum(st["T"] * n, axis=1)[:, None] * n
+    out["lam_t"][idx] = np.stack([np.sum(Tt * t1, axis=1), np.sum(Tt * t2, axis=1)], axis=1)
+    held = st["stick"][G["g"]] | (G["phi"] == 0.0)
+    out["stick"][idx] = held.all(axis=1)
+    out["slip"][idx] = d["slip"]
+    for name in ("HL", "HK"):
+        if name not in out:
+            out[name] = np.tile(np.eye(4), (n_sel, 1, 1))
+        out[name][idx] = d[name]
+
+
 class ContactSystem(Contribution):
     """The contact of ``system`` (an ``assembly.System`` whose model has contact declarations) as a
     contribution: the pipeline of the module docstring.  ``kernel``: the module evaluating the contact
@@ -758,12 +774,7 @@ class ContactSystem(Contribution):
                 K_pairs = None            # in ``dfdq``
         else:
             d = kernel_jit.mortar_terms(X, pm, law)
-        # nodal weights: half of each element at the node, the whole element beside a held node
-        e = P.e[sel[idx]]
-        merged = np.unique(G["g"][:, 0][G["g"][:, 0] == G["g"][:, 1]] * np.int64(len(self.sys.L))
-                           + e[G["g"][:, 0] == G["g"][:, 1]])
-        m = self._node_len[G["node"]] + np.bincount(merged // len(self.sys.L), weights=0.5 * self.sys.L[
-            merged % len(self.sys.L)], minlength=len(G["key"]))
+        m = self._nodal_weights(G, P.e[sel[idx]])
         hold = v = None
         if ssn:
             # groups with a point in the normal law's band: the point law's stiffness floor (mortar.py)
@@ -779,44 +790,10 @@ class ContactSystem(Contribution):
             st["T"] = np.einsum("pa,pai->pi", G["phi"], v[G["g"]])
         d["f"] = np.einsum("pij,pj->pi", d["A"], st["T"])
         if tangent:
-            d["G"] = d["A"]
-            if d.get("dfdq") is None:
-                d["dfdq"] = np.einsum("pk,pkij->pij", st["T"], d["dK"])
-            if K_pairs is not None:      # the points' own (normal) blocks go to their groups with the friction's
-                rows = idx
-                if len(K_pairs) < len(sel):     # left out by ``_local_blocks`` (a kernel without ``whole``: oracles)
-                    K_pairs = -self._kernels(X, pm, P.decl[sel[idx]], True, friction=False)[1]
-                    rows = np.arange(len(idx))
-                mortar_jit.subtract_indexed(d["dfdq"], K_pairs, rows)
-            if ssn:
-                f, K, Kql, Klq, Kll, C = mortar.multiplier_blocks(G, d, st, R, Lam, eps, mu)
-                mult = dict(Kql=-Kql, Klq=Klq, Kll=Kll)
-            else:
-                f, K = mortar.blocks(G, d, st, R, Lam, eps, mu)
-            if self.n_slots:
-                ends = self._mortar_ends(P, sel, idx, X, pm, G, d, st, v if ssn else st["lam"], eps, mu,
-                                         next(iter(laws.values())), None if ssn else d["active"])
-                if ends is not None:
-                    F, B = ends
-                    weak = st["weak"] if ssn else np.ones(len(m), dtype=bool)
-                    A = np.einsum("gij,gkj->gik", Kql, R) if ssn else mortar._point_parts(G, d)[2]
-                    K += F
-                    K[weak] += A[weak] @ B[weak]
-                    if ssn:
-                        B[weak] = 0.0
-                        Klq -= B
+            f, K, mult = self._mortar_tangent(P, sel, idx, X, pm, G, d, st, R, Lam, eps, mu, law, v, K_pairs)
         else:
             f, K = mortar.group_forces(G, d["f"]), None
-        n, t1, t2 = d["n"], d["t1"], d["t2"]
-        Tt = st["T"] - np.sum(st["T"] * n, axis=1)[:, None] * n
-        out["lam_t"][idx] = np.stack([np.sum(Tt * t1, axis=1), np.sum(Tt * t2, axis=1)], axis=1)
-        held = st["stick"][G["g"]] | (G["phi"] == 0.0)
-        out["stick"][idx] = held.all(axis=1)
-        out["slip"][idx] = d["slip"]
-        for name in ("HL", "HK"):
-            if name not in out:
-                out[name] = np.tile(np.eye(4), (len(sel), 1, 1))
-            out[name][idx] = d[name]
+        _point_data(out, idx, len(sel), G, d, st)
         if ssn:
             if tangent:
                 mult["B"] = mortar.multiplier_basis(st)
@@ -833,6 +810,49 @@ class ContactSystem(Contribution):
         return dict(members=G["members"], f=f, K=K, key=G["key"], decl=gdecl,
                     lam=v if ssn else st["lam"], u=st["u"], stick=st["stick"], R=R,
                     mult=mult, folded=folded, f_own=own)
+
+    def _nodal_weights(self, G, e):
+        """``m`` ``(n,)`` of the groups ``G`` (``mortar.nodal_state``), their points on the slave elements ``e``:
+        half of each element at the node, the whole element beside a held node."""
+        L = self.sys.L
+        one = G["g"][:, 0] == G["g"][:, 1]
+        merged = np.unique(G["g"][:, 0][one] * np.int64(len(L)) + e[one])
+        return self._node_len[G["node"]] + np.bincount(merged // len(L), weights=0.5 * L[merged % len(L)],
+                                                       minlength=len(G["key"]))
+
+    def _mortar_tangent(self, P, sel, idx, X, pm, G, d, st, R, Lam, eps, mu, law, v, K_pairs):
+        """``_mortar``'s blocks with the tangent: ``(f, K, mult)`` (forces and tangent blocks of the groups, the
+        multiplier blocks with exact stick's multipliers as Newton unknowns, else None); ``v`` the multipliers'
+        tractions (None with the updates), ``K_pairs`` the pairs' own blocks to fold in (or None)."""
+        ssn = v is not None
+        d["G"] = d["A"]
+        if d.get("dfdq") is None:
+            d["dfdq"] = np.einsum("pk,pkij->pij", st["T"], d["dK"])
+        if K_pairs is not None:      # the points' own (normal) blocks go to their groups with the friction's
+            rows = idx
+            if len(K_pairs) < len(sel):     # left out by ``_local_blocks`` (a kernel without ``whole``: oracles)
+                K_pairs = -self._kernels(X, pm, P.decl[sel[idx]], True, friction=False)[1]
+                rows = np.arange(len(idx))
+            mortar_jit.subtract_indexed(d["dfdq"], K_pairs, rows)
+        mult = None
+        if ssn:
+            f, K, Kql, Klq, Kll, C = mortar.multiplier_blocks(G, d, st, R, Lam, eps, mu)
+            mult = dict(Kql=-Kql, Klq=Klq, Kll=Kll)
+        else:
+            f, K = mortar.blocks(G, d, st, R, Lam, eps, mu)
+        if self.n_slots:
+            ends = self._mortar_ends(P, sel, idx, X, pm, G, d, st, v if ssn else st["lam"], eps, mu, law,
+                                     None if ssn else d["active"])
+            if ends is not None:
+                F, B = ends
+                weak = st["weak"] if ssn else np.ones(len(st["m"]), dtype=bool)
+                A = np.einsum("gij,gkj->gik", Kql, R) if ssn else mortar._point_parts(G, d)[2]
+                K += F
+                K[weak] += A[weak] @ B[weak]
+                if ssn:
+                    B[weak] = 0.0
+                    Klq -= B
+        return f, K, mult
 
     def _mortar_ends(self, P, sel, idx, X, pm, G, d, st, vals, eps, mu, law, active):
         """The exact-stick terms of the moving segment ends (``segment_tangent.mortar_end_terms``) of the
