@@ -59,6 +59,7 @@ from ..model.buffers import BufferPool
 from ..elements.element_jit import _dq_du, _dq_dw
 from ..lie.se3_jit import madd, mscale
 from ..lie.se3_jit import A_, B_, C_, CP_, D_, Q2P_, Q2_, Q3P_, Q3_, add, add_outer, coefficient, cross, dot, log_relative, mat, mm, mv, q_matrix, scale, ti_matrix, transpose
+from . import mortar_jit
 from .frames import LINE, ORTHOGONAL
 from .law import PENALTY_COULOMB, PENALTY_T_MIN
 
@@ -1169,6 +1170,16 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
             Kq = K[0, p]
         else:
             Kq = spare[0]
+        # no normal traction and no given traction, nor their derivatives: the force and its tangent are zeros
+        # (up to their signs), which the forces-only lines below give and ``Kq`` is set to; a point of the
+        # overlap out of the normal law with zero multipliers at its nodes skips the wrenches' and nodal rows
+        zero = Kq.shape[1] > 0 and lam == 0.0 and dlam == 0.0 and lamp[0] == 0.0 and lamp[1] == 0.0 and \
+            lamp[2] == 0.0
+        if zero:
+            for i in range(24):
+                for j in range(24):
+                    Kq[i, j] = 0.0
+            Kq = spare[0]
         if Kq.shape[1] == 0:        # forces only: the values of the lines below, no gradient rows
             lt, stick = (dot(lamp, t1), dot(lamp, t2)), True
             F = add(scale(-wgt * lam, n), add(scale(wgt * lt[0], t1), scale(wgt * lt[1], t2)))
@@ -1214,11 +1225,19 @@ def _evaluate_mortar(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flag
     (``make_kernel(law, mortar=True)``)."""
     own = _scratch()
     ws = (_borrowed(own[0]), _borrowed(own[1]), _borrowed(own[2]), _borrowed(own[3]))
-    spare = (np.empty((0, 0)), np.empty((4, 6)))
+    own_spare = (np.empty((0, 0)), np.empty((4, 6)))
+    spare = (_borrowed(own_spare[0]), _borrowed(own_spare[1]))
+    # borrowed views (no reference counting per point and traction; the caller holds the arguments), as ``_evaluate``
+    X, par, HCL, HFK, HLKp, T = _borrowed(X), _borrowed(par), _borrowed(HCL), _borrowed(HFK), _borrowed(HLKp), \
+        _borrowed(T)
+    kind, has, f, K, sc = _borrowed(kind), _borrowed(has), _borrowed(f), _borrowed(K), _borrowed(sc)
+    vec, two, flags, frames, rows = _borrowed(vec), _borrowed(two), _borrowed(flags), _borrowed(frames), \
+        _borrowed(rows)
     for p in range(X.shape[0]):
         _point_mortar(X[p], kind[p], par[p], has[p], HCL[p], HFK[p], HLKp[p], f, K, p, sc[p], vec[p], two[p],
                       flags[p], frames[p], ws, rows[p], T[p % T.shape[0]], spare)
-    own[0][0, 0, 0, 0] = 0.0
+    own[0][0, 0, 0, 0] = 0.0           # the scratch arrays' owners live until here
+    own_spare[1][0, 0] = 0.0
 
 
 # ---------------------------------------------------------------- the kernel of a contact law
@@ -1477,10 +1496,10 @@ def _mortar_terms(P, df, dK, sc, vec, two, flags, frames, rows):
     A = np.transpose(df, (1, 2, 3, 0)).reshape(P, 24, 3)
     dK = None if dK is None else np.transpose(dK, (1, 0, 2, 3))
     n, t1, t2, s = vec[:, 0], vec[:, 1], vec[:, 2], two[:, 1]
-    dn, dt1, dt2 = rows[:, 0:3], rows[:, 3:6], rows[:, 6:9]
     S = s[:, :1] * t1 + s[:, 1:] * t2
-    dS = (t1[:, :, None] * rows[:, None, 9] + s[:, 0, None, None] * dt1
-          + t2[:, :, None] * rows[:, None, 10] + s[:, 1, None, None] * dt2)
-    return dict(A=A, dK=dK, S=S, dS=dS, lam_n=sc[:, 1].copy(), dlam_n=rows[:, 11].copy(), n=n, t1=t1, t2=t2, dn=dn,
-                slip=s.copy(), HL=frames[:, 0].copy(), HK=frames[:, 1].copy(), active=flags[:, 0].copy(),
+    # ``G``: ``A`` contiguous (the scatters' input; ``A`` itself, a view, for the forces' products); the slip's
+    # gradient ``dS = t1 ds1 + s1 dt1 + t2 ds2 + s2 dt2`` and the rows in one compiled pass (``mortar_jit.point_terms``)
+    Ac, dS, dn, dlam_n = mortar_jit.point_terms(df, rows, t1, t2, s)
+    return dict(A=A, G=Ac, dK=dK, S=S, dS=dS, lam_n=sc[:, 1].copy(), dlam_n=dlam_n, n=n, t1=t1, t2=t2, dn=dn,
+                slip=s.copy(), HL=frames[:, 0], HK=frames[:, 1], active=flags[:, 0].copy(),
                 xi1=sc[:, 2].copy(), xi2=sc[:, 3].copy())

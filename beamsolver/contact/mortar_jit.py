@@ -9,7 +9,7 @@ import numpy as np
 from .._jit import jit
 
 __all__ = ["scatter_rows", "scatter_block", "scatter_columns", "scatter_rows_numpy", "scatter_block_numpy",
-           "scatter_columns_numpy", "trial_rows", "subtract_indexed"]
+           "scatter_columns_numpy", "trial_rows", "subtract_indexed", "point_terms"]
 
 
 @jit
@@ -69,6 +69,33 @@ def _trial_rows(B, g2, rows2, wphi, wn, m, eps, mu, Pi, Q, C, c, dS, dn, dlam_n)
                 r = rows2[p, a, k]
                 for i in range(3):
                     o[i, r] += C[g, i, 0] * t0 + C[g, i, 1] * t1 + C[g, i, 2] * t2 + sm * c[g, i] * dlam_n[p, k]
+
+
+@jit
+def _point_terms(df, rows, t1, t2, s, A, dS, dn, dlam):
+    for p in range(rows.shape[0]):
+        for r in range(24):
+            for q in range(3):
+                A[p, r, q] = df[q, p, r // 6, r % 6]
+        for i in range(3):
+            for k in range(24):
+                dS[p, i, k] = ((t1[p, i] * rows[p, 9, k] + s[p, 0] * rows[p, 3 + i, k]) + t2[p, i] * rows[p, 10, k]) \
+                    + s[p, 1] * rows[p, 6 + i, k]
+                dn[p, i, k] = rows[p, i, k]
+        for k in range(24):
+            dlam[p, k] = rows[p, 11, k]
+
+
+def point_terms(df, rows, t1, t2, s):
+    """The mortar kernel's point terms as contiguous arrays in one pass (``kernel_jit._mortar_terms``): ``A``
+    ``(P, 24, 3)`` from the force differences ``df`` ``(3, P, 4, 6)``, the global slip's gradient ``dS`` ``(P, 3, 24)``
+    = ``t1 ds1 + s1 dt1 + t2 ds2 + s2 dt2`` (summed in this order, as the numpy form), ``dn`` ``(P, 3, 24)`` and
+    ``dlam_n`` ``(P, 24)`` from the gradient rows ``rows`` ``(P, N_ROWS, 24)``; ``t1``, ``t2`` ``(P, 3)``, ``s``
+    ``(P, 2)`` (no ``(P, 3, 24)`` temporaries, no strided copies downstream)."""
+    P = rows.shape[0]
+    A, dS, dn, dlam = np.empty((P, 24, 3)), np.empty((P, 3, 24)), np.empty((P, 3, 24)), np.empty((P, 24))
+    _point_terms(df, rows, _c(t1), _c(t2), _c(s), A, dS, dn, dlam)
+    return A, dS, dn, dlam
 
 
 @jit

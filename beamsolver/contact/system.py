@@ -825,7 +825,8 @@ class ContactSystem(Contribution):
         multiplier blocks with exact stick's multipliers as Newton unknowns, else None); ``v`` the multipliers'
         tractions (None with the updates), ``K_pairs`` the pairs' own blocks to fold in (or None)."""
         ssn = v is not None
-        d["G"] = d["A"]
+        if "G" not in d:        # (``kernel_jit.mortar_terms`` gives it contiguous)
+            d["G"] = d["A"]
         if d.get("dfdq") is None:
             d["dfdq"] = np.einsum("pk,pkij->pij", st["T"], d["dK"])
         if K_pairs is not None:      # the points' own (normal) blocks go to their groups with the friction's
