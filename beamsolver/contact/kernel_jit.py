@@ -1440,7 +1440,17 @@ def mortar_terms(X, p, law=None, T=None, whole=False):
         return _mortar_terms(P, f[1:], K[1:], sc, vec, two, flags, frames, rows)
     d = _mortar_terms(P, f[1:], None, sc, vec, two, flags, frames, rows)
     d["dfdq"] = K[-1]
+    d["pairs"] = _pair_data(f, sc, vec, par)
     return d
+
+
+def _pair_data(f, sc, vec, par):
+    """The pairs' kernel without friction (``contact_kernel(X, p, friction=False)``) from the mortar kernel's pass
+    at ``T = 0``: forces ``f[0]`` ``(P, 4, 6)`` and its point data (the same bits up to the signs of zeros: the
+    unit tractions' terms of that pass are zeros)."""
+    n, lam = vec[:, 0], sc[:, 1]
+    return f[0], dict(gap=sc[:, 0], lam_n=lam, n=n, t1=vec[:, 1], t2=vec[:, 2], xC=vec[:, 3], xF=vec[:, 4],
+                      xi1=sc[:, 2], xi2=sc[:, 3], F_slave=(-par[:, WEIGHT] * lam)[:, None] * n)
 
 
 def mortar_forces(X, p, law=None):
@@ -1458,8 +1468,8 @@ def mortar_forces(X, p, law=None):
     A = np.transpose(f[1:], (1, 2, 3, 0)).reshape(P, 24, 3)
     n, t1, t2, s = vec[:, 0], vec[:, 1], vec[:, 2], two[:, 1]
     return dict(A=A, S=s[:, :1] * t1 + s[:, 1:] * t2, lam_n=sc[:, 1].copy(), n=n, t1=t1, t2=t2, slip=s.copy(),
-                HL=frames[:, 0].copy(), HK=frames[:, 1].copy(), active=flags[:, 0].copy(), xi1=sc[:, 2].copy(),
-                xi2=sc[:, 3].copy())
+                HL=frames[:, 0], HK=frames[:, 1], active=flags[:, 0].copy(), xi1=sc[:, 2].copy(),
+                xi2=sc[:, 3].copy(), pairs=_pair_data(f, sc, vec, par))
 
 
 def mortar_terms_four(X, p, law=None):

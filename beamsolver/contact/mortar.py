@@ -78,8 +78,15 @@ def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=No
     k = max(4, int(slot.max(initial=0)) + 1)
     members = np.repeat(node[:, None], k, axis=1)
     members[ug, slot] = u % n_nodes
-    return dict(key=ukey, node=node, g=g, phi=np.stack([1.0 - xi1, xi1], axis=1), members=members,
-                pos=slot[inv].reshape(P, 2, 4))
+    pos = slot[inv].reshape(P, 2, 4)
+    rows2 = (6 * pos[:, :, :, None] + np.arange(6)).reshape(P, 2, 24)
+    g = np.ascontiguousarray(g, dtype=np.int64)
+    # kept with the groups (``Groups``): the points' slots (``_slots``), their rows (``_trial_rows``) and the
+    # columns of each group's own node rotation (``_turn``)
+    own = np.argmax(members == node[:, None], axis=1)
+    return dict(key=ukey, node=node, g=g, phi=np.stack([1.0 - xi1, xi1], axis=1), members=members, pos=pos,
+                rows2=rows2, slots=tuple((np.ascontiguousarray(g[:, a]), np.ascontiguousarray(rows2[:, a]))
+                                         for a in range(2)), rot=6 * own[:, None] + np.arange(3, 6), kept={})
 
 
 class Groups:
@@ -134,7 +141,19 @@ def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu, m, active=None, hold=None):
     nothing, where a weight over the active points would jump); ``active`` ``(P,)``: the points whose
     slip counts (where the traction acts; the mean normal takes every point).  Returns a dict with ``m``, ``u`` (projected), ``lamN``, ``trial``, ``lam``, ``stick``,
     ``C``, ``c``, ``Pi``, ``Q`` (d trial / d nbar) per group and the point tractions ``T`` ``(P, 3)``.
+    Compiled (``mortar_jit.nodal_state``: the same sums in the same order); ``use_numpy_scatter``: the numpy form.
     """
+    if _SCATTER["rows"] is mortar_jit.scatter_rows:
+        st = mortar_jit.nodal_state(G["g"], G["phi"], w, active, S, lam_n, n, np.einsum("gij,gj->gi", R, Lam), eps,
+                                    mu, m, hold)
+        st["u"] = st.pop("up")
+        st["m"] = m
+        return st
+    return nodal_state_numpy(G, w, S, lam_n, n, R, Lam, eps, mu, m, active, hold)
+
+
+def nodal_state_numpy(G, w, S, lam_n, n, R, Lam, eps, mu, m, active=None, hold=None):
+    """``nodal_state`` in numpy (its oracle)."""
     k = len(G["key"])
     wn = G["phi"] * w[:, None]
     wphi = wn if active is None else wn * active[:, None]
@@ -186,6 +205,8 @@ def multiplier_basis(st):
 
 def _slots(G, a):
     """Group of each point's node ``a`` (0: A, 1: B) and the point's 24 rows in that group's block."""
+    if "slots" in G:
+        return G["slots"][a]
     P = len(G["g"])
     return G["g"][:, a], (6 * G["pos"][:, a, :, None] + np.arange(6)).reshape(P, 24)
 
@@ -239,7 +260,7 @@ def _trial_rows(G, d, st, eps, mu):
     n, k = G["members"].shape
     B = np.zeros((n, 3, 6 * k))
     if _SCATTER["rows"] is mortar_jit.scatter_rows:
-        rows2 = (6 * G["pos"][:, :, :, None] + np.arange(6)).reshape(len(G["g"]), 2, 24)
+        rows2 = G["rows2"] if "rows2" in G else (6 * G["pos"][:, :, :, None] + np.arange(6)).reshape(len(G["g"]), 2, 24)
         return mortar_jit.trial_rows(B, G["g"], rows2, st["wphi"], st["wn"], st["m"], eps, mu, st["Pi"], st["Q"],
                                      st["C"], st["c"], d["dS"], d["dn"], d["dlam_n"])
     for a in range(2):
@@ -256,8 +277,12 @@ def _trial_rows(G, d, st, eps, mu):
 def _turn(G, R, Lam):
     """Columns ``(n, 3)`` of the node's rotation increment in each group's block and ``d(R Lam) / dtheta``
     ``(n, 3, 3)`` = ``-R hat(Lam)`` (body increment of the node)."""
-    own = np.argmax(G["members"] == G["node"][:, None], axis=1)
-    return 6 * own[:, None] + np.arange(3, 6), -np.einsum("gij,gjk->gik", R, se3.skew(Lam))
+    if "rot" in G:
+        cols = G["rot"]
+    else:
+        own = np.argmax(G["members"] == G["node"][:, None], axis=1)
+        cols = 6 * own[:, None] + np.arange(3, 6)
+    return cols, -np.einsum("gij,gjk->gik", R, se3.skew(Lam))
 
 
 def _add_columns(M, cols, V):

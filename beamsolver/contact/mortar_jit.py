@@ -9,7 +9,8 @@ import numpy as np
 from .._jit import jit
 
 __all__ = ["scatter_rows", "scatter_block", "scatter_columns", "scatter_rows_numpy", "scatter_block_numpy",
-           "scatter_columns_numpy", "trial_rows", "subtract_indexed", "point_terms"]
+           "scatter_columns_numpy", "trial_rows", "subtract_indexed", "point_terms",
+           "nodal_state", "point_data"]
 
 
 @jit
@@ -96,6 +97,108 @@ def point_terms(df, rows, t1, t2, s):
     A, dS, dn, dlam = np.empty((P, 24, 3)), np.empty((P, 3, 24)), np.empty((P, 3, 24)), np.empty((P, 24))
     _point_terms(df, rows, _c(t1), _c(t2), _c(s), A, dS, dn, dlam)
     return A, dS, dn, dlam
+
+
+@jit
+def _nodal_state(g2, phi, w, active, S, lam_n, n, Rl, eps, mu, m, hold, u, lamN, trial, lam, stick, C, c, T, wphi, wn,
+                 Pi, Q, weak, nu, up):
+    G = len(m)
+    nbar = np.zeros((G, 3))
+    for p in range(g2.shape[0]):               # the sums in ``np.bincount``'s order (points, then nodes A, B)
+        for a in range(2):
+            g = g2[p, a]
+            x = phi[p, a] * w[p]
+            wn[p, a] = x
+            y = x * (1.0 if active[p] else 0.0) if active.shape[0] > 0 else x
+            wphi[p, a] = y
+            for i in range(3):
+                u[g, i] += y * S[p, i]
+            lamN[g] += y * lam_n[p]
+            for i in range(3):
+                nbar[g, i] += x * n[p, i]
+    for g in range(G):
+        for i in range(3):
+            u[g, i] /= m[g]
+            nbar[g, i] /= m[g]
+        lamN[g] /= m[g]
+        size = np.sqrt((nbar[g, 0] * nbar[g, 0] + nbar[g, 1] * nbar[g, 1]) + nbar[g, 2] * nbar[g, 2])
+        for i in range(3):
+            nu[g, i] = nbar[g, i] / size
+        for i in range(3):
+            for j in range(3):
+                Pi[g, i, j] = (1.0 if i == j else 0.0) - nu[g, i] * nu[g, j]
+        v0, v1, v2 = Rl[g, 0] + eps[g] * u[g, 0], Rl[g, 1] + eps[g] * u[g, 1], Rl[g, 2] + eps[g] * u[g, 2]
+        for i in range(3):          # ``np.einsum("gij,gj->gi")`` on contiguous arrays: (x0 + x2) + x1
+            trial[g, i] = (Pi[g, i, 0] * v0 + Pi[g, i, 2] * v2) + Pi[g, i, 1] * v1
+            up[g, i] = (Pi[g, i, 0] * u[g, 0] + Pi[g, i, 2] * u[g, 2]) + Pi[g, i, 1] * u[g, 1]
+        nv = (nu[g, 0] * v0 + nu[g, 1] * v1) + nu[g, 2] * v2
+        for i in range(3):
+            for j in range(3):
+                Q[g, i, j] = -(nv * Pi[g, i, j] + nu[g, i] * trial[g, j]) / size
+        # ``mortar.return_mapping`` onto the disk ``mu max(lamN, 0)``
+        cap = mu[g] * max(lamN[g], 0.0) if not np.isnan(lamN[g]) else mu[g] * lamN[g]
+        norm = np.sqrt((trial[g, 0] * trial[g, 0] + trial[g, 1] * trial[g, 1]) + trial[g, 2] * trial[g, 2])
+        st = norm <= cap and cap > 0.0
+        stick[g] = st
+        safe = 1.0 if (st or norm == 0.0) else norm
+        t0, t1, t2 = trial[g, 0] / safe, trial[g, 1] / safe, trial[g, 2] / safe
+        k = cap / safe
+        for i in range(3):
+            ti = t0 if i == 0 else t1 if i == 1 else t2
+            for j in range(3):
+                tj = t0 if j == 0 else t1 if j == 1 else t2
+                C[g, i, j] = (1.0 if i == j else 0.0) if st else k * ((1.0 if i == j else 0.0) - ti * tj)
+            lam[g, i] = trial[g, i] if st else cap * ti
+            c[g, i] = 0.0 if st else ti
+        wk = hold.shape[0] > 0 and hold[g] > 0 and lamN[g] <= 0.0
+        weak[g] = wk
+        if wk:
+            h = hold[g] / eps[g]
+            for i in range(3):
+                for j in range(3):
+                    C[g, i, j] = h * (1.0 if i == j else 0.0)
+                c[g, i] = 0.0
+    for p in range(g2.shape[0]):
+        ga, gb = g2[p, 0], g2[p, 1]
+        for i in range(3):
+            T[p, i] = phi[p, 0] * lam[ga, i] + phi[p, 1] * lam[gb, i]
+
+
+def nodal_state(g2, phi, w, active, S, lam_n, n, Rl, eps, mu, m, hold):
+    """``mortar.nodal_state``'s arrays in one compiled pass (``g2`` ``(P, 2)`` the points' groups, ``Rl`` ``(n, 3)``
+    the multipliers' tractions ``R Lam``, ``active`` and ``hold`` None or arrays): ``u`` (projected), ``lamN``,
+    ``trial``, ``lam``, ``stick``, ``C``, ``c``, ``T``, ``wphi``, ``wn``, ``Pi``, ``Q``, ``weak``, ``nu`` as a dict.
+    The sums keep numpy's order (``np.bincount``'s, ``np.einsum``'s on contiguous arrays), so the results are the
+    numpy form's to the bit on this machine (``tests/contact/test_contact_mortar_jit.py``: to round-off anywhere)."""
+    P, G = len(g2), len(m)
+    out = dict(u=np.zeros((G, 3)), lamN=np.zeros(G), trial=np.empty((G, 3)), lam=np.empty((G, 3)),
+               stick=np.empty(G, dtype=np.bool_), C=np.empty((G, 3, 3)), c=np.empty((G, 3)), T=np.empty((P, 3)),
+               wphi=np.empty((P, 2)), wn=np.empty((P, 2)), Pi=np.empty((G, 3, 3)), Q=np.empty((G, 3, 3)),
+               weak=np.empty(G, dtype=np.bool_), nu=np.empty((G, 3)), up=np.empty((G, 3)))
+    _nodal_state(_c(g2, np.int64), _c(phi), _c(w), np.zeros(0, dtype=np.bool_) if active is None else _c(active, np.bool_),
+                 _c(S), _c(lam_n), _c(n), _c(Rl), _c(eps), _c(mu), _c(m), np.zeros(0) if hold is None else _c(hold),
+                 *out.values())
+    return out
+
+
+@jit
+def _point_data(T, n, t1, t2, stick, g2, phi, lam_t, held):
+    for p in range(T.shape[0]):
+        tn = (T[p, 0] * n[p, 0] + T[p, 1] * n[p, 1]) + T[p, 2] * n[p, 2]
+        a0, a1, a2 = T[p, 0] - tn * n[p, 0], T[p, 1] - tn * n[p, 1], T[p, 2] - tn * n[p, 2]
+        lam_t[p, 0] = (a0 * t1[p, 0] + a1 * t1[p, 1]) + a2 * t1[p, 2]
+        lam_t[p, 1] = (a0 * t2[p, 0] + a1 * t2[p, 1]) + a2 * t2[p, 2]
+        held[p] = (stick[g2[p, 0]] or phi[p, 0] == 0.0) and (stick[g2[p, 1]] or phi[p, 1] == 0.0)
+
+
+def point_data(T, n, t1, t2, stick, g2, phi):
+    """Exact stick's point data (``system._point_data``): the tangential part of the traction ``T`` ``(P, 3)`` in the
+    point's ``t1, t2`` ``(P, 2)`` (``T - (T . n) n``, the numpy form's sums) and whether every node of the point sticks
+    (``stick`` ``(n,)`` of the groups ``g2`` ``(P, 2)``, a node of zero weight ``phi`` counting as sticking)."""
+    P = len(T)
+    lam_t, held = np.empty((P, 2)), np.empty(P, dtype=np.bool_)
+    _point_data(_c(T), _c(n), _c(t1), _c(t2), _c(stick, np.bool_), _c(g2, np.int64), _c(phi), lam_t, held)
+    return lam_t, held
 
 
 @jit

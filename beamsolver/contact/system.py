@@ -143,13 +143,16 @@ def _point_data(out, idx, n_sel, G, d, st):
     """Exact stick's point data of the pairs ``idx`` into ``out`` (of ``n_sel`` active pairs): the tangential
     traction ``lam_t`` in the point's ``t1, t2``, ``stick`` (every node of the point sticking), ``slip`` and
     the contact frames ``HL``, ``HK``."""
-    n, t1, t2 = d["n"], d["t1"], d["t2"]
-    Tt = st["T"] - np.sum(st["T"] * n, axis=1)[:, None] * n
-    out["lam_t"][idx] = np.stack([np.sum(Tt * t1, axis=1), np.sum(Tt * t2, axis=1)], axis=1)
-    held = st["stick"][G["g"]] | (G["phi"] == 0.0)
-    out["stick"][idx] = held.all(axis=1)
-    out["slip"][idx] = d["slip"]
+    every = len(idx) == n_sel           # (``idx`` sorted: every active pair)
+    lam_t, stick = mortar_jit.point_data(st["T"], d["n"], d["t1"], d["t2"], st["stick"], G["g"], G["phi"])
+    if every:
+        out["lam_t"], out["stick"], out["slip"] = lam_t, stick, d["slip"]
+    else:
+        out["lam_t"][idx], out["stick"][idx], out["slip"][idx] = lam_t, stick, d["slip"]
     for name in ("HL", "HK"):
+        if every:
+            out[name] = d[name]
+            continue
         if name not in out:
             out[name] = np.tile(np.eye(4), (n_sel, 1, 1))
         out[name][idx] = d[name]
@@ -673,11 +676,14 @@ class ContactSystem(Contribution):
         # every pair a mortar pair whose whole tangent the mortar kernel gives (``_mortar``: points integration,
         # multipliers as unknowns): the pairs' kernel without tangent (its forces: the same bits)
         whole = tangent and self.kernel is kernel_jit and self.newton_multipliers and not self.n_slots and mort.all()
-        f, K, out = self._kernels(H[P.nodes[sel]], p, P.decl[sel], tangent and not whole,
-                                  friction=(p["mu"] > 0) & ~mort if mort.any() else None)
         if whole:
-            K = np.empty((0, 24, 24))       # (``_mortar``, ``_with_mortar``: every pair's blocks in its group's)
-        np.negative(f, out=f)
+            # the pairs' forces (the normal law's) and point data: the mortar kernel's at zero traction (``_mortar``,
+            # ``kernel_jit.mortar_terms``: the same bits as the pairs' kernel without friction; one pass, not two)
+            f, K, out = None, np.empty((0, 24, 24)), {}   # (``_with_mortar``: every pair's blocks in its group's)
+        else:
+            f, K, out = self._kernels(H[P.nodes[sel]], p, P.decl[sel], tangent,
+                                      friction=(p["mu"] > 0) & ~mort if mort.any() else None)
+            np.negative(f, out=f)
         if K is not None:
             np.negative(K, out=K)
         if K is not None and self.n_slots:
@@ -690,6 +696,8 @@ class ContactSystem(Contribution):
             # line-search trial); its blocks when it is (``evaluate``: ``mortar_pending``)
             lazy = LAZY_MORTAR and not asked
             out["mortar"] = self._mortar(H, P, sel, p, np.flatnonzero(mort), out, not lazy, f, K)
+            if f is None:
+                f = out["mortar"].pop("pair_f")
             if lazy:
                 out["mortar_pending"] = np.flatnonzero(mort)
         self._lap("kernel")
@@ -750,7 +758,7 @@ class ContactSystem(Contribution):
         point's node A holds all of its nodes), so that ``_with_mortar`` leaves them out (``folded``)."""
         n_nodes = len(H)
         X = H[P.nodes[sel[idx]]]
-        pm = {k: (v[idx] if np.ndim(v) else v) for k, v in p.items()}
+        pm = p if len(idx) == len(sel) else {k: (v[idx] if np.ndim(v) else v) for k, v in p.items()}
         G = self._groups(P.nodes[sel[idx], :2], pm["xi1"], self.el_beam[P.m[sel[idx]]], P.decl[sel[idx]],
                           P.nodes[sel[idx]], n_nodes, self.n_beams, self._held_slip(P.nodes[sel[idx]]))
         gdecl = G["key"] // (np.int64(n_nodes) * self.n_beams)
@@ -758,7 +766,8 @@ class ContactSystem(Contribution):
         ssn = self.newton_multipliers
         Lam = self.iterate_multipliers(G["key"]) if ssn else self.history.tangential_multipliers(G["key"])
         eps, mu = (self._decl_eps_t if ssn else self._decl_aug_t)[gdecl], self._decl_mu[gdecl]
-        laws = {id(self.decls[k].law): self.decls[k].law for k in np.unique(gdecl)}
+        laws = {id(self.decls[0].law): self.decls[0].law} if len(self.decls) == 1 else \
+            {id(self.decls[k].law): self.decls[k].law for k in np.unique(gdecl)}
         if len(laws) > 1:
             raise InputError("contact: exact stick needs one contact law over the declarations of a scene, "
                              f"got {len(laws)}")
@@ -774,6 +783,11 @@ class ContactSystem(Contribution):
                 K_pairs = None            # in ``dfdq``
         else:
             d = kernel_jit.mortar_terms(X, pm, law)
+        if f_pairs is None and "pairs" in d:    # the pairs' own kernel (``_local_blocks``: every pair a mortar pair)
+            f_pairs, pair_out = d.pop("pairs")
+            np.negative(f_pairs, out=f_pairs)
+            out.update(pair_out, active=d["active"], lam_t=np.zeros((len(idx), 2)), stick=np.ones(len(idx), dtype=bool),
+                       slip=np.zeros((len(idx), 2)))
         m = self._nodal_weights(G, P.e[sel[idx]])
         hold = v = None
         if ssn:
@@ -809,11 +823,20 @@ class ContactSystem(Contribution):
             folded = idx
         return dict(members=G["members"], f=f, K=K, key=G["key"], decl=gdecl,
                     lam=v if ssn else st["lam"], u=st["u"], stick=st["stick"], R=R,
-                    mult=mult, folded=folded, f_own=own)
+                    mult=mult, folded=folded, f_own=own, pair_f=f_pairs.reshape(-1, 4, 6) if f_pairs is not None else None)
 
     def _nodal_weights(self, G, e):
         """``m`` ``(n,)`` of the groups ``G`` (``mortar.nodal_state``), their points on the slave elements ``e``:
         half of each element at the node, the whole element beside a held node."""
+        kept = G.get("kept", {})             # (kept with the groups, ``mortar.Groups``)
+        c = kept.get("nodal_weights")
+        if c is not None and np.array_equal(c[0], e):
+            return c[1]
+        m = self._nodal_weights_of(G, e)
+        kept["nodal_weights"] = (np.array(e), m)
+        return m
+
+    def _nodal_weights_of(self, G, e):
         L = self.sys.L
         one = G["g"][:, 0] == G["g"][:, 1]
         merged = np.unique(G["g"][:, 0][one] * np.int64(len(L)) + e[one])
