@@ -1406,6 +1406,8 @@ def contact_kernel(X, p, friction=True, law=None):
 
 
 _MORTAR_POOL = BufferPool()      # ``mortar_terms``' tangent buffers (free again once its results are dropped)
+_ROWS_POOL = BufferPool()        # its gradient rows (141 MB on the 19-wire bundle: fresh, their page faults cost)
+_FRAMES_POOL = BufferPool(keep=3)   # the contact frames ``mortar_terms`` and ``mortar_forces`` return views of
 
 
 def mortar_terms(X, p, law=None, T=None, whole=False):
@@ -1433,7 +1435,8 @@ def mortar_terms(X, p, law=None, T=None, whole=False):
     nK = 4 if T is None else 1 if whole else 2
     f, K = np.empty((4, P, 4, 6)), _MORTAR_POOL.take((nK * P * 576,)).reshape(nK, P, 24, 24)
     sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
-    flags, frames, rows = np.empty((P, 2), dtype=np.bool_), np.empty((P, 4, 4, 4)), np.empty((P, N_ROWS, 24))
+    flags, frames, rows = np.empty((P, 2), dtype=np.bool_), _FRAMES_POOL.take((P, 4, 4, 4)), \
+        _ROWS_POOL.take((P, N_ROWS, 24))
     Tc = np.zeros((1, 3)) if T is None else np.ascontiguousarray(T, dtype=float)
     kern(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows, Tc)
     if T is None:
@@ -1463,7 +1466,7 @@ def mortar_forces(X, p, law=None):
     kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar=True)
     f, K = np.empty((4, P, 4, 6)), np.empty((4, P, 0, 0))
     sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
-    flags, frames, rows = np.empty((P, 2), dtype=np.bool_), np.empty((P, 4, 4, 4)), np.empty((P, 0, 0))
+    flags, frames, rows = np.empty((P, 2), dtype=np.bool_), _FRAMES_POOL.take((P, 4, 4, 4)), np.empty((P, 0, 0))
     kern(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows, np.zeros((1, 3)))
     A = np.transpose(f[1:], (1, 2, 3, 0)).reshape(P, 24, 3)
     n, t1, t2, s = vec[:, 0], vec[:, 1], vec[:, 2], two[:, 1]

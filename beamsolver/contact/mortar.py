@@ -85,8 +85,8 @@ def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=No
     # columns of each group's own node rotation (``_turn``)
     own = np.argmax(members == node[:, None], axis=1)
     return dict(key=ukey, node=node, g=g, phi=np.stack([1.0 - xi1, xi1], axis=1), members=members, pos=pos,
-                rows2=rows2, slots=tuple((np.ascontiguousarray(g[:, a]), np.ascontiguousarray(rows2[:, a]))
-                                         for a in range(2)), rot=6 * own[:, None] + np.arange(3, 6), kept={})
+                rows2=rows2, slot_groups=np.ascontiguousarray(g.T), slot_rows=np.ascontiguousarray(rows2.transpose(1, 0, 2)),
+                rot=6 * own[:, None] + np.arange(3, 6))
 
 
 class Groups:
@@ -205,8 +205,8 @@ def multiplier_basis(st):
 
 def _slots(G, a):
     """Group of each point's node ``a`` (0: A, 1: B) and the point's 24 rows in that group's block."""
-    if "slots" in G:
-        return G["slots"][a]
+    if "slot_rows" in G:
+        return G["slot_groups"][a], G["slot_rows"][a]
     P = len(G["g"])
     return G["g"][:, a], (6 * G["pos"][:, a, :, None] + np.arange(6)).reshape(P, 24)
 

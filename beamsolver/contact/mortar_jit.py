@@ -7,6 +7,7 @@ cost about 0.8 ms an evaluation on the twisted pair (issue 26, speed: ``docs/ben
 import numpy as np
 
 from .._jit import jit
+from ..model.buffers import BufferPool
 
 __all__ = ["scatter_rows", "scatter_block", "scatter_columns", "scatter_rows_numpy", "scatter_block_numpy",
            "scatter_columns_numpy", "trial_rows", "subtract_indexed", "point_terms",
@@ -72,6 +73,10 @@ def _trial_rows(B, g2, rows2, wphi, wn, m, eps, mu, Pi, Q, C, c, dS, dn, dlam_n)
                     o[i, r] += C[g, i, 0] * t0 + C[g, i, 1] * t1 + C[g, i, 2] * t2 + sm * c[g, i] * dlam_n[p, k]
 
 
+# ``point_terms``' outputs in kept memory (fresh memory's page faults cost as much as the pass on the 19-wire bundle)
+_TERMS_POOLS = tuple(BufferPool() for _ in range(4))
+
+
 @jit
 def _point_terms(df, rows, t1, t2, s, A, dS, dn, dlam):
     for p in range(rows.shape[0]):
@@ -94,7 +99,8 @@ def point_terms(df, rows, t1, t2, s):
     ``dlam_n`` ``(P, 24)`` from the gradient rows ``rows`` ``(P, N_ROWS, 24)``; ``t1``, ``t2`` ``(P, 3)``, ``s``
     ``(P, 2)`` (no ``(P, 3, 24)`` temporaries, no strided copies downstream)."""
     P = rows.shape[0]
-    A, dS, dn, dlam = np.empty((P, 24, 3)), np.empty((P, 3, 24)), np.empty((P, 3, 24)), np.empty((P, 24))
+    A, dS, dn, dlam = (pool.take(shape) for pool, shape in zip(_TERMS_POOLS, ((P, 24, 3), (P, 3, 24), (P, 3, 24),
+                                                                              (P, 24))))
     _point_terms(df, rows, _c(t1), _c(t2), _c(s), A, dS, dn, dlam)
     return A, dS, dn, dlam
 

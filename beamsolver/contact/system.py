@@ -222,6 +222,7 @@ class ContactSystem(Contribution):
         self._augments = 0
         self.newton_multipliers = True   # exact stick: multipliers are Newton unknowns (else Uzawa updates)
         self._groups = mortar.Groups()   # the mortar groups, kept while the pairs' nodes hold
+        self._kept_weights = None         # their nodal weights (``_nodal_weights``)
         self._mstep, self._ms = None, 0.0     # the Newton step of the multipliers (keys, dLam) and its trial length
         self._sweepable = {}       # per declaration: whether the last search found no crossing (``_candidates``)
         self._H_prev = None        # last converged poses (start of the step)
@@ -828,12 +829,11 @@ class ContactSystem(Contribution):
     def _nodal_weights(self, G, e):
         """``m`` ``(n,)`` of the groups ``G`` (``mortar.nodal_state``), their points on the slave elements ``e``:
         half of each element at the node, the whole element beside a held node."""
-        kept = G.get("kept", {})             # (kept with the groups, ``mortar.Groups``)
-        c = kept.get("nodal_weights")
-        if c is not None and np.array_equal(c[0], e):
-            return c[1]
+        c = self._kept_weights              # (kept while the groups, ``mortar.Groups``, and the elements hold)
+        if c is not None and c[0] is G["members"] and np.array_equal(c[1], e):
+            return c[2]
         m = self._nodal_weights_of(G, e)
-        kept["nodal_weights"] = (np.array(e), m)
+        self._kept_weights = (G["members"], np.array(e), m)
         return m
 
     def _nodal_weights_of(self, G, e):
