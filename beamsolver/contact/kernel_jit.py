@@ -1410,13 +1410,14 @@ _ROWS_POOL = BufferPool()        # its gradient rows (141 MB on the 19-wire bund
 _FRAMES_POOL = BufferPool(keep=3)   # the contact frames ``mortar_terms`` and ``mortar_forces`` return views of
 
 
-def mortar_terms(X, p, law=None, T=None, whole=False):
+def mortar_terms(X, p, law=None, T=None, whole=False, pairs=False):
     """Point terms of the mortar friction (``mortar.py``) from the compiled mortar kernel.
 
     ``T`` ``(P, 3)``: the points' tractions, known before the call (exact stick's multipliers): ``dfdq``
     ``(P, 24, 24)`` = ``sum_k T_k dK_k`` from two tangents (at ``T`` and at 0) instead of ``dK`` (equal to
     round-off; half the kernel's tangent rows and memory).  ``whole``: ``dfdq`` is the whole tangent at ``T``
-    (the normal law's too, as the point kernel gives it without friction): one tangent.
+    (the normal law's too, as the point kernel gives it without friction): one tangent.  ``pairs`` (with ``T``):
+    ``d["pairs"]``, the pairs' forces and point data without friction (``_pair_data``).
 
     A point's friction force is linear in the global traction ``T`` (force per length) it is given:
     ``f = A T`` and, at fixed ``T``, ``df/dq = sum_k T_k dK_k``.  Four tractions (``T = 0, e_x, e_y,
@@ -1443,7 +1444,8 @@ def mortar_terms(X, p, law=None, T=None, whole=False):
         return _mortar_terms(P, f[1:], K[1:], sc, vec, two, flags, frames, rows)
     d = _mortar_terms(P, f[1:], None, sc, vec, two, flags, frames, rows)
     d["dfdq"] = K[-1]
-    d["pairs"] = _pair_data(f, sc, vec, par)
+    if pairs:
+        d["pairs"] = _pair_data(f, sc, vec, par)
     return d
 
 
@@ -1456,10 +1458,11 @@ def _pair_data(f, sc, vec, par):
                       xi1=sc[:, 2], xi2=sc[:, 3], F_slave=(-par[:, WEIGHT] * lam)[:, None] * n)
 
 
-def mortar_forces(X, p, law=None):
+def mortar_forces(X, p, law=None, pairs=False):
     """``mortar_terms`` without the tangent's parts (a line-search trial needs the residuals only): ``A``, ``S``,
     ``lam_n``, ``n``, ``t1``, ``t2``, ``slip``, ``HL``, ``HK``, ``active``, ``xi1``, ``xi2``, the same bits as
-    ``mortar_terms``' (the mortar kernel with an empty tangent: no frame variations, no gradient rows)."""
+    ``mortar_terms``' (the mortar kernel with an empty tangent: no frame variations, no gradient rows); ``pairs``:
+    as ``mortar_terms``'."""
     X = np.ascontiguousarray(X, dtype=float)
     P = X.shape[0]
     kind, par, has, (HCL, HFK, HLKp), _ = _table(X, p)
@@ -1470,9 +1473,11 @@ def mortar_forces(X, p, law=None):
     kern(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows, np.zeros((1, 3)))
     A = np.transpose(f[1:], (1, 2, 3, 0)).reshape(P, 24, 3)
     n, t1, t2, s = vec[:, 0], vec[:, 1], vec[:, 2], two[:, 1]
-    return dict(A=A, S=s[:, :1] * t1 + s[:, 1:] * t2, lam_n=sc[:, 1].copy(), n=n, t1=t1, t2=t2, slip=s.copy(),
-                HL=frames[:, 0], HK=frames[:, 1], active=flags[:, 0].copy(), xi1=sc[:, 2].copy(),
-                xi2=sc[:, 3].copy(), pairs=_pair_data(f, sc, vec, par))
+    d = dict(A=A, S=s[:, :1] * t1 + s[:, 1:] * t2, lam_n=sc[:, 1].copy(), n=n, t1=t1, t2=t2, slip=s.copy(),
+             HL=frames[:, 0], HK=frames[:, 1], active=flags[:, 0].copy(), xi1=sc[:, 2].copy(), xi2=sc[:, 3].copy())
+    if pairs:
+        d["pairs"] = _pair_data(f, sc, vec, par)
+    return d
 
 
 def mortar_terms_four(X, p, law=None):

@@ -756,7 +756,10 @@ class ContactSystem(Contribution):
         (residual signs: minus the forces); the point data ``lam_t``, ``stick``, ``slip``, ``HL``,
         ``HK`` of ``out`` are overwritten for these pairs.  ``f_pairs`` ``(m, 4, 6)``, ``K_pairs`` ``(m, 24, 24)``:
         the active pairs' blocks (residual signs), which these pairs' go to (``mortar.add_pairs``: the group of the
-        point's node A holds all of its nodes), so that ``_with_mortar`` leaves them out (``folded``)."""
+        point's node A holds all of its nodes), so that ``_with_mortar`` leaves them out (``folded``).  ``f_pairs``
+        None (``_local_blocks``: every active pair a mortar pair): the pairs' forces and point data are the mortar
+        kernel's at zero traction (``kernel_jit.mortar_terms(pairs=True)``), written to ``out``, the forces returned
+        as ``pair_f``."""
         n_nodes = len(H)
         X = H[P.nodes[sel[idx]]]
         pm = p if len(idx) == len(sel) else {k: (v[idx] if np.ndim(v) else v) for k, v in p.items()}
@@ -774,12 +777,13 @@ class ContactSystem(Contribution):
                              f"got {len(laws)}")
         law = next(iter(laws.values()))
         if not tangent:
-            d = kernel_jit.mortar_forces(X, pm, law)
+            d = kernel_jit.mortar_forces(X, pm, law, pairs=f_pairs is None)
         elif ssn:         # the points' tractions are known (the multipliers): the tangent at them, two not four
             # (one, the normal law's included, where the pairs' own tangent has no segment ends' terms to keep)
             whole = K_pairs is not None and not self.n_slots
             d = kernel_jit.mortar_terms(X, pm, law, T=np.einsum("pa,pai->pi", G["phi"],
-                                                                np.einsum("gij,gj->gi", R, Lam)[G["g"]]), whole=whole)
+                                                                np.einsum("gij,gj->gi", R, Lam)[G["g"]]), whole=whole,
+                                        pairs=f_pairs is None)
             if whole and d.get("dfdq") is not None:
                 K_pairs = None            # in ``dfdq``
         else:

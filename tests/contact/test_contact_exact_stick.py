@@ -353,9 +353,10 @@ def test_the_forces_only_mortar_kernel_gives_the_bits_of_the_full_one(monkeypatc
     from beamsolver.contact import kernel_jit
     compiled, X, pm = _mortar_inputs(monkeypatch)
     full, forces = compiled(X, pm), kernel_jit.mortar_forces(X, pm)
-    assert set(forces) == set(full) - {"dK", "dS", "dlam_n", "dn"}
+    assert set(forces) == set(full) - {"dK", "dS", "dlam_n", "dn", "G"}     # ``G``: ``A`` contiguous, for the tangent
     for k in forces:
         assert np.array_equal(forces[k], full[k]), k
+    assert np.array_equal(full["G"], full["A"]) and full["G"].flags.c_contiguous
     assert np.abs(forces["A"]).max() > 0 and np.abs(forces["S"]).max() > 0
 
 
@@ -461,3 +462,23 @@ def test_a_second_evaluation_of_the_same_poses_has_the_tangent_without_the_schur
     np.testing.assert_array_equal(again.extra[2], fresh.extra[2])
     A2, b2 = problem.linear_system(again)
     assert np.array_equal(A1.toarray(), A2.toarray()) and np.array_equal(b1, b2)
+
+
+def test_the_mortar_kernel_gives_the_pairs_kernel_without_friction(monkeypatch):
+    """Every active pair a mortar pair: ``_local_blocks`` takes the pairs' forces and point data from the mortar
+    kernel's pass at zero traction (``mortar_terms(pairs=True)``, ``mortar_forces(pairs=True)``) instead of a second
+    pass of the point kernel without friction: the same bits.  At zero traction the whole tangent is the point
+    kernel's without friction, the points out of the normal law (their forces' pass only, zeros) included."""
+    from beamsolver.contact import kernel_jit
+    compiled, X, pm = _mortar_inputs(monkeypatch)
+    X = X.copy()
+    X[::3, 2:, 2, 3] -= 4.0 * R          # every third pair's master moved away: out of the normal law
+    zero = np.zeros((len(X), 3))
+    f, K, ref = kernel_jit.kernel_and_tangent(X, pm, friction=False)
+    assert (ref["lam_n"] == 0).any() and (ref["lam_n"] > 0).any()      # points in and out of the normal law
+    for d in (compiled(X, pm, T=zero, whole=True, pairs=True), kernel_jit.mortar_forces(X, pm, pairs=True)):
+        fp, out = d["pairs"]
+        assert np.array_equal(fp, f)
+        for k in out:
+            assert np.array_equal(out[k], ref[k]), k
+    assert np.array_equal(compiled(X, pm, T=zero, whole=True)["dfdq"], K)

@@ -99,3 +99,68 @@ def test_groups_are_kept_while_the_pairs_nodes_hold():
     held[1] = ~held[1]
     check(slave, rng.uniform(0, 1, P), beam, decl, nodes, n_nodes, 2, held)
     assert keep.builds == 3
+
+
+def _nodal_case(seed, P=50, n_nodes=12):
+    from beamsolver.contact import mortar
+    rng = np.random.default_rng(seed)
+    slave = np.sort(rng.choice(n_nodes, (P, 2), replace=True), axis=1)
+    nodes = np.concatenate([slave, rng.integers(0, n_nodes, (P, 2))], axis=1)
+    G = mortar.groups(slave, rng.uniform(0, 1, P), rng.integers(0, 2, P), np.zeros(P, int), nodes, n_nodes, 2)
+    k = len(G["key"])
+    lam_n = np.where(rng.random(P) < 0.3, 0.0, rng.uniform(0, 1, P))     # points without pressure
+    R = np.linalg.qr(rng.standard_normal((k, 3, 3)))[0]
+    # multipliers from small (sticking) to large (sliding), some zero
+    Lam = rng.standard_normal((k, 3)) * np.where(rng.random(k) < 0.5, 1e-3, 1.0)[:, None]
+    Lam[rng.random(k) < 0.2] = 0.0
+    args = (G, rng.uniform(0.1, 1, P), 1e-3 * rng.standard_normal((P, 3)), lam_n, rng.standard_normal((P, 3)), R, Lam,
+            rng.uniform(0.5, 2, k), 0.3 * np.ones(k), rng.uniform(1, 2, k))
+    return args, rng
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+@pytest.mark.parametrize("variant", ["newton", "updates"])
+def test_compiled_nodal_state_is_the_numpy_form(seed, variant):
+    """``mortar.nodal_state`` (one compiled pass, ``mortar_jit.nodal_state``) against its numpy form: the sums of
+    ``np.bincount`` to the bit, the projected and mapped values to round-off (``np.einsum``'s order of a 3-term sum
+    depends on the machine's vector width), the stick / weak decisions the same; with the updates' active points
+    and with the Newton path's hold stiffness (touching groups without pressure)."""
+    from beamsolver.contact import mortar
+    args, rng = _nodal_case(seed)
+    P, k = len(args[1]), len(args[-1])
+    kw = dict(active=rng.random(P) < 0.7) if variant == "updates" else dict(hold=np.where(rng.random(k) < 0.5, 5.0, 0.0))
+    ref, out = mortar.nodal_state_numpy(*args, **kw), mortar.nodal_state(*args, **kw)
+    assert set(out) == set(ref)
+    for key in ("wn", "wphi", "lamN", "stick", "weak", "m"):
+        assert np.array_equal(out[key], ref[key]), key
+    for key in set(ref) - {"wn", "wphi", "lamN", "stick", "weak", "m"}:
+        scale = np.abs(ref[key]).max()
+        assert np.abs(out[key] - ref[key]).max() <= 1e-14 * scale, key
+    assert ref["stick"].any() and (~ref["stick"]).any()
+    if variant == "newton":
+        assert ref["weak"].any()
+
+
+def test_point_terms_and_point_data_are_the_numpy_forms():
+    """``mortar_jit.point_terms`` (the mortar kernel's ``A``, ``dS``, ``dn``, ``dlam_n`` in one pass) gives the bits of
+    the numpy expressions it replaced; ``mortar_jit.point_data`` the tangential traction and stick flags of
+    ``system._point_data``'s numpy form."""
+    from beamsolver.contact import mortar_jit
+    rng = np.random.default_rng(3)
+    P = 37
+    df, rows = rng.standard_normal((3, P, 4, 6)), rng.standard_normal((P, 12, 24))
+    vec, s = rng.standard_normal((P, 6, 3)), rng.standard_normal((P, 2, 2))[:, 1]
+    t1, t2 = vec[:, 1], vec[:, 2]
+    A, dS, dn, dlam = mortar_jit.point_terms(df, rows, t1, t2, s)
+    assert np.array_equal(A, np.transpose(df, (1, 2, 3, 0)).reshape(P, 24, 3))
+    assert np.array_equal(dS, t1[:, :, None] * rows[:, None, 9] + s[:, 0, None, None] * rows[:, 3:6]
+                          + t2[:, :, None] * rows[:, None, 10] + s[:, 1, None, None] * rows[:, 6:9])
+    assert np.array_equal(dn, rows[:, 0:3]) and np.array_equal(dlam, rows[:, 11])
+    T, n = rng.standard_normal((P, 3)), rng.standard_normal((P, 3))
+    g2 = rng.integers(0, 9, (P, 2))
+    stick, phi = rng.random(9) < 0.5, np.where(rng.random((P, 2)) < 0.2, 0.0, rng.random((P, 2)))
+    lam_t, held = mortar_jit.point_data(T, n, t1, t2, stick, g2, phi)
+    Tt = T - np.sum(T * n, axis=1)[:, None] * n
+    ref = np.stack([np.sum(Tt * t1, axis=1), np.sum(Tt * t2, axis=1)], axis=1)
+    assert np.abs(lam_t - ref).max() <= 1e-15 * np.abs(ref).max()
+    assert np.array_equal(held, (stick[g2] | (phi == 0.0)).all(axis=1)) and held.any() and not held.all()
