@@ -16,12 +16,17 @@ multiplier blocks at every trial; ``condense.ENABLED``: the full bordered system
 the current path.  Each mode runs once to warm up (compilation, caches), then ``--repeat`` times: the best CPU time
 (``time.process_time``: the machine is shared) is reported.  The twisted pair's Newton iterations move with round-off
 (224-314 over variants that differ at round-off only, docs/benchmarks.md): compare the ms per linear solve.
-``--profile``: a cProfile table of one warm exact run per scene (tottime).
+``--profile``: a cProfile table of one warm exact run per scene (tottime).  ``--modes``: the modes to run (default
+all four).  ``--tree PATH`` (repeatable): the same rows, each run in a child process against the beamsolver of the
+source tree ``PATH`` (e.g. the main branch's worktree), interleaved with this tree's rows mode by mode, so that a
+before/after comparison is one run on one (shared) machine: its rows are labelled with the tree.
 """
 import argparse
 import cProfile
 import contextlib
+import os
 import pstats
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -126,12 +131,21 @@ def main():
     ap.add_argument("--scenes", nargs="+", default=list(SCENES))
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--profile", action="store_true")
+    ap.add_argument("--modes", nargs="+", default=list(MODES), choices=MODES)
+    ap.add_argument("--tree", action="append", default=[], help="another source tree to run the same rows against")
+    ap.add_argument("--label", default="", help=argparse.SUPPRESS)      # (a child's rows: the tree's label)
+    ap.add_argument("--no-header", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args()
-    print("| scene | stick | Newton it. | linear solves | time [s] | ms per linear solve | ratio to penalty |")
-    print("|---|---|---:|---:|---:|---:|---:|")
+    if not a.no_header:
+        print("| scene | stick | Newton it. | linear solves | time [s] | ms per linear solve | ratio to penalty |")
+        print("|---|---|---:|---:|---:|---:|---:|", flush=True)
     for scene in a.scenes:
         ref = None
-        for name in MODES:
+        for name in a.modes:
+            for tree in a.tree:         # the other trees' row first, in a child process (its own imports)
+                env = dict(os.environ, PYTHONPATH=str(Path(tree).resolve()))
+                subprocess.run([sys.executable, __file__, "--scenes", scene, "--modes", name, "--repeat", str(a.repeat),
+                                "--label", f" ({Path(tree).resolve().name})", "--no-header"], env=env, check=False)
             try:
                 with mode(name):
                     SCENES[scene]()                             # warm-up
@@ -139,17 +153,18 @@ def main():
                     for _ in range(a.repeat):
                         runs.append(SCENES[scene]() + (SOLVES[0] if scene == "twisted_pair" else 1, dict(PARTS)))
             except Exception as e:      # noqa: BLE001  (a singular bordered matrix: a row of the table)
-                print(f"| {scene} | {name} | failed: {type(e).__name__}: {e} | | | | |", flush=True)
+                print(f"| {scene} | {name}{a.label} | failed: {type(e).__name__}: {e} | | | | |", flush=True)
                 continue
             best = min(runs, key=lambda r: r[1])
             its, solves, t = runs[0][0], runs[0][2], best[1]
             PARTS.update(best[3])
             ms = 1e3 * t / max(solves, 1)
-            ref = ms if ref is None else ref
+            ref = ms if name == "penalty" and ref is None else ref      # (this process's penalty row)
             parts = "" if scene != "bundle19" else (
                 f" (evaluation {PARTS['evaluate']:.3f}, Newton system {PARTS['matrix']:.3f}, factorisation and "
                 f"solve {PARTS['solve']:.3f}; {PARTS['unknowns']} unknowns, {PARTS['nnz']} non-zeros)")
-            print(f"| {scene} | {name} | {its} | {solves} | {t:.3f}{parts} | {ms:.2f} | {ms / ref:.2f} |", flush=True)
+            print(f"| {scene} | {name}{a.label} | {its} | {solves} | {t:.3f}{parts} | {ms:.2f} | {'' if ref is None else f'{ms / ref:.2f}'} |",
+                  flush=True)
         if a.profile:
             with mode("exact"):
                 pr = cProfile.Profile()
