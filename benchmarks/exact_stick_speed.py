@@ -1,6 +1,7 @@
 """Exact stick's cost per Newton iteration against the penalty stick (issue 26, speed): the main job
 (``examples/twisted_pair.py``, 16 steps: Newton iterations, linear solves (every Newton iteration, those of failed
-attempts too), warm solve CPU time, ms per linear solve) and one Newton iteration of the 19-wire bundle
+attempts too), warm solve CPU time, ms per linear solve; its parts: the evaluations (line-search trials and tangents)
+and their mean CPU time, the Newton systems, the factorisations and solves) and one Newton iteration of the 19-wire bundle
 (``scaling.bundle_model`` at ``scaling_scenes.PER_WIRE``, its reference poses: evaluation, Newton system (bordered
 with the multipliers for exact stick), factorisation and solve, CPU s, and these parts).
 
@@ -73,22 +74,41 @@ def mode(name):
 SOLVES = [0]     # linear solves (``Newton.direction`` calls) of the last run
 
 
+SPLIT = {}       # the last twisted_pair run by parts: evaluations (count, CPU s), Newton systems and solves (CPU s)
+
+
 def twisted_pair():
-    """``(Newton iterations, CPU s)`` of the main job's solve; its linear solves in ``SOLVES``."""
+    """``(Newton iterations, CPU s)`` of the main job's solve; its linear solves in ``SOLVES``, its parts in ``SPLIT``:
+    ``evaluations`` (``Problem.evaluate`` calls: line-search trials and tangents), ``evaluate`` (their CPU s),
+    ``system`` (``Problem.linear_system``) and ``direction`` (``Newton.direction``: the Newton system, its
+    factorisation and solve)."""
     import twisted_pair as tp
     model = tp.build()[0]
-    direction = newton.Newton.direction
+    direction, evaluate, linear_system = newton.Newton.direction, Problem.evaluate, Problem.linear_system
+    SPLIT.update(evaluations=0, evaluate=0.0, system=0.0, direction=0.0)
+
+    def timed(f, key, count=None):
+        def g(*a, **k):
+            t = time.process_time()
+            try:
+                return f(*a, **k)
+            finally:
+                SPLIT[key] += time.process_time() - t
+                if count:
+                    SPLIT[count] += 1
+        return g
 
     def counted(self, *a, **k):
         SOLVES[0] += 1
         return direction(self, *a, **k)
-    newton.Newton.direction, SOLVES[0] = counted, 0
+    newton.Newton.direction, SOLVES[0] = timed(counted, "direction"), 0
+    Problem.evaluate, Problem.linear_system = timed(evaluate, "evaluate", "evaluations"), timed(linear_system, "system")
     try:
         t0 = time.process_time()
         sol = bs.solve(model, steps=16)
         return int(sum(s["iterations"] for s in sol.stats)), time.process_time() - t0
     finally:
-        newton.Newton.direction = direction
+        newton.Newton.direction, Problem.evaluate, Problem.linear_system = direction, evaluate, linear_system
 
 
 PARTS = {}       # the last bundle19 iteration by parts (CPU s)
@@ -151,18 +171,20 @@ def main():
                     SCENES[scene]()                             # warm-up
                     runs = []
                     for _ in range(a.repeat):
-                        runs.append(SCENES[scene]() + (SOLVES[0] if scene == "twisted_pair" else 1, dict(PARTS)))
+                        runs.append(SCENES[scene]() + (SOLVES[0] if scene == "twisted_pair" else 1,
+                                                       dict(PARTS) if scene == "bundle19" else dict(SPLIT)))
             except Exception as e:      # noqa: BLE001  (a singular bordered matrix: a row of the table)
                 print(f"| {scene} | {name}{a.label} | failed: {type(e).__name__}: {e} | | | | |", flush=True)
                 continue
             best = min(runs, key=lambda r: r[1])
             its, solves, t = runs[0][0], runs[0][2], best[1]
-            PARTS.update(best[3])
             ms = 1e3 * t / max(solves, 1)
             ref = ms if name == "penalty" and ref is None else ref      # (this process's penalty row)
-            parts = "" if scene != "bundle19" else (
-                f" (evaluation {PARTS['evaluate']:.3f}, Newton system {PARTS['matrix']:.3f}, factorisation and "
-                f"solve {PARTS['solve']:.3f}; {PARTS['unknowns']} unknowns, {PARTS['nnz']} non-zeros)")
+            q = best[3]
+            parts = (f" (evaluation {q['evaluate']:.3f}, Newton system {q['matrix']:.3f}, factorisation and "
+                     f"solve {q['solve']:.3f}; {q['unknowns']} unknowns, {q['nnz']} non-zeros)") if scene == "bundle19" \
+                else (f" ({q['evaluations']} evaluations, {1e3 * q['evaluate'] / max(q['evaluations'], 1):.2f} ms each; "
+                      f"Newton systems {q['system']:.3f}, factorisations and solves {q['direction'] - q['system']:.3f})")
             print(f"| {scene} | {name}{a.label} | {its} | {solves} | {t:.3f}{parts} | {ms:.2f} | {'' if ref is None else f'{ms / ref:.2f}'} |",
                   flush=True)
         if a.profile:
