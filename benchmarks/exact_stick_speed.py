@@ -5,7 +5,8 @@ and their mean CPU time, the Newton systems, the factorisations and solves) and 
 (``scaling.bundle_model`` at ``scaling_scenes.PER_WIRE``, its reference poses: evaluation, Newton system (bordered
 with the multipliers for exact stick), factorisation and solve, CPU s, and these parts).
 
-    python benchmarks/exact_stick_speed.py [--scenes twisted_pair bundle19] [--repeat 3] [--profile]
+    python benchmarks/exact_stick_speed.py [--scenes twisted_pair bundle19 kernel19] [--repeat 3] [--profile]
+        [--modes penalty exact] [--tree ../main]
 
 Four modes: ``penalty``; ``exact (before)``, the exact path on the numpy/scipy oracles that were its code
 before the compiled parts (``mortar.use_numpy_scatter``: ``np.add.at`` scatters and the numpy trial rows;
@@ -20,7 +21,8 @@ the current path.  Each mode runs once to warm up (compilation, caches), then ``
 ``--profile``: a cProfile table of one warm exact run per scene (tottime).  ``--modes``: the modes to run (default
 all four).  ``--tree PATH`` (repeatable): the same rows, each run in a child process against the beamsolver of the
 source tree ``PATH`` (e.g. the main branch's worktree), interleaved with this tree's rows mode by mode, so that a
-before/after comparison is one run on one (shared) machine: its rows are labelled with the tree.
+before/after comparison is one run on one (shared) machine: its rows are labelled with the tree.  ``kernel19``: the
+kernels alone on the bundle's points (``kernel19``), a table of its own, printed first.
 """
 import argparse
 import cProfile
@@ -142,13 +144,73 @@ def bundle19():
     return 1, best
 
 
+def kernel19(label="", repeat=3):
+    """Rows of the kernels alone on the 19-wire bundle's points at its reference poses (the exact path's first
+    evaluation): the point kernel (``kernel_and_tangent`` with friction) on the points exact stick evaluates (every
+    point of the overlap) against the mortar kernel (``mortar_terms`` at the points' tractions, whole tangent) and its
+    compiled pass alone; the penalty's own evaluation has the points of the normal law only (its count printed)."""
+    import scaling_scenes
+    from scaling import bundle_model
+    counts, cap = {}, {}
+    for stick in ("penalty", "exact"):
+        with mode(stick):
+            m, _ = bundle_model(scaling_scenes.PER_WIRE, n_layers=2)
+        problem = Problem.from_model(m)
+        H = problem.system.poses0.copy()
+        problem.begin_step(H, 0.0)
+        spied = {}
+        for name in ("kernel_and_tangent", "mortar_terms"):
+            f = getattr(kernel_jit, name)
+
+            def spy(X, p, *a, _f=f, _n=name, **k):
+                spied[_n] = (X.copy(), dict(p), a, k)
+                return _f(X, p, *a, **k)
+            spied[name + "_orig"] = f
+            setattr(kernel_jit, name, spy)
+        try:
+            problem.evaluate(H, 1.0, tangent=True)
+        finally:
+            for name in ("kernel_and_tangent", "mortar_terms"):
+                setattr(kernel_jit, name, spied.pop(name + "_orig"))
+        key = "kernel_and_tangent" if stick == "penalty" else "mortar_terms"
+        counts[stick] = len(spied[key][0])
+        if stick == "exact":
+            cap = spied[key]
+    X, p, a, k = cap
+    law = a[0] if a and a[0] is not None else k.get("law") or kernel_jit.PENALTY_COULOMB
+    T = k.get("T")
+    P = len(X)
+
+    def best(fn):
+        out = np.inf
+        fn()
+        for _ in range(repeat):
+            t0 = time.process_time()
+            fn()
+            out = min(out, time.process_time() - t0)
+        return out
+    K = np.empty((P, 24, 24))
+    kind, par, has, (HCL, HFK, HLKp), _ = kernel_jit._table(X, p)
+    kern = kernel_jit.make_kernel(law, mortar=True)
+    f, Kq = np.empty((4, P, 4, 6)), np.empty((1, P, 24, 24))
+    sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
+    flags, frames, rows = np.empty((P, 2), dtype=np.bool_), np.empty((P, 4, 4, 4)), np.empty((P, kernel_jit.N_ROWS, 24))
+    t_point = best(lambda: kernel_jit.kernel_and_tangent(X, p, friction=True, law=law, K=K))
+    t_terms = best(lambda: kernel_jit.mortar_terms(X, p, law, T=T, whole=True))
+    t_raw = best(lambda: kern(X, kind, par, has, HCL, HFK, HLKp, f, Kq, sc, vec, two, flags, frames, rows,
+                              np.ascontiguousarray(T)))
+    print(f"| bundle19 kernels{label} | {counts['penalty']} (penalty) / {P} (exact) | {1e3 * t_point:.1f} | "
+          f"{1e3 * t_terms:.1f} ({t_terms / t_point:.2f}x) | {1e3 * t_raw:.1f} ({t_raw / t_point:.2f}x) |", flush=True)
+    return 1, t_terms
+
+
 SCENES = dict(twisted_pair=twisted_pair, bundle19=bundle19)
 MODES = ("penalty", "exact (before)", "exact (eager, full)", "exact")
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--scenes", nargs="+", default=list(SCENES))
+    ap.add_argument("--scenes", nargs="+", default=list(SCENES) + ["kernel19"])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--profile", action="store_true")
     ap.add_argument("--modes", nargs="+", default=list(MODES), choices=MODES)
@@ -156,10 +218,19 @@ def main():
     ap.add_argument("--label", default="", help=argparse.SUPPRESS)      # (a child's rows: the tree's label)
     ap.add_argument("--no-header", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args()
-    if not a.no_header:
+    if not a.no_header and set(a.scenes) - {"kernel19"}:
         print("| scene | stick | Newton it. | linear solves | time [s] | ms per linear solve | ratio to penalty |")
         print("|---|---|---:|---:|---:|---:|---:|", flush=True)
-    for scene in a.scenes:
+    if "kernel19" in a.scenes:
+        if not a.no_header:
+            print("\n| kernels | points evaluated | point kernel [ms] | mortar_terms [ms] | its compiled pass [ms] |")
+            print("|---|---|---:|---:|---:|", flush=True)
+        for tree in a.tree:
+            env = dict(os.environ, PYTHONPATH=str(Path(tree).resolve()))
+            subprocess.run([sys.executable, __file__, "--scenes", "kernel19", "--repeat", str(a.repeat),
+                            "--label", f" ({Path(tree).resolve().name})", "--no-header"], env=env, check=False)
+        kernel19(a.label, a.repeat)
+    for scene in (s for s in a.scenes if s != "kernel19"):
         ref = None
         for name in a.modes:
             for tree in a.tree:         # the other trees' row first, in a child process (its own imports)
