@@ -128,7 +128,7 @@ def return_mapping(trial, cap):
     return lam, stick, C, c
 
 
-def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu, m, active=None, hold=None):
+def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu, m, active=None, hold=None, RL=None):
     """Nodal weighted slip, normal traction and multipliers of the groups ``G`` (``groups``).
 
     ``w`` ``(P,)`` point weights, ``S`` ``(P, 3)`` slips, ``lam_n`` ``(P,)``, ``n`` ``(P, 3)`` normals; per group:
@@ -142,10 +142,11 @@ def nodal_state(G, w, S, lam_n, n, R, Lam, eps, mu, m, active=None, hold=None):
     slip counts (where the traction acts; the mean normal takes every point).  Returns a dict with ``m``, ``u`` (projected), ``lamN``, ``trial``, ``lam``, ``stick``,
     ``C``, ``c``, ``Pi``, ``Q`` (d trial / d nbar) per group and the point tractions ``T`` ``(P, 3)``.
     Compiled (``mortar_jit.nodal_state``: the same sums in the same order); ``use_numpy_scatter``: the numpy form.
+    ``RL``: ``np.einsum("gij,gj->gi", R, Lam)`` if the caller has it.
     """
     if _SCATTER["rows"] is mortar_jit.scatter_rows:
-        st = mortar_jit.nodal_state(G["g"], G["phi"], w, active, S, lam_n, n, np.einsum("gij,gj->gi", R, Lam), eps,
-                                    mu, m, hold)
+        st = mortar_jit.nodal_state(G["g"], G["phi"], w, active, S, lam_n, n,
+                                    np.einsum("gij,gj->gi", R, Lam) if RL is None else RL, eps, mu, m, hold)
         st["u"] = st.pop("up")
         st["m"] = m
         return st
@@ -190,7 +191,10 @@ def multiplier_basis(st):
     complementarity function's derivative ``dC/dv = I - M_P Pi`` is diagonal (``nonlinear.condense``):
     ``diag(1, 0, 0)`` sticking, ``diag(1, 1, 1 - mu lamN / |trial|)`` sliding with ``e1`` along the trial,
     ``I`` without pressure.  Otherwise ``e1`` is the global axis least aligned with ``nu`` projected on the
-    tangent plane (a scene held in a plane keeps its normal axis as a component, whose row is idle)."""
+    tangent plane (a scene held in a plane keeps its normal axis as a component, whose row is idle).  Compiled
+    (``mortar_jit.multiplier_basis``); ``use_numpy_scatter``: this numpy form."""
+    if _SCATTER["rows"] is mortar_jit.scatter_rows:
+        return mortar_jit.multiplier_basis(st["nu"], st["trial"], st["stick"], st["weak"])
     nu = st["nu"]
     a = np.argmin(np.abs(nu), axis=1)
     e1 = -nu[np.arange(len(nu)), a][:, None] * nu

@@ -11,7 +11,7 @@ from ..model.buffers import BufferPool
 
 __all__ = ["scatter_rows", "scatter_block", "scatter_columns", "scatter_rows_numpy", "scatter_block_numpy",
            "scatter_columns_numpy", "trial_rows", "subtract_indexed", "point_terms",
-           "nodal_state", "point_data"]
+           "nodal_state", "point_data", "multiplier_basis"]
 
 
 @jit
@@ -205,6 +205,39 @@ def point_data(T, n, t1, t2, stick, g2, phi):
     lam_t, held = np.empty((P, 2)), np.empty(P, dtype=np.bool_)
     _point_data(_c(T), _c(n), _c(t1), _c(t2), _c(stick, np.bool_), _c(g2, np.int64), _c(phi), lam_t, held)
     return lam_t, held
+
+
+@jit
+def _multiplier_basis(nu, trial, stick, weak, B):
+    for g in range(nu.shape[0]):
+        a = 0                           # ``np.argmin(np.abs(nu))``: the first of equal magnitudes
+        for i in range(1, 3):
+            if abs(nu[g, i]) < abs(nu[g, a]):
+                a = i
+        e0, e1, e2 = -nu[g, a] * nu[g, 0], -nu[g, a] * nu[g, 1], -nu[g, a] * nu[g, 2]
+        if a == 0:
+            e0 += 1.0
+        elif a == 1:
+            e1 += 1.0
+        else:
+            e2 += 1.0
+        t0, t1, t2 = trial[g, 0], trial[g, 1], trial[g, 2]
+        norm = np.sqrt((t0 * t0 + t1 * t1) + t2 * t2)
+        if not stick[g] and not weak[g] and norm > 0.0:
+            e0, e1, e2 = t0, t1, t2
+        n = np.sqrt((e0 * e0 + e1 * e1) + e2 * e2)
+        e0, e1, e2 = e0 / n, e1 / n, e2 / n
+        n0, n1, n2 = nu[g, 0], nu[g, 1], nu[g, 2]
+        B[g, 0, 0], B[g, 1, 0], B[g, 2, 0] = n0, n1, n2
+        B[g, 0, 1], B[g, 1, 1], B[g, 2, 1] = e0, e1, e2
+        B[g, 0, 2], B[g, 1, 2], B[g, 2, 2] = n1 * e2 - n2 * e1, n2 * e0 - n0 * e2, n0 * e1 - n1 * e0
+
+
+def multiplier_basis(nu, trial, stick, weak):
+    """``mortar.multiplier_basis`` compiled (the numpy form's operations per group): ``(n, 3, 3)``."""
+    B = np.empty((len(nu), 3, 3))
+    _multiplier_basis(_c(nu), _c(trial), _c(stick, np.bool_), _c(weak, np.bool_), B)
+    return B
 
 
 @jit

@@ -776,14 +776,15 @@ class ContactSystem(Contribution):
             raise InputError("contact: exact stick needs one contact law over the declarations of a scene, "
                              f"got {len(laws)}")
         law = next(iter(laws.values()))
+        RL = np.einsum("gij,gj->gi", R, Lam)        # the multipliers' tractions (global)
+        # with multipliers as Newton unknowns, the points' tractions: the multipliers interpolated
+        T_pts = np.einsum("pa,pai->pi", G["phi"], RL[G["g"]]) if ssn else None
         if not tangent:
             d = kernel_jit.mortar_forces(X, pm, law, pairs=f_pairs is None)
         elif ssn:         # the points' tractions are known (the multipliers): the tangent at them, two not four
             # (one, the normal law's included, where the pairs' own tangent has no segment ends' terms to keep)
             whole = K_pairs is not None and not self.n_slots
-            d = kernel_jit.mortar_terms(X, pm, law, T=np.einsum("pa,pai->pi", G["phi"],
-                                                                np.einsum("gij,gj->gi", R, Lam)[G["g"]]), whole=whole,
-                                        pairs=f_pairs is None)
+            d = kernel_jit.mortar_terms(X, pm, law, T=T_pts, whole=whole, pairs=f_pairs is None)
             if whole and d.get("dfdq") is not None:
                 K_pairs = None            # in ``dfdq``
         else:
@@ -799,14 +800,14 @@ class ContactSystem(Contribution):
             # groups with a point in the normal law's band: the point law's stiffness floor (mortar.py)
             touch = np.bincount(G["g"].ravel(), weights=np.repeat(d["active"].astype(float), 2), minlength=len(m))
             hold = np.where(touch > 0, mu * PENALTY_T_MIN * self._decl_penalty[gdecl], 0.0)
-            v = np.einsum("gij,gj->gi", R, Lam)
+            v = RL
         # with the updates, the slip is integrated where the normal law acts (the kernel applies the traction
         # there); as Newton unknowns the traction field acts on every point of the overlap
         st = mortar.nodal_state(G, pm["weight"], d["S"], d["lam_n"], d["n"], R, Lam, eps, mu, m,
-                                None if ssn else d["active"], hold=hold)
+                                None if ssn else d["active"], hold=hold, RL=RL)
         mult = None
         if ssn:       # the multiplier itself is the traction (its complementarity function is an equation)
-            st["T"] = np.einsum("pa,pai->pi", G["phi"], v[G["g"]])
+            st["T"] = T_pts
         d["f"] = np.einsum("pij,pj->pi", d["A"], st["T"])
         if tangent:
             f, K, mult = self._mortar_tangent(P, sel, idx, X, pm, G, d, st, R, Lam, eps, mu, law, v, K_pairs)

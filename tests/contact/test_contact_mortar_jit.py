@@ -164,3 +164,23 @@ def test_point_terms_and_point_data_are_the_numpy_forms():
     ref = np.stack([np.sum(Tt * t1, axis=1), np.sum(Tt * t2, axis=1)], axis=1)
     assert np.abs(lam_t - ref).max() <= 1e-15 * np.abs(ref).max()
     assert np.array_equal(held, (stick[g2] | (phi == 0.0)).all(axis=1)) and held.any() and not held.all()
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_compiled_multiplier_basis_is_the_numpy_form(seed):
+    """``mortar.multiplier_basis`` compiled (``mortar_jit.multiplier_basis``) against its numpy form on sticking,
+    sliding and weak groups: the same bits (the condensation's basis: the Newton step depends on it), orthonormal."""
+    from beamsolver.contact import mortar
+    args, rng = _nodal_case(seed)
+    k = len(args[-1])
+    st = mortar.nodal_state(*args, hold=np.where(rng.random(k) < 0.5, 5.0, 0.0))
+    out = mortar.multiplier_basis(st)
+    try:
+        mortar.use_numpy_scatter(True)
+        ref = mortar.multiplier_basis(st)
+    finally:
+        mortar.use_numpy_scatter(False)
+    assert np.array_equal(out, ref)
+    assert np.abs(np.einsum("gji,gjk->gik", out, out) - np.eye(3)).max() < 1e-14
+    slide = ~st["stick"] & ~st["weak"]
+    assert slide.any() and st["stick"].any() and st["weak"].any()
