@@ -1157,6 +1157,8 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
             rows[10, k] = G[(G_DSLIP + 1) * W + k]
             rows[11, k] = G[G_DLAM * W + k]
     contracted = tangent and K.shape[0] < 4       # 2: at T = 0 and at Tp; 1: at Tp only
+    _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2)     # (the geometry's: once, not per traction)
+    F, lt, stick = (0.0, 0.0, 0.0), (0.0, 0.0), True
     for step in range(5 if contracted else 4):
         q = step if not contracted else (0, 4, 1, 2, 3)[step]         # the unit tractions last (the point data)
         lamp = (1.0 if q == 1 else 0.0, 1.0 if q == 2 else 0.0, 1.0 if q == 3 else 0.0) if q < 4 else \
@@ -1183,7 +1185,6 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
         if Kq.shape[1] == 0:        # forces only: the values of the lines below, no gradient rows
             lt, stick = (dot(lamp, t1), dot(lamp, t2)), True
             F = add(scale(-wgt * lam, n), add(scale(wgt * lt[0], t1), scale(wgt * lt[1], t2)))
-            _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2)
             mF = cross(n, F)
             _wrench_value(RC, F, scale(R1, mF), v[0, V_WR])
             _wrench_value(RF, scale(-1.0, F), scale(R2, mF), v[1, V_WR])
@@ -1194,18 +1195,18 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
                     G[(G_DF + i) * W + k] = -wgt * (n[i] * G[G_DLAM * W + k] + lam * G[(G_DN + i) * W + k])
             lt, Dlt, stick = _friction_given(slip, lamp, t1, t2, lam, par, G)
             F = _add_friction_force(F, G, wgt, lt, Dlt, t1, t2)
-            _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2)
             mF = cross(n, F)
             _moment_gradient(n, F, G)
             _wrench(RC, F, False, scale(R1, mF), R1, G, G_VC, G_DWC, v[0, V_WR])
             _wrench(RF, scale(-1.0, F), True, scale(R2, mF), R2, G, G_VF, G_DWF, v[1, V_WR])
         _nodal(u1, w1, xi1, co1[0], co1[1], S1, v[0], cache[0], G, G_DWC, G_DH1, G_DXI1, fq, Kq, 0)
         _nodal(u2, w2, xi2, co2[0], co2[1], S2, v[1], cache[1], G, G_DWF, G_DH2, G_DXI2, fq, Kq, 2)
-        sc[0], sc[1], sc[2], sc[3] = gap, lam, xi1, xi2
-        for i in range(3):
-            vec[0, i], vec[1, i], vec[2, i], vec[3, i], vec[4, i], vec[5, i] = n[i], t1[i], t2[i], xC[i], xF[i], F[i]
-        two[0, 0], two[0, 1], two[1, 0], two[1, 1] = lt[0], lt[1], slip[0], slip[1]
-        flags[0], flags[1] = active, stick
+    # the point data as the last traction's pass left them (written once)
+    sc[0], sc[1], sc[2], sc[3] = gap, lam, xi1, xi2
+    for i in range(3):
+        vec[0, i], vec[1, i], vec[2, i], vec[3, i], vec[4, i], vec[5, i] = n[i], t1[i], t2[i], xC[i], xF[i], F[i]
+    two[0, 0], two[0, 1], two[1, 0], two[1, 1] = lt[0], lt[1], slip[0], slip[1]
+    flags[0], flags[1] = active, stick
     for q in range(1, 4):               # the differences to T = 0: the friction's parts (``mortar_terms``)
         fq, f0 = f[q, p], f[0, p]
         for i in range(4):
