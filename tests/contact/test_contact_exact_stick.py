@@ -163,7 +163,7 @@ def test_shear_lag_does_not_depend_on_the_penalty():
     N = [_shear_lag(10, penalty_t=pt)[4] for pt in (None, 1e8, 1e10)]
     assert np.abs(N[0] - N[1]).max() < 1e-3 * 15.0
     assert np.abs(N[0] - N[2]).max() < 1e-3 * 15.0
-    sol, wire, _ = shear_lag.main(n_wire=10)
+    sol, wire, _ = shear_lag.main(n_wire=10, stick="penalty")
     assert np.abs(shear_lag.axial_force(sol, wire)[1] - N[0]).max() > 1.0
 
 
