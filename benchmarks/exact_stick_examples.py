@@ -51,8 +51,19 @@ def _capstan():
     return capstan.main()[-1]
 
 
+def _twisted_pair_extreme():
+    import twisted_pair_extreme
+    return bs.solve(twisted_pair_extreme.build()[0], steps=16)
+
+
+def _plectoneme():
+    import plectoneme
+    return bs.solve(plectoneme.build()[0], **plectoneme.solve_options)
+
+
 SCENES = dict(twisted_pair=_twisted_pair, three_wires=_three_wires, shear_lag=_shear_lag,
-              contact_patch=_contact_patch, rolling=_rolling, capstan=_capstan)
+              contact_patch=_contact_patch, rolling=_rolling, capstan=_capstan,
+              twisted_pair_extreme=_twisted_pair_extreme, plectoneme=_plectoneme)
 
 
 def run(scene, stick, c=None, integration=None):

@@ -828,7 +828,7 @@ class ContactSystem(Contribution):
             mortar.add_pairs(G, f, None, f_pairs.reshape(-1, 24)[idx], None)
             folded = idx
         return dict(members=G["members"], f=f, K=K, key=G["key"], decl=gdecl,
-                    lam=v if ssn else st["lam"], u=st["u"], stick=st["stick"], R=R,
+                    lam=v if ssn else st["lam"], u=st["u"], stick=st["stick"], R=R, m=m, lamN=st["lamN"],
                     mult=mult, folded=folded, f_own=own, pair_f=f_pairs.reshape(-1, 4, 6) if f_pairs is not None else None)
 
     def _nodal_weights(self, G, e):
@@ -1137,10 +1137,11 @@ class ContactSystem(Contribution):
         P, sel, po = self._state(H)
         if P is None or len(sel) == 0:
             self.history.commit(self._decl_mu)
-            self._last = None
+            self._last = self._last_mortar = None
             return
         p, out = po
         m = out.get("mortar")
+        self._last_mortar = m
         tmult = None if m is None else (m["key"], np.einsum("gji,gj->gi", m["R"], m["lam"]))
         keys = P.key[sel]
         order = np.argsort(keys)
@@ -1154,6 +1155,26 @@ class ContactSystem(Contribution):
                         xi2=out["xi2"][order], lam_t=lam_vec[order])
         self.history.commit(self._decl_mu, friction, tmult)
         self._last = (P, sel, p, out, (np.array(H), HC, HF))
+
+    def nodal_results(self):
+        """Exact stick's nodal table of the committed state (``Solution.extra``, one entry per step), or None
+        without mortar groups: per group (a slave node against a master beam) ``mortar_node`` and
+        ``mortar_master_beam`` (ids), ``mortar_normal_force`` ``m lamN`` and ``mortar_tangential_force`` (g, 3)
+        ``m lam`` (global; forces on the slave: the nodal weight ``m`` times the weighted tractions, the quantities
+        whose Coulomb cone the law enforces, ``|m lam| <= mu m lamN``), ``mortar_status`` (``OPEN``,
+        ``STICK``, ``SLIP``) and ``mortar_slip`` ``|u|``, the weighted slip of the step (a length)."""
+        m = getattr(self, "_last_mortar", None)
+        if m is None:
+            return None
+        n_nodes = len(self.sys.poses0)
+        key = np.asarray(m["key"], dtype=np.int64)
+        lamN = np.maximum(m["lamN"], 0.0)
+        mu = self._decl_mu[m["decl"]]
+        stick = m["stick"] & (lamN > 0) & (mu > 0)
+        return dict(mortar_node=(key // self.n_beams) % n_nodes, mortar_master_beam=key % self.n_beams,
+                    mortar_normal_force=m["m"] * lamN, mortar_tangential_force=m["m"][:, None] * m["lam"],
+                    mortar_status=np.where(lamN > 0, np.where(stick, STICK, SLIP), OPEN).astype(np.int8),
+                    mortar_slip=np.linalg.norm(m["u"], axis=1))
 
     def results(self, H):
         """Contact point table of the committed state (dict of arrays).

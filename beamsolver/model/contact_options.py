@@ -121,8 +121,9 @@ class ContactOptions:
         "element length): it changes the path of the iterations, not the answer", kernel_none=np.nan)
     slip_tolerance: float = option(
         SLIP_TOLERANCE, _real("slip_tolerance", above=0.0),
-        "elastic slip at the onset of sliding, in slave element lengths (default 0.005, Abaqus' "
-        "default); the tangential stiffness of a point is then ``mu lam_N / (slip_tolerance L_e)``")
+        "with ``stick=\"penalty\"`` (and point pairs): elastic slip at the onset of sliding, in slave element "
+        "lengths (default 0.005, Abaqus' default); the tangential stiffness of a point is then "
+        "``mu lam_N / (slip_tolerance L_e)``")
     tolerance: Optional[float] = option(
         None, _real("tolerance", above=0.0, none=True),
         "penetration below which augmented-Lagrangian updates stop (default None: pure penalty, "
@@ -150,13 +151,15 @@ class ContactOptions:
         "(``ADJUST``); 0: no adjustment; the count and the largest overlap adjusted are in "
         "``Solution.stats[0][\"adjusted\"]``; docs/theory_adjust.md)", kernel_none=np.nan)
     stick: str = option(
-        "penalty", _stick,
-        "``\"penalty\"`` (default: the tangential penalty above, per Gauss point: sticking points slip "
-        "elastically by ``lam_T / penalty_t``, up to ``slip_tolerance`` element lengths, an error in the "
-        "answer) or ``\"exact\"`` (line contact's tangential traction is a field of nodal multipliers on "
-        "the slave beam, Newton unknowns with their Coulomb complementarity functions: a sticking node's "
-        "weighted slip is below ``stick_tolerance``, whatever ``penalty_t``; point and orthogonal pairs "
-        "keep the point law; docs/theory_mortar.md)")
+        "exact", _stick,
+        "``\"exact\"`` (default: line contact's tangential traction is a field of nodal multipliers on the "
+        "slave beam, Newton unknowns with their Coulomb complementarity functions: a sticking node's weighted "
+        "slip is below ``stick_tolerance``, whatever ``penalty_t``; the nodal forces are in ``Solution.extra"
+        "[\"mortar_*\"]``; point and orthogonal pairs keep the point law; docs/theory_mortar.md) or "
+        "``\"penalty\"`` (the tangential penalty above, per Gauss point: cheaper per Newton iteration, 1.5-7x "
+        "fewer iterations on the contact examples, but sticking points slip elastically by ``lam_T / penalty_t``, "
+        "up to ``slip_tolerance`` element lengths, an error in the answer: a tensioned strand bent with the "
+        "default ``slip_tolerance`` never sticks, its bending stiffness 4x low; docs/benchmarks.md)")
     stick_tolerance: Optional[float] = option(
         None, _real("stick_tolerance", above=0.0, none=True),
         "that slip, a length (default ``1e-8 (R1 + R2)`` (``STICK_TOLERANCE``) of the largest radii "

@@ -48,6 +48,7 @@ one sparse product, see ``_poor``, and re-analyses once before giving up).
 Threads: PARDISO uses MKL's OpenMP threads (``MKL_NUM_THREADS``), SuperLU one.
 """
 import copy
+import os
 import weakref
 
 import numpy as np
@@ -89,9 +90,31 @@ class SingularMatrixError(RuntimeError):
 _PYPARDISO = []
 
 
+def _mkl_rt():
+    """Where MKL's ``mkl_rt`` library is, looked up in ``lib`` (``Library/bin``) of ``sys.prefix`` and of the
+    user base without recursion (None if not there).  pypardiso's own look-up, when ``PYPARDISO_MKL_RT`` is not
+    set and ``find_library`` fails (pip installs), globs ``sys.prefix/lib*/**`` recursively, site-packages
+    included, twice per process (its import makes a solver, ``_pardiso_handle`` another): 0.6-0.9 s of start-up
+    here (``benchmarks/jit_startup.py``)."""
+    import glob
+    import site
+    import sys
+    for base in (sys.prefix, getattr(site, "USER_BASE", None) or ""):
+        for sub, pattern in (("lib", "libmkl_rt.so*"), ("lib", "libmkl_rt*.dylib"), ("Library/bin", "mkl_rt*.dll")):
+            found = sorted(glob.glob(os.path.join(base, sub, pattern)), key=len)
+            if found:
+                return found[0]
+    return None
+
+
 def _pypardiso():
-    """The pypardiso module, or None if it is not installed (looked up once)."""
+    """The pypardiso module, or None if it is not installed (looked up once; MKL's library found for it,
+    ``_mkl_rt``, unless ``PYPARDISO_MKL_RT`` says where)."""
     if not _PYPARDISO:
+        if not os.environ.get("PYPARDISO_MKL_RT"):
+            path = _mkl_rt()
+            if path is not None:
+                os.environ["PYPARDISO_MKL_RT"] = path
         try:
             import pypardiso
         except ImportError:

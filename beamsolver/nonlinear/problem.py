@@ -77,6 +77,7 @@ class Problem:
         self.contributions = list(contributions)
         self._lf = (None, np.zeros(0))
         self._bordered = Bordered()      # the bordered matrix's pattern, kept across Newton iterations
+        self.extras = {}                 # the last ``commit``'s per-step values besides the record
 
     @classmethod
     def from_model(cls, model, check_rigid_modes=True):
@@ -351,13 +352,16 @@ class Problem:
         return "; ".join(texts) if texts else None
 
     def commit(self, H):
-        """Accept the step at ``H``; returns the contributions' record of it (or ``None``)."""
-        record = None
+        """Accept the step at ``H``; returns the contributions' record of it (or ``None``).  Their per-step
+        values of other shapes (exact stick's nodal table) are in ``extras`` then."""
+        record, self.extras = None, {}
         for c in self.contributions:
             c.commit(H)
             res = c.results(H)
             if res is not None:
                 record = res if record is None else {**record, **res}
+            nodal = getattr(c, "nodal_results", None)
+            self.extras.update((nodal() if nodal is not None else None) or {})
         return record
 
     def get_state(self):

@@ -226,7 +226,12 @@ class Solution:
                          ``normal`` (k, 3)
     ``extra``            dict ``name -> list`` of ``s`` per-step values (arrays or numbers; ``None``
                          where a step has none): room for per-step data of any kind (buckling modes,
-                         path-following data) without a new field
+                         path-following data) without a new field; with exact stick
+                         (``add_contact(stick="exact")``) the nodal table of the mortar groups,
+                         ``mortar_node``, ``mortar_master_beam``, ``mortar_normal_force``,
+                         ``mortar_tangential_force`` (g, 3), ``mortar_status``, ``mortar_slip``
+                         (``contact.system.ContactSystem.nodal_results``): the forces whose Coulomb
+                         cone the law holds (the point table's tractions are interpolated from them)
     ``description``      arrays describing the model (``describe_model``)
     ``converged``        bool; ``message`` (str) why not, and warnings
     ``off_equilibrium``  bool: the run reached its end but its final state is not an equilibrium of

@@ -445,7 +445,8 @@ class ArcLengthRun(Run):
         stats["t"] = t
         if self.range is not None:
             self.range.check(ev.state.strain, stats, len(sol))
-        sol.append(t, H, sys.reactions(H, ev.r), ev.state.sigma, ev.state.strain, stats, record)
+        sol.append(t, H, sys.reactions(H, ev.r), ev.state.sigma, ev.state.strain, stats, record,
+                   problem.extras or None)
         sol.resume = self._resume()
         ds = next_arc_length(self.ds, stats["iterations"], self.arc.target_iterations, stats["cutbacks"] > 0,
                              stats["linearised"] > 0)

@@ -221,7 +221,8 @@ class Run:
             stats["adjusted"] = dict(adjusted)
             log.info("t = %.6g: %d point(s) of reference overlap adjusted to touching, strain-free (largest "
                      "overlap %.3g)", t_start, adjusted["count"], adjusted["largest"])
-        self.sol.append(t_start, H, sys.reactions(H, ev0.r), ev0.state.sigma, ev0.state.strain, stats, record)
+        self.sol.append(t_start, H, sys.reactions(H, ev0.r), ev0.state.sigma, ev0.state.strain, stats, record,
+                        problem.extras or None)
         self.H = H
         if self.writer is not None:
             self.writer.write(self.sol, 0)
@@ -460,7 +461,8 @@ class Run:
             sol.contact_state = problem.get_state()
         if self.range is not None:
             self.range.check(ev.state.strain, stats, len(sol))
-        sol.append(t_next, H, sys.reactions(H, ev.r), ev.state.sigma, ev.state.strain, stats, record)
+        sol.append(t_next, H, sys.reactions(H, ev.r), ev.state.sigma, ev.state.strain, stats, record,
+                   problem.extras or None)
         sol.resume = dict(t0=float(self.grid[0]), t_end=float(self.grid[-1]), steps=len(self.grid) - 1,
                           dt=float(dt), easy=int(easy), **self._memory_state())
         self.H, self.t, self.k, self.dt, self.easy = H, t, k, dt, easy

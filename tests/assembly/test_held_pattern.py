@@ -134,7 +134,8 @@ def test_newton_steps_keep_one_pattern_and_the_same_results(monkeypatch):
     """The main job (two wires twisted, 16 steps) solved with the held pattern and with the exact one: the
     same Newton iterations in every step and the same poses; the held tangents keep one pattern over the
     whole run (the wires touch along their length from the start), the exact ones change 60 times in 159
-    tangents as contact points enter and leave."""
+    tangents as contact points enter and leave.  (The penalty stick: exact stick's iteration counts move with
+    round-off, which another pivot order gives.)"""
     import twisted_pair
     import beamsolver as bs
     from beamsolver.assembly import system as system_mod
@@ -151,7 +152,7 @@ def test_newton_steps_keep_one_pattern_and_the_same_results(monkeypatch):
     for hold in (False, True):
         monkeypatch.setattr(system_mod, "HOLD_PATTERN", hold)
         patterns.clear()
-        model, _, _ = twisted_pair.build(n_elements=16, turns=2.0)
+        model, _, _ = twisted_pair.build(n_elements=16, turns=2.0, stick="penalty")
         sols[hold] = bs.solve(model, steps=16, verbose=False)
         changes[hold] = sum(a != b for a, b in zip(patterns, patterns[1:]))
     assert [s["iterations"] for s in sols[True].stats] == [s["iterations"] for s in sols[False].stats]

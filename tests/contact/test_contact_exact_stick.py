@@ -163,7 +163,7 @@ def test_shear_lag_does_not_depend_on_the_penalty():
     N = [_shear_lag(10, penalty_t=pt)[4] for pt in (None, 1e8, 1e10)]
     assert np.abs(N[0] - N[1]).max() < 1e-3 * 15.0
     assert np.abs(N[0] - N[2]).max() < 1e-3 * 15.0
-    sol, wire, _ = shear_lag.main(n_wire=10)
+    sol, wire, _ = shear_lag.main(n_wire=10, stick="penalty")
     assert np.abs(shear_lag.axial_force(sol, wire)[1] - N[0]).max() > 1.0
 
 
@@ -482,3 +482,30 @@ def test_the_mortar_kernel_gives_the_pairs_kernel_without_friction(monkeypatch):
         for k in out:
             assert np.array_equal(out[k], ref[k]), k
     assert np.array_equal(compiled(X, pm, T=zero, whole=True)["dfdq"], K)
+
+
+def test_nodal_table_of_exact_stick_is_in_the_solution_and_its_file(tmp_path):
+    """``Solution.extra["mortar_*"]``: per slave node and master beam the nodal forces whose cone the law
+    holds; on the shear lag (10 elements) the slipping nodes are those of the pulled end, on the cone to
+    Newton's tolerance, the sticking ones inside it with a weighted slip below ``stick_tolerance``; the
+    forces sum to the pull; saved and loaded as they are.  The penalty stick has no such table."""
+    sol, wire, a, x, N = _shear_lag(10)
+    ex = sol.extra
+    node, fn, ft = ex["mortar_node"][-1], ex["mortar_normal_force"][-1], ex["mortar_tangential_force"][-1]
+    st, slip = ex["mortar_status"][-1], ex["mortar_slip"][-1]
+    assert len(node) == len(fn) == len(ft) == len(st) == len(slip) > 0
+    assert set(node) <= set(wire.nodes)
+    mag = np.linalg.norm(ft, axis=1)
+    xs = sol.poses[0][node, 0, 3]
+    assert (st == 2).any() and (st == 1).any()
+    assert xs[st == 2].min() > xs[st == 1].max()                      # the slip zone at the pulled end
+    np.testing.assert_allclose(mag[st == 2], 0.3 * fn[st == 2], rtol=1e-6)
+    assert np.all(mag[st == 1] < 0.3 * fn[st == 1])
+    assert slip[st == 1].max() <= 1e-8 * (0.01 + 0.01)                 # STICK_TOLERANCE (R1 + R2)
+    assert abs(ft[:, 0].sum()) == pytest.approx(15.0, rel=1e-3)     # the pull, carried by friction
+    sol.save(tmp_path / "s.npz")
+    back = bs.load(tmp_path / "s.npz")
+    for k in ("mortar_node", "mortar_status", "mortar_tangential_force"):
+        np.testing.assert_array_equal(back.extra[k][-1], ex[k][-1])
+    pen = shear_lag.main(n_wire=10, stick="penalty")[0]
+    assert not any(k.startswith("mortar_") for k in pen.extra)

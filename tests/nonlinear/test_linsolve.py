@@ -295,3 +295,22 @@ def test_saddle_point_systems_solve_on_every_backend(backend):
         y = solver.factorize(sp.csc_matrix(K)).solve(b[:n])
         assert (ps.iparm[7], ps.iparm[9]) != (linsolve.SADDLE_REFINE, linsolve.SADDLE_PERTURB)
         assert backward(K, y, b[:n]) <= 1e-14
+
+
+def test_mkl_library_is_found_without_pypardisos_recursive_search():
+    """``linsolve._mkl_rt`` finds the MKL library pypardiso loads (a look-up in ``lib`` instead of pypardiso's
+    recursive glob of the whole prefix, 1.0-1.3 s wall of start-up per process), in a subprocess so the import
+    is the first; the solve works with it (the time: ``python benchmarks/jit_startup.py``)."""
+    pytest.importorskip("pypardiso")
+    import subprocess
+    import sys
+    code = ("import os, time, numpy as np, scipy.sparse as sp\n"
+            "os.environ.pop('PYPARDISO_MKL_RT', None)\n"
+            "from beamsolver.nonlinear import linsolve\n"
+            "t = time.perf_counter(); m = linsolve._pypardiso(); dt = time.perf_counter() - t\n"
+            "f = linsolve.Solver('pardiso').factorize(sp.csc_matrix(np.diag([2.0, 4.0])))\n"
+            "print(os.environ.get('PYPARDISO_MKL_RT'), f.solve(np.array([2.0, 4.0])).tolist(), dt)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    path, x = out[0], out[1:3]
+    assert "mkl_rt" in path and path == linsolve._mkl_rt()
+    assert x == ["[1.0,", "1.0]"]

@@ -141,9 +141,10 @@ def test_slip_steps_regrow_after_a_forced_cut_back():
     17 states, 135 iterations) with its first step forced to fail: the steps at half size then
     take a steady 10-14 iterations (slip), never as few as ``EASY_ITERATIONS``, and no step had
     been taken at the user's size: with ``easy_limit`` alone the step stayed halved until the
-    iterations fell to 6 near the end (25 states, 214 iterations).  Steady steps regrow."""
+    iterations fell to 6 near the end (25 states, 214 iterations).  Steady steps regrow.  (The penalty
+    stick: the scene is one that is never cut back.)"""
     from twisted_pair_extreme import build
-    sol = bs.solve(build()[0], steps=16, callback=_forced_cut_back())
+    sol = bs.solve(build(stick="penalty")[0], steps=16, callback=_forced_cut_back())
     assert sol.converged and sol.times[-1] == 1.0
     assert sum(s["cutbacks"] for s in sol.stats) == 1 and sol.stats[1]["cutbacks"] == 1
     half = [s["dt"] < 0.75 / 16 for s in sol.stats[1:]]
@@ -159,7 +160,7 @@ def test_a_restart_keeps_the_previous_iterations_of_steady():
     the restart needs the previous step's iterations (``resume["previous"]``) to regrow where
     the whole run did."""
     from twisted_pair_extreme import build
-    model = build()[0]
+    model = build(stick="penalty")[0]
     calls, force = [], _forced_cut_back()
 
     def record(info):
