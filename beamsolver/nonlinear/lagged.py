@@ -124,6 +124,21 @@ class LaggedFactor:
         self.direct = solver.fresh(self.K)
         return self.direct.solve(b)
 
+    def apply(self, b):
+        """The preconditioner's solve (the last fresh factor's ``apply``): an outer iteration that uses this
+        factor as its own preconditioner (``augmented``) reports back with ``done``."""
+        base = self.solver._base
+        if base is None:                      # (a saddle system was factorised since: no preconditioner kept)
+            if self.direct is None:
+                self.direct = self.solver.fresh(self.K)
+            return self.direct.apply(b)
+        return base.apply(b)
+
+    def done(self, iterations, converged):
+        """Bookkeeping of an outer iteration preconditioned by ``apply`` (``Solver.lagged_done``)."""
+        self.iterations = iterations
+        self.solver.lagged_done(iterations, self.budget, converged)
+
     @property
     def factor_nnz(self):
         """Entries of the preconditioner's factor (0 once it is gone)."""
@@ -132,7 +147,7 @@ class LaggedFactor:
 
     def __getattr__(self, name):
         """``det_sign`` (and any other attribute of a factor): from a fresh factorisation of ``K``."""
-        if name in ("direct", "solver", "K", "budget", "_preconditioner") or name.startswith("__"):
+        if name in ("direct", "solver", "K", "budget", "_preconditioner", "iterations") or name.startswith("__"):
             raise AttributeError(name)
         if self.direct is None:
             base = self.solver._base

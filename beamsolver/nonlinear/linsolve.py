@@ -126,14 +126,16 @@ def factorize(K, backend=None):
     return Solver(backend).factorize(K)
 
 
-def factorize_tangent(K, solver=None, what="singular tangent", saddle=False):
+def factorize_tangent(K, solver=None, what="singular tangent", saddle=False, fresh=False):
     """``solver.factorize(K)`` (default a fresh ``Solver()``) as a factor whose singularity, found
     by the factorisation or by a solve (pardiso), is the typed step failure
     ``failures.SingularTangent(f"{what} ({error})")``: the one wrapper of the Newton loop, the
     arc-length solves and the branch switch.  The factor keeps the back-end's ``det_sign`` and
-    ``factor_nnz`` where it has them.  ``saddle``: ``K`` is a saddle-point system (``Solver.factorize``)."""
+    ``factor_nnz`` where it has them.  ``saddle``: ``K`` is a saddle-point system (``Solver.factorize``);
+    ``fresh``: not lagged (``Solver.fresh``)."""
+    solver = solver if solver is not None else Solver()
     try:
-        return _Typed((solver if solver is not None else Solver()).factorize(K, saddle=saddle), what)
+        return _Typed(solver.fresh(K) if fresh else solver.factorize(K, saddle=saddle), what)
     except SingularMatrixError as e:
         raise SingularTangent(f"{what} ({e})") from None
 
