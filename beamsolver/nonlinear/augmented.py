@@ -35,12 +35,13 @@ from .lagged import gmres
 from .linsolve import factorize_tangent
 from ..failures import SingularTangent
 
-__all__ = ["Augmented", "weights", "RATIO", "RTOL", "MAX_ITERATIONS", "ENABLED"]
+__all__ = ["Augmented", "weights", "RATIO", "RTOL", "MAX_ITERATIONS", "MIN_UNKNOWNS", "ENABLED"]
 
 RATIO = 1e6            # |E| times the constraint's stiffness over the structure's (answers do not depend on it)
 RTOL = 1e-10           # |M x - b| / |b| the iterations must reach (``lagged.LAG_RTOL``; the direct saddle solve: 2e-9 on the 19-wire bundle)
 MAX_ITERATIONS = 30    # GMRES iterations with a fresh factorisation of ``A`` before the direct fallback
 POLISH = True          # after GMRES, one more step of the preconditioned iteration (the multipliers' last digits)
+MIN_UNKNOWNS = 1_500   # smaller systems are factorised directly (``linsolve.AUTO_MIN_UNKNOWNS``: SuperLU, ~1 ms)
 ENABLED = True         # False: ``Newton.direction`` solves the saddle system directly (benchmarks: before)
 STATS = ("saddle_augmented", "saddle_iterations", "saddle_fallbacks")
 

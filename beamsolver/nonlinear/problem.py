@@ -284,17 +284,19 @@ class Problem:
         return A, np.concatenate([rhs, rc])
 
     def augments(self, ev):
-        """Whether ``ev``'s Newton system is solved through ``augmented_system`` (``augmented.ENABLED``, the
-        condensed multiplier path with kept components)."""
+        """Whether ``ev``'s Newton system is solved through ``augmented_system``: ``augmented.ENABLED``, the
+        condensed multiplier path, at least ``augmented.MIN_UNKNOWNS`` free unknowns (smaller saddle systems are
+        factorised directly: as fast per solve, docs/benchmarks.md)."""
         mu = ev.mult
         return (augmented_.ENABLED and mu is not None and condense_.ENABLED and mu.get("B") is not None
-                and "offset" in mu and "Kql" in mu)
+                and "offset" in mu and "Kql" in mu and self.system.n_free >= augmented_.MIN_UNKNOWNS)
 
     def augmented_system(self, ev, dz_c=None):
         """The condensed Newton system of ``ev`` (``linear_system``) as an ``augmented.Augmented``: the tangent
-        ``K'`` (kept, for products) and ``A = K' + Kq E Kl`` (``E``: ``augmented.weights``; added into ``ev``'s
-        values, in place, once), the kept rows' couplings and right-hand sides; its ``solve(solver)`` gives
-        ``linear_system``'s solution.  Needs the condensed path (``augments``)."""
+        ``K'`` (kept, for products) and ``A = K' + Kq E Kl`` (``E``: ``augmented.weights``; added to ``K'``'s values
+        on the held pattern, ``System.add_products``, else into ``ev``'s values, in place, and assembled again), the
+        kept rows' couplings and right-hand sides; its ``solve(solver)`` gives ``linear_system``'s solution.  Needs
+        the condensed path (``augments``); built once per evaluation, the right-hand sides per ``dz_c``."""
         mu = ev.mult
         sp = self._split(ev)
         if sp is None:
@@ -307,24 +309,29 @@ class Problem:
         idle = (free_row <= IDLE * max(free_row.max(initial=0.0), 1e-300)) & \
             (own <= IDLE * max(own.max(initial=0.0), 1e-300))
         first = "E" not in mu
-        f = self._force_rhs(ev, dz_c, sp)        # (before the augmentation, which the coupling would read)
+        f = self._force_rhs(ev, dz_c, sp)        # (before an augmentation in the values, which the coupling reads)
         if first:
-            mu["Kp"] = self.tangent(ev)
+            Kp = mu["Kp"] = self.tangent(ev)
             E, p22 = augmented_.weights(Kq, Kl, free, self._element_diagonal(ev)[mu["dofs"][g]], d, idle)
-            w = np.zeros(sp.d.shape)
-            w[g, j] = -E
-            condense_.add_products(ev.extra[2], mu["offset"], sp, w)
             mu["E"], mu["p22"] = E, p22
+            A = self.system.add_products(Kp, mu["dofs"][g], Kq, Kl, E)     # on the held pattern: no assembly
+            if A is None:
+                w = np.zeros(sp.d.shape)
+                w[g, j] = -E
+                condense_.add_products(ev.extra[2], mu["offset"], sp, w)
+                mu["in_values"] = True
+                A = self.tangent(ev)
+            mu["A"] = A
         E, p22 = mu["E"], mu["p22"]
         gv = -sp.C[g, j]
         gv[idle] = -sp.b[g, j][idle]
         if dz_c is not None:
             pc = np.einsum("ua,ua->u", Kl, self._prescribed_slots(mu, dz_c)[g])
             gv = gv - pc
-            if not first:       # the coupling read from the augmented values holds Kq E Kl_c dz_c
+            if not first and mu.get("in_values"):       # the coupling read from the values holds Kq E Kl_c dz_c
                 f = f + np.bincount(rows[free], weights=(Kq * (E * pc)[:, None])[free], minlength=len(f))
         Kp = mu["Kp"]
-        return augmented_.Augmented(Kp, self.tangent(ev), f, gv, Kq, Kl, rows, np.where(idle, 1.0, d), E, p22, idle,
+        return augmented_.Augmented(Kp, mu["A"], f, gv, Kq, Kl, rows, np.where(idle, 1.0, d), E, p22, idle,
                                     direct=lambda: self._condensed(ev, Kp, f, dz_c))
 
     def _element_diagonal(self, ev):

@@ -122,6 +122,11 @@ def test_the_augmented_matrix_has_the_tangents_pattern():
     aug = problem.augmented_system(ev)
     for A in (first, aug.A, aug.K):
         assert A.shape == K.shape and np.array_equal(A.indptr, K.indptr) and np.array_equal(A.indices, K.indices)
+    # the products added on the held pattern (``System.add_products``) are Kq E Kl
+    dense = np.zeros(K.shape)
+    for u in range(len(aug.E)):
+        np.add.at(dense, np.ix_(aug.rows[u], aug.rows[u]), aug.E[u] * np.outer(aug.Kq[u], aug.Kl[u]))
+    assert np.abs((aug.A - aug.K).toarray() - dense).max() <= 1e-12 * np.abs(dense).max()
     M, b = problem.linear_system(ev)
     dq, dl = problem.split_solution(ev, spla.spsolve(M.tocsc(), b))
     assert _close(dq, dq0) and _close(dl, dl0)
