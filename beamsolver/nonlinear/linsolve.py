@@ -32,7 +32,9 @@ numpy 2); CHOLMOD and PARDISO's symmetric modes: Newton tangents are not symmetr
 frictionless ones (``max |K - K^T| / max |K|`` 1e-3 .. 9e-3 on the bundles: SE(3) beams off
 equilibrium, contact).  Saddle-point systems (multiplier contact: a zero diagonal block) go to
 the same unsymmetric back-ends, which pivot (SuperLU: threshold partial pivoting; PARDISO:
-weighted matching and pivot perturbation, its solutions checked by ``_poor``).
+weighted matching and pivot perturbation, its solutions checked by ``_poor``).  Exact stick's condensed saddle
+systems from ``augmented.MIN_UNKNOWNS`` unknowns are not factorised as such: ``augmented`` solves them by GMRES
+preconditioned by a (lagged) factorisation of ``A = K' + Kq E Kl``, a non-saddle matrix of the tangent's pattern.
 
 Lagged solves (``Solver(lagged="auto")``, the default; ``lagged.py``): while a factorisation is
 expensive (``Solver.lag_budget``), ``Solver.factorize`` returns a factor that solves the new matrix
