@@ -109,14 +109,15 @@ def main():
                     help="how exact stick solves its saddle-point systems (default: auto, the library's rule)")
     a = ap.parse_args()
     a.c = [None if c is None or c <= 0 else c for c in a.c]      # 0: the default
-    print("| scene | integration | stick | c / penalty | Newton it. | cut-backs | wall [s] | CPU [s] | end | ratio to penalty |")
+    print("| scene | integration | stick | c / penalty | Newton it. | cut-backs | wall [s] | CPU [s] | end "
+          "| ratio to penalty |")
     print("|---|---|---|---|---:|---:|---:|---:|---|---:|")
     for scene in a.scenes:
         for integ in a.integration:
             label = integ or "default"
             ref = run(scene, "penalty", integration=integ)
-            print(f"| {scene} | {label} | penalty | | {ref[0]} | {ref[1]} | {ref[2]:.1f} | {ref[4]:.1f} | {ref[3]} | 1 |",
-                  flush=True)
+            print(f"| {scene} | {label} | penalty | | {ref[0]} | {ref[1]} | {ref[2]:.1f} | {ref[4]:.1f} | {ref[3]} "
+                  "| 1 |", flush=True)
             for c in a.c:
                 for saddle in a.saddle:
                     r = run(scene, "exact", c, integration=integ, saddle=saddle)

@@ -144,7 +144,8 @@ def _one_iteration(model):
 
 
 def bundle19():
-    """One Newton iteration of the 19-wire bundle (``scaling.bundle_model``) at its reference poses (``_one_iteration``)."""
+    """One Newton iteration of the 19-wire bundle (``scaling.bundle_model``) at its reference poses
+    (``_one_iteration``)."""
     import scaling_scenes
     from scaling import bundle_model
     return _one_iteration(bundle_model(scaling_scenes.PER_WIRE, n_layers=2)[0])

@@ -14,20 +14,22 @@ factorisation of
 
 and ``A`` has the tangent's own pattern (a group's ``Kq E Kl`` lies in its block), so it is factorised as the
 penalty path's tangent is, non-saddle and lagged (``linsolve.Solver.factorize``).  GMRES (``lagged.gmres``) on
-``M`` right-preconditioned by ``P^-1`` meets ``|M x - b| <= RTOL |b|``: ``M P^-1 - I`` lives on the multiplier
-rows, of size ``(D - P22) / S`` (``S = Kl K'^-1 Kq`` a group's compliance), ``1 / (E S) ~ 1 / RATIO`` where
-``D = 0``, so a few iterations reach round-off and the step does not depend on ``E`` (tests over five decades).
-``E_j``: the sign of ``sum_a Kq_aj Kl_ja / k_a`` (``Kq ~ -Kl^T`` for exact stick: negative) so that ``Kq E Kl``
-stiffens, and ``|E_j| max_a |Kq_aj Kl_ja| / k_a = RATIO`` (``k_a`` the elements' diagonal stiffness of slot ``a``:
-the constraint ``RATIO`` times stiffer than the structure where it acts).  A row with ``E_j d_j < 0`` takes
-``P22 = d - 1 / E`` (exact up to ``1 / E``: ``A`` holds ``E / (1 - E d)``, softer), one with ``E_j d_j > 0``
-``P22 = -1 / E`` (``D - P22 = d + 1 / E``, GMRES absorbs it).  Idle rows and rows without coupling: ``P22 = D``
-(or 1), ``Kl`` taken as empty there: exact.
+``M`` right-preconditioned by ``P^-1`` meets ``|M x - b| <= RTOL |b|`` (its products with ``K'`` itself: nothing
+cancels), then one more preconditioned step (``POLISH``: the multipliers' last digits).  ``M P^-1 - I`` lives on
+the multiplier rows, of size ``1 / (E S)`` (``S = Kl K'^-1 Kq``) where ``D = 0``: two iterations, and the step does
+not depend on ``E`` (against the direct solve 2e-14 .. 1e-12 for ``RATIO`` 1e4 .. 1e9).  ``A`` is singular where
+``E^-1 + S`` is: on a bundle at rest ``K'`` is nearly singular (the wires' spins, held by friction alone) with an
+indefinite symmetric part, and ``A`` of the 19 wires is numerically singular for ``RATIO`` 0.1 .. 1e3, regular
+from 1e5 to 1e9 (docs/theory_mortar.md 3b): hence the stiff default.
+``E_j``: the sign of ``sum_a Kq_aj Kl_ja / k_a`` (``Kq_j = -c_j Kl_j^T`` for exact stick: negative) so that
+``Kq E Kl`` stiffens, and ``|E_j| max_a |Kq_aj Kl_ja| / k_a = RATIO`` (``k_a`` the elements' diagonal stiffness of
+slot ``a``).  A row with ``E_j d_j < 0`` takes ``P22 = d - 1 / E`` (exact up to ``1 / E``: ``A`` holds
+``E / (1 - E d)``, softer), one with ``E_j d_j > 0`` ``P22 = -1 / E`` (``D - P22 = d + 1 / E``, GMRES absorbs it).
+Idle rows and rows without coupling: ``P22 = D`` (or 1), ``Kl`` taken as empty there: exact.
 
 ``Augmented.solve`` counts in ``Solver.stats``: ``saddle_augmented`` (solves), ``saddle_iterations`` (GMRES),
 ``saddle_fallbacks``: a preconditioner (lagged, then fresh) that does not get there within its iterations falls
-back to the direct saddle solve of the equivalent ``[[A, Kq (1 + E D)], [Kl, D]]`` (right-hand side
-``[f + Kq E g, g]``: the first rows plus ``Kq E`` times the second), without a warning.
+back to the direct saddle solve of ``M`` (``Problem.linear_system``'s), without a warning.
 """
 import numpy as np
 
@@ -38,7 +40,7 @@ from ..failures import SingularTangent
 __all__ = ["Augmented", "weights", "RATIO", "RTOL", "MAX_ITERATIONS", "MIN_UNKNOWNS", "ENABLED"]
 
 RATIO = 1e6            # |E| times the constraint's stiffness over the structure's (answers do not depend on it)
-RTOL = 1e-10           # |M x - b| / |b| the iterations must reach (``lagged.LAG_RTOL``; the direct saddle solve: 2e-9 on the 19-wire bundle)
+RTOL = 1e-10           # |M x - b| / |b| GMRES must reach (``lagged.LAG_RTOL``; the direct saddle solve: 2e-9, 19 wires)
 MAX_ITERATIONS = 30    # GMRES iterations with a fresh factorisation of ``A`` before the direct fallback
 POLISH = True          # after GMRES, one more step of the preconditioned iteration (the multipliers' last digits)
 MIN_UNKNOWNS = 1_500   # smaller systems are factorised directly (``linsolve.AUTO_MIN_UNKNOWNS``: SuperLU, ~1 ms)
@@ -69,7 +71,8 @@ class Augmented:
     """One condensed Newton system ``M x = [f; g]`` with its augmented matrix ``A`` (CSC ``(n, n)``, the
     tangent's pattern); ``Kq``, ``Kl`` ``(u, k6)`` the kept rows' couplings on the free rows ``rows`` ``(u, k6)``
     (``-1``: held slot, ignored), ``D`` ``(u,)`` the multiplier rows' diagonal (idle rows: 1), ``E``, ``p22``
-    from ``weights``, ``idle`` ``(u,)``; ``direct()`` builds the equivalent bordered system for the fallback."""
+    from ``weights``, ``idle`` ``(u,)``; ``K`` ``(n, n)`` the tangent ``K'`` (products); ``direct()`` builds
+    ``M`` (bordered, CSC) and its right-hand side for the fallback."""
 
     def __init__(self, K, A, f, g, Kq, Kl, rows, D, E, p22, idle, direct):
         self.K, self.A, self.f, self.g = K, A, f, g
@@ -79,7 +82,7 @@ class Augmented:
         self.Klp = np.where(idle[:, None], 0.0, self.Kl)      # the preconditioner's Kl: none on idle rows
         self.D, self.E, self.p22, self.idle = D, E, p22, idle
         self.plain = E == 0.0
-        self.direct = direct           # () -> (M, rhs): the equivalent bordered system
+        self.direct = direct           # () -> (M, rhs): the bordered system
         self.n = A.shape[0]
         self.iterations = 0
         self.fallback = False
@@ -139,12 +142,3 @@ class Augmented:
         lu = factorize_tangent(M, solver, saddle=True)
         self.factor = lu
         return lu.solve(rhs)
-
-    def det_sign(self):
-        """Sign of ``det(M)`` (``Newton`` reads it on the first tangent), from a direct factorisation."""
-        M, _ = self.direct()
-        lu = factorize_tangent(M, saddle=True)
-        sign = getattr(lu, "det_sign", None)
-        if sign is None:
-            raise AttributeError("det_sign")
-        return sign()
