@@ -130,3 +130,36 @@ def test_the_augmented_matrix_has_the_tangents_pattern():
     M, b = problem.linear_system(ev)
     dq, dl = problem.split_solution(ev, spla.spsolve(M.tocsc(), b))
     assert _close(dq, dq0) and _close(dl, dl0)
+
+
+@pytest.mark.parametrize("scene", ["contact_patch", "shear_lag"])
+def test_newton_through_the_augmented_solve_takes_the_direct_path(monkeypatch, scene):
+    """The Newton loop with the augmented solve at any size (``MIN_UNKNOWNS`` 0) takes the direct solve's
+    iterations to the same states (the contact patch with friction; the shear lag's slip front).  The shear lag's
+    first system falls back to the direct solve: no pressure yet, every kept row idle (``A = K'``), the wire held
+    along its axis by the unloaded groups' stiffness floor alone; GMRES stalls at 3e-6 of the right-hand side."""
+    import contact_patch
+    import shear_lag
+    import beamsolver as bs
+
+    def run():
+        if scene == "contact_patch":
+            return bs.solve(contact_patch.build(stick="exact")[0], **contact_patch.solve_options)
+        return shear_lag.main(n_wire=10, stick="exact")[0]
+
+    direct = run()
+    monkeypatch.setattr(augmented, "MIN_UNKNOWNS", 0)
+    counts = dict(n=0, fallbacks=0)
+    solve = augmented.Augmented.solve
+
+    def counted(self, solver):
+        x = solve(self, solver)
+        counts["n"] += 1
+        counts["fallbacks"] += self.fallback
+        return x
+    monkeypatch.setattr(augmented.Augmented, "solve", counted)
+    aug = run()
+    assert counts["n"] >= 8 and counts["fallbacks"] == (1 if scene == "shear_lag" else 0)
+    assert [s["iterations"] for s in aug.stats] == [s["iterations"] for s in direct.stats]
+    x0, x1 = direct.poses[-1][:, :3, 3], aug.poses[-1][:, :3, 3]
+    assert np.abs(x1 - x0).max() <= 1e-9 * np.abs(x0).max()
