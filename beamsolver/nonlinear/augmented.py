@@ -43,6 +43,7 @@ RATIO = 1e6            # |E| times the constraint's stiffness over the structure
 RTOL = 1e-10           # |M x - b| / |b| GMRES must reach (``lagged.LAG_RTOL``; the direct saddle solve: 2e-9, 19 wires)
 MAX_ITERATIONS = 30    # GMRES iterations with a fresh factorisation of ``A`` before the direct fallback
 POLISH = True          # after GMRES, one more step of the preconditioned iteration (the multipliers' last digits)
+LAGGED = True          # ``A`` factorised through the solver's lagging (``linsolve.Solver.factorize``), else afresh
 MIN_UNKNOWNS = 1_500   # smaller systems are factorised directly (``linsolve.AUTO_MIN_UNKNOWNS``: SuperLU, ~1 ms)
 ENABLED = True         # False: ``Newton.direction`` solves the saddle system directly (benchmarks: before)
 STATS = ("saddle_augmented", "saddle_iterations", "saddle_fallbacks")
@@ -117,7 +118,7 @@ class Augmented:
         solver.stats["saddle_augmented"] += 1
         b = np.concatenate([self.f, self.g])
         try:
-            lu = factorize_tangent(self.A, solver)
+            lu = factorize_tangent(self.A, solver, kind="augmented", fresh=not LAGGED)
             for attempt in range(2):
                 lagged = getattr(lu, "lagged", False)
                 budget = lu.budget if lagged else MAX_ITERATIONS
