@@ -2,11 +2,15 @@
 Newton iterations, cut-backs and wall time of each (issue 26: at most 1.5 times the penalty's iterations).
 
     python benchmarks/exact_stick_examples.py [--c 1e-3 1] [--scenes twisted_pair three_wires ...]
-        [--integration points segments]
+        [--integration points segments] [--saddle auto direct augmented]
 
 ``--c``: ``penalty_t`` of the exact runs as a fraction of each declaration's normal penalty (default: the
 library's default, ``EXACT_C``).  Every ``add_contact`` of a scene gets the mode through a wrapper of
-``Model.add_contact``, as does ``--integration`` (line contact's, each scene run with each).  Rows print as they finish (markdown table).
+``Model.add_contact``, as does ``--integration`` (line contact's, each scene run with each).  ``--saddle``: how the
+exact runs solve their saddle-point Newton systems (``auto``: the library's rule, through ``A = K' + Kq E Kl`` from
+``augmented.MIN_UNKNOWNS`` free unknowns, directly below; ``augmented``: through ``A`` at any size; ``direct``:
+PARDISO / SuperLU on the bordered system, before; ``nonlinear/augmented.py``), each run with each.  Rows
+print as they finish (markdown table); CPU time by ``time.process_time`` (the machine is shared).
 """
 import argparse
 import sys
@@ -66,9 +70,10 @@ SCENES = dict(twisted_pair=_twisted_pair, three_wires=_three_wires, shear_lag=_s
               twisted_pair_extreme=_twisted_pair_extreme, plectoneme=_plectoneme)
 
 
-def run(scene, stick, c=None, integration=None):
-    """``(iterations, cut-backs, wall s, message)`` of ``scene`` with every declaration's ``stick`` (and
-    ``penalty_t = c x`` its normal penalty when given)."""
+def run(scene, stick, c=None, integration=None, saddle="auto"):
+    """``(iterations, cut-backs, wall s, message, CPU s)`` of ``scene`` with every declaration's ``stick`` (and
+    ``penalty_t = c x`` its normal penalty when given; ``saddle``: ``--saddle``)."""
+    from beamsolver.nonlinear import augmented
     orig = bs.Model.add_contact
 
     def add_contact(self, slave, master, mu=0.0, penalty=None, **options):
@@ -84,19 +89,24 @@ def run(scene, stick, c=None, integration=None):
         return orig(self, slave, master, mu=mu, penalty=penalty, **options)
 
     bs.Model.add_contact = add_contact
-    t0 = time.perf_counter()
+    augmented.ENABLED, min_unknowns = saddle != "direct", augmented.MIN_UNKNOWNS
+    if saddle == "augmented":
+        augmented.MIN_UNKNOWNS = 0
+    t0, c0 = time.perf_counter(), time.process_time()
     try:
         sol = SCENES[scene]()
         stats = sol.stats
         its = int(sum(s["iterations"] for s in stats))
         cuts = int(sum(s.get("cutbacks", 0) for s in stats))
-        return its, cuts, time.perf_counter() - t0, "t = %.3g" % sol.times[-1]
+        return its, cuts, time.perf_counter() - t0, "t = %.3g" % sol.times[-1], time.process_time() - c0
     except bs.ConvergenceError as e:
         sol = e.solution
         its = int(sum(s["iterations"] for s in sol.stats)) if sol is not None else 0
-        return its, 0, time.perf_counter() - t0, "failed at t = %.3g" % (sol.times[-1] if sol is not None else np.nan)
+        return (its, 0, time.perf_counter() - t0, "failed at t = %.3g" % (sol.times[-1] if sol is not None else np.nan),
+                time.process_time() - c0)
     finally:
         bs.Model.add_contact = orig
+        augmented.ENABLED, augmented.MIN_UNKNOWNS = True, min_unknowns
 
 
 def main():
@@ -106,19 +116,25 @@ def main():
                     help="penalty_t / normal penalty of the exact runs (0: the default, EXACT_C)")
     ap.add_argument("--integration", nargs="+", default=[None], choices=["points", "segments"],
                     help="add_contact(integration=...) of every declaration (default: the library's)")
+    ap.add_argument("--saddle", nargs="+", default=["auto"], choices=["auto", "direct", "augmented"],
+                    help="how exact stick solves its saddle-point systems (default: auto, the library's rule)")
     a = ap.parse_args()
     a.c = [None if c is None or c <= 0 else c for c in a.c]      # 0: the default
-    print("| scene | integration | stick | c / penalty | Newton it. | cut-backs | wall [s] | end | ratio to penalty |")
-    print("|---|---|---|---|---:|---:|---:|---|---:|")
+    print("| scene | integration | stick | c / penalty | Newton it. | cut-backs | wall [s] | CPU [s] | end "
+          "| ratio to penalty |")
+    print("|---|---|---|---|---:|---:|---:|---:|---|---:|")
     for scene in a.scenes:
         for integ in a.integration:
             label = integ or "default"
             ref = run(scene, "penalty", integration=integ)
-            print(f"| {scene} | {label} | penalty | | {ref[0]} | {ref[1]} | {ref[2]:.1f} | {ref[3]} | 1 |", flush=True)
+            print(f"| {scene} | {label} | penalty | | {ref[0]} | {ref[1]} | {ref[2]:.1f} | {ref[4]:.1f} | {ref[3]} "
+                  "| 1 |", flush=True)
             for c in a.c:
-                r = run(scene, "exact", c, integration=integ)
-                print(f"| {scene} | {label} | exact | {'default' if c is None else f'{c:g}'} | {r[0]} | {r[1]} | "
-                      f"{r[2]:.1f} | {r[3]} | {r[0] / max(ref[0], 1):.2f} |", flush=True)
+                for saddle in a.saddle:
+                    r = run(scene, "exact", c, integration=integ, saddle=saddle)
+                    name = dict(auto="exact", direct="exact (direct saddle)", augmented="exact (augmented)")[saddle]
+                    print(f"| {scene} | {label} | {name} | {'default' if c is None else f'{c:g}'} | {r[0]} | {r[1]} | "
+                          f"{r[2]:.1f} | {r[4]:.1f} | {r[3]} | {r[0] / max(ref[0], 1):.2f} |", flush=True)
 
 
 if __name__ == "__main__":

@@ -153,6 +153,38 @@ def _values(el_data, el_pos, node, vals, red, nfree, indptr, eoff, nptr, nrow, t
     return True
 
 
+@jit
+def _add_products(node, Kq, Kl, w, red, indptr, eoff, nptr, nrow, out):
+    """``out += sum_u w_u Kq_u Kl_u^T`` on the held pattern, ``Kq``, ``Kl`` ``(m, 6 k)`` over the nodes ``node``
+    ``(m, k)`` (rank-one blocks; held rows and columns dropped).  Returns False (``out`` partly changed) if a
+    node pair with an entry has no place in the pattern."""
+    k = node.shape[1]
+    for u in range(node.shape[0]):
+        if w[u] == 0.0:
+            continue
+        for t in range(k):
+            b = node[u, t]
+            for s in range(k):
+                a = node[u, s]
+                e = _find(nptr, nrow, a, b)
+                for q in range(6):
+                    j = red[6 * b + q]
+                    c = w[u] * Kl[u, 6 * t + q]
+                    if j < 0 or c == 0.0:
+                        continue
+                    r = 0
+                    for p in range(6):
+                        if red[6 * a + p] >= 0:
+                            v = Kq[u, 6 * s + p] * c
+                            if e < 0:
+                                if v != 0.0:
+                                    return False
+                            else:
+                                out[indptr[j] + eoff[e] + r] += v
+                            r += 1
+    return True
+
+
 def _pair_keys(node, vals, nfree, n):
     """Sorted unique keys ``b n + a`` of the node pairs of the blocks ``vals`` ``(m, 6 k, 6 k)`` over ``node``
     ``(m, k)`` whose both nodes have free dofs and whose 6 x 6 block is not all zero."""
@@ -214,6 +246,15 @@ class HeldPattern:
         """Whether the pattern holds the blocks ``vals`` ``(m, 6 k, 6 k)`` over ``node`` ``(m, k)``: every node
         pair of theirs, except those whose 6 x 6 block is all zero (a contact point without stiffness)."""
         return _uncovered(node, vals, self.nfree, self.nptr, self.nrow) == 0
+
+    def add_products(self, data, node, Kq, Kl, w):
+        """Add the rank-one blocks ``w_u Kq_u Kl_u^T`` (``Kq``, ``Kl`` ``(m, 6 k)`` over the nodes ``node`` ``(m, k)``,
+        full numbering; ``w`` ``(m,)``) to the values ``data`` of a matrix on this pattern, in place: no second
+        assembly of a tangent that only changes there (``nonlinear.augmented``).  False where a block leaves the
+        pattern (``data`` is then partly changed)."""
+        return bool(_add_products(np.ascontiguousarray(node, dtype=np.int64), np.ascontiguousarray(Kq),
+                                  np.ascontiguousarray(Kl), np.ascontiguousarray(w, dtype=float), self.red,
+                                  self.indptr, self.eoff, self.nptr, self.nrow, data))
 
     def grown(self, node, vals):
         """The pattern holding the node pairs of the blocks ``vals`` over ``node`` too (``covers``): this reserve

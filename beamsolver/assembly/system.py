@@ -704,6 +704,18 @@ class System:
         self._held_cache = p
         return p.matrix(el_data, node, vals, tail)
 
+    def add_products(self, K, dofs, Kq, Kl, w):
+        """``K + sum_u w_u Kq_u Kl_u^T`` (CSC, a new ``data``) for a tangent ``K`` of ``matrix`` on the held pattern,
+        ``Kq``, ``Kl`` ``(m, 6 k)`` over whole-node dofs ``dofs`` ``(m, 6 k)`` (full numbering), ``w`` ``(m,)``;
+        ``None`` where no pattern is held for ``K`` or a block leaves it (then assemble the changed values)."""
+        p = self.held_pattern
+        if p is None or K.nnz != p.nnz or not np.array_equal(K.indptr, p.indptr):
+            return None
+        data = K.data.copy()
+        if not p.add_products(data, np.asarray(dofs)[:, 0::6] // 6, Kq, Kl, w):
+            return None
+        return canonical_csc(data, K.indices, K.indptr, K.shape[0])
+
     def _block_nodes(self, d):
         """The nodes ``(m, k)`` of whole-node block dofs ``d`` ``(m, 6 k)`` (kept while ``d`` is the same array)."""
         c = getattr(self, "_block_nodes_cache", None)

@@ -16,7 +16,7 @@ import numpy as np
 
 from .._jit import jit
 
-__all__ = ["ELIMINATE", "Split", "split", "add_schur"]
+__all__ = ["ELIMINATE", "Split", "split", "add_schur", "add_products"]
 
 ELIMINATE = 0.1      # smallest diagonal entry of D eliminated (a sliding group at the cone's edge stays an unknown)
 ENABLED = True       # False: ``Problem.linear_system`` solves the full bordered system (benchmarks: before)
@@ -68,8 +68,13 @@ def _schur(vals, off, Kql, Klq, w):
 def add_schur(vals, off, sp):
     """Add the eliminated components' Schur terms to the groups' tangent blocks, the ``(g, k6, k6)`` values
     starting at ``off`` of the COO values ``vals`` (z numbering, in place)."""
-    w = np.where(sp.elim, 1.0 / np.where(sp.elim, sp.d, 1.0), 0.0)
-    _schur(vals, off, np.ascontiguousarray(sp.Kql), np.ascontiguousarray(sp.Klq), w)
+    add_products(vals, off, sp, np.where(sp.elim, 1.0 / np.where(sp.elim, sp.d, 1.0), 0.0))
+
+
+def add_products(vals, off, sp, w):
+    """``vals[off:]`` as ``(g, k6, k6)`` blocks ``-= K'_ql diag(w) K'_lq`` per group (``w`` ``(g, 3)``, in place):
+    the Schur terms (``add_schur``) and the augmentation of the kept components (``augmented``)."""
+    _schur(vals, off, np.ascontiguousarray(sp.Kql), np.ascontiguousarray(sp.Klq), np.ascontiguousarray(w))
 
 
 def rhs_terms(sp):

@@ -32,7 +32,9 @@ numpy 2); CHOLMOD and PARDISO's symmetric modes: Newton tangents are not symmetr
 frictionless ones (``max |K - K^T| / max |K|`` 1e-3 .. 9e-3 on the bundles: SE(3) beams off
 equilibrium, contact).  Saddle-point systems (multiplier contact: a zero diagonal block) go to
 the same unsymmetric back-ends, which pivot (SuperLU: threshold partial pivoting; PARDISO:
-weighted matching and pivot perturbation, its solutions checked by ``_poor``).
+weighted matching and pivot perturbation, its solutions checked by ``_poor``).  Exact stick's condensed saddle
+systems from ``augmented.MIN_UNKNOWNS`` unknowns are not factorised as such: ``augmented`` solves them by GMRES
+preconditioned by a (lagged) factorisation of ``A = K' + Kq E Kl``, a non-saddle matrix of the tangent's pattern.
 
 Lagged solves (``Solver(lagged="auto")``, the default; ``lagged.py``): while a factorisation is
 expensive (``Solver.lag_budget``), ``Solver.factorize`` returns a factor that solves the new matrix
@@ -149,14 +151,16 @@ def factorize(K, backend=None):
     return Solver(backend).factorize(K)
 
 
-def factorize_tangent(K, solver=None, what="singular tangent", saddle=False):
+def factorize_tangent(K, solver=None, what="singular tangent", saddle=False, fresh=False, kind=None):
     """``solver.factorize(K)`` (default a fresh ``Solver()``) as a factor whose singularity, found
     by the factorisation or by a solve (pardiso), is the typed step failure
     ``failures.SingularTangent(f"{what} ({error})")``: the one wrapper of the Newton loop, the
     arc-length solves and the branch switch.  The factor keeps the back-end's ``det_sign`` and
-    ``factor_nnz`` where it has them.  ``saddle``: ``K`` is a saddle-point system (``Solver.factorize``)."""
+    ``factor_nnz`` where it has them.  ``saddle``: ``K`` is a saddle-point system (``Solver.factorize``);
+    ``fresh``: not lagged (``Solver.fresh``); ``kind``: ``Solver.factorize``'s."""
+    solver = solver if solver is not None else Solver()
     try:
-        return _Typed((solver if solver is not None else Solver()).factorize(K, saddle=saddle), what)
+        return _Typed(solver.fresh(K) if fresh else solver.factorize(K, saddle=saddle, kind=kind), what)
     except SingularMatrixError as e:
         raise SingularTangent(f"{what} ({e})") from None
 
@@ -190,6 +194,7 @@ class Solver:
         self._pardiso = None            # _Pardiso handle, created on first use
         self._base = None               # the last fresh factor, the lagged solves' preconditioner
         self._base_shape = None
+        self._base_kind = None          # ``factorize(kind=)`` of the base: lagging only between matrices of one kind
         self._refresh = False           # the next factorize is a fresh one
         self._skip = 0                  # fresh factorisations before the next lagged try (``lagged_done``)
         self._backoff = 0               # the skip after the next failed lagged solve
@@ -246,7 +251,7 @@ class Solver:
         its = int(min(LAG_COST_SHARE * fresh, LAG_MAX_ITERATIONS))
         return its if its >= LAG_MIN_ITERATIONS else 0
 
-    def factorize(self, K, saddle=False):
+    def factorize(self, K, saddle=False, kind=None):
         """A factor of ``K`` with ``solve(b)``: fresh, or lagged (``lagged.LaggedFactor``: GMRES
         preconditioned by the last fresh factor, while ``lag_budget`` allows, the shape holds and
         the previous lagged solve took at most ``LAG_REFRESH_SHARE`` of its budget).  ``saddle``: ``K`` is
@@ -254,11 +259,15 @@ class Solver:
         perturbs tiny pivots to ``SADDLE_PERTURB`` (not 1e-13) and refines the solution up to
         ``SADDLE_REFINE`` steps, which its static pivoting needs there (19-wire bundle, exact stick, 55 000
         unknowns: 709 perturbed pivots, a residual 7.6e3 |b| with the defaults, 2.4e-9 |b| so); SuperLU
-        pivots by rows itself."""
+        pivots by rows itself.  ``kind``: a label of the matrix family (``augmented``'s ``A`` against a plain
+        tangent of the same shape): a factor of another kind does not precondition it."""
         if K.shape[0] != K.shape[1]:
             raise InputError(f"linsolve: the matrix must be square, got shape {K.shape}")
         if saddle:
             return self.fresh(K, saddle=True)
+        if kind != self._base_kind:
+            self._refresh = True
+        self._base_kind = kind
         base = self._base
         if self._skip > 0:
             self._skip -= 1

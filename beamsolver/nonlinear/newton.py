@@ -229,11 +229,16 @@ class Newton:
         unknowns ``(n_free,)`` (with the prescribed-motion coupling of ``dz_c`` ``(n, 6)``)."""
         problem = self.problem
         t0 = time.perf_counter()
-        K, rhs = problem.linear_system(ev, dz_c)     # with multipliers: condensed and bordered
+        aug = problem.augmented_system(ev, dz_c) if problem.augments(ev) else None
+        if aug is None:
+            K, rhs = problem.linear_system(ev, dz_c)     # with multipliers: condensed and bordered
         t1 = time.perf_counter()
         try:
-            lu = linsolve.factorize_tangent(K, self.linsolver, saddle=ev.mult is not None)
-            dzf = lu.solve(rhs)
+            if aug is not None:                          # the saddle system through A = K' + Kq E Kl
+                lu, dzf = aug, aug.solve(self.linsolver)
+            else:
+                lu = linsolve.factorize_tangent(K, self.linsolver, saddle=ev.mult is not None)
+                dzf = lu.solve(rhs)
         finally:
             t2 = time.perf_counter()
             self.timings["assembly"] += t1 - t0

@@ -36,7 +36,7 @@ import numpy as np
 from ..model import contributions
 from ..assembly.system import System
 from ..errors import InputError
-from . import bordered as bordered_, condense as condense_
+from . import augmented as augmented_, bordered as bordered_, condense as condense_
 from .bordered import Bordered
 
 __all__ = ["Problem", "Evaluation"]
@@ -221,42 +221,127 @@ class Problem:
             rc = rc - np.einsum("gij,gj->gi", mu["Klq"], dzf).ravel()
         return A, np.concatenate([rhs, rc])
 
+    def _split(self, ev, condense=True):
+        """The ``condense.Split`` of ``ev``'s multipliers with its Schur terms in ``ev``'s tangent values (added
+        in place, once), ``None`` where the full bordered system is solved."""
+        mu = ev.mult
+        if mu is None or not (condense and condense_.ENABLED and mu.get("B") is not None and "offset" in mu):
+            return None
+        if "split" not in mu:
+            mu["split"] = condense_.split(mu["Kql"], mu["Klq"], mu["Kll"], mu["R"], mu["Lam"], mu["C"], mu["B"])
+            condense_.add_schur(ev.extra[2], mu["offset"], mu["split"])
+        return mu["split"]
+
+    def _force_rhs(self, ev, dz_c, sp):
+        """The free rows' right-hand side ``(n_free,)``: ``-r``, the prescribed coupling and the eliminated
+        components' terms (``condense.rhs_terms``)."""
+        s = self.system
+        rhs = -ev.r[s.free_dofs]
+        if dz_c is not None:
+            rhs -= self.coupling(ev, dz_c)
+        if sp is not None:
+            rows_red = s.red[ev.mult["dofs"]]
+            corr = condense_.rhs_terms(sp)
+            free = rows_red >= 0
+            rhs += np.bincount(rows_red[free], weights=corr[free], minlength=len(rhs))
+        return rhs
+
+    def _kept(self, ev):
+        """The kept components of ``ev``'s split: ``(g, j, Kq, Kl, d, rows_red)``, their groups and components
+        ``(u,)``, couplings ``(u, k6)``, ``D``'s entries ``(u,)`` (round-off set to zero) and free rows ``(u, k6)``."""
+        mu, sp = ev.mult, ev.mult["split"]
+        g, j = sp.kept[:, 0], sp.kept[:, 1]
+        d = sp.d[g, j]
+        d = np.where(np.abs(d) < bordered_.IDLE, 0.0, d)       # a sticking group's tangential components: zero
+        return g, j, sp.Kql[g, :, j], sp.Klq[g, j], d, self.system.red[mu["dofs"]][g]
+
     def linear_system(self, ev, dz_c=None, condense=True):
         """``(A, rhs)``: the Newton system of ``ev`` (CSC, free unknowns first; ``dz_c`` ``(n, 6)`` prescribed
         increments).  With multipliers, those components their owner's basis makes eliminable are eliminated
         exactly (``condense``: their Schur terms go into ``ev``'s tangent values, in place, once) and the others
         border the tangent (``Bordered``, one row each); ``condense=False``: the full ``bordered`` system.
-        ``split_solution`` gives the increments and the multipliers' step from its solution."""
-        s = self.system
+        Once ``augmented_system`` has put its augmentation into the tangent values, the same system from the
+        tangent it kept.  ``split_solution`` gives the increments and the multipliers' step from its solution."""
         mu = ev.mult
-        if mu is not None and condense and condense_.ENABLED and mu.get("B") is not None and "offset" in mu:
-            if "split" not in mu:
-                mu["split"] = condense_.split(mu["Kql"], mu["Klq"], mu["Kll"], mu["R"], mu["Lam"], mu["C"], mu["B"])
-                condense_.add_schur(ev.extra[2], mu["offset"], mu["split"])
-            sp = mu["split"]
-        else:
-            sp = None
-        rhs = -ev.r[s.free_dofs]
-        if dz_c is not None:
-            rhs -= self.coupling(ev, dz_c)
+        sp = self._split(ev, condense)
+        if mu is not None and sp is not None and "E" in mu:
+            return self.augmented_system(ev, dz_c).direct()
+        rhs = self._force_rhs(ev, dz_c, sp)
         K = self.tangent(ev)
         if mu is None:
             return K, rhs
         if sp is None:
             return self.bordered(ev, K, rhs, dz_c)
-        rows_red = s.red[mu["dofs"]]
-        corr = condense_.rhs_terms(sp)
-        free = rows_red >= 0
-        rhs += np.bincount(rows_red[free], weights=corr[free], minlength=len(rhs))
-        g, j = sp.kept[:, 0], sp.kept[:, 1]
-        d = sp.d[g, j]
-        d = np.where(np.abs(d) < bordered_.IDLE, 0.0, d)       # a sticking group's tangential components: zero
-        A, rc = self._bordered.matrix(K, rows_red[g], sp.Kql[g, :, j][:, :, None], sp.Klq[g, j][:, None, :],
-                                      d[:, None, None], np.ones((len(g), 1, 1)), sp.b[g, j][:, None],
-                                      sp.C[g, j][:, None])
+        return self._condensed(ev, K, rhs, dz_c)
+
+    def _condensed(self, ev, K, rhs, dz_c):
+        """The condensed bordered system on the tangent ``K`` (``linear_system``)."""
+        sp = ev.mult["split"]
+        g, j, Kq, Kl, d, rows = self._kept(ev)
+        A, rc = self._bordered.matrix(K, rows, Kq[:, :, None], Kl[:, None, :], d[:, None, None],
+                                      np.ones((len(g), 1, 1)), sp.b[g, j][:, None], sp.C[g, j][:, None])
         if dz_c is not None:
-            rc = rc - np.einsum("ua,ua->u", sp.Klq[g, j], self._prescribed_slots(mu, dz_c)[g])
+            rc = rc - np.einsum("ua,ua->u", Kl, self._prescribed_slots(ev.mult, dz_c)[g])
         return A, np.concatenate([rhs, rc])
+
+    def augments(self, ev):
+        """Whether ``ev``'s Newton system is solved through ``augmented_system``: ``augmented.ENABLED``, the
+        condensed multiplier path, at least ``augmented.MIN_UNKNOWNS`` free unknowns (smaller saddle systems are
+        factorised directly: as fast per solve, docs/benchmarks.md)."""
+        mu = ev.mult
+        return (augmented_.ENABLED and mu is not None and condense_.ENABLED and mu.get("B") is not None
+                and "offset" in mu and "Kql" in mu and self.system.n_free >= augmented_.MIN_UNKNOWNS)
+
+    def augmented_system(self, ev, dz_c=None):
+        """The condensed Newton system of ``ev`` (``linear_system``) as an ``augmented.Augmented``: the tangent
+        ``K'`` (kept, for products) and ``A = K' + Kq E Kl`` (``E``: ``augmented.weights``; added to ``K'``'s values
+        on the held pattern, ``System.add_products``, else into ``ev``'s values, in place, and assembled again), the
+        kept rows' couplings and right-hand sides; its ``solve(solver)`` gives ``linear_system``'s solution.  Needs
+        the condensed path (``augments``); built once per evaluation, the right-hand sides per ``dz_c``."""
+        mu = ev.mult
+        sp = self._split(ev)
+        if sp is None:
+            raise ValueError("Problem.augmented_system: no condensed multiplier system in this evaluation")
+        g, j, Kq, Kl, d, rows = self._kept(ev)
+        free = rows >= 0
+        free_row = np.linalg.norm(np.where(free, Kl, 0.0), axis=1)
+        own = np.abs(d)
+        IDLE = bordered_.IDLE
+        idle = (free_row <= IDLE * max(free_row.max(initial=0.0), 1e-300)) & \
+            (own <= IDLE * max(own.max(initial=0.0), 1e-300))
+        first = "E" not in mu
+        f = self._force_rhs(ev, dz_c, sp)        # (before an augmentation in the values, which the coupling reads)
+        if first:
+            Kp = mu["Kp"] = self.tangent(ev)
+            E, p22 = augmented_.weights(Kq, Kl, free, self._element_diagonal(ev)[mu["dofs"][g]], d, idle)
+            mu["E"], mu["p22"] = E, p22
+            A = self.system.add_products(Kp, mu["dofs"][g], Kq, Kl, E)     # on the held pattern: no assembly
+            if A is None:
+                w = np.zeros(sp.d.shape)
+                w[g, j] = -E
+                condense_.add_products(ev.extra[2], mu["offset"], sp, w)
+                mu["in_values"] = True
+                A = self.tangent(ev)
+            mu["A"] = A
+        E, p22 = mu["E"], mu["p22"]
+        gv = -sp.C[g, j]
+        gv[idle] = -sp.b[g, j][idle]
+        if dz_c is not None:
+            pc = np.einsum("ua,ua->u", Kl, self._prescribed_slots(mu, dz_c)[g])
+            gv = gv - pc
+            if not first and mu.get("in_values"):       # the coupling read from the values holds Kq E Kl_c dz_c
+                f = f + np.bincount(rows[free], weights=(Kq * (E * pc)[:, None])[free], minlength=len(f))
+        Kp = mu["Kp"]
+        return augmented_.Augmented(Kp, mu["A"], f, gv, Kq, Kl, rows, np.where(idle, 1.0, d), E, p22, idle,
+                                    direct=lambda: self._condensed(ev, Kp, f, dz_c))
+
+    def _element_diagonal(self, ev):
+        """The elements' diagonal stiffness ``(6 n,)`` (z numbering) of ``ev``'s tangent values."""
+        s = self.system
+        if getattr(self, "_diag_entries", None) is None:
+            self._diag_entries = np.flatnonzero(s.coo_rows == s.coo_cols)
+        i = self._diag_entries
+        return np.bincount(s.coo_rows[i], weights=ev.kvals[i], minlength=6 * s.n_nodes)
 
     def _prescribed_slots(self, mu, dz_c):
         """``(g, k6)``: the prescribed increments ``dz_c`` on the groups' held slots (zero on free ones)."""

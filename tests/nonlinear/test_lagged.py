@@ -196,3 +196,16 @@ def test_lagged_newton_reaches_the_direct_solution(rolled_lagged):
     np.testing.assert_array_equal(sol.iterations, sol0.iterations)
     np.testing.assert_allclose(d, d0, rtol=1e-9)
     np.testing.assert_allclose(ft, ft0, rtol=1e-7)
+
+
+def test_a_factor_of_another_kind_does_not_precondition():
+    """``factorize(kind=)``: the augmented matrix of exact stick (``augmented``) and a plain tangent of the same
+    shape do not precondition each other (each switch factorises afresh); within one kind the factor lags."""
+    A = matrix()
+    s = linsolve.Solver("splu", lagged=True)
+    s.factorize(A)
+    assert not isinstance(s.factorize(perturbed(A, 1e-4), kind="augmented"), lagged.LaggedFactor)
+    assert isinstance(s.factorize(perturbed(A, 2e-4), kind="augmented"), lagged.LaggedFactor)
+    assert not isinstance(s.factorize(perturbed(A, 3e-4)), lagged.LaggedFactor)
+    assert s.stats["factorizations"] == 3 and s.stats["lagged"] == 1
+    s.close()

@@ -1,0 +1,145 @@
+"""Exact stick's condensed saddle-point system solved through a matrix of the displacement size (issue 26, speed).
+
+After the exact block elimination (``condense``) the Newton system is ``M = [[K', Kq], [Kl, D]]``: ``n`` free
+unknowns, ``u`` kept multiplier components (``Kq`` ``(n, u)``, ``Kl`` ``(u, n)`` one group's slots per column /
+row), ``D`` diagonal: 0 for a sticking group's tangential components, ``d`` in ``(-0.1, 0.1)`` for a sliding group
+at the cone's edge, 1 on idle rows (``bordered``: their ``Kl`` row is empty).  A direct solve of ``M`` needs
+PARDISO's perturbed pivots and refinement, afresh every iteration (``linsolve.Solver.factorize(saddle=True)``).
+
+Here (the augmented Lagrangian on the linear level, Fortin & Glowinski 1983; Benzi, Golub & Liesen 2005, sec. 10.2):
+``P = [[K', Kq], [Kl, P22]]`` with ``P22_j = -1 / E_j`` (``E`` diagonal, below) is inverted exactly by one
+factorisation of
+
+    A = K' + Kq E Kl,     v -> (du, db):  du = A^-1 (v_f + Kq E v_g),   db = E (Kl du - v_g),
+
+and ``A`` has the tangent's own pattern (a group's ``Kq E Kl`` lies in its block), so it is factorised as the
+penalty path's tangent is, non-saddle and lagged (``linsolve.Solver.factorize``).  GMRES (``lagged.gmres``) on
+``M`` right-preconditioned by ``P^-1`` meets ``|M x - b| <= RTOL |b|`` (its products with ``K'`` itself: nothing
+cancels), then one more preconditioned step (``POLISH``: the multipliers' last digits).  ``M P^-1 - I`` lives on
+the multiplier rows, of size ``1 / (E S)`` (``S = Kl K'^-1 Kq``) where ``D = 0``: two iterations, and the step does
+not depend on ``E`` (against the direct solve 2e-14 .. 1e-12 for ``RATIO`` 1e4 .. 1e9).  ``A`` is singular where
+``E^-1 + S`` is: on a bundle at rest ``K'`` is nearly singular (the wires' spins, held by friction alone) with an
+indefinite symmetric part, and ``A`` of the 19 wires is numerically singular for ``RATIO`` 0.1 .. 1e3, regular
+from 1e5 to 1e9 (docs/theory_mortar.md 3b): hence the stiff default.
+``E_j``: the sign of ``sum_a Kq_aj Kl_ja / k_a`` (``Kq_j = -c_j Kl_j^T`` for exact stick: negative) so that
+``Kq E Kl`` stiffens, and ``|E_j| max_a |Kq_aj Kl_ja| / k_a = RATIO`` (``k_a`` the elements' diagonal stiffness of
+slot ``a``).  A row with ``E_j d_j < 0`` takes ``P22 = d - 1 / E`` (exact up to ``1 / E``: ``A`` holds
+``E / (1 - E d)``, softer), one with ``E_j d_j > 0`` ``P22 = -1 / E`` (``D - P22 = d + 1 / E``, GMRES absorbs it).
+Idle rows and rows without coupling: ``P22 = D`` (or 1), ``Kl`` taken as empty there: exact.
+
+``Augmented.solve`` counts in ``Solver.stats``: ``saddle_augmented`` (solves), ``saddle_iterations`` (GMRES),
+``saddle_fallbacks``: a preconditioner (lagged, then fresh) that does not get there within its iterations falls
+back to the direct saddle solve of ``M`` (``Problem.linear_system``'s), without a warning.
+"""
+import numpy as np
+
+from .lagged import gmres
+from .linsolve import factorize_tangent
+from ..failures import SingularTangent
+
+__all__ = ["Augmented", "weights", "RATIO", "RTOL", "MAX_ITERATIONS", "MIN_UNKNOWNS", "ENABLED"]
+
+RATIO = 1e6            # |E| times the constraint's stiffness over the structure's (answers do not depend on it)
+RTOL = 1e-10           # |M x - b| / |b| GMRES must reach (``lagged.LAG_RTOL``; the direct saddle solve: 2e-9, 19 wires)
+MAX_ITERATIONS = 30    # GMRES iterations with a fresh factorisation of ``A`` before the direct fallback
+POLISH = True          # after GMRES, one more step of the preconditioned iteration (the multipliers' last digits)
+LAGGED = True          # ``A`` factorised through the solver's lagging (``linsolve.Solver.factorize``), else afresh
+MIN_UNKNOWNS = 1_500   # smaller systems are factorised directly (``linsolve.AUTO_MIN_UNKNOWNS``: SuperLU, ~1 ms)
+ENABLED = True         # False: ``Newton.direction`` solves the saddle system directly (benchmarks: before)
+STATS = ("saddle_augmented", "saddle_iterations", "saddle_fallbacks")
+
+
+def weights(Kq, Kl, free, kdiag, d, idle):
+    """``(E, p22)`` ``(u,)``: the augmentation of each kept row (0: none) and the preconditioner's diagonal
+    entry there, from the rows' couplings ``Kq``, ``Kl`` ``(u, k6)`` (columns / rows of the group's slots), the
+    slots' freedom ``free`` and the elements' diagonal stiffness ``kdiag`` ``(u, k6)``, ``D``'s entries ``d`` and
+    the idle rows ``idle`` ``(u,)`` (module docstring)."""
+    use = free & (kdiag > 0.0)
+    p = Kq * Kl / np.where(use, kdiag, 1.0)
+    p = np.where(use, p, 0.0)
+    scale = np.abs(p).max(axis=1, initial=0.0)
+    sign = np.sign(p.sum(axis=1))
+    coupled = ~idle & (scale > 0.0) & (sign != 0.0)
+    E = np.where(coupled, sign * RATIO / np.where(coupled, scale, 1.0), 0.0)
+    inv = np.where(coupled, 1.0 / np.where(coupled, E, 1.0), 0.0)
+    p22 = np.where(E * d < 0.0, d - inv, -inv)
+    p22 = np.where(coupled, p22, np.where(idle | (d == 0.0), 1.0, d))
+    E = np.where(coupled, -1.0 / np.where(coupled, p22, 1.0), 0.0)
+    return E, p22
+
+
+class Augmented:
+    """One condensed Newton system ``M x = [f; g]`` with its augmented matrix ``A`` (CSC ``(n, n)``, the
+    tangent's pattern); ``Kq``, ``Kl`` ``(u, k6)`` the kept rows' couplings on the free rows ``rows`` ``(u, k6)``
+    (``-1``: held slot, ignored), ``D`` ``(u,)`` the multiplier rows' diagonal (idle rows: 1), ``E``, ``p22``
+    from ``weights``, ``idle`` ``(u,)``; ``K`` ``(n, n)`` the tangent ``K'`` (products); ``direct()`` builds
+    ``M`` (bordered, CSC) and its right-hand side for the fallback."""
+
+    def __init__(self, K, A, f, g, Kq, Kl, rows, D, E, p22, idle, direct):
+        self.K, self.A, self.f, self.g = K, A, f, g
+        free = rows >= 0
+        self.rows = np.where(free, rows, 0)
+        self.Kq, self.Kl = np.where(free, Kq, 0.0), np.where(free, Kl, 0.0)
+        self.Klp = np.where(idle[:, None], 0.0, self.Kl)      # the preconditioner's Kl: none on idle rows
+        self.D, self.E, self.p22, self.idle = D, E, p22, idle
+        self.plain = E == 0.0
+        self.direct = direct           # () -> (M, rhs): the bordered system
+        self.n = A.shape[0]
+        self.iterations = 0
+        self.fallback = False
+
+    def _Kq(self, y):
+        """``Kq y`` ``(n,)`` for ``y`` ``(u,)``."""
+        return np.bincount(self.rows.ravel(), weights=(self.Kq * y[:, None]).ravel(), minlength=self.n)
+
+    def _Kl(self, x, K=None):
+        """``Kl x`` ``(u,)`` for ``x`` ``(n,)``."""
+        return np.einsum("ua,ua->u", self.Kl if K is None else K, x[self.rows])
+
+    def matvec(self, x):
+        """``M x`` for ``x`` ``(n + u,)``."""
+        xu, xb = x[:self.n], x[self.n:]
+        return np.concatenate([self.K @ xu + self._Kq(xb), self._Kl(xu) + self.D * xb])
+
+    def precondition(self, v, apply):
+        """``P^-1 v`` with ``apply`` the solve with (a factorisation of) ``A``."""
+        vf, vg = v[:self.n], v[self.n:]
+        db0 = np.where(self.plain, vg / self.p22, 0.0)
+        du = apply(vf + self._Kq(np.where(self.plain, -db0, self.E * vg)))
+        db = np.where(self.plain, db0, self.E * (self._Kl(du, self.Klp) - vg))
+        return np.concatenate([du, db])
+
+    def solve(self, solver):
+        """The solution ``x`` ``(n + u,)`` of ``M x = [f; g]`` (``Problem.split_solution`` reads it): GMRES
+        preconditioned by ``solver``'s factor of ``A`` (lagged while it allows, then fresh), else the direct
+        saddle solve (module docstring).  ``solver.stats`` counts."""
+        for k in STATS:
+            solver.stats.setdefault(k, 0)
+        solver.stats["saddle_augmented"] += 1
+        b = np.concatenate([self.f, self.g])
+        try:
+            lu = factorize_tangent(self.A, solver, kind="augmented", fresh=not LAGGED)
+            for attempt in range(2):
+                lagged = getattr(lu, "lagged", False)
+                budget = lu.budget if lagged else MAX_ITERATIONS
+                x, its, ok = gmres(self.matvec, lambda v: self.precondition(v, lu.apply), b, RTOL, budget)
+                self.iterations += its
+                solver.stats["saddle_iterations"] += its
+                if lagged:
+                    lu.done(its, ok)
+                if ok and np.all(np.isfinite(x)):
+                    if POLISH:                 # one step of the preconditioned (augmented Lagrangian) iteration
+                        x = x + self.precondition(b - self.matvec(x), lu.apply)
+                    self.factor = lu
+                    return x
+                if not lagged:
+                    break
+                lu = factorize_tangent(self.A, solver, fresh=True)
+        except SingularTangent:
+            pass
+        self.fallback = True
+        solver.stats["saddle_fallbacks"] += 1
+        M, rhs = self.direct()
+        lu = factorize_tangent(M, solver, saddle=True)
+        self.factor = lu
+        return lu.solve(rhs)
