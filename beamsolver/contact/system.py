@@ -842,6 +842,10 @@ class ContactSystem(Contribution):
         if ssn:
             f, K, Kql, Klq, Kll, C = mortar.multiplier_blocks(G, d, st, R, Lam, eps, mu)
             mult = dict(Kql=-Kql, Klq=Klq, Kll=Kll)
+            if not self.n_slots:      # the active-set inner loop's rows (segments' ends: not linearised there)
+                Tq, Vq, capq = mortar.branch_rows(G, d, st, R, Lam, eps, mu)
+                mult.update(Tq=Tq, Vq=Vq, capq=capq, trial=st["trial"], cap=mu * np.maximum(st["lamN"], 0.0),
+                            Pi=st["Pi"], weak=st["weak"] | (st["lamN"] <= 0.0))
         else:
             f, K = mortar.blocks(G, d, st, R, Lam, eps, mu)
         if self.n_slots:

@@ -50,6 +50,8 @@ GRACE_ITER = 10                      # ... at most this many more (``Newton.iter
 DAMPING_MIN = 1.0 / 64.0             # shortest damped Newton step (smooth problems)
 STALL_RATIO = 1.5                    # undamped fallback if the shortest damped step grows the correction less
 FORCES_ONLY_TRIALS = True            # semi-smooth problems: the line search's full-step trial without tangent
+INNER_SWITCHES = 8                   # exact stick: branch switches of the linearised groups per Newton direction ...
+INNER_PREDICTOR = False              # ... also in a load step's first iteration (the prescribed motions' predictor)
 
 
 class Constraint(Protocol):
@@ -228,6 +230,8 @@ class Newton:
         """``(lu, dzf)``: the factorised tangent of ``ev`` and the Newton increment of the free
         unknowns ``(n_free,)`` (with the prescribed-motion coupling of ``dz_c`` ``(n, 6)``)."""
         problem = self.problem
+        if ev.mult is not None and INNER_SWITCHES and "Tq" in ev.mult and (dz_c is None or INNER_PREDICTOR):
+            return self._active_set_direction(ev, dz_c)
         t0 = time.perf_counter()
         K, rhs = problem.linear_system(ev, dz_c)     # with multipliers: condensed and bordered
         t1 = time.perf_counter()
@@ -243,6 +247,41 @@ class Newton:
         if ev.mult is not None:
             dzf, dlam = problem.split_solution(ev, dzf, dz_c)
             problem.multiplier_step(ev, dlam)
+        return lu, dzf
+
+    def _active_set_direction(self, ev, dz_c=None):
+        """``direction`` with the groups' stick / slip branches decided on the linearised problem (exact stick): the
+        bordered system is solved, each group's branch predicted at the step's end by its linearised trial traction
+        and disk (``Problem.predicted_branches``); groups predicted on the other branch get that branch's rows
+        (``Problem.branch_rows``) and the system is solved again, at most ``INNER_SWITCHES`` times, until no group
+        changes (a slip front then moves by several nodes in one Newton iteration).  Not in the iteration that carries
+        the prescribed motions (``INNER_PREDICTOR``): predicted that far, the branches of a 1+6+12 strand's first step
+        from zero tractions settled with 276 groups switched and Newton crawled (residual 5 after 30 iterations)."""
+        problem, mu = self.problem, ev.mult
+        used, rows = mu["stick"], None
+        for inner in range(INNER_SWITCHES + 1):
+            t0 = time.perf_counter()
+            K, rhs = problem.linear_system(ev, dz_c, condense=False, rows=rows)
+            t1 = time.perf_counter()
+            try:
+                lu = linsolve.factorize_tangent(K, self.linsolver, saddle=True)
+                x = lu.solve(rhs)
+            finally:
+                t2 = time.perf_counter()
+                self.timings["assembly"] += t1 - t0
+                self.timings["linear_solve"] += t2 - t1
+            if not np.all(np.isfinite(x)):
+                raise SingularTangent("the linear solve returned non-finite values")
+            stick, tdir = problem.predicted_branches(ev, x, dz_c)
+            stick = np.where(mu["weak"], mu["stick"], stick)
+            if np.array_equal(stick, used):
+                break
+            if inner == INNER_SWITCHES:
+                break
+            used = stick
+            rows = problem.branch_rows(ev, used, tdir)
+        dzf, dlam = problem.split_solution(ev, x, dz_c)
+        problem.multiplier_step(ev, dlam)
         return lu, dzf
 
     def evaluate(self, H, t, tangent=True):
