@@ -16,7 +16,7 @@ import numpy as np
 
 from .._jit import jit
 
-__all__ = ["ELIMINATE", "Split", "split", "add_schur"]
+__all__ = ["ELIMINATE", "Split", "split", "add_schur", "remove_schur"]
 
 ELIMINATE = 0.1      # smallest diagonal entry of D eliminated (a sliding group at the cone's edge stays an unknown)
 ENABLED = True       # False: ``Problem.linear_system`` solves the full bordered system (benchmarks: before)
@@ -70,6 +70,13 @@ def add_schur(vals, off, sp):
     starting at ``off`` of the COO values ``vals`` (z numbering, in place)."""
     w = np.where(sp.elim, 1.0 / np.where(sp.elim, sp.d, 1.0), 0.0)
     _schur(vals, off, np.ascontiguousarray(sp.Kql), np.ascontiguousarray(sp.Klq), w)
+
+
+def remove_schur(vals, off, sp):
+    """Take ``add_schur``'s terms out of the values again (to round-off): the tangent of the evaluation, for a
+    bordered system with other multiplier rows (``Problem.uncondense``)."""
+    w = np.where(sp.elim, 1.0 / np.where(sp.elim, sp.d, 1.0), 0.0)
+    _schur(vals, off, np.ascontiguousarray(sp.Kql), np.ascontiguousarray(sp.Klq), -w)
 
 
 def rhs_terms(sp):

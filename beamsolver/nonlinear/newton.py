@@ -251,17 +251,19 @@ class Newton:
 
     def _active_set_direction(self, ev, dz_c=None):
         """``direction`` with the groups' stick / slip branches decided on the linearised problem (exact stick): the
-        bordered system is solved, each group's branch predicted at the step's end by its linearised trial traction
-        and disk (``Problem.predicted_branches``); groups predicted on the other branch get that branch's rows
-        (``Problem.branch_rows``) and the system is solved again, at most ``INNER_SWITCHES`` times, until no group
-        changes (a slip front then moves by several nodes in one Newton iteration).  Not in the iteration that carries
-        the prescribed motions (``INNER_PREDICTOR``): predicted that far, the branches of a 1+6+12 strand's first step
-        from zero tractions settled with 276 groups switched and Newton crawled (residual 5 after 30 iterations)."""
+        Newton system is solved (condensed, as ``direction``), each group's branch predicted at the step's end by its
+        linearised trial traction and disk (``Problem.predicted_branches``); groups predicted on the other branch get
+        that branch's rows (``Problem.branch_rows``) and the full bordered system (``Problem.uncondense``) is solved
+        again, at most ``INNER_SWITCHES`` times, until no group changes (a slip front then moves by several nodes in
+        one Newton iteration).  Not in the iteration that carries the prescribed motions (``INNER_PREDICTOR``):
+        predicted that far, the branches of a 1+6+12 strand's first step from zero tractions settled with 276 groups
+        switched and Newton crawled (residual 5 after 30 iterations)."""
         problem, mu = self.problem, ev.mult
+        n = self.sys.n_free
         used, rows = mu["stick"], None
         for inner in range(INNER_SWITCHES + 1):
             t0 = time.perf_counter()
-            K, rhs = problem.linear_system(ev, dz_c, condense=False, rows=rows)
+            K, rhs = problem.linear_system(ev, dz_c, condense=inner == 0, rows=rows)
             t1 = time.perf_counter()
             try:
                 lu = linsolve.factorize_tangent(K, self.linsolver, saddle=True)
@@ -272,17 +274,19 @@ class Newton:
                 self.timings["linear_solve"] += t2 - t1
             if not np.all(np.isfinite(x)):
                 raise SingularTangent("the linear solve returned non-finite values")
-            stick, tdir = problem.predicted_branches(ev, x, dz_c)
+            if inner == 0:
+                dzf, dlam = problem.split_solution(ev, x, dz_c)
+                x = np.concatenate([dzf, np.ravel(dlam)])
+            stick, trial, _ = problem.predicted_branches(ev, x, dz_c)
             stick = np.where(mu["weak"], mu["stick"], stick)
-            if np.array_equal(stick, used):
+            if np.array_equal(stick, used) or inner == INNER_SWITCHES:
                 break
-            if inner == INNER_SWITCHES:
-                break
+            if inner == 0:
+                problem.uncondense(ev)
             used = stick
-            rows = problem.branch_rows(ev, used, tdir)
-        dzf, dlam = problem.split_solution(ev, x, dz_c)
-        problem.multiplier_step(ev, dlam)
-        return lu, dzf
+            rows = problem.branch_rows(ev, used, trial)
+        problem.multiplier_step(ev, x[n:].reshape(-1, 3))
+        return lu, x[:n]
 
     def evaluate(self, H, t, tangent=True):
         """``Problem.evaluate`` timed into ``timings`` and checked (finite residual, element rotations

@@ -216,7 +216,7 @@ class Problem:
 
     def predicted_branches(self, ev, x, dz_c=None):
         """The groups' branches at the Newton step ``x`` (a solution of ``linear_system(condense=False)``) by the
-        linearised trial tractions and disks: ``(stick (g,), t (g, 3))`` (``t``: the predicted trial's direction)."""
+        linearised trial tractions and disks: ``(stick (g,), trial (g, 3), cap (g,))``."""
         mu = ev.mult
         n = self.system.n_free
         dz = self._group_increments(mu, x, dz_c)
@@ -224,8 +224,7 @@ class Problem:
         trial = mu["trial"] + np.einsum("gij,gj->gi", mu["Tq"], dz) + \
             np.einsum("gij,gjk,gk->gi", mu["Pi"], mu["R"], dLam)
         cap = mu["cap"] + np.einsum("ga,ga->g", mu["capq"], dz)
-        norm = np.linalg.norm(trial, axis=1)
-        return (norm <= cap) & (cap > 0.0), trial / np.where(norm > 0.0, norm, 1.0)[:, None]
+        return (np.linalg.norm(trial, axis=1) <= cap) & (cap > 0.0), trial, cap
 
     def _group_increments(self, mu, x, dz_c=None):
         """``(g, k6)``: the increments of the groups' slots (free ones from ``x``, prescribed ones from ``dz_c``)."""
@@ -233,12 +232,15 @@ class Problem:
         dz = np.where(rows_red >= 0, x[:self.system.n_free][np.maximum(rows_red, 0)], 0.0)
         return dz if dz_c is None else dz + self._prescribed_slots(mu, dz_c)
 
-    def branch_rows(self, ev, stick, t):
+    def branch_rows(self, ev, stick, trial):
         """``(Klq, Kll, C)`` of the multipliers of ``ev`` with the groups whose branch ``stick`` ``(g,)`` differs from
         their iterate's (not those without pressure) linearised on that branch at the iterate: sticking ``C = v -
-        trial`` (derivatives ``Vq - Tq``, ``R - Pi R``), sliding along the predicted direction ``t`` ``(g, 3)`` ``C = v -
-        cap t`` (``Vq - t capq^T``, ``R``); the others' rows as evaluated."""
+        trial`` (derivatives ``Vq - Tq``, ``R - Pi R``), sliding along the direction ``t`` of the predicted ``trial``
+        ``(g, 3)`` (``predicted_branches``) ``C = v - cap t`` (``Vq - t capq^T``, ``R``); the others' rows as
+        evaluated."""
         mu = ev.mult
+        norm = np.linalg.norm(trial, axis=1)
+        t = trial / np.where(norm > 0.0, norm, 1.0)[:, None]
         Klq, Kll, C = mu["Klq"].copy(), mu["Kll"].copy(), mu["C"].copy()
         sw = (stick != mu["stick"]) & ~mu["weak"]
         v = np.einsum("gij,gj->gi", mu["R"], mu["Lam"])
@@ -305,6 +307,14 @@ class Problem:
         if dz_c is not None:
             rc = rc - np.einsum("ua,ua->u", sp.Klq[g, j], self._prescribed_slots(mu, dz_c)[g])
         return A, np.concatenate([rhs, rc])
+
+    def uncondense(self, ev):
+        """The tangent values of ``ev`` without the Schur terms ``linear_system`` put into them (``condense.
+        remove_schur``), so that ``linear_system(ev, condense=False)`` is the full bordered system again."""
+        mu = ev.mult
+        sp = None if mu is None else mu.pop("split", None)
+        if sp is not None:
+            condense_.remove_schur(ev.extra[2], mu["offset"], sp)
 
     def _prescribed_slots(self, mu, dz_c):
         """``(g, k6)``: the prescribed increments ``dz_c`` on the groups' held slots (zero on free ones)."""
