@@ -219,6 +219,7 @@ class ContactSystem(Contribution):
                                      minlength=len(system.poses0))
         self._augments = 0
         self.newton_multipliers = True   # exact stick: multipliers are Newton unknowns (else Uzawa updates)
+        self.branch_rows = False         # exact stick: the rows of Newton's active-set inner loop (``mortar.branch_rows``)
         self._groups = mortar.Groups()   # the mortar groups, kept while the pairs' nodes hold
         self._mstep, self._ms = None, 0.0     # the Newton step of the multipliers (keys, dLam) and its trial length
         self._t_step = None        # t of the step begun (``begin_step``)
@@ -842,7 +843,7 @@ class ContactSystem(Contribution):
         if ssn:
             f, K, Kql, Klq, Kll, C = mortar.multiplier_blocks(G, d, st, R, Lam, eps, mu)
             mult = dict(Kql=-Kql, Klq=Klq, Kll=Kll)
-            if not self.n_slots:      # the active-set inner loop's rows (segments' ends: not linearised there)
+            if self.branch_rows and not self.n_slots:   # the active-set inner loop's rows (not with segments' ends)
                 Tq, Vq, capq = mortar.branch_rows(G, d, st, R, Lam, eps, mu)
                 mult.update(Tq=Tq, Vq=Vq, capq=capq, trial=st["trial"], cap=mu * np.maximum(st["lamN"], 0.0),
                             Pi=st["Pi"], weak=st["weak"] | (st["lamN"] <= 0.0))

@@ -50,8 +50,10 @@ GRACE_ITER = 10                      # ... at most this many more (``Newton.iter
 DAMPING_MIN = 1.0 / 64.0             # shortest damped Newton step (smooth problems)
 STALL_RATIO = 1.5                    # undamped fallback if the shortest damped step grows the correction less
 FORCES_ONLY_TRIALS = True            # semi-smooth problems: the line search's full-step trial without tangent
-INNER_SWITCHES = 8                   # exact stick: branch switches of the linearised groups per Newton direction ...
+INNER_SWITCHES = 0                   # exact stick: branch switches of the linearised groups per Newton direction ...
 INNER_PREDICTOR = False              # ... also in a load step's first iteration (the prescribed motions' predictor)
+                                     # (an option: twisted pair 244 -> 195, shear lag 39 -> 22 iterations with 8, but
+                                     # the strand bending cycle 197 -> 250 with 8 cut-backs and 7x the CPU time)
 
 
 class Constraint(Protocol):
@@ -153,6 +155,7 @@ class Newton:
         self.L_ref = system.length_scale
         self.rotations = RotationGuard(system)
         self.linsolver = linsolve.Solver()    # solve(linear_solver=...) replaces it
+        problem.want_branch_rows(INNER_SWITCHES > 0)
         self.stall_ratio = np.inf             # correction growth of the shortest damped trial
         self.indefinite_seen = False          # the step's first tangent had det < 0 (or a back-end that cannot tell)
         self.crawl = 0                        # backtracked line searches in a row (``backtrack``)

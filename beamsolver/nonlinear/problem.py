@@ -337,6 +337,13 @@ class Problem:
             dz = dz + self._prescribed_slots(mu, dz_c)
         return x[:n], condense_.recover(sp, x[n:], dz)
 
+    def want_branch_rows(self, flag):
+        """Whether the multipliers' owners compute the rows of Newton's active-set inner loop (``predicted_branches``,
+        ``branch_rows``; ``newton.INNER_SWITCHES``)."""
+        for c in self.contributions:
+            if hasattr(c, "branch_rows"):
+                c.branch_rows = bool(flag)
+
     def multipliers_in_newton(self, flag):
         """Whether multipliers may be Newton unknowns (exact stick); otherwise their owners update them
         between Newton solves (augmented-Lagrangian outer iterations)."""
