@@ -28,7 +28,7 @@ from ..model.buffers import BufferPool
 from . import mortar_jit
 
 __all__ = ["groups", "Groups", "return_mapping", "nodal_state", "multiplier_basis", "group_forces", "blocks",
-           "multiplier_blocks"]
+           "multiplier_blocks", "branch_rows"]
 
 # the scatters of the points' rows into their groups: compiled (``mortar_jit``), or their numpy oracle
 _COMPILED = dict(rows=mortar_jit.scatter_rows, block=mortar_jit.scatter_block, columns=mortar_jit.scatter_columns)
@@ -342,3 +342,21 @@ def multiplier_blocks(G, d, st, R, Lam, c, mu):
     Kll = R - MP @ R
     v = np.einsum("gij,gj->gi", R, Lam)
     return f, Kqq, Kql, Klq, Kll, v - st["lam"]
+
+
+def branch_rows(G, d, st, R, Lam, c, mu):
+    """The linearisation of the groups' trial tractions and disks (the active-set inner loop of Newton's direction,
+    ``nonlinear.problem.Problem.branch_rows``): ``Tq`` ``(n, 3, 6 k)`` = d trial / d q (the node's turn of ``R Lam``
+    included), ``Vq`` ``(n, 3, 6 k)`` = d (R Lam) / d q (the turn's columns only) and ``capq`` ``(n, 6 k)`` =
+    d (mu lamN) / d q, rows over the groups' slots (``st``: ``nodal_state`` with ``eps = c``)."""
+    n, k = G["members"].shape
+    eye = dict(st, C=np.ascontiguousarray(np.broadcast_to(np.eye(3), (n, 3, 3))), c=np.zeros((n, 3)))
+    Tq = _trial_rows(G, d, eye, c, mu)
+    e = np.zeros((n, 3))
+    e[:, 0] = 1.0
+    capq = _trial_rows(G, d, dict(st, C=np.zeros((n, 3, 3)), c=e), c, mu)[:, 0, :].copy()
+    rot, dv = _turn(G, R, Lam)
+    Vq = np.zeros((n, 3, 6 * k))
+    _add_columns(Vq, rot, dv)
+    _add_columns(Tq, rot, np.einsum("gij,gjk->gik", st["Pi"], dv))
+    return Tq, Vq, capq

@@ -63,7 +63,7 @@ from .record import OPEN, SLIP, STICK, Candidates, PairSet
 from .ownership import gauss_owners, gauss_record
 from .projection import closest_points, element_twists, gauss_projections, section_points, segment_bounds
 from .search import broad_pairs, element_spheres
-from .history import ContactHistory
+from .history import ContactHistory, lookup as history_lookup
 from .state import KeyLayout
 from . import adjust, conditioning, rules
 
@@ -73,6 +73,7 @@ OVERLAP_REPORT = 1e-4    # penetration / (R1 + R2) in the given poses that step 
 SWITCH_TOL = 1e-12        # a step ending within this (relative) of active_from / friction_from ends before it
 TIMED = ("search", "rules", "projection", "params", "kernel", "blocks")   # parts of ``ContactSystem.timings``
 LAZY_MORTAR = True       # exact stick: the multiplier blocks only when the tangent is asked for (False: benchmarks)
+EXTRAPOLATE = True       # exact stick: a step's first multipliers extrapolated from the last two steps' (False: before)
 
 
 _default = {"kernel": kernel_jit}       # the kernel of contact systems made without one (``use_numpy_kernel``)
@@ -221,9 +222,12 @@ class ContactSystem(Contribution):
                                      minlength=len(system.poses0))
         self._augments = 0
         self.newton_multipliers = True   # exact stick: multipliers are Newton unknowns (else Uzawa updates)
+        self.branch_rows = False         # exact stick: the rows of Newton's active-set inner loop (``mortar.branch_rows``)
         self._groups = mortar.Groups()   # the mortar groups, kept while the pairs' nodes hold
         self._kept_weights = None         # their nodal weights (``_nodal_weights``)
         self._mstep, self._ms = None, 0.0     # the Newton step of the multipliers (keys, dLam) and its trial length
+        self._t_step = None        # t of the step begun (``begin_step``)
+        self._commits = []         # (t, (keys, Lam)) of the last two converged steps' multipliers (``_extrapolate``)
         self._sweepable = {}       # per declaration: whether the last search found no crossing (``_candidates``)
         self._H_prev = None        # last converged poses (start of the step)
         self._geo = self._geo_prev = None    # (poses, element twists) of the last evaluation / of H_prev
@@ -294,6 +298,7 @@ class ContactSystem(Contribution):
         first, ``InputError`` naming a damaged or foreign entry)."""
         self.history.restore(state)
         self._blocks = None
+        self._commits = []
 
     def _lap(self, part=None):
         """Add the CPU time since the last lap to ``timings[part]`` (``None``: start a lap)."""
@@ -867,6 +872,10 @@ class ContactSystem(Contribution):
         if ssn:
             f, K, Kql, Klq, Kll, C = mortar.multiplier_blocks(G, d, st, R, Lam, eps, mu)
             mult = dict(Kql=-Kql, Klq=Klq, Kll=Kll)
+            if self.branch_rows and not self.n_slots:   # the active-set inner loop's rows (not with segments' ends)
+                Tq, Vq, capq = mortar.branch_rows(G, d, st, R, Lam, eps, mu)
+                mult.update(Tq=Tq, Vq=Vq, capq=capq, trial=st["trial"], cap=mu * np.maximum(st["lamN"], 0.0),
+                            Pi=st["Pi"], weak=st["weak"] | (st["lamN"] <= 0.0))
         else:
             f, K = mortar.blocks(G, d, st, R, Lam, eps, mu)
         if self.n_slots:
@@ -1053,6 +1062,25 @@ class ContactSystem(Contribution):
         self._geo_prev = None
         self._augments = 0
         self._mstep, self._ms = None, 0.0
+        self._t_step = t
+        if EXTRAPOLATE and self._decl_exact.any() and self.newton_multipliers:
+            self._extrapolate(t)
+
+    def _extrapolate(self, t):
+        """Exact stick's first multipliers of the step to ``t``: linear in ``t`` through the last two converged
+        steps' (``_commits``; docs/theory_mortar.md, section 3c), for the groups both have (the others start from
+        the last step's, as before).  Only forwards (``t`` beyond the last step) and with two distinct times."""
+        c = self._commits
+        if len(c) < 2 or None in (c[-1][0], c[-2][0]) or c[-1][0] <= c[-2][0]:
+            return
+        (t0, (k0, L0)), (t1, (k1, L1)) = c[-2], c[-1]
+        if t <= t1 or not len(k1):
+            return
+        i, found = history_lookup(k0, k1)
+        vals = L1.copy()
+        s = (t - t1) / (t1 - t0)
+        vals[found] += s * (L1[found] - L0[i[found]])
+        self.history.update_multipliers(None, (k1, vals))
 
     def _state(self, H):
         if self._decl_exact.any():      # the mortar pass: through the evaluation (kept for these poses)
@@ -1138,6 +1166,7 @@ class ContactSystem(Contribution):
         if P is None or len(sel) == 0:
             self.history.commit(self._decl_mu)
             self._last = self._last_mortar = None
+            self._commits = []
             return
         p, out = po
         m = out.get("mortar")
@@ -1155,6 +1184,7 @@ class ContactSystem(Contribution):
                         xi2=out["xi2"][order], lam_t=lam_vec[order])
         self.history.commit(self._decl_mu, friction, tmult)
         self._last = (P, sel, p, out, (np.array(H), HC, HF))
+        self._commits = [] if tmult is None else (self._commits + [(self._t_step, tmult)])[-2:]
 
     def nodal_results(self):
         """Exact stick's nodal table of the committed state (``Solution.extra``, one entry per step), or None

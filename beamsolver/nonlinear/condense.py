@@ -16,7 +16,7 @@ import numpy as np
 
 from .._jit import jit
 
-__all__ = ["ELIMINATE", "Split", "split", "add_schur", "add_products"]
+__all__ = ["ELIMINATE", "Split", "split", "add_schur", "add_products", "remove_schur"]
 
 ELIMINATE = 0.1      # smallest diagonal entry of D eliminated (a sliding group at the cone's edge stays an unknown)
 ENABLED = True       # False: ``Problem.linear_system`` solves the full bordered system (benchmarks: before)
@@ -75,6 +75,12 @@ def add_products(vals, off, sp, w):
     """``vals[off:]`` as ``(g, k6, k6)`` blocks ``-= K'_ql diag(w) K'_lq`` per group (``w`` ``(g, 3)``, in place):
     the Schur terms (``add_schur``) and the augmentation of the kept components (``augmented``)."""
     _schur(vals, off, np.ascontiguousarray(sp.Kql), np.ascontiguousarray(sp.Klq), np.ascontiguousarray(w))
+
+
+def remove_schur(vals, off, sp):
+    """Take ``add_schur``'s terms out of the values again (to round-off): the tangent of the evaluation, for a
+    bordered system with other multiplier rows (``Problem.uncondense``)."""
+    add_products(vals, off, sp, -np.where(sp.elim, 1.0 / np.where(sp.elim, sp.d, 1.0), 0.0))
 
 
 def rhs_terms(sp):

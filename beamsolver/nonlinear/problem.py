@@ -189,6 +189,7 @@ class Problem:
         if "Kql" not in m:
             return out
         Kql, Klq = m["Kql"], m["Klq"]
+        rows = {k: m[k] for k in ("Tq", "Vq", "capq") if k in m}
         if s.transformed.any() and len(nodes):
             which = np.flatnonzero(s.transformed[nodes].any(axis=1))
             if len(which):
@@ -200,25 +201,75 @@ class Problem:
                 Kql, Klq = Kql.copy(), Klq.copy()
                 Kql[which] = np.swapaxes(T, 1, 2) @ Kql[which]
                 Klq[which] = Klq[which] @ T
+                for k in ("Tq", "Vq"):
+                    if k in rows:
+                        rows[k] = rows[k].copy()
+                        rows[k][which] = rows[k][which] @ T
+                if "capq" in rows:
+                    rows["capq"] = rows["capq"].copy()
+                    rows["capq"][which] = np.einsum("ga,gab->gb", rows["capq"][which], T)
         from ..model import blocks as _blocks
         out.update(Kql=Kql, Klq=Klq, Kll=m["Kll"], R=m["R"], Lam=m["Lam"], B=m.get("B"),
                    dofs=_blocks.dofs(s.rep, nodes))
+        if rows:
+            out.update(rows, trial=m["trial"], cap=m["cap"], Pi=m["Pi"], weak=m["weak"])
         return out
 
-    def bordered(self, ev, K, rhs, dz_c=None):
+    def predicted_branches(self, ev, x, dz_c=None):
+        """The groups' branches at the Newton step ``x`` (a solution of ``linear_system(condense=False)``) by the
+        linearised trial tractions and disks: ``(stick (g,), trial (g, 3), cap (g,))``."""
+        mu = ev.mult
+        n = self.system.n_free
+        dz = self._group_increments(mu, x, dz_c)
+        dLam = x[n:].reshape(-1, 3)
+        trial = mu["trial"] + np.einsum("gij,gj->gi", mu["Tq"], dz) + \
+            np.einsum("gij,gjk,gk->gi", mu["Pi"], mu["R"], dLam)
+        cap = mu["cap"] + np.einsum("ga,ga->g", mu["capq"], dz)
+        return (np.linalg.norm(trial, axis=1) <= cap) & (cap > 0.0), trial, cap
+
+    def _group_increments(self, mu, x, dz_c=None):
+        """``(g, k6)``: the increments of the groups' slots (free ones from ``x``, prescribed ones from ``dz_c``)."""
+        rows_red = self.system.red[mu["dofs"]]
+        dz = np.where(rows_red >= 0, x[:self.system.n_free][np.maximum(rows_red, 0)], 0.0)
+        return dz if dz_c is None else dz + self._prescribed_slots(mu, dz_c)
+
+    def branch_rows(self, ev, stick, trial):
+        """``(Klq, Kll, C)`` of the multipliers of ``ev`` with the groups whose branch ``stick`` ``(g,)`` differs from
+        their iterate's (not those without pressure) linearised on that branch at the iterate: sticking ``C = v -
+        trial`` (derivatives ``Vq - Tq``, ``R - Pi R``), sliding along the direction ``t`` of the predicted ``trial``
+        ``(g, 3)`` (``predicted_branches``) ``C = v - cap t`` (``Vq - t capq^T``, ``R``); the others' rows as
+        evaluated."""
+        mu = ev.mult
+        norm = np.linalg.norm(trial, axis=1)
+        t = trial / np.where(norm > 0.0, norm, 1.0)[:, None]
+        Klq, Kll, C = mu["Klq"].copy(), mu["Kll"].copy(), mu["C"].copy()
+        sw = (stick != mu["stick"]) & ~mu["weak"]
+        v = np.einsum("gij,gj->gi", mu["R"], mu["Lam"])
+        on, off = sw & stick, sw & ~stick
+        Klq[on] = mu["Vq"][on] - mu["Tq"][on]
+        Kll[on] = mu["R"][on] - mu["Pi"][on] @ mu["R"][on]
+        C[on] = v[on] - mu["trial"][on]
+        Klq[off] = mu["Vq"][off] - t[off][:, :, None] * mu["capq"][off][:, None, :]
+        Kll[off] = mu["R"][off]
+        C[off] = v[off] - mu["cap"][off][:, None] * t[off]
+        return Klq, Kll, C
+
+    def bordered(self, ev, K, rhs, dz_c=None, rows=None):
         """The Newton system with the multiplier unknowns of ``ev`` appended: ``[[K, K_ql], [K_lq, K_ll]]``
         (CSC, ``bordered.Bordered``: its pattern kept while the tangent's and the groups' hold) and
         ``[rhs; -C - K_lc dz_c]``.  A multiplier direction no free unknown can slip in (supports hold it, e.g.
         a scene kept in a plane) has an empty row and column: its traction acts on held unknowns only, so it
-        is set to zero there (row: the traction's component itself)."""
+        is set to zero there (row: the traction's component itself).  ``rows``: ``(Klq, Kll, C)`` in place of the
+        evaluation's (``branch_rows``)."""
         mu = ev.mult
         red = self.system.red
         rows_red = red[mu["dofs"]]
-        A, rc = self._bordered.matrix(K, rows_red, mu["Kql"], mu["Klq"], mu["Kll"], mu["R"], mu["Lam"], mu["C"])
+        Klq, Kll, C = (mu["Klq"], mu["Kll"], mu["C"]) if rows is None else rows
+        A, rc = self._bordered.matrix(K, rows_red, mu["Kql"], Klq, Kll, mu["R"], mu["Lam"], C)
         if dz_c is not None:
             dzf = np.ravel(dz_c)[mu["dofs"]]                       # (g, 6 k): constrained increments only
             dzf = np.where(rows_red < 0, dzf, 0.0)
-            rc = rc - np.einsum("gij,gj->gi", mu["Klq"], dzf).ravel()
+            rc = rc - np.einsum("gij,gj->gi", Klq, dzf).ravel()
         return A, np.concatenate([rhs, rc])
 
     def _split(self, ev, condense=True):
@@ -255,7 +306,7 @@ class Problem:
         d = np.where(np.abs(d) < bordered_.IDLE, 0.0, d)       # a sticking group's tangential components: zero
         return g, j, sp.Kql[g, :, j], sp.Klq[g, j], d, self.system.red[mu["dofs"]][g]
 
-    def linear_system(self, ev, dz_c=None, condense=True):
+    def linear_system(self, ev, dz_c=None, condense=True, rows=None):
         """``(A, rhs)``: the Newton system of ``ev`` (CSC, free unknowns first; ``dz_c`` ``(n, 6)`` prescribed
         increments).  With multipliers, those components their owner's basis makes eliminable are eliminated
         exactly (``condense``: their Schur terms go into ``ev``'s tangent values, in place, once) and the others
@@ -271,7 +322,7 @@ class Problem:
         if mu is None:
             return K, rhs
         if sp is None:
-            return self.bordered(ev, K, rhs, dz_c)
+            return self.bordered(ev, K, rhs, dz_c, rows)
         return self._condensed(ev, K, rhs, dz_c)
 
     def _condensed(self, ev, K, rhs, dz_c):
@@ -343,6 +394,21 @@ class Problem:
         i = self._diag_entries
         return np.bincount(s.coo_rows[i], weights=ev.kvals[i], minlength=6 * s.n_nodes)
 
+    def uncondense(self, ev):
+        """The tangent values of ``ev`` without the Schur terms ``linear_system`` put into them (``condense.
+        remove_schur``), so that ``linear_system(ev, condense=False)`` is the full bordered system again."""
+        mu = ev.mult
+        sp = None if mu is None else mu.pop("split", None)
+        if sp is not None:
+            if mu.pop("in_values", False):          # ``augmented_system``'s augmentation in the values: out too
+                g, j = sp.kept[:, 0], sp.kept[:, 1]
+                w = np.zeros(sp.d.shape)
+                w[g, j] = mu["E"]
+                condense_.add_products(ev.extra[2], mu["offset"], sp, w)
+            for k in ("E", "p22", "A", "Kp"):
+                mu.pop(k, None)
+            condense_.remove_schur(ev.extra[2], mu["offset"], sp)
+
     def _prescribed_slots(self, mu, dz_c):
         """``(g, k6)``: the prescribed increments ``dz_c`` on the groups' held slots (zero on free ones)."""
         dz = np.ravel(dz_c)[mu["dofs"]]
@@ -363,6 +429,13 @@ class Problem:
         if dz_c is not None:
             dz = dz + self._prescribed_slots(mu, dz_c)
         return x[:n], condense_.recover(sp, x[n:], dz)
+
+    def want_branch_rows(self, flag):
+        """Whether the multipliers' owners compute the rows of Newton's active-set inner loop (``predicted_branches``,
+        ``branch_rows``; ``newton.INNER_SWITCHES``)."""
+        for c in self.contributions:
+            if hasattr(c, "branch_rows"):
+                c.branch_rows = bool(flag)
 
     def multipliers_in_newton(self, flag):
         """Whether multipliers may be Newton unknowns (exact stick); otherwise their owners update them
