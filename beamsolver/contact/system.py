@@ -290,8 +290,16 @@ class ContactSystem(Contribution):
     # ------------------------------------------------------------ history
     def get_state(self):
         """Committed contact state as a flat dict of arrays (``ContactHistory.state``: saved with a
-        ``Solution``, restart); ``set_state`` restores it."""
-        return self.history.state()
+        ``Solution``, restart), with exact stick's extrapolation data (``_extrapolate``): ``tmult_steps`` the times
+        of the last two steps' multipliers, ``tmult_prev_keys`` / ``tmult_prev_values`` the older ones (the last
+        are the history's ``tmult_*``); ``set_state`` restores it, so a restart takes the same steps."""
+        out = self.history.state()
+        c = self._commits
+        if c and all(t is not None for t, _ in c):
+            out["tmult_steps"] = np.array([t for t, _ in c], dtype=float)
+            if len(c) == 2:
+                out["tmult_prev_keys"], out["tmult_prev_values"] = (np.array(a) for a in c[0][1])
+        return out
 
     def set_state(self, state):
         """Restore a state from ``get_state`` (``ContactHistory.restore``: missing parts empty, checked
@@ -299,6 +307,15 @@ class ContactSystem(Contribution):
         self.history.restore(state)
         self._blocks = None
         self._commits = []
+        times = np.asarray(state.get("tmult_steps", ()), dtype=float).ravel()
+        if len(times) and "tmult_keys" in state:
+            last = (times[-1], self.history.tmult_committed)
+            if len(times) == 2 and "tmult_prev_keys" in state:
+                prev = (np.asarray(state["tmult_prev_keys"], dtype=np.int64),
+                        np.asarray(state["tmult_prev_values"], dtype=float).reshape(-1, 3))
+                self._commits = [(times[0], prev), last]
+            else:
+                self._commits = [last]
 
     def _lap(self, part=None):
         """Add the CPU time since the last lap to ``timings[part]`` (``None``: start a lap)."""
