@@ -160,7 +160,9 @@ def factorize_tangent(K, solver=None, what="singular tangent", saddle=False, fre
     ``fresh``: not lagged (``Solver.fresh``); ``kind``: ``Solver.factorize``'s."""
     solver = solver if solver is not None else Solver()
     try:
-        return _Typed(solver.fresh(K) if fresh else solver.factorize(K, saddle=saddle, kind=kind), what)
+        if fresh:
+            return _Typed(solver.fresh(K), what)
+        return _Typed(solver.factorize(K, saddle=saddle, **({} if kind is None else dict(kind=kind))), what)
     except SingularMatrixError as e:
         raise SingularTangent(f"{what} ({e})") from None
 
