@@ -310,6 +310,7 @@ def _scene(model, worker):
         problem.commit(H)                 # the friction history's frames (contact.frames_jit, lie.se3_twin)
     finally:
         kernel_jit.evaluate = compiled
+    _exact_stick_callees()
     c = problem.contact
     geo = c._twists(H)
     for d in c.decls:
@@ -319,6 +320,16 @@ def _scene(model, worker):
     if worker is not None and worker.running():
         _wait(worker)
     _kernel_call()
+
+
+def _exact_stick_callees():
+    """The exact stick path's compiled helpers that the stand-in's data do not reach (they run where some pairs are
+    not folded into their groups, and where a group's components are eliminated), on empty arrays of the solve's
+    types (``contact.mortar_jit.subtract_indexed``, ``nonlinear.condense._schur``)."""
+    from ..contact import mortar_jit
+    from . import condense
+    mortar_jit.subtract_indexed(np.zeros((0, 24, 24)), np.zeros((0, 24, 24)), np.zeros(0, dtype=np.int64))
+    condense._schur(np.zeros(0), 0, np.zeros((0, 24, 3)), np.zeros((0, 3, 24)), np.zeros((0, 3)))
 
 
 def _stand_in(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames):
