@@ -54,7 +54,8 @@ INNER_SWITCHES = 0                   # exact stick: branch switches of the linea
 INNER_PREDICTOR = False              # ... also in a load step's first iteration (the prescribed motions' predictor)
 INNER_UNSETTLED = "last"             # branches still changing after INNER_SWITCHES: "last" solve or "plain" Newton's
                                      # (an option: twisted pair 244 -> 195, shear lag 39 -> 22 iterations with 8, but
-                                     # the strand bending cycle 197 -> 250 with 8 cut-backs and 7x the CPU time)
+                                     # the strand bending cycle 197 -> 244 with 6 cut-backs and 5x the CPU time;
+                                     # docs/theory_mortar.md section 3c)
 
 
 class Constraint(Protocol):
