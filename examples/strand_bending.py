@@ -21,7 +21,7 @@ first slip ``kappa_b = mu F sin b / (E A_w cos^2 b r)``; slipping share ``2 psi 
 ``sin(psi) / psi = kappa_b / kappa`` up to ``kappa_t = (pi / 2) kappa_b``; saturated friction moment
 ``M_f = (2 n / pi) mu F r sin b cos b``; reversals by Masing's rule; loop energy from it.
 
-Stick: by default exact (``stick="exact"``: the mortar nodal multipliers as Newton unknowns,
+Stick: the library's default, exact (``stick="exact"``: the mortar nodal multipliers as Newton unknowns,
 docs/theory_mortar.md), whose stick state does not depend on a penalty: initial stiffness 90.6-91.1
 N m^2 at 16-48 el/lay, about 12 % below the plane-section ``EI_max`` (the wires stick at their surface,
 a lever arm ``R_w`` from their axes, and turn under the friction's moment; tying the axes rigidly to
@@ -115,9 +115,10 @@ SLIP_TOLERANCE = 5e-6            # with stick="penalty": its elastic slip / elem
 
 
 def _contact_options(stick, slip_tolerance):
-    """Friction from the tensioned state; exact stick, or the penalty stick with ``slip_tolerance``."""
+    """Friction from the tensioned state; the library's default stick (exact), or the penalty stick with
+    ``slip_tolerance``."""
     stick = STICK if stick is None else stick
-    return dict(friction_from=1.0, stick=stick) | (dict(slip_tolerance=slip_tolerance) if stick == "penalty" else {})
+    return dict(friction_from=1.0) | (dict(stick=stick, slip_tolerance=slip_tolerance) if stick == "penalty" else {})
 
 
 def build(lays=LAYS, elements_per_lay=ELEMENTS, mu=MU, amplitude=AMPLITUDE, tied=False, kappa_b=None, slip_tolerance=SLIP_TOLERANCE,
