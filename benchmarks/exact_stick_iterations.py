@@ -1,10 +1,10 @@
 """Exact stick's Newton iterations and cut-backs on the six contact examples, also under round-off perturbations
 of the initial poses (issue 26: a gain must not be luck; the twisted pair's count moved 224-314 at round-off).
 
-    python benchmarks/exact_stick_iterations.py [--scenes twisted_pair shear_lag ...] [--perturb 0 1e-12 -1e-12]
+    python benchmarks/exact_stick_iterations.py [--scenes twisted_pair shear_lag ...] [--perturb 0 1e-12 ...]
         [--stick exact] [--option NAME=VALUE ...]
 
-``--perturb d``: every beam's node positions' x and y scaled by ``1 + d`` (``Model.add_beam`` wrapped; z kept:
+``--perturb d``: every beam's node positions' x and y scaled by ``1 + d`` (default 0, +-1e-12, +-3e-12) (``Model.add_beam`` wrapped; z kept:
 the rolling beam rests on its master along z): the same scene to round-off.  ``--option``: a module attribute of ``beamsolver.contact.system`` or
 ``beamsolver.nonlinear.newton`` set before the runs (``system.SSN_FREEZE=0``: the experiments' switches).
 Prints one markdown row per scene and perturbation with Newton iterations, cut-backs and the CPU time
@@ -60,7 +60,9 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenes", nargs="+", default=["twisted_pair", "three_wires", "shear_lag", "rolling", "capstan",
                                                     "contact_patch"])
-    ap.add_argument("--perturb", type=float, nargs="+", default=[0.0, 1e-12, -1e-12])
+    ap.add_argument("--perturb", type=float, nargs="+", default=[0.0, 1e-12, -1e-12, 3e-12, -3e-12],
+                    help="positions' x, y scaled by 1 + each (default: 0 +-1e-12 +-3e-12; argparse takes -1e-12 for "
+                         "an option: write negative ones as -0.000000000001)")
     ap.add_argument("--stick", default="exact")
     ap.add_argument("--option", nargs="*", default=[])
     a = ap.parse_args()

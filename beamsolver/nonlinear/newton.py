@@ -52,8 +52,10 @@ STALL_RATIO = 1.5                    # undamped fallback if the shortest damped 
 FORCES_ONLY_TRIALS = True            # semi-smooth problems: the line search's full-step trial without tangent
 INNER_SWITCHES = 0                   # exact stick: branch switches of the linearised groups per Newton direction ...
 INNER_PREDICTOR = False              # ... also in a load step's first iteration (the prescribed motions' predictor)
+INNER_UNSETTLED = "last"             # branches still changing after INNER_SWITCHES: "last" solve or "plain" Newton's
                                      # (an option: twisted pair 244 -> 195, shear lag 39 -> 22 iterations with 8, but
-                                     # the strand bending cycle 197 -> 250 with 8 cut-backs and 7x the CPU time)
+                                     # the strand bending cycle 197 -> 244 with 6 cut-backs and 5x the CPU time;
+                                     # docs/theory_mortar.md section 3c)
 
 
 class Constraint(Protocol):
@@ -280,9 +282,14 @@ class Newton:
             if inner == 0:
                 dzf, dlam = problem.split_solution(ev, x, dz_c)
                 x = np.concatenate([dzf, np.ravel(dlam)])
+                first = (lu, x)
             stick, trial, _ = problem.predicted_branches(ev, x, dz_c)
             stick = np.where(mu["weak"], mu["stick"], stick)
-            if np.array_equal(stick, used) or inner == INNER_SWITCHES:
+            if np.array_equal(stick, used):
+                break
+            if inner == INNER_SWITCHES:
+                if INNER_UNSETTLED == "plain":
+                    lu, x = first
                 break
             if inner == 0:
                 problem.uncondense(ev)

@@ -215,8 +215,9 @@ class Problem:
         return out
 
     def predicted_branches(self, ev, x, dz_c=None):
-        """The groups' branches at the Newton step ``x`` (a solution of ``linear_system(condense=False)``) by the
-        linearised trial tractions and disks: ``(stick (g,), trial (g, 3), cap (g,))``."""
+        """The groups' branches at the Newton step ``x`` ``(n_free + 3 g,)`` (free increments, then the multipliers'
+        step: ``linear_system(condense=False)``'s solution) by their linearised trial tractions and disks (the rows of
+        ``mortar.branch_rows``, ``want_branch_rows``): ``(stick (g,), trial (g, 3), cap (g,))``."""
         mu = ev.mult
         n = self.system.n_free
         dz = self._group_increments(mu, x, dz_c)
