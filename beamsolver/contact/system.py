@@ -73,6 +73,11 @@ OVERLAP_REPORT = 1e-4    # penetration / (R1 + R2) in the given poses that step 
 SWITCH_TOL = 1e-12        # a step ending within this (relative) of active_from / friction_from ends before it
 TIMED = ("search", "rules", "projection", "params", "kernel", "blocks")   # parts of ``ContactSystem.timings``
 LAZY_MORTAR = True       # exact stick: the multiplier blocks only when the tangent is asked for (False: benchmarks)
+SLIP_C = True            # exact stick: a group's c for the next step scaled by its last step's slip over the largest
+#                          of its declaration's sliding groups (``_balanced_c``; False: the declaration's c everywhere)
+SLIP_C_RULES = 10.0      # ... in a declaration whose c max |u| exceeds SLIP_C_RULES x its median sliding traction
+SLIP_C_FLOOR = 1e-3      # ... but not below SLIP_C_FLOOR x the declaration's c (c -> 0 would hide a sticking group's
+#                          slip from its equation ``C = -c u``: measured, a stall with the forces met and the slips not)
 EXTRAPOLATE = True       # exact stick: a step's first multipliers extrapolated from the last two steps' (False: before)
 
 
@@ -227,6 +232,7 @@ class ContactSystem(Contribution):
         self._kept_weights = None         # their nodal weights (``_nodal_weights``)
         self._mstep, self._ms = None, 0.0     # the Newton step of the multipliers (keys, dLam) and its trial length
         self._t_step = None        # t of the step begun (``begin_step``)
+        self._slide_c = None       # (keys, factor) of the groups' c for the next step (``_balanced_c``)
         self._commits = []         # (t, (keys, Lam)) of the last two converged steps' multipliers (``_extrapolate``)
         self._sweepable = {}       # per declaration: whether the last search found no crossing (``_candidates``)
         self._H_prev = None        # last converged poses (start of the step)
@@ -292,13 +298,16 @@ class ContactSystem(Contribution):
         """Committed contact state as a flat dict of arrays (``ContactHistory.state``: saved with a
         ``Solution``, restart), with exact stick's extrapolation data (``_extrapolate``): ``tmult_steps`` the times
         of the last two steps' multipliers, ``tmult_prev_keys`` / ``tmult_prev_values`` the older ones (the last
-        are the history's ``tmult_*``); ``set_state`` restores it, so a restart takes the same steps."""
+        are the history's ``tmult_*``), and the groups' ``c`` factors ``slide_c_keys`` / ``slide_c_factors``
+        (``_balanced_c``); ``set_state`` restores it, so a restart takes the same steps."""
         out = self.history.state()
         c = self._commits
         if c and all(t is not None for t, _ in c):
             out["tmult_steps"] = np.array([t for t, _ in c], dtype=float)
             if len(c) == 2:
                 out["tmult_prev_keys"], out["tmult_prev_values"] = (np.array(a) for a in c[0][1])
+        if self._slide_c is not None:
+            out["slide_c_keys"], out["slide_c_factors"] = (np.array(a) for a in self._slide_c)
         return out
 
     def set_state(self, state):
@@ -316,6 +325,10 @@ class ContactSystem(Contribution):
                 self._commits = [(times[0], prev), last]
             else:
                 self._commits = [last]
+        self._slide_c = None
+        if "slide_c_keys" in state:
+            self._slide_c = (np.asarray(state["slide_c_keys"], dtype=np.int64),
+                             np.asarray(state["slide_c_factors"], dtype=float))
 
     def _lap(self, part=None):
         """Add the CPU time since the last lap to ``timings[part]`` (``None``: start a lap)."""
@@ -792,6 +805,8 @@ class ContactSystem(Contribution):
         ssn = self.newton_multipliers
         Lam = self.iterate_multipliers(G["key"]) if ssn else self.history.tangential_multipliers(G["key"])
         eps, mu = (self._decl_eps_t if ssn else self._decl_aug_t)[gdecl], self._decl_mu[gdecl]
+        if ssn:
+            eps = self._balanced_c(G["key"], eps)
         laws = {id(self.decls[0].law): self.decls[0].law} if len(self.decls) == 1 else \
             {id(self.decls[k].law): self.decls[k].law for k in np.unique(gdecl)}
         if len(laws) > 1:
@@ -1029,6 +1044,49 @@ class ContactSystem(Contribution):
         return b, info
 
     # ------------------------------------------------------------ multipliers as Newton unknowns
+    def _sliding_c(self, m):
+        """``(keys, f)`` (sorted keys): the factor ``clip(|u_g| / max |u|, SLIP_C_FLOOR, 1)`` of ``c`` of the groups
+        of a converged state's mortar data ``m`` (sticking ones included: their slip is below the tolerance), ``max |u|``
+        over their declaration's sliding groups; 1 in a declaration where none slid or where ``c max |u|`` is below
+        ``SLIP_C_RULES`` times the median traction of its sliding groups (the slip does not rule their trials: the twisted
+        pair's and the shear lag's sliding groups, ``c |u| / |lam|`` 0.01 .. 2, got slower with a lower ``c``; ``_balanced_c``);
+        None when ``SLIP_C`` is off or no group slid."""
+        if not SLIP_C:
+            return None
+        lam, u = np.linalg.norm(m["lam"], axis=1), np.linalg.norm(m["u"], axis=1)
+        slid = ~m["stick"] & (lam > 0.0) & (u > 0.0)
+        if not slid.any():
+            return None
+        eps = self._decl_eps_t
+        umax, lmed = np.zeros(len(eps)), np.zeros(len(eps))
+        np.maximum.at(umax, m["decl"][slid], u[slid])
+        for k in np.unique(m["decl"][slid]):
+            lmed[k] = np.median(lam[slid & (m["decl"] == k)])
+        umax[eps * umax <= SLIP_C_RULES * lmed] = 0.0      # the slip does not rule the trials: c stays
+        top = umax[m["decl"]]
+        keys = np.asarray(m["key"])
+        f = np.where(top > 0.0, np.clip(u / np.where(top > 0.0, top, 1.0), SLIP_C_FLOOR, 1.0), 1.0)
+        order = np.argsort(keys)
+        return keys[order], f[order]
+
+    def _balanced_c(self, keys, eps):
+        """``c`` ``(k,)`` of exact stick's complementarity function for the groups ``keys`` (declarations' ``eps``):
+        lowered for a group of the last converged step in proportion to its slip against the largest sliding one of
+        its declaration (``_sliding_c``; docs/theory_mortar.md section 3d).
+
+        ``c`` weighs a slip against a traction in the trial ``v + c u``, and is not in the equations a solution
+        meets.  A group whose slip is a small fraction of its neighbours' (a nearly sticking one) with the
+        declaration's ``c`` has a stick band ``|u| < (mu lamN - |v|) / c`` of picometres and a sliding direction
+        that is its slip's: Newton's corrections reversed that slip from one iterate to the next (measured on
+        the extreme twisted pair: the slip direction of the sliding groups turned by 180 degrees while the force
+        residual fell a thousandfold, the Armijo test refused the full steps and the line search crawled)."""
+        sc = self._slide_c
+        if sc is None or not len(keys):
+            return eps
+        i = np.searchsorted(sc[0], keys).clip(max=len(sc[0]) - 1)
+        found = sc[0][i] == keys
+        return np.where(found, eps * sc[1][i], eps)
+
     def iterate_multipliers(self, keys):
         """Nodal multipliers ``(k, 3)`` of the groups ``keys`` at the current iterate: the trial ones of the
         step (``history``) plus the trial length times the last Newton step of the multipliers."""
@@ -1184,6 +1242,7 @@ class ContactSystem(Contribution):
             self.history.commit(self._decl_mu)
             self._last = self._last_mortar = None
             self._commits = []
+            self._slide_c = None
             return
         p, out = po
         m = out.get("mortar")
@@ -1202,6 +1261,7 @@ class ContactSystem(Contribution):
         self.history.commit(self._decl_mu, friction, tmult)
         self._last = (P, sel, p, out, (np.array(H), HC, HF))
         self._commits = [] if tmult is None else (self._commits + [(self._t_step, tmult)])[-2:]
+        self._slide_c = None if m is None else self._sliding_c(m)
 
     def nodal_results(self):
         """Exact stick's nodal table of the committed state (``Solution.extra``, one entry per step), or None
