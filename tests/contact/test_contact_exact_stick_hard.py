@@ -49,3 +49,30 @@ def test_sliding_c_scales_each_group_by_its_slip_against_the_largest():
     assert f == pytest.approx([0.25, system.SLIP_C_FLOOR, 1.0, 1.0])
     m["stick"][:] = True
     assert cs._sliding_c(m) is None
+
+
+class _Stop(Exception):
+    pass
+
+
+def test_restart_takes_the_same_steps_with_extrapolated_multipliers_and_scaled_c(monkeypatch):
+    """The state a restart needs besides the history (``ContactSystem.get_state``): the last two steps'
+    multipliers (``_extrapolate``) and the groups' ``c`` factors (``_balanced_c``).  The reduced extreme pair
+    stopped after its second step and restarted ends on the uninterrupted run's poses, bit for bit."""
+    monkeypatch.setattr(system, "SLIP_C", True)
+    full, _ = _extreme(monkeypatch)
+
+    def stop(info):
+        if info["t"] > 0.6:
+            raise _Stop
+
+    model, _, _ = twisted_pair_extreme.build(n_elements=16, turns=0.5, stick="exact")
+    with pytest.raises(_Stop) as e:
+        bs.solve(model, steps=4, callback=stop, verbose=False)
+    part = e.value.solution
+    state = part.contact_state
+    assert "contact/tmult_steps" in state and "contact/slide_c_keys" in state
+    model, _, _ = twisted_pair_extreme.build(n_elements=16, turns=0.5, stick="exact")
+    rest = bs.solve(model, steps=4, restart=part, verbose=False)
+    np.testing.assert_array_equal(rest.times, full.times)
+    np.testing.assert_array_equal(rest.poses[-1], full.poses[-1])
