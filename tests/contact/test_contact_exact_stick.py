@@ -51,6 +51,32 @@ def _pressed(problem, slave, depth):
     return H
 
 
+def _committed(model, slave, turned=False):
+    """``(problem, H)``: ``model``'s slave pressed into its master (``_pressed``), the contact's step begun and
+    committed there (``turned``: the committed multipliers replaced by random ones)."""
+    problem = Problem.from_model(model, check_rigid_modes=False)
+    c = problem.contact
+    H = _pressed(problem, slave, 2e-3 * R)
+    c.begin_step(H, 0.0)
+    c.commit(H)
+    if turned:
+        keys, lam = c.history.tmult
+        c.history.update_multipliers(tmult=(keys, np.random.default_rng(3).normal(size=lam.shape) * 50.0))
+    return problem, H
+
+
+def _slid_evaluation(mu=0.5):
+    """``(problem, H, ev)``: ``_parallel(mu)`` pressed, its step begun and committed through the problem, the slave
+    then slid by 1e-7 R and evaluated with the tangent."""
+    model, slave, master = _parallel(mu)
+    problem = Problem.from_model(model, check_rigid_modes=False)
+    H = _pressed(problem, slave, 2e-3 * R)
+    problem.begin_step(H, 0.0)
+    problem.commit(H)
+    H = _move(H, slave.nodes, se3.exp(np.array([1e-7 * R, 1e-7 * R, 0.0, 1e-7 * R, 0.0, 0.0])))
+    return problem, H, problem.evaluate(H, 0.0, tangent=True)
+
+
 def _mortar_inputs(monkeypatch):
     """``(kernel_jit.mortar_terms, X, pm)``: the compiled mortar terms and the inputs ``_mortar`` gives them on
     pressed, slid pairs (with friction history) of ``_parallel``."""
@@ -396,14 +422,7 @@ def test_condensed_step_is_the_bordered_one(regime):
     import scipy.sparse.linalg as spla
     model, slave, master = _parallel(0.5 if regime != "slip" else 0.05,
                                      **(dict(penalty_t=1e7) if regime == "slip" else {}))
-    problem = Problem.from_model(model, check_rigid_modes=False)
-    c = problem.contact
-    H = _pressed(problem, slave, 2e-3 * R)
-    c.begin_step(H, 0.0)
-    c.commit(H)
-    if regime == "turned":
-        keys, lam = c.history.tmult
-        c.history.update_multipliers(tmult=(keys, np.random.default_rng(3).normal(size=lam.shape) * 50.0))
+    problem, H = _committed(model, slave, turned=regime == "turned")
     slide = {"stick": 1e-7, "slip": 2e-3, "turned": 1e-7}[regime] * R
     H = _move(H, slave.nodes, se3.exp(np.array([slide, slide, 0.0, slide, 0.0, 0.5 * slide])))
     system = problem.system
@@ -447,13 +466,7 @@ def test_a_second_evaluation_of_the_same_poses_has_the_tangent_without_the_schur
     """The groups' blocks go to the evaluation without a copy and the condensed Newton system adds its Schur terms
     to them in place: evaluated again at the same poses (a step's start after ``at_rest``), the contact computes
     them again; the tangent and the Newton system are those of a fresh evaluation."""
-    model, slave, master = _parallel(0.5)
-    problem = Problem.from_model(model, check_rigid_modes=False)
-    H = _pressed(problem, slave, 2e-3 * R)
-    problem.begin_step(H, 0.0)
-    problem.commit(H)
-    H = _move(H, slave.nodes, se3.exp(np.array([1e-7 * R, 1e-7 * R, 0.0, 1e-7 * R, 0.0, 0.0])))
-    first = problem.evaluate(H, 0.0, tangent=True)
+    problem, H, first = _slid_evaluation()
     A1, b1 = problem.linear_system(first)
     assert len(first.mult["split"].kept) < 3 * len(first.mult["C"])
     again = problem.evaluate(H, 0.0, tangent=True)
@@ -617,13 +630,7 @@ def test_uncondense_gives_back_the_tangent_without_the_schur_terms():
     """``Problem.uncondense`` (the inner loop's bordered solves after a condensed one) takes the eliminated components'
     Schur terms out of the evaluation's tangent values again: the tangent of a fresh evaluation to round-off, and the
     full bordered system is built from it."""
-    model, slave, master = _parallel(0.5)
-    problem = Problem.from_model(model, check_rigid_modes=False)
-    H = _pressed(problem, slave, 2e-3 * R)
-    problem.begin_step(H, 0.0)
-    problem.commit(H)
-    H = _move(H, slave.nodes, se3.exp(np.array([1e-7 * R, 1e-7 * R, 0.0, 1e-7 * R, 0.0, 0.0])))
-    ev = problem.evaluate(H, 0.0, tangent=True)
+    problem, H, ev = _slid_evaluation()
     raw = problem.tangent(ev).toarray()
     problem.linear_system(ev)
     schur = np.abs(problem.tangent(ev).toarray() - raw).max()

@@ -10,21 +10,13 @@ import scipy.sparse.linalg as spla
 
 from beamsolver import se3
 from beamsolver.nonlinear import augmented, linsolve
-from beamsolver.nonlinear.problem import Problem
-from test_contact_exact_stick import R, _move, _parallel, _pressed
+from test_contact_exact_stick import R, _committed, _move, _parallel
 
 
 def _scene(regime):
     """``(problem, ev)``: an evaluation of ``_parallel`` with multiplier unknowns of the given regime."""
     model, slave, master = _parallel(0.5, n_slave=8 if regime == "mixed" else 4)
-    problem = Problem.from_model(model, check_rigid_modes=False)
-    c = problem.contact
-    H = _pressed(problem, slave, 2e-3 * R)
-    c.begin_step(H, 0.0)
-    c.commit(H)
-    if regime == "turned":
-        keys, lam = c.history.tmult
-        c.history.update_multipliers(tmult=(keys, np.random.default_rng(3).normal(size=lam.shape) * 50.0))
+    problem, H = _committed(model, slave, turned=regime == "turned")
     if regime == "mixed":        # turned about the vertical through the clamped end: its far group slides
         x0 = np.eye(4)
         x0[:3, 3] = H[slave.first, :3, 3]
