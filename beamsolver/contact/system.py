@@ -807,25 +807,11 @@ class ContactSystem(Contribution):
         eps, mu = (self._decl_eps_t if ssn else self._decl_aug_t)[gdecl], self._decl_mu[gdecl]
         if ssn:
             eps = self._balanced_c(G["key"], eps)
-        laws = {id(self.decls[0].law): self.decls[0].law} if len(self.decls) == 1 else \
-            {id(self.decls[k].law): self.decls[k].law for k in np.unique(gdecl)}
-        if len(laws) > 1:
-            raise InputError("contact: exact stick needs one contact law over the declarations of a scene, "
-                             f"got {len(laws)}")
-        law = next(iter(laws.values()))
+        law = self._mortar_law(gdecl)
         RL = np.einsum("gij,gj->gi", R, Lam)        # the multipliers' tractions (global)
         # with multipliers as Newton unknowns, the points' tractions: the multipliers interpolated
         T_pts = np.einsum("pa,pai->pi", G["phi"], RL[G["g"]]) if ssn else None
-        if not tangent:
-            d = kernel_jit.mortar_forces(X, pm, law, pairs=f_pairs is None)
-        elif ssn:         # the points' tractions are known (the multipliers): the tangent at them, two not four
-            # (one, the normal law's included, where the pairs' own tangent has no segment ends' terms to keep)
-            whole = K_pairs is not None and not self.n_slots
-            d = kernel_jit.mortar_terms(X, pm, law, T=T_pts, whole=whole, pairs=f_pairs is None)
-            if whole and d.get("dfdq") is not None:
-                K_pairs = None            # in ``dfdq``
-        else:
-            d = kernel_jit.mortar_terms(X, pm, law)
+        d, K_pairs = self._mortar_kernel(X, pm, law, T_pts, tangent, f_pairs is None, K_pairs)
         if f_pairs is None and "pairs" in d:    # the pairs' own kernel (``_local_blocks``: every pair a mortar pair)
             f_pairs, pair_out = d.pop("pairs")
             np.negative(f_pairs, out=f_pairs)
@@ -867,6 +853,30 @@ class ContactSystem(Contribution):
         return dict(members=G["members"], f=f, K=K, key=G["key"], decl=gdecl,
                     lam=v if ssn else st["lam"], u=st["u"], stick=st["stick"], R=R, m=m, lamN=st["lamN"],
                     mult=mult, folded=folded, f_own=own, pair_f=f_pairs.reshape(-1, 4, 6) if f_pairs is not None else None)
+
+    def _mortar_law(self, gdecl):
+        """The one contact law of the declarations ``gdecl`` of the mortar groups (``InputError`` if they differ)."""
+        laws = {id(self.decls[0].law): self.decls[0].law} if len(self.decls) == 1 else \
+            {id(self.decls[k].law): self.decls[k].law for k in np.unique(gdecl)}
+        if len(laws) > 1:
+            raise InputError("contact: exact stick needs one contact law over the declarations of a scene, "
+                             f"got {len(laws)}")
+        return next(iter(laws.values()))
+
+    def _mortar_kernel(self, X, pm, law, T_pts, tangent, pairs, K_pairs):
+        """``(d, K_pairs)``: the mortar kernel's point terms of ``_mortar`` (forces only without ``tangent``; with the
+        multipliers as Newton unknowns, ``T_pts`` given, the tangent at the points' tractions) and the pairs' own
+        blocks still to fold in (None where the kernel's ``dfdq`` holds them); ``pairs``: the pairs' own forces
+        and point data too (``kernel_jit.mortar_terms(pairs=True)``)."""
+        if not tangent:
+            return kernel_jit.mortar_forces(X, pm, law, pairs=pairs), K_pairs
+        if T_pts is None:
+            return kernel_jit.mortar_terms(X, pm, law), K_pairs
+        # the points' tractions are known (the multipliers): the tangent at them, two not four (one, the normal
+        # law's included, where the pairs' own tangent has no segment ends' terms to keep)
+        whole = K_pairs is not None and not self.n_slots
+        d = kernel_jit.mortar_terms(X, pm, law, T=T_pts, whole=whole, pairs=pairs)
+        return d, (None if whole and d.get("dfdq") is not None else K_pairs)
 
     def _nodal_weights(self, G, e):
         """``m`` ``(n,)`` of the groups ``G`` (``mortar.nodal_state``), their points on the slave elements ``e``:
