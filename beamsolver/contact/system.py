@@ -78,6 +78,8 @@ SLIP_C = True            # exact stick: a group's c for the next step scaled by 
 SLIP_C_RULES = 10.0      # ... in a declaration whose c max |u| exceeds SLIP_C_RULES x its median sliding traction
 SLIP_C_FLOOR = 1e-3      # ... but not below SLIP_C_FLOOR x the declaration's c (c -> 0 would hide a sticking group's
 #                          slip from its equation ``C = -c u``: measured, a stall with the forces met and the slips not)
+SKIP_OPEN = True         # exact stick: Newton's evaluations leave out the points of certainly open groups (``_open_points``)
+SKIP_MARGIN = 1e-2       # ... whose gap exceeds the normal law's band by SKIP_MARGIN (R1 + R2) at least
 EXTRAPOLATE = True       # exact stick: a step's first multipliers extrapolated from the last two steps' (False: before)
 
 
@@ -238,6 +240,8 @@ class ContactSystem(Contribution):
         self._H_prev = None        # last converged poses (start of the step)
         self._geo = self._geo_prev = None    # (poses, element twists) of the last evaluation / of H_prev
         self._blocks = None        # (poses, local blocks) of the last evaluation, for the same state
+        self._skipped = 0          # points of open groups the last evaluation left out (``_open_points``)
+        self._full = False         # evaluate every point (``_state``: commit, updates, results)
         self._tangent_pool = BufferPool()     # tangent buffers of the compiled kernel (``_tangent_out``)
         self._mortar_pool = BufferPool()      # tangent blocks of pairs and mortar groups (``_with_mortar``)
         self.timings = dict.fromkeys(TIMED, 0.0)
@@ -628,6 +632,39 @@ class ContactSystem(Contribution):
             on |= self._decl_exact[P.decl] & (P.kind == LINE) & (self._decl_mu[P.decl] > 0)
         return np.flatnonzero(on)
 
+    def _open_points(self, P, H, sel, centres):
+        """``sel`` without the exact-stick points that certainly act on nothing at ``H`` (``SKIP_OPEN``): a point whose
+        gap from the centre points exceeds the normal law's band (``_active``'s) by ``SKIP_MARGIN (R1 + R2)`` and whose
+        two candidate groups (its slave nodes A, B against its master beam, ``mortar.groups``' keys before the boundary
+        modification, which moves a point to the other node's group only) have zero multipliers and no point within
+        that band.  Such a group's disk is empty and its traction zero: its complementarity function ``C = v = 0``,
+        its rows and its Schur terms vanish whatever its slip and normal, so its points' forces, tangents and slips
+        change nothing Newton uses (a point kept for its other group adds nothing to this one: no normal traction, zero
+        traction).  The evaluations of ``commit`` and the updates take every point (``_state``): the points' history
+        and the groups' slips are those of the whole overlap.  Counted in ``_skipped``."""
+        nb, nn = self.n_beams, len(H)
+        dec = P.decl[sel]
+        mort = self._decl_exact[dec] & (P.kind[sel] == LINE) & (self._decl_mu[dec] > 0)
+        if not mort.any():
+            return sel
+        xC, xF = centres
+        R12 = P.R1[sel] + P.R2[sel]
+        gap = np.linalg.norm(xF[sel] - xC[sel], axis=1) - R12
+        pen = self._decl_penalty[dec]
+        band = self._smoothing(P, sel) + 1e-3 * R12 + touch_tolerance(_extent(H), P.R1[sel], P.R2[sel]) + SKIP_MARGIN * R12
+        far = mort & (self.history.normal_multipliers(P.key[sel]) - pen * gap <= -pen * band)
+        if not far.any():
+            return sel
+        keys = (dec.astype(np.int64)[:, None] * nn + P.nodes[sel, :2]) * nb + self.el_beam[P.m[sel]][:, None]
+        ukeys = np.unique(keys[mort])
+        hot = np.zeros(len(ukeys), dtype=bool)
+        hot[np.searchsorted(ukeys, keys[mort & ~far].ravel())] = True
+        hot |= np.any(self.iterate_multipliers(ukeys) != 0.0, axis=1)
+        skip = far.copy()
+        skip[far] = ~hot[np.searchsorted(ukeys, keys[far])].any(axis=1)
+        self._skipped = int(skip.sum())
+        return sel[~skip] if self._skipped else sel
+
     # ------------------------------------------------------------ refusals
     def element_label(self, e):
         """``Beam b 'name' element j`` for the global element id ``e``."""
@@ -705,6 +742,12 @@ class ContactSystem(Contribution):
             self._blocks = (np.array(H), None)
             return None
         self._check_normals(P, sel, H, centres)
+        self._skipped = 0
+        if SKIP_OPEN and not self._full and self.newton_multipliers and not self.n_slots and self._decl_exact.any():
+            sel = self._open_points(P, H, sel, centres)
+            if len(sel) == 0:
+                self._blocks = (np.array(H), None)
+                return None
         p = self._params(P, sel, H)
         self._lap("params")
         self._blocks = None        # its tangent buffer may be reused (``_tangent_out``)
@@ -1169,7 +1212,13 @@ class ContactSystem(Contribution):
 
     def _state(self, H):
         if self._decl_exact.any():      # the mortar pass: through the evaluation (kept for these poses)
-            self._local_blocks(H, False)
+            if self._skipped:           # an evaluation that left points out (``_open_points``): every point
+                self._blocks, self._cache = None, None
+            self._full = True
+            try:
+                self._local_blocks(H, False)
+            finally:
+                self._full = False
         cache = getattr(self, "_cache", None)
         if cache is not None and cache[0].shape == H.shape and np.array_equal(cache[0], H):
             _, P, sel, p, out = cache
