@@ -242,6 +242,7 @@ class ContactSystem(Contribution):
         self._blocks = None        # (poses, local blocks) of the last evaluation, for the same state
         self._skipped = 0          # points of open groups the last evaluation left out (``_open_points``)
         self._full = False         # evaluate every point (``_state``: commit, updates, results)
+        self._far = None           # (pairs, far beyond the normal law's band) of the last ``_active``
         self._tangent_pool = BufferPool()     # tangent buffers of the compiled kernel (``_tangent_out``)
         self._mortar_pool = BufferPool()      # tangent blocks of pairs and mortar groups (``_with_mortar``)
         self.timings = dict.fromkeys(TIMED, 0.0)
@@ -626,13 +627,15 @@ class ContactSystem(Contribution):
         # the smoothing zone plus a small band keeps the projection-updated gap consistent
         band = self._smoothing(P, slice(None)) + 1e-3 * (P.R1 + P.R2) + touch_tolerance(_extent(H), P.R1, P.R2)
         on = mult - pen * gap > -pen * band
+        # (``_open_points``: the pairs far beyond that band, from the same gaps)
+        self._far = (P, mult - pen * gap <= -pen * (band + SKIP_MARGIN * (P.R1 + P.R2))) if SKIP_OPEN else None
         if self.newton_multipliers and self._decl_exact.any():
             # exact stick: the nodal traction field acts over the whole overlap the search found (a point
             # that left the normal law keeps its share of the field: no jump in the residual)
             on |= self._decl_exact[P.decl] & (P.kind == LINE) & (self._decl_mu[P.decl] > 0)
         return np.flatnonzero(on)
 
-    def _open_points(self, P, H, sel, centres):
+    def _open_points(self, P, H, sel):
         """``sel`` without the exact-stick points that certainly act on nothing at ``H`` (``SKIP_OPEN``): a point whose
         gap from the centre points exceeds the normal law's band (``_active``'s) by ``SKIP_MARGIN (R1 + R2)`` and whose
         two candidate groups (its slave nodes A, B against its master beam, ``mortar.groups``' keys before the boundary
@@ -642,17 +645,13 @@ class ContactSystem(Contribution):
         change nothing Newton uses (a point kept for its other group adds nothing to this one: no normal traction, zero
         traction).  The evaluations of ``commit`` and the updates take every point (``_state``): the points' history
         and the groups' slips are those of the whole overlap.  Counted in ``_skipped``."""
+        far = self._far[1][sel] if self._far is not None and self._far[0] is P else None
+        if far is None or not far.any():
+            return sel
         nb, nn = self.n_beams, len(H)
         dec = P.decl[sel]
         mort = self._decl_exact[dec] & (P.kind[sel] == LINE) & (self._decl_mu[dec] > 0)
-        if not mort.any():
-            return sel
-        xC, xF = centres
-        R12 = P.R1[sel] + P.R2[sel]
-        gap = np.linalg.norm(xF[sel] - xC[sel], axis=1) - R12
-        pen = self._decl_penalty[dec]
-        band = self._smoothing(P, sel) + 1e-3 * R12 + touch_tolerance(_extent(H), P.R1[sel], P.R2[sel]) + SKIP_MARGIN * R12
-        far = mort & (self.history.normal_multipliers(P.key[sel]) - pen * gap <= -pen * band)
+        far &= mort
         if not far.any():
             return sel
         keys = (dec.astype(np.int64)[:, None] * nn + P.nodes[sel, :2]) * nb + self.el_beam[P.m[sel]][:, None]
@@ -744,7 +743,7 @@ class ContactSystem(Contribution):
         self._check_normals(P, sel, H, centres)
         self._skipped = 0
         if SKIP_OPEN and not self._full and self.newton_multipliers and not self.n_slots and self._decl_exact.any():
-            sel = self._open_points(P, H, sel, centres)
+            sel = self._open_points(P, H, sel)
             if len(sel) == 0:
                 self._blocks = (np.array(H), None)
                 return None

@@ -57,6 +57,25 @@ class Bordered:
         return True
 
     def _build(self, K, rows_red, nf, c):
+        """The pattern of ``matrix``.  ``K``'s entries (canonical: sorted, no duplicates) and the border's (a row or a
+        column of a multiplier: never at one of ``K``'s) are merged by their sorted keys; only the border's are
+        sorted and made unique (``_build_unique``: the same pattern by one ``np.unique`` over all the entries)."""
+        g = rows_red.shape[0]
+        N = nf + c * g
+        rb, cb, iq, il = _coo(rows_red, nf, c)
+        kc = np.repeat(np.arange(nf, dtype=np.int64), np.diff(K.indptr))
+        kkeys = kc * N + K.indices.astype(np.int64)
+        ubk, inv = np.unique(cb * N + rb, return_inverse=True)
+        inv = inv.ravel()
+        posK = np.arange(len(kkeys)) + np.searchsorted(ubk, kkeys)
+        ub = np.arange(len(ubk)) + np.searchsorted(kkeys, ubk)
+        u = np.empty(len(kkeys) + len(ubk), dtype=np.int64)
+        u[posK] = kkeys
+        u[ub] = ubk
+        self._store(K, rows_red, nf, c, g, N, u, posK, ub, inv, iq, il)
+
+    def _build_unique(self, K, rows_red, nf, c):
+        """``_build`` by one ``np.unique`` over every entry (its oracle: the same pattern)."""
         g = rows_red.shape[0]
         N = nf + c * g
         rb, cb, iq, il = _coo(rows_red, nf, c)
@@ -65,17 +84,22 @@ class Bordered:
         cols = np.concatenate([kc, cb])
         u, pos = np.unique(cols * N + rows, return_inverse=True)
         pos = pos.ravel()
+        nk = K.nnz
+        ub, inv = np.unique(pos[nk:], return_inverse=True)      # the border's entries (apart from K's)
+        self._store(K, rows_red, nf, c, g, N, u, pos[:nk], ub, inv.ravel(), iq, il)
+
+    def _store(self, K, rows_red, nf, c, g, N, u, posK, ub, inv, iq, il):
+        """Keep the pattern: ``u`` the sorted keys ``col N + row`` of the entries, ``posK`` where ``K``'s go, ``ub``
+        where the border's distinct ones go and ``inv`` which of them each border entry (``_coo``'s order) is."""
         indptr = np.zeros(N + 1, dtype=np.int32)
         np.cumsum(np.bincount(u // N, minlength=N), out=indptr[1:])
-        nk, nb = K.nnz, len(rb)
-        ub, inv = np.unique(pos[nk:], return_inverse=True)      # the border's entries (apart from K's)
         nlq = len(iq) + len(il)
-        lq = inv.ravel()[len(iq):nlq]
+        lq = inv[len(iq):nlq]
         ulq, lq_inv = np.unique(lq, return_inverse=True)
         self._p = dict(nf=nf, c=c, indptr_out=indptr, indices=(u % N).astype(np.int32), nnz=len(u), N=N,
-                       posK=pos[:nk], border=ub, inv=inv.ravel(), iq=iq, il=il,
+                       posK=posK, border=ub, inv=inv, iq=iq, il=il,
                        lq_rows=(u[ub[ulq]] % N) - nf, lq_entries=ub[ulq],
-                       ll=pos[nk + nlq:].reshape(g, c, c), n_border=nb,
+                       ll=ub[inv[nlq:]].reshape(g, c, c), n_border=len(inv),
                        indptr=K.indptr, kindices=K.indices, rows_red=rows_red.copy())
         self.builds += 1
 

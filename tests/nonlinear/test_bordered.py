@@ -66,3 +66,23 @@ def test_one_component_groups_are_the_bmat_of_their_blocks():
     B, rc0 = bordered.bmat(*args)
     _same(A, rc, B, rc0)
     assert A.shape[0] == K.shape[0] + 7 and rc[3] == -Lam[3, 0]
+
+
+def test_the_merged_pattern_is_the_one_of_a_sort_of_every_entry():
+    """``_build`` (``K``'s sorted entries merged with the border's, only those sorted) keeps what ``_build_unique``
+    (one ``np.unique`` over every entry) keeps, array for array; so the matrix is the same bits."""
+    rng = np.random.default_rng(4)
+    for c, idle in ((3, None), (3, 1), (1, None)):
+        K, rows, Kql, Klq, Kll, R, Lam, C = _case(rng, idle_group=idle)
+        if c == 1:
+            Kql, Klq, Kll, R, Lam, C = Kql[:, :, :1], Klq[:, :1], Kll[:, :1, :1], R[:, :1, :1], Lam[:, :1], C[:, :1]
+        a, b = bordered.Bordered(), bordered.Bordered()
+        a._build(K, rows, K.shape[0], c)
+        b._build_unique(K, rows, K.shape[0], c)
+        assert a._p.keys() == b._p.keys()
+        for key in a._p:
+            assert np.array_equal(a._p[key], b._p[key]), key
+        b._build = b._build_unique
+        A, rc = a.matrix(K, rows, Kql, Klq, Kll, R, Lam, C)
+        B, rc0 = b.matrix(K, rows, Kql, Klq, Kll, R, Lam, C)
+        assert np.array_equal(A.indices, B.indices) and np.array_equal(A.data, B.data) and np.array_equal(rc, rc0)
