@@ -7,11 +7,12 @@ of the initial poses (issue 26: a gain must not be luck; the twisted pair's coun
 ``--perturb d``: every beam's node positions' x and y scaled by ``1 + d`` (default 0, +-1e-12, +-3e-12) (``Model.add_beam`` wrapped; z kept:
 the rolling beam rests on its master along z): the same scene to round-off.  ``--option``: a module attribute of ``beamsolver.contact.system`` or
 ``beamsolver.nonlinear.newton`` set before the runs (``system.SSN_FREEZE=0``: the experiments' switches).
-Prints one markdown row per scene and perturbation with Newton iterations, cut-backs and the CPU time
-(``time.process_time``: the machine is shared).
+Prints one markdown row per scene and perturbation with Newton iterations, cut-backs, the CPU time
+(``time.process_time``: the machine is shared) and a digest of the final node positions (the same bits: the same digest).
 """
 import argparse
 import contextlib
+import hashlib
 import io
 import sys
 import time
@@ -47,7 +48,9 @@ def run(scene, stick="exact", perturb=0.0):
             sol = SCENES[scene]()
         its = int(sum(s["iterations"] for s in sol.stats))
         cuts = int(sum(s.get("cutbacks", 0) for s in sol.stats))
-        return its, cuts, time.process_time() - t0, "t = %.3g" % sol.times[-1]
+        X = np.ascontiguousarray(np.asarray(sol.poses[-1])[..., :3, 3])
+        return its, cuts, time.process_time() - t0, "t = %.3g, end poses %s" % (
+            sol.times[-1], hashlib.sha1(X.tobytes()).hexdigest()[:10])
     except bs.ConvergenceError as e:
         sol = e.solution
         its = int(sum(s["iterations"] for s in sol.stats)) if sol is not None else 0
