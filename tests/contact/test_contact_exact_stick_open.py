@@ -26,6 +26,7 @@ def _run(monkeypatch, skip, keys_lam=None):
     """The lifted scene with ``SKIP_OPEN = skip``: begun and committed, slid, evaluated with the tangent, its
     Newton step solved directly, then committed there: ``(r, dq, dlam, skipped, history)``."""
     monkeypatch.setattr(csys, "SKIP_OPEN", skip)
+    monkeypatch.setattr(csys, "SKIP_MIN", 0)        # (a small scene: 30 far points)
     problem, H, slave = _lifted()
     c = problem.contact
     problem.begin_step(H, 0.0)
@@ -90,6 +91,7 @@ def test_a_group_with_a_multiplier_keeps_its_points(monkeypatch):
 def test_every_group_open_but_one(monkeypatch, lift):
     """Lifted further: most points left out, the same residual bits."""
     rs = []
+    monkeypatch.setattr(csys, "SKIP_MIN", 0)
     for flag in (False, True):
         monkeypatch.setattr(csys, "SKIP_OPEN", flag)
         problem, H, slave = _lifted(lift)
@@ -98,3 +100,16 @@ def test_every_group_open_but_one(monkeypatch, lift):
         rs.append((ev.r.copy(), problem.contact._skipped))
     assert rs[0][1] == 0 and rs[1][1] > 0
     assert np.array_equal(rs[0][0], rs[1][0])
+
+
+def test_too_few_far_points_are_not_tried(monkeypatch):
+    """Below ``SKIP_MIN`` far points nothing is left out (the look-ups would cost what they save)."""
+    monkeypatch.setattr(csys, "SKIP_OPEN", True)
+    problem, H, slave = _lifted()
+    problem.begin_step(H, 0.0)
+    problem.evaluate(H, 0.0, tangent=False)
+    assert problem.contact._skipped == 0
+    monkeypatch.setattr(csys, "SKIP_MIN", 0)
+    problem.begin_step(H, 0.0)
+    problem.evaluate(H, 0.0, tangent=False)
+    assert problem.contact._skipped > 0
