@@ -25,8 +25,8 @@ sys.path.insert(0, str(HERE.parents[0] / "examples"))
 
 import beamsolver as bs  # noqa: E402
 from beamsolver.assembly import system as asm  # noqa: E402
-from beamsolver.contact import kernel_jit, mortar, system as csys  # noqa: E402
-from beamsolver.nonlinear import augmented, linsolve, lagged, newton  # noqa: E402
+from beamsolver.contact import kernel_jit, mortar, mortar_jit, system as csys  # noqa: E402
+from beamsolver.nonlinear import augmented, lagged, linsolve, newton  # noqa: E402
 from beamsolver.nonlinear.problem import Problem  # noqa: E402
 
 # (part, owner, attribute): the functions timed; a part's time excludes the timed functions it calls
@@ -42,7 +42,7 @@ TARGETS = [
     ("nodal state", mortar, "nodal_state"),
     ("multiplier blocks", mortar, "multiplier_blocks"), ("multiplier blocks", mortar, "multiplier_basis"),
     ("multiplier blocks", mortar, "group_forces"), ("multiplier blocks", mortar, "add_pairs"),
-    ("multiplier blocks", mortar_jit := __import__("beamsolver.contact.mortar_jit", fromlist=["x"]), "subtract_indexed"),
+    ("multiplier blocks", mortar_jit, "subtract_indexed"),
     ("contact glue", csys.ContactSystem, "_mortar"), ("contact glue", csys.ContactSystem, "_local_blocks"),
     ("contact glue", csys.ContactSystem, "evaluate"),
     ("contact assembly", csys, "_with_mortar"), ("contact assembly", asm.System, "assemble_blocks"),
@@ -65,6 +65,7 @@ TRIAL = [0]        # > 0 inside a forces-only ``Problem.evaluate``
 
 
 def _wrap(part, f):
+    """``f`` timed into ``TIMES[(part, inside a trial)]``, exclusive of the timed calls it makes."""
     def g(*a, **k):
         trial = f is ORIG.get((Problem, "evaluate")) and not k.get("tangent", a[3] if len(a) > 3 else True)
         TRIAL[0] += trial
@@ -87,6 +88,7 @@ ORIG = {}
 
 
 def install():
+    """Wrap every ``TARGETS`` function (``uninstall`` puts them back)."""
     for part, owner, name in TARGETS:
         f = owner.__dict__[name] if isinstance(owner, type) else getattr(owner, name)
         if isinstance(f, staticmethod):
@@ -103,6 +105,7 @@ def uninstall():
 
 
 def stick_mode(stick):
+    """``(original, wrapper)`` of ``Model.add_contact`` with the given ``stick`` as its default."""
     orig = bs.Model.add_contact
 
     def add_contact(self, *a, **options):
