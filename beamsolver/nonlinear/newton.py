@@ -164,6 +164,7 @@ class Newton:
         self.near = False                     # the iterate's residual below LS_NEAR x the step's largest
         self.watch_sign = False               # whether to look (stepping.Run: conservative problems)
         self.t_evaluated = None               # t of the last evaluation (failure messages)
+        self.stall_window = None              # a step fails after this many iterations without a new lowest residual
         self.last_evaluation = None           # of the last converged state
         self.reset_timings()
 
@@ -413,6 +414,9 @@ class Newton:
                 return self._converged(H, t, ev, constraint, dict(iterations=it, residuals=residuals, **stats_extra))
             if verdict is not CONTINUE:
                 raise self._failure(verdict, ratio)
+            if self.stall_window and it - int(np.argmin(residuals)) >= self.stall_window:
+                raise NotConverged(f"no progress in {self.stall_window} iterations (scaled residual {ratio:.3g}, "
+                                   f"lowest {min(residuals):.3g})", ratio)
             if dzf is None:
                 lu, dzf = constraint.direction(self, ev, H, t)
             if it == 0 and self.watch_sign and constraint.watch_sign:

@@ -36,7 +36,7 @@ from ..model.material_range import RangeCheck
 from ..results.solution import Solution, describe_model
 
 __all__ = ["Run", "growth", "easy_limit", "steady", "next_step", "after_failure", "STEP_TOLERANCE", "EASY_ITERATIONS", "WAIT_MAX",
-           "STEP_ZERO_ITERATIONS", "STEADY_GROWTH", "STEADY_SHARE"]
+           "STEP_ZERO_ITERATIONS", "STEP_ZERO_STALL", "STEADY_GROWTH", "STEADY_SHARE"]
 
 log = logging.getLogger("beamsolver")
 
@@ -50,6 +50,7 @@ WAIT_MAX = 32              # most easy steps running before a step regrows to a 
 MAX_OUTER = 100            # outer iterations of a step (Problem.repeat_step) before it fails
 UNDAMPED_MARGIN = 2.0      # an undamped residual up to this times the damped one Newton accepted is equilibrium
 STEP_ZERO_ITERATIONS = 4   # Newton budget at t_start / max_iter (no cut-back there; docs/theory.md section 17)
+STEP_ZERO_STALL = 20       # step 0 with exact stick's friction: given up after this many iterations without progress
 
 
 def growth(iterations, easy):
@@ -232,17 +233,24 @@ class Run:
         ``t_start``: if the equilibrium is not found with it, it is found without it and friction starts from zero
         traction there, with a warning in the stats (the touching wires of a 1+6+12 strand under their contact
         pre-stress: docs/theory_mortar.md 3b)."""
+        newton = self.newton
+        # with exact stick's friction, an attempt that stalls (the multipliers' updates alternating between two
+        # states, a rope piece: 0.30 / 0.34 for 80 iterations) gives up early: the fallback below solves it
+        newton.stall_window = STEP_ZERO_STALL if self.problem.exact_friction(True) else None
         try:
             return self.newton_step(t_start)
         except StepFailed as e:
             if not self.problem.exact_friction(False):
                 raise
-            H, ev0, stats = self.newton_step(t_start)
-            note = (f"step 0 (t = {t_start:.6g}): no equilibrium with exact stick's friction ({e}); found "
-                    "without it, friction starts from zero traction at that state")
-            log.warning(note)
-            stats.setdefault("warnings", []).append(note)
-            return H, ev0, stats
+            failed = e
+        finally:
+            newton.stall_window = None
+        H, ev0, stats = self.newton_step(t_start)
+        note = (f"step 0 (t = {t_start:.6g}): no equilibrium with exact stick's friction ({failed}); found "
+                "without it, friction starts from zero traction at that state")
+        log.warning(note)
+        stats.setdefault("warnings", []).append(note)
+        return H, ev0, stats
 
     def _start_failure(self, e, pushed, H, t_start):
         """The ``ConvergenceError`` of a step 0 that failed with ``e`` (``pushed``: contact pushes the given
