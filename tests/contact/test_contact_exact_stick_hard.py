@@ -76,3 +76,23 @@ def test_restart_takes_the_same_steps_with_extrapolated_multipliers_and_scaled_c
     rest = bs.solve(model, steps=4, restart=part, verbose=False)
     np.testing.assert_array_equal(rest.times, full.times)
     np.testing.assert_array_equal(rest.poses[-1], full.poses[-1])
+
+
+def _refined_pair(**options):
+    """The main job at 128 elements per wire, reduced: a quarter of its wires (0.25 m, 32 elements of 7.8 mm), the
+    same pull and twist per length, the main job's first step (1/8 turn a metre) in one step."""
+    import twisted_pair
+    model, plate, _ = twisted_pair.build(n_elements=32, length=0.25, turns=1.0 / 32.0, mu=0.3, **options)
+    return bs.solve(model, steps=1, verbose=False), plate
+
+
+def test_refined_twisted_pair_converges_with_the_default_c():
+    """Issue 26: with ``c = 24 EI / L_e^4`` (6.3e7 N/m^2 at 7.8 mm elements, 4096 times the 16-element main
+    job's) the first step stalled at a scaled residual 1.16e-6 at every step size (the main job at 128 elements
+    too): the nearly unloaded groups slid with ``c |u|`` far above their traction and Newton reversed their slip
+    from one iterate to the next.  The default ``c`` converges, to the torque of an explicit ``c`` 1e6 N/m^2."""
+    sol, plate = _refined_pair()
+    ref, _ = _refined_pair(penalty_t=1e6)
+    assert sol.times[-1] == 1.0
+    assert sum(s.get("cutbacks", 0) for s in sol.stats) == 0
+    assert sol.reaction(plate, -1)[5] == pytest.approx(ref.reaction(plate, -1)[5], rel=1e-6)
