@@ -18,11 +18,12 @@ from .validation import count, real
 
 __all__ = ["ContactOptions", "check_contact_options", "describe", "SMOOTHING", "SLIP_TOLERANCE", "GAUSS_POINTS",
            "SEGMENT_POINTS",
-           "STICK_TOLERANCE", "LINE_ANGLE", "ADJUST", "EXACT_C"]
+           "STICK_TOLERANCE", "LINE_ANGLE", "ADJUST", "EXACT_C", "EXACT_N"]
 
 SMOOTHING = 1e-6          # default smoothing gap of the normal law / (R1 + R2) (benchmarks/touching_defaults.py)
 SLIP_TOLERANCE = 0.005    # elastic slip at the onset of sliding / slave element length (Abaqus' default)
-EXACT_C = 24.0            # stick="exact": default c of the complementarity function / (EI / L_e^4) of the slave
+EXACT_C = 24.0            # stick="exact": default c of the complementarity function / (EI / (L_e L_s^3)) of the slave,
+EXACT_N = 16              # ... L_s = its length / EXACT_N (docs/theory_mortar.md 3b, "c under refinement")
 STICK_TOLERANCE = 1e-8    # weighted slip of a sticking node / (R1 + R2) with stick="exact"
 LINE_ANGLE = float(np.deg2rad(20.0))   # below this crossing angle: line contact (search.py, rule 1)
 GAUSS_POINTS = 5          # integration="points": Gauss points per slave element
