@@ -98,21 +98,23 @@ def use_numpy_kernel(flag=True):
     return previous
 
 
-def exact_c(EI, L, length):
-    """Default ``c`` of exact stick (force / length^2): ``EXACT_C EI / (L_e L_s^3)``, the slave's bending stiffness
-    against a nodal displacement at the reference element length ``L_s = length / EXACT_N`` (``24 EI / L_s^3``)
-    per unit length ``L_e`` of the node (``EI`` its smaller bending stiffness, ``L_e`` the median of its element
-    lengths ``L``, ``length`` the slave beam's).  ``c`` weighs slip against traction in the stick/slip decision of
-    an iterate: the scenes' best values follow the slave's stiffness, not the normal penalty, and under mesh
-    refinement grow like ``1 / L_e`` (a wire's stiffness against a nodal load is the wire's, not its element's;
-    ``24 EI / L_e^4`` grew 4096-fold from 16 to 128 elements and stalled Newton; docs/theory_mortar.md 3b)."""
+def exact_c(EI, L, n):
+    """Default ``c`` of exact stick (force / length^2): ``EXACT_C EI / (L_e L_s^3)`` with ``L_s = n L_e / EXACT_N``
+    (the slave's length over ``EXACT_N``): the slave's bending stiffness against a nodal displacement at that
+    reference element length (``24 EI / L_s^3``) per unit length ``L_e`` of the node (``EI`` its smaller bending
+    stiffness, ``L_e`` the median of its element lengths ``L``, ``n`` its elements per beam).  At ``EXACT_N``
+    elements it is ``24 EI / L_e^4`` (the previous default) to the bit.  ``c`` weighs slip against traction in the
+    stick/slip decision of an iterate: the scenes' best values follow the slave's stiffness, not the normal penalty,
+    and under refinement grow like ``1 / L_e`` (a wire's stiffness against a nodal load is the wire's, not its
+    element's; ``24 EI / L_e^4`` grew 4096-fold from 16 to 128 elements and Newton stalled;
+    docs/theory_mortar.md 3b)."""
     Le = float(np.median(L))
-    return float(EXACT_C * EI / (Le * (length / EXACT_N) ** 3))
+    return float(EXACT_C * EI / Le ** 4 * (EXACT_N / n) ** 3)
 
 
-def _slave_length(L, beams):
-    """Median length of the slave beams ``beams`` (element ids of each; ``L`` the element lengths)."""
-    return float(np.median([L[e].sum() for e in beams]))
+def _slave_elements(beams):
+    """Median element count of the slave beams ``beams`` (element ids of each)."""
+    return float(np.median([len(e) for e in beams]))
 
 
 class _Decl:
@@ -227,7 +229,7 @@ class ContactSystem(Contribution):
         self._decl_exact = np.array([d.exact for d in self.decls])
         for d in self.decls:
             if d.eps_t is None:
-                d.eps_t = exact_c(d.slave_bending, system.L[d.slave_el], _slave_length(system.L, d.slave_beams))
+                d.eps_t = exact_c(d.slave_bending, system.L[d.slave_el], _slave_elements(d.slave_beams))
         self._decl_eps_t = np.array([d.eps_t for d in self.decls])
         self._decl_aug_t = np.array([d.aug_t for d in self.decls])
         self._decl_stick_tol = np.array([d.stick_tolerance for d in self.decls])
