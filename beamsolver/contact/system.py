@@ -107,9 +107,9 @@ def exact_c(EI, L, n):
     stick/slip decision of an iterate: the scenes' best values follow the slave's stiffness, not the normal penalty,
     and under refinement grow like ``1 / L_e`` (a wire's stiffness against a nodal load is the wire's, not its
     element's; ``24 EI / L_e^4`` grew 4096-fold from 16 to 128 elements and Newton stalled;
-    docs/theory_mortar.md 3b)."""
+    docs/theory_mortar.md 3b).  ``contact.system.EXACT_N = None``: ``L_s = L_e``, the rule before (benchmarks)."""
     Le = float(np.median(L))
-    return float(EXACT_C * EI / Le ** 4 * (EXACT_N / n) ** 3)
+    return float(EXACT_C * EI / Le ** 4 * ((n if EXACT_N is None else EXACT_N) / n) ** 3)
 
 
 def _slave_elements(beams):
