@@ -55,8 +55,8 @@ from ..failures import ContactTunnelling, NoContactNormal
 from ..model.model import JOIN_TOL
 from .law import PENALTY_T_MIN, default_penalty
 from . import kernel_jit, mortar, mortar_jit, segment_tangent
-from .options import (ADJUST, EXACT_C, EXACT_N, GAUSS_POINTS, SEGMENT_POINTS, SMOOTHING, STICK_TOLERANCE, ContactOptions,
-                      declaration_table)
+from .options import (ADJUST, EXACT_C, EXACT_N, GAUSS_POINTS, SEGMENT_POINTS, SMOOTHING, STICK_TOLERANCE,
+                      ContactOptions, declaration_table)
 from .frames import LINE, NORMAL_TOL, POINT, no_normal, touch_tolerance
 from .frames_jit import material_frames
 from .record import OPEN, SLIP, STICK, Candidates, PairSet
