@@ -183,3 +183,64 @@ def test_a_restart_keeps_the_previous_iterations_of_steady():
     assert part.n_steps == j and part.resume["previous"] == full.stats[j]["iterations"]
     sol = bs.solve(model, steps=16, restart=part)
     np.testing.assert_array_equal(sol.times, full.times)
+
+
+def _driven(motion, fixed, loads):
+    """A stand-in system for ``stepping.kinks``: one prescribed node turned by ``motion(t)`` about e_z, one ``fix``
+    value ``fixed(t)`` and one load factor ``loads(t)``."""
+    from types import SimpleNamespace
+
+    def poses(t):
+        a = motion(t)
+        R = np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
+        H = np.eye(4)
+        H[:3, :3] = R
+        return H[None]
+    return SimpleNamespace(prescribed_nodes=[0], prescribed_poses=poses, fix_values=[(1, 4, fixed)],
+                           load_scales=[loads], load_factors=lambda t: np.array([loads(t)]))
+
+
+def test_kinks_of_the_loading_path_are_reversals_starts_and_stops():
+    """``kinks.kink``: the increments of the prescribed poses, the fix values or the load factors turn back, or one
+    of them starts or stops, between ``t0 -> t1`` and ``t1 -> t2``; a path going on (faster or slower) has none."""
+    from beamsolver.stepping.kinks import kink
+    tri = lambda t: 0.1 * (t if t <= 1.0 else 2.0 - t)        # noqa: E731  up, then back
+    ramp = lambda t: 0.1 * t                                   # noqa: E731
+    zero = lambda t: 0.0                                       # noqa: E731
+    assert not kink(_driven(ramp, ramp, ramp), 0.5, 0.75, 1.0)
+    assert not kink(_driven(lambda t: t**2, ramp, zero), 0.5, 0.75, 1.5)      # faster, same direction
+    assert kink(_driven(tri, zero, zero), 0.75, 1.0, 1.25)                     # the motion turns back
+    assert kink(_driven(zero, tri, zero), 0.75, 1.0, 1.25)                     # a fix value turns back
+    assert kink(_driven(zero, zero, tri), 0.75, 1.0, 1.25)                     # a load turns back
+    start = lambda t: 0.0 if t <= 1.0 else 0.1 * (t - 1.0)     # noqa: E731
+    stop = lambda t: min(t, 1.0)                               # noqa: E731
+    assert kink(_driven(start, zero, stop), 0.75, 1.0, 1.25)                   # pull stops, bending starts
+    assert not kink(_driven(start, zero, stop), 1.0, 1.25, 1.5)
+
+
+def test_the_step_after_a_kink_starts_at_the_size_that_converged_after_the_last_kink(monkeypatch):
+    """``Run.loop``: the first kink of a triangle history (no memory) is tried at the grown size; a failure there
+    halves it; the next kink starts at the size that converged after the first one, and a restart keeps it."""
+    from beamsolver.stepping import steps as steps_mod
+    from beamsolver.failures import NotConverged
+    model = bs.Model()
+    beam = model.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 4), bs.Section.circular(radius=0.01, E=2e11, nu=0.3))
+    model.fix(beam.first)
+    tri = lambda t: t if t <= 1.0 else (2.0 - t if t <= 2.0 else t - 2.0)     # noqa: E731
+    model.add_load(beam.last, force=(0.0, 1.0, 0.0), scale=tri)
+    real = steps_mod.Run.newton_step
+    tried = []
+
+    def step(self, t_next, start=None):
+        tried.append((self.t, t_next))
+        if abs(self.t - 1.0) < 1e-9 and t_next - self.t > 0.3:        # the first reversal: the grown step fails
+            raise NotConverged("forced", 1.0)
+        return real(self, t_next, start)
+    monkeypatch.setattr(steps_mod.Run, "newton_step", step)
+    sol = bs.solve(model, steps=6, t_end=3.0, verbose=False)
+    assert sol.converged
+    kinked = [(float(sol.times[k - 1]), float(s["dt"])) for k, s in enumerate(sol.stats) if s.get("kink")]
+    assert [t for t, _ in kinked] == pytest.approx([1.0, 2.0])
+    assert kinked[0][1] == pytest.approx(0.25) and kinked[1][1] == pytest.approx(0.25)
+    assert [(a, b) for a, b in tried if abs(a - 2.0) < 1e-9][0][1] == pytest.approx(2.25)   # not 2.5 first
+    assert sol.resume["kink_size"] == pytest.approx(0.25)
