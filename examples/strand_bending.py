@@ -202,6 +202,14 @@ def compare(res):
     err = np.abs(M[down] - masing) / th["M_f"]
     rows.append(("Masing branch: max |M - M_Masing| / M_f", 0.0, err.max()))
     rows.append(("Masing branch at -k: |M - M_Masing| / M_f", 0.0, err[-1]))
+    # Masing's rule on the model's own virgin curve and reversal point: the two rows above measure the theory's
+    # reversal point, so they repeat the model's M_f error; these measure the rule itself
+    xs = np.concatenate([[0.0], kap[up]])
+    fs = np.concatenate([[0.0], M[up] - th["EI_min"] * kap[up]])
+    own = th["EI_min"] * kap[down] + fs[-1] - 2 * np.interp((kr - kap[down]) / 2, xs, fs)
+    err_own = np.abs(M[down] - own) / th["M_f"]
+    rows.append(("Masing on the model's virgin curve: max |M - M_Masing| / M_f", 0.0, err_own.max()))
+    rows.append(("Masing on the model's virgin curve at -k: |M - M_Masing| / M_f", 0.0, err_own[-1]))
     last = t >= 2.0 - 1e-9
     W = np.trapezoid(M[last], kap[last])                         # one full cycle +k -> -k -> +k
     rows.append(("loop energy [J/m]", loop_energy(res["k"], th), W))

@@ -4,12 +4,13 @@ stop (the reversals of a cyclic history, a bending that starts after a pull).
 The step after a kink meets a new regime (contact points that slid stick again, friction that starts) and the
 size the steps before it grew to may not carry it: on the strand bending cycle the user's step failed twice at
 each reversal (8-9 s of CPU each) before a quarter of it converged.  ``stepping.steps.Run`` starts the step after
-a kink at the size that converged after the last kink (``kink_size``)."""
+a kink at the size that converged after the last kink (``kink_size``), the first at ``FIRST`` times the step."""
 import numpy as np
 
 __all__ = ["drive", "kink", "ZERO"]
 
 ZERO = 1e-12            # a part's increment below this times its size (at least 1) counts as none
+FIRST = 1.0             # the first kink of a run (no size known yet): this share of the step (1: the step as grown)
 
 
 def drive(system, t):

@@ -288,8 +288,10 @@ class Run:
             if grid[self.k] - t_next < max(1e-9 * self.dt_user, LANDING * self.dt):
                 t_next = grid[self.k]           # no sliver before the grid point
             kink = self.t_before is not None and kinks.kink(self.sys, self.t_before, self.t, t_next)
-            if kink and self.kink_size is not None and t_next - self.t > self.kink_size * (1.0 + STEP_TOLERANCE):
-                t_next = self.t + self.kink_size     # the size that converged after the last kink
+            if kink:                             # the size that converged after the last kink, or a share of the step
+                size = self.kink_size if self.kink_size is not None else kinks.FIRST * (t_next - self.t)
+                if t_next - self.t > size * (1.0 + STEP_TOLERANCE):
+                    t_next = self.t + max(size, self.dt_min)
             t0 = time.perf_counter()
             t_start = self.t
             t_next, H, ev, stats = self._attempt(t_next)

@@ -219,10 +219,12 @@ def test_kinks_of_the_loading_path_are_reversals_starts_and_stops():
 
 
 def test_the_step_after_a_kink_starts_at_the_size_that_converged_after_the_last_kink(monkeypatch):
-    """``Run.loop``: the first kink of a triangle history (no memory) is tried at the grown size; a failure there
-    halves it; the next kink starts at the size that converged after the first one, and a restart keeps it."""
-    from beamsolver.stepping import steps as steps_mod
+    """``Run.loop``: the first kink of a triangle history (no memory; ``kinks.FIRST`` = 1) is tried at the grown size; a
+    failure there halves it; the next kink starts at the size that converged after the first one, and ``resume``
+    keeps it (restart)."""
+    from beamsolver.stepping import kinks, steps as steps_mod
     from beamsolver.failures import NotConverged
+    monkeypatch.setattr(kinks, "FIRST", 1.0)
     model = bs.Model()
     beam = model.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 4), bs.Section.circular(radius=0.01, E=2e11, nu=0.3))
     model.fix(beam.first)
@@ -244,3 +246,19 @@ def test_the_step_after_a_kink_starts_at_the_size_that_converged_after_the_last_
     assert kinked[0][1] == pytest.approx(0.25) and kinked[1][1] == pytest.approx(0.25)
     assert [(a, b) for a, b in tried if abs(a - 2.0) < 1e-9][0][1] == pytest.approx(2.25)   # not 2.5 first
     assert sol.resume["kink_size"] == pytest.approx(0.25)
+
+
+def test_the_first_kink_of_a_run_starts_at_a_share_of_the_step(monkeypatch):
+    """``kinks.FIRST`` (default 1: the step as grown): with no size known after a kink, the step after the first one
+    is ``FIRST`` times the step as grown (the strand bending cycle's bending after the pull: the user's step and its
+    half failed there)."""
+    from beamsolver.stepping import kinks
+    assert kinks.FIRST == 1.0
+    monkeypatch.setattr(kinks, "FIRST", 0.25)
+    model = bs.Model()
+    beam = model.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 4), bs.Section.circular(radius=0.01, E=2e11, nu=0.3))
+    model.fix(beam.first)
+    model.add_load(beam.last, force=(0.0, 1.0, 0.0), scale=lambda t: t if t <= 1.0 else 2.0 - t)
+    sol = bs.solve(model, steps=4, t_end=2.0, verbose=False)
+    kinked = [float(s["dt"]) for s in sol.stats if s.get("kink")]
+    assert kinked == [pytest.approx(kinks.FIRST * 0.5)]
