@@ -79,8 +79,9 @@ SLIP_C_RULES = 10.0      # ... in a declaration whose c max |u| exceeds SLIP_C_R
 SLIP_C_FLOOR = 1e-3      # ... but not below SLIP_C_FLOOR x the declaration's c (c -> 0 would hide a sticking group's
 #                          slip from its equation ``C = -c u``: measured, a stall with the forces met and the slips not)
 EXTRAPOLATE = True       # exact stick: a step's first multipliers extrapolated from the last two steps' (False: before)
-SLID_START = 1.2         # ... and those of the groups that slid in the last step scaled by this, out of the Coulomb disk:
-#                          a step starts with them sliding (1.0: on the disk's edge, where round-off decides; ``_extrapolate``)
+SLID_START = 1.2         # ... and those of the groups that slid in the last step scaled by this, out of their
+#                          Coulomb disk: a step starts with them sliding (1.0: on the disk's edge, where round-off
+#                          decides; ``_extrapolate``)
 
 
 _default = {"kernel": kernel_jit}       # the kernel of contact systems made without one (``use_numpy_kernel``)
