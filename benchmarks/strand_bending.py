@@ -31,7 +31,7 @@ def main():
     for n in a.meshes:
         res = sb.run(a.lays, n, amplitude=a.amplitude, steps=a.steps, slip_tolerance=a.slip_tolerance)
         th, rows = sb.compare(res)
-        (EI0, F0), (EIt, Ft) = sb.stiffness_checks(a.lays, n, a.steps)
+        (EI0, F0), (EIt, Ft) = sb.stiffness_checks(a.lays, n)
         rows += [("EI frictionless contact", th["EI_min"], EI0, EI0 / sb.theory(F0)["EI_min"] - 1),
                  ("EI wires tied to the core", th["EI_max"], EIt, EIt / sb.theory(Ft)["EI_max"] - 1)]
         k1, kb = sb.first_slip(a.lays, n, steps=a.onset_steps)

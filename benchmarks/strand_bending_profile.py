@@ -6,7 +6,7 @@ Runs ``examples/strand_bending.py``'s cyclic history and its two stiffness check
 evaluations); every Newton attempt (a step try) is timed and counted, failed ones apart.  Prints the parts table,
 the steps table (t, dt, iterations, failed tries) and the answer-quality table of ``compare``.
 
-    python benchmarks/strand_bending_profile.py [--lays 4] [--elements 48] [--steps 4] [--no-checks]
+    python benchmarks/strand_bending_profile.py [--lays 4] [--elements 48] [--steps 4] [--check-steps 1] [--no-checks]
 """
 import argparse
 import sys
@@ -97,13 +97,15 @@ def main():
     ap.add_argument("--steps", type=int, default=sb.STEPS)
     ap.add_argument("--amplitude", type=float, default=sb.AMPLITUDE)
     ap.add_argument("--no-checks", action="store_true")
+    ap.add_argument("--check-steps", type=int, default=sb.CHECK_STEPS, help="steps per unit t of the checks")
     a = ap.parse_args()
     install()
     runs = [("cyclic", dict(lays=a.lays, elements_per_lay=a.elements, amplitude=a.amplitude, steps=a.steps))]
     if not a.no_checks:
+        cs = a.steps if a.check_steps is None else a.check_steps
         runs += [("frictionless", dict(lays=a.lays, elements_per_lay=a.elements, amplitude=a.amplitude,
-                                       steps=a.steps, t_end=2.0, mu=0.0)),
-                 ("tied", dict(lays=a.lays, elements_per_lay=a.elements, amplitude=a.amplitude, steps=a.steps,
+                                       steps=cs, t_end=2.0, mu=0.0)),
+                 ("tied", dict(lays=a.lays, elements_per_lay=a.elements, amplitude=a.amplitude, steps=cs,
                                t_end=2.0, tied=True))]
     total, results = {}, {}
     for name, kw in runs:

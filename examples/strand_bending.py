@@ -227,10 +227,15 @@ def first_slip(lays=LAYS, elements_per_lay=ELEMENTS, steps=40, upto=2.0, stick=N
     return (res["kappa"][hit[0]] if len(hit) else np.nan), th["kappa_b"]
 
 
-def stiffness_checks(lays=LAYS, elements_per_lay=ELEMENTS, steps=STEPS):
+CHECK_STEPS = 1                  # steps per unit t of the stiffness checks: elastic, so path-independent
+
+
+def stiffness_checks(lays=LAYS, elements_per_lay=ELEMENTS, steps=CHECK_STEPS):
     """``(EI frictionless, EI tied)``: the initial slopes ``M / kappa`` of the strand with frictionless
     contact (full slip: against ``EI_min``) and with the wires tied rigidly to the core (against
-    ``EI_max``), each on the virgin branch ``t`` in ``[1, 2]``, with their wire forces."""
+    ``EI_max``), each on the virgin branch ``t`` in ``[1, 2]``, with their wire forces.  Both are elastic (no
+    friction), so one step per unit ``t`` gives the slopes of four (4 lays, 48 el/lay: 13.31322 and 103.3276
+    N m^2 either way) for 3.7 s of CPU instead of 7.5."""
     out = []
     for kw in (dict(mu=0.0), dict(tied=True)):
         res = run(lays, elements_per_lay, amplitude=AMPLITUDE, steps=steps, t_end=2.0, **kw)
@@ -243,7 +248,7 @@ def main(lays=LAYS, elements_per_lay=ELEMENTS, amplitude=AMPLITUDE, steps=STEPS,
     res = run(lays, elements_per_lay, mu, amplitude, steps)
     th, rows = compare(res)
     if checks:
-        (EI0, F0), (EIt, Ft) = stiffness_checks(lays, elements_per_lay, steps)
+        (EI0, F0), (EIt, Ft) = stiffness_checks(lays, elements_per_lay)
         rows += [("EI frictionless contact (full slip) [N m^2]", theory(F0)["EI_min"], EI0,
                   EI0 / theory(F0)["EI_min"] - 1),
                  ("EI wires tied to the core (full stick) [N m^2]", theory(Ft)["EI_max"], EIt,
