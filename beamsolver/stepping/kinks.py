@@ -10,7 +10,7 @@ import numpy as np
 __all__ = ["drive", "kink", "ZERO"]
 
 ZERO = 1e-12            # a part's increment below this times its size (at least 1) counts as none
-FIRST = 1.0             # the first kink of a run (no size known yet): this share of the step (1: the step as grown)
+FIRST = 1.0             # the first kink of a run (no size known yet) where a motion starts: this share of the step
 
 
 def drive(system, t):
@@ -24,15 +24,19 @@ def drive(system, t):
 def kink(system, t0, t1, t2, before=None):
     """Whether the loading path kinks at ``t1`` between the steps ``t0 -> t1`` and ``t1 -> t2``: for some part
     of ``drive`` the increment turns back (``a . b <= 0`` with both non-zero) or starts or stops.
-    ``before``: ``drive(system, t0)`` and ``drive(system, t1)`` if known.  Returns ``bool``."""
+    ``before``: ``drive(system, t0)`` and ``drive(system, t1)`` if known.  Returns ``"start"`` where a prescribed
+    motion or ``fix`` value starts to move (from rest), ``"kink"`` for any other kink, ``None`` for none."""
     d0, d1 = before if before is not None else (drive(system, t0), drive(system, t1))
     d2 = drive(system, t2)
-    for x0, x1, x2 in zip(d0, d1, d2):
+    found = None
+    for part, (x0, x1, x2) in enumerate(zip(d0, d1, d2)):
         if not len(x1):
             continue
         a, b = x1 - x0, x2 - x1
         tol = ZERO * max(1.0, float(np.abs(x1).max()))
         on_a, on_b = np.abs(a).max() > tol, np.abs(b).max() > tol
+        if on_b and not on_a and part < 2:
+            return "start"
         if on_a != on_b or (on_a and float(a @ b) <= 0.0):
-            return True
-    return False
+            found = "kink"
+    return found

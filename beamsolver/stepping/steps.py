@@ -289,7 +289,8 @@ class Run:
                 t_next = grid[self.k]           # no sliver before the grid point
             kink = self.t_before is not None and kinks.kink(self.sys, self.t_before, self.t, t_next)
             if kink:                             # the size that converged after the last kink, or a share of the step
-                size = self.kink_size if self.kink_size is not None else kinks.FIRST * (t_next - self.t)
+                size = self.kink_size if self.kink_size is not None else \
+                    (kinks.FIRST if kink == "start" else 1.0) * (t_next - self.t)
                 if t_next - self.t > size * (1.0 + STEP_TOLERANCE):
                     t_next = self.t + max(size, self.dt_min)
             t0 = time.perf_counter()

@@ -214,7 +214,10 @@ def test_kinks_of_the_loading_path_are_reversals_starts_and_stops():
     assert kink(_driven(zero, zero, tri), 0.75, 1.0, 1.25)                     # a load turns back
     start = lambda t: 0.0 if t <= 1.0 else 0.1 * (t - 1.0)     # noqa: E731
     stop = lambda t: min(t, 1.0)                               # noqa: E731
-    assert kink(_driven(start, zero, stop), 0.75, 1.0, 1.25)                   # pull stops, bending starts
+    assert kink(_driven(start, zero, stop), 0.75, 1.0, 1.25) == "start"        # pull stops, bending starts
+    assert kink(_driven(zero, start, zero), 0.75, 1.0, 1.25) == "start"        # a fix value starts
+    assert kink(_driven(zero, zero, start), 0.75, 1.0, 1.25) == "kink"         # a load starts
+    assert kink(_driven(tri, zero, zero), 0.75, 1.0, 1.25) == "kink"
     assert not kink(_driven(start, zero, stop), 1.0, 1.25, 1.5)
 
 
@@ -249,16 +252,22 @@ def test_the_step_after_a_kink_starts_at_the_size_that_converged_after_the_last_
 
 
 def test_the_first_kink_of_a_run_starts_at_a_share_of_the_step(monkeypatch):
-    """``kinks.FIRST`` (default 1: the step as grown): with no size known after a kink, the step after the first one
-    is ``FIRST`` times the step as grown (the strand bending cycle's bending after the pull: the user's step and its
-    half failed there)."""
+    """``kinks.FIRST`` (default 1: the step as grown): with no size known, the step after the first kink where a
+    prescribed motion or ``fix`` value starts to move is ``FIRST`` times the step as grown (the strand bending cycle's
+    bending after the pull: the user's step and its half failed there); a load that turns back is not such a kink."""
     from beamsolver.stepping import kinks
     assert kinks.FIRST == 1.0
     monkeypatch.setattr(kinks, "FIRST", 0.25)
-    model = bs.Model()
-    beam = model.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 4), bs.Section.circular(radius=0.01, E=2e11, nu=0.3))
-    model.fix(beam.first)
-    model.add_load(beam.last, force=(0.0, 1.0, 0.0), scale=lambda t: t if t <= 1.0 else 2.0 - t)
-    sol = bs.solve(model, steps=4, t_end=2.0, verbose=False)
-    kinked = [float(s["dt"]) for s in sol.stats if s.get("kink")]
-    assert kinked == [pytest.approx(kinks.FIRST * 0.5)]
+    for start in (True, False):
+        model = bs.Model()
+        beam = model.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 4),
+                              bs.Section.circular(radius=0.01, E=2e11, nu=0.3))
+        model.fix(beam.first)
+        if start:        # a pull, then a motion of the end from rest
+            model.add_load(beam.last, force=(100.0, 0.0, 0.0), scale=lambda t: min(t, 1.0))
+            model.fix(beam.last, ("uz",), values={"uz": lambda t: 1e-3 * max(t - 1.0, 0.0)})
+        else:            # a load that turns back
+            model.add_load(beam.last, force=(0.0, 1.0, 0.0), scale=lambda t: t if t <= 1.0 else 2.0 - t)
+        sol = bs.solve(model, steps=4, t_end=2.0, verbose=False)
+        kinked = [float(s["dt"]) for s in sol.stats if s.get("kink")]
+        assert kinked == [pytest.approx(0.125 if start else 0.5)], (start, kinked)
