@@ -83,6 +83,9 @@ SKIP_MARGIN = 1e-2       # ... whose gap exceeds the normal law's band by SKIP_M
 SKIP_MIN = 64            # ... when at least this many points are that far (fewer: the test costs what it saves; the main
 #                          job has 10 a median evaluation, and ~50 us of look-ups per evaluation was 4 % of its trials)
 EXTRAPOLATE = True       # exact stick: a step's first multipliers extrapolated from the last two steps' (False: before)
+SLID_START = 1.2         # ... and those of the groups that slid in the last step scaled by this, out of their
+#                          Coulomb disk: a step starts with them sliding (1.0: on the disk's edge, where round-off
+#                          decides; ``_extrapolate``)
 
 
 _default = {"kernel": kernel_jit}       # the kernel of contact systems made without one (``use_numpy_kernel``)
@@ -250,6 +253,7 @@ class ContactSystem(Contribution):
         self._t_step = None        # t of the step begun (``begin_step``)
         self._slide_c = None       # (keys, factor) of the groups' c for the next step (``_balanced_c``)
         self._commits = []         # (t, (keys, Lam)) of the last two converged steps' multipliers (``_extrapolate``)
+        self._slid = None          # keys (sorted) of the groups that slid in the last converged step (``_extrapolate``)
         self._sweepable = {}       # per declaration: whether the last search found no crossing (``_candidates``)
         self._H_prev = None        # last converged poses (start of the step)
         self._geo = self._geo_prev = None    # (poses, element twists) of the last evaluation / of H_prev
@@ -327,6 +331,8 @@ class ContactSystem(Contribution):
                 out["tmult_prev_keys"], out["tmult_prev_values"] = (np.array(a) for a in c[0][1])
         if self._slide_c is not None:
             out["slide_c_keys"], out["slide_c_factors"] = (np.array(a) for a in self._slide_c)
+        if self._slid is not None:
+            out["slid_keys"] = np.array(self._slid)
         return out
 
     def set_state(self, state):
@@ -345,6 +351,7 @@ class ContactSystem(Contribution):
             else:
                 self._commits = [last]
         self._slide_c = None
+        self._slid = np.asarray(state["slid_keys"], dtype=np.int64) if "slid_keys" in state else None
         if "slide_c_keys" in state:
             self._slide_c = (np.asarray(state["slide_c_keys"], dtype=np.int64),
                              np.asarray(state["slide_c_factors"], dtype=float))
@@ -1222,6 +1229,11 @@ class ContactSystem(Contribution):
         vals = L1.copy()
         s = (t - t1) / (t1 - t0)
         vals[found] += s * (L1[found] - L0[i[found]])
+        if self._slid is not None and SLID_START != 1.0:
+            # a group that slid in the last step has its traction on the disk's edge: unscaled, round-off decides
+            # whether a step's first iterate (no slip yet) sticks, and half of them did (the strand bent in full
+            # slip: 560 of 1146 groups sticking at the first iterate, 54 at the end, ~8 Newton iterations to get there)
+            vals[np.isin(k1, self._slid)] *= SLID_START
         self.history.update_multipliers(None, (k1, vals))
 
     def _state(self, H):
@@ -1315,7 +1327,7 @@ class ContactSystem(Contribution):
             self.history.commit(self._decl_mu)
             self._last = self._last_mortar = None
             self._commits = []
-            self._slide_c = None
+            self._slide_c = self._slid = None
             return
         p, out = po
         m = out.get("mortar")
@@ -1335,6 +1347,7 @@ class ContactSystem(Contribution):
         self._last = (P, sel, p, out, (np.array(H), HC, HF))
         self._commits = [] if tmult is None else (self._commits + [(self._t_step, tmult)])[-2:]
         self._slide_c = None if m is None else self._sliding_c(m)
+        self._slid = None if m is None else np.sort(np.asarray(m["key"])[~m["stick"] & (m["lamN"] > 0.0)])
 
     def nodal_results(self):
         """Exact stick's nodal table of the committed state (``Solution.extra``, one entry per step), or None

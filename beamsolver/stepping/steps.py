@@ -13,7 +13,9 @@ about as many iterations as the step before, within 2/3 of the Newton budget, as
 iterations at any size), and not back to the size of the
 last failed step before ``wait`` easy steps running (``next_step``: the wait doubles
 each time that size fails again, up to ``WAIT_MAX``; 2, the fixed rule, until then), and
-lands on the grid (no sliver shorter than ``LANDING`` steps before a grid point).  Every loop is
+lands on the grid (no sliver shorter than ``LANDING`` steps before a grid point).  A step after a kink of the
+loading path (``kinks``: a reversal, or a motion or load that starts or stops) starts at the size that converged
+after the last kink.  Every loop is
 bounded: each pass of the main loop advances by at least ``dt_min`` or stops.
 
 Whatever ends a run (``ConvergenceError``, Ctrl-C, an exception from a callback
@@ -26,7 +28,7 @@ import warnings
 
 import numpy as np
 
-from . import branching, diagnosis, stability, stable_branch
+from . import branching, diagnosis, kinks, stability, stable_branch
 from ..model import motion_path
 from ..errors import ConvergenceError, InputError, StabilityWarning, StabilizationWarning
 from ..failures import AugmentationFailed, LeftStableBranch, MotionTooFast, NonFinite, StepFailed
@@ -138,6 +140,7 @@ class Run:
         t_start, steps = grid[0], len(grid) - 1
         self.dt, self.t, self.k, self.easy = self.dt_user, t_start, 1, 0
         self.failed, self.wait, self.reference, self.previous = np.inf, EASY_RUN, None, None
+        self.t_before, self.kink_size = None, None     # the converged step before the last one; ``kinks``
         if restart_solution is None:
             self.sol = Solution(sys.model, sys)
             self.range = RangeCheck.of(self.sol.description)
@@ -157,6 +160,8 @@ class Run:
                     self.failed, self.wait = _memory(rs)
                     self.reference = _reference(rs)
                     self.previous = _reference(rs, "previous")
+                    self.kink_size = _size(rs.get("kink_size"))
+            self.t_before = float(sol.times[-2]) if len(sol) >= 2 else None
             if self.writer is not None:
                 for j in range(len(sol)):
                     self.writer.write(sol, j)
@@ -290,9 +295,19 @@ class Run:
             t_next = min(self.t + self.dt, grid[self.k])
             if grid[self.k] - t_next < max(1e-9 * self.dt_user, LANDING * self.dt):
                 t_next = grid[self.k]           # no sliver before the grid point
+            kink = self.t_before is not None and kinks.kink(self.sys, self.t_before, self.t, t_next)
+            if kink:                             # the size that converged after the last kink, or a share of the step
+                size = self.kink_size if self.kink_size is not None else \
+                    (kinks.FIRST if kink == "start" else 1.0) * (t_next - self.t)
+                if t_next - self.t > size * (1.0 + STEP_TOLERANCE):
+                    t_next = self.t + max(size, self.dt_min)
             t0 = time.perf_counter()
+            t_start = self.t
             t_next, H, ev, stats = self._attempt(t_next)
-            stats.update(wall_time=time.perf_counter() - t0, dt=t_next - self.t)
+            stats.update(wall_time=time.perf_counter() - t0, dt=t_next - t_start)
+            if kink:
+                self.kink_size = t_next - t_start
+                stats["kink"] = True
             self._record(t_next, H, ev, stats)
 
     def _attempt(self, t_next):
@@ -473,6 +488,7 @@ class Run:
                    problem.extras or None)
         sol.resume = dict(t0=float(self.grid[0]), t_end=float(self.grid[-1]), steps=len(self.grid) - 1,
                           dt=float(dt), easy=int(easy), **self._memory_state())
+        self.t_before = self.t
         self.H, self.t, self.k, self.dt, self.easy = H, t, k, dt, easy
         if self.writer is not None:
             self.writer.write(sol, sol.n_steps)
@@ -529,7 +545,8 @@ class Run:
         """The failed-size memory of ``next_step``, the ``easy_limit`` reference and the ``steady``
         previous iterations for ``resume`` (JSON: no inf)."""
         return dict(failed=None if not np.isfinite(self.failed) else float(self.failed), wait=int(self.wait),
-                    reference=self.reference, previous=self.previous)
+                    reference=self.reference, previous=self.previous,
+                    kink_size=None if self.kink_size is None else float(self.kink_size))
 
     def _stability(self, stats, t, H, ev):
         """Record whether the converged state ``H`` (evaluation ``ev``) is a stable equilibrium
@@ -631,6 +648,15 @@ def _memory(resume):
     if not (np.isfinite(failed) and failed > 0):
         return np.inf, EASY_RUN
     return failed, min(max(wait, EASY_RUN), WAIT_MAX)
+
+
+def _size(value):
+    """A step size from a ``resume`` entry; missing or damaged: ``None``."""
+    try:
+        size = float(value)
+    except (TypeError, ValueError, OverflowError):
+        return None
+    return size if np.isfinite(size) and size > 0 else None
 
 
 def _reference(resume, key="reference"):

@@ -556,6 +556,36 @@ def test_a_step_starts_from_the_multipliers_extrapolated_from_the_last_two_steps
     np.testing.assert_array_equal(c.history.tmult[1], L1)
 
 
+def test_a_step_starts_with_the_groups_that_slid_out_of_their_disk():
+    """``begin_step`` scales the extrapolated multipliers of the groups that slid in the last converged step
+    (``_slid``) by ``SLID_START``: their traction was on the disk's edge, where round-off decided whether the step's
+    first iterate (no slip yet) sticks; the others are extrapolated as before.  ``commit`` records the groups that
+    slid (pressed, not sticking) and ``get_state`` / ``set_state`` carry them (restart)."""
+    from beamsolver.contact import system as contact_system
+    assert contact_system.SLID_START > 1.0
+    model, slave, master = _parallel(0.5)
+    problem = Problem.from_model(model, check_rigid_modes=False)
+    c = problem.contact
+    H = problem.system.poses0.copy()
+    k0, k1 = np.array([3, 7], dtype=np.int64), np.array([3, 7, 11], dtype=np.int64)
+    L0 = np.array([[1.0, 0.0, 0.0], [0.0, 2.0, 0.0]])
+    L1 = np.array([[2.0, 0.0, 1.0], [0.0, 1.0, 0.0], [5.0, 5.0, 5.0]])
+    c.history.commit(c._decl_mu, None, (k1, L1))
+    c._commits = [(0.2, (k0, L0)), (0.4, (k1, L1))]
+    c._slid = np.array([7, 11], dtype=np.int64)
+    c.begin_step(H, 0.5)
+    s = contact_system.SLID_START
+    np.testing.assert_allclose(c.history.tmult[1], [[2.5, 0.0, 1.5], [0.0, 0.5 * s, 0.0], [5.0 * s, 5.0 * s, 5.0 * s]],
+                               rtol=1e-15)
+    state = c.get_state()
+    np.testing.assert_array_equal(state["slid_keys"], [7, 11])
+    c._slid = None
+    c.set_state(state)
+    np.testing.assert_array_equal(c._slid, [7, 11])
+    c.commit(_pressed(problem, slave, 2e-3 * R))       # pressed, nothing slid in this step
+    assert c._slid is not None and len(c._slid) == 0
+
+
 @pytest.mark.slow
 def test_three_wires_exact_stick_iterations_with_extrapolated_multipliers():
     """Three wires twisted half a turn in four steps (12 elements) with exact stick: at most 150 Newton iterations

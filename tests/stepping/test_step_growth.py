@@ -183,3 +183,91 @@ def test_a_restart_keeps_the_previous_iterations_of_steady():
     assert part.n_steps == j and part.resume["previous"] == full.stats[j]["iterations"]
     sol = bs.solve(model, steps=16, restart=part)
     np.testing.assert_array_equal(sol.times, full.times)
+
+
+def _driven(motion, fixed, loads):
+    """A stand-in system for ``stepping.kinks``: one prescribed node turned by ``motion(t)`` about e_z, one ``fix``
+    value ``fixed(t)`` and one load factor ``loads(t)``."""
+    from types import SimpleNamespace
+
+    def poses(t):
+        a = motion(t)
+        R = np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
+        H = np.eye(4)
+        H[:3, :3] = R
+        return H[None]
+    return SimpleNamespace(prescribed_nodes=[0], prescribed_poses=poses, fix_values=[(1, 4, fixed)],
+                           load_scales=[loads], load_factors=lambda t: np.array([loads(t)]))
+
+
+def test_kinks_of_the_loading_path_are_reversals_starts_and_stops():
+    """``kinks.kink``: the increments of the prescribed poses, the fix values or the load factors turn back, or one
+    of them starts or stops, between ``t0 -> t1`` and ``t1 -> t2``; a path going on (faster or slower) has none."""
+    from beamsolver.stepping.kinks import kink
+    tri = lambda t: 0.1 * (t if t <= 1.0 else 2.0 - t)        # noqa: E731  up, then back
+    ramp = lambda t: 0.1 * t                                   # noqa: E731
+    zero = lambda t: 0.0                                       # noqa: E731
+    assert not kink(_driven(ramp, ramp, ramp), 0.5, 0.75, 1.0)
+    assert not kink(_driven(lambda t: t**2, ramp, zero), 0.5, 0.75, 1.5)      # faster, same direction
+    assert kink(_driven(tri, zero, zero), 0.75, 1.0, 1.25)                     # the motion turns back
+    assert kink(_driven(zero, tri, zero), 0.75, 1.0, 1.25)                     # a fix value turns back
+    assert kink(_driven(zero, zero, tri), 0.75, 1.0, 1.25)                     # a load turns back
+    start = lambda t: 0.0 if t <= 1.0 else 0.1 * (t - 1.0)     # noqa: E731
+    stop = lambda t: min(t, 1.0)                               # noqa: E731
+    assert kink(_driven(start, zero, stop), 0.75, 1.0, 1.25) == "start"        # pull stops, bending starts
+    assert kink(_driven(zero, start, zero), 0.75, 1.0, 1.25) == "start"        # a fix value starts
+    assert kink(_driven(zero, zero, start), 0.75, 1.0, 1.25) == "kink"         # a load starts
+    assert kink(_driven(tri, zero, zero), 0.75, 1.0, 1.25) == "kink"
+    assert not kink(_driven(start, zero, stop), 1.0, 1.25, 1.5)
+
+
+def test_the_step_after_a_kink_starts_at_the_size_that_converged_after_the_last_kink(monkeypatch):
+    """``Run.loop``: the first kink of a triangle history (no memory; ``kinks.FIRST`` = 1) is tried at the grown size; a
+    failure there halves it; the next kink starts at the size that converged after the first one, and ``resume``
+    keeps it (restart)."""
+    from beamsolver.stepping import kinks, steps as steps_mod
+    from beamsolver.failures import NotConverged
+    monkeypatch.setattr(kinks, "FIRST", 1.0)
+    model = bs.Model()
+    beam = model.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 4), bs.Section.circular(radius=0.01, E=2e11, nu=0.3))
+    model.fix(beam.first)
+    tri = lambda t: t if t <= 1.0 else (2.0 - t if t <= 2.0 else t - 2.0)     # noqa: E731
+    model.add_load(beam.last, force=(0.0, 1.0, 0.0), scale=tri)
+    real = steps_mod.Run.newton_step
+    tried = []
+
+    def step(self, t_next, start=None):
+        tried.append((self.t, t_next))
+        if abs(self.t - 1.0) < 1e-9 and t_next - self.t > 0.3:        # the first reversal: the grown step fails
+            raise NotConverged("forced", 1.0)
+        return real(self, t_next, start)
+    monkeypatch.setattr(steps_mod.Run, "newton_step", step)
+    sol = bs.solve(model, steps=6, t_end=3.0, verbose=False)
+    assert sol.converged
+    kinked = [(float(sol.times[k - 1]), float(s["dt"])) for k, s in enumerate(sol.stats) if s.get("kink")]
+    assert [t for t, _ in kinked] == pytest.approx([1.0, 2.0])
+    assert kinked[0][1] == pytest.approx(0.25) and kinked[1][1] == pytest.approx(0.25)
+    assert [(a, b) for a, b in tried if abs(a - 2.0) < 1e-9][0][1] == pytest.approx(2.25)   # not 2.5 first
+    assert sol.resume["kink_size"] == pytest.approx(0.25)
+
+
+def test_the_first_kink_of_a_run_starts_at_a_share_of_the_step(monkeypatch):
+    """``kinks.FIRST`` (default 1: the step as grown): with no size known, the step after the first kink where a
+    prescribed motion or ``fix`` value starts to move is ``FIRST`` times the step as grown (the strand bending cycle's
+    bending after the pull: the user's step and its half failed there); a load that turns back is not such a kink."""
+    from beamsolver.stepping import kinks
+    assert kinks.FIRST == 1.0
+    monkeypatch.setattr(kinks, "FIRST", 0.25)
+    for start in (True, False):
+        model = bs.Model()
+        beam = model.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 4),
+                              bs.Section.circular(radius=0.01, E=2e11, nu=0.3))
+        model.fix(beam.first)
+        if start:        # a pull, then a motion of the end from rest
+            model.add_load(beam.last, force=(100.0, 0.0, 0.0), scale=lambda t: min(t, 1.0))
+            model.fix(beam.last, ("uz",), values={"uz": lambda t: 1e-3 * max(t - 1.0, 0.0)})
+        else:            # a load that turns back
+            model.add_load(beam.last, force=(0.0, 1.0, 0.0), scale=lambda t: t if t <= 1.0 else 2.0 - t)
+        sol = bs.solve(model, steps=4, t_end=2.0, verbose=False)
+        kinked = [float(s["dt"]) for s in sol.stats if s.get("kink")]
+        assert kinked == [pytest.approx(0.125 if start else 0.5)], (start, kinked)
