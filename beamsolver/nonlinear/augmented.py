@@ -44,7 +44,8 @@ RTOL = 1e-10           # |M x - b| / |b| GMRES must reach (``lagged.LAG_RTOL``; 
 MAX_ITERATIONS = 30    # GMRES iterations with a fresh factorisation of ``A`` before the direct fallback
 POLISH = True          # after GMRES, one more step of the preconditioned iteration (the multipliers' last digits)
 LAGGED = True          # ``A`` factorised through the solver's lagging (``linsolve.Solver.factorize``), else afresh
-MIN_UNKNOWNS = 1_500   # smaller systems are factorised directly (``linsolve.AUTO_MIN_UNKNOWNS``: SuperLU, ~1 ms)
+MIN_UNKNOWNS = 300     # smaller saddle systems are factorised directly (SuperLU); from 300 the augmented path is faster
+                       # (the twisted pair at 32 / 64 el/wire: 8.8 -> 5.9 / 22.9 -> 10.6 ms an iteration, benchmarks/saddle_size.py)
 ENABLED = True         # False: ``Newton.direction`` solves the saddle system directly (benchmarks: before)
 STATS = ("saddle_augmented", "saddle_iterations", "saddle_fallbacks")
 
