@@ -176,8 +176,11 @@ def run(lays=LAYS, elements_per_lay=ELEMENTS, mu=MU, amplitude=AMPLITUDE, steps=
                 wall=wall, cpu=cpu, iterations=int(sol.iterations.sum()), cutbacks=sum(s.get("cutbacks", 0) for s in sol.stats))
 
 
-def compare(res):
-    """Theory against the model's measurements: list of ``(name, theory, model, relative error)``."""
+def compare(res, EI_frictionless=None):
+    """Theory against the model's measurements: list of ``(name, theory, model, relative error)``.
+    ``EI_frictionless``: the model's own full-slip stiffness (``stiffness_checks``); given, the row
+    ``M_f, friction part`` subtracts it instead of the theory's ``EI_min`` (docs/theory_strand_bending.md,
+    section 5: the friction part of the moment is the moment less the frictionless one)."""
     th = theory(res["F"])
     t, kap, M = res["times"], res["kappa"], res["M"]
     up = (t > 1.0) & (t <= 2.0 + 1e-9)
@@ -191,6 +194,9 @@ def compare(res):
     rows.append(("EI full slip, slope of the virgin branch [N m^2]", th["EI_min"], EI_slip))
     Mf = float(np.mean(Ms - th["EI_min"] * ks)) if len(ks) else np.nan
     rows.append(("M_f [N m]", th["M_f"], Mf))
+    if EI_frictionless is not None:
+        rows.append(("M_f, friction part M - EI_frictionless kappa [N m]", th["M_f"],
+                     float(np.mean(Ms - EI_frictionless * ks)) if len(ks) else np.nan))
     onset = np.flatnonzero(up & (res["share"] > 0))
     rows.append(("kappa first slip [1/m]", th["kappa_b"], kap[onset[0]] if len(onset) else np.nan))
     mid = up & (kap > th["kappa_b"]) & (kap < th["kappa_t"])
@@ -244,11 +250,26 @@ def stiffness_checks(lays=LAYS, elements_per_lay=ELEMENTS, steps=CHECK_STEPS):
     return out
 
 
+ALONG = (0.05, 0.25, 0.5)         # cuts z / L of the printed moment along the strand
+
+
+def moment_along(res, fractions=ALONG, step=None):
+    """``(M - EI_min kappa) / M_f - 1`` across the cuts at ``z = fractions L`` at ``step`` (default: the
+    end of the virgin branch): the friction moment along the strand (the tied ends carry more)."""
+    sol, fx, th = res["sol"], res["fixture"], theory(res["F"])
+    j = int(np.flatnonzero(res["times"] <= 2.0 + 1e-9)[-1]) if step is None else step
+    k = res["kappa"][j]
+    return np.array([(fx.moment(sol, fx.z0 + f * fx.length, step=j) - th["EI_min"] * k) / th["M_f"] - 1
+                     for f in fractions])
+
+
 def main(lays=LAYS, elements_per_lay=ELEMENTS, amplitude=AMPLITUDE, steps=STEPS, mu=MU, checks=True):
     res = run(lays, elements_per_lay, mu, amplitude, steps)
-    th, rows = compare(res)
+    (EI0, F0), (EIt, Ft) = stiffness_checks(lays, elements_per_lay) if checks else ((None, None), (None, None))
+    th, rows = compare(res, EI0)
+    rows += [(f"M - EI_min kappa at z = {f:g} L, +k of the virgin branch, / M_f - 1", 0.0, e, e)
+             for f, e in zip(ALONG, moment_along(res))]
     if checks:
-        (EI0, F0), (EIt, Ft) = stiffness_checks(lays, elements_per_lay)
         rows += [("EI frictionless contact (full slip) [N m^2]", theory(F0)["EI_min"], EI0,
                   EI0 / theory(F0)["EI_min"] - 1),
                  ("EI wires tied to the core (full stick) [N m^2]", theory(Ft)["EI_max"], EIt,
