@@ -28,8 +28,9 @@ a lever arm ``R_w`` from their axes, and turn under the friction's moment; tying
 the core gives ``EI_max``), first slip at 1.15 ``kappa_b``, which is where the model's own stick
 stiffness puts it (docs/theory_strand_bending.md, section 5); beyond 2 ``kappa_b`` the moment is within
 2.1 % of the theory at 16 el/lay, 1.4 % at 24.  The ends, where the wires are tied to the plates, carry more
-friction moment (+9 % of ``M_f`` at 0.05 ``L``); about 1.3 lays from a plate the moment settles on the long strand's
-value, 3.2 % below ``M_f`` at 48 el/lay (4 lays; 2 lays have no plateau and their middle is lifted by the ends).
+friction moment (+5 to +10 % of ``M_f`` at 0.05 ``L``); 1.3 lays or more from a plate the moment settles on the long
+strand's value, 3.6 % below ``M_f`` at 48 el/lay (6 lays; 4 lays: 3.2 %; 2 lays have no plateau, their middle is
+lifted by the ends).
 The row ``M_f, friction part`` subtracts the model's own frictionless moment (the stiffness checks) instead of
 ``EI_min kappa``; the rows ``M - EI_min kappa at z`` give the moment along the strand (section 5).
 The issue's size (``--lays 4 --elements 48``): 406 Newton iterations, 4 cut-backs, 121.5 s CPU for the cycle.  Exact stick wants 16 el/lay or more: at 8 the linear
