@@ -27,8 +27,12 @@ N m^2 at 16-48 el/lay, about 12 % below the plane-section ``EI_max`` (the wires 
 a lever arm ``R_w`` from their axes, and turn under the friction's moment; tying the axes rigidly to
 the core gives ``EI_max``), first slip at 1.15 ``kappa_b``, which is where the model's own stick
 stiffness puts it (docs/theory_strand_bending.md, section 5); beyond 2 ``kappa_b`` the moment is within
-2.1 % of the theory at 16 el/lay, 1.4 % at 24.  At 4 lays the mid-length moment is 3.2 % below (48 el/lay): in
-slip the moment varies along a longer strand (the pull's P-delta on a sag of micrometres), section 5.
+2.1 % of the theory at 16 el/lay, 1.4 % at 24.  The ends, where the wires are tied to the plates, carry more
+friction moment (+5 to +10 % of ``M_f`` at 0.05 ``L``); 1.3 lays or more from a plate the moment settles on the long
+strand's value, 3.6 % below ``M_f`` at 48 el/lay (6 lays; 4 lays: 3.2 %; 2 lays have no plateau, their middle is
+lifted by the ends).
+The row ``M_f, friction part`` subtracts the model's own frictionless moment (the stiffness checks) instead of
+``EI_min kappa``; the rows ``M - EI_min kappa at z`` give the moment along the strand (section 5).
 The issue's size (``--lays 4 --elements 48``): 406 Newton iterations, 4 cut-backs, 121.5 s CPU for the cycle.  Exact stick wants 16 el/lay or more: at 8 the linear
 nodal tractions smear the friction's reversal at the neutral axis over an element (``M_f`` 6 % low).
 ``--stick penalty`` uses the Gauss-point penalty with ``slip_tolerance`` 5e-6 element lengths (with the
@@ -176,8 +180,11 @@ def run(lays=LAYS, elements_per_lay=ELEMENTS, mu=MU, amplitude=AMPLITUDE, steps=
                 wall=wall, cpu=cpu, iterations=int(sol.iterations.sum()), cutbacks=sum(s.get("cutbacks", 0) for s in sol.stats))
 
 
-def compare(res):
-    """Theory against the model's measurements: list of ``(name, theory, model, relative error)``."""
+def compare(res, EI_frictionless=None):
+    """Theory against the model's measurements: list of ``(name, theory, model, relative error)``.
+    ``EI_frictionless``: the model's own full-slip stiffness (``stiffness_checks``); given, the row
+    ``M_f, friction part`` subtracts it instead of the theory's ``EI_min`` (docs/theory_strand_bending.md,
+    section 5: the friction part of the moment is the moment less the frictionless one)."""
     th = theory(res["F"])
     t, kap, M = res["times"], res["kappa"], res["M"]
     up = (t > 1.0) & (t <= 2.0 + 1e-9)
@@ -191,6 +198,9 @@ def compare(res):
     rows.append(("EI full slip, slope of the virgin branch [N m^2]", th["EI_min"], EI_slip))
     Mf = float(np.mean(Ms - th["EI_min"] * ks)) if len(ks) else np.nan
     rows.append(("M_f [N m]", th["M_f"], Mf))
+    if EI_frictionless is not None:
+        rows.append(("M_f, friction part M - EI_frictionless kappa [N m]", th["M_f"],
+                     float(np.mean(Ms - EI_frictionless * ks)) if len(ks) else np.nan))
     onset = np.flatnonzero(up & (res["share"] > 0))
     rows.append(("kappa first slip [1/m]", th["kappa_b"], kap[onset[0]] if len(onset) else np.nan))
     mid = up & (kap > th["kappa_b"]) & (kap < th["kappa_t"])
@@ -244,11 +254,26 @@ def stiffness_checks(lays=LAYS, elements_per_lay=ELEMENTS, steps=CHECK_STEPS):
     return out
 
 
+ALONG = (0.05, 0.25, 0.5)         # cuts z / L of the printed moment along the strand
+
+
+def moment_along(res, fractions=ALONG, step=None):
+    """``(M - EI_min kappa) / M_f - 1`` across the cuts at ``z = fractions L`` at ``step`` (default: the
+    end of the virgin branch): the friction moment along the strand (the tied ends carry more)."""
+    sol, fx, th = res["sol"], res["fixture"], theory(res["F"])
+    j = int(np.flatnonzero(res["times"] <= 2.0 + 1e-9)[-1]) if step is None else step
+    k = res["kappa"][j]
+    return np.array([(fx.moment(sol, fx.z0 + f * fx.length, step=j) - th["EI_min"] * k) / th["M_f"] - 1
+                     for f in fractions])
+
+
 def main(lays=LAYS, elements_per_lay=ELEMENTS, amplitude=AMPLITUDE, steps=STEPS, mu=MU, checks=True):
     res = run(lays, elements_per_lay, mu, amplitude, steps)
-    th, rows = compare(res)
+    (EI0, F0), (EIt, Ft) = stiffness_checks(lays, elements_per_lay) if checks else ((None, None), (None, None))
+    th, rows = compare(res, EI0)
+    rows += [(f"M - EI_min kappa at z = {f:g} L, +k of the virgin branch, / M_f - 1", 0.0, e, e)
+             for f, e in zip(ALONG, moment_along(res))]
     if checks:
-        (EI0, F0), (EIt, Ft) = stiffness_checks(lays, elements_per_lay)
         rows += [("EI frictionless contact (full slip) [N m^2]", theory(F0)["EI_min"], EI0,
                   EI0 / theory(F0)["EI_min"] - 1),
                  ("EI wires tied to the core (full stick) [N m^2]", theory(Ft)["EI_max"], EIt,
