@@ -86,6 +86,9 @@ EXTRAPOLATE = True       # exact stick: a step's first multipliers extrapolated 
 SLID_START = 1.2         # ... and those of the groups that slid in the last step scaled by this, out of their
 #                          Coulomb disk: a step starts with them sliding (1.0: on the disk's edge, where round-off
 #                          decides; ``_extrapolate``)
+FIRST_SLIDE = 1.2        # ... and those of the groups sliding at a step's first iterate scaled by this after its first
+#                          Newton step (the predictor): that step puts them on its linearised disk's edge, where the
+#                          disk's nonlinearity decided (``_first_slide``; 1.0: before)
 
 
 _default = {"kernel": kernel_jit}       # the kernel of contact systems made without one (``use_numpy_kernel``)
@@ -249,6 +252,7 @@ class ContactSystem(Contribution):
         self.branch_rows = False         # exact stick: the rows of Newton's active-set inner loop (``mortar.branch_rows``)
         self._groups = mortar.Groups()   # the mortar groups, kept while the pairs' nodes hold
         self._kept_weights = None         # their nodal weights (``_nodal_weights``)
+        self._first = False       # the step's first Newton step of the multipliers is still to come (``_first_slide``)
         self._mstep, self._ms = None, 0.0     # the Newton step of the multipliers (keys, dLam) and its trial length
         self._t_step = None        # t of the step begun (``begin_step``)
         self._slide_c = None       # (keys, factor) of the groups' c for the next step (``_balanced_c``)
@@ -1171,7 +1175,7 @@ class ContactSystem(Contribution):
             Lam[found] += self._ms * self._mstep[1][i[found]]
         return Lam
 
-    def multiplier_step(self, keys, dLam):
+    def multiplier_step(self, keys, dLam, stick=None):
         """The Newton step ``dLam`` ``(k, 3)`` of the multipliers of the groups ``keys`` (sorted); trial length 0.
         The multipliers of groups the step's iterate did not have (no contact point: they acted nowhere there)
         are set to zero: a group coming back starts without traction, not with a value Newton never saw (on the
@@ -1181,7 +1185,26 @@ class ContactSystem(Contribution):
         gone = ~np.isin(old_keys, keys)
         if gone.any() and np.any(old[gone]):
             self.history.update_multipliers(None, (old_keys, np.where(gone[:, None], 0.0, old)))
-        self._mstep, self._ms = (keys, np.asarray(dLam).reshape(-1, 3)), 0.0
+        dLam = np.asarray(dLam).reshape(-1, 3)
+        if self._first and stick is not None:
+            dLam = self._first_slide(keys, dLam, np.asarray(stick))
+        self._first = False
+        self._mstep, self._ms = (keys, dLam), 0.0
+
+    def _first_slide(self, keys, dLam, stick):
+        """The step's first Newton step ``dLam`` ``(k, 3)`` of the groups ``keys`` with the groups not sticking at its
+        iterate (``stick`` ``(k,)``) ending ``FIRST_SLIDE`` times out: ``f (Lam + dLam) - Lam``.  That step (the
+        predictor's, which carries the prescribed motions) puts a sliding group's traction on its linearised disk;
+        at the next iterate the disk's nonlinearity decided whether it sticks, with a slip of up to 1e6 times its
+        tolerance (the twisted pair at t = 0.4375: 3 of its 4 sliding groups, then Newton reversing their slip).
+        Like ``SLID_START`` an initial guess: the equations are unchanged."""
+        if FIRST_SLIDE == 1.0 or stick.all():
+            return dLam
+        Lam = self.iterate_multipliers(keys)
+        out = dLam.copy()
+        s = ~stick
+        out[s] = FIRST_SLIDE * (Lam[s] + dLam[s]) - Lam[s]
+        return out
 
     def multiplier_trial(self, s):
         """The iterate's multipliers are the step's plus ``s`` times the last Newton step."""
@@ -1211,6 +1234,7 @@ class ContactSystem(Contribution):
         self._geo_prev = None
         self._augments = 0
         self._mstep, self._ms = None, 0.0
+        self._first = True
         self._t_step = t
         if EXTRAPOLATE and self._decl_exact.any() and self.newton_multipliers:
             self._extrapolate(t)

@@ -458,7 +458,7 @@ class Problem:
 
     def multiplier_step(self, ev, x):
         """Hand the Newton step ``x`` ``(3 g,)`` of the multipliers of ``ev`` to their owner (trial length 0)."""
-        ev.mult["owner"].multiplier_step(ev.mult["key"], x)
+        ev.mult["owner"].multiplier_step(ev.mult["key"], x, ev.mult.get("stick"))
 
     def multiplier_trial(self, s):
         """The iterate's multipliers: the accepted ones plus ``s`` times the last Newton step."""
