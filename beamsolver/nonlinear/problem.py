@@ -185,7 +185,8 @@ class Problem:
         (``dofs``: full ``z`` numbering)."""
         s = self.system
         nodes = m["members"]
-        out = dict(owner=owner, C=m["C"], m=m["m"], key=m["key"], stick=m["stick"], u=m["u"], tol=m["tol"])
+        out = dict(owner=owner, C=m["C"], m=m["m"], key=m["key"], stick=m["stick"], u=m["u"], tol=m["tol"],
+                   cap=m.get("cap"))
         if "Kql" not in m:
             return out
         Kql, Klq = m["Kql"], m["Klq"]
@@ -458,7 +459,7 @@ class Problem:
 
     def multiplier_step(self, ev, x):
         """Hand the Newton step ``x`` ``(3 g,)`` of the multipliers of ``ev`` to their owner (trial length 0)."""
-        ev.mult["owner"].multiplier_step(ev.mult["key"], x)
+        ev.mult["owner"].multiplier_step(ev.mult["key"], x, ev.mult.get("stick"), ev.mult.get("cap"))
 
     def multiplier_trial(self, s):
         """The iterate's multipliers: the accepted ones plus ``s`` times the last Newton step."""

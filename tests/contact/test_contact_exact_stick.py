@@ -675,3 +675,39 @@ def test_uncondense_gives_back_the_tangent_without_the_schur_terms():
     A, _ = problem.linear_system(ev, condense=False)
     assert A.shape[0] == problem.system.n_free + 3 * len(ev.mult["C"])
     assert np.abs(problem.tangent(ev).toarray() - raw).max() <= 1e-6 * schur
+
+
+def test_a_step_s_first_newton_step_leaves_the_sliding_groups_out_of_their_disk(monkeypatch):
+    """The step's first Newton step of the multipliers (the predictor's, ``multiplier_step`` with the iterate's stick
+    flags and disks) ends a group not sticking at ``f (Lam + dLam)``, ``f = 1 + FIRST_SLIDE | |Lam + dLam| / cap - 1 |``
+    (at most ``FIRST_SLIDE_MAX``): out of its linearised disk by that step's relative change of the disk, where the
+    disk's nonlinearity decided the next iterate's branch (the twisted pair at t = 0.4375: three of its four sliding
+    groups stuck there with slips of 1e5-1e6 times the tolerance).  Sticking groups, groups without a disk, groups
+    whose disk shrinks or whose traction turns back (``FIRST_SLIDE_GROWN``) and later Newton steps are not scaled."""
+    from beamsolver.contact import system as contact_system
+    monkeypatch.setattr(contact_system, "FIRST_SLIDE", 1.0)
+    top = contact_system.FIRST_SLIDE_MAX
+    model, slave, master = _parallel(0.5)
+    problem = Problem.from_model(model, check_rigid_modes=False)
+    c = problem.contact
+    H = problem.system.poses0.copy()
+    assert contact_system.FIRST_SLIDE_GROWN
+    keys = np.array([3, 7, 11, 12, 13, 14], dtype=np.int64)
+    Lam = np.array([[2.0, 0.0, 1.0], [0.0, 1.0, 0.0], [5.0, 5.0, 5.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0],
+                    [0.0, 0.0, 2.0]])
+    dLam = np.array([[1.0, 1.0, 1.0], [0.5, 0.0, 0.0], [-1.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-2.0, 0.0, 0.0],
+                     [0.0, 0.0, -1.0]])
+    stick = np.array([True, False, False, False, False, False])
+    cap = np.array([9.0, 1.0, 4.0, 0.0, 0.5, 1.5])
+    c.begin_step(H, 0.5)
+    c.history.update_multipliers(None, (keys, Lam))
+    c.multiplier_step(keys, dLam, stick, cap)
+    c.multiplier_trial(1.0)
+    f = np.sqrt(1.25)                                   # 1 + (|(0.5, 1, 0)| / 1 - 1)
+    np.testing.assert_allclose(c.iterate_multipliers(keys),
+                               [[3.0, 1.0, 2.0], [0.5 * f, f, 0.0], [4.0 * top, 5.0 * top, 6.0 * top], [0.0, 2.0, 0.0],
+                                [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]], rtol=1e-15)
+    c.accept_multipliers()
+    c.multiplier_step(keys, dLam, stick, cap)      # the step's second Newton step: as computed
+    c.multiplier_trial(1.0)
+    np.testing.assert_allclose(c.iterate_multipliers(keys) - c.history.tangential_multipliers(keys), dLam, rtol=1e-15)
