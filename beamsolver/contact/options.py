@@ -6,11 +6,11 @@ default, check and meaning written once) is read here by the contact system;
 """
 import numpy as np
 
-from ..model.contact_options import (ADJUST, EXACT_C, GAUSS_POINTS, LINE_ANGLE, SEGMENT_POINTS, SLIP_TOLERANCE, SMOOTHING,
-                                     STICK_TOLERANCE, ContactOptions, describe)
+from ..model.contact_options import (ADJUST, EXACT_C, EXACT_N, GAUSS_POINTS, LINE_ANGLE, SEGMENT_POINTS,
+                                     SLIP_TOLERANCE, SMOOTHING, STICK_TOLERANCE, ContactOptions, describe)
 
 __all__ = ["ContactOptions", "declaration_table", "describe", "SMOOTHING", "SLIP_TOLERANCE", "STICK_TOLERANCE",
-           "LINE_ANGLE", "ADJUST", "EXACT_C", "GAUSS_POINTS", "SEGMENT_POINTS"]
+           "LINE_ANGLE", "ADJUST", "EXACT_C", "EXACT_N", "GAUSS_POINTS", "SEGMENT_POINTS"]
 
 
 def declaration_table(options):

@@ -55,8 +55,8 @@ from ..failures import ContactTunnelling, NoContactNormal
 from ..model.model import JOIN_TOL
 from .law import PENALTY_T_MIN, default_penalty
 from . import kernel_jit, mortar, mortar_jit, segment_tangent
-from .options import (ADJUST, EXACT_C, GAUSS_POINTS, SEGMENT_POINTS, SMOOTHING, STICK_TOLERANCE, ContactOptions,
-                      declaration_table)
+from .options import (ADJUST, EXACT_C, EXACT_N, GAUSS_POINTS, SEGMENT_POINTS, SMOOTHING, STICK_TOLERANCE,
+                      ContactOptions, declaration_table)
 from .frames import LINE, NORMAL_TOL, POINT, no_normal, touch_tolerance
 from .frames_jit import material_frames
 from .record import OPEN, SLIP, STICK, Candidates, PairSet
@@ -98,12 +98,23 @@ def use_numpy_kernel(flag=True):
     return previous
 
 
-def exact_c(EI, L):
-    """Default ``c`` of exact stick (force / length^2): ``EXACT_C EI / L_e^4``, the slave's bending stiffness
-    against a nodal displacement per unit length (``EI`` its smaller bending stiffness, ``L_e`` the median of
-    its element lengths ``L``).  ``c`` weighs slip against traction in the stick/slip decision of an iterate:
-    the scenes' best values follow the slave's stiffness, not the normal penalty (docs/theory_mortar.md 3b)."""
-    return float(EXACT_C * EI / np.median(L) ** 4)
+def exact_c(EI, L, n):
+    """Default ``c`` of exact stick (force / length^2): ``EXACT_C EI / (L_e L_s^3)`` with ``L_s = n L_e / EXACT_N``
+    (the slave's length over ``EXACT_N``): the slave's bending stiffness against a nodal displacement at that
+    reference element length (``24 EI / L_s^3``) per unit length ``L_e`` of the node (``EI`` its smaller bending
+    stiffness, ``L_e`` the median of its element lengths ``L``, ``n`` its elements per beam).  At ``EXACT_N``
+    elements it is ``24 EI / L_e^4`` (the previous default) to the bit.  ``c`` weighs slip against traction in the
+    stick/slip decision of an iterate: the scenes' best values follow the slave's stiffness, not the normal penalty,
+    and under refinement grow like ``1 / L_e`` (a wire's stiffness against a nodal load is the wire's, not its
+    element's; ``24 EI / L_e^4`` grew 4096-fold from 16 to 128 elements and Newton stalled;
+    docs/theory_mortar.md 3b).  ``contact.system.EXACT_N = None``: ``L_s = L_e``, the rule before (benchmarks)."""
+    Le = float(np.median(L))
+    return float(EXACT_C * EI / Le ** 4 * ((n if EXACT_N is None else EXACT_N) / n) ** 3)
+
+
+def _slave_elements(beams):
+    """Median element count of the slave beams ``beams`` (element ids of each)."""
+    return float(np.median([len(e) for e in beams]))
 
 
 class _Decl:
@@ -136,9 +147,10 @@ class _Decl:
         self.law = o.law                      # None: the kernel's default law
         self.exact = o.stick == "exact" and decl.mu > 0
         # exact stick: the complementarity parameter c (force / length^2) and the slip tolerance (length)
-        # default: EXACT_C EI / L_e^4 of the slave (set by ContactSystem, which knows the element lengths)
+        # default: EXACT_C EI / (L_e L_s^3) of the slave (``exact_c``; set by ContactSystem, which knows the lengths)
         self.eps_t = o.penalty_t
         self.slave_bending = min(min(b.section.C[4, 4], b.section.C[5, 5]) for b in decl.slave)
+        self.slave_beams = [np.asarray(b.elements) for b in decl.slave]     # element ids of each slave beam
         # ... and, where the multipliers are not Newton unknowns (arc length), the Uzawa updates' penalty
         self.aug_t = self.penalty if o.penalty_t is None else o.penalty_t
         self.stick_tolerance = (STICK_TOLERANCE * 2.0 * max(s.radius for s in secs)
@@ -217,7 +229,7 @@ class ContactSystem(Contribution):
         self._decl_exact = np.array([d.exact for d in self.decls])
         for d in self.decls:
             if d.eps_t is None:
-                d.eps_t = exact_c(d.slave_bending, system.L[d.slave_el])
+                d.eps_t = exact_c(d.slave_bending, system.L[d.slave_el], _slave_elements(d.slave_beams))
         self._decl_eps_t = np.array([d.eps_t for d in self.decls])
         self._decl_aug_t = np.array([d.aug_t for d in self.decls])
         self._decl_stick_tol = np.array([d.stick_tolerance for d in self.decls])

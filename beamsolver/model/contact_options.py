@@ -18,11 +18,13 @@ from .validation import count, real
 
 __all__ = ["ContactOptions", "check_contact_options", "describe", "SMOOTHING", "SLIP_TOLERANCE", "GAUSS_POINTS",
            "SEGMENT_POINTS",
-           "STICK_TOLERANCE", "LINE_ANGLE", "ADJUST", "EXACT_C"]
+           "STICK_TOLERANCE", "LINE_ANGLE", "ADJUST", "EXACT_C", "EXACT_N"]
 
 SMOOTHING = 1e-6          # default smoothing gap of the normal law / (R1 + R2) (benchmarks/touching_defaults.py)
 SLIP_TOLERANCE = 0.005    # elastic slip at the onset of sliding / slave element length (Abaqus' default)
-EXACT_C = 24.0            # stick="exact": default c of the complementarity function / (EI / L_e^4) of the slave
+EXACT_C = 24.0            # stick="exact": default c of the complementarity function / (EI / (L_e L_s^3)) of the slave,
+EXACT_N = 16              # ... L_s = its length / EXACT_N (n L_e / EXACT_N; docs/theory_mortar.md 3b, "c under mesh
+                          # refinement": c grows like 1 / L_e, and equals 24 EI / L_e^4 at 16 elements)
 STICK_TOLERANCE = 1e-8    # weighted slip of a sticking node / (R1 + R2) with stick="exact"
 LINE_ANGLE = float(np.deg2rad(20.0))   # below this crossing angle: line contact (search.py, rule 1)
 GAUSS_POINTS = 5          # integration="points": Gauss points per slave element
@@ -116,9 +118,11 @@ class ContactOptions:
         "with ``stick=\"penalty\"``: a fixed tangential penalty, force / length^3, instead of one from "
         "``slip_tolerance`` (default None); with ``stick=\"exact\"``: the parameter ``c`` of the "
         "complementarity function ``C = lam - P(lam + c u)`` the semi-smooth Newton solves, force / "
-        "length^2 (default ``24 EI / L_e^4`` (``EXACT_C``), the slave's bending stiffness against a "
-        "nodal displacement per unit length: ``EI`` its smaller bending stiffness, ``L_e`` its median "
-        "element length): it changes the path of the iterations, not the answer", kernel_none=np.nan)
+        "length^2 (default ``24 EI / (L_e L_s^3)`` (``EXACT_C``), the slave's bending stiffness against a "
+        "nodal displacement at the reference element length ``L_s`` = its length / 16 (``EXACT_N``), per unit "
+        "length of the node: ``EI`` its smaller bending stiffness, ``L_e`` its median element length; it grows "
+        "like ``1 / L_e`` under refinement and is ``24 EI / L_e^4`` at 16 elements): it changes the path of the "
+        "iterations, not the answer", kernel_none=np.nan)
     slip_tolerance: float = option(
         SLIP_TOLERANCE, _real("slip_tolerance", above=0.0),
         "with ``stick=\"penalty\"`` (and point pairs): elastic slip at the onset of sliding, in slave element "

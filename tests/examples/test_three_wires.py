@@ -38,7 +38,8 @@ def test_wires_stay_in_touch_and_carry_the_torsion(run):
 
 
 def test_exact_stick_needs_no_more_than_half_again_the_penalty_iterations(run):
-    """``stick="exact"`` with its default ``c`` (``24 EI / L_e^4`` of the slave: 22 Newton iterations here;
+    """``stick="exact"`` with its default ``c`` (``EXACT_C EI / (L_e L_s^3)`` of the slave: 23 Newton iterations here,
+    22 with ``24 EI / L_e^4``;
     ``1e-3`` of the normal penalty, the previous default, took 52) against the penalty stick's 21."""
     sol, _ = run
     exact, _ = three_wires.main(turns=TURNS, steps=2, n_elements=8, length=L, stick="exact")
