@@ -131,12 +131,9 @@ def slivers(key, slave_nodes, xi1):
     k, part = key.ravel(), key[:, ::-1].ravel()
     f, fp = phi.ravel(), phi[:, ::-1].ravel()
     elem = np.repeat(slave_nodes[:, 0] * np.int64(slave_nodes.max() + 1) + slave_nodes[:, 1], 2)
-    uk, inv = np.unique(k, return_inverse=True)
+    uk, first, inv = np.unique(k, return_index=True, return_inverse=True)
     n = len(uk)
-    e_min = np.full(n, np.iinfo(np.int64).max)
-    e_max = np.full(n, np.iinfo(np.int64).min)
-    np.minimum.at(e_min, inv, elem)
-    np.maximum.at(e_max, inv, elem)
+    one_elem = np.bincount(inv, weights=elem != elem[first][inv], minlength=n) == 0
     whole = np.bincount(inv, weights=~own, minlength=n) > 0
     s_own = np.bincount(inv, weights=f, minlength=n)
     s_part = np.bincount(inv, weights=fp, minlength=n)
@@ -148,7 +145,7 @@ def slivers(key, slave_nodes, xi1):
     b_side = np.zeros(n, dtype=bool)
     b_side[inv] = np.tile([False, True], P)
     single = (npts == 1) & (p_npts == 1) & ((s_own < s_part) | ((s_own == s_part) & b_side))
-    sliver = (e_min == e_max) & ~whole & ((s_own < SLIVER * s_part) | single)
+    sliver = one_elem & ~whole & ((s_own < SLIVER * s_part) | single)
     return sliver[inv].reshape(P, 2) & own.reshape(P, 2)
 
 
