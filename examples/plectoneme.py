@@ -5,7 +5,7 @@ issue 32; linear elastic, no yield limit: surface strains far beyond steel's ran
 mathematical benchmark like it): two wires of radius ``R = 0.5 mm``, 20 mm long, clamped
 below, their upper ends rigidly linked to a plate turned about ``e_z`` under a 5 N dead
 pull, Coulomb friction ``mu = 0.3`` (the penalty stick, ``stick="penalty"``: the runs below were measured with
-it, and with exact stick, the library's default, the five-turn extension-controlled run stops at t = 0.28),
+it, and with exact stick, the library's default, the five-turn extension-controlled run stops at t = 0.68),
 with two additions:
 
 - a small imperfection: a dead lateral force of ``imperfection`` times the pull on the
@@ -192,7 +192,8 @@ def build(turns=5.0, n_elements=16, mu=0.3, imperfection=1e-2, pull=PULL, E=200e
             bs.motion.translation(lambda t: (0.0, 0.0, -approach * length * stage2(t))),
             bs.motion.rotation((0.0, 0.0, 1.0), angle)))
     # the penalty stick (issue 26): with exact stick, the library's default, the extension-controlled five-turn
-    # run stops at t = 0.28 (docs/benchmarks.md, "Exact stick, session 6: hard scenes")
+    # run stops at t = 0.68, 3.4 turns (t = 0.28 before sliver groups were folded; docs/benchmarks.md, "Exact stick,
+    # session 7: rope piece and plectoneme")
     opts = dict(mu=mu, smoothing=smoothing * R, stick=stick)
     if line_angle is not None:
         opts["line_angle"] = np.radians(line_angle)

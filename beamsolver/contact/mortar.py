@@ -42,7 +42,25 @@ def use_numpy_scatter(flag=True):
     _SCATTER.update(_NUMPY if flag else _COMPILED)
 
 
-def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=None):
+def _held_moved(slave_nodes, held):
+    """The points' slave nodes with a held node moved to its neighbour (``groups``)."""
+    if held is None:
+        return slave_nodes
+    slave_nodes = slave_nodes.copy()
+    hA, hB = held[:, 0], held[:, 1]
+    slave_nodes[hA & ~hB, 0] = slave_nodes[hA & ~hB, 1]
+    slave_nodes[hB & ~hA, 1] = slave_nodes[hB & ~hA, 0]
+    return slave_nodes
+
+
+def fold_of(slave_nodes, xi1, master_beam, decl, n_nodes, n_beams, held=None):
+    """``slivers`` of the groups ``groups`` makes from these arguments."""
+    sn = _held_moved(slave_nodes, held)
+    key = (np.asarray(decl, dtype=np.int64)[:, None] * n_nodes + sn) * n_beams + master_beam[:, None]
+    return slivers(key, sn, xi1)
+
+
+def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=None, fold=None):
     """Nodal groups (one slave node against one master beam) of ``P`` points.
 
     ``held`` ``(P, 2)``: whether the point's slave node A, B has a prescribed slip (every increment
@@ -55,15 +73,18 @@ def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=No
     the pairs' nodes.  Returns a dict: ``key`` ``(G,)`` (``(decl n_nodes + node) n_beams + beam``,
     sorted), ``node`` ``(G,)``, ``g`` ``(P, 2)`` the groups of each point's nodes A and B, ``phi`` ``(P, 2)``
     the shape functions, ``members`` ``(G, k)`` the nodes of each group (padded with its first node)
-    and ``pos`` ``(P, 2, 4)`` the slot of each pair node in the group of its node A and B.
+    and ``pos`` ``(P, 2, 4)`` the slot of each pair node in the group of its node A and B.  Sliver groups
+    (``slivers``; ``fold`` ``(P, 2)`` if already known) are folded into their neighbour as held nodes are.
     """
     P = len(xi1)
-    if held is not None:
-        slave_nodes = slave_nodes.copy()
-        hA, hB = held[:, 0], held[:, 1]
-        slave_nodes[hA & ~hB, 0] = slave_nodes[hA & ~hB, 1]
-        slave_nodes[hB & ~hA, 1] = slave_nodes[hB & ~hA, 0]
+    slave_nodes = _held_moved(slave_nodes, held)
     key = (np.asarray(decl, dtype=np.int64)[:, None] * n_nodes + slave_nodes) * n_beams + master_beam[:, None]
+    if fold is None:
+        fold = slivers(key, slave_nodes, xi1)
+    if fold.any():
+        slave_nodes = slave_nodes.copy()
+        slave_nodes[fold] = slave_nodes[:, ::-1][fold]
+        key = (np.asarray(decl, dtype=np.int64)[:, None] * n_nodes + slave_nodes) * n_beams + master_beam[:, None]
     ukey, g = np.unique(key.ravel(), return_inverse=True)
     g = g.reshape(P, 2)
     node = (ukey // n_beams) % n_nodes
@@ -89,9 +110,48 @@ def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=No
                 rot=6 * own[:, None] + np.arange(3, 6))
 
 
+SLIVER = 0.25    # a group on one slave element whose shape functions sum to less than this times its partner's there
+                 # is folded into it (``slivers``; None: never, as before session 7)
+
+
+def slivers(key, slave_nodes, xi1):
+    """``(P, 2)`` bool: the points' nodes whose group (``key`` ``(P, 2)``) is a sliver, folded into the other node's
+    group of the element (the boundary modification of ``groups``' held nodes).  A sliver has its points on one slave
+    element and there sums its shape functions to less than ``SLIVER`` times its partner's (a node whose support
+    meets this master beam at the end of the element only: the plectoneme's slave node next to a joint of the master's
+    pieces, one Gauss point with ``Phi = 0.047``), or both have the same single point (then the smaller one folds): its
+    multiplier acts through the partner's points only, 20 times weaker, and when both stick their weighted slips are
+    the same constraint (a singular saddle system: Newton steps of the multiplier of 1e22)."""
+    P = len(xi1)
+    fold = np.zeros((P, 2), dtype=bool)
+    if P == 0 or SLIVER is None:
+        return fold
+    phi = np.stack([1.0 - xi1, xi1], axis=1)
+    own = np.repeat(key[:, 0] != key[:, 1], 2)          # (a point of a held node's element counts wholly)
+    k, part = key.ravel(), key[:, ::-1].ravel()
+    f, fp = phi.ravel(), phi[:, ::-1].ravel()
+    elem = np.repeat(slave_nodes[:, 0] * np.int64(slave_nodes.max() + 1) + slave_nodes[:, 1], 2)
+    uk, first, inv = np.unique(k, return_index=True, return_inverse=True)
+    n = len(uk)
+    one_elem = np.bincount(inv, weights=elem != elem[first][inv], minlength=n) == 0
+    whole = np.bincount(inv, weights=~own, minlength=n) > 0
+    s_own = np.bincount(inv, weights=f, minlength=n)
+    s_part = np.bincount(inv, weights=fp, minlength=n)
+    npts = np.bincount(inv, minlength=n)
+    pk = np.zeros(n, dtype=np.int64)          # the partner (every point of a one-element group has the same one)
+    pk[inv] = part
+    j = np.searchsorted(uk, pk)
+    p_npts = npts[j]
+    b_side = np.zeros(n, dtype=bool)
+    b_side[inv] = np.tile([False, True], P)
+    single = (npts == 1) & (p_npts == 1) & ((s_own < s_part) | ((s_own == s_part) & b_side))
+    sliver = one_elem & ~whole & ((s_own < SLIVER * s_part) | single)
+    return sliver[inv].reshape(P, 2) & own.reshape(P, 2)
+
+
 class Groups:
-    """``groups`` kept between evaluations while the points' nodes, master beams, declarations and held flags
-    are those of the last call (the pairs of a Newton step): then only the shape functions ``phi`` follow
+    """``groups`` kept between evaluations while the points' nodes, master beams, declarations, held flags and
+    sliver folds are those of the last call (the pairs of a Newton step): then only the shape functions ``phi`` follow
     ``xi1`` (two ``np.unique`` and a sort less per evaluation).  The arrays returned are shared between
     the calls that reuse them: read them only."""
 
@@ -100,13 +160,14 @@ class Groups:
         self.builds = 0          # ``groups`` calls (tests)
 
     def __call__(self, slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=None):
-        args = (slave_nodes, master_beam, decl, nodes, held)
+        fold = fold_of(slave_nodes, xi1, master_beam, decl, n_nodes, n_beams, held)
+        args = (slave_nodes, master_beam, decl, nodes, held, fold)
         last = self._last
         if last is not None and last[0] == (n_nodes, n_beams) and all(
                 (a is None and b is None) or (a is not None and b is not None and np.array_equal(a, b))
                 for a, b in zip(last[1], args)):
             return dict(last[2], phi=np.stack([1.0 - xi1, xi1], axis=1))
-        G = groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held)
+        G = groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held, fold)
         self._last = ((n_nodes, n_beams), tuple(None if a is None else np.array(a) for a in args), G)
         self.builds += 1
         return G

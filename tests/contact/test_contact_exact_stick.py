@@ -255,6 +255,27 @@ def test_groups_move_a_held_node_to_its_neighbour():
             assert (G["members"][G["g"][p, a], G["pos"][p, a]] == nodes[p]).all()
 
 
+def test_groups_fold_a_sliver_into_its_neighbour():
+    """``mortar.groups``: a slave node whose support meets a master beam in one Gauss point with a small shape function
+    (the plectoneme: the master's pieces join there, ``Phi = 0.047``) has no group of its own against that beam; the
+    point counts wholly for the other node of the element.  Points with comparable shares keep both groups."""
+    from beamsolver.contact.mortar import groups
+    slave = np.array([[0, 1], [0, 1], [1, 2], [1, 2], [1, 2]])
+    nodes = np.array([[0, 1, 5, 6], [0, 1, 5, 6], [1, 2, 6, 7], [1, 2, 6, 7], [1, 2, 3, 4]])
+    beam = np.array([0, 0, 0, 0, 1])
+    for xi, kept in ((0.047, 1), (0.953, 2)):       # the point on beam 1 near node 1 / near node 2
+        G = groups(slave, np.array([0.2, 0.8, 0.2, 0.6, xi]), beam, np.zeros(5, dtype=int), nodes, 8, 2)
+        on1 = G["key"] % 2 == 1
+        assert G["node"][on1].tolist() == [kept]                     # one group against beam 1
+        assert G["g"][4, 0] == G["g"][4, 1]                          # its point counts wholly for it
+        assert G["node"][~on1].tolist() == [0, 1, 2]                 # beam 0: comparable shares, every node kept
+    G = groups(slave, np.array([0.2, 0.8, 0.2, 0.6, 0.4]), beam, np.zeros(5, dtype=int), nodes, 8, 2)
+    assert G["node"][G["key"] % 2 == 1].tolist() == [1]              # the same single point, shares 0.6 / 0.4
+    G = groups(slave, np.array([0.2, 0.8, 0.2, 0.6, 0.047]), beam, np.zeros(5, dtype=int), nodes, 8, 2,
+               fold=np.zeros((5, 2), dtype=bool))
+    assert G["node"][G["key"] % 2 == 1].tolist() == [1, 2]           # without the fold: two groups, one point
+
+
 def test_compiled_mortar_terms_match_the_complex_step_oracle(monkeypatch):
     """``kernel_jit.mortar_terms`` (compiled, four evaluations, the friction linear in the given traction)
     against ``reference.mortar_point_derivatives`` (numpy complex steps) on pressed, slid pairs at a random

@@ -89,8 +89,9 @@ def test_groups_are_kept_while_the_pairs_nodes_hold():
         assert set(ref) == set(out)
         for k in ref:
             assert np.array_equal(ref[k], out[k]), k
+    x0 = rng.uniform(0.01, 0.99, P)          # the points move a little within a Newton step: no sliver appears
     for _ in range(3):
-        check(slave, rng.uniform(0, 1, P), beam, decl, nodes, n_nodes, 2, held)
+        check(slave, x0 + 1e-6 * rng.uniform(-1, 1, P), beam, decl, nodes, n_nodes, 2, held)
     assert keep.builds == 1
     nodes = nodes.copy()
     nodes[0, 3] = (nodes[0, 3] + 1) % n_nodes
@@ -99,6 +100,18 @@ def test_groups_are_kept_while_the_pairs_nodes_hold():
     held[1] = ~held[1]
     check(slave, rng.uniform(0, 1, P), beam, decl, nodes, n_nodes, 2, held)
     assert keep.builds == 3
+    # a point that moves far enough to make or unmake a sliver group (``mortar.slivers``): built again
+    x1 = rng.uniform(0, 1, P)
+    fold = mortar.fold_of(slave, x1, beam, decl, n_nodes, 2, held)
+    x2 = x1.copy()
+    for p in range(P):
+        x2[p] = 1.0 - x1[p]
+        if not np.array_equal(mortar.fold_of(slave, x2, beam, decl, n_nodes, 2, held), fold):
+            break
+        x2[p] = x1[p]
+    check(slave, x1, beam, decl, nodes, n_nodes, 2, held)
+    check(slave, x2, beam, decl, nodes, n_nodes, 2, held)
+    assert not np.array_equal(x1, x2) and keep.builds == 5
 
 
 def _nodal_case(seed, P=50, n_nodes=12):

@@ -138,3 +138,15 @@ def test_extension_controlled_pair_passes_five_turns_through_the_pop_of_its_loop
     lk, wr = np.array([r.lk for r in rows]), np.array([r.wr for r in rows])
     gain = wr - wr[np.searchsorted(lk, lk - 0.01)]      # writhe gained over the last 0.01 turn
     assert wr[-1] > 1.0 and gain.max() > 0.25           # the pop: Wr 0.58 -> 0.87 within 4e-4 turn
+
+
+@pytest.mark.slow
+def test_exact_stick_passes_where_a_sliver_group_stalled_it():
+    """The extension-controlled run of the five-turn test with exact stick, to t = 0.3 (1.5 turns), steps cut to
+    1e-3 of 0.02 at most: it stalled at t = 0.2839 (multiplier steps of 1e22: a group of the slave node next to
+    the joint of the master's pieces had one Gauss point with a shape function of 0.047, shared with its
+    neighbour, ``mortar.slivers``); now 607 Newton iterations, about 11 s of CPU."""
+    import beamsolver as bs
+    model, _, _ = plectoneme.build(turns=5.0, n_elements=24, length=0.06, pull=50.0, approach=0.3, stick="exact")
+    sol = bs.solve(model, steps=15, t_end=0.3, stabilize=5e-2, min_step_ratio=1e-3, verbose=False)
+    assert sol.times[-1] == pytest.approx(0.3)
