@@ -33,7 +33,8 @@ strand's value, 3.6 % below ``M_f`` at 48 el/lay (6 lays; 4 lays: 3.2 %; 2 lays 
 lifted by the ends).
 The row ``M_f, friction part`` subtracts the model's own frictionless moment (the stiffness checks) instead of
 ``EI_min kappa``; the rows ``M - EI_min kappa at z`` give the moment along the strand (section 5).
-The issue's size (``--lays 4 --elements 48``): 406 Newton iterations, 4 cut-backs, 121.5 s CPU for the cycle.  Exact stick wants 16 el/lay or more: at 8 the linear
+The issue's size (``--lays 4 --elements 48``): 245 Newton iterations, no cut-back, 47 s CPU for the cycle
+(51 s for the whole example).  Exact stick wants 16 el/lay or more: at 8 the linear
 nodal tractions smear the friction's reversal at the neutral axis over an element (``M_f`` 6 % low).
 ``--stick penalty`` uses the Gauss-point penalty with ``slip_tolerance`` 5e-6 element lengths (with the
 library's default 0.005 the strand does not stick at all: initial stiffness 15 N m^2).
