@@ -550,12 +550,9 @@ def test_nodal_table_of_exact_stick_is_in_the_solution_and_its_file(tmp_path):
     assert not any(k.startswith("mortar_") for k in pen.extra)
 
 
-def test_a_step_starts_from_the_multipliers_extrapolated_from_the_last_two_steps():
-    """``begin_step`` (exact stick, multipliers as Newton unknowns) starts the step to ``t`` from the nodal multipliers
-    linear in ``t`` through the last two converged steps', for the groups both have; a group only the last step has
-    keeps its value; a step not beyond the last one (a repeat, or only one step known) starts from the last step's."""
-    from beamsolver.contact import system as contact_system
-    assert contact_system.EXTRAPOLATE
+def _two_committed_steps():
+    """A parallel pair's contact with two committed steps of nodal multipliers (t = 0.2: groups 3, 7; t = 0.4:
+    groups 3, 7, 11): ``(problem, slave, contact, poses, keys at 0.4, multipliers at 0.4)``."""
     model, slave, master = _parallel(0.5)
     problem = Problem.from_model(model, check_rigid_modes=False)
     c = problem.contact
@@ -565,6 +562,16 @@ def test_a_step_starts_from_the_multipliers_extrapolated_from_the_last_two_steps
     L1 = np.array([[2.0, 0.0, 1.0], [0.0, 1.0, 0.0], [5.0, 5.0, 5.0]])
     c.history.commit(c._decl_mu, None, (k1, L1))
     c._commits = [(0.2, (k0, L0)), (0.4, (k1, L1))]
+    return problem, slave, c, H, k1, L1
+
+
+def test_a_step_starts_from_the_multipliers_extrapolated_from_the_last_two_steps():
+    """``begin_step`` (exact stick, multipliers as Newton unknowns) starts the step to ``t`` from the nodal multipliers
+    linear in ``t`` through the last two converged steps', for the groups both have; a group only the last step has
+    keeps its value; a step not beyond the last one (a repeat, or only one step known) starts from the last step's."""
+    from beamsolver.contact import system as contact_system
+    assert contact_system.EXTRAPOLATE
+    _, _, c, H, k1, L1 = _two_committed_steps()
     c.begin_step(H, 0.5)                       # half a step ahead
     keys, lam = c.history.tmult
     np.testing.assert_array_equal(keys, k1)
@@ -584,15 +591,7 @@ def test_a_step_starts_with_the_groups_that_slid_out_of_their_disk():
     slid (pressed, not sticking) and ``get_state`` / ``set_state`` carry them (restart)."""
     from beamsolver.contact import system as contact_system
     assert contact_system.SLID_START > 1.0
-    model, slave, master = _parallel(0.5)
-    problem = Problem.from_model(model, check_rigid_modes=False)
-    c = problem.contact
-    H = problem.system.poses0.copy()
-    k0, k1 = np.array([3, 7], dtype=np.int64), np.array([3, 7, 11], dtype=np.int64)
-    L0 = np.array([[1.0, 0.0, 0.0], [0.0, 2.0, 0.0]])
-    L1 = np.array([[2.0, 0.0, 1.0], [0.0, 1.0, 0.0], [5.0, 5.0, 5.0]])
-    c.history.commit(c._decl_mu, None, (k1, L1))
-    c._commits = [(0.2, (k0, L0)), (0.4, (k1, L1))]
+    problem, slave, c, H, k1, L1 = _two_committed_steps()
     c._slid = np.array([7, 11], dtype=np.int64)
     c.begin_step(H, 0.5)
     s = contact_system.SLID_START
