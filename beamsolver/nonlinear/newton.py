@@ -405,18 +405,11 @@ class Newton:
             log.debug("t = %.6g  iteration %d  scaled residual %.3e", t, it, ratio)
             if self.callback is not None:
                 self.callback(dict(t=t, iteration=it, residual=ratio, poses=H))
-            verdict = conv.decide(ratio, last_inc, it, floor, final=constraint.final)
-            if verdict is MAX_ITER and not problem.smooth and self.converging(residuals, it - conv.max_iter):
-                verdict = CONTINUE
+            verdict = self._verdict(residuals, last_inc, it, floor, constraint)
             if verdict is CONVERGED:
                 if damped_its:
                     stats_extra["damped"] = damped_its
                 return self._converged(H, t, ev, constraint, dict(iterations=it, residuals=residuals, **stats_extra))
-            if verdict is not CONTINUE:
-                raise self._failure(verdict, ratio)
-            if self.stall_window and it - int(np.argmin(residuals)) >= self.stall_window:
-                raise NotConverged(f"no progress in {self.stall_window} iterations (scaled residual {ratio:.3g}, "
-                                   f"lowest {min(residuals):.3g})", ratio)
             if dzf is None:
                 lu, dzf = constraint.direction(self, ev, H, t)
             if it == 0 and self.watch_sign and constraint.watch_sign:
@@ -459,6 +452,21 @@ class Newton:
             last_inc = inc if lam == 1.0 else np.inf
         raise AssertionError("unreachable: decide() returns MAX_ITER from max_iter on, converging is False "
                              "after GRACE_ITER more")
+
+    def _verdict(self, residuals, last_inc, it, floor, constraint):
+        """``Convergence.decide`` on the iterate whose scaled residual is ``residuals[-1]``: ``CONVERGED`` or
+        ``CONTINUE`` (past ``max_iter`` while ``converging``), else the ``failures.StepFailed`` raised, also after
+        ``stall_window`` iterations without a new lowest residual."""
+        ratio = residuals[-1]
+        verdict = self.conv.decide(ratio, last_inc, it, floor, final=constraint.final)
+        if verdict is MAX_ITER and not self.problem.smooth and self.converging(residuals, it - self.conv.max_iter):
+            verdict = CONTINUE
+        if verdict is not CONTINUE and verdict is not CONVERGED:
+            raise self._failure(verdict, ratio)
+        if verdict is CONTINUE and self.stall_window and it - int(np.argmin(residuals)) >= self.stall_window:
+            raise NotConverged(f"no progress in {self.stall_window} iterations (scaled residual {ratio:.3g}, "
+                               f"lowest {min(residuals):.3g})", ratio)
+        return verdict
 
     @staticmethod
     def converging(residuals, extra):
