@@ -165,6 +165,7 @@ class Newton:
         self.watch_sign = False               # whether to look (stepping.Run: conservative problems)
         self.t_evaluated = None               # t of the last evaluation (failure messages)
         self.stall_window = None              # a step fails after this many iterations without a new lowest residual
+        self.status = None                    # exact stick: (keys, stick flags) of the groups at the last iterate
         self.last_evaluation = None           # of the last converged state
         self.reset_timings()
 
@@ -401,6 +402,7 @@ class Newton:
             ahead = None
             problem.accept_multipliers()        # those the iterate was evaluated with
             residuals.append(ratio)
+            self._count_changes(ev, stats_extra, it)
             self.near = ratio <= LS_NEAR * max(residuals)
             log.debug("t = %.6g  iteration %d  scaled residual %.3e", t, it, ratio)
             if self.callback is not None:
@@ -452,6 +454,22 @@ class Newton:
             last_inc = inc if lam == 1.0 else np.inf
         raise AssertionError("unreachable: decide() returns MAX_ITER from max_iter on, converging is False "
                              "after GRACE_ITER more")
+
+    def _count_changes(self, ev, stats, it):
+        """Exact stick: append to ``stats["changes"]`` how many groups of ``ev`` are on the other branch (stick /
+        slip) than at the iterate before (groups that appeared or vanished count; 0 at the first iterate), the
+        contact status changes a semi-smooth Newton converges superlinearly without."""
+        mu = ev.mult
+        if mu is None:
+            return
+        prev, self.status = (None if it == 0 else self.status), (mu["key"], mu["stick"])
+        changes = stats.setdefault("changes", [])
+        if prev is None:
+            changes.append(0)
+            return
+        common, i0, i1 = np.intersect1d(prev[0], mu["key"], assume_unique=True, return_indices=True)
+        changes.append(int(len(prev[0]) + len(mu["key"]) - 2 * len(common)
+                           + np.count_nonzero(prev[1][i0] != mu["stick"][i1])))
 
     def _verdict(self, residuals, last_inc, it, floor, constraint):
         """``Convergence.decide`` on the iterate whose scaled residual is ``residuals[-1]``: ``CONVERGED`` or
