@@ -213,7 +213,8 @@ class Solution:
                          ``cutbacks``, and whatever the solver adds (``failed_dt``, ``warnings``,
                          ``timings``; by default ``stable``, ``negative_eigenvalues``,
                          ``lowest_eigenvalue`` and, where ``stable`` is ``None`` or not the step's own
-                         tangent's, ``stable_note``: ``stepping.stability``)
+                         tangent's, ``stable_note``: ``stepping.stability``; with exact stick ``changes``,
+                         per Newton iteration the groups whose stick / slip branch changed)
     ``contacts``         list of ``s`` contact point tables (dicts of arrays of equal length ``k``,
                          one row per contact point the search found; ``{}`` for a step without
                          contact): ``position`` (k, 3) midway between the contour points, ``gap``,
