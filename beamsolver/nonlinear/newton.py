@@ -401,12 +401,7 @@ class Newton:
             ev, scales, ratio, lu, dzf, nrm = self._measured(self.evaluate(H, t)) if ahead is None else ahead
             ahead = None
             problem.accept_multipliers()        # those the iterate was evaluated with
-            residuals.append(ratio)
-            self._count_changes(ev, stats_extra, it)
-            self.near = ratio <= LS_NEAR * max(residuals)
-            log.debug("t = %.6g  iteration %d  scaled residual %.3e", t, it, ratio)
-            if self.callback is not None:
-                self.callback(dict(t=t, iteration=it, residual=ratio, poses=H))
+            self._record(ev, ratio, residuals, stats_extra, it, t, H)
             verdict = self._verdict(residuals, last_inc, it, floor, constraint)
             if verdict is CONVERGED:
                 if damped_its:
@@ -454,6 +449,16 @@ class Newton:
             last_inc = inc if lam == 1.0 else np.inf
         raise AssertionError("unreachable: decide() returns MAX_ITER from max_iter on, converging is False "
                              "after GRACE_ITER more")
+
+    def _record(self, ev, ratio, residuals, stats, it, t, H):
+        """Book an iterate (``ev`` at ``(H, t)``, scaled residual ``ratio``, iteration ``it``): its residual, exact
+        stick's status changes (``_count_changes``), ``near`` for the line search, the log and the callback."""
+        residuals.append(ratio)
+        self._count_changes(ev, stats, it)
+        self.near = ratio <= LS_NEAR * max(residuals)
+        log.debug("t = %.6g  iteration %d  scaled residual %.3e", t, it, ratio)
+        if self.callback is not None:
+            self.callback(dict(t=t, iteration=it, residual=ratio, poses=H))
 
     def _count_changes(self, ev, stats, it):
         """Exact stick: append to ``stats["changes"]`` how many groups of ``ev`` are on the other branch (stick /
