@@ -61,10 +61,10 @@ solve_options = dict(steps=6 * STEPS, t_end=6.0)   # for `beamsolver run example
 
 
 # ---------------------------------------------------------------- theory
-def theory(F, mu=MU):
-    """Closed-form quantities for a wire force ``F`` (docs/theory_strand_bending.md): dict."""
+def theory(F, mu=MU, lay=LAY):
+    """Closed-form quantities for a wire force ``F`` and a lay length ``lay`` (docs/theory_strand_bending.md): dict."""
     r = RC + RW
-    b = np.arctan(2 * np.pi * r / LAY)
+    b = np.arctan(2 * np.pi * r / lay)
     Aw, Iw, Ic = np.pi * RW**2, np.pi * RW**4 / 4, np.pi * RC**4 / 4
     c = np.cos(b) * (1 + np.cos(b) ** 2 + np.sin(b) ** 2 / (1 + NU)) / 2
     EI_min = E * Ic + N * c * E * Iw
@@ -129,12 +129,15 @@ def _contact_options(stick, slip_tolerance):
 
 
 def build(lays=LAYS, elements_per_lay=ELEMENTS, mu=MU, amplitude=AMPLITUDE, tied=False, kappa_b=None, slip_tolerance=SLIP_TOLERANCE,
-          stick=None):
+          stick=None, lay=LAY, curvature=None, sections=None):
     """The strand in its bending fixture: ``(model, strand, fixture, T, k)``; ``kappa_b`` sets the
-    curvature unit (default: the theory's with the fibre-limit wire force)."""
-    b = np.arctan(2 * np.pi * (RC + RW) / LAY)
-    layers = [cables.Layer(RC, 1), cables.Layer(RW, N, lay_length=LAY)]
-    st = cables.build_strand(layers, lays * LAY, E, nu=NU, elements_per_lay=elements_per_lay, mu=mu,
+    curvature unit (default: the theory's with the fibre-limit wire force); ``lay``: the lay length;
+    ``curvature(t, k)``: the history for ``t`` in ``[1, 6]`` (default: the cycle of the module docstring);
+    ``sections``: ``(core, wire)`` ``Section`` objects (default: steel circles of ``RC``, ``RW``)."""
+    b = np.arctan(2 * np.pi * (RC + RW) / lay)
+    core, wire = (None, None) if sections is None else sections
+    layers = [cables.Layer(RC, 1, section=core), cables.Layer(RW, N, lay_length=lay, section=wire)]
+    st = cables.build_strand(layers, lays * lay, E, nu=NU, elements_per_lay=elements_per_lay, mu=mu,
                              contact=not tied, touch_tol=0.0, contact_options=_contact_options(stick, slip_tolerance))
     if tied:                                   # every wire node rigidly on the core node at its height
         core = st.wires[0][0]
@@ -143,11 +146,13 @@ def build(lays=LAYS, elements_per_lay=ELEMENTS, mu=MU, amplitude=AMPLITUDE, tied
                 st.model.join(c, a, rigid=True)
     Kee = E * np.pi * RC**2 + N * E * np.pi * RW**2 * np.cos(b) ** 3
     T = Kee * STRAIN
-    kb = theory(E * np.pi * RW**2 * np.cos(b) ** 2 * STRAIN, mu if mu > 0 else MU)["kappa_b"] \
+    kb = theory(E * np.pi * RW**2 * np.cos(b) ** 2 * STRAIN, mu if mu > 0 else MU, lay)["kappa_b"] \
         if kappa_b is None else kappa_b
     k = amplitude * kb
 
-    def curvature(t):
+    def cycle(t):
+        if curvature is not None:
+            return 0.0 if t <= 1.0 else curvature(t, k)
         if t <= 1.0:
             return 0.0
         if t <= 2.0:
@@ -155,14 +160,16 @@ def build(lays=LAYS, elements_per_lay=ELEMENTS, mu=MU, amplitude=AMPLITUDE, tied
         if t <= 4.0:
             return k * (3.0 - t)
         return k * (t - 5.0)
-    fx = cables.bending_fixture(st, curvature=curvature, pull=lambda t: T * min(t, 1.0))
+    fx = cables.bending_fixture(st, curvature=cycle, pull=lambda t: T * min(t, 1.0))
     return st.model, st, fx, T, k
 
 
 def run(lays=LAYS, elements_per_lay=ELEMENTS, mu=MU, amplitude=AMPLITUDE, steps=STEPS, tied=False, t_end=6.0, verbose=False,
-        slip_tolerance=SLIP_TOLERANCE, stick=None):
-    """Solve with ``steps`` steps per unit pseudo-time; returns a dict of the measured curves."""
-    model, st, fx, T, k = build(lays, elements_per_lay, mu, amplitude, tied, slip_tolerance=slip_tolerance, stick=stick)
+        slip_tolerance=SLIP_TOLERANCE, stick=None, lay=LAY, curvature=None, sections=None):
+    """Solve with ``steps`` steps per unit pseudo-time; returns a dict of the measured curves (``build`` for the
+    keywords)."""
+    model, st, fx, T, k = build(lays, elements_per_lay, mu, amplitude, tied, slip_tolerance=slip_tolerance, stick=stick,
+                                lay=lay, curvature=curvature, sections=sections)
     t0, c0 = time.perf_counter(), time.process_time()
     sol = bs.solve(model, steps=int(round(steps * t_end)), t_end=t_end, verbose=verbose)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
@@ -177,7 +184,7 @@ def run(lays=LAYS, elements_per_lay=ELEMENTS, mu=MU, amplitude=AMPLITUDE, steps=
         z = c["position"][:, 2]
         mid = (c["normal_force"] > 0) & (np.abs(z - 0.5 * fx.length) < 0.25 * fx.length)
         share[i] = np.mean(c["status"][mid] == SLIP) if mid.any() else np.nan
-    return dict(sol=sol, fixture=fx, strand=st, times=sol.times, kappa=kappa, M=M, F=F, T=T, k=k, share=share,
+    return dict(sol=sol, fixture=fx, strand=st, lay=lay, times=sol.times, kappa=kappa, M=M, F=F, T=T, k=k, share=share,
                 wall=wall, cpu=cpu, iterations=int(sol.iterations.sum()), cutbacks=sum(s.get("cutbacks", 0) for s in sol.stats))
 
 
@@ -186,7 +193,7 @@ def compare(res, EI_frictionless=None):
     ``EI_frictionless``: the model's own full-slip stiffness (``stiffness_checks``); given, the row
     ``M_f, friction part`` subtracts it instead of the theory's ``EI_min`` (docs/theory_strand_bending.md,
     section 5: the friction part of the moment is the moment less the frictionless one)."""
-    th = theory(res["F"])
+    th = theory(res["F"], lay=res.get("lay", LAY))
     t, kap, M = res["times"], res["kappa"], res["M"]
     up = (t > 1.0) & (t <= 2.0 + 1e-9)
     down = (t > 2.0) & (t <= 4.0 + 1e-9)
@@ -199,6 +206,10 @@ def compare(res, EI_frictionless=None):
     rows.append(("EI full slip, slope of the virgin branch [N m^2]", th["EI_min"], EI_slip))
     Mf = float(np.mean(Ms - th["EI_min"] * ks)) if len(ks) else np.nan
     rows.append(("M_f [N m]", th["M_f"], Mf))
+    beyond = np.flatnonzero(up & (kap >= 2.0 * th["kappa_b"] * (1 - 1e-9)))   # issue 26: M beyond 2 kappa_b
+    for j in sorted({beyond[0], beyond[-1]}) if len(beyond) else ():
+        rows.append((f"M at {kap[j] / th['kappa_b']:.3g} kappa_b, virgin branch [N m]",
+                     float(np.ravel(moment(kap[j], th))[0]), M[j]))
     if EI_frictionless is not None:
         rows.append(("M_f, friction part M - EI_frictionless kappa [N m]", th["M_f"],
                      float(np.mean(Ms - EI_frictionless * ks)) if len(ks) else np.nan))
@@ -229,19 +240,38 @@ def compare(res, EI_frictionless=None):
     return th, [(n, a, b, (b - a) / a if a else b) for n, a, b in rows]
 
 
-def first_slip(lays=LAYS, elements_per_lay=ELEMENTS, steps=40, upto=2.0, stick=None):
-    """``(kappa at the first slipping point of the middle half, kappa_b of the theory)`` on a virgin
-    ramp ``0 -> upto kappa_b`` in ``steps`` steps (``t`` in ``[1, 2]``; the flags resolve ``upto / steps``)."""
-    res = run(lays, elements_per_lay, amplitude=upto, steps=steps, t_end=2.0, stick=stick)
-    th = theory(res["F"])
-    hit = np.flatnonzero((res["times"] > 1.0) & (res["share"] > 0))
-    return (res["kappa"][hit[0]] if len(hit) else np.nan), th["kappa_b"]
+ONSET = (0.9, 0.01, 1.3)          # first-slip ramp: one step to 0.9 kappa_b, then steps of 0.01 kappa_b up to 1.3
+
+
+def first_slip(lays=LAYS, elements_per_lay=ELEMENTS, lay=LAY, ramp=ONSET, stick=None, sections=None):
+    """First slip on the virgin branch, read from the stick flags of the contact points of the middle half:
+    dict with ``kappa`` (the first step with a slipping point), ``kappa_b`` (the theory's, with the model's wire
+    force), ``EI0`` (the stick branch's slope ``M / kappa`` at the first step), ``own`` (``kappa_b`` scaled by
+    the model's stick part ``(EI_max - EI_min) / (EI0 - EI_min)``: where the model's own stick stiffness puts the
+    onset, docs/theory_strand_bending.md section 5) and the run's ``res``.  ``ramp = (start, step, end)`` in
+    units of ``kappa_b``: the stick branch is elastic, so one step reaches ``start``; then steps of ``step``
+    (the flags resolve it)."""
+    start, step, end = ramp
+    n = int(round((end - start) / step))
+
+    def curvature(t, k):                       # k = 1 kappa_b; t in [1, 2] in n + 1 equal steps
+        x = (t - 1.0) * (n + 1)
+        return k * (start * min(x, 1.0) + step * max(x - 1.0, 0.0))
+    res = run(lays, elements_per_lay, amplitude=1.0, steps=n + 1, t_end=2.0, stick=stick, lay=lay,
+              curvature=curvature, sections=sections)
+    th = theory(res["F"], lay=lay)
+    up = np.flatnonzero(res["times"] > 1.0)
+    hit = up[res["share"][up] > 0]
+    EI0 = res["M"][up[0]] / res["kappa"][up[0]]
+    own = th["kappa_b"] * (th["EI_max"] - th["EI_min"]) / (EI0 - th["EI_min"])
+    return dict(kappa=res["kappa"][hit[0]] if len(hit) else np.nan, kappa_b=th["kappa_b"], EI0=EI0, own=own,
+                EI_max=th["EI_max"], res=res)
 
 
 CHECK_STEPS = 1                  # steps per unit t of the stiffness checks: elastic, so path-independent
 
 
-def stiffness_checks(lays=LAYS, elements_per_lay=ELEMENTS, steps=CHECK_STEPS):
+def stiffness_checks(lays=LAYS, elements_per_lay=ELEMENTS, steps=CHECK_STEPS, lay=LAY):
     """``(EI frictionless, EI tied)``: the initial slopes ``M / kappa`` of the strand with frictionless
     contact (full slip: against ``EI_min``) and with the wires tied rigidly to the core (against
     ``EI_max``), each on the virgin branch ``t`` in ``[1, 2]``, with their wire forces.  Both are elastic (no
@@ -249,7 +279,7 @@ def stiffness_checks(lays=LAYS, elements_per_lay=ELEMENTS, steps=CHECK_STEPS):
     N m^2 either way) for 3.7 s of CPU instead of 7.5."""
     out = []
     for kw in (dict(mu=0.0), dict(tied=True)):
-        res = run(lays, elements_per_lay, amplitude=AMPLITUDE, steps=steps, t_end=2.0, **kw)
+        res = run(lays, elements_per_lay, amplitude=AMPLITUDE, steps=steps, t_end=2.0, lay=lay, **kw)
         j = np.flatnonzero(res["times"] > 1.0)[-1]
         out.append((res["M"][j] / res["kappa"][j], res["F"]))
     return out
@@ -261,25 +291,31 @@ ALONG = (0.05, 0.25, 0.5)         # cuts z / L of the printed moment along the s
 def moment_along(res, fractions=ALONG, step=None):
     """``(M - EI_min kappa) / M_f - 1`` across the cuts at ``z = fractions L`` at ``step`` (default: the
     end of the virgin branch): the friction moment along the strand (the tied ends carry more)."""
-    sol, fx, th = res["sol"], res["fixture"], theory(res["F"])
+    sol, fx, th = res["sol"], res["fixture"], theory(res["F"], lay=res.get("lay", LAY))
     j = int(np.flatnonzero(res["times"] <= 2.0 + 1e-9)[-1]) if step is None else step
     k = res["kappa"][j]
     return np.array([(fx.moment(sol, fx.z0 + f * fx.length, step=j) - th["EI_min"] * k) / th["M_f"] - 1
                      for f in fractions])
 
 
-def main(lays=LAYS, elements_per_lay=ELEMENTS, amplitude=AMPLITUDE, steps=STEPS, mu=MU, checks=True):
-    res = run(lays, elements_per_lay, mu, amplitude, steps)
-    (EI0, F0), (EIt, Ft) = stiffness_checks(lays, elements_per_lay) if checks else ((None, None), (None, None))
+def main(lays=LAYS, elements_per_lay=ELEMENTS, amplitude=AMPLITUDE, steps=STEPS, mu=MU, checks=True, lay=LAY,
+         onset=False):
+    res = run(lays, elements_per_lay, mu, amplitude, steps, lay=lay)
+    (EI0, F0), (EIt, Ft) = stiffness_checks(lays, elements_per_lay, lay=lay) if checks else ((None, None), (None, None))
     th, rows = compare(res, EI0)
+    if onset:
+        fs = first_slip(lays, elements_per_lay, lay=lay)
+        rows += [(name, ref, fs["kappa"], fs["kappa"] / ref - 1) for name, ref in
+                 ((f"first slip on a ramp in steps of {ONSET[1]:g} kappa_b [1/m]", fs["kappa_b"]),
+                  ("first slip against the model's own stick stiffness [1/m]", fs["own"]))]
     rows += [(f"M - EI_min kappa at z = {f:g} L, +k of the virgin branch, / M_f - 1", 0.0, e, e)
              for f, e in zip(ALONG, moment_along(res))]
     if checks:
-        rows += [("EI frictionless contact (full slip) [N m^2]", theory(F0)["EI_min"], EI0,
-                  EI0 / theory(F0)["EI_min"] - 1),
-                 ("EI wires tied to the core (full stick) [N m^2]", theory(Ft)["EI_max"], EIt,
-                  EIt / theory(Ft)["EI_max"] - 1)]
-    print(f"1+6 strand (Utting & Jones 1987): Rc = {RC * 1e3} mm, Rw = {RW * 1e3} mm, lay {LAY * 1e3} mm, "
+        rows += [("EI frictionless contact (full slip) [N m^2]", theory(F0, lay=lay)["EI_min"], EI0,
+                  EI0 / theory(F0, lay=lay)["EI_min"] - 1),
+                 ("EI wires tied to the core (full stick) [N m^2]", theory(Ft, lay=lay)["EI_max"], EIt,
+                  EIt / theory(Ft, lay=lay)["EI_max"] - 1)]
+    print(f"1+6 strand (Utting & Jones 1987): Rc = {RC * 1e3} mm, Rw = {RW * 1e3} mm, lay {lay * 1e3:.4g} mm, "
           f"beta = {np.degrees(th['beta']):.2f} deg, mu = {mu}, T = {res['T']:.4g} N, wire force F = {res['F']:.4g} N;"
           f" {lays} lays, {elements_per_lay} elements per lay, +-{amplitude} kappa_b, {steps} steps per unit t, "
           f"stick {STICK}" + (f", slip_tolerance {SLIP_TOLERANCE}" if STICK == "penalty" else ""))
@@ -331,11 +367,14 @@ if __name__ == "__main__":
     ap.add_argument("--steps", type=int, default=STEPS)
     ap.add_argument("--mu", type=float, default=MU)
     ap.add_argument("--stick", default=STICK, choices=("exact", "penalty"))
+    ap.add_argument("--lay", type=float, default=LAY * 1e3, help="lay length [mm] (default: Utting & Jones' 114.6)")
+    ap.add_argument("--onset", action="store_true",
+                    help="also the first slip on a fine ramp (steps of 0.01 kappa_b from 0.9 kappa_b)")
     ap.add_argument("--plot", default=None, help="PNG of the loop against the theory (needs matplotlib)")
     ap.add_argument("--map", default=None, help="PNG of the stick/slip map where slip spreads (needs pyvista)")
     a = ap.parse_args()
     STICK = a.stick
-    res, th, rows = main(a.lays, a.elements, a.amplitude, a.steps, a.mu)
+    res, th, rows = main(a.lays, a.elements, a.amplitude, a.steps, a.mu, lay=a.lay * 1e-3, onset=a.onset)
     if a.map:
         stick_slip_map(res, th, a.map)
         print(f"written: {a.map}")

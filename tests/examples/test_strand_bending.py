@@ -8,6 +8,7 @@ sections (docs/theory_strand_bending.md section 5)."""
 import numpy as np
 import pytest
 
+import beamsolver as bs
 import strand_bending as sb
 
 TH = sb.theory(2000.0)
@@ -135,3 +136,33 @@ def test_the_middle_of_a_long_strand_reads_the_plateau_and_two_lays_are_lifted_b
     assert abs(err[6][1] - err[4][1]) < 0.005
     assert err[2][1] - err[4][1] > 0.02
     assert all(e[0] > e[1] + 0.02 for e in err.values())
+
+
+@pytest.mark.slow
+def test_first_slip_of_a_long_lay_strand_is_kappa_b_at_two_meshes():
+    """Issue 26's strand-bending onset, default options: the example's wires on a lay of 229.2 mm (6.0 deg,
+    a lay ratio of 20 of the layer's diameter, as the steel cores of ACSR conductors), 2 lays, first slip
+    from the stick flags on a ramp in steps of 0.01 kappa_b. Measured 1.030 / 1.040 kappa_b at 24 / 48 el/lay,
+    0.991 / 0.998 of the model's own onset (its stick stiffness is 3.3 % of S below plane sections)."""
+    for n in (24, 48):
+        fs = sb.first_slip(lays=2, elements_per_lay=n, lay=229.2e-3)
+        assert abs(fs["kappa"] / fs["kappa_b"] - 1) <= 0.05
+        assert abs(fs["kappa"] / fs["own"] - 1) <= 0.02
+        assert fs["res"]["cutbacks"] == 0
+
+
+@pytest.mark.slow
+def test_the_stick_stiffness_deficit_is_the_wires_compliance():
+    """Stuck at their surfaces, the wires of the Utting & Jones strand turn and shear under the friction's
+    moment: the stick branch's slope is 13.7 % of the Steiner term S below plane sections (2 lays, 16 el/lay);
+    with wires 100 times stiffer in shear 4.5 % (docs/theory_strand_bending.md section 5)."""
+    def deficit(shear):
+        core = bs.Section.circular(radius=sb.RC, E=sb.E, nu=sb.NU)
+        wire = bs.Section.circular(radius=sb.RW, E=sb.E, nu=sb.NU)
+        for s in (core, wire):
+            s.C[1:3, 1:3] *= shear
+        res = sb.run(lays=2, elements_per_lay=16, amplitude=0.5, steps=1, t_end=2.0, sections=(core, wire))
+        th, j = sb.theory(res["F"]), np.flatnonzero(res["times"] > 1.0)[0]
+        return (th["EI_max"] - res["M"][j] / res["kappa"][j]) / th["S"]
+    assert deficit(1.0) == pytest.approx(0.137, abs=0.01)
+    assert deficit(100.0) == pytest.approx(0.045, abs=0.01)
