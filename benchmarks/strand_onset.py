@@ -1,7 +1,8 @@
 """First slip of the bent 1+6 strand against the plane-section kappa_b: lay angle, mesh and the wires' compliance
 (issues 26 and 27; docs/theory_strand_bending.md section 5).
 
-    python benchmarks/strand_onset.py [--lays-mm 114.6 171.9 229.2 343.8] [--meshes 24 48] [--compliance]
+    python benchmarks/strand_onset.py [--lays-mm 114.6 171.9 229.2 343.8] [--meshes 24 48] [--c 0 0.1 10]
+        [--compliance]
 
 Rows 1: the example's wires (Utting & Jones 1987) on several lay lengths, default options (exact stick), 2 lays;
 first slip from the stick flags of the middle half on a ramp in steps of 0.01 kappa_b (``first_slip``); the stick
@@ -25,19 +26,31 @@ import strand_bending as sb  # noqa: E402
 SCALES = {"shear": (1, 2), "torsion": (3,), "bending": (4, 5)}     # rows/columns of the section's C
 
 
-def onset_rows(lays_mm, meshes, lays):
-    print("| lay [mm] | lay angle [deg] | el/lay | EI0 [N m^2] | EI_max | deficit / S | first slip / kappa_b "
+def _with_c(factor):
+    """The example's contact options with ``penalty_t = factor E`` (the exact stick's ``c``; ``None``: the default)."""
+    orig = sb._contact_options
+    if factor is not None:
+        sb._contact_options = lambda stick, tol: orig(stick, tol) | dict(penalty_t=factor * sb.E)
+    return orig
+
+
+def onset_rows(lays_mm, meshes, lays, factors=(None,)):
+    print("| lay [mm] | lay angle [deg] | el/lay | c | EI0 [N m^2] | EI_max | deficit / S | first slip / kappa_b "
           "| model's own onset / kappa_b | first slip / own | Newton it. | CPU [s] |")
-    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
-    for lay in lays_mm:
-        for n in meshes:
-            c0 = time.process_time()
+    print("|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for lay, n, f in [(lay, n, f) for lay in lays_mm for n in meshes for f in factors]:
+        c0 = time.process_time()
+        orig = _with_c(f)
+        try:
             fs = sb.first_slip(lays, n, lay=lay * 1e-3)
-            th = sb.theory(fs["res"]["F"], lay=lay * 1e-3)
-            print(f"| {lay:g} | {np.degrees(th['beta']):.2f} | {n} | {fs['EI0']:.2f} | {th['EI_max']:.2f} "
-                  f"| {(th['EI_max'] - fs['EI0']) / th['S']:.4f} | {fs['kappa'] / fs['kappa_b']:.3f} "
-                  f"| {fs['own'] / fs['kappa_b']:.3f} | {fs['kappa'] / fs['own']:.3f} | {fs['res']['iterations']} "
-                  f"| {time.process_time() - c0:.1f} |", flush=True)
+        finally:
+            sb._contact_options = orig
+        th = sb.theory(fs["res"]["F"], lay=lay * 1e-3)
+        c = "default" if f is None else f"{f:g} E"
+        print(f"| {lay:g} | {np.degrees(th['beta']):.2f} | {n} | {c} | {fs['EI0']:.2f} | {th['EI_max']:.2f} "
+              f"| {(th['EI_max'] - fs['EI0']) / th['S']:.4f} | {fs['kappa'] / fs['kappa_b']:.3f} "
+              f"| {fs['own'] / fs['kappa_b']:.3f} | {fs['kappa'] / fs['own']:.3f} | {fs['res']['iterations']} "
+              f"| {time.process_time() - c0:.1f} |", flush=True)
 
 
 def compliance_rows(factors=((None, 1.0), ("shear", 100.0), ("shear", 1e4), ("torsion", 100.0),
@@ -68,11 +81,13 @@ def main():
     ap.add_argument("--meshes", type=int, nargs="+", default=[24, 48])
     ap.add_argument("--lays", type=float, default=2.0)
     ap.add_argument("--compliance", action="store_true")
+    ap.add_argument("--c", type=float, nargs="+", default=[0.0],
+                    help="penalty_t / E, the exact stick's c (0: the default, 24 EI / L_e^4 at 16 el/beam)")
     a = ap.parse_args()
     if a.compliance:
         compliance_rows()
     if a.lays_mm:
-        onset_rows(a.lays_mm, a.meshes, a.lays)
+        onset_rows(a.lays_mm, a.meshes, a.lays, [None if f == 0 else f for f in a.c])
 
 
 if __name__ == "__main__":

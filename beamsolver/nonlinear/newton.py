@@ -41,6 +41,7 @@ __all__ = ["Newton", "Constraint", "FixedTime", "Convergence", "Verdict", "Rotat
 
 log = logging.getLogger("beamsolver")
 
+MULT_GROWTH = 1.0 - 1e-4   # semi-smooth Newton with multiplier unknowns: the merit must fall (Armijo) from the full step
 LS_GROWTH = 10.0                     # full Newton steps are kept unless the merit grows this much
 LS_CRAWL = 3                         # backtracked iterations in a row after which the next full step ...
 LS_WATCHDOG = 1e4                    # ... is kept unless the merit grows this much (``Newton.backtrack``) ...
@@ -616,7 +617,7 @@ class Newton:
         # step, the backtracking guards the contact examples' iterations)
         watchdog = self.crawl >= LS_CRAWL and self.near
         growth = (LS_WATCHDOG if watchdog else LS_GROWTH) if ev0.mult is None \
-            else 1.0 - 1e-4      # semi-smooth with multipliers: Armijo from the full step
+            else MULT_GROWTH     # semi-smooth with multipliers: Armijo from the full step
         for _ in range(8):
             ev1 = None
             try:
