@@ -41,7 +41,12 @@ library's default 0.005 the strand does not stick at all: initial stiffness 15 N
 ``tied=True`` ties the wires rigidly to the core (no contact) to measure the beam model's own
 full-stick stiffness (shear and torsion of the wires included) against ``EI_max``.
 
-    python examples/strand_bending.py [--lays 2] [--elements 16] [--amplitude 3] [--steps 8]
+``--lay`` sets the lay length (mm): the first slip meets the plane-section ``kappa_b`` within 5 % from 6 deg
+(``--lay 229.2``: 1.040 ``kappa_b`` at 48 and 96 el/lay), since the wires' compliance under the friction's couple
+falls like ``sin^2(beta)`` (docs/theory_strand_bending.md section 5); ``--onset`` adds the first slip on a ramp in
+steps of 0.01 ``kappa_b`` (``first_slip``).
+
+    python examples/strand_bending.py [--lays 2] [--elements 16] [--amplitude 3] [--steps 8] [--lay 114.6] [--onset]
 """
 import argparse
 import time
