@@ -1,9 +1,10 @@
 """examples/strand_bending.py: the closed-form strand-bending theory is self-consistent, and the beam
 model meets it: EI_min with frictionless contact, EI_max with the wires tied to the core, and in the
 cyclic run with exact stick (the example's default) the saturated friction moment, the Masing branch at
-the end of a half cycle and the loop energy.  The full-stick stiffness and the first slip with friction
-are not asserted against plane sections: stuck at their surface the wires are 12 % softer than plane
-sections (docs/theory_strand_bending.md section 5)."""
+the end of a half cycle and the loop energy.  The full-stick stiffness and the first slip of the example's
+strand (11.9 deg) are not asserted against plane sections: stuck at their surface the wires are 14 % (of the
+Steiner term) softer than plane sections, a compliance that falls like sin^2(beta); on a 6 deg lay the first
+slip is asserted against kappa_b at two meshes (docs/theory_strand_bending.md section 5)."""
 
 import numpy as np
 import pytest
