@@ -147,7 +147,7 @@ def test_first_slip_of_a_long_lay_strand_is_kappa_b_at_two_meshes():
     0.991 / 0.998 of the model's own onset (its stick stiffness is 3.3 % of S below plane sections)."""
     for n in (24, 48):
         fs = sb.first_slip(lays=2, elements_per_lay=n, lay=229.2e-3)
-        assert abs(fs["kappa"] / fs["kappa_b"] - 1) <= 0.05
+        assert abs(fs["kappa"] / fs["kappa_b"] - 1) <= 0.05 + 1e-9        # the ramp resolves 0.01 kappa_b
         assert abs(fs["kappa"] / fs["own"] - 1) <= 0.02
         assert fs["res"]["cutbacks"] == 0
 
