@@ -387,8 +387,7 @@ class Newton:
         """
         conv, problem = self.conv, self.problem
         residuals = []
-        self.crawl = 0
-        self.full_taken = False
+        self.crawl, self.full_taken = 0, False
         if constraint.watch_sign:
             self.indefinite_seen = False
         damped_its = 0
@@ -602,7 +601,9 @@ class Newton:
 
         Returns ``(H1, ahead)``: the accepted poses and, when the full step is accepted, its
         ``_Measured`` evaluation (with tangent: the next iteration's, computed once; ``None`` otherwise).
-        The residual does not depend on whether the tangent is computed."""
+        The residual does not depend on whether the tangent is computed: semi-smooth problems evaluate the full
+        step's trial with it only after the step's last line search kept the full step (``FULL_AFTER_FULL``, then
+        kept 79 times in 105 on the main job, against 27 in 67 otherwise), else forces only."""
         problem = self.problem
         phi0 = self._merit(ev0, scales)
         H1 = problem.update(H, dz)
@@ -625,7 +626,7 @@ class Newton:
             try:
                 # the full step is nearly always accepted: evaluated with the tangent the next
                 # iteration needs; the backtracked trials need the residual only.  Semi-smooth (bordered)
-                # problems reject many full steps (Armijo): residuals only there too
+                # problems reject many full steps (Armijo): residuals only there too, unless the last one was kept
                 ev1 = self.evaluate(H1, t, tangent=alpha == 1.0 and (ev0.mult is None or not FORCES_ONLY_TRIALS
                                                                      or (FULL_AFTER_FULL and self.full_taken)))
                 phi = self._merit(ev1, scales)
