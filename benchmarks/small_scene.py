@@ -13,7 +13,8 @@ rounds (the machine is shared: ratios within one run, not across runs).  In a pr
   least CPU of 3 solves after the first;
 - per el/wire: the same scene (``twisted_pair.build(n_elements=n)``) solved twice warm: CPU per
   Newton iteration (all), and its **compute floor**: the compiled element and contact kernels
-  (``element_jit.evaluate``, ``kernel_jit.evaluate``) + the linear solver's factorisations and solves,
+  (``element_jit.evaluate``, ``kernel_jit.evaluate``; exact stick's mortar kernel ``kernel_jit.mortar_terms``,
+  ``mortar_forces``, with their thin wrappers) + the linear solver's factorisations and solves,
   timed by wrapping them.  The default solver (PARDISO from 1500 unknowns: 128 el/wire; loaded before
   the first such size is timed, after the smaller ones: a process that has loaded MKL runs the small
   scenes ~0.03 s slower).
@@ -71,6 +72,9 @@ def child(root, sizes):
                its=sum(s["iterations"] for s in sol.stats), sizes={})
     timed(element_jit, "evaluate")
     timed(kernel_jit, "evaluate")
+    for name in ("mortar_terms", "mortar_forces"):      # exact stick's kernel (the default since session 6)
+        if hasattr(kernel_jit, name):
+            timed(kernel_jit, name)
     factorize = linsolve.Solver.factorize
 
     def factorized(solver, K, *a, **k):

@@ -33,7 +33,7 @@ def lookup(keys_sorted, keys):
     """``(index, found)`` of ``keys`` in the sorted ``keys_sorted`` (binary search)."""
     if len(keys_sorted) == 0:
         return np.zeros(len(keys), dtype=int), np.zeros(len(keys), dtype=bool)
-    idx = np.clip(np.searchsorted(keys_sorted, keys), 0, len(keys_sorted) - 1)
+    idx = np.minimum(np.searchsorted(keys_sorted, keys), len(keys_sorted) - 1)     # (np.clip: 7 us a call, this 3)
     return idx, keys_sorted[idx] == keys
 
 

@@ -57,6 +57,8 @@ def fold_of(slave_nodes, xi1, master_beam, decl, n_nodes, n_beams, held=None):
     """``slivers`` of the groups ``groups`` makes from these arguments."""
     sn = _held_moved(slave_nodes, held)
     key = (np.asarray(decl, dtype=np.int64)[:, None] * n_nodes + sn) * n_beams + master_beam[:, None]
+    if SLIVER is not None and _SCATTER["rows"] is mortar_jit.scatter_rows:
+        return mortar_jit.slivers(key, sn, xi1, SLIVER)        # compiled, the same flags (``slivers`` its oracle)
     return slivers(key, sn, xi1)
 
 

@@ -9,6 +9,7 @@ is its numpy/scipy oracle (the former ``Problem.bordered``): the same pattern an
 import numpy as np
 import scipy.sparse as sp
 
+from .._jit import jit
 from ..assembly.csc import canonical_csc
 
 __all__ = ["Bordered", "bmat", "use_bmat", "IDLE"]
@@ -67,11 +68,9 @@ class Bordered:
         kkeys = kc * N + K.indices.astype(np.int64)
         ubk, inv = np.unique(cb * N + rb, return_inverse=True)
         inv = inv.ravel()
-        posK = np.arange(len(kkeys)) + np.searchsorted(ubk, kkeys)
-        ub = np.arange(len(ubk)) + np.searchsorted(kkeys, ubk)
+        posK, ub = np.empty(len(kkeys), dtype=np.int64), np.empty(len(ubk), dtype=np.int64)
         u = np.empty(len(kkeys) + len(ubk), dtype=np.int64)
-        u[posK] = kkeys
-        u[ub] = ubk
+        _merge(kkeys, ubk, posK, ub, u)
         self._store(K, rows_red, nf, c, g, N, u, posK, ub, inv, iq, il)
 
     def _build_unique(self, K, rows_red, nf, c):
@@ -134,6 +133,24 @@ class Bordered:
             data[p["ll"][gg, ii]] = R[gg, ii]
             rc[idle] = -np.einsum("gj,gj->g", R[gg, ii], Lam[gg])
         return canonical_csc(data, p["indices"], p["indptr_out"], p["N"]), rc
+
+
+@jit
+def _merge(a, b, pa, pb, u):
+    """Merge the sorted, disjoint keys ``a`` and ``b`` into ``u``; ``pa``, ``pb``: where each of them goes (the
+    positions ``np.arange(len(a)) + np.searchsorted(b, a)`` and alike, in one linear pass: the two searches took 0.12 ms
+    of a build's 0.26 on the main job's bordered tangents)."""
+    i = j = 0
+    n, m = len(a), len(b)
+    for k in range(n + m):
+        if j >= m or (i < n and a[i] < b[j]):
+            pa[i] = k
+            u[k] = a[i]
+            i += 1
+        else:
+            pb[j] = k
+            u[k] = b[j]
+            j += 1
 
 
 def bmat(K, rows_red, Kql, Klq, Kll, R, Lam, C):

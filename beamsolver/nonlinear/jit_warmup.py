@@ -324,12 +324,15 @@ def _scene(model, worker):
 
 def _exact_stick_callees():
     """The exact stick path's compiled helpers that the stand-in's data do not reach (they run where some pairs are
-    not folded into their groups, and where a group's components are eliminated), on empty arrays of the solve's
-    types (``contact.mortar_jit.subtract_indexed``, ``nonlinear.condense._schur``)."""
+    not folded into their groups, where a group's components are eliminated and in the Newton system), on empty
+    arrays of the solve's types (``contact.mortar_jit.subtract_indexed``, ``nonlinear.condense._schur``, the bordered
+    pattern's merge ``nonlinear.bordered._merge``)."""
     from ..contact import mortar_jit
-    from . import condense
+    from . import bordered, condense
     mortar_jit.subtract_indexed(np.zeros((0, 24, 24)), np.zeros((0, 24, 24)), np.zeros(0, dtype=np.int64))
     condense._schur(np.zeros(0), 0, np.zeros((0, 24, 3)), np.zeros((0, 3, 24)), np.zeros((0, 3)))
+    none = np.zeros(0, dtype=np.int64)
+    bordered._merge(none, none, none, none, none)
 
 
 def _stand_in(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames):

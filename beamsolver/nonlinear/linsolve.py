@@ -69,6 +69,8 @@ BACKENDS = ("splu", "splu-rcm", "pardiso", "auto")
 DEFAULT = "auto"          # splu for beams and small scenes; pardiso (else splu-rcm) for coupled ones
 SADDLE_PERTURB = 8        # PARDISO on saddle-point systems: pivots perturbed to 1e-8 |K| (iparm(10))
 SADDLE_REFINE = 20        # ... and up to 20 steps of iterative refinement (iparm(8)); ``Solver.factorize``
+SADDLE_SPLU_ORDERING = "COLAMD"   # splu on saddle-point systems (the main job's bordered tangents: 0.40 ms a
+                                  # factorisation against MMD_AT_PLUS_A's 0.63, 20 % less fill; docs/benchmarks.md)
 AUTO_MIN_UNKNOWNS = 1_500      # "auto": below this size the default splu is as fast as any
 AUTO_COUPLED_NNZ = 24.0        # "auto": non-zeros per column above which contact couples the beams
 BACKWARD_ERROR = 1e-9          # pardiso, splu-rcm: |K x - b| / (|K| |x| + |b|) above this -> re-analyse / pivot fully
@@ -306,7 +308,7 @@ class Solver:
         self.stats["factorizations"] += 1
         backend = self.backend_for(K)
         if backend == "splu":
-            return _SpluFactor(K)
+            return _SpluFactor(K, SADDLE_SPLU_ORDERING if saddle else "MMD_AT_PLUS_A")
         if backend == "splu-rcm":
             return _SpluRcmFactor(K)
         if self._pardiso is None:
@@ -324,11 +326,11 @@ class Solver:
 class _SpluFactor:
     backend = "splu"
 
-    def __init__(self, K):
+    def __init__(self, K, ordering="MMD_AT_PLUS_A"):
         if not (sp.issparse(K) and K.format == "csc"):
             K = sp.csc_matrix(K)
         try:
-            self._lu = spla.splu(K, permc_spec="MMD_AT_PLUS_A")
+            self._lu = spla.splu(K, permc_spec=ordering)
         except RuntimeError as e:          # "Factor is exactly singular"
             raise SingularMatrixError(str(e)) from None
 

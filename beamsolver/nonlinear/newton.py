@@ -50,7 +50,8 @@ GRACE_RATE = 3.0                     # past max_iter, iterations go on while eac
 GRACE_ITER = 10                      # ... at most this many more (``Newton.iterate``)
 DAMPING_MIN = 1.0 / 64.0             # shortest damped Newton step (smooth problems)
 STALL_RATIO = 1.5                    # undamped fallback if the shortest damped step grows the correction less
-FORCES_ONLY_TRIALS = True            # semi-smooth problems: the line search's full-step trial without tangent
+FORCES_ONLY_TRIALS = True            # semi-smooth problems: the line search's full-step trial without tangent ...
+FULL_AFTER_FULL = True               # ... but with it after a full step was accepted (``backtrack``)
 INNER_SWITCHES = 0                   # exact stick: branch switches of the linearised groups per Newton direction ...
 INNER_PREDICTOR = False              # ... also in a load step's first iteration (the prescribed motions' predictor)
 INNER_UNSETTLED = "last"             # branches still changing after INNER_SWITCHES: "last" solve or "plain" Newton's
@@ -162,6 +163,7 @@ class Newton:
         self.stall_ratio = np.inf             # correction growth of the shortest damped trial
         self.indefinite_seen = False          # the step's first tangent had det < 0 (or a back-end that cannot tell)
         self.crawl = 0                        # backtracked line searches in a row (``backtrack``)
+        self.full_taken = False               # the last line search of the step kept the full step (``backtrack``)
         self.near = False                     # the iterate's residual below LS_NEAR x the step's largest
         self.watch_sign = False               # whether to look (stepping.Run: conservative problems)
         self.t_evaluated = None               # t of the last evaluation (failure messages)
@@ -386,7 +388,7 @@ class Newton:
         """
         conv, problem = self.conv, self.problem
         residuals = []
-        self.crawl = 0
+        self.crawl, self.full_taken = 0, False
         if constraint.watch_sign:
             self.indefinite_seen = False
         damped_its = 0
@@ -600,7 +602,9 @@ class Newton:
 
         Returns ``(H1, ahead)``: the accepted poses and, when the full step is accepted, its
         ``_Measured`` evaluation (with tangent: the next iteration's, computed once; ``None`` otherwise).
-        The residual does not depend on whether the tangent is computed."""
+        The residual does not depend on whether the tangent is computed: semi-smooth problems evaluate the full
+        step's trial with it only after the step's last line search kept the full step (``FULL_AFTER_FULL``, then
+        kept 79 times in 105 on the main job, against 27 in 67 otherwise), else forces only."""
         problem = self.problem
         phi0 = self._merit(ev0, scales)
         H1 = problem.update(H, dz)
@@ -623,8 +627,9 @@ class Newton:
             try:
                 # the full step is nearly always accepted: evaluated with the tangent the next
                 # iteration needs; the backtracked trials need the residual only.  Semi-smooth (bordered)
-                # problems reject many full steps (Armijo): residuals only there too
-                ev1 = self.evaluate(H1, t, tangent=alpha == 1.0 and (ev0.mult is None or not FORCES_ONLY_TRIALS))
+                # problems reject many full steps (Armijo): residuals only there too, unless the last one was kept
+                ev1 = self.evaluate(H1, t, tangent=alpha == 1.0 and (ev0.mult is None or not FORCES_ONLY_TRIALS
+                                                                     or (FULL_AFTER_FULL and self.full_taken)))
                 phi = self._merit(ev1, scales)
             except StepFailed:
                 phi = np.inf
@@ -632,6 +637,7 @@ class Newton:
                 best = (phi, H1, alpha)
             if np.isfinite(phi) and phi <= (growth * phi0 if alpha == 1.0 else (1.0 - 1e-4 * alpha) * phi0):
                 self.crawl = 0 if alpha == 1.0 else self.crawl + 1
+                self.full_taken = alpha == 1.0
                 return H1, (self._measured(ev1) if alpha == 1.0 and ev1.kvals is not None else None)
             # minimiser of the quadratic through phi(0), phi'(0) = -2 phi0, phi(alpha)
             if np.isfinite(phi):
@@ -646,6 +652,7 @@ class Newton:
         if not np.isfinite(best[0]):
             raise NonFinite("line search found no finite residual along the Newton direction")
         self.crawl += 1
+        self.full_taken = False
         problem.multiplier_trial(best[2])
         return best[1], None
 

@@ -197,3 +197,49 @@ def test_compiled_multiplier_basis_is_the_numpy_form(seed):
     assert np.abs(np.einsum("gji,gjk->gik", out, out) - np.eye(3)).max() < 1e-14
     slide = ~st["stick"] & ~st["weak"]
     assert slide.any() and st["stick"].any() and st["weak"].any()
+
+
+def _sliver_inputs(rng, P):
+    """Keys ``(P, 2)`` of points on slave elements ``(j, j + 1)`` against 3 master beams, some with a held node (both
+    keys equal), shape functions near 0 and 1 (slivers) and some single points with equal shares (the ties)."""
+    el = rng.integers(0, 6, P)
+    slave = np.stack([el, el + 1], axis=1)
+    held = rng.uniform(size=P) < 0.15
+    slave[held, 1] = slave[held, 0]
+    beam = rng.integers(0, 3, P)
+    xi1 = rng.choice([0.047, 0.5, 0.953, 0.2, 0.8], P) if rng.uniform() < 0.5 else rng.uniform(0.0, 1.0, P)
+    key = (slave.astype(np.int64)) * 3 + beam[:, None]
+    return key, slave, xi1
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_compiled_slivers_are_the_numpy_ones(seed):
+    """``mortar_jit.slivers`` gives ``mortar.slivers``' flags (groups by a stable sort, shares summed in the points'
+    order) on random groups with slivers, held nodes and single points of equal shares, at two ratios."""
+    from beamsolver.contact import mortar
+    rng = np.random.default_rng(seed)
+    key, slave, xi1 = _sliver_inputs(rng, int(rng.integers(1, 40)))
+    for ratio in (mortar.SLIVER, 0.6):
+        old = mortar.SLIVER
+        mortar.SLIVER = ratio
+        try:
+            ref = mortar.slivers(key, slave, xi1)
+        finally:
+            mortar.SLIVER = old
+        assert np.array_equal(mortar_jit.slivers(key, slave, xi1, ratio), ref)
+
+
+def test_compiled_slivers_see_every_kind_of_fold():
+    """The random groups of ``test_compiled_slivers_are_the_numpy_ones`` hold slivers by ratio and single points
+    folded by the tie rule (the test is not passed by empty flags), and no points give no flags."""
+    from beamsolver.contact import mortar
+    folds = ties = 0
+    for seed in range(40):
+        rng = np.random.default_rng(seed)
+        key, slave, xi1 = _sliver_inputs(rng, int(rng.integers(1, 40)))
+        folds += int(mortar.slivers(key, slave, xi1).sum())
+        one = np.array([[key[0, 0], key[0, 0] + 3]]), np.array([[0, 1]]), np.array([0.5])
+        ties += int(mortar_jit.slivers(*one, mortar.SLIVER).sum())
+    assert folds > 20 and ties == 40
+    assert mortar_jit.slivers(np.zeros((0, 2), dtype=np.int64), np.zeros((0, 2), dtype=np.int64), np.zeros(0),
+                              mortar.SLIVER).shape == (0, 2)
