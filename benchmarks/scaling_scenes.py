@@ -29,7 +29,8 @@ Each scene runs in its own child process (``scaling.py --child scene NAME``) and
   (the loop's own iterations, line search included);
 - peak memory: ``ru_maxrss`` of the child (MB).
 
-``SCALING_NO_STEP=rope-600,...`` (environment): scenes whose loaded step is not run (one iteration only).
+``SCALING_NO_STEP=rope-600,...`` (environment): scenes whose loaded step is not run (one iteration only);
+``SCALING_NO_NEW=...``: scenes without ``iteration (new pattern)`` (a second ``Problem``: its memory).
 
 The bundles are those of ``scaling.bundle_model`` at ``PER_WIRE`` = 158 elements per wire (the
 issue's 3002 / 5846 / 9638 elements).  The rope (``cables.build_rope``): ``ROPE_STRAND`` strands
@@ -244,7 +245,8 @@ def measure_scene(name, rss_mb):
     out["analyses"] = solver.stats["analyses"]
     solver.close()
     del problem, system
-    out.update(new_pattern(m, H, solver_kind=linsolve.Solver))
+    if name not in os.environ.get("SCALING_NO_NEW", "").split(","):
+        out.update(new_pattern(m, H, solver_kind=linsolve.Solver))
     out["rss_mb"] = rss_mb()
     if name in os.environ.get("SCALING_NO_STEP", "").split(","):
         out.update(step_iterations=0, step_status="not run", step_s=float("nan"), step_it_s=float("nan"))
