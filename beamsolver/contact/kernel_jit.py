@@ -1465,7 +1465,7 @@ def _mortar_chunks(X, table, kern, T, pairs, sink):
     ``MORTAR_CHUNK`` points at a time, each pass's tangents handed to ``sink`` (``table``: ``_table``'s arrays)."""
     P = X.shape[0]
     C = max(1, min(P, MORTAR_CHUNK))
-    f = np.empty((4, P, 4, 6))
+    f = np.empty((1, P, 4, 6))       # the forces at T = 0 (the pairs'); those of the unit tractions: ``A``
     sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
     flags, frames = np.empty((P, 2), dtype=np.bool_), _FRAMES_POOL.take((P, 4, 4, 4))
     terms = tuple(pool.take(shape) for pool, shape in zip(mortar_jit._TERMS_POOLS, ((P, 24, 3), (P, 3, 24),
@@ -1480,10 +1480,10 @@ def _mortar_chunks(X, table, kern, T, pairs, sink):
         rows = rbuf[:n * N_ROWS * 24].reshape(n, N_ROWS, 24)
         kern(X[a:b], *(t[a:b] for t in table), fc, Kc, sc[a:b], vec[a:b], two[a:b], flags[a:b], frames[a:b], rows,
              Tc[a:b])
-        f[:, a:b] = fc
+        f[0, a:b] = fc[0]
         mortar_jit.point_terms_into(fc[1:], rows, vec[a:b, 1], vec[a:b, 2], two[a:b, 1], *(t[a:b] for t in terms))
         sink(a, b, Kc[0])
-    d = _mortar_terms(P, f[1:], None, sc, vec, two, flags, frames, None, terms=terms)
+    d = _mortar_terms(P, None, None, sc, vec, two, flags, frames, None, terms=terms)
     if pairs:
         d["pairs"] = _pair_data(f, sc, vec, table[1])
     return d
@@ -1551,8 +1551,9 @@ def mortar_terms_four(X, p, law=None):
 def _mortar_terms(P, df, dK, sc, vec, two, flags, frames, rows, terms=None):
     """``mortar_terms``' dict from the differences of the forces ``df`` ``(3, P, 4, 6)`` and tangents ``dK``
     ``(3, P, 24, 24)`` at ``T = e_x, e_y, e_z`` to those at ``T = 0`` and the kernel's point data (``terms``:
-    ``mortar_jit.point_terms``' results, if computed already; then ``rows`` is not read)."""
-    A = np.transpose(df, (1, 2, 3, 0)).reshape(P, 24, 3)
+    ``mortar_jit.point_terms``' results, if computed already; then ``rows`` is not read, and ``df`` may be None:
+    ``A`` is then their contiguous ``A``, the same values)."""
+    A = terms[0] if df is None else np.transpose(df, (1, 2, 3, 0)).reshape(P, 24, 3)
     dK = None if dK is None else np.transpose(dK, (1, 0, 2, 3))
     n, t1, t2, s = vec[:, 0], vec[:, 1], vec[:, 2], two[:, 1]
     S = s[:, :1] * t1 + s[:, 1:] * t2
