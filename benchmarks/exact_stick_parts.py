@@ -4,13 +4,14 @@ augmented ``A``), factorisation, solve and the rest, exclusive (a part's time wi
 into tangent evaluations and forces-only (line-search) trials.
 
     python benchmarks/exact_stick_parts.py [--scenes twisted_pair bundle19 strand19] [--stick exact penalty]
-        [--repeat 2]
+        [--repeat 2] [--fresh]
 
 ``twisted_pair``: the main job's warm solve (``examples/twisted_pair.py``, 16 steps), per linear solve (every
-Newton iteration, failed attempts included).  ``bundle19`` / ``strand19``: one Newton iteration at the reference
-poses of ``scaling.bundle_model`` / ``scaling_scenes.strand_model("19")`` (tangent evaluation, Newton system,
-factorisation with the solver's lagging, solve) and the line search's full-step trial at the step's end (forces
-only for exact stick, as ``newton.backtrack`` evaluates it).  Best of ``--repeat`` warm runs (least total CPU).
+Newton iteration, failed attempts included).  ``bundle19`` (``bundle37``, ``bundle61``) / ``strand19``: one
+Newton iteration at the reference poses of ``scaling.bundle_model`` / ``scaling_scenes.strand_model("19")``
+(tangent evaluation, Newton system, factorisation with the solver's lagging, or afresh with ``--fresh``, solve)
+and the line search's full-step trial at the step's end (forces only for exact stick, as ``newton.backtrack``
+evaluates it).  Best of ``--repeat`` warm runs (least total CPU).
 """
 import argparse
 import sys
@@ -115,6 +116,7 @@ def stick_mode(stick):
 
 
 SOLVES = [0]
+LAGGED = ["auto"]  # the bundles' solver: ``--fresh``: a factorisation per iteration (the iterations share their poses)
 
 
 def twisted_pair():
@@ -147,7 +149,7 @@ def _one_iteration(model):
     best of three: patterns and the solver's analysis in place, lagged factorisations where ``linsolve`` lags)."""
     problem = Problem.from_model(model)
     H = problem.system.poses0.copy()
-    solver = linsolve.Solver()
+    solver = linsolve.Solver(lagged=LAGGED[0])
     best = None
     for _ in range(3):
         TIMES.clear()
@@ -178,10 +180,22 @@ def _one_iteration(model):
     return best
 
 
-def bundle19():
+def _bundle(name):
     import scaling_scenes
     from scaling import bundle_model
-    return _one_iteration(bundle_model(scaling_scenes.PER_WIRE, n_layers=2)[0])
+    return _one_iteration(bundle_model(scaling_scenes.PER_WIRE, n_layers=scaling_scenes.LAYERS[name])[0])
+
+
+def bundle19():
+    return _bundle("19")
+
+
+def bundle37():
+    return _bundle("37")
+
+
+def bundle61():
+    return _bundle("61")
 
 
 def strand19():
@@ -194,7 +208,9 @@ def main():
     ap.add_argument("--scenes", nargs="+", default=["twisted_pair", "bundle19", "strand19"])
     ap.add_argument("--stick", nargs="+", default=["penalty", "exact"])
     ap.add_argument("--repeat", type=int, default=2)
+    ap.add_argument("--fresh", action="store_true", help="bundles, strands: a factorisation per iteration")
     a = ap.parse_args()
+    LAGGED[0] = False if a.fresh else "auto"
     cols = []
     for scene in a.scenes:
         for stick in a.stick:

@@ -4,9 +4,10 @@
 
 Builds the scene of ``scaling_scenes.scene_model`` (``19``, ``37``, ``61``, ``rope-<mm>``) and runs
 ``--iterations`` Newton iterations at the reference poses as ``Newton.iterate`` does them:
-``Problem.begin_step``, the evaluation with tangent, ``Problem.tangent`` (CSC), the factorisation and
-solve with the default ``linsolve.Solver`` (``--lagged off``: without lagged solves; the iterations
-share their poses, so the lagged ones take one GMRES iteration), ``Evaluation.drop_tangent``, then a residual-only
+``Problem.begin_step``, the evaluation with tangent, the Newton system (``Problem.tangent``, CSC; exact stick:
+``Problem.augmented_system``, the tangent ``K'`` and ``A = K' + Kq E Kl``), the factorisation and solve (exact
+stick: GMRES preconditioned by the factor of ``A``) with the default
+``linsolve.Solver`` (``--lagged off``: without lagged solves; the iterations share their poses, so the lagged ones take one GMRES iteration), ``Evaluation.drop_tangent``, then a residual-only
 evaluation at slightly moved poses (a line-search trial).  After each stage it reads
 ``/proc/self/status``: the resident memory ``VmRSS`` and the peak since the previous stage
 (``VmHWM``, reset by writing ``5`` to ``/proc/self/clear_refs``), in MB.  One thread (MKL pinned).
@@ -73,15 +74,22 @@ def main(argv):
         problem.begin_step(H, 0.0)
         ev = problem.evaluate(H, 1.0, tangent=True)
         mark(f"{it}: evaluate (tangent)")
-        K = problem.tangent(ev)
-        mark(f"{it}: tangent (CSC)")
-        f = solver.factorize(K)
-        f.solve(-ev.r[system.free_dofs])
-        ev.drop_tangent()
-        mark(f"{it}: factorise + solve")
+        t = {}
+        if problem.augments(ev):         # exact stick: the Newton system and its solve as ``Newton.direction``
+            aug = problem.augmented_system(ev)
+            mark(f"{it}: Newton system (tangent K', augmented A)")
+            f = aug.solve(solver)
+            problem.multiplier_step(ev, problem.split_solution(ev, f)[1])
+            del aug
+            ev.drop_tangent()
+            mark(f"{it}: factorise + solve")
+        else:
+            f, _ = scaling_scenes.newton_direction(problem, ev, solver, t)
+            ev.drop_tangent()
+            mark(f"{it}: Newton system, factorise + solve")
         problem.evaluate(system.update(H, 1e-9 * rng.standard_normal((system.n_nodes, 6))), 1.0, tangent=False)
         mark(f"{it}: residual (trial)")
-        del ev, K, f
+        del ev, f
     solver.close()
     print(f"`python benchmarks/iteration_memory.py --scene {a.scene} --iterations {a.iterations} --lagged {a.lagged}` "
           f"({machine()}; "

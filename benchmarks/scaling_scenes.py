@@ -2,15 +2,21 @@
 
 Each scene runs in its own child process (``scaling.py --child scene NAME``) and reports:
 
-- the model: elements, unknowns, active contact points;
+- the model: elements, unknowns, active contact points, the stick of its frictional contact (``exact``, the
+  default, or ``penalty``) and its Newton system (``newton_direction``: ``tangent``; exact stick's ``augmented``
+  saddle solve, GMRES on ``A = K' + Kq E Kl``, or ``saddle``, the bordered system factorised directly) with its
+  multiplier rows and GMRES iterations;
 - one Newton iteration at the reference poses by parts (CPU s): ``element`` (``System.evaluate``),
   ``contact`` (the rest of ``Problem.evaluate``: search, kernels, blocks, their assembly into the
-  residual and COO), ``assembly`` (``Problem.tangent``, CSC), ``solve`` (the default
-  ``linsolve.Solver`` without lagging: a factorisation + solve; its back-end, fill and flops, the flops reported by
+  residual and COO), ``assembly`` (the Newton system: ``Problem.tangent``, CSC; exact stick's condensation and
+  ``A``), ``solve`` (the default ``linsolve.Solver`` without lagging: a factorisation of the tangent or of ``A``
+  and the solve or GMRES; its back-end, fill and flops, the flops reported by
   PARDISO or counted from SuperLU's factors) and ``update``: their sum is ``iteration``, what
   ``Newton.iterate`` pays per iteration (an accepted full step is evaluated once, with the tangent:
   the next iteration's evaluation); the first iteration (a new pattern: PARDISO's analysis, the maps
-  of the tangent) and a second one on the same pattern (analysis reused); ``residual (trial)``: a
+  of the tangent, and the process's first touch of its buffers) and a second one on the same pattern (analysis
+  reused); ``iteration (new pattern)``: one of a second ``Problem`` of the same model in the same process
+  (``new_pattern``: a new pattern, buffers and compiled code warm); ``residual (trial)``: a
   residual-only evaluation, what each backtracked line-search trial adds (not in ``iteration``);
 - a loaded step: ``bs.solve(model, steps=1)`` stretching the scene by ``STRAIN`` (every wire end at
   the top moved along ``e_z``, the bottom clamped): Newton iterations, CPU s.  The bundles of
@@ -23,7 +29,8 @@ Each scene runs in its own child process (``scaling.py --child scene NAME``) and
   (the loop's own iterations, line search included);
 - peak memory: ``ru_maxrss`` of the child (MB).
 
-``SCALING_NO_STEP=rope-600,...`` (environment): scenes whose loaded step is not run (one iteration only).
+``SCALING_NO_STEP=rope-600,...`` (environment): scenes whose loaded step is not run (one iteration only);
+``SCALING_NO_NEW=...``: scenes without ``iteration (new pattern)`` (a second ``Problem``: its memory).
 
 The bundles are those of ``scaling.bundle_model`` at ``PER_WIRE`` = 158 elements per wire (the
 issue's 3002 / 5846 / 9638 elements).  The rope (``cables.build_rope``): ``ROPE_STRAND`` strands
@@ -40,6 +47,7 @@ import time
 import numpy as np
 
 PER_WIRE = 158
+WARM = 24                   # elements per wire of ``warm_contact``'s 7-wire bundle
 LAYERS = {"19": 2, "37": 3, "61": 4}
 STRAIN = 1e-4               # of the loaded step
 STEP_FLOOR = 2.0 ** -3      # of the loaded step: at most three halvings, then reported as not converged
@@ -95,12 +103,97 @@ def _solver_info(f):
     return out
 
 
+def _stick(contact):
+    """``exact``, ``penalty`` or ``mixed``: the stick of the scene's frictional contact declarations."""
+    if contact is None:
+        return "-"
+    kinds = {"exact" if d.exact else "penalty" for d in contact.decls if d.mu > 0}
+    return kinds.pop() if len(kinds) == 1 else ("mixed" if kinds else "frictionless")
+
+
+def newton_direction(problem, ev, solver, t):
+    """The Newton direction of ``ev`` as ``Newton.direction`` computes it (``INNER_SWITCHES`` = 0): with exact
+    stick's multipliers the augmented saddle solve (``Problem.augmented_system``, GMRES preconditioned by a
+    factorisation of ``A = K' + Kq E Kl``) or the condensed bordered system factorised directly, else the tangent;
+    CPU s into ``t``: ``assembly`` (the Newton system: CSC tangent, condensation, ``A``), ``solve`` (factorisation,
+    GMRES or solve, the split of the solution and the multipliers' step).  Returns ``(factor, info)``: ``info``
+    the Newton system's ``nnz``, ``system`` (``tangent``, ``augmented`` or ``saddle``), unknowns, multiplier rows,
+    GMRES iterations and fallbacks."""
+    from beamsolver.nonlinear import linsolve
+    t0 = clock()
+    aug = problem.augmented_system(ev) if problem.augments(ev) else None
+    if aug is None:
+        K, rhs = problem.linear_system(ev)
+    t["assembly"] = clock() - t0
+    t0 = clock()
+    st0 = {k: solver.stats.get(k, 0) for k in ("saddle_iterations", "saddle_fallbacks")}
+    if aug is not None:
+        x = aug.solve(solver)
+        f = aug.factor
+        info = dict(system="augmented", nnz=aug.A.nnz, multiplier_rows=len(aug.D))
+    else:
+        f = linsolve.factorize_tangent(K, solver, saddle=ev.mult is not None)
+        x = f.solve(rhs)
+        info = dict(system="tangent" if ev.mult is None else "saddle", nnz=K.nnz,
+                    multiplier_rows=K.shape[0] - problem.system.n_free)
+    if ev.mult is not None:
+        dzf, dlam = problem.split_solution(ev, x)
+        problem.multiplier_step(ev, dlam)
+    t["solve"] = clock() - t0
+    info.update(gmres=solver.stats.get("saddle_iterations", 0) - st0["saddle_iterations"],
+                fallbacks=solver.stats.get("saddle_fallbacks", 0) - st0["saddle_fallbacks"])
+    return f, info
+
+
+def warm_contact():
+    """The process's first-call costs of the contact path (compiled kernels loaded from numba's cache, scipy's and
+    PARDISO's first calls) out of the timings: one Newton direction of a small 7-wire bundle (``WARM`` elements a
+    wire, 15 % of the 19-wire scene's, with its own patterns), so that ``iteration (1st)`` does not pay their loading
+    (it still pays the first touch of the buffers: ``new_pattern``).  Returns ``warm_s``: its CPU s."""
+    from beamsolver.nonlinear import linsolve
+    from beamsolver.nonlinear.problem import Problem
+    from scaling import bundle_model
+    t0 = clock()
+    m, _ = bundle_model(WARM, n_layers=1)
+    problem = Problem.from_model(m)
+    H = problem.system.poses0.copy()
+    problem.begin_step(H, 0.0)
+    ev = problem.evaluate(H, 1.0, tangent=True)
+    solver = linsolve.Solver(lagged=False)
+    newton_direction(problem, ev, solver, {})
+    problem.evaluate(H, 1.0, tangent=False)
+    solver.close()
+    return dict(warm_s=clock() - t0)
+
+
+def new_pattern(m, H, solver_kind):
+    """One Newton iteration (``it3_*``, CPU s: evaluation with tangent, Newton system, solve) of a second
+    ``Problem`` of the model ``m`` at ``H``, with a fresh solver, in the same process: a new pattern (the groups,
+    the held tangent pattern and PARDISO's analysis built anew) with the process's compiled code and kept buffers
+    warm, what a Newton iteration pays when the contact pattern changes (``iteration (1st)`` also pays the
+    process's first touch of its buffers)."""
+    from beamsolver.nonlinear.problem import Problem
+    problem = Problem.from_model(m)
+    solver = solver_kind(lagged=False)
+    t = {}
+    problem.begin_step(H, 0.0)
+    t0 = clock()
+    ev = problem.evaluate(H, 1.0, tangent=True)
+    t["evaluation"] = clock() - t0
+    f, _ = newton_direction(problem, ev, solver, t)
+    t["iteration"] = sum(t.values())
+    del f, ev
+    solver.close()
+    return {f"it3_{k}": v for k, v in t.items()}
+
+
 def measure_scene(name, rss_mb):
     import beamsolver as bs
     from beamsolver.nonlinear import linsolve
     from beamsolver.nonlinear.problem import Problem
     from scaling import warm_up
     warm_up()                                   # MKL's and meshio's first-call costs out of the timings
+    out_warm = warm_contact()
     t0 = clock()
     m, wires, length = scene_model(name)
     if name.startswith("rope"):
@@ -109,12 +202,14 @@ def measure_scene(name, rss_mb):
     problem = Problem.from_model(m)
     system = problem.system
     out = dict(scene=name, build_s=clock() - t0, elements=system.n_elements, unknowns=system.n_free,
-               length_m=length)
+               length_m=length, **out_warm)
     H = system.poses0.copy()
     # a factorisation per iteration: the second tangent, at the same poses, equals the first, and a lagged
     # solve (the default ``Solver``'s, preconditioned by the first factor) would take one GMRES iteration, not
     # what a Newton iteration pays; lagged solves over real Newton sequences: ``lagged_solves.py``
     solver = linsolve.Solver(lagged=False)
+    c = problem.contact
+    out["stick"] = _stick(c)
     for it in (1, 2):
         t = {}
         problem.begin_step(H, 0.0)
@@ -125,14 +220,7 @@ def measure_scene(name, rss_mb):
         t0 = clock()
         ev = problem.evaluate(H, 1.0, tangent=True)
         t["contact"] = max(clock() - t0 - t["element"], 0.0)
-        t0 = clock()
-        K = problem.tangent(ev)
-        t["assembly"] = clock() - t0
-        rhs = -ev.r[system.free_dofs]
-        t0 = clock()
-        f = solver.factorize(K)
-        f.solve(rhs)
-        t["solve"] = clock() - t0
+        f, g = newton_direction(problem, ev, solver, t)
         ev.drop_tangent()                       # as ``Newton.iterate`` once the tangent is factorised
         # update and residual timed on a tiny increment (as scaling.py): the full Newton increment of
         # the pre-stressed bundles at the reference poses pushes wires through each other
@@ -143,19 +231,22 @@ def measure_scene(name, rss_mb):
         t0 = clock()
         problem.evaluate(H1, 1.0, tangent=False)
         t["residual"] = clock() - t0
-        # a Newton iteration: evaluation with tangent, assembly, factorisation + solve, update; the
-        # residual-only evaluation is a backtracked line-search trial (an accepted full step is
-        # evaluated with its tangent, the next iteration's evaluation), not part of every iteration
+        # a Newton iteration: evaluation with tangent, Newton system (assembly), factorisation + solve, update;
+        # the residual-only evaluation is a backtracked line-search trial (an accepted full step is evaluated
+        # with its tangent, the next iteration's evaluation), not part of every iteration
         t["iteration"] = sum(v for k, v in t.items() if k != "residual")
         out.update({f"it{it}_{k}": v for k, v in t.items()})
         out["contact_points"] = int(ev.details["contact"].get("n_active", -1))
-        out["nnz"] = int(K.nnz)
+        out["nnz"] = int(g["nnz"])
+        out.update({k: v for k, v in g.items() if k != "nnz"})
         out.update(_solver_info(f))
         out[f"rss_it{it}_mb"] = rss_mb()
-        del f, K, ev
+        del f, ev
     out["analyses"] = solver.stats["analyses"]
     solver.close()
     del problem, system
+    if name not in os.environ.get("SCALING_NO_NEW", "").split(","):
+        out.update(new_pattern(m, H, solver_kind=linsolve.Solver))
     out["rss_mb"] = rss_mb()
     if name in os.environ.get("SCALING_NO_STEP", "").split(","):
         out.update(step_iterations=0, step_status="not run", step_s=float("nan"), step_it_s=float("nan"))
@@ -186,8 +277,10 @@ def report(rows, base_mb, table):
     """Markdown: the scenes table and the rope's extrapolation to ``ROPE_FULL``."""
     def g(v, f="{:.3g}"):
         return "-" if v is None or (isinstance(v, float) and not np.isfinite(v)) else f.format(v)
-    head = ["scene", "elements", "unknowns", "contact points", "solver", "fill (1e6)", "flops (1e9)",
-            "element", "contact", "assembly", "solve", "update", "iteration (1st)", "iteration",
+    head = ["scene", "elements", "unknowns", "contact points", "stick (Newton system: multiplier rows, GMRES its)",
+            "solver", "fill (1e6)", "flops (1e9)",
+            "element", "contact", "assembly", "solve", "update", "iteration (1st)", "iteration (new pattern)",
+            "iteration",
             "residual (trial)", "loaded step (its)", "s per iteration, step", "peak MB, iteration",
             "peak MB, with the step"]
     body = []
@@ -195,10 +288,14 @@ def report(rows, base_mb, table):
         if "error" in r:
             body.append([r["scene"], r["error"]] + ["-"] * (len(head) - 2))
             continue
-        body.append([r["scene"], r["elements"], r["unknowns"], r["contact_points"], r["backend"],
+        sysd = r.get("system", "tangent")
+        stick = f"{r.get('stick', '?')} ({sysd}" + (f": {r.get('multiplier_rows', 0)}, {r.get('gmres', 0)}"
+                                                    if sysd != "tangent" else "") + ")"
+        body.append([r["scene"], r["elements"], r["unknowns"], r["contact_points"], stick, r["backend"],
                      g(r["fill"] / 1e6), g(r.get("flops", np.nan) / 1e9)]
                     + [g(r[f"it2_{k}"]) for k in ("element", "contact", "assembly", "solve", "update")]
-                    + [g(r["it1_iteration"]), g(r["it2_iteration"]), g(r["it2_residual"]),
+                    + [g(r["it1_iteration"]), g(r.get("it3_iteration", np.nan)), g(r["it2_iteration"]),
+                       g(r["it2_residual"]),
                        f"{g(r['step_s'])} ({r['step_iterations']}"
                        f"{'' if r['step_status'] == 'ok' else ', ' + r['step_status']})",
                        g(r.get("step_it_s", np.nan)), f"{r['rss_it2_mb']:.0f}", f"{r['rss_mb']:.0f}"])

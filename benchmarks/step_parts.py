@@ -68,14 +68,15 @@ class _Clock:
         setattr(obj, name, timed)
 
     def wrap_pardiso(self, cls):
-        orig = cls._call_pardiso
+        """Time PARDISO's phases: ``cls`` is ``linsolve._Pardiso`` (its ``_call``, ``self.ps.phase``)."""
+        orig = cls._call
         clock = self
 
-        def timed(ps, A, b):
-            part = PHASES.get(int(ps.phase), "solve")
+        def timed(handle, A, b):
+            part = PHASES.get(int(handle.ps.phase), "solve")
             c0, w0 = time.process_time(), time.perf_counter()
             try:
-                return orig(ps, A, b)
+                return orig(handle, A, b)
             finally:
                 dc, dw = time.process_time() - c0, time.perf_counter() - w0
                 clock.cpu[part] += dc
@@ -83,12 +84,11 @@ class _Clock:
                 if clock.stack:                   # inside another timed part: counted here, not there
                     clock.cpu[clock.stack[-1]] -= dc
                     clock.wall[clock.stack[-1]] -= dw
-        cls._call_pardiso = timed
+        cls._call = timed
 
 
 def measure(name, hold, threads, rss_mb):
     import beamsolver as bs
-    import pypardiso
     import scaling_scenes as ss
     from beamsolver.assembly import system as system_mod
     from beamsolver.nonlinear import linsolve
@@ -118,7 +118,7 @@ def measure(name, hold, threads, rss_mb):
     clock.wrap(Problem, "update", "update")
     for f in ("solve", "apply"):
         clock.wrap(linsolve._PardisoFactor, f, "solve")
-    clock.wrap_pardiso(pypardiso.PyPardisoSolver)
+    clock.wrap_pardiso(linsolve._Pardiso)
     analyses = []
     orig_fresh = linsolve.Solver.fresh
 

@@ -1409,9 +1409,12 @@ def contact_kernel(X, p, friction=True, law=None):
 _MORTAR_POOL = BufferPool()      # ``mortar_terms``' tangent buffers (free again once its results are dropped)
 _ROWS_POOL = BufferPool()        # its gradient rows (141 MB on the 19-wire bundle: fresh, their page faults cost)
 _FRAMES_POOL = BufferPool(keep=3)   # the contact frames ``mortar_terms`` and ``mortar_forces`` return views of
+MORTAR_CHUNK = 2048              # points per pass of ``mortar_terms`` with a ``sink`` (its tangent and rows buffers)
+_CHUNK_POOL = BufferPool()       # the passes' tangent and gradient rows (``MORTAR_CHUNK`` points: 14 MB)
+_CHUNK_ROWS_POOL = BufferPool()
 
 
-def mortar_terms(X, p, law=None, T=None, whole=False, pairs=False):
+def mortar_terms(X, p, law=None, T=None, whole=False, pairs=False, sink=None):
     """Point terms of the mortar friction (``mortar.py``) from the compiled mortar kernel.
 
     ``T`` ``(P, 3)``: the points' tractions, known before the call (exact stick's multipliers): ``dfdq``
@@ -1427,11 +1430,18 @@ def mortar_terms(X, p, law=None, T=None, whole=False, pairs=False):
     ``dS`` ``(P, 3, 24)``, ``lam_n`` ``(P,)``, ``dlam_n`` ``(P, 24)``, ``n``, ``t1``, ``t2`` ``(P, 3)``, ``dn``
     ``(P, 3, 24)``, ``slip`` ``(P, 2)``, ``HL``, ``HK`` ``(P, 4, 4)``, ``active`` ``(P,)``.  Columns as in
     ``kernel_and_tangent`` (body increments of the nodes A1, B1, A2, B2).
+
+    ``sink`` (with ``T`` and ``whole``): ``sink(a, b, dfdq)`` takes the whole tangents ``(b - a, 24, 24)`` of the
+    points ``a .. b - 1``, in order, and ``d`` has no ``dfdq``: the kernel runs over ``MORTAR_CHUNK`` points at a
+    time (``_mortar_chunks``; the same operations per point: the same bits), so neither the ``(P, 24, 24)`` tangents
+    nor the ``(P, N_ROWS, 24)`` gradient rows are held at once (7 kB a point: 0.5 GB on the 61-wire bundle).
     """
     X = np.ascontiguousarray(X, dtype=float)
     P = X.shape[0]
     kind, par, has, (HCL, HFK, HLKp), _ = _table(X, p)
     kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar=True)
+    if sink is not None and T is not None and whole:
+        return _mortar_chunks(X, (kind, par, has, HCL, HFK, HLKp), kern, T, pairs, sink)
     # the tangents into kept memory (4.6 kB a point and traction; fresh memory's page faults cost about as much
     # as the kernel on the 19-wire bundle), a contiguous (4, P, 24, 24) prefix as ``np.empty`` would give
     nK = 4 if T is None else 1 if whole else 2
@@ -1447,6 +1457,35 @@ def mortar_terms(X, p, law=None, T=None, whole=False, pairs=False):
     d["dfdq"] = K[-1]
     if pairs:
         d["pairs"] = _pair_data(f, sc, vec, par)
+    return d
+
+
+def _mortar_chunks(X, table, kern, T, pairs, sink):
+    """``mortar_terms(X, p, law, T, whole=True, pairs, sink)``: the kernel ``kern`` and the point terms over
+    ``MORTAR_CHUNK`` points at a time, each pass's tangents handed to ``sink`` (``table``: ``_table``'s arrays)."""
+    P = X.shape[0]
+    C = max(1, min(P, MORTAR_CHUNK))
+    f = np.empty((1, P, 4, 6))       # the forces at T = 0 (the pairs'); those of the unit tractions: ``A``
+    sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
+    flags, frames = np.empty((P, 2), dtype=np.bool_), _FRAMES_POOL.take((P, 4, 4, 4))
+    terms = tuple(pool.take(shape) for pool, shape in zip(mortar_jit._TERMS_POOLS, ((P, 24, 3), (P, 3, 24),
+                                                                                       (P, 3, 24), (P, 24))))
+    Tc = np.ascontiguousarray(T, dtype=float)
+    fbuf, Kbuf = np.empty(4 * C * 24), _CHUNK_POOL.take((C * 576,))
+    rbuf = _CHUNK_ROWS_POOL.take((C * N_ROWS * 24,))
+    for a in range(0, P, C):
+        b = min(a + C, P)
+        n = b - a
+        fc, Kc = fbuf[:4 * n * 24].reshape(4, n, 4, 6), Kbuf[:n * 576].reshape(1, n, 24, 24)
+        rows = rbuf[:n * N_ROWS * 24].reshape(n, N_ROWS, 24)
+        kern(X[a:b], *(t[a:b] for t in table), fc, Kc, sc[a:b], vec[a:b], two[a:b], flags[a:b], frames[a:b], rows,
+             Tc[a:b])
+        f[0, a:b] = fc[0]
+        mortar_jit.point_terms_into(fc[1:], rows, vec[a:b, 1], vec[a:b, 2], two[a:b, 1], *(t[a:b] for t in terms))
+        sink(a, b, Kc[0])
+    d = _mortar_terms(P, None, None, sc, vec, two, flags, frames, None, terms=terms)
+    if pairs:
+        d["pairs"] = _pair_data(f, sc, vec, table[1])
     return d
 
 
@@ -1509,16 +1548,18 @@ def mortar_terms_four(X, p, law=None):
     return _mortar_terms(P, f[1:] - f[0], K[1:] - K[0], sc, vec, two, flags, frames, rows)
 
 
-def _mortar_terms(P, df, dK, sc, vec, two, flags, frames, rows):
+def _mortar_terms(P, df, dK, sc, vec, two, flags, frames, rows, terms=None):
     """``mortar_terms``' dict from the differences of the forces ``df`` ``(3, P, 4, 6)`` and tangents ``dK``
-    ``(3, P, 24, 24)`` at ``T = e_x, e_y, e_z`` to those at ``T = 0`` and the kernel's point data."""
-    A = np.transpose(df, (1, 2, 3, 0)).reshape(P, 24, 3)
+    ``(3, P, 24, 24)`` at ``T = e_x, e_y, e_z`` to those at ``T = 0`` and the kernel's point data (``terms``:
+    ``mortar_jit.point_terms``' results, if computed already; then ``rows`` is not read, and ``df`` may be None:
+    ``A`` is then their contiguous ``A``, the same values)."""
+    A = terms[0] if df is None else np.transpose(df, (1, 2, 3, 0)).reshape(P, 24, 3)
     dK = None if dK is None else np.transpose(dK, (1, 0, 2, 3))
     n, t1, t2, s = vec[:, 0], vec[:, 1], vec[:, 2], two[:, 1]
     S = s[:, :1] * t1 + s[:, 1:] * t2
     # ``G``: ``A`` contiguous (the scatters' input; ``A`` itself, a view, for the forces' products); the slip's
     # gradient ``dS = t1 ds1 + s1 dt1 + t2 ds2 + s2 dt2`` and the rows in one compiled pass (``mortar_jit.point_terms``)
-    Ac, dS, dn, dlam_n = mortar_jit.point_terms(df, rows, t1, t2, s)
+    Ac, dS, dn, dlam_n = mortar_jit.point_terms(df, rows, t1, t2, s) if terms is None else terms
     return dict(A=A, G=Ac, dK=dK, S=S, dS=dS, lam_n=sc[:, 1].copy(), dlam_n=dlam_n, n=n, t1=t1, t2=t2, dn=dn,
                 slip=s.copy(), HL=frames[:, 0], HK=frames[:, 1], active=flags[:, 0].copy(),
                 xi1=sc[:, 2].copy(), xi2=sc[:, 3].copy())

@@ -305,14 +305,29 @@ def _zero_blocks(shape):
     return K
 
 
+def block_sink(G):
+    """``(K, sink)``: the groups' tangent blocks ``K`` ``(n, 6 k, 6 k)``, zero, and ``sink(a, b, dfdq)``, which adds
+    the points ``a .. b - 1``'s tangents ``(b - a, 24, 24)`` to the groups of their node A as ``_point_parts``
+    does (``kernel_jit.mortar_terms(sink=)``: pass by pass, in the points' order, the same sums); ``d["Kqq"] = K``
+    then stands for ``d["dfdq"]``."""
+    n, k = G["members"].shape
+    gA, rowsA = _slots(G, 0)
+    K = _zero_blocks((n, 6 * k, 6 * k))
+
+    def sink(a, b, vals):
+        _SCATTER["block"](K, gA[a:b], rowsA[a:b], vals)
+    return K, sink
+
+
 def _point_parts(G, d):
     """Point forces and their derivatives at fixed traction on the groups of the points' node A:
     ``f`` ``(n, 6 k)``, ``K`` ``(n, 6 k, 6 k)``; and ``A`` ``(n, 6 k, 3)`` = d f / d lam_g (the forces of
-    the interpolated tractions: ``A_g = sum_p Phi_j(p) df_p/dT``, rows over the group's slots)."""
+    the interpolated tractions: ``A_g = sum_p Phi_j(p) df_p/dT``, rows over the group's slots).  ``d["Kqq"]``
+    (``block_sink``): ``K`` scattered already."""
     n, k = G["members"].shape
     gA, rowsA = _slots(G, 0)
     f = group_forces(G, d["f"])
-    K = _SCATTER["block"](_zero_blocks((n, 6 * k, 6 * k)), gA, rowsA, d["dfdq"])
+    K = d.pop("Kqq") if "Kqq" in d else _SCATTER["block"](_zero_blocks((n, 6 * k, 6 * k)), gA, rowsA, d["dfdq"])
     A = np.zeros((n, 6 * k, 3))
     for a in range(2):
         g, rows = _slots(G, a)

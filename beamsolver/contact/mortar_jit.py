@@ -14,7 +14,7 @@ from .._jit import jit
 from ..model.buffers import BufferPool
 
 __all__ = ["scatter_rows", "scatter_block", "scatter_columns", "scatter_rows_numpy", "scatter_block_numpy",
-           "scatter_columns_numpy", "trial_rows", "subtract_indexed", "point_terms",
+           "scatter_columns_numpy", "trial_rows", "subtract_indexed", "point_terms", "point_terms_into",
            "nodal_state", "point_data", "multiplier_basis", "slivers"]
 
 
@@ -107,6 +107,12 @@ def point_terms(df, rows, t1, t2, s):
                                                                               (P, 24))))
     _point_terms(df, rows, _c(t1), _c(t2), _c(s), A, dS, dn, dlam)
     return A, dS, dn, dlam
+
+
+def point_terms_into(df, rows, t1, t2, s, A, dS, dn, dlam):
+    """``point_terms`` into the given C-contiguous outputs ``A`` ``(P, 24, 3)``, ``dS``, ``dn`` ``(P, 3, 24)``,
+    ``dlam`` ``(P, 24)`` (``kernel_jit._mortar_chunks``: one pass's points)."""
+    _point_terms(_c(df), rows, _c(t1), _c(t2), _c(s), A, dS, dn, dlam)
 
 
 @jit

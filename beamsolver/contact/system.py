@@ -73,6 +73,8 @@ OVERLAP_REPORT = 1e-4    # penetration / (R1 + R2) in the given poses that step 
 SWITCH_TOL = 1e-12        # a step ending within this (relative) of active_from / friction_from ends before it
 TIMED = ("search", "rules", "projection", "params", "kernel", "blocks")   # parts of ``ContactSystem.timings``
 LAZY_MORTAR = True       # exact stick: the multiplier blocks only when the tangent is asked for (False: benchmarks)
+CHUNKED = True           # exact stick: the mortar kernel's tangents into the groups' blocks pass by pass
+#                          (``kernel_jit.MORTAR_CHUNK`` points; False: the whole (P, 24, 24) array, then scattered)
 SLIP_C = True            # exact stick: a group's c for the next step scaled by its last step's slip over the largest
 #                          of its declaration's sliding groups (``_balanced_c``; False: the declaration's c everywhere)
 SLIP_C_RULES = 10.0      # ... in a declaration whose c max |u| exceeds SLIP_C_RULES x its median sliding traction
@@ -882,7 +884,7 @@ class ContactSystem(Contribution):
         RL = np.einsum("gij,gj->gi", R, Lam)        # the multipliers' tractions (global)
         # with multipliers as Newton unknowns, the points' tractions: the multipliers interpolated
         T_pts = np.einsum("pa,pai->pi", G["phi"], RL[G["g"]]) if ssn else None
-        d, K_pairs = self._mortar_kernel(X, pm, law, T_pts, tangent, f_pairs is None, K_pairs)
+        d, K_pairs = self._mortar_kernel(X, pm, law, T_pts, tangent, f_pairs is None, K_pairs, G)
         if f_pairs is None and "pairs" in d:    # the pairs' own kernel (``_local_blocks``: every pair a mortar pair)
             f_pairs, pair_out = d.pop("pairs")
             np.negative(f_pairs, out=f_pairs)
@@ -935,11 +937,13 @@ class ContactSystem(Contribution):
                              f"got {len(laws)}")
         return next(iter(laws.values()))
 
-    def _mortar_kernel(self, X, pm, law, T_pts, tangent, pairs, K_pairs):
+    def _mortar_kernel(self, X, pm, law, T_pts, tangent, pairs, K_pairs, G=None):
         """``(d, K_pairs)``: the mortar kernel's point terms of ``_mortar`` (forces only without ``tangent``; with the
         multipliers as Newton unknowns, ``T_pts`` given, the tangent at the points' tractions) and the pairs' own
         blocks still to fold in (None where the kernel's ``dfdq`` holds them); ``pairs``: the pairs' own forces
-        and point data too (``kernel_jit.mortar_terms(pairs=True)``)."""
+        and point data too (``kernel_jit.mortar_terms(pairs=True)``).  With the whole tangent at ``T_pts`` and the
+        groups ``G`` (``CHUNKED``), the points' tangents go to the groups' blocks pass by pass (``mortar.block_sink``,
+        ``d["Kqq"]``) instead of ``d["dfdq"]`` ``(P, 24, 24)``."""
         if not tangent:
             return kernel_jit.mortar_forces(X, pm, law, pairs=pairs), K_pairs
         if T_pts is None:
@@ -947,8 +951,11 @@ class ContactSystem(Contribution):
         # the points' tractions are known (the multipliers): the tangent at them, two not four (one, the normal
         # law's included, where the pairs' own tangent has no segment ends' terms to keep)
         whole = K_pairs is not None and not self.n_slots
-        d = kernel_jit.mortar_terms(X, pm, law, T=T_pts, whole=whole, pairs=pairs)
-        return d, (None if whole and d.get("dfdq") is not None else K_pairs)
+        Kqq, sink = mortar.block_sink(G) if whole and CHUNKED and G is not None else (None, None)
+        d = kernel_jit.mortar_terms(X, pm, law, T=T_pts, whole=whole, pairs=pairs, sink=sink)
+        if sink is not None:
+            d["Kqq"] = Kqq
+        return d, (None if whole and (d.get("dfdq") is not None or "Kqq" in d) else K_pairs)
 
     def _nodal_weights(self, G, e):
         """``m`` ``(n,)`` of the groups ``G`` (``mortar.nodal_state``), their points on the slave elements ``e``:
@@ -974,7 +981,7 @@ class ContactSystem(Contribution):
         ssn = v is not None
         if "G" not in d:        # (``kernel_jit.mortar_terms`` gives it contiguous)
             d["G"] = d["A"]
-        if d.get("dfdq") is None:
+        if d.get("dfdq") is None and "Kqq" not in d:
             d["dfdq"] = np.einsum("pk,pkij->pij", st["T"], d["dK"])
         if K_pairs is not None:      # the points' own (normal) blocks go to their groups with the friction's
             rows = idx

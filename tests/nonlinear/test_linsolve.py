@@ -332,3 +332,39 @@ def test_splu_orders_saddle_point_systems_by_their_own_ordering():
         assert f.det_sign() == np.sign(np.linalg.det(dense))
     assert linsolve.SADDLE_SPLU_ORDERING == "COLAMD"
     assert not np.array_equal(spla.splu(A, permc_spec="COLAMD").perm_c, spla.splu(A, permc_spec="MMD_AT_PLUS_A").perm_c)
+
+
+@pytest.mark.skipif(not HAVE_PARDISO, reason="pypardiso not installed")
+def test_pardiso_keeps_its_one_based_indices_per_pattern(monkeypatch):
+    """``_Pardiso._call`` (``ONE_BASED``): PARDISO gets the analysed pattern's 1-based index arrays, made once per
+    pattern (pypardiso's own call copies them twice at every phase): the same bits as pypardiso's call, and no
+    copy at a re-factorisation or a solve on the same pattern; a new pattern is analysed with its own arrays."""
+    made = []
+    one_based = linsolve._one_based
+
+    def counted(a):
+        made.append(len(a))
+        return one_based(a)
+    A = nonsymmetric_matrix()
+    A2 = A.copy()
+    A2.data = A2.data * np.linspace(0.5, 2.0, A2.nnz)
+    b = np.random.default_rng(3).standard_normal(A.shape[0])
+    out = {}
+    for flag in (False, True):
+        monkeypatch.setattr(linsolve, "ONE_BASED", flag)
+        monkeypatch.setattr(linsolve, "_one_based", counted)
+        made.clear()
+        s = linsolve.Solver("pardiso", lagged=False)
+        x1 = s.factorize(A).solve(b)
+        f2 = s.factorize(A2)
+        x2, x3 = f2.solve(b), f2.solve(2.0 * b)
+        assert len(made) == 2 and s.stats["analyses"] == 1       # indptr and indices, once
+        B = A2 + sp.eye(A.shape[0], k=5, format="csc")             # a new pattern
+        x4 = s.factorize(B).solve(b)
+        assert len(made) == 4 and s.stats["analyses"] == 2
+        assert s._pardiso._direct is flag
+        out[flag] = (x1, x2, x3, x4)
+        s.close()
+    for x, y in zip(out[False], out[True]):
+        assert np.array_equal(x, y)
+    np.testing.assert_allclose(out[True][3], np.linalg.solve(B.toarray(), b), rtol=1e-10)

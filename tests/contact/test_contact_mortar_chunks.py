@@ -1,0 +1,58 @@
+"""Exact stick's mortar kernel in passes (``contact.system.CHUNKED``, ``kernel_jit.mortar_terms(sink=)``,
+``mortar.block_sink``): the points' tangents go to their groups' blocks ``kernel_jit.MORTAR_CHUNK`` points at a
+time instead of through one ``(P, 24, 24)`` array (issue 30: 0.3 GB on the 37-wire bundle).  The same operations
+per point and the same order of the sums: the evaluation is the same bits."""
+import numpy as np
+import pytest
+
+from beamsolver import se3
+from beamsolver.contact import kernel_jit, system as csys
+from beamsolver.nonlinear.problem import Problem
+from test_contact_exact_stick import R, _move, _parallel, _pressed
+
+TERMS = kernel_jit.mortar_terms
+
+
+def _evaluated(monkeypatch, chunked, chunk):
+    """The pressed, slid slave of ``_parallel`` evaluated with the tangent and its augmented Newton matrix:
+    ``(residual, tangent values, A's values, multiplier blocks, passes)``, ``passes`` the ``(a, b)`` the sink got."""
+    monkeypatch.setattr(csys, "CHUNKED", chunked)
+    monkeypatch.setattr(kernel_jit, "MORTAR_CHUNK", chunk)
+    passes = []
+    terms = TERMS
+
+    def spy(*a, sink=None, **k):
+        if sink is not None:
+            def counted(a0, b0, vals, _sink=sink):
+                passes.append((a0, b0, len(vals)))
+                _sink(a0, b0, vals)
+            return terms(*a, sink=counted, **k)
+        return terms(*a, **k)
+    monkeypatch.setattr(kernel_jit, "mortar_terms", spy)
+    model, slave, _ = _parallel(0.5, n_slave=8)
+    problem = Problem.from_model(model, check_rigid_modes=False)
+    H = _pressed(problem, slave, 2e-3 * R)
+    problem.begin_step(H, 0.0)
+    problem.commit(H)
+    problem.begin_step(H, 0.1)
+    H = _move(H, slave.nodes, se3.exp(np.array([1e-6 * R, 2e-7 * R, 0.0, 1e-6 * R, 0.0, 0.0])))
+    ev = problem.evaluate(H, 0.1, tangent=True)
+    assert ev.mult is not None
+    blocks = {k: np.array(ev.mult[k]) for k in ("Kql", "Klq", "Kll", "C")}
+    A = problem.augmented_system(ev).A if problem.augments(ev) else problem.linear_system(ev)[0]
+    return ev.r.copy(), np.array(ev.extra[2]), A.data.copy(), blocks, passes
+
+
+@pytest.mark.parametrize("chunk", [1, 7, 1 << 20])
+def test_passes_give_the_bits_of_one_array(monkeypatch, chunk):
+    ref = _evaluated(monkeypatch, False, chunk)
+    out = _evaluated(monkeypatch, True, chunk)
+    assert not ref[4]
+    P = out[4][-1][1]
+    assert P > 7                                      # (several passes at the small chunk sizes)
+    assert [(a, b) for a, b, _ in out[4]] == [(a, min(a + chunk, P)) for a in range(0, P, chunk)]
+    assert all(n == b - a for a, b, n in out[4])
+    for x, y in zip(ref[:3], out[:3]):
+        assert np.array_equal(x, y)
+    for k in ref[3]:
+        assert np.array_equal(ref[3][k], out[3][k]), k
