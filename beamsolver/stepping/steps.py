@@ -52,7 +52,7 @@ WAIT_MAX = 32              # most easy steps running before a step regrows to a 
 MAX_OUTER = 100            # outer iterations of a step (Problem.repeat_step) before it fails
 UNDAMPED_MARGIN = 2.0      # an undamped residual up to this times the damped one Newton accepted is equilibrium
 STEP_ZERO_ITERATIONS = 4   # Newton budget at t_start / max_iter (no cut-back there; docs/theory.md section 17)
-STEP_ZERO_STALL = 20       # step 0 with exact stick's friction: given up after this many iterations without progress
+STEP_ZERO_STALL = 10       # step 0 with exact stick's friction: given up after this many iterations without progress
 
 
 def growth(iterations, easy):

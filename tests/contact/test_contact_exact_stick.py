@@ -378,7 +378,7 @@ def test_the_one_pass_mortar_kernel_gives_the_bits_of_four_kernel_calls(monkeypa
 @pytest.mark.slow
 def test_pre_stressed_strand_starts_without_exact_friction_when_it_must():
     """A 1+6+12 strand whose touching layers carry contact forces at t_start: with exact stick's friction
-    step 0 finds no equilibrium (the residual stays near 1: given up after 20 iterations without progress,
+    step 0 finds no equilibrium (the residual stays near 1: given up after 10 iterations without progress,
     where it took the whole budget of 120 before); the solve then finds it without
     that friction, says so, and the stretched step converges with friction (it raised ConvergenceError)."""
     L = bs.cables.Layer
