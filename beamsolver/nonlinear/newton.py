@@ -168,6 +168,7 @@ class Newton:
         self.watch_sign = False               # whether to look (stepping.Run: conservative problems)
         self.t_evaluated = None               # t of the last evaluation (failure messages)
         self.stall_window = None              # a step fails after this many iterations without a new lowest residual
+        self.least_inc = (np.inf, 0)          # ... or a new shortest full Newton increment (``_verdict``)
         self.status = None                    # exact stick: (keys, stick flags) of the groups at the last iterate
         self.last_evaluation = None           # of the last converged state
         self.reset_timings()
@@ -389,6 +390,7 @@ class Newton:
         conv, problem = self.conv, self.problem
         residuals = []
         self.crawl, self.full_taken = 0, False
+        self.least_inc = (np.inf, 0)         # the shortest full Newton increment of the step and its iteration
         if constraint.watch_sign:
             self.indefinite_seen = False
         damped_its = 0
@@ -482,14 +484,19 @@ class Newton:
     def _verdict(self, residuals, last_inc, it, floor, constraint):
         """``Convergence.decide`` on the iterate whose scaled residual is ``residuals[-1]``: ``CONVERGED`` or
         ``CONTINUE`` (past ``max_iter`` while ``converging``), else the ``failures.StepFailed`` raised, also after
-        ``stall_window`` iterations without a new lowest residual."""
+        ``stall_window`` iterations without a new lowest residual or full-step increment."""
         ratio = residuals[-1]
         verdict = self.conv.decide(ratio, last_inc, it, floor, final=constraint.final)
         if verdict is MAX_ITER and not self.problem.smooth and self.converging(residuals, it - self.conv.max_iter):
             verdict = CONTINUE
         if verdict is not CONTINUE and verdict is not CONVERGED:
             raise self._failure(verdict, ratio)
-        if verdict is CONTINUE and self.stall_window and it - int(np.argmin(residuals)) >= self.stall_window:
+        if np.isfinite(last_inc) and last_inc < self.least_inc[0]:
+            self.least_inc = (last_inc, it)
+        # progress: a new lowest residual, or a new shortest full Newton increment (a crawl to a double root of the
+        # normal law, the touching start of docs/theory/contact_laws.md 17.2, keeps its residual and halves its steps)
+        if verdict is CONTINUE and self.stall_window and \
+                it - max(int(np.argmin(residuals)), self.least_inc[1]) >= self.stall_window:
             raise NotConverged(f"no progress in {self.stall_window} iterations (scaled residual {ratio:.3g}, "
                                f"lowest {min(residuals):.3g})", ratio)
         return verdict
