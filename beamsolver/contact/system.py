@@ -78,6 +78,8 @@ SLIP_C = True            # exact stick: a group's c for the next step scaled by 
 SLIP_C_RULES = 10.0      # ... in a declaration whose c max |u| exceeds SLIP_C_RULES x its median sliding traction
 SLIP_C_FLOOR = 1e-3      # ... but not below SLIP_C_FLOOR x the declaration's c (c -> 0 would hide a sticking group's
 #                          slip from its equation ``C = -c u``: measured, a stall with the forces met and the slips not)
+CHAIN_C = True           # exact stick: c's slave length is its chain's (beams joined end to end, ``beam_chains``)
+CHAIN_GROUPS = True      # exact stick: a mortar group is a slave node against a master chain, not a master beam
 SKIP_OPEN = True         # exact stick: Newton's evaluations leave out the points of certainly open groups (``_open_points``)
 SKIP_MARGIN = 1e-2       # ... whose gap exceeds the normal law's band by SKIP_MARGIN (R1 + R2) at least
 SKIP_MIN = 64            # ... when at least this many points are that far (fewer: the test costs what it saves; the main
@@ -126,8 +128,43 @@ def exact_c(EI, L, n):
 
 
 def _slave_elements(beams):
-    """Median element count of the slave beams ``beams`` (element ids of each)."""
-    return float(np.median([len(e) for e in beams]))
+    """Median element count of the slave beams ``beams`` (element ids of each, or counts)."""
+    return float(np.median([n if np.ndim(n) == 0 else len(n) for n in beams]))
+
+
+def beam_chains(model):
+    """``(root, count)`` ``(n_beams,)``: for each beam of ``model`` the first beam (smallest id) and the element count
+    of its chain, the beams joined end to end (``model.join`` of an end node of one beam to an end node of another, or
+    an end node shared; a join through a node outside beams, such as a plate's, does not chain).  A wire made of
+    pieces is one chain: exact stick keys its mortar groups by the master's chain (``CHAIN_GROUPS``) and takes the
+    slave's length for ``c`` from its chain (``CHAIN_C``; docs/theory_mortar.md 3b, 3d)."""
+    beams = model.beams
+    end = {}
+    for k, b in enumerate(beams):
+        end.setdefault(int(b.first), []).append(k)
+        end.setdefault(int(b.last), []).append(k)
+    parent = list(range(len(beams)))
+
+    def find(k):
+        while parent[k] != k:
+            parent[k] = parent[parent[k]]
+            k = parent[k]
+        return k
+
+    def union(i, j):
+        i, j = find(i), find(j)
+        parent[max(i, j)] = min(i, j)
+
+    for a, b in model.joins:
+        for i in end.get(int(a), ()):
+            for j in end.get(int(b), ()):
+                union(i, j)
+    for ks in end.values():              # beams sharing an end node
+        for i in ks[1:]:
+            union(i, ks[0])
+    root = np.array([find(k) for k in range(len(beams))], dtype=np.int64)
+    count = np.bincount(root, weights=[b.n_elements for b in beams], minlength=len(beams))
+    return root, count[root].astype(np.int64)
 
 
 class _Decl:
@@ -164,6 +201,7 @@ class _Decl:
         self.eps_t = o.penalty_t
         self.slave_bending = min(min(b.section.C[4, 4], b.section.C[5, 5]) for b in decl.slave)
         self.slave_beams = [np.asarray(b.elements) for b in decl.slave]     # element ids of each slave beam
+        self.slave_ids = [b.id for b in decl.slave]
         # ... and, where the multipliers are not Newton unknowns (arc length), the Uzawa updates' penalty
         self.aug_t = self.penalty if o.penalty_t is None else o.penalty_t
         self.stick_tolerance = (STICK_TOLERANCE * 2.0 * max(s.radius for s in secs)
@@ -240,9 +278,13 @@ class ContactSystem(Contribution):
         self._decl_smoothing, self._decl_tolerance = table["smoothing"], table["tolerance"]
         self._decl_adjust = table["adjust"]
         self._decl_exact = np.array([d.exact for d in self.decls])
+        chain_root, chain = beam_chains(model)
+        # the mortar groups' master: its chain (a slave node against a wire in pieces has one multiplier)
+        self.el_master = chain_root[self.el_beam] if CHAIN_GROUPS else self.el_beam
         for d in self.decls:
             if d.eps_t is None:
-                d.eps_t = exact_c(d.slave_bending, system.L[d.slave_el], _slave_elements(d.slave_beams))
+                n = chain[d.slave_ids] if CHAIN_C else d.slave_beams
+                d.eps_t = exact_c(d.slave_bending, system.L[d.slave_el], _slave_elements(n))
         self._decl_eps_t = np.array([d.eps_t for d in self.decls])
         self._decl_aug_t = np.array([d.aug_t for d in self.decls])
         self._decl_stick_tol = np.array([d.stick_tolerance for d in self.decls])
@@ -683,7 +725,7 @@ class ContactSystem(Contribution):
         far &= mort
         if np.count_nonzero(far) < max(SKIP_MIN, 1):
             return sel
-        keys = (dec.astype(np.int64)[:, None] * nn + P.nodes[sel, :2]) * nb + self.el_beam[P.m[sel]][:, None]
+        keys = (dec.astype(np.int64)[:, None] * nn + P.nodes[sel, :2]) * nb + self.el_master[P.m[sel]][:, None]
         ukeys = np.unique(keys[mort])
         hot = np.zeros(len(ukeys), dtype=bool)
         hot[np.searchsorted(ukeys, keys[mort & ~far].ravel())] = True
@@ -869,7 +911,7 @@ class ContactSystem(Contribution):
         n_nodes = len(H)
         X = H[P.nodes[sel[idx]]]
         pm = p if len(idx) == len(sel) else {k: (v[idx] if np.ndim(v) else v) for k, v in p.items()}
-        G = self._groups(P.nodes[sel[idx], :2], pm["xi1"], self.el_beam[P.m[sel[idx]]], P.decl[sel[idx]],
+        G = self._groups(P.nodes[sel[idx], :2], pm["xi1"], self.el_master[P.m[sel[idx]]], P.decl[sel[idx]],
                           P.nodes[sel[idx]], n_nodes, self.n_beams, self._held_slip(P.nodes[sel[idx]]))
         gdecl = G["key"] // (np.int64(n_nodes) * self.n_beams)
         R = H[G["node"], :3, :3]
