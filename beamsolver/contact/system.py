@@ -80,6 +80,7 @@ SLIP_C_FLOOR = 1e-3      # ... but not below SLIP_C_FLOOR x the declaration's c 
 #                          slip from its equation ``C = -c u``: measured, a stall with the forces met and the slips not)
 CHAIN_C = True           # exact stick: c's slave length is its chain's (beams joined end to end, ``beam_chains``)
 HOLD_CROSSINGS = True    # exact stick: an element pair's line / crossing decision kept within a step (``step_crossings``)
+HOLD_BAND = float(np.radians(5.0))   # ... remembered from pairs this close to line_angle on (cheaper on bundles)
 CHAIN_GROUPS = True      # exact stick: a mortar group is a slave node against a master chain, not a master beam
 SKIP_OPEN = True         # exact stick: Newton's evaluations leave out the points of certainly open groups (``_open_points``)
 SKIP_MARGIN = 1e-2       # ... whose gap exceeds the normal law's band by SKIP_MARGIN (R1 + R2) at least
@@ -515,9 +516,10 @@ class ContactSystem(Contribution):
             self._sweepable[d.index] = not edge and not rules.may_cross(least, d.line_angle)
         self._lap("search")
         cross = rules.crossing(cos, d.line_angle, least)
-        if HOLD_CROSSINGS and d.exact and (rules.may_cross(least, d.line_angle) or self.history.cross_values.any()):
-            # exact stick: line or crossing kept within the step (``step_crossings``; nothing to keep where no pair is
-            # near ``line_angle`` and none was held)
+        if HOLD_CROSSINGS and d.exact and (rules.may_cross(least, d.line_angle - HOLD_BAND)
+                                           or self.history.cross_values.any()):
+            # exact stick: line or crossing kept within the step (``step_crossings``; nothing to keep where every pair
+            # is ``HOLD_BAND`` below ``line_angle`` and none was held)
             held = self.history.step_crossings(d.index, e, m, cross)
             if swept and np.any(held & ~cross):    # (a crossing held: the pairs in the distance matrix's order)
                 e, m, cos, c2, reach, least = broad_pairs(*args)
