@@ -55,6 +55,7 @@ from ..failures import ContactTunnelling, NoContactNormal
 from ..model.model import JOIN_TOL
 from .law import PENALTY_T_MIN, default_penalty
 from . import kernel_jit, mortar, mortar_jit, segment_tangent
+from .chains import beam_chains
 from .options import (ADJUST, EXACT_C, EXACT_N, GAUSS_POINTS, SEGMENT_POINTS, SMOOTHING, STICK_TOLERANCE,
                       ContactOptions, declaration_table)
 from .frames import LINE, NORMAL_TOL, POINT, no_normal, touch_tolerance
@@ -132,41 +133,6 @@ def exact_c(EI, L, n):
 def _slave_elements(beams):
     """Median element count of the slave beams ``beams`` (element ids of each, or counts)."""
     return float(np.median([n if np.ndim(n) == 0 else len(n) for n in beams]))
-
-
-def beam_chains(model):
-    """``(root, count)`` ``(n_beams,)``: for each beam of ``model`` the first beam (smallest id) and the element count
-    of its chain, the beams joined end to end (``model.join`` of an end node of one beam to an end node of another, or
-    an end node shared; a join through a node outside beams, such as a plate's, does not chain).  A wire made of
-    pieces is one chain: exact stick keys its mortar groups by the master's chain (``CHAIN_GROUPS``) and takes the
-    slave's length for ``c`` from its chain (``CHAIN_C``; docs/theory_mortar.md 3b, 3d)."""
-    beams = model.beams
-    end = {}
-    for k, b in enumerate(beams):
-        end.setdefault(int(b.first), []).append(k)
-        end.setdefault(int(b.last), []).append(k)
-    parent = list(range(len(beams)))
-
-    def find(k):
-        while parent[k] != k:
-            parent[k] = parent[parent[k]]
-            k = parent[k]
-        return k
-
-    def union(i, j):
-        i, j = find(i), find(j)
-        parent[max(i, j)] = min(i, j)
-
-    for a, b in model.joins:
-        for i in end.get(int(a), ()):
-            for j in end.get(int(b), ()):
-                union(i, j)
-    for ks in end.values():              # beams sharing an end node
-        for i in ks[1:]:
-            union(i, ks[0])
-    root = np.array([find(k) for k in range(len(beams))], dtype=np.int64)
-    count = np.bincount(root, weights=[b.n_elements for b in beams], minlength=len(beams))
-    return root, count[root].astype(np.int64)
 
 
 class _Decl:
@@ -1449,8 +1415,8 @@ class ContactSystem(Contribution):
 
     def nodal_results(self):
         """Exact stick's nodal table of the committed state (``Solution.extra``, one entry per step), or None
-        without mortar groups: per group (a slave node against a master beam) ``mortar_node`` and
-        ``mortar_master_beam`` (ids), ``mortar_normal_force`` ``m lamN`` and ``mortar_tangential_force`` (g, 3)
+        without mortar groups: per group (a slave node against a master beam, or the chain of beams joined end to end
+        it belongs to: ``beam_chains``) ``mortar_node`` and ``mortar_master_beam`` (ids; of a chain its first beam), ``mortar_normal_force`` ``m lamN`` and ``mortar_tangential_force`` (g, 3)
         ``m lam`` (global; forces on the slave: the nodal weight ``m`` times the weighted tractions, the quantities
         whose Coulomb cone the law enforces, ``|m lam| <= mu m lamN``), ``mortar_status`` (``OPEN``,
         ``STICK``, ``SLIP``) and ``mortar_slip`` ``|u|``, the weighted slip of the step (a length)."""
