@@ -26,6 +26,9 @@ within 2 % and compares the torque at the onset of writhing with Greenhill's.
 
 Measured (16 elements per wire, 40 steps, one run each on a loaded 2-core machine):
 
+- defaults with exact stick (session 8): the pair stays a straight two-ply (sticking, it bends as one rod) and stops
+  at 4.16 turns (Newton fails at steps of 6e-6; ``Wr / Lk = 0.008``), 475 Newton iterations, 9 s CPU; with
+  ``--stick penalty`` it writhes from 2.08 turns and stops at 2.91 (872 iterations, 12 s);
 - defaults (``mu = 0.3``, imperfection 1e-2, ``stabilize = 2e-2``): writhing from 2.08 turns
   (10.9 N m), a loop at the top; stops at 2.12 of the 5 turns (Newton fails as the loop
   tightens on itself), ``Wr / Lk = 0.41``, ``|Lk - Tw - Wr| / Lk <= 1.5e-3``, dissipated 0.40 of
