@@ -275,6 +275,7 @@ class ContactSystem(Contribution):
         self._H_prev = None        # last converged poses (start of the step)
         self._geo = self._geo_prev = None    # (poses, element twists) of the last evaluation / of H_prev
         self._blocks = None        # (poses, local blocks) of the last evaluation, for the same state
+        self._forced = None        # keys of points linearised on the normal law's open branch (``force_open``)
         self._skipped = 0          # points of open groups the last evaluation left out (``_open_points``)
         self._full = False         # evaluate every point (``_state``: commit, updates, results)
         self._far = None           # (pairs, far beyond the normal law's band) of the last ``_active``
@@ -603,6 +604,10 @@ class ContactSystem(Contribution):
         p["touch"] = np.where(p["smoothing"] >= touch, 0.0, touch)
         key = P.key[sel]
         p["multiplier"] = self.history.normal_multipliers(key)
+        if self._forced is not None and len(self._forced):     # the normal law's open branch (``force_open``)
+            off = _member(key, self._forced)
+            p["penalty"] = np.where(off, 0.0, p["penalty"])
+            p["multiplier"] = np.where(off, 0.0, p["multiplier"])
         hf = self.history.frictional(p, key, P.e[sel], P.m[sel])
         hist = self.history.friction
         # a point pair whose crossing moved to a neighbouring element pair keeps the
@@ -1147,6 +1152,21 @@ class ContactSystem(Contribution):
             b = Blocks(P.nodes[sel], f.reshape(-1, 24), K if tangent else None)
         self._lap("blocks")
         return b, info
+
+    # ------------------------------------------------------------ the normal law's branches (an option)
+    def pressed_points(self, H):
+        """Sorted keys of the points whose normal law presses at poses ``H`` (``lam_n > 0``)."""
+        blocks = self._local_blocks(H, False)
+        if blocks is None:
+            return np.zeros(0, dtype=np.int64)
+        P, sel, _, _, _, out = blocks
+        return np.sort(P.key[sel][out["lam_n"] > 0])
+
+    def force_open(self, keys):
+        """Evaluate the points ``keys`` (sorted; None: none) on the normal law's open branch (no normal force, no
+        stiffness): Newton's active-set step for the normal law (``nonlinear.newton.NORMAL_SWITCHES``)."""
+        self._forced = None if keys is None else np.asarray(keys, dtype=np.int64)
+        self._blocks = None
 
     # ------------------------------------------------------------ multipliers as Newton unknowns
     def _sliding_c(self, m):

@@ -52,6 +52,9 @@ STALL_RATIO = 1.5                    # undamped fallback if the shortest damped 
 FORCES_ONLY_TRIALS = True            # semi-smooth problems: the line search's full-step trial without tangent
 INNER_SWITCHES = 0                   # exact stick: branch switches of the linearised groups per Newton direction ...
 INNER_PREDICTOR = False              # ... also in a load step's first iteration (the prescribed motions' predictor)
+NORMAL_SWITCHES = 0                  # exact stick: Newton directions again with the points the full step opens
+                                     # linearised open (the normal law's active set; an option, ``_normal_branches``)
+NORMAL_NEAR = True                   # ... only near the solution (``near``: the residual cut LS_NEAR-fold)
 INNER_UNSETTLED = "last"             # branches still changing after INNER_SWITCHES: "last" solve or "plain" Newton's
                                      # (an option: twisted pair 244 -> 195, shear lag 39 -> 22 iterations with 8, but
                                      # the strand bending cycle 197 -> 244 with 6 cut-backs and 5x the CPU time;
@@ -261,6 +264,32 @@ class Newton:
             problem.multiplier_step(ev, dlam)
         return lu, dzf
 
+    def _normal_branches(self, ev, H, t, lu, dzf):
+        """The Newton direction ``(lu, dzf)`` at ``(H, t)`` with the points that press at ``H`` but not at the full
+        step linearised on the normal law's open branch (``ContactSystem.force_open``), again until no more open
+        (at most ``NORMAL_SWITCHES`` times): a lift-off front moves by several nodes in one Newton iteration.  The
+        residual, line search and convergence test are the exact law's."""
+        contact = self.problem.contact
+        if contact is None or not hasattr(contact, "force_open"):
+            return lu, dzf
+        now = contact.pressed_points(H)
+        forced = np.zeros(0, dtype=np.int64)
+        try:
+            for _ in range(NORMAL_SWITCHES):
+                self.problem.multiplier_trial(0.0)
+                opened = np.setdiff1d(now, contact.pressed_points(self.problem.update(H, self.full(dzf))))
+                opened = np.setdiff1d(opened, forced)
+                if not len(opened):
+                    break
+                forced = np.union1d(forced, opened)
+                contact.force_open(forced)
+                ev2 = self.evaluate(H, t)
+                lu, dzf = self.direction(ev2)
+                ev2.drop_tangent()
+        finally:
+            contact.force_open(None)
+        return lu, dzf
+
     def _active_set_direction(self, ev, dz_c=None):
         """``direction`` with the groups' stick / slip branches decided on the linearised problem (exact stick): the
         Newton system is solved (condensed, as ``direction``), each group's branch predicted at the step's end by its
@@ -409,6 +438,9 @@ class Newton:
                 return self._converged(H, t, ev, constraint, dict(iterations=it, residuals=residuals, **stats_extra))
             if dzf is None:
                 lu, dzf = constraint.direction(self, ev, H, t)
+                if NORMAL_SWITCHES and ev.mult is not None and constraint.final and not constraint.moves \
+                        and (self.near or not NORMAL_NEAR):
+                    lu, dzf = self._normal_branches(ev, H, t, lu, dzf)
             if it == 0 and self.watch_sign and constraint.watch_sign:
                 self._watch_first_tangent(lu)
             # the tangent of ``ev`` is factorised: its values (the contact's (m, 24, 24) blocks) are not

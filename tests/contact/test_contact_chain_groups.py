@@ -145,3 +145,25 @@ def test_line_or_crossing_is_kept_within_a_step_with_exact_stick(monkeypatch, ho
         assert kept == (hold and stick == "exact")
         cs.begin_step(H1, 0.2)
         assert not (cs.pairs(H1).kind == LINE).any()
+
+
+def test_points_forced_open_carry_no_normal_force():
+    """``ContactSystem.force_open`` (the normal law's open branch, for ``newton.NORMAL_SWITCHES``): the pressed points
+    of the frictionless patch test forced open give no contact force and no tangent; released, the same force as
+    before (to the bit)."""
+    import contact_patch
+    model, slave, master = contact_patch.build(mu=0.0, tau=0.0)
+    sol = bs.solve(model, steps=2, t_end=0.5, check_rigid_modes=False, verbose=False)
+    problem = bs.nonlinear.problem.Problem.from_model(model, check_rigid_modes=False)
+    H = sol.poses[-1]
+    contact = problem.contact
+    pressed = contact.pressed_points(H)
+    assert len(pressed) > 10
+    b0, _ = contact.evaluate(H)
+    contact.force_open(pressed)
+    b1, _ = contact.evaluate(H)
+    assert len(contact.pressed_points(H)) == 0
+    assert np.abs(b1.f).max() == 0.0 and np.abs(b1.K).max() == 0.0
+    contact.force_open(None)
+    b2, _ = contact.evaluate(H)
+    assert np.array_equal(b2.f, b0.f) and np.abs(b0.f).max() > 0.0
