@@ -80,7 +80,7 @@ SLIP_C_RULES = 10.0      # ... in a declaration whose c max |u| exceeds SLIP_C_R
 SLIP_C_FLOOR = 1e-3      # ... but not below SLIP_C_FLOOR x the declaration's c (c -> 0 would hide a sticking group's
 #                          slip from its equation ``C = -c u``: measured, a stall with the forces met and the slips not)
 CHAIN_C = True           # exact stick: c's slave length is its chain's (beams joined end to end, ``beam_chains``)
-HOLD_CROSSINGS = True    # exact stick: an element pair's line / crossing decision kept within a step (``step_crossings``)
+HOLD_CROSSINGS = True    # exact stick: an element pair's line / crossing decision kept in a step (``step_crossings``)
 HOLD_BAND = float(np.radians(5.0))   # ... remembered from pairs this close to line_angle on (cheaper on bundles)
 CHAIN_GROUPS = True      # exact stick: a mortar group is a slave node against a master chain, not a master beam
 SKIP_OPEN = True         # exact stick: Newton's evaluations leave out the points of certainly open groups (``_open_points``)
@@ -1435,8 +1435,9 @@ class ContactSystem(Contribution):
 
     def nodal_results(self):
         """Exact stick's nodal table of the committed state (``Solution.extra``, one entry per step), or None
-        without mortar groups: per group (a slave node against a master beam, or the chain of beams joined end to end
-        it belongs to: ``beam_chains``) ``mortar_node`` and ``mortar_master_beam`` (ids; of a chain its first beam), ``mortar_normal_force`` ``m lamN`` and ``mortar_tangential_force`` (g, 3)
+        without mortar groups: per group (a slave node against a master beam, or the chain of beams joined end to
+        end it belongs to: ``beam_chains``) ``mortar_node`` and ``mortar_master_beam`` (ids; of a chain its first
+        beam), ``mortar_normal_force`` ``m lamN`` and ``mortar_tangential_force`` (g, 3)
         ``m lam`` (global; forces on the slave: the nodal weight ``m`` times the weighted tractions, the quantities
         whose Coulomb cone the law enforces, ``|m lam| <= mu m lamN``), ``mortar_status`` (``OPEN``,
         ``STICK``, ``SLIP``) and ``mortar_slip`` ``|u|``, the weighted slip of the step (a length)."""
