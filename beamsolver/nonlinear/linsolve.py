@@ -69,8 +69,9 @@ BACKENDS = ("splu", "splu-rcm", "pardiso", "auto")
 DEFAULT = "auto"          # splu for beams and small scenes; pardiso (else splu-rcm) for coupled ones
 SADDLE_PERTURB = 8        # PARDISO on saddle-point systems: pivots perturbed to 1e-8 |K| (iparm(10))
 SADDLE_REFINE = 20        # ... and up to 20 steps of iterative refinement (iparm(8)); ``Solver.factorize``
-SADDLE_SPLU_ORDERING = "COLAMD"   # splu on saddle-point systems (the main job's bordered tangents: 0.40 ms a
-                                  # factorisation against MMD_AT_PLUS_A's 0.63, 20 % less fill; docs/benchmarks.md)
+SADDLE_SPLU_ORDERING = "MMD_AT_PLUS_A"   # splu on saddle-point systems; "COLAMD" factorises the main job's bordered
+                                  # tangents in 0.40 ms against 0.63 (20 % less fill), but its round-off took the
+                                  # plectoneme's five-turn run into a crawl at t = 0.6553 (docs/benchmarks.md, session 8)
 AUTO_MIN_UNKNOWNS = 1_500      # "auto": below this size the default splu is as fast as any
 AUTO_COUPLED_NNZ = 24.0        # "auto": non-zeros per column above which contact couples the beams
 BACKWARD_ERROR = 1e-9          # pardiso, splu-rcm: |K x - b| / (|K| |x| + |b|) above this -> re-analyse / pivot fully
