@@ -32,7 +32,7 @@ import numpy as np
 
 from ..failures import DampingStalled, Diverged, NonFinite, NotConverged, SingularTangent, StepFailed
 from ..lie import se3
-from . import linsolve
+from . import augmented as augmented_, linsolve
 from .convergence import CONTINUE, CONVERGED, MAX_ITER, Convergence, Verdict
 from .rotations import MAX_ELEMENT_ROTATION, RotationGuard, angle, largest_element_rotation, relative_rotations
 
@@ -417,6 +417,8 @@ class Newton:
             # the tangent of ``ev`` is factorised: its values (the contact's (m, 24, 24) blocks) are not
             # needed any more, and freeing them lets the next evaluation reuse their memory
             ev.drop_tangent()
+            if isinstance(lu, augmented_.Augmented):
+                lu.drop_tangent()               # (exact stick's K': only the factor of A is kept)
             if ev.mult is not None:
                 problem.multiplier_trial(1.0)
             if constraint.moves:

@@ -158,3 +158,44 @@ def test_newton_through_the_augmented_solve_takes_the_direct_path(monkeypatch, s
     assert [s["iterations"] for s in aug.stats] == [s["iterations"] for s in direct.stats]
     x0, x1 = direct.poses[-1][:, :3, 3], aug.poses[-1][:, :3, 3]
     assert np.abs(x1 - x0).max() <= 1e-9 * np.abs(x0).max()
+
+
+def test_dropping_the_tangent_frees_k_prime(monkeypatch):
+    """Once the Newton system is solved (``Newton.iterate``: ``Evaluation.drop_tangent`` and
+    ``Augmented.drop_tangent``) nothing holds exact stick's tangent ``K'`` any more, before the line search's trial
+    (issue 30: 0.3 GB on the 0.6 m rope; ``A`` lives on in its factor); the evaluation's Newton system and the solve
+    are then errors that say so."""
+    import weakref
+    import shear_lag
+    from beamsolver.nonlinear.problem import Problem
+    monkeypatch.setattr(augmented, "MIN_UNKNOWNS", 0)
+    seen = dict(solved=0, freed=0)
+    refs = []
+    solve = augmented.Augmented.solve
+
+    def tracked(self, solver):
+        x = solve(self, solver)
+        refs.append(weakref.ref(self.K))
+        seen["solved"] += 1
+        return x
+    trial = Problem.multiplier_trial
+
+    def check(self, s):
+        if refs:
+            seen["freed"] += refs.pop()() is None
+        return trial(self, s)
+    monkeypatch.setattr(augmented.Augmented, "solve", tracked)
+    monkeypatch.setattr(Problem, "multiplier_trial", check)
+    shear_lag.main(n_wire=20)
+    assert seen["solved"] >= 8 and seen["freed"] == seen["solved"], seen
+
+    problem, H, slave = _scene("stick")
+    (dq, dl), ev, aug = _augmented(problem, H, None)
+    ev.drop_tangent()
+    assert "Kp" not in ev.mult and "A" not in ev.mult
+    with pytest.raises(ValueError, match="dropped"):
+        problem.augmented_system(ev)
+    aug.drop_tangent()
+    assert aug.K is None and aug.factor is not None
+    with pytest.raises(ValueError, match="dropped"):
+        aug.solve(linsolve.Solver())
