@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..model import contributions
+from ..model import buffers, contributions
 from ..assembly.system import System
 from ..errors import InputError
 from . import augmented as augmented_, bordered as bordered_, condense as condense_
@@ -67,11 +67,15 @@ class Evaluation:
         buffers they hold (``contact.system``'s tangent pool) can then serve the next evaluation.  Exact
         stick: ``K'`` and ``A`` of ``Problem.augmented_system`` too (``A`` lives on in its factor; ``K'`` is
         freed with the ``augmented.Augmented``'s own ``drop_tangent``: 0.3 GB on the 0.6 m rope during the
-        line search's trial); ``augmented_system`` of this evaluation is then an error."""
+        line search's trial); ``augmented_system`` of this evaluation is then an error.  A large evaluation
+        (``buffers.RELEASE_MIN_VALUES`` tangent values) lets the pools' idle buffers go (``buffers.release_idle``)."""
+        large = self.kvals is not None and self.kvals.size >= buffers.RELEASE_MIN_VALUES
         self.kvals = self.extra = None
         if self.mult is not None:
             for k in ("Kp", "A"):
                 self.mult.pop(k, None)
+        if large:
+            buffers.release_idle()
 
 
 class Problem:
