@@ -161,19 +161,30 @@ def test_newton_through_the_augmented_solve_takes_the_direct_path(monkeypatch, s
 
 
 def test_dropping_the_tangent_frees_k_prime(monkeypatch):
-    """Once the Newton system is solved (``Newton.iterate``: ``Evaluation.drop_tangent`` and
-    ``Augmented.drop_tangent``) nothing holds exact stick's tangent ``K'`` any more, before the line search's trial
-    (issue 30: 0.3 GB on the 0.6 m rope; ``A`` lives on in its factor); the evaluation's Newton system and the solve
-    are then errors that say so."""
+    """The evaluation's tangent values are dropped once ``K'`` and ``A`` are built, before the factorisation
+    (``newton.DROP_BEFORE_SOLVE``), and once the Newton system is solved (``Newton.iterate``: ``Augmented.
+    drop_tangent``) nothing holds exact stick's tangent ``K'`` any more, before the line search's trial (issue 30:
+    the 0.6 m rope's peak; ``A`` lives on in its factor): the shear lag's iterations and poses bit for bit as with
+    the tangent kept to the end; the evaluation's Newton system and the solve are then errors that say so."""
     import weakref
     import shear_lag
+    from beamsolver.nonlinear import newton
     from beamsolver.nonlinear.problem import Problem
     monkeypatch.setattr(augmented, "MIN_UNKNOWNS", 0)
-    seen = dict(solved=0, freed=0)
-    refs = []
+    monkeypatch.setattr(newton, "DROP_BEFORE_SOLVE", False)
+    kept = shear_lag.main(n_wire=20)[0]
+    monkeypatch.setattr(newton, "DROP_BEFORE_SOLVE", True)
+    seen = dict(solved=0, freed=0, dropped=0)
+    refs, evs = [], []
     solve = augmented.Augmented.solve
+    system = Problem.augmented_system
+
+    def built(self, ev, dz_c=None):
+        evs.append(ev)
+        return system(self, ev, dz_c)
 
     def tracked(self, solver):
+        seen["dropped"] += evs.pop().kvals is None        # (``DROP_BEFORE_SOLVE``: before the factorisation)
         x = solve(self, solver)
         refs.append(weakref.ref(self.K))
         seen["solved"] += 1
@@ -186,8 +197,12 @@ def test_dropping_the_tangent_frees_k_prime(monkeypatch):
         return trial(self, s)
     monkeypatch.setattr(augmented.Augmented, "solve", tracked)
     monkeypatch.setattr(Problem, "multiplier_trial", check)
-    shear_lag.main(n_wire=20)
-    assert seen["solved"] >= 8 and seen["freed"] == seen["solved"], seen
+    monkeypatch.setattr(Problem, "augmented_system", built)
+    dropped = shear_lag.main(n_wire=20)[0]
+    assert seen["solved"] >= 8 and seen["freed"] == seen["solved"] == seen["dropped"], seen
+    assert [s["iterations"] for s in dropped.stats] == [s["iterations"] for s in kept.stats]
+    assert np.array_equal(dropped.poses, kept.poses)            # the same bits
+    monkeypatch.undo()
 
     problem, H, slave = _scene("stick")
     (dq, dl), ev, aug = _augmented(problem, H, None)
