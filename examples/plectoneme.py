@@ -4,8 +4,8 @@ The scene is the 20 mm benchmark's (``examples/twisted_pair_extreme.py``, the ma
 issue 32; linear elastic, no yield limit: surface strains far beyond steel's range, a
 mathematical benchmark like it): two wires of radius ``R = 0.5 mm``, 20 mm long, clamped
 below, their upper ends rigidly linked to a plate turned about ``e_z`` under a 5 N dead
-pull, Coulomb friction ``mu = 0.3`` (the penalty stick, ``stick="penalty"``: the runs below were measured with
-it, and with exact stick, the library's default, the five-turn extension-controlled run stops at t = 0.68),
+pull, Coulomb friction ``mu = 0.3`` (exact stick, the library's default, since session 8 of 2026-11-27; the runs
+below were measured with the penalty stick, ``build(stick="penalty")``, unless said otherwise),
 with two additions:
 
 - a small imperfection: a dead lateral force of ``imperfection`` times the pull on the
@@ -26,6 +26,9 @@ within 2 % and compares the torque at the onset of writhing with Greenhill's.
 
 Measured (16 elements per wire, 40 steps, one run each on a loaded 2-core machine):
 
+- defaults with exact stick (session 8): the pair stays a straight two-ply (sticking, it bends as one rod) and stops
+  at 4.16 turns (Newton fails at steps of 6e-6; ``Wr / Lk = 0.008``), 475 Newton iterations, 9 s CPU; with
+  ``--stick penalty`` it writhes from 2.08 turns and stops at 2.91 (872 iterations, 12 s);
 - defaults (``mu = 0.3``, imperfection 1e-2, ``stabilize = 2e-2``): writhing from 2.08 turns
   (10.9 N m), a loop at the top; stops at 2.12 of the 5 turns (Newton fails as the loop
   tightens on itself), ``Wr / Lk = 0.41``, ``|Lk - Tw - Wr| / Lk <= 1.5e-3``, dissipated 0.40 of
@@ -125,7 +128,7 @@ residual of 3e-3 to 0.16 and a positive definite tangent.
     python examples/plectoneme.py [--output plectoneme_output] [--turns 5] [--steps 40] [--mu 0.3] [--stabilize 2e-2]
         [--elements 16] [--imperfection 1e-2] [--length 0.02] [--pull 5] [--approach s] [--pieces 2]
         [--min-step-ratio 2**-12] [--twist-until 1] [--relax F] [--path load] [--smoothing 2e-3]
-        [--line-angle deg] [--point-ratio r]
+        [--line-angle deg] [--point-ratio r] [--stick exact|penalty]
 """
 import argparse
 import time
@@ -146,7 +149,7 @@ solve_options = dict(steps=40, stabilize=dict(fraction=2e-2, settle=True))
 
 def build(turns=5.0, n_elements=16, mu=0.3, imperfection=1e-2, pull=PULL, E=200e9, nu=0.3, length=LENGTH,
           approach=None, pieces=2, twist_until=1.0, relax=None, smoothing=2e-3, line_angle=None,
-          point_ratio=None, stick="penalty"):
+          point_ratio=None, stick=None):
     """Returns ``(model, plate node, (wire a, wire b))``, each wire a tuple of ``pieces`` beams
     (bottom to top) of ``n_elements // pieces`` elements joined rigidly.  ``approach=None``: a
     dead ``pull`` on the plate (free in ``z``); a number ``s``: extension control, the plate's
@@ -154,7 +157,7 @@ def build(turns=5.0, n_elements=16, mu=0.3, imperfection=1e-2, pull=PULL, E=200e
     the imperfection).  ``twist_until = t1 < 1``: a two-stage path, the turns reached at ``t1``
     and then held; over ``[t1, 1]`` the dead pull goes linearly from ``pull`` to ``relax`` (``relax``
     also scales the imperfection), or with ``approach`` the plate's height from ``length`` to
-    ``length (1 - s)``."""
+    ``length (1 - s)``.  ``stick``: ``add_contact(stick=)`` of every declaration (None: the library's default)."""
     sec = bs.Section.circular(radius=R, E=E, nu=nu)
     model = bs.Model()
     if pieces < 2 or n_elements % pieces:
@@ -191,10 +194,11 @@ def build(turns=5.0, n_elements=16, mu=0.3, imperfection=1e-2, pull=PULL, E=200e
         model.prescribe(plate, bs.motion.compose(
             bs.motion.translation(lambda t: (0.0, 0.0, -approach * length * stage2(t))),
             bs.motion.rotation((0.0, 0.0, 1.0), angle)))
-    # the penalty stick (issue 26): with exact stick, the library's default, the extension-controlled five-turn
-    # run stops at t = 0.68, 3.4 turns (t = 0.28 before sliver groups were folded; docs/benchmarks.md, "Exact stick,
-    # session 7: rope piece and plectoneme")
-    opts = dict(mu=mu, smoothing=smoothing * R, stick=stick)
+    # stick None: the library's default, exact stick; the five-turn extension-controlled run converges with it since
+    # session 8 (docs/benchmarks.md, "Exact stick, session 8: plectoneme"; it stopped at t = 0.68 or 0.86 before)
+    opts = dict(mu=mu, smoothing=smoothing * R)
+    if stick is not None:
+        opts["stick"] = stick
     if line_angle is not None:
         opts["line_angle"] = np.radians(line_angle)
     if point_ratio is not None:
@@ -263,13 +267,13 @@ def onset(rows):
 def main(output=None, turns=5.0, steps=40, n_elements=16, mu=0.3, stabilize=2e-2, imperfection=1e-2,
          verbose=False, length=LENGTH, pull=PULL, approach=None, pieces=2, min_step_ratio=2.0**-12,
          twist_until=1.0, relax=None, path="load", smoothing=2e-3, line_angle=None,
-         point_ratio=None):
+         point_ratio=None, stick=None):
     """Solve, print the table and the checks; returns ``(solution, rows, wall time, checks)``."""
     model, plate, wires = build(turns=turns, n_elements=n_elements, mu=mu, imperfection=imperfection,
                                  length=length, pull=pull, approach=approach,
                                  pieces=pieces, twist_until=twist_until, relax=relax,
                                  smoothing=smoothing, line_angle=line_angle,
-                                 point_ratio=point_ratio)
+                                 point_ratio=point_ratio, stick=stick)
     t0 = time.perf_counter()
     try:
         sol = bs.solve(model, steps=steps, output=output, verbose=verbose, stabilize=stabilize,
@@ -341,9 +345,10 @@ if __name__ == "__main__":
     ap.add_argument("--smoothing", type=float, default=2e-3, help="contact smoothing gap / wire radius")
     ap.add_argument("--line-angle", type=float, default=None, help="add_contact(line_angle=) in degrees")
     ap.add_argument("--point-ratio", type=float, default=None, help="add_contact(point_ratio=)")
+    ap.add_argument("--stick", default=None, help="add_contact(stick=): exact (the default) or penalty")
     a = ap.parse_args()
     main(output=a.output, turns=a.turns, steps=a.steps, n_elements=a.elements, mu=a.mu, stabilize=a.stabilize,
          imperfection=a.imperfection, verbose=True, length=a.length, pull=a.pull,
          approach=a.approach, pieces=a.pieces, min_step_ratio=a.min_step_ratio, twist_until=a.twist_until,
          relax=a.relax, path=a.path, smoothing=a.smoothing, line_angle=a.line_angle,
-         point_ratio=a.point_ratio)
+         point_ratio=a.point_ratio, stick=a.stick)

@@ -144,8 +144,31 @@ class ContactHistory:
 
     # ------------------------------------------------------------ kinds of crossings
     def forget_kinds(self):
-        """Empty the kinds of the step (``step_kinds``): the next evaluation decides them."""
+        """Empty the kinds of the step (``step_kinds``, ``step_crossings``): the next evaluation decides them."""
         self.kind_keys, self.kind_values = np.zeros(0, dtype=np.int64), np.zeros(0, dtype=int)
+        self.cross_keys, self.cross_values = np.zeros(0, dtype=np.int64), np.zeros(0, dtype=bool)
+
+    def step_crossings(self, decl, e, m, cross):
+        """Line or crossing of element pairs kept within a step (exact stick's declarations): a pair (declaration
+        ``decl``, slave ``e``, master ``m``) seen at an earlier evaluation of the step keeps that decision (``cross``
+        ``(n,)`` bool, crossing at ``line_angle`` and above); the others are remembered as decided now.
+
+        With exact stick a line pair's friction is the mortar multipliers' and a crossing's the point law's: a pair
+        whose angle passes ``line_angle`` within a Newton step changes its friction force by the difference of the two
+        (the plectoneme at t = 0.858: 8 N on a node; the line search's trials landed on the other side at any length
+        above 1/32 of the step, and Newton crawled).  Held for the step, the residual has no such jump; a new step
+        decides afresh."""
+        n_el = np.int64(self.layout.n_el)
+        keys = (np.int64(decl) * n_el + e) * n_el + m
+        idx, found = lookup(self.cross_keys, keys)
+        if found.any():
+            cross = np.where(found, self.cross_values[idx], cross)
+        if not found.all():
+            k = np.concatenate([self.cross_keys, keys[~found]])
+            v = np.concatenate([self.cross_values, cross[~found]])
+            order = np.argsort(k, kind="stable")
+            self.cross_keys, self.cross_values = k[order], v[order]
+        return cross
 
     def step_kinds(self, decl, e, m, kinds):
         """Kinds of crossing element pairs kept within a step: a pair (declaration ``decl``, slave
@@ -173,12 +196,14 @@ class ContactHistory:
 
     # ------------------------------------------------------------ the search's memory
     def memory(self):
-        """The search's memory (point pairs, owners, kinds of the step), for ``recall``."""
-        return self.prev_points, self.prev_owners, self.kind_keys, self.kind_values
+        """The search's memory (point pairs, owners, kinds and crossings of the step), for ``recall``."""
+        return (self.prev_points, self.prev_owners, self.kind_keys, self.kind_values, self.cross_keys,
+                self.cross_values)
 
     def recall(self, memory):
         """Put back the search's memory saved by ``memory``."""
-        self.prev_points, self.prev_owners, self.kind_keys, self.kind_values = memory
+        (self.prev_points, self.prev_owners, self.kind_keys, self.kind_values, self.cross_keys,
+         self.cross_values) = memory
 
     # ------------------------------------------------------------ restart
     def state(self):

@@ -55,6 +55,7 @@ from ..failures import ContactTunnelling, NoContactNormal
 from ..model.model import JOIN_TOL
 from .law import PENALTY_T_MIN, default_penalty
 from . import kernel_jit, mortar, mortar_jit, segment_tangent
+from .chains import beam_chains
 from .options import (ADJUST, EXACT_C, EXACT_N, GAUSS_POINTS, SEGMENT_POINTS, SMOOTHING, STICK_TOLERANCE,
                       ContactOptions, declaration_table)
 from .frames import LINE, NORMAL_TOL, POINT, no_normal, touch_tolerance
@@ -80,6 +81,10 @@ SLIP_C = True            # exact stick: a group's c for the next step scaled by 
 SLIP_C_RULES = 10.0      # ... in a declaration whose c max |u| exceeds SLIP_C_RULES x its median sliding traction
 SLIP_C_FLOOR = 1e-3      # ... but not below SLIP_C_FLOOR x the declaration's c (c -> 0 would hide a sticking group's
 #                          slip from its equation ``C = -c u``: measured, a stall with the forces met and the slips not)
+CHAIN_C = True           # exact stick: c's slave length is its chain's (beams joined end to end, ``beam_chains``)
+HOLD_CROSSINGS = True    # exact stick: an element pair's line / crossing decision kept in a step (``step_crossings``)
+HOLD_BAND = float(np.radians(5.0))   # ... remembered from pairs this close to line_angle on (cheaper on bundles)
+CHAIN_GROUPS = True      # exact stick: a mortar group is a slave node against a master chain, not a master beam
 SKIP_OPEN = True         # exact stick: Newton's evaluations leave out the points of certainly open groups (``_open_points``)
 SKIP_MARGIN = 1e-2       # ... whose gap exceeds the normal law's band by SKIP_MARGIN (R1 + R2) at least
 SKIP_MIN = 64            # ... when at least this many points are that far (fewer: the test costs what it saves; the main
@@ -128,8 +133,8 @@ def exact_c(EI, L, n):
 
 
 def _slave_elements(beams):
-    """Median element count of the slave beams ``beams`` (element ids of each)."""
-    return float(np.median([len(e) for e in beams]))
+    """Median element count of the slave beams ``beams`` (element ids of each, or counts)."""
+    return float(np.median([n if np.ndim(n) == 0 else len(n) for n in beams]))
 
 
 class _Decl:
@@ -166,6 +171,7 @@ class _Decl:
         self.eps_t = o.penalty_t
         self.slave_bending = min(min(b.section.C[4, 4], b.section.C[5, 5]) for b in decl.slave)
         self.slave_beams = [np.asarray(b.elements) for b in decl.slave]     # element ids of each slave beam
+        self.slave_ids = [b.id for b in decl.slave]
         # ... and, where the multipliers are not Newton unknowns (arc length), the Uzawa updates' penalty
         self.aug_t = self.penalty if o.penalty_t is None else o.penalty_t
         self.stick_tolerance = (STICK_TOLERANCE * 2.0 * max(s.radius for s in secs)
@@ -242,9 +248,13 @@ class ContactSystem(Contribution):
         self._decl_smoothing, self._decl_tolerance = table["smoothing"], table["tolerance"]
         self._decl_adjust = table["adjust"]
         self._decl_exact = np.array([d.exact for d in self.decls])
+        chain_root, chain = beam_chains(model)
+        # the mortar groups' master: its chain (a slave node against a wire in pieces has one multiplier)
+        self.el_master = chain_root[self.el_beam] if CHAIN_GROUPS else self.el_beam
         for d in self.decls:
             if d.eps_t is None:
-                d.eps_t = exact_c(d.slave_bending, system.L[d.slave_el], _slave_elements(d.slave_beams))
+                n = chain[d.slave_ids] if CHAIN_C else d.slave_beams
+                d.eps_t = exact_c(d.slave_bending, system.L[d.slave_el], _slave_elements(n))
         self._decl_eps_t = np.array([d.eps_t for d in self.decls])
         self._decl_aug_t = np.array([d.aug_t for d in self.decls])
         self._decl_stick_tol = np.array([d.stick_tolerance for d in self.decls])
@@ -267,6 +277,7 @@ class ContactSystem(Contribution):
         self._H_prev = None        # last converged poses (start of the step)
         self._geo = self._geo_prev = None    # (poses, element twists) of the last evaluation / of H_prev
         self._blocks = None        # (poses, local blocks) of the last evaluation, for the same state
+        self._forced = None        # keys of points linearised on the normal law's open branch (``force_open``)
         self._skipped = 0          # points of open groups the last evaluation left out (``_open_points``)
         self._full = False         # evaluate every point (``_state``: commit, updates, results)
         self._far = None           # (pairs, far beyond the normal law's band) of the last ``_active``
@@ -473,9 +484,22 @@ class ContactSystem(Contribution):
         if sweep:
             self._sweepable[d.index] = not edge and not rules.may_cross(least, d.line_angle)
         self._lap("search")
+        cross = rules.crossing(cos, d.line_angle, least)
+        if HOLD_CROSSINGS and d.exact and (rules.may_cross(least, d.line_angle - HOLD_BAND)
+                                           or self.history.cross_values.any()):
+            # exact stick: line or crossing kept within the step (``step_crossings``; nothing to keep where every pair
+            # is ``HOLD_BAND`` below ``line_angle`` and none was held)
+            held = self.history.step_crossings(d.index, e, m, cross)
+            if swept and np.any(held & ~cross):    # (a crossing held: the pairs in the distance matrix's order)
+                e, m, cos, c2, reach, least = broad_pairs(*args)
+                swept = False
+                if sweep:
+                    self._sweepable[d.index] = False
+                held = self.history.step_crossings(d.index, e, m, rules.crossing(cos, d.line_angle, least))
+            cross = held
         kinds = np.full(len(e), LINE)
         xi1, xi2 = np.zeros(len(e)), np.zeros(len(e))
-        b = np.flatnonzero(rules.crossing(cos, d.line_angle, least))
+        b = np.flatnonzero(cross)
         if len(b):
             self._lap("rules")
             x1, x2, ratio = closest_points(H, en[e[b], 0], h[e[b]], en[m[b], 0], h[m[b]])
@@ -582,6 +606,10 @@ class ContactSystem(Contribution):
         p["touch"] = np.where(p["smoothing"] >= touch, 0.0, touch)
         key = P.key[sel]
         p["multiplier"] = self.history.normal_multipliers(key)
+        if self._forced is not None and len(self._forced):     # the normal law's open branch (``force_open``)
+            off = _member(key, self._forced)
+            p["penalty"] = np.where(off, 0.0, p["penalty"])
+            p["multiplier"] = np.where(off, 0.0, p["multiplier"])
         hf = self.history.frictional(p, key, P.e[sel], P.m[sel])
         hist = self.history.friction
         # a point pair whose crossing moved to a neighbouring element pair keeps the
@@ -685,7 +713,7 @@ class ContactSystem(Contribution):
         far &= mort
         if np.count_nonzero(far) < max(SKIP_MIN, 1):
             return sel
-        keys = (dec.astype(np.int64)[:, None] * nn + P.nodes[sel, :2]) * nb + self.el_beam[P.m[sel]][:, None]
+        keys = (dec.astype(np.int64)[:, None] * nn + P.nodes[sel, :2]) * nb + self.el_master[P.m[sel]][:, None]
         ukeys = np.unique(keys[mort])
         hot = np.zeros(len(ukeys), dtype=bool)
         hot[np.searchsorted(ukeys, keys[mort & ~far].ravel())] = True
@@ -871,7 +899,7 @@ class ContactSystem(Contribution):
         n_nodes = len(H)
         X = H[P.nodes[sel[idx]]]
         pm = p if len(idx) == len(sel) else {k: (v[idx] if np.ndim(v) else v) for k, v in p.items()}
-        G = self._groups(P.nodes[sel[idx], :2], pm["xi1"], self.el_beam[P.m[sel[idx]]], P.decl[sel[idx]],
+        G = self._groups(P.nodes[sel[idx], :2], pm["xi1"], self.el_master[P.m[sel[idx]]], P.decl[sel[idx]],
                           P.nodes[sel[idx]], n_nodes, self.n_beams, self._held_slip(P.nodes[sel[idx]]))
         gdecl = G["key"] // (np.int64(n_nodes) * self.n_beams)
         R = H[G["node"], :3, :3]
@@ -1131,6 +1159,21 @@ class ContactSystem(Contribution):
             b = Blocks(P.nodes[sel], f.reshape(-1, 24), K if tangent else None)
         self._lap("blocks")
         return b, info
+
+    # ------------------------------------------------------------ the normal law's branches (an option)
+    def pressed_points(self, H):
+        """Sorted keys of the points whose normal law presses at poses ``H`` (``lam_n > 0``)."""
+        blocks = self._local_blocks(H, False)
+        if blocks is None:
+            return np.zeros(0, dtype=np.int64)
+        P, sel, _, _, _, out = blocks
+        return np.sort(P.key[sel][out["lam_n"] > 0])
+
+    def force_open(self, keys):
+        """Evaluate the points ``keys`` (sorted; None: none) on the normal law's open branch (no normal force, no
+        stiffness): Newton's active-set step for the normal law (``nonlinear.newton.NORMAL_SWITCHES``)."""
+        self._forced = None if keys is None else np.asarray(keys, dtype=np.int64)
+        self._blocks = None
 
     # ------------------------------------------------------------ multipliers as Newton unknowns
     def _sliding_c(self, m):
@@ -1399,8 +1442,9 @@ class ContactSystem(Contribution):
 
     def nodal_results(self):
         """Exact stick's nodal table of the committed state (``Solution.extra``, one entry per step), or None
-        without mortar groups: per group (a slave node against a master beam) ``mortar_node`` and
-        ``mortar_master_beam`` (ids), ``mortar_normal_force`` ``m lamN`` and ``mortar_tangential_force`` (g, 3)
+        without mortar groups: per group (a slave node against a master beam, or the chain of beams joined end to
+        end it belongs to: ``beam_chains``) ``mortar_node`` and ``mortar_master_beam`` (ids; of a chain its first
+        beam), ``mortar_normal_force`` ``m lamN`` and ``mortar_tangential_force`` (g, 3)
         ``m lam`` (global; forces on the slave: the nodal weight ``m`` times the weighted tractions, the quantities
         whose Coulomb cone the law enforces, ``|m lam| <= mu m lamN``), ``mortar_status`` (``OPEN``,
         ``STICK``, ``SLIP``) and ``mortar_slip`` ``|u|``, the weighted slip of the step (a length)."""

@@ -487,6 +487,18 @@ class Problem:
             if f is not None:
                 f()
 
+    def pressed_points(self, H):
+        """Per contribution, the sorted keys of its points whose normal law presses at poses ``H`` (None where it has
+        no such points): for ``Newton``'s active set of the normal law (``newton.NORMAL_SWITCHES``)."""
+        return [c.pressed_points(H) if hasattr(c, "pressed_points") else None for c in self.contributions]
+
+    def force_open(self, keys):
+        """Evaluate the points ``keys`` (per contribution, as ``pressed_points``; None: none) on the normal law's open
+        branch (no normal force, no stiffness) until called again."""
+        for k, c in enumerate(self.contributions):
+            if hasattr(c, "force_open"):
+                c.force_open(None if keys is None else keys[k])
+
     def multiplier_ratio(self, ev, F):
         """How far the multipliers of ``ev`` are from their equations, on the scale of the residual ratio:
         ``max |C_g| m_g / F`` and, for sticking groups, ``rtol``-free ``max |u_g| / tol_g`` (returned apart):

@@ -737,3 +737,18 @@ def test_a_step_s_first_newton_step_leaves_the_sliding_groups_out_of_their_disk(
     c.multiplier_step(keys, dLam, stick, cap)      # the step's second Newton step: as computed
     c.multiplier_trial(1.0)
     np.testing.assert_allclose(c.iterate_multipliers(keys) - c.history.tangential_multipliers(keys), dLam, rtol=1e-15)
+
+
+def test_a_touching_start_crawling_to_the_normal_law_s_double_root_is_progress_not_a_stall():
+    """Step 0 of the contact patch (touching beams, exact stick's friction): Newton crawls to the smoothed normal
+    law's zero-force end (docs/theory/contact_laws.md 17.2), its scaled residual constant to 10 digits while its
+    increments halve, 11 iterations. The stall window (``steps.STEP_ZERO_STALL`` = 10 iterations) counts a new
+    shortest increment as progress: without it step 0 fell back to a start without friction, whose tangent is
+    singular here (the slave is held along the beams by friction alone)."""
+    from beamsolver.stepping import steps
+    model, slave, master = contact_patch.build(stick="exact")
+    sol = bs.solve(model, **contact_patch.solve_options)
+    st = sol.stats[0]
+    assert sol.converged and st["iterations"] > steps.STEP_ZERO_STALL
+    assert np.ptp(np.log10(st["residuals"])) < 1e-6                       # no new lowest residual on the way
+    assert not [w for w in st.get("warnings", []) if "exact stick's friction" in w]
