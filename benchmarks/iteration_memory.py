@@ -49,7 +49,7 @@ def main(argv):
     import scaling_scenes
     from scaling import warm_up
 
-    from beamsolver.nonlinear import linsolve
+    from beamsolver.nonlinear import linsolve, newton as newton_
     from beamsolver.nonlinear.problem import Problem
     rows = []
 
@@ -77,6 +77,8 @@ def main(argv):
         t = {}
         if problem.augments(ev):         # exact stick: the Newton system and its solve as ``Newton.direction``
             aug = problem.augmented_system(ev)
+            if newton_.DROP_BEFORE_SOLVE:        # as ``Newton.direction``
+                ev.drop_tangent()
             mark(f"{it}: Newton system (tangent K', augmented A)")
             f = aug.solve(solver)
             problem.multiplier_step(ev, problem.split_solution(ev, f)[1])

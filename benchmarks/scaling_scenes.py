@@ -119,11 +119,13 @@ def newton_direction(problem, ev, solver, t):
     GMRES or solve, the split of the solution and the multipliers' step).  Returns ``(factor, info)``: ``info``
     the Newton system's ``nnz``, ``system`` (``tangent``, ``augmented`` or ``saddle``), unknowns, multiplier rows,
     GMRES iterations and fallbacks."""
-    from beamsolver.nonlinear import linsolve
+    from beamsolver.nonlinear import linsolve, newton as newton_
     t0 = clock()
     aug = problem.augmented_system(ev) if problem.augments(ev) else None
     if aug is None:
         K, rhs = problem.linear_system(ev)
+    elif getattr(newton_, "DROP_BEFORE_SOLVE", False):
+        ev.drop_tangent()                       # as ``Newton.direction``: the tangent's values are in K' and A
     t["assembly"] = clock() - t0
     t0 = clock()
     st0 = {k: solver.stats.get(k, 0) for k in ("saddle_iterations", "saddle_fallbacks")}

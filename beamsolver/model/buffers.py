@@ -7,13 +7,38 @@ it) is alive.  That count of the caller's own references is an implementation de
 3.14 borrows references on the stack): buffers are reused only on the CPython versions where it was
 checked (``REUSE_BUFFERS``), else made anew.
 """
+import ctypes
+import platform
 import sys
+import weakref
 
 import numpy as np
 
-__all__ = ["REUSE_BUFFERS", "BufferPool"]
+__all__ = ["REUSE_BUFFERS", "BufferPool", "release_idle", "RELEASE_MIN_VALUES", "MMAP_THRESHOLD"]
 
 REUSE_BUFFERS = sys.implementation.name == "cpython" and sys.version_info < (3, 14)
+RELEASE_MIN_VALUES = 4_000_000  # tangent values of an evaluation from which ``Evaluation.drop_tangent`` calls
+#                                 ``release_idle`` (~28 000 elements: the rope pieces of 0.3 m and more, not the bundles)
+MMAP_THRESHOLD = 4 << 20        # bytes: glibc's mmap threshold fixed there by ``release_idle`` (None: left alone)
+_POOLS = weakref.WeakSet()
+_MMAP_SET = []
+
+
+def release_idle():
+    """Memory over speed for large models (issue 30, the 0.6 m rope within 8 GB): every pool drops the buffers
+    nothing else references (the groups' tangent blocks and the kernel's point terms while a line search's
+    residual-only trial runs: 1.3 GB on that rope; the next evaluation with tangent takes fresh memory), and,
+    once per process on glibc, its mmap threshold is fixed at ``MMAP_THRESHOLD`` (its default grows up to 32 MB
+    as large arrays are freed, and freed arrays below it stay in the heap).  Values do not change: a pool's
+    buffer is filled by its caller.  Returns the bytes dropped."""
+    if MMAP_THRESHOLD is not None and not _MMAP_SET:
+        _MMAP_SET.append(True)
+        if sys.platform.startswith("linux") and platform.libc_ver()[0] == "glibc":
+            try:
+                ctypes.CDLL(None).mallopt(-3, int(MMAP_THRESHOLD))       # M_MMAP_THRESHOLD
+            except (OSError, AttributeError):
+                pass
+    return sum(p.release() for p in list(_POOLS))
 
 
 class BufferPool:
@@ -28,6 +53,14 @@ class BufferPool:
     def __init__(self, dtype=float, axis=0, keep=2):
         self.dtype, self.axis, self.keep = np.dtype(dtype), axis, keep
         self.buffers = []
+        _POOLS.add(self)
+
+    def release(self):
+        """Drop the kept buffers that nothing else references (``release_idle``); returns their bytes."""
+        idle = [sys.getrefcount(b) <= 3 for b in self.buffers]     # (the list, ``b``, the argument)
+        freed = sum(b.nbytes for b, i in zip(self.buffers, idle) if i)
+        self.buffers = [b for b, i in zip(self.buffers, idle) if not i]
+        return freed
 
     def take(self, shape):
         n = shape[self.axis]

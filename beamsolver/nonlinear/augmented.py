@@ -89,6 +89,11 @@ class Augmented:
         self.iterations = 0
         self.fallback = False
 
+    def drop_tangent(self):
+        """Forget ``K'`` and the direct fallback's system once solved (``Evaluation.drop_tangent``, ``Newton.iterate``):
+        ``solve`` is then an error; the factor of ``A`` (``factor``) stays."""
+        self.K = self.direct = None
+
     def _Kq(self, y):
         """``Kq y`` ``(n,)`` for ``y`` ``(u,)``."""
         return np.bincount(self.rows.ravel(), weights=(self.Kq * y[:, None]).ravel(), minlength=self.n)
@@ -114,6 +119,8 @@ class Augmented:
         """The solution ``x`` ``(n + u,)`` of ``M x = [f; g]`` (``Problem.split_solution`` reads it): GMRES
         preconditioned by ``solver``'s factor of ``A`` (lagged while it allows, then fresh), else the direct
         saddle solve (module docstring).  ``solver.stats`` counts."""
+        if self.K is None:
+            raise ValueError("Augmented.solve: its tangent K' was dropped (drop_tangent)")
         for k in STATS:
             solver.stats.setdefault(k, 0)
         solver.stats["saddle_augmented"] += 1

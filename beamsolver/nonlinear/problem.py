@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..model import contributions
+from ..model import buffers, contributions
 from ..assembly.system import System
 from ..errors import InputError
 from . import augmented as augmented_, bordered as bordered_, condense as condense_
@@ -64,8 +64,18 @@ class Evaluation:
 
     def drop_tangent(self):
         """Forget the tangent data (``kvals``, ``extra``) once it is factorised: the contributions'
-        buffers they hold (``contact.system``'s tangent pool) can then serve the next evaluation."""
+        buffers they hold (``contact.system``'s tangent pool) can then serve the next evaluation.  Exact
+        stick: ``K'`` and ``A`` of ``Problem.augmented_system`` too (``A`` lives on in its factor; ``K'`` is
+        freed with the ``augmented.Augmented``'s own ``drop_tangent``: 0.3 GB on the 0.6 m rope during the
+        line search's trial); ``augmented_system`` of this evaluation is then an error.  A large evaluation
+        (``buffers.RELEASE_MIN_VALUES`` tangent values) lets the pools' idle buffers go (``buffers.release_idle``)."""
+        large = self.kvals is not None and self.kvals.size >= buffers.RELEASE_MIN_VALUES
         self.kvals = self.extra = None
+        if self.mult is not None:
+            for k in ("Kp", "A"):
+                self.mult.pop(k, None)
+        if large:
+            buffers.release_idle()
 
 
 class Problem:
@@ -363,6 +373,8 @@ class Problem:
         idle = (free_row <= IDLE * max(free_row.max(initial=0.0), 1e-300)) & \
             (own <= IDLE * max(own.max(initial=0.0), 1e-300))
         first = "E" not in mu
+        if not first and "Kp" not in mu:
+            raise ValueError("Problem.augmented_system: the evaluation's tangent was dropped (Evaluation.drop_tangent)")
         f = self._force_rhs(ev, dz_c, sp)        # (before an augmentation in the values, which the coupling reads)
         if first:
             Kp = mu["Kp"] = self.tangent(ev)

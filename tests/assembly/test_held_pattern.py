@@ -188,3 +188,36 @@ def test_pardiso_analysis_only_when_the_held_pattern_grows():
         assert np.abs(A @ x - b).max() <= 1e-10 * np.abs(b).max()
         counts.append(solver.stats["analyses"])
     assert counts == [1, 1, 2, 2]
+
+
+def test_tangents_share_the_patterns_index_arrays():
+    """The held tangents (and exact stick's ``A = K' + Kq E Kl``, ``System.add_products``) hold the pattern's own
+    ``indices`` / ``indptr``, not copies (issue 30: one index array less on the 0.6 m rope); a factorisation and
+    solve with PARDISO leaves them as they were, and the values are those of a tangent on copied arrays."""
+    from beamsolver.model.blocks import Blocks
+    from beamsolver.nonlinear import linsolve
+    s = _twisted_pair_system(True).system
+    rng = np.random.default_rng(5)
+    free = np.flatnonzero(s.is_rep & (s.kind == 0))
+    pairs = rng.choice(free, size=(40, 4))
+    kvals = rng.standard_normal(s.group_kslices[-1] + 36 * len(s.block_nodes))
+    K = rng.standard_normal((40, 24, 24))
+    _, extra, _, _ = s.assemble_blocks(s.poses0, Blocks(pairs, np.zeros((40, 24)), K))
+    T = s.matrix(kvals, extra)
+    p = s.held_pattern
+    assert T.indices is p.indices and T.indptr is p.indptr
+    kept = p.indices.copy(), p.indptr.copy()
+    dofs = 6 * np.repeat(pairs[:, :2], 6, axis=1) + np.tile(np.arange(6), 2)
+    A = s.add_products(T, dofs, rng.standard_normal((40, 12)), rng.standard_normal((40, 12)), rng.random(40))
+    assert A is not None and A.indices is p.indices and A.indptr is p.indptr
+    again = s.matrix(kvals, extra)
+    assert s.held_pattern is p and again.indices is p.indices and np.array_equal(again.data, T.data)
+    if "pardiso" in linsolve.available():
+        col = np.repeat(np.arange(s.n_free), np.diff(A.indptr))
+        A.data[:] = np.where(A.indices == col, 10.0, 1e-3 * rng.standard_normal(A.nnz))
+        b = rng.standard_normal(s.n_free)
+        solver = linsolve.Solver("pardiso", lagged=False)
+        x = solver.factorize(A).solve(b)
+        assert np.abs(A @ x - b).max() <= 1e-10 * np.abs(b).max()
+        solver.close()
+    assert np.array_equal(p.indices, kept[0]) and np.array_equal(p.indptr, kept[1])

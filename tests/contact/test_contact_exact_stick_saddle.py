@@ -158,3 +158,60 @@ def test_newton_through_the_augmented_solve_takes_the_direct_path(monkeypatch, s
     assert [s["iterations"] for s in aug.stats] == [s["iterations"] for s in direct.stats]
     x0, x1 = direct.poses[-1][:, :3, 3], aug.poses[-1][:, :3, 3]
     assert np.abs(x1 - x0).max() <= 1e-9 * np.abs(x0).max()
+
+
+def test_dropping_the_tangent_frees_k_prime(monkeypatch):
+    """The evaluation's tangent values are dropped once ``K'`` and ``A`` are built, before the factorisation
+    (``newton.DROP_BEFORE_SOLVE``), and once the Newton system is solved (``Newton.iterate``: ``Augmented.
+    drop_tangent``) nothing holds exact stick's tangent ``K'`` any more, before the line search's trial (issue 30:
+    the 0.6 m rope's peak; ``A`` lives on in its factor): the shear lag's iterations and poses bit for bit as with
+    the tangent kept to the end; the evaluation's Newton system and the solve are then errors that say so."""
+    import weakref
+    import shear_lag
+    from beamsolver.nonlinear import newton
+    from beamsolver.nonlinear.problem import Problem
+    monkeypatch.setattr(augmented, "MIN_UNKNOWNS", 0)
+    monkeypatch.setattr(newton, "DROP_BEFORE_SOLVE", False)
+    kept = shear_lag.main(n_wire=20)[0]
+    monkeypatch.setattr(newton, "DROP_BEFORE_SOLVE", True)
+    seen = dict(solved=0, freed=0, dropped=0)
+    refs, evs = [], []
+    solve = augmented.Augmented.solve
+    system = Problem.augmented_system
+
+    def built(self, ev, dz_c=None):
+        evs.append(ev)
+        return system(self, ev, dz_c)
+
+    def tracked(self, solver):
+        seen["dropped"] += evs.pop().kvals is None        # (``DROP_BEFORE_SOLVE``: before the factorisation)
+        x = solve(self, solver)
+        refs.append(weakref.ref(self.K))
+        seen["solved"] += 1
+        return x
+    trial = Problem.multiplier_trial
+
+    def check(self, s):
+        if s != 0.0:           # (``Newton._normal_branches`` sets 0 before its second direction: ``K'`` in use)
+            seen["freed"] += sum(r() is None for r in refs)
+            refs.clear()
+        return trial(self, s)
+    monkeypatch.setattr(augmented.Augmented, "solve", tracked)
+    monkeypatch.setattr(Problem, "multiplier_trial", check)
+    monkeypatch.setattr(Problem, "augmented_system", built)
+    dropped = shear_lag.main(n_wire=20)[0]
+    assert seen["solved"] >= 8 and seen["freed"] == seen["solved"] == seen["dropped"], seen
+    assert [s["iterations"] for s in dropped.stats] == [s["iterations"] for s in kept.stats]
+    assert np.array_equal(dropped.poses, kept.poses)            # the same bits
+    monkeypatch.undo()
+
+    problem, H, slave = _scene("stick")
+    (dq, dl), ev, aug = _augmented(problem, H, None)
+    ev.drop_tangent()
+    assert "Kp" not in ev.mult and "A" not in ev.mult
+    with pytest.raises(ValueError, match="dropped"):
+        problem.augmented_system(ev)
+    aug.drop_tangent()
+    assert aug.K is None and aug.factor is not None
+    with pytest.raises(ValueError, match="dropped"):
+        aug.solve(linsolve.Solver())

@@ -51,3 +51,43 @@ def test_without_reuse_every_take_is_new(monkeypatch):
     b = pool.take((5, 3))
     assert _base(b).shape == (5, 3)
     assert len(pool.buffers) == 2 and pool.buffers[1].__array_interface__["data"][0] == address
+
+
+@pytest.mark.skipif(not REUSE_BUFFERS, reason="buffers are not reused on this Python")
+def test_release_drops_only_the_buffers_nothing_uses():
+    """``BufferPool.release`` (``buffers.release_idle``, issue 30: the 0.6 m rope's idle tangent blocks during a
+    line search's trial) drops the kept buffers without a live view and keeps the others, with their values."""
+    from beamsolver.model import buffers
+    pool = BufferPool()
+    a = pool.take((8, 24, 24))
+    a[...] = 2.0
+    b = pool.take((4, 24, 24))
+    del b
+    assert len(pool.buffers) == 2
+    assert pool.release() == 4 * 24 * 24 * 8 and len(pool.buffers) == 1 and _base(a) is pool.buffers[0]
+    np.testing.assert_array_equal(a, 2.0)
+    assert pool.release() == 0
+    del a
+    assert buffers.release_idle() >= 9 * 24 * 24 * 8 and pool.buffers == []      # (a: 8 + an eighth)
+
+
+def test_released_buffers_give_the_same_bits(monkeypatch):
+    """The shear lag with exact stick (31 Newton systems) with the pools' idle buffers released at every
+    ``Evaluation.drop_tangent`` (``RELEASE_MIN_VALUES`` 0; the default releases from 4e6 tangent values only) and
+    the mmap threshold fixed: the same iterations and the same poses, bit for bit, as with the buffers kept."""
+    import shear_lag
+    from beamsolver.model import buffers
+    calls = []
+    release = buffers.release_idle
+
+    def counted():
+        calls.append(release())
+        return calls[-1]
+    kept = shear_lag.main(n_wire=20)[0]
+    assert not calls
+    monkeypatch.setattr(buffers, "RELEASE_MIN_VALUES", 0)
+    monkeypatch.setattr(buffers, "release_idle", counted)
+    released = shear_lag.main(n_wire=20)[0]
+    assert len(calls) >= 30 and sum(calls) > 0
+    assert [s["iterations"] for s in released.stats] == [s["iterations"] for s in kept.stats]
+    assert np.array_equal(released.poses, kept.poses)
