@@ -98,6 +98,7 @@ def test_joined_through_a_free_node_are_not_compared():
     assert _kinds(m) == []
 
 
+@pytest.mark.slow
 def test_segment_distances_against_sampling():
     rng = np.random.default_rng(3)
     a0, a1, b0, b1 = (rng.standard_normal((200, 3)) for _ in range(4))
