@@ -210,16 +210,7 @@ class ContactSystem(Contribution):
         self.kernel = _default["kernel"] if kernel is None else kernel
         model = system.model
         n_el = system.n_elements
-        self.el_beam = np.empty(n_el, dtype=int)
-        self.el_radius = np.empty(n_el)
-        for b in model.beams:
-            self.el_beam[b.elements] = b.id
-            self.el_radius[b.elements] = b.section.radius
-        self.el_last = np.zeros(n_el, dtype=bool)
-        self.el_first = np.zeros(n_el, dtype=bool)
-        for b in model.beams:
-            self.el_last[b.elements[-1]] = True
-            self.el_first[b.elements[0]] = True
+        self.el_beam, self.el_radius, self.el_first, self.el_last = self._element_tables(model, n_el)
         self.n_beams = len(model.beams)
         # element end nodes with the nodes of a joint merged: elements meeting there never pair
         self._joint_enodes = rules.joint_nodes(system.rep, system.poses0[:, :3, 3],
@@ -290,6 +281,18 @@ class ContactSystem(Contribution):
         self._adjusted = adjust.EMPTY
         self._adjusted = self._reference_adjustment(system.poses0)
         self.adjusted = adjust.summary(self._adjusted)    # count and largest overlap adjusted away
+
+    @staticmethod
+    def _element_tables(model, n_el):
+        """Per element ``(n_el,)``: its beam's id, section radius, and whether it is its beam's first / last."""
+        beam, radius = np.empty(n_el, dtype=int), np.empty(n_el)
+        first, last = np.zeros(n_el, dtype=bool), np.zeros(n_el, dtype=bool)
+        for b in model.beams:
+            beam[b.elements] = b.id
+            radius[b.elements] = b.section.radius
+            first[b.elements[0]] = True
+            last[b.elements[-1]] = True
+        return beam, radius, first, last
 
     def _segment_slots(self, system):
         """Key slots of line segments per slave element: more than the master elements one slave element

@@ -274,6 +274,24 @@ class Newton:
             problem.multiplier_step(ev, dlam)
         return lu, dzf
 
+    def _direction(self, ev, H, t, constraint):
+        """The constraint's Newton direction ``(lu, dzf)`` at the iterate ``ev``; with exact stick near the solution,
+        with the normal law's active set (``_normal_branches``)."""
+        lu, dzf = constraint.direction(self, ev, H, t)
+        if NORMAL_SWITCHES and ev.mult is not None and constraint.final and not constraint.moves \
+                and (self.near or not NORMAL_NEAR):
+            lu, dzf = self._normal_branches(ev, H, t, lu, dzf)
+        return lu, dzf
+
+    @staticmethod
+    def _drop(ev, lu):
+        """The tangent of ``ev`` is factorised in ``lu``: its values (the contact's (m, 24, 24) blocks) are not needed
+        any more, and freeing them lets the next evaluation reuse their memory (exact stick's K' too: only the factor
+        of A is kept)."""
+        ev.drop_tangent()
+        if isinstance(lu, augmented_.Augmented):
+            lu.drop_tangent()
+
     def _normal_branches(self, ev, H, t, lu, dzf):
         """The Newton direction ``(lu, dzf)`` at ``(H, t)`` with the points that press at ``H`` but not at the full
         step linearised on the normal law's open branch (``Problem.force_open``), again until no more open (at most
@@ -449,17 +467,10 @@ class Newton:
                     stats_extra["damped"] = damped_its
                 return self._converged(H, t, ev, constraint, dict(iterations=it, residuals=residuals, **stats_extra))
             if dzf is None:
-                lu, dzf = constraint.direction(self, ev, H, t)
-                if NORMAL_SWITCHES and ev.mult is not None and constraint.final and not constraint.moves \
-                        and (self.near or not NORMAL_NEAR):
-                    lu, dzf = self._normal_branches(ev, H, t, lu, dzf)
+                lu, dzf = self._direction(ev, H, t, constraint)
             if it == 0 and self.watch_sign and constraint.watch_sign:
                 self._watch_first_tangent(lu)
-            # the tangent of ``ev`` is factorised: its values (the contact's (m, 24, 24) blocks) are not
-            # needed any more, and freeing them lets the next evaluation reuse their memory
-            ev.drop_tangent()
-            if isinstance(lu, augmented_.Augmented):
-                lu.drop_tangent()               # (exact stick's K': only the factor of A is kept)
+            self._drop(ev, lu)
             if ev.mult is not None:
                 problem.multiplier_trial(1.0)
             if constraint.moves:
