@@ -365,6 +365,7 @@ def gauss_projections(H, enodes, h, e, m, xg, kind, c2, reach, iterations=8, win
     return row[:k], gp[:k], out2[:k], dist[:k]
 
 
+SEGMENT_SNAP = 1e-4 # segment ends this close to the slave element's ends are snapped to them
 PLANE_TOL = 1e-14   # segment ends: Newton stops when its step is this small (parameter units)
 
 
@@ -389,8 +390,18 @@ def _plane_through(RA, xA, u, w, xB, xN, iterations):
     return xi
 
 
+@jit_callee
+def _snap(s, snap):
+    """``s`` within ``snap`` of the slave element's ends taken as the end itself."""
+    if s < snap:
+        return 0.0
+    if s > 1.0 - snap:
+        return 1.0
+    return s
+
+
 @jit
-def _segment_bounds(H, enodes, h, e, m, seg, iterations, lo, hi):
+def _segment_bounds(H, enodes, h, e, m, seg, iterations, lo, hi, snap):
     for k in range(len(e)):
         lo[k], hi[k] = 0.0, 1.0
         if not seg[k]:
@@ -402,8 +413,8 @@ def _segment_bounds(H, enodes, h, e, m, seg, iterations, lo, hi):
         _, xB2 = _pose_of(H, enodes[m[k], 1])
         a = _plane_through(RA1, xA1, u1, w1, xB1, xA2, iterations)
         b = _plane_through(RA1, xA1, u1, w1, xB1, xB2, iterations)
-        lo[k] = min(max(min(a, b), 0.0), 1.0)
-        hi[k] = min(max(max(a, b), 0.0), 1.0)
+        lo[k] = _snap(min(max(min(a, b), 0.0), 1.0), snap)
+        hi[k] = _snap(min(max(max(a, b), 0.0), 1.0), snap)
 
 
 def segment_bounds(H, enodes, h, e, m, seg, iterations=8):
@@ -416,7 +427,8 @@ def segment_bounds(H, enodes, h, e, m, seg, iterations=8):
     c = np.ascontiguousarray
     n = len(e)
     lo, hi = np.empty(n), np.empty(n)
-    _segment_bounds(H, enodes, c(h, dtype=float), c(e), c(m), c(seg, dtype=np.bool_), int(iterations), lo, hi)
+    _segment_bounds(H, enodes, c(h, dtype=float), c(e), c(m), c(seg, dtype=np.bool_), int(iterations), lo, hi,
+                    float(SEGMENT_SNAP))
     return lo, hi
 
 

@@ -101,6 +101,29 @@ def test_segment_bounds_on_straight_beams_are_the_master_nodes():
     assert abs(np.sum(hi - lo) - 7.0) <= 1e-12                # the slave covered once
 
 
+def test_segment_ends_next_to_a_slave_node_snap_to_it(monkeypatch):
+    """A master node within ``SEGMENT_SNAP`` of a slave node (equal meshes: the twisted pair's) gives no sliver
+    segment: the bound is the slave node itself, the neighbour's segment covers the element, the slave is still
+    covered once; without the snap the sliver is there."""
+    from beamsolver.contact import projection
+    xm = np.linspace(0.0, 1.0, 11)
+    xm[3] = 2.0 / 7.0 + 3e-5 / 7.0          # a master node 3e-5 element lengths inside slave element 2
+    system, slave, master = _model_of(np.linspace((0, 0, 0.02), (1, 0, 0.02), 8),
+                                      np.stack([xm, 0 * xm, 0 * xm], axis=1))
+    H, en = system.poses0, system.enodes
+    h = element_twists(H, en)
+    e, m = np.meshgrid(slave.elements, master.elements, indexing="ij")
+    e, m = e.ravel(), m.ravel()
+    for snap, slivers in ((0.0, 1), (projection.SEGMENT_SNAP, 0)):
+        monkeypatch.setattr(projection, "SEGMENT_SNAP", snap)
+        lo, hi = segment_bounds(H, en, h, e, m, np.ones(len(e), dtype=bool))
+        on = hi > lo
+        assert int(np.sum(on & (hi - lo < 1e-4))) == slivers
+        assert abs(np.sum(hi - lo) - 7.0) <= 1e-12
+        j = (e - slave.elements[0] == 2) & on            # element 2 also holds master node 4 (at 0.8)
+        assert j.sum() == 2 + slivers and lo[j].min() == 0.0 and hi[j].max() == 1.0
+
+
 def test_segments_tile_a_curved_slave_element():
     """On helices (curved, twisted elements) the segments of one slave element against consecutive
     master elements meet (the plane through their shared node) and cover it once."""
