@@ -1175,7 +1175,10 @@ class ContactSystem(Contribution):
     def force_open(self, keys):
         """Evaluate the points ``keys`` (sorted; None: none) on the normal law's open branch (no normal force, no
         stiffness): Newton's active-set step for the normal law (``nonlinear.newton.NORMAL_SWITCHES``)."""
-        self._forced = None if keys is None else np.asarray(keys, dtype=np.int64)
+        forced = None if keys is None else np.asarray(keys, dtype=np.int64)
+        if forced is None and self._forced is None:
+            return                 # nothing forced before nor now: the kept blocks stay valid (``_local_blocks``)
+        self._forced = forced
         self._blocks = None
 
     # ------------------------------------------------------------ multipliers as Newton unknowns

@@ -60,6 +60,8 @@ NORMAL_SWITCHES = 4                  # exact stick: Newton directions again with
                                      # linearised open (the normal law's active set, ``_normal_branches``; 0: off.
                                      # The rope pieces' loaded steps 31 -> 14 and failed -> 19 iterations, the contact
                                      # examples and the strand cycle within 1 %: docs/theory_mortar.md 3d)
+PRESSED_AT_TRIAL = True              # ... the full step's pressed points evaluated with the line search's multipliers
+                                     # (its forces-only evaluation reused by the trial; issue 30, session 9)
 NORMAL_NEAR = True                   # ... only near the solution (``near``: the residual cut LS_NEAR-fold)
 INNER_UNSETTLED = "last"             # branches still changing after INNER_SWITCHES: "last" solve or "plain" Newton's
                                      # (an option: twisted pair 244 -> 195, shear lag 39 -> 22 iterations with 8, but
@@ -304,7 +306,9 @@ class Newton:
         forced = [np.zeros(0, dtype=np.int64) for _ in now]
         try:
             for _ in range(NORMAL_SWITCHES):
-                problem.multiplier_trial(0.0)
+                # the multipliers of the line search's full step: the normal law does not depend on them, and the
+                # full step's evaluation (forces only) then serves the line search's first trial when nothing opens
+                problem.multiplier_trial(1.0 if PRESSED_AT_TRIAL else 0.0)
                 then = problem.pressed_points(problem.update(H, self.full(dzf)))
                 opened = [np.setdiff1d(np.setdiff1d(a, b), f) if a is not None else f[:0]
                           for a, b, f in zip(now, then, forced)]
