@@ -269,7 +269,7 @@ class ContactSystem(Contribution):
         self._geo = self._geo_prev = None    # (poses, element twists) of the last evaluation / of H_prev
         self._blocks = None        # (poses, local blocks) of the last evaluation, for the same state
         self._forced = None        # keys of points linearised on the normal law's open branch (``force_open``)
-        self._secant = None        # (keys, gaps) of points linearised on the parabola's secant (``force_secant``)
+        self._secant = None        # (keys, gaps, reach): points linearised on the parabola's secant (``force_secant``)
         self._skipped = 0          # points of open groups the last evaluation left out (``_open_points``)
         self._full = False         # evaluate every point (``_state``: commit, updates, results)
         self._far = None           # (pairs, far beyond the normal law's band) of the last ``_active``
@@ -1195,10 +1195,10 @@ class ContactSystem(Contribution):
 
     def force_secant(self, keys, gaps=None, reach=1.0):
         """Evaluate the points ``keys`` (sorted; None: none) on the secant of the normal law's smoothing parabola from
-        their traction at the gaps ``gaps`` to the share ``reach`` of the way to its zero-force end (the gap ``w``), until
-        called again: the same traction there, ``1 / (2 reach)`` times the stiffness.  Newton's step then takes a point
-        whose traction falls to zero that far in one iteration where the parabola's tangent halves its distance to the
-        end (a double root: ``newton.START_SECANT``)."""
+        their traction at the gaps ``gaps`` to the share ``reach`` of the way to its zero-force end (the gap ``w``),
+        until called again: the same traction there, ``1 / (2 reach)`` times the stiffness.  Newton's step then takes
+        a point whose traction falls to zero that far in one iteration where the parabola's tangent halves its distance
+        to the end (a double root: ``newton.START_SECANT``)."""
         if keys is None and self._secant is None:
             return
         self._secant = None if keys is None else (np.asarray(keys, dtype=np.int64), np.asarray(gaps, dtype=float),

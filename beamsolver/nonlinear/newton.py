@@ -62,8 +62,9 @@ NORMAL_SWITCHES = 4                  # exact stick: Newton directions again with
                                      # examples and the strand cycle within 1 %: docs/theory_mortar.md 3d)
 PRESSED_AT_TRIAL = True              # ... the full step's pressed points evaluated with the line search's multipliers
                                      # (its forces-only evaluation reused by the trial; issue 30, session 9)
-START_SWITCHES = True                # ... at t_start (step 0, ``Newton.start``) from the first iteration, with or without
-                                     # multipliers (a touching start's lift-off front: main job's step 0 10 -> 8)
+START_SWITCHES = True                # ... at t_start (step 0, ``Newton.start``) from the first iteration, with or
+                                     # without multipliers (a touching start's lift-off front: main job's step 0
+                                     # 10 -> 8 iterations, 4 with START_SECANT)
 START_SECANT = True                  # ... and there the points on the smoothing parabola whose traction the full step
 SECANT_SHARE = 0.3                   # cuts to at most this share linearised on its secant to its zero-force end (the
                                      # parabola's double root, which Newton's tangent only halves its distance to:
@@ -310,8 +311,8 @@ class Newton:
         ``NORMAL_SWITCHES`` times): a lift-off front moves by several nodes in one Newton iteration.  At t_start
         (``START_SECANT``) the points on the smoothing parabola that press at both but whose traction the full step
         cuts to ``SECANT_SHARE`` or less are linearised, once in the step, on the parabola's secant to ``SECANT_REACH``
-        of the way to its zero-force end (``Problem.force_secant``): the parabola's tangent only halves their distance to
-        that double root per iteration.  The residual, line search and convergence test are the exact law's."""
+        of the way to its zero-force end (``Problem.force_secant``): the parabola's tangent only halves their distance
+        to that double root per iteration.  The residual, line search and convergence test are the exact law's."""
         problem = self.problem
         secant = self.start and START_SECANT
         now = problem.pressed_points(H, law=secant)
@@ -355,9 +356,9 @@ class Newton:
 
     @staticmethod
     def _crawling(now, then, forced, on_secant):
-        """Sorted keys of ``on_secant`` and of the points of ``now`` (``(keys, lam_n, gap, parabola)`` at the iterate) on
-        the parabola whose traction at the full step (``then``, the same form) is at most ``SECANT_SHARE`` of theirs,
-        not ``forced`` open (``_normal_branches``)."""
+        """Sorted keys of ``on_secant`` and of the points of ``now`` (``(keys, lam_n, gap, parabola)`` at the
+        iterate) on the parabola whose traction at the full step (``then``, the same form) is at most
+        ``SECANT_SHARE`` of theirs, not ``forced`` open (``_normal_branches``)."""
         ka, la, _, pa = now
         kb, lb = then[0], then[1]
         i = np.minimum(np.searchsorted(kb, ka), max(len(kb) - 1, 0))

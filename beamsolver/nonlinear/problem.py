@@ -495,9 +495,9 @@ class Problem:
                 for c in self.contributions]
 
     def force_secant(self, keys, gaps=None, reach=1.0):
-        """Evaluate the points ``keys`` (per contribution, as ``pressed_points``; None: none) at the gaps ``gaps`` on the
-        secant of the normal law's smoothing parabola to the share ``reach`` of the way to its zero-force end until called again
-        (``ContactSystem.force_secant``)."""
+        """Evaluate the points ``keys`` (per contribution, as ``pressed_points``; None: none) at the gaps ``gaps`` on
+        the secant of the normal law's smoothing parabola to the share ``reach`` of the way to its zero-force end until
+        called again (``ContactSystem.force_secant``)."""
         for k, c in enumerate(self.contributions):
             if hasattr(c, "force_secant"):
                 c.force_secant(None if keys is None else keys[k], None if keys is None else gaps[k], reach)
