@@ -269,6 +269,7 @@ class ContactSystem(Contribution):
         self._geo = self._geo_prev = None    # (poses, element twists) of the last evaluation / of H_prev
         self._blocks = None        # (poses, local blocks) of the last evaluation, for the same state
         self._forced = None        # keys of points linearised on the normal law's open branch (``force_open``)
+        self._secant = None        # (keys, gaps, reach): points linearised on the parabola's secant (``force_secant``)
         self._skipped = 0          # points of open groups the last evaluation left out (``_open_points``)
         self._full = False         # evaluate every point (``_state``: commit, updates, results)
         self._far = None           # (pairs, far beyond the normal law's band) of the last ``_active``
@@ -613,6 +614,8 @@ class ContactSystem(Contribution):
             off = _member(key, self._forced)
             p["penalty"] = np.where(off, 0.0, p["penalty"])
             p["multiplier"] = np.where(off, 0.0, p["multiplier"])
+        if self._secant is not None:     # the smoothing parabola's secant to its zero-force end (``force_secant``)
+            self._secant_law(key, p)
         hf = self.history.frictional(p, key, P.e[sel], P.m[sel])
         hist = self.history.friction
         # a point pair whose crossing moved to a neighbouring element pair keeps the
@@ -1164,19 +1167,61 @@ class ContactSystem(Contribution):
         return b, info
 
     # ------------------------------------------------------------ the normal law's branches (an option)
-    def pressed_points(self, H):
-        """Sorted keys of the points whose normal law presses at poses ``H`` (``lam_n > 0``)."""
+    def pressed_points(self, H, law=False):
+        """Sorted keys of the points whose normal law presses at poses ``H`` (``lam_n > 0``); with ``law``,
+        ``(keys, lam_n, gap, parabola)`` in that order, ``parabola`` where the traction is on the smoothing parabola
+        (``0 < lam_n < penalty smoothing``, docs/theory/contact_laws.md 7.2)."""
         blocks = self._local_blocks(H, False)
         if blocks is None:
-            return np.zeros(0, dtype=np.int64)
-        P, sel, _, _, _, out = blocks
-        return np.sort(P.key[sel][out["lam_n"] > 0])
+            e = np.zeros(0, dtype=np.int64)
+            return (e, np.zeros(0), np.zeros(0), np.zeros(0, dtype=bool)) if law else e
+        P, sel, p, _, _, out = blocks
+        on = out["lam_n"] > 0
+        key = P.key[sel][on]
+        order = np.argsort(key)
+        if not law:
+            return key[order]
+        lam = out["lam_n"][on][order]
+        return key[order], lam, out["gap"][on][order], lam < (p["penalty"] * p["smoothing"])[on][order]
 
     def force_open(self, keys):
         """Evaluate the points ``keys`` (sorted; None: none) on the normal law's open branch (no normal force, no
         stiffness): Newton's active-set step for the normal law (``nonlinear.newton.NORMAL_SWITCHES``)."""
-        self._forced = None if keys is None else np.asarray(keys, dtype=np.int64)
+        forced = None if keys is None else np.asarray(keys, dtype=np.int64)
+        if forced is None and self._forced is None:
+            return                 # nothing forced before nor now: the kept blocks stay valid (``_local_blocks``)
+        self._forced = forced
         self._blocks = None
+
+    def force_secant(self, keys, gaps=None, reach=1.0):
+        """Evaluate the points ``keys`` (sorted; None: none) on the secant of the normal law's smoothing parabola from
+        their traction at the gaps ``gaps`` to the share ``reach`` of the way to its zero-force end (the gap ``w``),
+        until called again: the same traction there, ``1 / (2 reach)`` times the stiffness.  Newton's step then takes
+        a point whose traction falls to zero that far in one iteration where the parabola's tangent halves its distance
+        to the end (a double root: ``newton.START_SECANT``)."""
+        if keys is None and self._secant is None:
+            return
+        self._secant = None if keys is None else (np.asarray(keys, dtype=np.int64), np.asarray(gaps, dtype=float),
+                                                  float(reach))
+        self._blocks = None
+
+    def _secant_law(self, key, p):
+        """``force_secant``'s law in the kernel parameters ``p`` of the points ``key``: the parabola
+        ``(x + W)^2 / (4 W)``, ``x = m - eps g``, ``W = eps w``, through the point's traction at its gap ``g0`` with
+        ``k = 1 / (2 reach)`` times its slope is the parabola of ``W' = W / k^2`` with ``x' + W' = (x + W) / k``:
+        smoothing ``w / k^2`` and multiplier ``(x0 + W) / k - W / k^2 + eps g0``, ``x0 = m - eps g0``."""
+        keys, gaps, reach = self._secant
+        if not len(keys):
+            return
+        i = np.minimum(np.searchsorted(keys, key), len(keys) - 1)
+        on = keys[i] == key
+        if not on.any():
+            return
+        pen, w, m = p["penalty"], p["smoothing"], p["multiplier"]
+        k = 0.5 / reach
+        W, pg = pen * w, pen * gaps[i]
+        p["multiplier"] = np.where(on, (m - pg + W) / k - W / k**2 + pg, m)
+        p["smoothing"] = np.where(on, w / k**2, w)
 
     # ------------------------------------------------------------ multipliers as Newton unknowns
     def _sliding_c(self, m):

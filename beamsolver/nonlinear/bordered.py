@@ -90,14 +90,14 @@ class Bordered:
     def _store(self, K, rows_red, nf, c, g, N, u, posK, ub, inv, iq, il):
         """Keep the pattern: ``u`` the sorted keys ``col N + row`` of the entries, ``posK`` where ``K``'s go, ``ub``
         where the border's distinct ones go and ``inv`` which of them each border entry (``_coo``'s order) is."""
-        indptr = np.zeros(N + 1, dtype=np.int32)
-        np.cumsum(np.bincount(u // N, minlength=N), out=indptr[1:])
+        indptr, indices = np.zeros(N + 1, dtype=np.int32), np.empty(len(u), dtype=np.int32)
+        _split_keys(u, N, indptr, indices)
         nlq = len(iq) + len(il)
         lq = inv[len(iq):nlq]
         ulq, lq_inv = np.unique(lq, return_inverse=True)
-        self._p = dict(nf=nf, c=c, indptr_out=indptr, indices=(u % N).astype(np.int32), nnz=len(u), N=N,
+        self._p = dict(nf=nf, c=c, indptr_out=indptr, indices=indices, nnz=len(u), N=N,
                        posK=posK, border=ub, inv=inv, iq=iq, il=il,
-                       lq_rows=(u[ub[ulq]] % N) - nf, lq_entries=ub[ulq],
+                       lq_rows=indices[ub[ulq]].astype(np.int64) - nf, lq_entries=ub[ulq],
                        ll=ub[inv[nlq:]].reshape(g, c, c), n_border=len(inv),
                        indptr=K.indptr, kindices=K.indices, rows_red=rows_red.copy())
         self.builds += 1
@@ -151,6 +151,19 @@ def _merge(a, b, pa, pb, u):
             pb[j] = k
             u[k] = b[j]
             j += 1
+
+
+@jit
+def _split_keys(u, N, indptr, indices):
+    """The CSC pattern of the sorted keys ``u`` (``col N + row``): ``indices`` the rows ``u % N`` and ``indptr``
+    ``(N + 1,)`` (zeros in) the columns' starts, in one pass (``np.bincount(u // N)`` and ``u % N``: 0.08 ms of a
+    build's 0.22 on the main job's bordered tangents, issue 30 session 9)."""
+    for k in range(len(u)):
+        col = u[k] // N
+        indices[k] = u[k] - col * N
+        indptr[col + 1] += 1
+    for j in range(N):
+        indptr[j + 1] += indptr[j]
 
 
 def bmat(K, rows_red, Kql, Klq, Kll, R, Lam, C):

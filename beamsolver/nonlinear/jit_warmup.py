@@ -326,13 +326,14 @@ def _exact_stick_callees():
     """The exact stick path's compiled helpers that the stand-in's data do not reach (they run where some pairs are
     not folded into their groups, where a group's components are eliminated and in the Newton system), on empty
     arrays of the solve's types (``contact.mortar_jit.subtract_indexed``, ``nonlinear.condense._schur``, the bordered
-    pattern's merge ``nonlinear.bordered._merge``)."""
+    pattern's merge and split ``nonlinear.bordered._merge``, ``_split_keys``)."""
     from ..contact import mortar_jit
     from . import bordered, condense
     mortar_jit.subtract_indexed(np.zeros((0, 24, 24)), np.zeros((0, 24, 24)), np.zeros(0, dtype=np.int64))
     condense._schur(np.zeros(0), 0, np.zeros((0, 24, 3)), np.zeros((0, 3, 24)), np.zeros((0, 3)))
     none = np.zeros(0, dtype=np.int64)
     bordered._merge(none, none, none, none, none)
+    bordered._split_keys(none, 1, np.zeros(2, dtype=np.int32), np.zeros(0, dtype=np.int32))
 
 
 def _stand_in(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames):

@@ -60,6 +60,17 @@ NORMAL_SWITCHES = 4                  # exact stick: Newton directions again with
                                      # linearised open (the normal law's active set, ``_normal_branches``; 0: off.
                                      # The rope pieces' loaded steps 31 -> 14 and failed -> 19 iterations, the contact
                                      # examples and the strand cycle within 1 %: docs/theory_mortar.md 3d)
+PRESSED_AT_TRIAL = True              # ... the full step's pressed points evaluated with the line search's multipliers
+                                     # (its forces-only evaluation reused by the trial; issue 30, session 9)
+START_SWITCHES = True                # ... at t_start (step 0, ``Newton.start``) from the first iteration, with or
+                                     # without multipliers (a touching start's lift-off front: main job's step 0
+                                     # 10 -> 8 iterations, 4 with START_SECANT)
+START_SECANT = True                  # ... and there the points on the smoothing parabola whose traction the full step
+SECANT_SHARE = 0.3                   # cuts to at most this share linearised on its secant to its zero-force end (the
+                                     # parabola's double root, which Newton's tangent only halves its distance to:
+                                     # docs/theory/contact_laws.md 17.2; ``_normal_branches``) ...
+SECANT_REACH = 1.0 - 2.0 ** -10      # ... aimed at this share of the way: where ten tangent steps end (a beam held by
+                                     # contact alone keeps the stiffness the crawl left it: the contact patch's slave)
 NORMAL_NEAR = True                   # ... only near the solution (``near``: the residual cut LS_NEAR-fold)
 INNER_UNSETTLED = "last"             # branches still changing after INNER_SWITCHES: "last" solve or "plain" Newton's
                                      # (an option: twisted pair 244 -> 195, shear lag 39 -> 22 iterations with 8, but
@@ -178,6 +189,8 @@ class Newton:
         self.least_inc = (np.inf, 0)          # ... or a new shortest full Newton increment (``_verdict``)
         self.status = None                    # exact stick: (keys, stick flags) of the groups at the last iterate
         self.last_evaluation = None           # of the last converged state
+        self.start = False                    # solving at t_start (step 0: ``START_SWITCHES``, ``START_SECANT``)
+        self.secant_done = None               # per contribution, keys of the points the step put on the secant once
         self.reset_timings()
 
     def reset_timings(self):
@@ -278,8 +291,8 @@ class Newton:
         """The constraint's Newton direction ``(lu, dzf)`` at the iterate ``ev``; with exact stick near the solution,
         with the normal law's active set (``_normal_branches``)."""
         lu, dzf = constraint.direction(self, ev, H, t)
-        if NORMAL_SWITCHES and ev.mult is not None and constraint.final and not constraint.moves \
-                and (self.near or not NORMAL_NEAR):
+        if NORMAL_SWITCHES and constraint.final and not constraint.moves and \
+                ((ev.mult is not None and (self.near or not NORMAL_NEAR)) or (self.start and START_SWITCHES)):
             lu, dzf = self._normal_branches(ev, H, t, lu, dzf)
         return lu, dzf
 
@@ -295,29 +308,64 @@ class Newton:
     def _normal_branches(self, ev, H, t, lu, dzf):
         """The Newton direction ``(lu, dzf)`` at ``(H, t)`` with the points that press at ``H`` but not at the full
         step linearised on the normal law's open branch (``Problem.force_open``), again until no more open (at most
-        ``NORMAL_SWITCHES`` times): a lift-off front moves by several nodes in one Newton iteration.  The residual,
-        line search and convergence test are the exact law's."""
+        ``NORMAL_SWITCHES`` times): a lift-off front moves by several nodes in one Newton iteration.  At t_start
+        (``START_SECANT``) the points on the smoothing parabola that press at both but whose traction the full step
+        cuts to ``SECANT_SHARE`` or less are linearised, once in the step, on the parabola's secant to ``SECANT_REACH``
+        of the way to its zero-force end (``Problem.force_secant``): the parabola's tangent only halves their distance
+        to that double root per iteration.  The residual, line search and convergence test are the exact law's."""
         problem = self.problem
-        now = problem.pressed_points(H)
-        if not any(k is not None and len(k) for k in now):
+        secant = self.start and START_SECANT
+        now = problem.pressed_points(H, law=secant)
+        keys = [(k[0] if secant else k) if k is not None else None for k in now]
+        if not any(k is not None and len(k) for k in keys):
             return lu, dzf
         forced = [np.zeros(0, dtype=np.int64) for _ in now]
+        on_secant = [np.zeros(0, dtype=np.int64) for _ in now]
+        # a point goes on the secant once in a step: then it is where ten tangent steps would have taken it, and
+        # Newton's own steps finish (a beam held by contact alone keeps the stiffness that leaves it)
+        done = self.secant_done if self.secant_done is not None else on_secant
         try:
             for _ in range(NORMAL_SWITCHES):
-                problem.multiplier_trial(0.0)
-                then = problem.pressed_points(problem.update(H, self.full(dzf)))
-                opened = [np.setdiff1d(np.setdiff1d(a, b), f) if a is not None else f[:0]
-                          for a, b, f in zip(now, then, forced)]
-                if not any(len(o) for o in opened):
+                # the multipliers of the line search's full step: the normal law does not depend on them, and the
+                # full step's evaluation (forces only) then serves the line search's first trial when nothing opens
+                problem.multiplier_trial(1.0 if PRESSED_AT_TRIAL else 0.0)
+                then = problem.pressed_points(problem.update(H, self.full(dzf)), law=secant)
+                then_keys = [(b[0] if secant else b) if b is not None else None for b in then]
+                opened = [np.setdiff1d(np.setdiff1d(np.setdiff1d(a, b), f), s) if a is not None else f[:0]
+                          for a, b, f, s in zip(keys, then_keys, forced, on_secant)]
+                crawl = [self._crawling(a, b, np.union1d(f, d), s) if secant and a is not None else s
+                         for a, b, f, s, d in zip(now, then, forced, on_secant, done)]
+                grew = [len(c) > len(s) for c, s in zip(crawl, on_secant)]
+                if not any(len(o) for o in opened) and not any(grew):
                     break
                 forced = [np.union1d(f, o) for f, o in zip(forced, opened)]
+                on_secant = crawl
                 problem.force_open(forced)
+                if secant:
+                    problem.force_secant(on_secant, [a[2][np.searchsorted(a[0], c)] if a is not None else None
+                                                     for a, c in zip(now, on_secant)], SECANT_REACH)
                 ev2 = self.evaluate(H, t)
                 lu, dzf = self.direction(ev2)
                 ev2.drop_tangent()
         finally:
             problem.force_open(None)
+            if secant:
+                problem.force_secant(None)
+                self.secant_done = [np.union1d(d, s) for d, s in zip(done, on_secant)]
         return lu, dzf
+
+    @staticmethod
+    def _crawling(now, then, forced, on_secant):
+        """Sorted keys of ``on_secant`` and of the points of ``now`` (``(keys, lam_n, gap, parabola)`` at the
+        iterate) on the parabola whose traction at the full step (``then``, the same form) is at most
+        ``SECANT_SHARE`` of theirs, not ``forced`` open (``_normal_branches``)."""
+        ka, la, _, pa = now
+        kb, lb = then[0], then[1]
+        i = np.minimum(np.searchsorted(kb, ka), max(len(kb) - 1, 0))
+        both = kb[i] == ka if len(kb) else np.zeros(len(ka), dtype=bool)
+        lam1 = np.where(both, lb[i] if len(kb) else 0.0, 0.0)
+        c = both & pa & (lam1 <= SECANT_SHARE * la)
+        return np.union1d(on_secant, np.setdiff1d(ka[c], forced))
 
     def _active_set_direction(self, ev, dz_c=None):
         """``direction`` with the groups' stick / slip branches decided on the linearised problem (exact stick): the
@@ -445,6 +493,7 @@ class Newton:
         residuals = []
         self.crawl, self.full_taken = 0, False
         self.least_inc = (np.inf, 0)         # the shortest full Newton increment of the step and its iteration
+        self.secant_done = None
         if constraint.watch_sign:
             self.indefinite_seen = False
         damped_its = 0

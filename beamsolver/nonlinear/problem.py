@@ -487,10 +487,20 @@ class Problem:
             if f is not None:
                 f()
 
-    def pressed_points(self, H):
+    def pressed_points(self, H, law=False):
         """Per contribution, the sorted keys of its points whose normal law presses at poses ``H`` (None where it has
-        no such points): for ``Newton``'s active set of the normal law (``newton.NORMAL_SWITCHES``)."""
-        return [c.pressed_points(H) if hasattr(c, "pressed_points") else None for c in self.contributions]
+        no such points): for ``Newton``'s active set of the normal law (``newton.NORMAL_SWITCHES``); with ``law``,
+        ``(keys, lam_n, gap, parabola)`` (``ContactSystem.pressed_points``)."""
+        return [(c.pressed_points(H, law) if law else c.pressed_points(H)) if hasattr(c, "pressed_points") else None
+                for c in self.contributions]
+
+    def force_secant(self, keys, gaps=None, reach=1.0):
+        """Evaluate the points ``keys`` (per contribution, as ``pressed_points``; None: none) at the gaps ``gaps`` on
+        the secant of the normal law's smoothing parabola to the share ``reach`` of the way to its zero-force end until
+        called again (``ContactSystem.force_secant``)."""
+        for k, c in enumerate(self.contributions):
+            if hasattr(c, "force_secant"):
+                c.force_secant(None if keys is None else keys[k], None if keys is None else gaps[k], reach)
 
     def force_open(self, keys):
         """Evaluate the points ``keys`` (per contribution, as ``pressed_points``; None: none) on the normal law's open

@@ -242,15 +242,19 @@ class Run:
         # with exact stick's friction, an attempt that stalls (the multipliers' updates alternating between two
         # states, a rope piece: 0.30 / 0.34 for 80 iterations) gives up early: the fallback below solves it
         newton.stall_window = STEP_ZERO_STALL if self.problem.exact_friction(True) else None
+        newton.start = True                 # the normal law's active set and secant from the first iteration
         try:
-            return self.newton_step(t_start)
-        except StepFailed as e:
-            if not self.problem.exact_friction(False):
-                raise
-            failed = e
+            try:
+                return self.newton_step(t_start)
+            except StepFailed as e:
+                if not self.problem.exact_friction(False):
+                    raise
+                failed = e
+            finally:
+                newton.stall_window = None
+            H, ev0, stats = self.newton_step(t_start)
         finally:
-            newton.stall_window = None
-        H, ev0, stats = self.newton_step(t_start)
+            newton.start = False
         note = (f"step 0 (t = {t_start:.6g}): no equilibrium with exact stick's friction ({failed}); found "
                 "without it, friction starts from zero traction at that state")
         log.warning(note)

@@ -739,13 +739,16 @@ def test_a_step_s_first_newton_step_leaves_the_sliding_groups_out_of_their_disk(
     np.testing.assert_allclose(c.iterate_multipliers(keys) - c.history.tangential_multipliers(keys), dLam, rtol=1e-15)
 
 
-def test_a_touching_start_crawling_to_the_normal_law_s_double_root_is_progress_not_a_stall():
-    """Step 0 of the contact patch (touching beams, exact stick's friction): Newton crawls to the smoothed normal
-    law's zero-force end (docs/theory/contact_laws.md 17.2), its scaled residual constant to 10 digits while its
-    increments halve, 11 iterations. The stall window (``steps.STEP_ZERO_STALL`` = 10 iterations) counts a new
-    shortest increment as progress: without it step 0 fell back to a start without friction, whose tangent is
+def test_a_touching_start_crawling_to_the_normal_law_s_double_root_is_progress_not_a_stall(monkeypatch):
+    """Step 0 of the contact patch (touching beams, exact stick's friction) without the parabola's secant
+    (``newton.START_SECANT``, which takes it there in 2: ``test_contact_touching_secant.py``): Newton crawls to the
+    smoothed normal law's zero-force end (docs/theory/contact_laws.md 17.2), its scaled residual constant to 10 digits
+    while its increments halve, 11 iterations. The stall window (``steps.STEP_ZERO_STALL`` = 10 iterations) counts a
+    new shortest increment as progress: without it step 0 fell back to a start without friction, whose tangent is
     singular here (the slave is held along the beams by friction alone)."""
+    from beamsolver.nonlinear import newton
     from beamsolver.stepping import steps
+    monkeypatch.setattr(newton, "START_SECANT", False)
     model, slave, master = contact_patch.build(stick="exact")
     sol = bs.solve(model, **contact_patch.solve_options)
     st = sol.stats[0]

@@ -189,15 +189,15 @@ def test_dropping_the_tangent_frees_k_prime(monkeypatch):
         refs.append(weakref.ref(self.K))
         seen["solved"] += 1
         return x
-    trial = Problem.multiplier_trial
+    drop = newton.Newton._drop
 
-    def check(self, s):
-        if s != 0.0:           # (``Newton._normal_branches`` sets 0 before its second direction: ``K'`` in use)
-            seen["freed"] += sum(r() is None for r in refs)
-            refs.clear()
-        return trial(self, s)
+    def check(ev, lu):
+        # the iteration's Newton system solved (``Newton._normal_branches``' directions too), before the line search
+        drop(ev, lu)
+        seen["freed"] += sum(r() is None for r in refs)
+        refs.clear()
     monkeypatch.setattr(augmented.Augmented, "solve", tracked)
-    monkeypatch.setattr(Problem, "multiplier_trial", check)
+    monkeypatch.setattr(newton.Newton, "_drop", staticmethod(check))
     monkeypatch.setattr(Problem, "augmented_system", built)
     dropped = shear_lag.main(n_wire=20)[0]
     assert seen["solved"] >= 8 and seen["freed"] == seen["solved"] == seen["dropped"], seen

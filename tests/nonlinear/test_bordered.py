@@ -86,3 +86,18 @@ def test_the_merged_pattern_is_the_one_of_a_sort_of_every_entry():
         A, rc = a.matrix(K, rows, Kql, Klq, Kll, R, Lam, C)
         B, rc0 = b.matrix(K, rows, Kql, Klq, Kll, R, Lam, C)
         assert np.array_equal(A.indices, B.indices) and np.array_equal(A.data, B.data) and np.array_equal(rc, rc0)
+
+
+def test_the_pattern_s_split_of_sorted_keys_is_numpy_s():
+    """``_split_keys`` (one compiled pass) gives the rows ``u % N`` and the columns' starts ``cumsum(bincount(u //
+    N))`` of sorted keys ``col N + row``, empty columns (first, inner, last) and no keys included."""
+    rng = np.random.default_rng(5)
+    for N, n in ((7, 0), (7, 12), (40, 300)):
+        cols = np.sort(rng.integers(1, N - 1, n))
+        u = np.unique(cols * N + rng.integers(0, N, n)).astype(np.int64)
+        indptr, indices = np.zeros(N + 1, dtype=np.int32), np.empty(len(u), dtype=np.int32)
+        bordered._split_keys(u, N, indptr, indices)
+        ref = np.zeros(N + 1, dtype=np.int32)
+        np.cumsum(np.bincount(u // N, minlength=N), out=ref[1:])
+        assert np.array_equal(indptr, ref) and np.array_equal(indices, (u % N).astype(np.int32))
+        assert indptr[1] == 0 and indptr[-1] == indptr[-2] == len(u)
