@@ -21,11 +21,13 @@ node graph, ``eoff[e]`` its offset in the node column (the same for the six colu
 import numpy as np
 
 from .._jit import jit, jit_callee
+from . import node_keys
 from .csc import canonical_csc
 
-__all__ = ["HeldPattern", "RESET_SHARE"]
+__all__ = ["HeldPattern", "RESET_SHARE", "LINEAR_KEYS"]
 
 RESET_SHARE = 0.8      # growth: keep the old reserve while at least this share of its contact pairs is in use
+LINEAR_KEYS = True     # the node-pair keys by ``node_keys`` (linear time), else numpy's unique / union1d / setdiff1d
 
 
 @jit_callee
@@ -213,11 +215,17 @@ class HeldPattern:
         first = np.zeros(n, dtype=np.int64)
         first[node_of[::-1]] = np.arange(n_free)[::-1]          # the first free dof of each node
         if el_keys is None:            # the element pattern's node pairs (kept: ``grown`` passes them on)
-            el_col = np.repeat(np.arange(n_free), np.diff(el_indptr))
-            el_keys = np.unique(node_of[el_col] * n + node_of[el_indices])
+            if LINEAR_KEYS:
+                el_keys = node_keys.element_keys(el_indptr, el_indices, node_of, n)
+            else:
+                el_col = np.repeat(np.arange(n_free), np.diff(el_indptr))
+                el_keys = np.unique(node_of[el_col] * n + node_of[el_indices])
         self.el_keys = el_keys
-        self.keys = np.zeros(0, dtype=np.int64) if keys is None else np.setdiff1d(keys, el_keys)
-        allk = np.union1d(el_keys, self.keys)
+        if keys is None:
+            self.keys = np.zeros(0, dtype=np.int64)
+        else:
+            self.keys = node_keys.difference(keys, el_keys) if LINEAR_KEYS else np.setdiff1d(keys, el_keys)
+        allk = node_keys.union(el_keys, self.keys) if LINEAR_KEYS else np.union1d(el_keys, self.keys)
         self.nptr = np.searchsorted(allk // n, np.arange(n + 1)).astype(np.int64)
         self.nrow = (allk % n).astype(np.int64)
         self.eoff = np.empty(len(allk), dtype=np.int64)
@@ -260,10 +268,24 @@ class HeldPattern:
         """The pattern holding the node pairs of the blocks ``vals`` over ``node`` too (``covers``): this reserve
         plus theirs, or theirs alone when fewer than ``RESET_SHARE`` of the reserve's pairs are among them (a
         stale reserve is dropped)."""
-        new = _pair_keys(node, vals, self.nfree, self.n_nodes)
-        used = np.isin(self.keys, new, assume_unique=True).sum() if len(self.keys) else 0
-        keys = np.union1d(self.keys, new) if used >= RESET_SHARE * len(self.keys) else new
+        if LINEAR_KEYS:
+            new = node_keys.block_keys(node, vals, self.nfree, self.n_nodes)
+            used = node_keys.common(self.keys, new)
+            keys = node_keys.union(self.keys, new) if used >= RESET_SHARE * len(self.keys) else new
+        else:
+            new = _pair_keys(node, vals, self.nfree, self.n_nodes)
+            used = np.isin(self.keys, new, assume_unique=True).sum() if len(self.keys) else 0
+            keys = np.union1d(self.keys, new) if used >= RESET_SHARE * len(self.keys) else new
         return HeldPattern(self.base[0], self.n_free, self.base[1], self.base[2], keys=keys, el_keys=self.el_keys)
+
+    @classmethod
+    def of_blocks(cls, red, n_free, el_indptr, el_indices, node, vals):
+        """``HeldPattern(red, n_free, el_indptr, el_indices).grown(node, vals)`` where the blocks leave the element
+        pattern, else the element pattern alone: the same arrays, without building the element pattern's own
+        held pattern first (a new contact pattern's cost, ``System.matrix``)."""
+        nfree = np.bincount(np.flatnonzero(np.asarray(red) >= 0) // 6, minlength=len(red) // 6)
+        keys = node_keys.block_keys(node, vals, nfree, len(red) // 6)
+        return cls(red, n_free, el_indptr, el_indices, keys=keys)
 
     def matrix(self, el_data, node=None, vals=None, tail=None):
         """CSC ``(n_free, n_free)`` of the element values ``el_data`` (element pattern order) plus the blocks
