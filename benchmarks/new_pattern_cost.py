@@ -11,7 +11,16 @@ reference poses, then, alternating the variants ``--rounds`` times (least CPU s,
 Variants: ``held_pattern.LINEAR_KEYS`` on (``linear``) and off (``numpy``: ``np.unique`` / ``union1d`` /
 ``setdiff1d`` / ``isin``).  Prints a markdown table; the matrices of both variants are compared entry for entry.
 ``python benchmarks/new_pattern_cost.py --lengths 80,150,300 --rounds 3``
+
+``--iterations``: whole Newton iterations instead, each (piece, variant) in its own child process, the variants
+alternating, ``--rounds`` times (least CPU s of each part): as ``scaling_scenes`` (compiled code warmed on a small
+bundle first), a ``Problem``'s first iteration and its second (``repeated``: pattern and PARDISO's analysis
+reused), then a second ``Problem`` of the model (``new pattern``: groups, held pattern and PARDISO's analysis
+anew, buffers warm), each ``evaluation`` (with tangent) + ``assembly`` (the Newton system) + ``solve``
+(factorisation of ``A``, GMRES).  ``python benchmarks/new_pattern_cost.py --iterations --lengths 80,150,300``
 """
+import json
+import subprocess
 import argparse
 import os
 import sys
@@ -71,11 +80,90 @@ def measure(length_mm, rounds):
     return dict(length=length_mm, elements=s.n_elements, nnz=a.nnz, same=same, **{f"{v}_{k}": t for (v, k), t in best.items()})
 
 
+def _iteration(problem, solver, H):
+    """CPU s of one Newton iteration at ``H``: evaluation, assembly, solve (``scaling_scenes.newton_direction``)."""
+    from scaling_scenes import newton_direction
+    problem.begin_step(H, 0.0)
+    t = {}
+    t0 = clock()
+    ev = problem.evaluate(H, 1.0, tangent=True)
+    t["evaluation"] = clock() - t0
+    f, _ = newton_direction(problem, ev, solver, t)
+    ev.drop_tangent()
+    del f, ev
+    t["iteration"] = sum(t.values())
+    return t
+
+
+def child(length_mm, variant):
+    """JSON: the iterations of ``--iterations`` for one piece and variant."""
+    from scaling import warm_up
+    from scaling_scenes import rope_model, warm_contact
+    from beamsolver.assembly import held_pattern
+    from beamsolver.nonlinear import linsolve
+    from beamsolver.nonlinear.problem import Problem
+    held_pattern.LINEAR_KEYS = variant == "linear"
+    warm_up()
+    warm_contact()
+    m, wires, _ = rope_model(length_mm * 1e-3)
+    for w in wires:
+        m.clamp(w.first)
+    out = {}
+    for name, its in (("first", ("first", "repeated")), ("second", ("new pattern", "repeated 2"))):
+        problem = Problem.from_model(m)
+        H = problem.system.poses0.copy()
+        solver = linsolve.Solver(lagged=False)
+        for it in its:
+            out[it] = _iteration(problem, solver, H)
+        out["elements"] = problem.system.n_elements
+        solver.close()
+        del problem
+    print("JSON " + json.dumps(out))
+
+
+def iterations(lengths, rounds):
+    best = {}
+    for r in range(rounds):
+        for L in lengths:
+            for variant in ("numpy", "linear"):
+                res = subprocess.run([sys.executable, __file__, "--child", str(L), variant], capture_output=True,
+                                     text=True, env=dict(os.environ, OMP_NUM_THREADS="1", MKL_NUM_THREADS="1"))
+                line = [x for x in res.stdout.splitlines() if x.startswith("JSON ")]
+                if not line:
+                    print(res.stderr[-2000:])
+                    continue
+                out = json.loads(line[0][5:])
+                for it, parts in out.items():
+                    if it == "elements":
+                        best[L, "elements"] = parts
+                        continue
+                    for k, v in parts.items():
+                        key = (L, variant, it, k)
+                        best[key] = min(best.get(key, np.inf), v)
+                print(f"round {r} {L} mm {variant}: " + ", ".join(f"{it} {p['iteration']:.3f}" for it, p in out.items()
+                                                                  if it != "elements"), flush=True)
+    print("\n| rope piece | variant | iteration | evaluation | assembly | solve | total | new / repeated |")
+    print("|---|---|---|---:|---:|---:|---:|---:|")
+    for L in lengths:
+        for variant in ("numpy", "linear"):
+            rep = best.get((L, variant, "repeated", "iteration"), np.nan)
+            for it in ("first", "repeated", "new pattern"):
+                g = [best.get((L, variant, it, k), np.nan) for k in ("evaluation", "assembly", "solve", "iteration")]
+                ratio = f"{g[3] / rep:.2f}" if it == "new pattern" else ""
+                print(f"| {L:g} mm ({best.get((L, 'elements'), '?')} el.) | {variant} | {it} | {g[0]:.3f} | {g[1]:.3f} "
+                      f"| {g[2]:.3f} | {g[3]:.3f} | {ratio} |")
+
+
 def main():
+    if len(sys.argv) > 1 and sys.argv[1] == "--child":
+        return child(float(sys.argv[2]), sys.argv[3])
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--lengths", default="80,150,300")
     ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--iterations", action="store_true", help="whole Newton iterations, child processes")
     a = ap.parse_args()
+    if a.iterations:
+        return iterations([float(L) for L in a.lengths.split(",")], a.rounds)
     from scaling import warm_up
     warm_up()
     rows = [measure(float(L), a.rounds) for L in a.lengths.split(",")]

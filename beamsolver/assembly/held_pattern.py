@@ -161,14 +161,27 @@ def _add_products(node, Kq, Kl, w, red, indptr, eoff, nptr, nrow, out):
     ``(m, k)`` (rank-one blocks; held rows and columns dropped).  Returns False (``out`` partly changed) if a
     node pair with an entry has no place in the pattern."""
     k = node.shape[1]
+    place = np.empty((k, k), dtype=np.int64)       # the node pairs' places of the last row's nodes (a group's rows
+    last = -1                                      # are consecutive: found once per group, the same sums)
     for u in range(node.shape[0]):
         if w[u] == 0.0:
             continue
+        same = last >= 0
+        if same:
+            for t in range(k):
+                if node[u, t] != node[last, t]:
+                    same = False
+                    break
+        if not same:
+            for t in range(k):
+                for s in range(k):
+                    place[s, t] = _find(nptr, nrow, node[u, s], node[u, t])
+            last = u
         for t in range(k):
             b = node[u, t]
             for s in range(k):
                 a = node[u, s]
-                e = _find(nptr, nrow, a, b)
+                e = place[s, t]
                 for q in range(6):
                     j = red[6 * b + q]
                     c = w[u] * Kl[u, 6 * t + q]
