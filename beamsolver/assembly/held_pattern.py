@@ -244,16 +244,15 @@ class HeldPattern:
         self.eoff = np.empty(len(allk), dtype=np.int64)
         col_len = np.bincount(allk // n, weights=self.nfree[self.nrow], minlength=n).astype(np.int64)
         size = int((col_len * self.nfree).sum())
-        self.indptr = np.empty(n_free + 1, dtype=np.int64)
+        small = size < np.iinfo(np.int32).max      # int32 while they fit (half the memory), written as such
+        self.indptr = np.empty(n_free + 1, dtype=np.int32 if small else np.int64)
         self.indices = np.empty(size, dtype=np.int32)
         _expand(self.nptr, self.nrow, self.nfree, first, self.indptr, self.indices, self.eoff)
-        self.el_pos = np.empty(len(el_indices), dtype=np.int64)
+        self.el_pos = np.empty(len(el_indices), dtype=np.int32 if small else np.int64)
         missing = _element_positions(np.asarray(el_indptr, dtype=np.int64), el_indices, node_of, first, self.nptr,
                                      self.nrow, self.eoff, self.indptr, self.el_pos)
         if missing:
             raise ValueError(f"HeldPattern: {missing} element entries outside whole node blocks")
-        if size < np.iinfo(np.int32).max:          # int32 while they fit (half the memory)
-            self.indptr, self.el_pos = self.indptr.astype(np.int32), self.el_pos.astype(np.int32)
 
     @property
     def nnz(self):
