@@ -96,3 +96,29 @@ def test_of_blocks_is_the_element_pattern_grown():
             x, y = getattr(a, name), getattr(b, name)
             assert x.dtype == y.dtype and np.array_equal(x, y), name
         assert np.array_equal(a.matrix(el.data, nodes, v).data, b.matrix(el.data, nodes, v).data)
+
+
+@pytest.mark.slow
+def test_newton_run_is_the_same_with_numpys_keys(monkeypatch):
+    """The twisted pair at 26 elements a wire (exact stick, the augmented Newton system on the held pattern,
+    grows as contact points enter) solved with the keys of ``node_keys`` and with numpy's: the same iterations
+    and the same poses, bit for bit."""
+    import twisted_pair
+    import beamsolver as bs
+    from beamsolver.assembly import system as system_mod
+    monkeypatch.setattr(system_mod, "HOLD_PATTERN", True)
+    grown = [0]
+    orig = HeldPattern.grown
+
+    def counted(self, *a):
+        grown[0] += 1
+        return orig(self, *a)
+    monkeypatch.setattr(HeldPattern, "grown", counted)
+    sols = {}
+    for linear in (True, False):
+        monkeypatch.setattr(held_pattern, "LINEAR_KEYS", linear)
+        model, _, _ = twisted_pair.build(n_elements=26)
+        sols[linear] = bs.solve(model, steps=4, verbose=False)
+    assert grown[0] >= 1                       # (the numpy run grows its first pattern; node_keys: ``of_blocks``)
+    assert [s["iterations"] for s in sols[True].stats] == [s["iterations"] for s in sols[False].stats]
+    assert np.array_equal(sols[True].poses, sols[False].poses)
