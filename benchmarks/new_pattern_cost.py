@@ -17,7 +17,9 @@ alternating, ``--rounds`` times (least CPU s of each part): as ``scaling_scenes`
 bundle first), a ``Problem``'s first iteration and its second (``repeated``: pattern and PARDISO's analysis
 reused), then a second ``Problem`` of the model (``new pattern``: groups, held pattern and PARDISO's analysis
 anew, buffers warm), each ``evaluation`` (with tangent) + ``assembly`` (the Newton system) + ``solve``
-(factorisation of ``A``, GMRES).  ``python benchmarks/new_pattern_cost.py --iterations --lengths 80,150,300``
+(factorisation of ``A``, GMRES).  ``python benchmarks/new_pattern_cost.py --iterations --lengths 80,150,300``;
+``--variants numpy,linear,linear-nomatch``: the last with PARDISO's analysis without weighted matching from
+``NOMATCH_MIN`` unknowns (``linsolve.MATCHING_OFF_MIN``).
 """
 import json
 import subprocess
@@ -102,7 +104,9 @@ def child(length_mm, variant):
     from beamsolver.assembly import held_pattern
     from beamsolver.nonlinear import linsolve
     from beamsolver.nonlinear.problem import Problem
-    held_pattern.LINEAR_KEYS = variant == "linear"
+    held_pattern.LINEAR_KEYS = variant.startswith("linear")
+    if variant.endswith("-nomatch"):           # PARDISO's analysis without weighted matching (``linsolve``)
+        linsolve.MATCHING_OFF_MIN = NOMATCH_MIN
     warm_up()
     warm_contact()
     m, wires, _ = rope_model(length_mm * 1e-3)
@@ -121,11 +125,14 @@ def child(length_mm, variant):
     print("JSON " + json.dumps(out))
 
 
-def iterations(lengths, rounds):
+NOMATCH_MIN = 50_000          # the ``-nomatch`` variants' ``linsolve.MATCHING_OFF_MIN``
+
+
+def iterations(lengths, rounds, variants):
     best = {}
     for r in range(rounds):
         for L in lengths:
-            for variant in ("numpy", "linear"):
+            for variant in variants:
                 res = subprocess.run([sys.executable, __file__, "--child", str(L), variant], capture_output=True,
                                      text=True, env=dict(os.environ, OMP_NUM_THREADS="1", MKL_NUM_THREADS="1"))
                 line = [x for x in res.stdout.splitlines() if x.startswith("JSON ")]
@@ -145,7 +152,7 @@ def iterations(lengths, rounds):
     print("\n| rope piece | variant | iteration | evaluation | assembly | solve | total | new / repeated |")
     print("|---|---|---|---:|---:|---:|---:|---:|")
     for L in lengths:
-        for variant in ("numpy", "linear"):
+        for variant in variants:
             rep = best.get((L, variant, "repeated", "iteration"), np.nan)
             for it in ("first", "repeated", "new pattern"):
                 g = [best.get((L, variant, it, k), np.nan) for k in ("evaluation", "assembly", "solve", "iteration")]
@@ -161,9 +168,10 @@ def main():
     ap.add_argument("--lengths", default="80,150,300")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--iterations", action="store_true", help="whole Newton iterations, child processes")
+    ap.add_argument("--variants", default="numpy,linear", help="--iterations: numpy, linear, linear-nomatch")
     a = ap.parse_args()
     if a.iterations:
-        return iterations([float(L) for L in a.lengths.split(",")], a.rounds)
+        return iterations([float(L) for L in a.lengths.split(",")], a.rounds, a.variants.split(","))
     from scaling import warm_up
     warm_up()
     rows = [measure(float(L), a.rounds) for L in a.lengths.split(",")]
