@@ -6,7 +6,7 @@ into tangent evaluations and forces-only (line-search) trials.
     python benchmarks/exact_stick_parts.py [--scenes twisted_pair bundle19 strand19] [--stick exact penalty]
         [--repeat 2] [--fresh]
 
-``twisted_pair``: the main job's warm solve (``examples/twisted_pair.py``, 16 steps), per linear solve (every
+``twisted_pair``: the main job's warm solve (``twisted_pair128``: its scene at 128 elements a wire) (``examples/twisted_pair.py``, 16 steps), per linear solve (every
 Newton iteration, failed attempts included).  ``bundle19`` (``bundle37``, ``bundle61``) / ``strand19``: one
 Newton iteration at the reference poses of ``scaling.bundle_model`` / ``scaling_scenes.strand_model("19")``
 (tangent evaluation, Newton system, factorisation with the solver's lagging, or afresh with ``--fresh``, solve)
@@ -119,10 +119,11 @@ SOLVES = [0]
 LAGGED = ["auto"]  # the bundles' solver: ``--fresh``: a factorisation per iteration (the iterations share their poses)
 
 
-def twisted_pair():
-    """The main job's warm solve: ``(CPU s, linear solves, evaluations)``."""
+def twisted_pair(n_elements=None):
+    """The main job's warm solve (``n_elements`` a wire: ``twisted_pair128`` for 128): ``(CPU s, linear solves,
+    evaluations)``."""
     import twisted_pair as tp
-    model = tp.build()[0]
+    model = tp.build()[0] if n_elements is None else tp.build(n_elements=n_elements)[0]
     direction = newton.Newton.direction
     count = [0, 0]
     evaluate = Problem.evaluate
@@ -217,13 +218,14 @@ def main():
             orig, add = stick_mode(stick)
             bs.Model.add_contact = add
             try:
-                if scene == "twisted_pair":
-                    twisted_pair()                      # warm-up
+                if scene.startswith("twisted_pair"):
+                    n_el = int(scene[len("twisted_pair"):] or 0) or None
+                    twisted_pair(n_el)                  # warm-up
                     install()
                     best = None
                     for _ in range(a.repeat):
                         TIMES.clear()
-                        r = twisted_pair()
+                        r = twisted_pair(n_el)
                         if best is None or r[0] < best[0][0]:
                             best = (r, dict(TIMES))
                     uninstall()

@@ -21,11 +21,13 @@ node graph, ``eoff[e]`` its offset in the node column (the same for the six colu
 import numpy as np
 
 from .._jit import jit, jit_callee
+from . import node_keys
 from .csc import canonical_csc
 
-__all__ = ["HeldPattern", "RESET_SHARE"]
+__all__ = ["HeldPattern", "RESET_SHARE", "LINEAR_KEYS"]
 
 RESET_SHARE = 0.8      # growth: keep the old reserve while at least this share of its contact pairs is in use
+LINEAR_KEYS = True     # the node-pair keys by ``node_keys`` (linear time), else numpy's unique / union1d / setdiff1d
 
 
 @jit_callee
@@ -159,14 +161,27 @@ def _add_products(node, Kq, Kl, w, red, indptr, eoff, nptr, nrow, out):
     ``(m, k)`` (rank-one blocks; held rows and columns dropped).  Returns False (``out`` partly changed) if a
     node pair with an entry has no place in the pattern."""
     k = node.shape[1]
+    place = np.empty((k, k), dtype=np.int64)       # the node pairs' places of the last row's nodes (a group's rows
+    last = -1                                      # are consecutive: found once per group, the same sums)
     for u in range(node.shape[0]):
         if w[u] == 0.0:
             continue
+        same = last >= 0
+        if same:
+            for t in range(k):
+                if node[u, t] != node[last, t]:
+                    same = False
+                    break
+        if not same:
+            for t in range(k):
+                for s in range(k):
+                    place[s, t] = _find(nptr, nrow, node[u, s], node[u, t])
+            last = u
         for t in range(k):
             b = node[u, t]
             for s in range(k):
                 a = node[u, s]
-                e = _find(nptr, nrow, a, b)
+                e = place[s, t]
                 for q in range(6):
                     j = red[6 * b + q]
                     c = w[u] * Kl[u, 6 * t + q]
@@ -213,26 +228,31 @@ class HeldPattern:
         first = np.zeros(n, dtype=np.int64)
         first[node_of[::-1]] = np.arange(n_free)[::-1]          # the first free dof of each node
         if el_keys is None:            # the element pattern's node pairs (kept: ``grown`` passes them on)
-            el_col = np.repeat(np.arange(n_free), np.diff(el_indptr))
-            el_keys = np.unique(node_of[el_col] * n + node_of[el_indices])
+            if LINEAR_KEYS:
+                el_keys = node_keys.element_keys(el_indptr, el_indices, node_of, n)
+            else:
+                el_col = np.repeat(np.arange(n_free), np.diff(el_indptr))
+                el_keys = np.unique(node_of[el_col] * n + node_of[el_indices])
         self.el_keys = el_keys
-        self.keys = np.zeros(0, dtype=np.int64) if keys is None else np.setdiff1d(keys, el_keys)
-        allk = np.union1d(el_keys, self.keys)
+        if keys is None:
+            self.keys = np.zeros(0, dtype=np.int64)
+        else:
+            self.keys = node_keys.difference(keys, el_keys) if LINEAR_KEYS else np.setdiff1d(keys, el_keys)
+        allk = node_keys.union(el_keys, self.keys) if LINEAR_KEYS else np.union1d(el_keys, self.keys)
         self.nptr = np.searchsorted(allk // n, np.arange(n + 1)).astype(np.int64)
         self.nrow = (allk % n).astype(np.int64)
         self.eoff = np.empty(len(allk), dtype=np.int64)
         col_len = np.bincount(allk // n, weights=self.nfree[self.nrow], minlength=n).astype(np.int64)
         size = int((col_len * self.nfree).sum())
-        self.indptr = np.empty(n_free + 1, dtype=np.int64)
+        small = size < np.iinfo(np.int32).max      # int32 while they fit (half the memory), written as such
+        self.indptr = np.empty(n_free + 1, dtype=np.int32 if small else np.int64)
         self.indices = np.empty(size, dtype=np.int32)
         _expand(self.nptr, self.nrow, self.nfree, first, self.indptr, self.indices, self.eoff)
-        self.el_pos = np.empty(len(el_indices), dtype=np.int64)
+        self.el_pos = np.empty(len(el_indices), dtype=np.int32 if small else np.int64)
         missing = _element_positions(np.asarray(el_indptr, dtype=np.int64), el_indices, node_of, first, self.nptr,
                                      self.nrow, self.eoff, self.indptr, self.el_pos)
         if missing:
             raise ValueError(f"HeldPattern: {missing} element entries outside whole node blocks")
-        if size < np.iinfo(np.int32).max:          # int32 while they fit (half the memory)
-            self.indptr, self.el_pos = self.indptr.astype(np.int32), self.el_pos.astype(np.int32)
 
     @property
     def nnz(self):
@@ -260,10 +280,24 @@ class HeldPattern:
         """The pattern holding the node pairs of the blocks ``vals`` over ``node`` too (``covers``): this reserve
         plus theirs, or theirs alone when fewer than ``RESET_SHARE`` of the reserve's pairs are among them (a
         stale reserve is dropped)."""
-        new = _pair_keys(node, vals, self.nfree, self.n_nodes)
-        used = np.isin(self.keys, new, assume_unique=True).sum() if len(self.keys) else 0
-        keys = np.union1d(self.keys, new) if used >= RESET_SHARE * len(self.keys) else new
+        if LINEAR_KEYS:
+            new = node_keys.block_keys(node, vals, self.nfree, self.n_nodes)
+            used = node_keys.common(self.keys, new)
+            keys = node_keys.union(self.keys, new) if used >= RESET_SHARE * len(self.keys) else new
+        else:
+            new = _pair_keys(node, vals, self.nfree, self.n_nodes)
+            used = np.isin(self.keys, new, assume_unique=True).sum() if len(self.keys) else 0
+            keys = np.union1d(self.keys, new) if used >= RESET_SHARE * len(self.keys) else new
         return HeldPattern(self.base[0], self.n_free, self.base[1], self.base[2], keys=keys, el_keys=self.el_keys)
+
+    @classmethod
+    def of_blocks(cls, red, n_free, el_indptr, el_indices, node, vals):
+        """``HeldPattern(red, n_free, el_indptr, el_indices).grown(node, vals)`` where the blocks leave the element
+        pattern, else the element pattern alone: the same arrays, without building the element pattern's own
+        held pattern first (a new contact pattern's cost, ``System.matrix``)."""
+        nfree = np.bincount(np.flatnonzero(np.asarray(red) >= 0) // 6, minlength=len(red) // 6)
+        keys = node_keys.block_keys(node, vals, nfree, len(red) // 6)
+        return cls(red, n_free, el_indptr, el_indices, keys=keys)
 
     def matrix(self, el_data, node=None, vals=None, tail=None):
         """CSC ``(n_free, n_free)`` of the element values ``el_data`` (element pattern order) plus the blocks

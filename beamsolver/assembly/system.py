@@ -28,6 +28,7 @@ from ..model import blocks as _blocks
 from ..errors import InputError
 from .csc import canonical_csc
 from .extra_pattern import BlockPattern, ExtraPattern, whole_nodes
+from . import held_pattern as held_pattern_
 from .held_pattern import HeldPattern
 from ..lie.se3 import skew
 from ..model.validation import check_pose
@@ -692,13 +693,17 @@ class System:
             node = self._block_nodes(c[0])
         p = getattr(self, "_held_cache", None)
         base = (self.red, self.indptr, self.indices)
+        k = 1 if node is None else node.shape[1]
+        vals = None if node is None else extra[2][:n_b].reshape(-1, 6 * k, 6 * k)
         if p is None or not p.same_base(base):
+            if node is not None and held_pattern_.LINEAR_KEYS:      # a new pattern: built on the blocks at once
+                p = self._held_cache = HeldPattern.of_blocks(self.red, self.n_free, self.indptr, self.indices, node,
+                                                             vals)
+                return p.matrix(el_data, node, vals, tail)
             p = HeldPattern(self.red, self.n_free, self.indptr, self.indices)
         if node is None:
             self._held_cache = p
             return p.matrix(el_data)
-        k = node.shape[1]
-        vals = extra[2][:n_b].reshape(-1, 6 * k, 6 * k)
         if not p.covers(node, vals):
             p = p.grown(node, vals)
         self._held_cache = p

@@ -79,6 +79,9 @@ RCM_PIVOT_THRESHOLD = 1e-3     # splu-rcm: keep the diagonal pivot unless below 
 SINGULAR_RESIDUAL = 1e-6       # pardiso, with perturbed pivots: |K x - b| / |b| above this -> singular
 ONE_BASED = True               # PARDISO called with its 1-based index arrays kept per pattern (``_Pardiso._call``)
 FREE_DROPPED = True            # PARDISO's numerical factor freed (phase 0) once the caller drops its factorisation
+MATCHING_OFF_MIN = None        # int: PARDISO analyses non-saddle matrices of at least this many unknowns without its
+#                                weighted matching (iparm(13) = 0; half of the analysis on the rope pieces; round-off
+#                                of the factor changes); None: MKL's default (on) for every matrix
                                # (``_Pardiso._dropped``; the analysis is kept: 1 GB on the 0.6 m rope between iterations)
 LAGGED = "auto"                # Solver(lagged=None): the previous factor as GMRES preconditioner where it pays
 LAG_MAX_ITERATIONS = 30        # GMRES iterations of a lagged solve at most
@@ -591,6 +594,7 @@ class _Pardiso:
         self.current = _NONE
         self.flops = float("nan")     # of the numerical factorisation, from the last analysis
         self._defaults = None         # iparm(8), iparm(10) of the handle (refinement steps, pivot perturbation)
+        self._matching_default = None  # iparm(13) of the handle (``_matching``)
 
     def factorize(self, K, stats, saddle=False):
         K = K.tocsr() if K.format not in ("csr", "csc") else K
@@ -616,6 +620,7 @@ class _Pardiso:
             zero = np.zeros((K.shape[0], 1))
             if not same:                       # ordering + symbolic analysis (phase 11), then phase 22 alone
                 self.pattern = (_one_based(K.indptr), _one_based(K.indices), K.format)
+                self._matching(K.shape[0], f.saddle)
                 ps.iparm[18] = -1              # report the factorisation's Mflops (MKL iparm(19))
                 if stats is not None:
                     stats["analyses"] += 1
@@ -633,6 +638,24 @@ class _Pardiso:
         f.factor_nnz = int(iparm[17])
         f.peak_kb = int(max(iparm[14], iparm[15] + iparm[16]))
         f.flops = self.flops
+
+    def _matching(self, n, saddle):
+        """Before an analysis: PARDISO's weighted matching off for a non-saddle matrix of ``n >= MATCHING_OFF_MIN``
+        unknowns (MKL's defaults written first on a fresh handle, ``pardisoinit``), else back to MKL's default."""
+        ps = self.ps
+        off = MATCHING_OFF_MIN is not None and not saddle and n >= MATCHING_OFF_MIN
+        if off and ps.iparm[0] == 0 and hasattr(ps, "libmkl"):
+            import ctypes
+            transposed = int(ps.iparm[11])        # (pypardiso's ``_check_A``: CSC handed over as the CSR of K^T)
+            ps.libmkl.pardisoinit(ps.pt.ctypes.data_as(ctypes.POINTER(ps._pt_type[0])),
+                                  ctypes.byref(ctypes.c_int32(ps.mtype)),
+                                  ps.iparm.ctypes.data_as(ctypes.POINTER(ctypes.c_int32)))
+            ps.iparm[11] = transposed
+        if ps.iparm[0] == 0:
+            return
+        if self._matching_default is None:
+            self._matching_default = int(ps.iparm[12])
+        ps.iparm[12] = 0 if off else self._matching_default
 
     def _saddle(self, saddle):
         """Set the pivot perturbation and refinement steps for a saddle-point system (``Solver.factorize``) or

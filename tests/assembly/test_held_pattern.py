@@ -221,3 +221,43 @@ def test_tangents_share_the_patterns_index_arrays():
         assert np.abs(A @ x - b).max() <= 1e-10 * np.abs(b).max()
         solver.close()
     assert np.array_equal(p.indices, kept[0]) and np.array_equal(p.indptr, kept[1])
+
+
+def test_add_products_sums_row_by_row_in_order():
+    """``HeldPattern.add_products`` (a group's node pairs found once for its consecutive rows) adds
+    ``w_u Kq_u Kl_u^T`` row after row, in order: the same bits as those sums done one by one here."""
+    rng = np.random.default_rng(4)
+    n_nodes = 50
+    red, n = _reduction(rng, n_nodes, 3, 3)
+    el = _element_matrix(rng, n, 0.03)
+    groups = _nodes(_node_blocks(rng, n_nodes, 30, 3))
+    node = np.repeat(groups, rng.integers(1, 4, size=len(groups)), axis=0)   # 1-3 consecutive rows a group
+    node = np.concatenate([node, groups[:4]])                               # a group again, later
+    u = len(node)
+    Kq, Kl = rng.standard_normal((u, 18)), rng.standard_normal((u, 18))
+    w = rng.standard_normal(u)
+    w[::5] = 0.0
+    p = HeldPattern(red, n, el.indptr, el.indices).grown(groups, np.ones((len(groups), 18, 18)))
+    K = p.matrix(el.data)
+    data = K.data.copy()
+    assert p.add_products(data, node, Kq, Kl, w)
+    ref = K.data.copy()
+    where = {}
+    for j in range(n):
+        for s in range(K.indptr[j], K.indptr[j + 1]):
+            where[K.indices[s], j] = s
+    for r in range(u):
+        if w[r] == 0.0:
+            continue
+        for t in range(3):
+            for s in range(3):
+                for q in range(6):
+                    j = red[6 * node[r, t] + q]
+                    c = w[r] * Kl[r, 6 * t + q]
+                    if j < 0 or c == 0.0:
+                        continue
+                    for pp in range(6):
+                        i = red[6 * node[r, s] + pp]
+                        if i >= 0:
+                            ref[where[i, j]] += Kq[r, 6 * s + pp] * c
+    assert np.array_equal(data, ref)

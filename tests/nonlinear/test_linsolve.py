@@ -417,3 +417,28 @@ for free in (False, True):
     s.close()
 print("same" if all(np.array_equal(x, y) for x, y in zip(out[False], out[True])) else "different")
 """
+
+
+@pytest.mark.skipif(not HAVE_PARDISO, reason="pypardiso not installed")
+def test_pardiso_matching_off_from_a_size(monkeypatch):
+    """``MATCHING_OFF_MIN``: PARDISO analyses a non-saddle matrix of at least that many unknowns without its weighted
+    matching (from a fresh handle: MKL's defaults written first), a saddle-point one or a smaller one with it; the
+    solutions are right either way; the default (None) keeps MKL's matching."""
+    rng = np.random.default_rng(6)
+
+    def matrix(n):
+        A = sp.random(n, n, density=0.02, random_state=rng, format="csc") + sp.diags(4.0 + rng.random(n))
+        return sp.csc_matrix(A)
+    cases = [(matrix(120), False), (matrix(60), False), (matrix(120), True), (matrix(120), False)]
+    for off, expect in ((100, (0, 1, 1, 0)), (None, (1, 1, 1, 1))):
+        monkeypatch.setattr(linsolve, "MATCHING_OFF_MIN", off)
+        s = linsolve.Solver("pardiso", lagged=False)
+        got = []
+        for A, saddle in cases:
+            b = rng.standard_normal(A.shape[0])
+            f = s.factorize(A, saddle=saddle)
+            got.append(int(s._pardiso.ps.iparm[12]))
+            x = f.solve(b)
+            assert np.linalg.norm(A @ x - b) <= 1e-12 * np.linalg.norm(b)
+        assert tuple(got) == expect
+        s.close()
