@@ -79,9 +79,10 @@ RCM_PIVOT_THRESHOLD = 1e-3     # splu-rcm: keep the diagonal pivot unless below 
 SINGULAR_RESIDUAL = 1e-6       # pardiso, with perturbed pivots: |K x - b| / |b| above this -> singular
 ONE_BASED = True               # PARDISO called with its 1-based index arrays kept per pattern (``_Pardiso._call``)
 FREE_DROPPED = True            # PARDISO's numerical factor freed (phase 0) once the caller drops its factorisation
-MATCHING_OFF_MIN = None        # int: PARDISO analyses non-saddle matrices of at least this many unknowns without its
-#                                weighted matching (iparm(13) = 0; half of the analysis on the rope pieces; round-off
-#                                of the factor changes); None: MKL's default (on) for every matrix
+MATCHING_OFF_MIN = 50_000      # int: PARDISO analyses non-saddle matrices of at least this many unknowns without its
+#                                weighted matching (iparm(13) = 0: half of the analysis on the rope pieces, the same
+#                                fill, solutions within 4e-9; a rope's new pattern 1.45-1.56 -> 1.11-1.31 x a repeated
+#                                iteration, docs/benchmarks.md "Scaling, session 9"); None: MKL's default (on) everywhere
                                # (``_Pardiso._dropped``; the analysis is kept: 1 GB on the 0.6 m rope between iterations)
 LAGGED = "auto"                # Solver(lagged=None): the previous factor as GMRES preconditioner where it pays
 LAG_MAX_ITERATIONS = 30        # GMRES iterations of a lagged solve at most

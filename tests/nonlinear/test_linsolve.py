@@ -423,7 +423,7 @@ print("same" if all(np.array_equal(x, y) for x, y in zip(out[False], out[True]))
 def test_pardiso_matching_off_from_a_size(monkeypatch):
     """``MATCHING_OFF_MIN``: PARDISO analyses a non-saddle matrix of at least that many unknowns without its weighted
     matching (from a fresh handle: MKL's defaults written first), a saddle-point one or a smaller one with it; the
-    solutions are right either way; the default (None) keeps MKL's matching."""
+    solutions are right either way; None keeps MKL's matching."""
     rng = np.random.default_rng(6)
 
     def matrix(n):
