@@ -1,13 +1,13 @@
 """Where the long-lay strand's bending cycle spends its Newton iterations, and the soft modes of its frictionless pull
 (issue 27, session 9; docs/benchmarks.md "Strand bending, session 9").
 
-    python benchmarks/strand_long_lay.py --phases [--lays 4] [--elements 48] [--lay 229.2] [--t-end 6] [--no-shift]
+    python benchmarks/strand_long_lay.py --phases [--lays 4] [--elements 48] [--lay 229.2] [--t-end 6] [--shift 1e-3]
     python benchmarks/strand_long_lay.py --modes [--lays 4] [--elements 24] [--lay 229.2] [--scale torsion 100]
 
 ``--phases``: the example's cycle (``strand_bending.run``, default options) with every Newton attempt counted by phase
 of the history (step 0, pull, virgin branch, the two half cycles): attempts, failed ones, Newton directions (of them in
 failed attempts), residual evaluations of the line searches and the iterations whose line search tried 6 or more
-lengths (the crawl); ``--no-shift``: without exact stick's Levenberg shift (``newton.LM_SHIFT = 0``, before session 9).
+lengths (the crawl); ``--shift``: exact stick's Levenberg shift ``newton.LM_SHIFT`` (default 0: off).
 ``--modes``: the frictionless strand (``mu = 0``) pulled to ``T`` in 4 steps, the stable-branch
 rule off, and the 3 lowest scaled eigenvalues of its tangent at ``t = 1`` (``modes.lowest_modes``), with the lowest
 mode's energy split between the elements and the contact; ``--scale what factor`` scales the sections' shear,
@@ -118,10 +118,10 @@ if __name__ == "__main__":
     ap.add_argument("--lay", type=float, default=229.2, help="lay length [mm]")
     ap.add_argument("--t-end", type=float, default=6.0)
     ap.add_argument("--scale", nargs=2, default=None, metavar=("WHAT", "FACTOR"))
-    ap.add_argument("--no-shift", action="store_true", help="newton.LM_SHIFT = 0 (before session 9)")
+    ap.add_argument("--shift", type=float, default=None, help="newton.LM_SHIFT (default: the library's, 0)")
     a = ap.parse_args()
-    if a.no_shift:
-        newton.LM_SHIFT = 0.0
+    if a.shift is not None:
+        newton.LM_SHIFT = a.shift
     if a.modes:
         print("| lays | el/lay | lay [mm] | stiffness scaled | lowest scaled eigenvalues at t = 1 | lowest mode: "
               "elements' energy | contact's | CPU [s] |")

@@ -54,10 +54,12 @@ DROP_BEFORE_SOLVE = True             # exact stick (augmented): the tangent drop
 #                                      factorisation (issue 30: the groups' blocks freed first, 1.3 GB on the 0.6 m rope)
 FORCES_ONLY_TRIALS = True            # semi-smooth problems: the line search's full-step trial without tangent ...
 FULL_AFTER_FULL = True               # ... but with it after a full step was accepted (``backtrack``)
-LM_SHIFT = 1e-3                      # exact stick: after LM_AFTER backtracked iterations in a row, the direction from
+LM_SHIFT = 0.0                       # exact stick: after LM_AFTER backtracked iterations in a row, the direction from
 LM_AFTER = 2                         # K + LM_SHIFT |diag K| on the displacement block (Levenberg, ``Newton._levenberg``;
-                                     # 0: off): the long-lay strand's cycle 770 -> 584 iterations (docs/benchmarks.md,
-                                     # session 9); after one, 478-553, but three wires 138 -> 180
+                                     # 0: off, the default): with 1e-3 the long-lay strand's cycle 770 -> 584-586
+                                     # iterations, but the 40 mm rope's loaded step fails (30 iterations, 3.4e-4;
+                                     # 19 without); after one, 478-553, three wires 138 -> 180 (docs/benchmarks.md,
+                                     # session 9)
 INNER_SWITCHES = 0                   # exact stick: branch switches of the linearised groups per Newton direction ...
 INNER_PREDICTOR = False              # ... also in a load step's first iteration (the prescribed motions' predictor)
 NORMAL_SWITCHES = 4                  # exact stick: Newton directions again with the points the full step opens

@@ -1,6 +1,6 @@
-"""Exact stick's Levenberg shift after a backtracked line search (``newton.LM_SHIFT``, ``Problem._shifted``): the
-direction's tangent gets ``LM_SHIFT |diag K|`` on its diagonal; the residual and the convergence test are unchanged,
-so the answer is too."""
+"""Exact stick's Levenberg shift after backtracked line searches (``newton.LM_SHIFT``, off by default;
+``Problem._shifted``): the direction's tangent gets ``LM_SHIFT |diag K|`` on its diagonal; the residual and the
+convergence test are unchanged, so the answer is too."""
 import contextlib
 import io
 
