@@ -7,7 +7,7 @@
 ``--phases``: the example's cycle (``strand_bending.run``, default options) with every Newton attempt counted by phase
 of the history (step 0, pull, virgin branch, the two half cycles): attempts, failed ones, Newton directions (of them in
 failed attempts), residual evaluations of the line searches and the iterations whose line search tried 6 or more
-lengths (the crawl); ``--shift``: exact stick's Levenberg shift ``newton.LM_SHIFT`` (default 0: off).
+lengths (the crawl); ``--shift``: exact stick's Levenberg shift ``newton.LM_SHIFT`` (0: off, before session 9).
 ``--modes``: the frictionless strand (``mu = 0``) pulled to ``T`` in 4 steps, the stable-branch
 rule off, and the 3 lowest scaled eigenvalues of its tangent at ``t = 1`` (``modes.lowest_modes``), with the lowest
 mode's energy split between the elements and the contact; ``--scale what factor`` scales the sections' shear,
@@ -118,7 +118,7 @@ if __name__ == "__main__":
     ap.add_argument("--lay", type=float, default=229.2, help="lay length [mm]")
     ap.add_argument("--t-end", type=float, default=6.0)
     ap.add_argument("--scale", nargs=2, default=None, metavar=("WHAT", "FACTOR"))
-    ap.add_argument("--shift", type=float, default=None, help="newton.LM_SHIFT (default: the library's, 0)")
+    ap.add_argument("--shift", type=float, default=None, help="newton.LM_SHIFT (default: the library's; 0: off)")
     a = ap.parse_args()
     if a.shift is not None:
         newton.LM_SHIFT = a.shift

@@ -44,9 +44,9 @@ full-stick stiffness (shear and torsion of the wires included) against ``EI_max`
 ``--lay`` sets the lay length (mm): the first slip meets the plane-section ``kappa_b`` within 5 % from 6 deg
 (``--lay 229.2``: 1.040 ``kappa_b`` at 48 and 96 el/lay), since the wires' compliance under the friction's couple
 falls like ``sin^2(beta)`` (docs/theory_strand_bending.md section 5); ``--onset`` adds the first slip on a ramp in
-steps of 0.01 ``kappa_b`` (``first_slip``).  The 6 deg cycle at 4 lays, 48 el/lay: every quality target met, 770 Newton
-iterations, 5 cut-backs, 196 s CPU (586, 5, 142 s with ``newton.LM_SHIFT = 1e-3``): its slip steps crawl along soft
-torsion-bending modes of the wires, which make the frictionless strand's tangent indefinite from 0.42 of the pull
+steps of 0.01 ``kappa_b`` (``first_slip``).  The 6 deg cycle at 4 lays, 48 el/lay: every quality target met, 582 Newton
+iterations, 5 cut-backs, 148 s CPU (770, 5, 196 s without exact stick's Levenberg shift): its slip steps crawl along
+soft torsion-bending modes of the wires, which make the frictionless strand's tangent indefinite from 0.42 of the pull
 (docs/benchmarks.md, session 9).
 
     python examples/strand_bending.py [--lays 2] [--elements 16] [--amplitude 3] [--steps 8] [--lay 114.6] [--onset]

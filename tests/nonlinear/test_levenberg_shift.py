@@ -1,4 +1,4 @@
-"""Exact stick's Levenberg shift after backtracked line searches (``newton.LM_SHIFT``, off by default;
+"""Exact stick's Levenberg shift after backtracked line searches (``newton.LM_SHIFT``, ``LM_AFTER``, ``LM_FAR``;
 ``Problem._shifted``): the direction's tangent gets ``LM_SHIFT |diag K|`` on its diagonal; the residual and the
 convergence test are unchanged, so the answer is too."""
 import contextlib
@@ -46,6 +46,7 @@ def test_the_shift_changes_the_iterations_not_the_answer(monkeypatch):
     monkeypatch.setattr(Problem, "_shifted", lambda self, K: used.append(self.shift) or shifted(self, K))
     monkeypatch.setattr(newton, "LM_SHIFT", 1e-3)
     monkeypatch.setattr(newton, "LM_AFTER", 1)
+    monkeypatch.setattr(newton, "LM_FAR", False)
     sol = _three_wires()
     assert sol.converged and plain.converged and any(s > 0 for s in used)
     assert np.array_equal(sol.times, plain.times)
