@@ -54,6 +54,12 @@ DROP_BEFORE_SOLVE = True             # exact stick (augmented): the tangent drop
 #                                      factorisation (issue 30: the groups' blocks freed first, 1.3 GB on the 0.6 m rope)
 FORCES_ONLY_TRIALS = True            # semi-smooth problems: the line search's full-step trial without tangent ...
 FULL_AFTER_FULL = True               # ... but with it after a full step was accepted (``backtrack``)
+LM_SHIFT = 1e-3                      # exact stick: after LM_AFTER backtracked iterations in a row, away from the
+LM_AFTER = 2                         # solution (not ``near``, with LM_FAR), the direction from K + LM_SHIFT |diag K|
+LM_FAR = True                        # on the displacement block (Levenberg, ``Newton._levenberg``; 0: off): the
+                                     # long-lay strand's cycle 770 -> 582 iterations, 196 -> 148 s; near the solution
+                                     # too, the 40 mm rope's loaded step failed (30 iterations, 3.4e-4, against 19)
+                                     # (docs/benchmarks.md, session 9)
 INNER_SWITCHES = 0                   # exact stick: branch switches of the linearised groups per Newton direction ...
 INNER_PREDICTOR = False              # ... also in a load step's first iteration (the prescribed motions' predictor)
 NORMAL_SWITCHES = 4                  # exact stick: Newton directions again with the points the full step opens
@@ -296,6 +302,22 @@ class Newton:
             lu, dzf = self._normal_branches(ev, H, t, lu, dzf)
         return lu, dzf
 
+    def _levenberg(self, ev, H, t, constraint):
+        """``_direction`` at the iterate ``ev``; with exact stick's multipliers after ``LM_AFTER`` backtracked line
+        searches in a row (``crawl``) and, with ``LM_FAR``, not ``near`` the solution, from the tangent shifted by
+        ``LM_SHIFT`` times its diagonal's magnitudes (``Problem._shifted``: the augmented path's displacement block).
+        A frictional strand whose wires have soft torsion-bending modes (a long lay) took steps along them that the
+        residual's curvature cut to 1/8 .. 1/128 of their length, iteration after iteration, with no contact status
+        changing (docs/benchmarks.md, session 9); the shift shortens them.  The residual and the convergence test are
+        unchanged."""
+        shift = LM_SHIFT if LM_SHIFT > 0.0 and ev.mult is not None and self.crawl >= LM_AFTER and \
+            not (LM_FAR and self.near) else 0.0
+        self.problem.shift = shift
+        try:
+            return self._direction(ev, H, t, constraint)
+        finally:
+            self.problem.shift = 0.0
+
     @staticmethod
     def _drop(ev, lu):
         """The tangent of ``ev`` is factorised in ``lu``: its values (the contact's (m, 24, 24) blocks) are not needed
@@ -516,7 +538,7 @@ class Newton:
                     stats_extra["damped"] = damped_its
                 return self._converged(H, t, ev, constraint, dict(iterations=it, residuals=residuals, **stats_extra))
             if dzf is None:
-                lu, dzf = self._direction(ev, H, t, constraint)
+                lu, dzf = self._levenberg(ev, H, t, constraint)
             if it == 0 and self.watch_sign and constraint.watch_sign:
                 self._watch_first_tangent(lu)
             self._drop(ev, lu)

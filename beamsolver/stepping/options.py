@@ -20,7 +20,7 @@ class RunOptions:
     ``penalty_hint``: the tail naming a stiff penalty (``Problem.failure_hint``), also at ``t_start``;
     ``allow_unmet_tolerance``: accept a step whose contributions' tolerance is unmet, with a warning;
     ``check_stability``: ``None``/``True``: judge every converged state (``stability.StepCheck``),
-    ``False``: not;
+    ``False``: not (nor does the stable-branch rule cut steps back: ``stable_branch``);
     ``modes``: lowest eigenpairs recorded per checked step; ``branch_switching``: ``False``, ``True``
     or ``"auto"``; ``stabilizer``: the ``stabilize.Stabilization`` (a contribution of the problem) or
     ``None``; ``path``: the stepper's own options (``arclength.ArcLength`` for ``"arc-length"``)."""

@@ -22,7 +22,8 @@ converged at its first try; past that
 (the stable branch itself ends there: a limit point, or the bifurcation of a
 perfect structure) the unstable state is kept, and said so.  Steps from an
 unstable state and non-conservative problems (friction, follower loads,
-stabilisation) are not checked.
+stabilisation) are not checked, nor is any step of ``solve(check_stability=False)``
+(nothing is decided about stability there: ``stepping.steps.Run._watches_branch``).
 """
 from ..nonlinear.definiteness import negative_eigenvalues
 from ..failures import LeftStableBranch

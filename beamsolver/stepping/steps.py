@@ -131,8 +131,15 @@ class Run:
         self.step_negative = None     # the same of the step being tried, if the stable-branch rule counted them
         self.stability = stability.StepCheck(problem, options.check_stability, options.stabilizer)
         self.branch_tries = 0         # LeftStableBranch failures since a step converged at its first try
-        newton.watch_sign = (problem.conservative and not options.branch_switching   # stable_branch
-                             and stable_branch.ENABLED)
+        newton.watch_sign = self._watches_branch(problem, options)
+
+    @staticmethod
+    def _watches_branch(problem, options):
+        """Whether the stable-branch rule (``stable_branch``) watches the steps: a conservative problem, not with
+        ``branch_switching`` (its switch moves onto a stable branch itself) nor ``check_stability=False`` (nothing is
+        decided about stability then: no cut-back, no warning)."""
+        return (problem.conservative and not options.branch_switching and options.check_stability is not False
+                and stable_branch.ENABLED)
 
     # ------------------------------------------------------------------ start
     def start(self, restart_solution, initial_poses):
@@ -383,7 +390,7 @@ class Run:
         moves the path onto a stable branch itself).  Only a step whose first tangent had ``det < 0``
         (``Newton.indefinite_seen``) or that took undamped Newton iterations (the fallback, or
         ``line_search=False``) is checked."""
-        if self.opt.branch_switching or not stable_branch.ENABLED:
+        if not self._watches_branch(self.problem, self.opt):
             return
         if not (self.newton.indefinite_seen or stats.get("undamped") is not None or not self.newton.line_search):
             self.negative = None        # every tangent of the step had det > 0: not checked (stable_branch)

@@ -58,3 +58,17 @@ def test_below_p_cr_nothing_is_checked_or_said():
         warnings.simplefilter("error")
         sol = bs.solve(m, steps=4, verbose=False)
     assert sol.message == "" and not any(s.get("left_stable_branch") for s in sol.stats)
+
+
+def test_switched_off_stability_checks_leave_the_path_alone():
+    """``check_stability=False`` decides nothing about stability: no step of the perfect column past P_cr is cut
+    back for leaving the stable branch and nothing is said (with checks: cut back, kept, warned, above).  The
+    frictionless long-lay strand's elastic check (examples/strand_bending.py) needs it: its wires' torsion-bending
+    modes, which the frictionless contact barely holds, cross zero under the pull (docs/benchmarks.md, session 9)."""
+    m, b = _perfect_column(1.5)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sol = bs.solve(m, steps=2, verbose=False, check_stability=False)
+    assert sol.n_steps == 2 and sum(s["cutbacks"] for s in sol.stats) == 0
+    assert not any(s.get("left_stable_branch") for s in sol.stats) and sol.message == ""
+    assert abs(sol.position(b.last)[1]) < 1e-9
