@@ -46,15 +46,13 @@ def measure(length_mm, rounds):
     H = s.poses0.copy()
     problem.begin_step(H, 0.0)
     ev = problem.evaluate(H, 1.0, tangent=True)
-    node = s._block_nodes(s._coo_index[0])
-    k = node.shape[1]
-    vals = ev.extra[2][:s._coo_index[1].size].reshape(-1, 6 * k, 6 * k)
+    node, vals = s.contact_blocks(ev.extra)
     best = {}
     mats = {}
     for r in range(rounds):
         for variant in ("numpy", "linear"):
             held_pattern.LINEAR_KEYS = variant == "linear"
-            s._held_cache = None
+            s.forget_held_pattern()
             t0 = clock()
             K = s.matrix(ev.kvals, ev.extra)
             t_new = clock() - t0

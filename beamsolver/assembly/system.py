@@ -721,6 +721,20 @@ class System:
             return None
         return canonical_csc(data, K.indices, K.indptr, K.shape[0])
 
+    def forget_held_pattern(self):
+        """Drop the held pattern: the next ``matrix`` call builds a new one (what a new contact pattern costs)."""
+        self._held_cache = None
+
+    def contact_blocks(self, extra):
+        """The whole-node blocks of the contributions' COO ``extra``: nodes ``(m, k)`` and values ``(m, 6 k, 6 k)``
+        (views), or ``None`` where they are not whole-node blocks."""
+        c = getattr(self, "_coo_index", None)
+        if c is None or not c[3]:
+            return None
+        node = self._block_nodes(c[0])
+        k = node.shape[1]
+        return node, extra[2][:c[1].size].reshape(-1, 6 * k, 6 * k)
+
     def _block_nodes(self, d):
         """The nodes ``(m, k)`` of whole-node block dofs ``d`` ``(m, 6 k)`` (kept while ``d`` is the same array)."""
         c = getattr(self, "_block_nodes_cache", None)

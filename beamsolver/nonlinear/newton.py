@@ -305,7 +305,7 @@ class Newton:
     def _levenberg(self, ev, H, t, constraint):
         """``_direction`` at the iterate ``ev``; with exact stick's multipliers after ``LM_AFTER`` backtracked line
         searches in a row (``crawl``) and, with ``LM_FAR``, not ``near`` the solution, from the tangent shifted by
-        ``LM_SHIFT`` times its diagonal's magnitudes (``Problem._shifted``: the augmented path's displacement block).
+        ``LM_SHIFT`` times its diagonal's magnitudes (``Problem.levenberg``: the augmented path's displacement block).
         A frictional strand whose wires have soft torsion-bending modes (a long lay) took steps along them that the
         residual's curvature cut to 1/8 .. 1/128 of their length, iteration after iteration, with no contact status
         changing (docs/benchmarks.md, session 9); the shift shortens them.  The residual and the convergence test are
@@ -319,7 +319,7 @@ class Newton:
             self.problem.shift = 0.0
 
     @staticmethod
-    def _drop(ev, lu):
+    def release(ev, lu):
         """The tangent of ``ev`` is factorised in ``lu``: its values (the contact's (m, 24, 24) blocks) are not needed
         any more, and freeing them lets the next evaluation reuse their memory (exact stick's K' too: only the factor
         of A is kept)."""
@@ -541,7 +541,7 @@ class Newton:
                 lu, dzf = self._levenberg(ev, H, t, constraint)
             if it == 0 and self.watch_sign and constraint.watch_sign:
                 self._watch_first_tangent(lu)
-            self._drop(ev, lu)
+            self.release(ev, lu)
             if ev.mult is not None:
                 problem.multiplier_trial(1.0)
             if constraint.moves:

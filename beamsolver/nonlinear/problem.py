@@ -88,7 +88,7 @@ class Problem:
         self._lf = (None, np.zeros(0))
         self._bordered = Bordered()      # the bordered matrix's pattern, kept across Newton iterations
         self.extras = {}                 # the last ``commit``'s per-step values besides the record
-        self.shift = 0.0                 # Levenberg shift of the augmented path's displacement block (``_shifted``)
+        self.shift = 0.0                 # Levenberg shift of the augmented path's displacement block (``levenberg``)
 
     @classmethod
     def from_model(cls, model, check_rigid_modes=True):
@@ -378,7 +378,7 @@ class Problem:
             raise ValueError("Problem.augmented_system: the evaluation's tangent was dropped (Evaluation.drop_tangent)")
         f = self._force_rhs(ev, dz_c, sp)        # (before an augmentation in the values, which the coupling reads)
         if first:
-            Kp = mu["Kp"] = self._shifted(self.tangent(ev))
+            Kp = mu["Kp"] = self.levenberg(self.tangent(ev))
             E, p22 = augmented_.weights(Kq, Kl, free, self._element_diagonal(ev)[mu["dofs"][g]], d, idle)
             mu["E"], mu["p22"] = E, p22
             A = self.system.add_products(Kp, mu["dofs"][g], Kq, Kl, E)     # on the held pattern: no assembly
@@ -401,7 +401,7 @@ class Problem:
         return augmented_.Augmented(Kp, mu["A"], f, gv, Kq, Kl, rows, np.where(idle, 1.0, d), E, p22, idle,
                                     direct=lambda: self._condensed(ev, Kp, f, dz_c))
 
-    def _shifted(self, K):
+    def levenberg(self, K):
         """``K`` with ``shift`` times its diagonal's magnitudes added to its diagonal (``Newton``'s Levenberg shift of
         exact stick's displacement block, ``newton.LM_SHIFT``; the pattern kept), ``K`` itself without a shift."""
         if not self.shift > 0.0:

@@ -189,7 +189,7 @@ def test_dropping_the_tangent_frees_k_prime(monkeypatch):
         refs.append(weakref.ref(self.K))
         seen["solved"] += 1
         return x
-    drop = newton.Newton._drop
+    drop = newton.Newton.release
 
     def check(ev, lu):
         # the iteration's Newton system solved (``Newton._normal_branches``' directions too), before the line search
@@ -197,7 +197,7 @@ def test_dropping_the_tangent_frees_k_prime(monkeypatch):
         seen["freed"] += sum(r() is None for r in refs)
         refs.clear()
     monkeypatch.setattr(augmented.Augmented, "solve", tracked)
-    monkeypatch.setattr(newton.Newton, "_drop", staticmethod(check))
+    monkeypatch.setattr(newton.Newton, "release", staticmethod(check))
     monkeypatch.setattr(Problem, "augmented_system", built)
     dropped = shear_lag.main(n_wire=20)[0]
     assert seen["solved"] >= 8 and seen["freed"] == seen["solved"] == seen["dropped"], seen

@@ -1,5 +1,5 @@
 """Exact stick's Levenberg shift after backtracked line searches (``newton.LM_SHIFT``, ``LM_AFTER``, ``LM_FAR``;
-``Problem._shifted``): the direction's tangent gets ``LM_SHIFT |diag K|`` on its diagonal; the residual and the
+``Problem.levenberg``): the direction's tangent gets ``LM_SHIFT |diag K|`` on its diagonal; the residual and the
 convergence test are unchanged, so the answer is too."""
 import contextlib
 import io
@@ -16,9 +16,9 @@ def test_shifted_adds_the_diagonals_magnitudes_on_the_same_pattern():
     K = sp.csc_matrix(np.array([[4.0, 1.0, 0.0], [1.0, -2.0, 3.0], [0.0, 3.0, 5.0]]))
     p = Problem.__new__(Problem)
     p.shift = 0.0
-    assert p._shifted(K) is K
+    assert p.levenberg(K) is K
     p.shift = 0.5
-    S = p._shifted(K)
+    S = p.levenberg(K)
     assert np.allclose(S.diagonal(), [6.0, -1.0, 7.5])
     assert np.array_equal(S.indptr, K.indptr) and np.array_equal(S.indices, K.indices)
     assert np.allclose((S - K).toarray(), np.diag([2.0, 1.0, 2.5]))
@@ -42,8 +42,8 @@ def test_the_shift_changes_the_iterations_not_the_answer(monkeypatch):
     monkeypatch.setattr(newton, "LM_SHIFT", 0.0)
     plain = _three_wires()
     used = []
-    shifted = Problem._shifted
-    monkeypatch.setattr(Problem, "_shifted", lambda self, K: used.append(self.shift) or shifted(self, K))
+    shifted = Problem.levenberg
+    monkeypatch.setattr(Problem, "levenberg", lambda self, K: used.append(self.shift) or shifted(self, K))
     monkeypatch.setattr(newton, "LM_SHIFT", 1e-3)
     monkeypatch.setattr(newton, "LM_AFTER", 1)
     monkeypatch.setattr(newton, "LM_FAR", False)
