@@ -27,16 +27,25 @@ from beamsolver.nonlinear import linsolve, newton  # noqa: E402
 from beamsolver.nonlinear.problem import Problem  # noqa: E402
 
 
-def _pair_unloaded(R=0.5e-3, L=0.1, n=24):
+def touching_pair(R=0.5e-3, L=0.1, n=24, clamp_both=True, load=None):
+    """Two straight steel wires touching along ``L``, clamped at their first (and last) nodes, ``load`` on the
+    middle node of ``a``: ``(model, a, b)`` (also tests/contact/test_contact_touching_unloaded.py's scene)."""
     sec = bs.Section.circular(radius=R, E=200e9, nu=0.3)
     m = bs.Model()
     a = m.add_beam(bs.geometry.straight((0, 0, 0), (0, 0, L), n), sec, name="a")
     b = m.add_beam(bs.geometry.straight((2 * R, 0, 0), (2 * R, 0, L), n), sec, name="b")
     for w in (a, b):
         m.clamp(w.first)
-        m.clamp(w.last)
+        if clamp_both:
+            m.clamp(w.last)
+    if load is not None:
+        m.add_load(a.nodes[n // 2], force=load)
     m.add_contact(b, a)
-    return bs.solve(m, steps=2)
+    return m, a, b
+
+
+def _pair_unloaded():
+    return bs.solve(touching_pair()[0], steps=2)
 
 
 def _scene(name):

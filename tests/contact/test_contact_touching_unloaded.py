@@ -19,18 +19,8 @@ R, L = 0.5e-3, 0.1
 
 
 def _pair(n=24, clamp_both=True, load=None):
-    sec = bs.Section.circular(radius=R, E=200e9, nu=0.3)
-    m = bs.Model()
-    a = m.add_beam(bs.geometry.straight((0, 0, 0), (0, 0, L), n), sec, name="a")
-    b = m.add_beam(bs.geometry.straight((2 * R, 0, 0), (2 * R, 0, L), n), sec, name="b")
-    for w in (a, b):
-        m.clamp(w.first)
-        if clamp_both:
-            m.clamp(w.last)
-    if load is not None:
-        m.add_load(a.nodes[n // 2], force=load)
-    m.add_contact(b, a)
-    return m, a, b
+    from touching_start import touching_pair        # benchmarks/touching_start.py (on pytest's pythonpath)
+    return touching_pair(R, L, n, clamp_both=clamp_both, load=load)
 
 
 def test_touching_wires_without_load_find_their_first_equilibrium():
