@@ -77,6 +77,10 @@ SECANT_SHARE = 0.3                   # cuts to at most this share linearised on 
                                      # docs/theory/contact_laws.md 17.2; ``_normal_branches``) ...
 SECANT_REACH = 1.0 - 2.0 ** -10      # ... aimed at this share of the way: where ten tangent steps end (a beam held by
                                      # contact alone keeps the stiffness the crawl left it: the contact patch's slave)
+START_SWITCH_LIMIT = 1               # ... and at t_start one such direction again per iteration (not NORMAL_SWITCHES:
+                                     # each is an evaluation and a factorisation; the 19-wire strand twin's step 0
+                                     # took 7 iterations either way, 21.1 s with 4 against 11.5 s with 1; 9.3 s and
+                                     # 10 iterations without the start's switches)
 NORMAL_NEAR = True                   # ... only near the solution (``near``: the residual cut LS_NEAR-fold)
 INNER_UNSETTLED = "last"             # branches still changing after INNER_SWITCHES: "last" solve or "plain" Newton's
                                      # (an option: twisted pair 244 -> 195, shear lag 39 -> 22 iterations with 8, but
@@ -347,7 +351,7 @@ class Newton:
         # Newton's own steps finish (a beam held by contact alone keeps the stiffness that leaves it)
         done = self.secant_done if self.secant_done is not None else on_secant
         try:
-            for _ in range(NORMAL_SWITCHES):
+            for _ in range(min(NORMAL_SWITCHES, START_SWITCH_LIMIT) if self.start else NORMAL_SWITCHES):
                 # the multipliers of the line search's full step: the normal law does not depend on them, and the
                 # full step's evaluation (forces only) then serves the line search's first trial when nothing opens
                 problem.multiplier_trial(1.0 if PRESSED_AT_TRIAL else 0.0)
