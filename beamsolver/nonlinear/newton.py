@@ -80,7 +80,8 @@ SECANT_REACH = 1.0 - 2.0 ** -10      # ... aimed at this share of the way: where
 START_SWITCH_LIMIT = 1               # ... and at t_start one such direction again per iteration (not NORMAL_SWITCHES:
                                      # each is an evaluation and a factorisation; the 19-wire strand twin's step 0
                                      # took 7 iterations either way, 21.1 s with 4 against 11.5 s with 1; 9.3 s and
-                                     # 10 iterations without the start's switches)
+                                     # 10 iterations without the start's switches; the unloaded touching pair's step 0:
+                                     # 26 iterations against 10 with 4 and 44 without)
 NORMAL_NEAR = True                   # ... only near the solution (``near``: the residual cut LS_NEAR-fold)
 INNER_UNSETTLED = "last"             # branches still changing after INNER_SWITCHES: "last" solve or "plain" Newton's
                                      # (an option: twisted pair 244 -> 195, shear lag 39 -> 22 iterations with 8, but

@@ -78,3 +78,22 @@ def test_the_contact_patch_s_touching_start_reaches_the_double_root_in_two_itera
     assert abs(g_after[-1] - g_before[-1]) <= 1e-11           # dtol L (L = 1)
     for k in range(len(before.times)):
         np.testing.assert_allclose(after.poses[k][:, :3, 3], before.poses[k][:, :3, 3], rtol=0, atol=1e-13)
+
+
+def test_the_start_solves_one_direction_again_per_iteration(monkeypatch):
+    """``START_SWITCH_LIMIT`` = 1: at t_start the normal law's active set solves at most one more direction per Newton
+    iteration (each is an evaluation and a factorisation: with ``NORMAL_SWITCHES`` = 4 there the 19-wire strand twin's
+    loaded step took 21 s against 12.7 s). The unloaded touching pair (benchmarks/touching_start.py) then takes 26
+    iterations at step 0 and 49 directions (with 4: 10 and 30, 3 a iteration; without the start's switches 44)."""
+    from touching_start import touching_pair
+    count = [0]
+    direction = newton.Newton.direction
+
+    def counted(self, *a, **k):
+        count[0] += self.start
+        return direction(self, *a, **k)
+    monkeypatch.setattr(newton.Newton, "direction", counted)
+    sol = bs.solve(touching_pair()[0], steps=2, verbose=False)
+    its = sol.stats[0]["iterations"]
+    assert sol.converged and its < 44
+    assert count[0] <= 2 * its
