@@ -63,6 +63,7 @@ from .bending import BendingFixture, bending_fixture
 from ..errors import InputError
 from .model import Model
 from .section import Section
+from . import contact_options as _copts
 from .validation import count, real
 
 __all__ = ["Layer", "Strand", "build_strand", "Rope", "build_rope", "bending_fixture", "BendingFixture",
@@ -247,16 +248,34 @@ def build_strand(layers, length, E, nu=0.3, elements_per_lay=24, min_elements=8,
 def _strand_contacts(model, wires, geo, mu, opts, touch_tol):
     """Contact declarations of one strand's layers ``wires`` (lists of beams, centre out; ``geo``: their
     ``_geometry``): each layer against the one inside it, and neighbours within a layer whose centre
-    lines come within ``2 R (1 + touch_tol)``."""
+    lines come within ``2 R (1 + touch_tol)``; exact stick's ``c`` from the slave layer's axial stiffness
+    (``_axial_c``) unless ``opts`` give ``penalty_t`` or another stick."""
     contacts = []
     for k in range(1, len(wires)):
-        contacts.append(model.add_contact(wires[k], wires[k - 1], mu=mu, **opts))
+        contacts.append(model.add_contact(wires[k], wires[k - 1], mu=mu, **_axial_c(model, opts, mu, wires[k][0])))
     for k, lw in enumerate(wires):
         m = len(lw)
         if m >= 2 and _neighbour_distance(model, lw[0], lw[1]) <= 2.0 * geo[k][3] * (1.0 + touch_tol):
             for i in range(m if m > 2 else 1):
-                contacts.append(model.add_contact(lw[i], lw[(i + 1) % m], mu=mu, **opts))
+                contacts.append(model.add_contact(lw[i], lw[(i + 1) % m], mu=mu,
+                                                  **_axial_c(model, opts, mu, lw[i])))
     return contacts
+
+
+def _axial_c(model, opts, mu, slave):
+    """``opts`` with exact stick's ``c`` (``penalty_t``) of a strand's contact whose slave is the wire ``slave``:
+    ``EXACT_C_AXIAL EA / (L_e L_s)`` (``contact_options.axial_c``; ``L_e`` its median reference element length).
+    Slip between the wires of a strand runs along them, driven by their axial forces' gradients, and the wires resist
+    it with their axial stiffness; the library's default ``c`` (``EXACT_C``) takes the slave's bending stiffness,
+    1 / 159 of this on the strand of examples/strand_bending.py at a lay ratio of 20, where its slip steps crawled
+    (docs/benchmarks.md, "Strand bending, session 10").  ``c`` does not change the solution (exact stick), only
+    Newton's path."""
+    if mu == 0.0 or "penalty_t" in opts or opts.get("stick", "exact") != "exact" or not _copts.EXACT_C_AXIAL > 0:
+        return opts
+    x = model.poses0[slave.nodes, :3, 3]
+    n = len(x) - 1
+    Le = float(np.median(np.linalg.norm(np.diff(x, axis=0), axis=1)))
+    return dict(opts, penalty_t=_copts.axial_c(slave.section.C[0, 0], Le, n))
 
 
 def _geometry(layers):

@@ -18,13 +18,15 @@ from .validation import count, real
 
 __all__ = ["ContactOptions", "check_contact_options", "describe", "SMOOTHING", "SLIP_TOLERANCE", "GAUSS_POINTS",
            "SEGMENT_POINTS",
-           "STICK_TOLERANCE", "LINE_ANGLE", "ADJUST", "EXACT_C", "EXACT_N"]
+           "STICK_TOLERANCE", "LINE_ANGLE", "ADJUST", "EXACT_C", "EXACT_N",
+           "EXACT_C_AXIAL", "axial_c"]
 
 SMOOTHING = 1e-6          # default smoothing gap of the normal law / (R1 + R2) (benchmarks/touching_defaults.py)
 SLIP_TOLERANCE = 0.005    # elastic slip at the onset of sliding / slave element length (Abaqus' default)
 EXACT_C = 24.0            # stick="exact": default c of the complementarity function / (EI / (L_e L_s^3)) of the slave,
 EXACT_N = 16              # ... L_s = its length / EXACT_N (n L_e / EXACT_N; docs/theory_mortar.md 3b, "c under mesh
                           # refinement": c grows like 1 / L_e, and equals 24 EI / L_e^4 at 16 elements)
+EXACT_C_AXIAL = 1.0       # ... a strand's contacts (``cables.build_strand``): c = this times EA / (L_e L_s) of the slave
 STICK_TOLERANCE = 1e-8    # weighted slip of a sticking node / (R1 + R2) with stick="exact"
 LINE_ANGLE = float(np.deg2rad(20.0))   # below this crossing angle: line contact (search.py, rule 1)
 GAUSS_POINTS = 5          # integration="points": Gauss points per slave element
@@ -32,6 +34,14 @@ SEGMENT_POINTS = 3        # integration="segments": Gauss points per segment (2 
                           # 3 keep the contact examples' iterations: docs/benchmarks.md, segment-to-segment)
 ADJUST = 1e-3             # default overclosure adjusted away at the reference poses / (R1 + R2)
                           # (chords of a polyline on a post: 1.1e-4 at R1 + R2 = 1.02; docs/theory_adjust.md)
+
+
+def axial_c(EA, Le, n):
+    """Exact stick's ``c`` (force / length^2) from a slave's axial stiffness ``EA``: ``EXACT_C_AXIAL EA / (L_e L_s)``
+    with ``L_s = n L_e / EXACT_N`` (``L_e`` its element length, ``n`` its elements), the axial counterpart of the
+    default ``EXACT_C EI / (L_e L_s^3)`` (``contact.system.exact_c``): the wire's stiffness against a nodal
+    displacement along it, per unit length of the node."""
+    return float(EXACT_C_AXIAL * EA / Le ** 2 * (EXACT_N / n))
 
 
 def _gauss_points(v, owner):

@@ -63,3 +63,27 @@ def test_bad_layers_raise_input_error():
     with pytest.raises(InputError, match="direction"):
         cables.build_strand([cables.Layer(1e-3, 1), cables.Layer(1e-3, 6, lay_angle=0.2, direction="up")],
                             0.03, E)
+
+
+def test_strand_contacts_take_exact_stick_s_c_from_the_wires_axial_stiffness():
+    """``build_strand`` gives its frictional contacts exact stick's ``c`` from the slave wire's axial stiffness,
+    ``EXACT_C_AXIAL EA / (L_e L_s)`` with ``L_s = n L_e / EXACT_N`` (slip in a strand runs along the wires), not the
+    library's bending-based default (1/159 of it on the 6 deg strand of examples/strand_bending.py, whose slip steps
+    crawled with it: docs/benchmarks.md, "Strand bending, session 10"); a user's ``penalty_t``, the penalty stick
+    and frictionless contacts keep their options."""
+    from beamsolver.model import contact_options as co
+    layers = [cables.Layer(1e-3), cables.Layer(1e-3, 6, lay_length=0.1)]
+    st = cables.build_strand(layers, 0.2, E=2e11, elements_per_lay=12, mu=0.3, fit_core=True)
+    wire = st.wires[1][0]
+    x = st.model.poses0[wire.nodes, :3, 3]
+    Le = np.median(np.linalg.norm(np.diff(x, axis=0), axis=1))
+    n = len(wire.nodes) - 1
+    EA = 2e11 * np.pi * 1e-6
+    c = co.EXACT_C_AXIAL * EA / (Le * n * Le / co.EXACT_N)
+    assert len(st.contacts) == 7                     # the core, and the closed layer's neighbours
+    assert all(d.options["penalty_t"] == pytest.approx(c, rel=1e-12) for d in st.contacts)
+    EI = 2e11 * np.pi * 1e-12 / 4
+    assert c > 10 * co.EXACT_C * EI / (Le * (n * Le / co.EXACT_N) ** 3)     # stiffer than the bending-based c
+    for kw in (dict(contact_options=dict(penalty_t=5.0)), dict(contact_options=dict(stick="penalty")), dict(mu=0.0)):
+        st = cables.build_strand(layers, 0.2, E=2e11, elements_per_lay=12, **(dict(mu=0.3) | kw), fit_core=True)
+        assert all(d.options.get("penalty_t") == kw.get("contact_options", {}).get("penalty_t") for d in st.contacts)
