@@ -31,12 +31,12 @@ def row(elements_per_lay, factor, lays, upto, saddle="auto"):
     sb._contact_options = lambda stick, tol: orig("exact", tol) | extra
     try:
         t0, c0 = time.perf_counter(), time.process_time()
-        res = sb.run(lays, elements_per_lay, amplitude=upto, steps=int(round(upto / 0.05)), t_end=2.0)
+        res = sb.run(lays, elements_per_lay, amplitude=upto, steps=int(round(upto / 0.05)), t_end=2.0, lay=sb.LAY_UJ)
         wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     finally:
         sb._contact_options = orig
         augmented.ENABLED = True
-    th = sb.theory(res["F"])
+    th = sb.theory(res["F"], lay=sb.LAY_UJ)
     up = np.flatnonzero(res["times"] > 1.0)
     hit = up[res["share"][up] > 0]
     first = res["kappa"][hit[0]] / th["kappa_b"] if len(hit) else np.nan

@@ -24,7 +24,7 @@ def main():
     ap.add_argument("--amplitude", type=float, default=sb.AMPLITUDE)
     ap.add_argument("--steps", type=int, default=sb.STEPS)
     ap.add_argument("--slip-tolerance", type=float, default=sb.SLIP_TOLERANCE)
-    ap.add_argument("--lay", type=float, default=sb.LAY * 1e3, help="lay length [mm]")
+    ap.add_argument("--lay", type=float, default=sb.LAY_UJ * 1e3, help="lay length [mm]")
     a = ap.parse_args()
     sb.SLIP_TOLERANCE = a.slip_tolerance
     table, runtime = {}, []

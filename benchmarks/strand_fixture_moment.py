@@ -24,14 +24,14 @@ ALONG = (0.05, 0.125, 0.25, 0.375, 0.5)
 
 def ramp(lays, epl, amplitude, steps, line_load=1.0):
     """``(mid error, middle-lay mean error, profile errors at ALONG, kappa, M_mid, theory, CPU s)``."""
-    model, st, fx, T, k = sb.build(lays, epl, amplitude=amplitude)
+    model, st, fx, T, k = sb.build(lays, epl, amplitude=amplitude, lay=sb.LAY_UJ)
     for ld in fx.line_loads:
         ld.q = ld.q * line_load
     c0 = time.process_time()
     sol = bs.solve(model, steps=int(round(2 * steps)), t_end=2.0)
     cpu = time.process_time() - c0
     outer = np.concatenate([w.elements for w in st.wires[1]])
-    th = sb.theory(float(np.mean(sol.section_forces[int(np.argmin(np.abs(sol.times - 1.0))), outer, 0])))
+    th = sb.theory(float(np.mean(sol.section_forces[int(np.argmin(np.abs(sol.times - 1.0))), outer, 0])), lay=sb.LAY_UJ)
     j, kap = len(sol.times) - 1, fx.curvature(sol.times[-1])
     err = lambda z: (fx.moment(sol, fx.z0 + z, step=j) - th["EI_min"] * kap) / th["M_f"] - 1   # noqa: E731
     L = fx.length
@@ -60,8 +60,8 @@ def main():
             if a.no_checks:
                 fp, de = np.nan, np.nan
             else:
-                (EI0, F0), _ = sb.stiffness_checks(lays, epl)
-                fp, de = (M - EI0 * kap) / th["M_f"] - 1, EI0 / sb.theory(F0)["EI_min"] - 1
+                (EI0, F0), _ = sb.stiffness_checks(lays, epl, lay=sb.LAY_UJ)
+                fp, de = (M - EI0 * kap) / th["M_f"] - 1, EI0 / sb.theory(F0, lay=sb.LAY_UJ)["EI_min"] - 1
             print(f"| {lays:g} | {epl} | {mid:+.2%} | {mean:+.2%} | {fp:+.2%} | {de:+.2%} | "
                   + " | ".join(f"{e:+.1%}" for e in prof) + f" | {cpu:.1f} |", flush=True)
 

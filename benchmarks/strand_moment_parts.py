@@ -42,7 +42,7 @@ def main():
     ap.add_argument("--lays", type=float, default=4.0)
     ap.add_argument("--elements", type=int, default=48)
     ap.add_argument("--amplitude", type=float, default=5.0)
-    ap.add_argument("--lay", type=float, default=sb.LAY * 1e3, help="lay length [mm]")
+    ap.add_argument("--lay", type=float, default=sb.LAY_UJ * 1e3, help="lay length [mm]")
     a = ap.parse_args()
     lay = a.lay * 1e-3
     got = {}

@@ -67,10 +67,10 @@ def compliance_rows(factors=((None, 1.0), ("shear", 100.0), ("shear", 1e4), ("to
             secs.append(s)
         EI = []
         for mu in (sb.MU, 0.0):
-            res = sb.run(2, 16, mu=mu, amplitude=0.5, steps=1, t_end=2.0, sections=tuple(secs))
+            res = sb.run(2, 16, mu=mu, amplitude=0.5, steps=1, t_end=2.0, sections=tuple(secs), lay=sb.LAY_UJ)
             j = np.flatnonzero(res["times"] > 1.0)[0]
             EI.append(res["M"][j] / res["kappa"][j])
-        th = sb.theory(res["F"])
+        th = sb.theory(res["F"], lay=sb.LAY_UJ)
         print(f"| {what or '-'} | {f:g} | {EI[0]:.3f} | {EI[1]:.3f} | {(th['EI_max'] - EI[0]) / th['S']:.4f} "
               f"| {(EI[0] - EI[1]) / th['S']:.4f} |", flush=True)
 

@@ -1,9 +1,11 @@
 """Bending hysteresis of a tensioned 1+6 strand with Coulomb friction, against the closed-form theory.
 
-The strand: a straight core (radius 1.97 mm) and six helical wires (1.865 mm) with a lay length of
-114.6 mm (lay angle 11.9 deg): the 1+6 strand tested by Utting & Jones (1987), whose geometry is
-the common test case of strand theories (Costello 1997); steel, E = 200 GPa, nu = 0.3, mu = 0.3.
-With these radii the outer wires do not touch each other (clearance 42 um, ``cables.layer_clearance``).
+The strand: a straight core (radius 1.97 mm) and six helical wires (1.865 mm), the wires of the 1+6 strands
+tested by Utting & Jones (1987), the common test case of strand theories (Costello 1997), on a lay of 229.2 mm:
+a lay ratio of 20 (lay over the layer's diameter, lay angle 6.0 deg), as in the six-wire steel cores of overhead
+conductors.  Utting & Jones' own lay, 114.6 mm (11.9 deg), is ``--lay 114.6`` (``LAY_UJ``; below why it is not the
+default).  Steel, E = 200 GPa, nu = 0.3, mu = 0.3.  With these radii the outer wires do not touch each other
+(clearance ``cables.layer_clearance``).
 
 History (pseudo-time ``t``): ``[0, 1]`` the pull ``T`` (wire strain about 1e-3) is applied
 frictionless (``friction_from=1``: friction starts from zero traction at the tensioned state);
@@ -22,34 +24,33 @@ first slip ``kappa_b = mu F sin b / (E A_w cos^2 b r)``; slipping share ``2 psi 
 ``M_f = (2 n / pi) mu F r sin b cos b``; reversals by Masing's rule; loop energy from it.
 
 Stick: the library's default, exact (``stick="exact"``: the mortar nodal multipliers as Newton unknowns,
-docs/theory_mortar.md), whose stick state does not depend on a penalty: initial stiffness 90.6-91.1
-N m^2 at 16-48 el/lay, about 12 % below the plane-section ``EI_max`` (the wires stick at their surface,
-a lever arm ``R_w`` from their axes, and turn under the friction's moment; tying the axes rigidly to
-the core gives ``EI_max``), first slip at 1.15 ``kappa_b``, which is where the model's own stick
-stiffness puts it (docs/theory_strand_bending.md, section 5); beyond 2 ``kappa_b`` the moment is within
-2.1 % of the theory at 16 el/lay, 1.4 % at 24.  The ends, where the wires are tied to the plates, carry more
-friction moment (+5 to +10 % of ``M_f`` at 0.05 ``L``); 1.3 lays or more from a plate the moment settles on the long
-strand's value, 3.6 % below ``M_f`` at 48 el/lay (6 lays; 4 lays: 3.2 %; 2 lays have no plateau, their middle is
-lifted by the ends).
+docs/theory_mortar.md), whose stick state does not depend on a penalty; ``cables.build_strand`` gives its
+contacts exact stick's ``c`` from the wires' axial stiffness (slip in a strand runs along the wires).  The issue's
+size (``--lays 4 --elements 48 --onset``): the cycle in 228 Newton iterations, no cut-back, 41 s CPU; ``EI_min`` -0.8 %,
+``M_f`` -1.3 % (friction part -0.7 %), first slip 1.04 ``kappa_b`` on the fine ramp (24 el/lay: 1.03), the Masing
+branch at -k 0.02 % of ``M_f`` from the model's own virgin curve, the loop energy -3.5 %, the wires tied to the core
+``EI_max`` -0.07 % (docs/benchmarks.md, "Strand bending, session 10").
+
+The stick branch of a beam model is softer than plane sections: the wires stick at their surface, a lever arm
+``R_w`` from their axes, and shear and twist under the friction's couple (initial stiffness 6 % below ``EI_max`` here;
+tying the axes rigidly to the core gives ``EI_max``).  That compliance falls like ``sin^2(beta)``: at Utting & Jones'
+lay (11.9 deg) the stick branch is 13-14 % of the Steiner term below plane sections and the first slip comes at
+1.14 ``kappa_b``, where the model's own stick stiffness puts it (within 2.7 %), and ``M_f`` is 3.2 % low (4 lays, 48
+el/lay: 198 iterations, 36 s CPU); from 6 deg down plane sections hold within 5 % (docs/theory_strand_bending.md,
+section 5).  The ends, where the wires are tied to the plates, carry more friction moment (+5 to +20 % of ``M_f`` at
+0.05 ``L``); 1.3 lays or more from a plate the moment settles on the long strand's value (2 lays have no plateau,
+their middle is lifted by the ends).
 The row ``M_f, friction part`` subtracts the model's own frictionless moment (the stiffness checks) instead of
 ``EI_min kappa``; the rows ``M - EI_min kappa at z`` give the moment along the strand (section 5).
-The issue's size (``--lays 4 --elements 48``): 245 Newton iterations, no cut-back, 47 s CPU for the cycle
-(51 s for the whole example).  Exact stick wants 16 el/lay or more: at 8 the linear
-nodal tractions smear the friction's reversal at the neutral axis over an element (``M_f`` 6 % low).
+Exact stick wants a dozen elements per lay or more: with fewer the linear nodal tractions smear the friction's
+reversal at the neutral axis over an element (``M_f`` 6 % low at 8 el/lay).
 ``--stick penalty`` uses the Gauss-point penalty with ``slip_tolerance`` 5e-6 element lengths (with the
-library's default 0.005 the strand does not stick at all: initial stiffness 15 N m^2).
+library's default 0.005 the strand does not stick at all).
 ``tied=True`` ties the wires rigidly to the core (no contact) to measure the beam model's own
-full-stick stiffness (shear and torsion of the wires included) against ``EI_max``.
+full-stick stiffness (shear and torsion of the wires included) against ``EI_max``; ``--onset`` adds the first slip on
+a ramp in steps of 0.01 ``kappa_b`` (``first_slip``).
 
-``--lay`` sets the lay length (mm): the first slip meets the plane-section ``kappa_b`` within 5 % from 6 deg
-(``--lay 229.2``: 1.040 ``kappa_b`` at 48 and 96 el/lay), since the wires' compliance under the friction's couple
-falls like ``sin^2(beta)`` (docs/theory_strand_bending.md section 5); ``--onset`` adds the first slip on a ramp in
-steps of 0.01 ``kappa_b`` (``first_slip``).  The 6 deg cycle at 4 lays, 48 el/lay: every quality target met, 582 Newton
-iterations, 5 cut-backs, 148 s CPU (770, 5, 196 s without exact stick's Levenberg shift): its slip steps crawl along
-soft torsion-bending modes of the wires, which make the frictionless strand's tangent indefinite from 0.42 of the pull
-(docs/benchmarks.md, session 9).
-
-    python examples/strand_bending.py [--lays 2] [--elements 16] [--amplitude 3] [--steps 8] [--lay 114.6] [--onset]
+    python examples/strand_bending.py [--lays 2] [--elements 24] [--amplitude 3] [--steps 8] [--lay 229.2] [--onset]
 """
 import argparse
 import time
@@ -61,10 +62,12 @@ from beamsolver import cables
 from beamsolver.contact import SLIP
 
 E, NU, MU = 200e9, 0.3, 0.3
-RC, RW, LAY, N = 1.97e-3, 1.865e-3, 114.6e-3, 6
+RC, RW, N = 1.97e-3, 1.865e-3, 6
+LAY_UJ = 114.6e-3                 # Utting & Jones' lay (11.9 deg)
+LAY = 229.2e-3                    # the example's: their wires on a lay ratio of 20 (6.0 deg), as a conductor's steel core
 STRAIN = 1e-3                     # axial strain of the strand under the pull
 
-LAYS, ELEMENTS, AMPLITUDE, STEPS = 2, 16, 5.0, 4   # default size: about 40 s of CPU (2 lays: the cut in the middle)
+LAYS, ELEMENTS, AMPLITUDE, STEPS = 2, 24, 5.0, 4   # default size: about 20 s of CPU (2 lays: the cut in the middle)
 solve_options = dict(steps=6 * STEPS, t_end=6.0)   # for `beamsolver run examples/strand_bending.py`
 
 
@@ -329,7 +332,7 @@ def main(lays=LAYS, elements_per_lay=ELEMENTS, amplitude=AMPLITUDE, steps=STEPS,
                   EI0 / theory(F0, lay=lay)["EI_min"] - 1),
                  ("EI wires tied to the core (full stick) [N m^2]", theory(Ft, lay=lay)["EI_max"], EIt,
                   EIt / theory(Ft, lay=lay)["EI_max"] - 1)]
-    print(f"1+6 strand (Utting & Jones 1987): Rc = {RC * 1e3} mm, Rw = {RW * 1e3} mm, lay {lay * 1e3:.4g} mm, "
+    print(f"1+6 strand (wires of Utting & Jones 1987): Rc = {RC * 1e3} mm, Rw = {RW * 1e3} mm, lay {lay * 1e3:.4g} mm, "
           f"beta = {np.degrees(th['beta']):.2f} deg, mu = {mu}, T = {res['T']:.4g} N, wire force F = {res['F']:.4g} N;"
           f" {lays} lays, {elements_per_lay} elements per lay, +-{amplitude} kappa_b, {steps} steps per unit t, "
           f"stick {STICK}" + (f", slip_tolerance {SLIP_TOLERANCE}" if STICK == "penalty" else ""))
@@ -381,7 +384,7 @@ if __name__ == "__main__":
     ap.add_argument("--steps", type=int, default=STEPS)
     ap.add_argument("--mu", type=float, default=MU)
     ap.add_argument("--stick", default=STICK, choices=("exact", "penalty"))
-    ap.add_argument("--lay", type=float, default=LAY * 1e3, help="lay length [mm] (default: Utting & Jones' 114.6)")
+    ap.add_argument("--lay", type=float, default=LAY * 1e3, help="lay length [mm] (default 229.2: lay ratio 20; Utting & Jones' own lay: 114.6)")
     ap.add_argument("--onset", action="store_true",
                     help="also the first slip on a fine ramp (steps of 0.01 kappa_b from 0.9 kappa_b)")
     ap.add_argument("--plot", default=None, help="PNG of the loop against the theory (needs matplotlib)")
