@@ -345,6 +345,33 @@ def main(lays=LAYS, elements_per_lay=ELEMENTS, amplitude=AMPLITUDE, steps=STEPS,
     return res, th, rows
 
 
+def plot_loop(res, th, path):
+    """PNG ``path`` of the moment-curvature loop of ``run``'s result ``res`` against the theory ``th`` (``compare``):
+    the model's moment at the mid-length cut, the theory's virgin curve and Masing branches, ``EI_max`` and
+    ``EI_min`` (matplotlib, the ``viz`` extra)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    t, kap, M = res["times"], res["kappa"], res["M"]
+    kb = th["kappa_b"]
+    x = np.linspace(0.0, res["k"], 200)
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    ax.plot(kap[t >= 1] / kb, M[t >= 1], "o-", ms=3, label="beamsolver (cut at mid-length)")
+    ax.plot(x / kb, moment(x, th), "k-", lw=1, label="theory, virgin")
+    xr = np.linspace(res["k"], -res["k"], 400)
+    rev = (res["k"], friction_moment(res["k"], th)[0])
+    ax.plot(xr / kb, moment(xr, th, rev), "k--", lw=1, label="theory, Masing")
+    ax.plot(-xr / kb, -moment(xr, th, rev), "k--", lw=1)
+    ax.plot(x / kb, th["EI_max"] * x, ":", c="gray", label="EI_max (full stick)")
+    ax.plot(x / kb, th["EI_min"] * x, "-.", c="gray", label="EI_min (full slip)")
+    ax.set_xlabel("curvature / kappa_b")
+    ax.set_ylabel("bending moment [N m]")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
 def stick_slip_map(res, th, path):
     """PNG at ``path`` of the contact points (stick blue, slip red) on the wires at the first step of the
     virgin branch where slip has spread part way (needs pyvista, the ``viz`` extra)."""
@@ -384,7 +411,8 @@ if __name__ == "__main__":
     ap.add_argument("--steps", type=int, default=STEPS)
     ap.add_argument("--mu", type=float, default=MU)
     ap.add_argument("--stick", default=STICK, choices=("exact", "penalty"))
-    ap.add_argument("--lay", type=float, default=LAY * 1e3, help="lay length [mm] (default 229.2: lay ratio 20; Utting & Jones' own lay: 114.6)")
+    ap.add_argument("--lay", type=float, default=LAY * 1e3,
+                    help="lay length [mm] (default 229.2: lay ratio 20; Utting & Jones' own lay: 114.6)")
     ap.add_argument("--onset", action="store_true",
                     help="also the first slip on a fine ramp (steps of 0.01 kappa_b from 0.9 kappa_b)")
     ap.add_argument("--plot", default=None, help="PNG of the loop against the theory (needs matplotlib)")
@@ -392,6 +420,9 @@ if __name__ == "__main__":
     a = ap.parse_args()
     STICK = a.stick
     res, th, rows = main(a.lays, a.elements, a.amplitude, a.steps, a.mu, lay=a.lay * 1e-3, onset=a.onset)
+    if a.plot:
+        plot_loop(res, th, a.plot)
+        print(f"written: {a.plot}")
     if a.map:
         stick_slip_map(res, th, a.map)
         print(f"written: {a.map}")

@@ -170,3 +170,16 @@ def test_the_stick_stiffness_deficit_is_the_wires_compliance():
         return (th["EI_max"] - res["M"][j] / res["kappa"][j]) / th["S"]
     assert deficit(1.0) == pytest.approx(0.137, abs=0.01)
     assert deficit(100.0) == pytest.approx(0.045, abs=0.01)
+
+
+def test_plot_writes_the_loop_against_the_theory(tmp_path):
+    """``--plot PATH`` (``plot_loop``) writes the PNG of the loop with the theory's curves (it was parsed and ignored
+    from session 4 to 10)."""
+    pytest.importorskip("matplotlib")
+    k = 5 * TH["kappa_b"]
+    t = np.linspace(1.0, 6.0, 41)
+    kap = np.where(t <= 2.0, k * (t - 1.0), np.where(t <= 4.0, k * (3.0 - t), k * (t - 5.0)))
+    res = dict(times=t, kappa=kap, M=sb.moment(kap, TH), k=k)
+    path = tmp_path / "loop.png"
+    sb.plot_loop(res, TH, path)
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and path.stat().st_size > 10_000
