@@ -372,23 +372,33 @@ def plot_loop(res, th, path):
     plt.close(fig)
 
 
+MAP_SQUEEZE = 6.0                 # the stick/slip map's axial squeeze (a lay is 20 strand diameters long)
+
+
 def stick_slip_map(res, th, path):
-    """PNG at ``path`` of the contact points (stick blue, slip red) on the wires at the first step of the
-    virgin branch where slip has spread part way (needs pyvista, the ``viz`` extra)."""
+    """PNG at ``path`` of the contact points (stick blue, slip red) on the wires of the middle lay at the first step
+    of the virgin branch where slip has spread part way (needs pyvista, the ``viz`` extra)."""
     import os
     os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     import pyvista as pv
     sol, t = res["sol"], res["times"]
     k = int(np.flatnonzero((t > 1.0) & (res["share"] > 0) & (res["share"] < 1))[0])
     H = sol.poses[k]
-    pl = pv.Plotter(off_screen=True, window_size=(1600, 360))
-    for w in res["strand"].all_wires:
+    st = res["strand"]
+    z_mid, half = 0.5 * st.length, 0.5 * res["lay"]
+    pl = pv.Plotter(off_screen=True, window_size=(1600, 560))
+    squeeze = MAP_SQUEEZE
+
+    def squeezed(x):
+        return np.column_stack([x[:, :2], z_mid + (x[:, 2] - z_mid) / squeeze])
+    for w in st.all_wires:
         x = H[w.nodes, :3, 3]
-        pl.add_mesh(pv.Spline(x, 4 * len(x)).tube(radius=0.9 * w.section.radius), color="lightgray", opacity=0.35)
+        x = squeezed(x[np.abs(x[:, 2] - z_mid) <= half + 2 * (x[1, 2] - x[0, 2])])
+        pl.add_mesh(pv.Spline(x, 8 * len(x)).tube(radius=0.9 * w.section.radius), color="lightgray", opacity=0.35)
     c = sol.contacts[k]
-    on = c["normal_force"] > 0
+    on = (c["normal_force"] > 0) & (np.abs(c["position"][:, 2] - z_mid) <= half)
     for code, colour in ((bs.contact.STICK, "royalblue"), (bs.contact.SLIP, "crimson")):
-        pts = c["position"][on & (c["status"] == code)]
+        pts = squeezed(c["position"][on & (c["status"] == code)])
         if len(pts):
             pl.add_points(pv.PolyData(pts), color=colour, point_size=9, render_points_as_spheres=True,
                           label=bs.contact.STATUS_NAMES[code])
@@ -396,9 +406,10 @@ def stick_slip_map(res, th, path):
     pl.view_vector((0.0, -1.0, 0.0), viewup=(1.0, 0.0, 0.0))     # the strand axis e_z across the picture
     pl.enable_parallel_projection()
     pl.reset_camera()
-    pl.camera.zoom(3.5)
-    pl.add_text(f"kappa = {res['kappa'][k] / th['kappa_b']:.2f} kappa_b: slipping share {res['share'][k]:.2f} "
-                f"(theory {2 * slip_angle(res['kappa'][k], th)[0] / np.pi:.2f}, middle half)", font_size=10)
+    pl.camera.zoom(2.0)
+    pl.add_text(f"middle lay (length squeezed {squeeze:g} times), kappa = {res['kappa'][k] / th['kappa_b']:.2f} kappa_b: slipping share "
+                f"{res['share'][k]:.2f} (theory {2 * slip_angle(res['kappa'][k], th)[0] / np.pi:.2f}, middle half)",
+                font_size=10)
     pl.screenshot(path)
     pl.close()
 
