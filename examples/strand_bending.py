@@ -386,7 +386,7 @@ def stick_slip_map(res, th, path):
     H = sol.poses[k]
     st = res["strand"]
     z_mid, half = 0.5 * st.length, 0.5 * res["lay"]
-    pl = pv.Plotter(off_screen=True, window_size=(1600, 560))
+    pl = pv.Plotter(off_screen=True, window_size=(1200, 420))
     squeeze = MAP_SQUEEZE
 
     def squeezed(x):
