@@ -121,25 +121,27 @@ def _product(D1, O1, D2, O2, D, O, tmp):
 
 
 @jit_callee
-def _tmv(D, O, pu, pw, out, k, wg):
-    """``out[k:k+6] += wg [[D, O], [0, D]]^T (pu, pw)``."""
+def _tv(D, O, pu, pw, ou, ow):
+    """``(ou, ow) = [[D, O], [0, D]]^T (pu, pw)``."""
     for i in range(3):
         a, b = 0.0 * pu[0], 0.0 * pu[0]
         for j in range(3):
             a += D[j, i] * pu[j]
             b += O[j, i] * pu[j] + D[j, i] * pw[j]
-        out[k + i] += wg * a
-        out[k + 3 + i] += wg * b
+        ou[i], ow[i] = a, b
 
 
 @jit_callee
 def _element(vq, vm, h, L, q, m, follower, rotation, f, G, w6, XI, WEIGHTS):
-    """``f`` (12,) = ``line_load._loads`` of one element (complex twist ``h``; ``vq, vm`` the load in node A's
-    frame, ``q, m`` as given); with ``rotation`` also ``G`` (12, 3), d f / d w_A at fixed ``h`` (real ``h``).
-    Every 6x6 operator here is block upper triangular with equal diagonal blocks, kept as two 3x3 blocks."""
+    """``f`` (12,) = ``line_load._loads`` of one element (twist ``h``, real or complex; ``vq, vm`` the load in node
+    A's frame, ``q, m`` as given); with ``rotation`` also ``G`` (12, 3), d f / d w_A at fixed ``h`` (real ``h``).
+    Every 6x6 operator here is block upper triangular with equal diagonal blocks, kept as two 3x3 blocks.  The loads
+    as products of the operators with vectors, ``Phi_B^T p = T(h)^-T y``, ``Phi_A^T p = Ad(E^-1)^T p - T(-h)^-T y``,
+    ``y = x T(x h)^T p``; the operators themselves only for ``G``."""
     b, s, hx, pu, pw = w6
     Dp, Op, Dm, Om, Dx, Ox, Da, Oa, DA, OA, DB, OB, X = b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7], b[8], \
         b[9], b[10], b[11], b[12]
+    yu, yw, zu, zw = s[10][0], s[10][1], s[10][2], s[11][0]
     _tangents(h, True, Dp, Op, s)
     for i in range(6):
         hx[i] = -h[i]
@@ -154,24 +156,38 @@ def _element(vq, vm, h, L, q, m, follower, rotation, f, G, w6, XI, WEIGHTS):
         _inverse_adjoint(hx, Da, Oa, s)
         _tangents(hx, False, Dx, Ox, s)
         for i in range(3):
-            for j in range(3):
-                Dx[i, j] *= x
-                Ox[i, j] *= x
-        _product(Dx, Ox, Dm, Om, DA, OA, X)              # Phi_A = Ad(E^-1) - x T(x h) T(-h)^-1
-        for i in range(3):
-            for j in range(3):
-                DA[i, j] = Da[i, j] - DA[i, j]
-                OA[i, j] = Oa[i, j] - OA[i, j]
-        _product(Dx, Ox, Dp, Op, DB, OB, X)              # Phi_B = x T(x h) T(h)^-1
-        for i in range(3):
             if follower:
                 pu[i], pw[i] = q[i], m[i]
             else:
                 pu[i] = Da[i, 0] * vq[0] + Da[i, 1] * vq[1] + Da[i, 2] * vq[2]
                 pw[i] = Da[i, 0] * vm[0] + Da[i, 1] * vm[1] + Da[i, 2] * vm[2]
-        _tmv(DA, OA, pu, pw, f, 0, wg)
-        _tmv(DB, OB, pu, pw, f, 6, wg)
+        _tv(Dx, Ox, pu, pw, yu, yw)
+        for i in range(3):
+            yu[i] *= x
+            yw[i] *= x
+        _tv(Da, Oa, pu, pw, zu, zw)                      # Ad(E^-1)^T p
+        for i in range(3):
+            f[i] += wg * zu[i]
+            f[3 + i] += wg * zw[i]
+        _tv(Dm, Om, yu, yw, zu, zw)                      # Phi_A^T p = Ad(E^-1)^T p - T(-h)^-T y
+        for i in range(3):
+            f[i] -= wg * zu[i]
+            f[3 + i] -= wg * zw[i]
+        _tv(Dp, Op, yu, yw, zu, zw)                      # Phi_B^T p = T(h)^-T y
+        for i in range(3):
+            f[6 + i] += wg * zu[i]
+            f[9 + i] += wg * zw[i]
         if rotation:
+            for i in range(3):
+                for j in range(3):
+                    Dx[i, j] *= x
+                    Ox[i, j] *= x
+            _product(Dx, Ox, Dm, Om, DA, OA, X)          # Phi_A = Ad(E^-1) - x T(x h) T(-h)^-1
+            for i in range(3):
+                for j in range(3):
+                    DA[i, j] = Da[i, j] - DA[i, j]
+                    OA[i, j] = Oa[i, j] - OA[i, j]
+            _product(Dx, Ox, Dp, Op, DB, OB, X)          # Phi_B = x T(x h) T(h)^-1
             # dp = (E^T hat(vq), E^T hat(vm)) (6, 3): the rigid turn of the element by dw_A
             Xq, Xm = s[0], s[1]
             _skew(vq, X)
@@ -203,14 +219,17 @@ def line_loads(HA, HB, L, q, m, follower, tangent, f, K, XI, WEIGHTS, COMPLEX_ST
     """Consistent nodal loads ``f`` (n, 12) and, with ``tangent``, their derivative ``K`` (n, 12, 12) in the
     nodes' body increments (``line_load.nodal_loads_and_tangent``); poses ``HA, HB`` (n, 4, 4), lengths
     ``L`` (n,), loads per unit reference length ``q, m`` (n, 3), dead or ``follower``; Gauss points ``XI``,
-    weights ``WEIGHTS`` on ``[0, 1]`` and the imaginary step ``COMPLEX_STEP`` (``line_load``'s)."""
+    weights ``WEIGHTS`` on ``[0, 1]`` and the imaginary step ``COMPLEX_STEP`` (``line_load``'s).  The loads in
+    real arithmetic (the complex form's real part, to round-off), their derivative by complex steps."""
     c = np.complex128
-    w6 = (np.zeros((13, 3, 3), c), np.zeros((10, 3, 3), c), np.zeros(6, c), np.zeros(3, c), np.zeros(3, c))
-    h, hh, fe, fk = np.zeros(6, c), np.zeros(6, c), np.zeros(12, c), np.zeros(12, c)
-    vq, vm = np.zeros(3, c), np.zeros(3, c)
+    w6 = (np.zeros((13, 3, 3), c), np.zeros((12, 3, 3), c), np.zeros(6, c), np.zeros(3, c), np.zeros(3, c))
+    w6r = (np.zeros((13, 3, 3)), np.zeros((12, 3, 3)), np.zeros(6), np.zeros(3), np.zeros(3))     # real scratch
+    hh, fk = np.zeros(6, c), np.zeros(12, c)
+    h, fe = np.zeros(6), np.zeros(12)
+    vq, vm = np.zeros(3), np.zeros(3)
     G, D = np.zeros((12, 3)), np.zeros((12, 6))
     Tp, Tm = np.zeros((6, 6)), np.zeros((6, 6))
-    b, s, hx = w6[0], w6[1], w6[2]
+    b, s, hx = w6r[0], w6r[1], w6r[2]
     for e in range(HA.shape[0]):
         RA, xA = pose(HA, e)
         RB, xB = pose(HB, e)
@@ -220,9 +239,9 @@ def line_loads(HA, HB, L, q, m, follower, tangent, f, K, XI, WEIGHTS, COMPLEX_ST
             vq[i] = RA[0][i] * q[e, 0] + RA[1][i] * q[e, 1] + RA[2][i] * q[e, 2]
             vm[i] = RA[0][i] * m[e, 0] + RA[1][i] * m[e, 1] + RA[2][i] * m[e, 2]
         rotation = tangent and not follower
-        _element(vq, vm, h, L[e], q[e], m[e], follower, rotation, fe, G, w6, XI, WEIGHTS)
+        _element(vq, vm, h, L[e], q[e], m[e], follower, rotation, fe, G, w6r, XI, WEIGHTS)
         for i in range(12):
-            f[e, i] = fe[i].real
+            f[e, i] = fe[i]
         if not tangent:
             continue
         for k in range(6):
@@ -239,10 +258,10 @@ def line_loads(HA, HB, L, q, m, follower, tangent, f, K, XI, WEIGHTS, COMPLEX_ST
         _tangents(hx, True, b[2], b[3], s)
         for i in range(3):
             for j in range(3):
-                Tp[i, j] = Tp[3 + i, 3 + j] = b[0][i, j].real
-                Tp[i, 3 + j] = b[1][i, j].real
-                Tm[i, j] = Tm[3 + i, 3 + j] = b[2][i, j].real
-                Tm[i, 3 + j] = b[3][i, j].real
+                Tp[i, j] = Tp[3 + i, 3 + j] = b[0][i, j]
+                Tp[i, 3 + j] = b[1][i, j]
+                Tm[i, j] = Tm[3 + i, 3 + j] = b[2][i, j]
+                Tm[i, 3 + j] = b[3][i, j]
         for i in range(12):
             for j in range(6):
                 a, bb = 0.0, 0.0
