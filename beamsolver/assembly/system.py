@@ -618,6 +618,7 @@ class System:
         f = np.zeros((len(ln.element), 12))
         K = np.zeros((len(ln.element), 12, 12)) if kvals is not None else None
         for rows, follower in ((ln.dead, False), (ln.follower, True)):
+            rows = rows[lf[ln.load[rows]] != 0.0]      # a load scaled to zero: no loads, no stiffness (zero rows)
             if not len(rows):
                 continue
             HA, HB = H[ln.nodes[rows, 0]], H[ln.nodes[rows, 1]]

@@ -1,10 +1,12 @@
 """Compiled consistent nodal loads of line loads and their stiffness (``line_load``'s formulas).
 
 One element per pass of a loop, small arrays written in place (no allocation per element).  The
-derivative in the element twist ``h`` is the same complex step as the numpy form: every SE(3)
-function here takes complex twists (the coefficients switch from series to closed form on the real
-part of the angle, as ``se3.coefficient``), so both forms agree to round-off
-(``tests/elements/test_line_load.py``).  Conventions: ``line_load`` and docs/theory_line_loads.md.
+loads in real arithmetic, as products of the operators with vectors; their derivative in the rotation
+part of the element twist ``h`` by the same complex steps as the numpy form (every SE(3) function here
+takes complex twists; the coefficients switch from series to closed form on the real part of the angle,
+as ``se3.coefficient``), in its translation part in closed form (``_u_columns``): both forms agree to
+round-off (``tests/elements/test_line_load.py``; 1344 elements of the long-lay strand: loads 4.5 -> 2.2 ms,
+with the derivative 33.7 -> 21.1 ms of CPU against the all-complex form, docs/benchmarks.md session 10).  Conventions: ``line_load`` and docs/theory_line_loads.md.
 """
 import numpy as np
 
@@ -214,13 +216,65 @@ def _element(vq, vm, h, L, q, m, follower, rotation, f, G, w6, XI, WEIGHTS):
                 G[i, j] *= L
 
 
+@jit_callee
+def _u_columns(vq, vm, h, L, q, m, follower, D, w6, XI, WEIGHTS):
+    """The columns ``D[:, :3]`` of ``d f / d h`` (the translation part ``u`` of ``h``), real: ``f`` is linear in
+    ``u`` through the off-diagonal blocks ``O`` of the operators alone, each linear in ``u`` (``Q(u, w)``, the
+    position in ``Ad``), so ``dO / du e`` is ``O`` at the twist ``(e, w)``; the diagonal blocks and ``p`` do not
+    depend on ``u``, and with ``y = x T(x h)^T p``: ``d f_A = (0, dOa^T p_u - dOm^T y_u - Dm^T dy_w)``,
+    ``d f_B = (0, dOp^T y_u + Dp^T dy_w)``, ``dy_w = x dOx^T p_u`` (the translation rows are zero)."""
+    b, s, hx, pu, pw = w6
+    Dp, Op, Dm, Om, Dx, Ox, Da, Oa = b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]
+    yu, yw, zu, zw, dyw, z2 = s[10][0], s[10][1], s[10][2], s[11][0], s[11][1], s[11][2]
+    he = b[12][0]
+    for i in range(12):
+        for k in range(3):
+            D[i, k] = 0.0
+    for k in range(3):
+        for i in range(3):
+            hx[i], hx[3 + i] = (1.0 if i == k else 0.0), h[3 + i]
+        _tangents(hx, True, Dp, Op, s)                   # Op: dOp e_k
+        for i in range(6):
+            hx[i] = -hx[i]
+        _tangents(hx, True, Dm, Om, s)                   # Om: dOm e_k (u of -h moves by -e_k)
+        for g in range(XI.shape[0]):
+            x, wg = XI[g], WEIGHTS[g]
+            for i in range(3):
+                hx[i], hx[3 + i] = (x if i == k else 0.0), x * h[3 + i]
+            _inverse_adjoint(hx, Da, Oa, s)
+            _tangents(hx, False, Dx, Ox, s)
+            for i in range(3):
+                if follower:
+                    pu[i], pw[i] = q[i], m[i]
+                else:
+                    pu[i] = Da[i, 0] * vq[0] + Da[i, 1] * vq[1] + Da[i, 2] * vq[2]
+                    pw[i] = Da[i, 0] * vm[0] + Da[i, 1] * vm[1] + Da[i, 2] * vm[2]
+            for i in range(3):
+                a, c = 0.0, 0.0
+                for j in range(3):
+                    a += Dx[j, i] * pu[j]
+                    c += Ox[j, i] * pu[j]
+                yu[i], dyw[i] = x * a, x * c
+            for i in range(3):
+                a, c, d = 0.0, 0.0, 0.0
+                for j in range(3):
+                    a += Oa[j, i] * pu[j] - Om[j, i] * yu[j] - Dm[j, i] * dyw[j]
+                    c += Op[j, i] * yu[j] + Dp[j, i] * dyw[j]
+                D[3 + i, k] += wg * a
+                D[9 + i, k] += wg * c
+    for i in range(12):
+        for k in range(3):
+            D[i, k] *= L
+
+
 @jit
 def line_loads(HA, HB, L, q, m, follower, tangent, f, K, XI, WEIGHTS, COMPLEX_STEP):
     """Consistent nodal loads ``f`` (n, 12) and, with ``tangent``, their derivative ``K`` (n, 12, 12) in the
     nodes' body increments (``line_load.nodal_loads_and_tangent``); poses ``HA, HB`` (n, 4, 4), lengths
     ``L`` (n,), loads per unit reference length ``q, m`` (n, 3), dead or ``follower``; Gauss points ``XI``,
     weights ``WEIGHTS`` on ``[0, 1]`` and the imaginary step ``COMPLEX_STEP`` (``line_load``'s).  The loads in
-    real arithmetic (the complex form's real part, to round-off), their derivative by complex steps."""
+    real arithmetic (the complex form's real part, to round-off), their derivative in the rotation part of ``h`` by
+    complex steps, in the translation part in closed form (``_u_columns``)."""
     c = np.complex128
     w6 = (np.zeros((13, 3, 3), c), np.zeros((12, 3, 3), c), np.zeros(6, c), np.zeros(3, c), np.zeros(3, c))
     w6r = (np.zeros((13, 3, 3)), np.zeros((12, 3, 3)), np.zeros(6), np.zeros(3), np.zeros(3))     # real scratch
@@ -244,7 +298,8 @@ def line_loads(HA, HB, L, q, m, follower, tangent, f, K, XI, WEIGHTS, COMPLEX_ST
             f[e, i] = fe[i]
         if not tangent:
             continue
-        for k in range(6):
+        _u_columns(vq, vm, h, L[e], q[e], m[e], follower, D, w6r, XI, WEIGHTS)
+        for k in range(3, 6):                            # the rotation part: complex steps
             for i in range(6):
                 hh[i] = h[i]
             hh[k] += 1j * COMPLEX_STEP
