@@ -50,65 +50,69 @@ def _mm(A, B, C):
 
 
 @jit_callee
-def _so3(w, k1, sign, k2, M, W, WW):
-    """``M = I + sign k1(t) W + k2(t) W^2``, ``W = hat(w)``, ``t = |w|`` (complex; ``k1 < 0``: ``k1(t) = 1/2``);
-    returns ``t``."""
+def _inverse_tangents(h, Dp, Op, Dm, Om, s):
+    """The inverse right tangents of SE(3) at ``h`` and ``-h`` (``se3.tangent_inv``): ``[[Dp, Op], [0, Dp]]`` and
+    ``[[Dm, Om], [0, Dm]]``, written into the 3x3 blocks; the angle, its coefficients and ``hat(w)^2`` once
+    (``hat(-w) = -hat(w)``).  ``h`` (6,) real or complex."""
+    u, w = h[:3], h[3:]
+    W, WW = s[0], s[1]
     t = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
-    c1 = sign * (0.5 + 0.0 * t if k1 < 0 else _coef(k1, t))
-    c2 = _coef(k2, t)
+    c1, c2 = 1.0 * (0.5 + 0.0 * t), _coef(D_, t)
     _skew(w, W)
     _mm(W, W, WW)
     for i in range(3):
         for j in range(3):
-            M[i, j] = c1 * W[i, j] + c2 * WW[i, j] + (1.0 if i == j else 0.0)
-    return t
-
-
-@jit_callee
-def _tangents(h, inverse, Dg, Of, s):
-    """Right tangent of SE(3) (``inverse``: its inverse) at the twist ``h`` (6,): ``[[Dg, Of], [0, Dg]]``,
-    written into the 3x3 blocks ``Dg``, ``Of`` (``se3.tangent``, ``se3.tangent_inv``)."""
-    u, w = h[:3], h[3:]
-    if inverse:
-        t = _so3(w, -1, 1.0, D_, Dg, s[0], s[1])
-    else:
-        t = _so3(w, B_, -1.0, C_, Dg, s[0], s[1])
+            Dp[i, j] = c1 * W[i, j] + c2 * WW[i, j] + (1.0 if i == j else 0.0)
+            Dm[i, j] = c1 * -W[i, j] + c2 * WW[i, j] + (1.0 if i == j else 0.0)
+    c3, q2, q3 = _coef(C_, t), _coef(Q2_, t), _coef(Q3_, t)
     nu, nw = (-u[0], -u[1], -u[2]), (-w[0], -w[1], -w[2])
-    Q = q_matrix(nu, nw, dot(nw, nu), cross(nw, nu), t * t, _coef(C_, t), _coef(Q2_, t), _coef(Q3_, t))
-    for i in range(3):
-        for j in range(3):
-            s[8][i, j] = Q[i][j]
-    if inverse:
-        _mm(Dg, s[8], s[0])
-        _mm(s[0], Dg, Of)
+    for D, O, a, b in ((Dp, Op, nu, nw), (Dm, Om, (u[0], u[1], u[2]), (w[0], w[1], w[2]))):
+        Q = q_matrix(a, b, dot(b, a), cross(b, a), t * t, c3, q2, q3)
         for i in range(3):
             for j in range(3):
-                Of[i, j] = -Of[i, j]
-    else:
-        Of[:, :] = s[8]
+                s[8][i, j] = Q[i][j]
+        _mm(D, s[8], s[0])
+        _mm(s[0], D, O)
+        for i in range(3):
+            for j in range(3):
+                O[i, j] = -O[i, j]
 
 
 @jit_callee
-def _inverse_adjoint(h, Et, Of, s):
-    """``Ad(exp(h)^-1) = [[Et, Of], [0, Et]]``: ``Et`` the transposed rotation of ``exp(h)``."""
+def _gauss_operators(h, Da, Oa, Dx, Ox, s):
+    """At the twist ``h`` (6,): ``Ad(exp(h)^-1) = [[Da, Oa], [0, Da]]`` (``Da`` the transposed rotation of
+    ``exp(h)``) and the right tangent ``T(h) = [[Dx, Ox], [0, Dx]]`` (``se3.tangent``), written into the 3x3
+    blocks; the angle, its coefficients and ``hat(w)^2`` once."""
     u, w = h[:3], h[3:]
-    R = s[7]
-    t = _so3(w, A_, 1.0, B_, R, s[0], s[1])
-    b, c = _coef(B_, t), _coef(C_, t)
+    W, WW, R = s[0], s[1], s[7]
+    t = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+    ca, cb, cc = 1.0 * _coef(A_, t), _coef(B_, t), _coef(C_, t)
+    cx = -1.0 * cb
+    _skew(w, W)
+    _mm(W, W, WW)
+    for i in range(3):
+        for j in range(3):
+            R[i, j] = ca * W[i, j] + cb * WW[i, j] + (1.0 if i == j else 0.0)
+            Dx[i, j] = cx * W[i, j] + cc * WW[i, j] + (1.0 if i == j else 0.0)
+    nu, nw = (-u[0], -u[1], -u[2]), (-w[0], -w[1], -w[2])
+    Q = q_matrix(nu, nw, dot(nw, nu), cross(nw, nu), t * t, cc, _coef(Q2_, t), _coef(Q3_, t))
+    for i in range(3):
+        for j in range(3):
+            Ox[i, j] = Q[i][j]
     wxu = s[9][0]
     wxu[0], wxu[1], wxu[2] = w[1] * u[2] - w[2] * u[1], w[2] * u[0] - w[0] * u[2], w[0] * u[1] - w[1] * u[0]
     x = s[9][1]
-    x[0] = u[0] + b * wxu[0] + c * (w[1] * wxu[2] - w[2] * wxu[1])
-    x[1] = u[1] + b * wxu[1] + c * (w[2] * wxu[0] - w[0] * wxu[2])
-    x[2] = u[2] + b * wxu[2] + c * (w[0] * wxu[1] - w[1] * wxu[0])
+    x[0] = u[0] + cb * wxu[0] + cc * (w[1] * wxu[2] - w[2] * wxu[1])
+    x[1] = u[1] + cb * wxu[1] + cc * (w[2] * wxu[0] - w[0] * wxu[2])
+    x[2] = u[2] + cb * wxu[2] + cc * (w[0] * wxu[1] - w[1] * wxu[0])
     p = s[9][2]
     for i in range(3):
         p[i] = 0.0
         for j in range(3):
-            Et[i, j] = R[j, i]
-            p[i] -= R[j, i] * x[j]                       # position of the inverse: -R^T x
+            Da[i, j] = R[j, i]
+            p[i] -= R[j, i] * x[j]
     _skew(p, s[0])
-    _mm(s[0], Et, Of)
+    _mm(s[0], Da, Oa)
 
 
 @jit_callee
@@ -144,10 +148,7 @@ def _element(vq, vm, h, L, q, m, follower, rotation, f, G, w6, XI, WEIGHTS):
     Dp, Op, Dm, Om, Dx, Ox, Da, Oa, DA, OA, DB, OB, X = b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7], b[8], \
         b[9], b[10], b[11], b[12]
     yu, yw, zu, zw = s[10][0], s[10][1], s[10][2], s[11][0]
-    _tangents(h, True, Dp, Op, s)
-    for i in range(6):
-        hx[i] = -h[i]
-    _tangents(hx, True, Dm, Om, s)
+    _inverse_tangents(h, Dp, Op, Dm, Om, s)
     f[:] = 0.0
     if rotation:
         G[:, :] = 0.0
@@ -155,8 +156,7 @@ def _element(vq, vm, h, L, q, m, follower, rotation, f, G, w6, XI, WEIGHTS):
         x, wg = XI[g], WEIGHTS[g]
         for i in range(6):
             hx[i] = x * h[i]
-        _inverse_adjoint(hx, Da, Oa, s)
-        _tangents(hx, False, Dx, Ox, s)
+        _gauss_operators(hx, Da, Oa, Dx, Ox, s)
         for i in range(3):
             if follower:
                 pu[i], pw[i] = q[i], m[i]
@@ -233,16 +233,12 @@ def _u_columns(vq, vm, h, L, q, m, follower, D, w6, XI, WEIGHTS):
     for k in range(3):
         for i in range(3):
             hx[i], hx[3 + i] = (1.0 if i == k else 0.0), h[3 + i]
-        _tangents(hx, True, Dp, Op, s)                   # Op: dOp e_k
-        for i in range(6):
-            hx[i] = -hx[i]
-        _tangents(hx, True, Dm, Om, s)                   # Om: dOm e_k (u of -h moves by -e_k)
+        _inverse_tangents(hx, Dp, Op, Dm, Om, s)         # Op, Om: dOp e_k, dOm e_k (u of -h moves by -e_k)
         for g in range(XI.shape[0]):
             x, wg = XI[g], WEIGHTS[g]
             for i in range(3):
                 hx[i], hx[3 + i] = (x if i == k else 0.0), x * h[3 + i]
-            _inverse_adjoint(hx, Da, Oa, s)
-            _tangents(hx, False, Dx, Ox, s)
+            _gauss_operators(hx, Da, Oa, Dx, Ox, s)
             for i in range(3):
                 if follower:
                     pu[i], pw[i] = q[i], m[i]
@@ -307,10 +303,7 @@ def line_loads(HA, HB, L, q, m, follower, tangent, f, K, XI, WEIGHTS, COMPLEX_ST
             for i in range(12):
                 D[i, k] = fk[i].imag / COMPLEX_STEP
         # K_A = -D T(-h)^-1 (+ the rigid turn G), K_B = D T(h)^-1
-        _tangents(h, True, b[0], b[1], s)
-        for i in range(6):
-            hx[i] = -h[i]
-        _tangents(hx, True, b[2], b[3], s)
+        _inverse_tangents(h, b[0], b[1], b[2], b[3], s)
         for i in range(3):
             for j in range(3):
                 Tp[i, j] = Tp[3 + i, 3 + j] = b[0][i, j]
