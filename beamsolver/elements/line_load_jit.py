@@ -5,8 +5,9 @@ loads in real arithmetic, as products of the operators with vectors; their deriv
 part of the element twist ``h`` by the same complex steps as the numpy form (every SE(3) function here
 takes complex twists; the coefficients switch from series to closed form on the real part of the angle,
 as ``se3.coefficient``), in its translation part in closed form (``_u_columns``): both forms agree to
-round-off (``tests/elements/test_line_load.py``; 1344 elements of the long-lay strand: loads 4.5 -> 2.2 ms,
-with the derivative 33.7 -> 21.1 ms of CPU against the all-complex form, docs/benchmarks.md session 10).  Conventions: ``line_load`` and docs/theory_line_loads.md.
+round-off (``tests/elements/test_line_load.py``).  The angle's coefficients are computed once per twist
+(``_inverse_tangents``, ``_gauss_operators``).  Conventions: ``line_load`` and docs/theory_line_loads.md;
+speed: docs/benchmarks.md, "Strand bending, session 10".
 """
 import numpy as np
 
