@@ -5,16 +5,20 @@ stability checks added), per Newton direction (linear solve) and split into tang
 (line-search) trials.
 
     python benchmarks/strand_bending_iteration.py [--lays 4] [--elements 48] [--lay 229.2] [--t-end 1.5] [--steps 4]
-        [--repeat 1]
+        [--repeat 1] [--line-loads]
 
 Prints ``ms per Newton direction`` by part (``+ x trials``: the part's share inside forces-only evaluations), the
 counts of directions, tangent evaluations and trials, and the run's totals.  Run it against two trees (``PYTHONPATH``)
-in turns to compare them.
+in turns to compare them.  ``--line-loads``: instead, CPU ms of one call of the line loads' kernel on the strand's
+elements at the poses the piece ends in (forces only, and with their stiffness; best of 20), and the kernel's
+results' digest (``line_load.nodal_loads_and_tangent`` of two trees on the same poses).
 """
 import argparse
 import sys
 import time
 from pathlib import Path
+
+import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
@@ -65,6 +69,29 @@ def run_once(a):
     return total, count, dict(esp.TIMES), res
 
 
+def line_loads_only(a):
+    """``--line-loads``: the line-load kernel alone on the piece's last poses (module docstring)."""
+    import hashlib
+    res = sb.run(a.lays, a.elements, steps=a.steps, t_end=a.t_end, lay=a.lay * 1e-3)
+    ln = Problem.from_model(sb.build(a.lays, a.elements, lay=a.lay * 1e-3)[0]).system.line
+    H, scale = res["sol"].poses[-1], res["T"] * res["kappa"][-1]          # the P-delta load's scale T kappa at t
+    rows = ln.dead
+    args = (H[ln.nodes[rows, 0]], H[ln.nodes[rows, 1]], ln.L[rows], scale * ln.q[rows], scale * ln.m[rows], False)
+    out = {}
+    for name, fn in (("forces", line_load.nodal_loads), ("forces and stiffness", line_load.nodal_loads_and_tangent)):
+        fn(*args)
+        best = np.inf
+        for _ in range(20):
+            t0 = time.process_time()
+            r = fn(*args)
+            best = min(best, time.process_time() - t0)
+        out[name] = (best, r)
+    f, K = out["forces and stiffness"][1]
+    print(f"line loads on {len(rows)} elements at t = {a.t_end:g}: forces {out['forces'][0] * 1e3:.2f} ms, with "
+          f"stiffness {out['forces and stiffness'][0] * 1e3:.2f} ms CPU (best of 20); |f| {np.abs(f).max():.6e}, "
+          f"|K| {np.abs(K).max():.6e}, digest {hashlib.sha1(np.round(K, 6).tobytes()).hexdigest()[:8]}")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--lays", type=float, default=4)
@@ -73,7 +100,10 @@ def main():
     ap.add_argument("--t-end", type=float, default=1.5)
     ap.add_argument("--steps", type=int, default=sb.STEPS)
     ap.add_argument("--repeat", type=int, default=1)
+    ap.add_argument("--line-loads", action="store_true", help="the line loads' kernel alone (module docstring)")
     a = ap.parse_args()
+    if a.line_loads:
+        return line_loads_only(a)
     for part, owner, name in EXTRA:
         esp.TARGETS.append((part, owner, name))
     sb.run(2, 8, steps=1, t_end=1.2, lay=a.lay * 1e-3)          # warm-up: the kernels' compiled code loaded
