@@ -490,7 +490,7 @@ class System:
         c = getattr(self, "_coo_concat", None)
         if c is None or c[0] is not a_rows or c[1] is not a_cols or not (
                 (c[6] is b_rows and c[7] is b_cols) or (np.array_equal(c[2], b_rows) and np.array_equal(c[3], b_cols))):
-            rows, cols = np.concatenate([np.ravel(a_rows), b_rows]), np.concatenate([np.ravel(a_cols), b_cols])
+            rows, cols = _ravel_concat(a_rows, b_rows), _ravel_concat(a_cols, b_cols)
             rows.flags.writeable = cols.flags.writeable = False
             c = self._coo_concat = (a_rows, a_cols, np.array(b_rows), np.array(b_cols), rows, cols, b_rows, b_cols)
         return c[4], c[5]
@@ -618,6 +618,7 @@ class System:
         f = np.zeros((len(ln.element), 12))
         K = np.zeros((len(ln.element), 12, 12)) if kvals is not None else None
         for rows, follower in ((ln.dead, False), (ln.follower, True)):
+            rows = rows[lf[ln.load[rows]] != 0.0]      # a load scaled to zero: no loads, no stiffness (zero rows)
             if not len(rows):
                 continue
             HA, HB = H[ln.nodes[rows, 0]], H[ln.nodes[rows, 1]]
@@ -947,6 +948,14 @@ def _line_table(model, enodes, L):
     fol = np.array([ld.follower for ld in lls])[which]
     return _LineTable(el, enodes[el], L[el], np.array([ld.q for ld in lls])[which],
                       np.array([ld.m for ld in lls])[which], which, np.flatnonzero(~fol), np.flatnonzero(fol))
+
+
+def _ravel_concat(a, b):
+    """``np.concatenate([np.ravel(a), b])`` written in one pass (``a`` a broadcast view: no raveled copy first)."""
+    out = np.empty(a.size + len(b), dtype=np.result_type(a, b))
+    out[:a.size].reshape(a.shape)[...] = a
+    out[a.size:] = b
+    return out
 
 
 def _hat(v):

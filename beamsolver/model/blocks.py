@@ -79,12 +79,12 @@ def transform_rows(M, nodes, f, K, which):
 @jit
 def _transform(M, nodes, which, f, K, Kw, tangent):
     """``f[w] <- T^T f[w]`` (in place) and ``Kw[i] = (T^T K[w]) T``, ``w = which[i]``, ``T`` the block
-    diagonal of ``M[nodes[w]]``, every sum over all ``6 k`` terms in numpy's order."""
+    diagonal of ``M[nodes[w]]``: each sum in numpy's order over the six terms of ``T``'s node block (the other
+    ``6 (k - 1)`` are products with ``T``'s zeros, which leave a finite sum as it is: the same bits)."""
     m = f.shape[1]
     T, A, fw = np.zeros((m, m)), np.empty((m, m)), np.empty(m)
     for i in range(len(which)):
         w = which[i]
-        T[:] = 0.0
         for j in range(nodes.shape[1]):
             Mj = M[nodes[w, j]]
             for a in range(6):
@@ -93,22 +93,25 @@ def _transform(M, nodes, which, f, K, Kw, tangent):
         for r in range(m):
             fw[r] = f[w, r]
         for r in range(m):                  # einsum("ij,j->i", T^T, f)
-            acc = T[0, r] * fw[0]
-            for c in range(1, m):
+            q0 = r - r % 6
+            acc = T[q0, r] * fw[q0]
+            for c in range(q0 + 1, q0 + 6):
                 acc = acc + T[c, r] * fw[c]
             f[w, r] = acc
         if not tangent:
             continue
         for r in range(m):                  # A = T^T @ K[w]
+            q0 = r - r % 6
             for c in range(m):
-                acc = T[0, r] * K[w, 0, c]
-                for q in range(1, m):
+                acc = T[q0, r] * K[w, q0, c]
+                for q in range(q0 + 1, q0 + 6):
                     acc = fma(T[q, r], K[w, q, c], acc)
                 A[r, c] = acc
         for r in range(m):                  # Kw[i] = A @ T
             for c in range(m):
-                acc = A[r, 0] * T[0, c]
-                for q in range(1, m):
+                q0 = c - c % 6
+                acc = A[r, q0] * T[q0, c]
+                for q in range(q0 + 1, q0 + 6):
                     acc = fma(A[r, q], T[q, c], acc)
                 Kw[i, r, c] = acc
 

@@ -171,3 +171,29 @@ def test_compiled_loads_and_stiffness_are_the_numpy_forms_to_round_off(scale, fo
     assert np.abs(f - f0).max() <= 1e-14 * np.abs(f0).max()
     assert np.abs(f1 - f0).max() <= 1e-14 * np.abs(f0).max()
     assert np.abs(K - K0).max() <= 1e-13 * np.abs(K0).max()
+
+
+def test_a_line_load_scaled_to_zero_is_not_evaluated(monkeypatch):
+    """``System.evaluate`` skips the rows of a line load whose scale is zero at ``t`` (the strand's P-delta load
+    during the pull): no kernel call, and the residual and tangent those of the model without the load."""
+    import beamsolver as bs
+    from beamsolver.nonlinear.problem import Problem
+
+    def model(with_load):
+        m = bs.Model()
+        b = m.add_beam(bs.geometry.straight((0, 0, 0), (1, 0, 0), 4), bs.Section.circular(0.01, 1e9))
+        m.clamp(b.first)
+        m.add_load(b.last, force=(0.0, 1.0, 0.0))
+        if with_load:
+            m.add_line_load(b, force_per_length=(0.0, 0.0, 3.0), scale=lambda t: max(t - 1.0, 0.0))
+        return m
+    calls = []
+    tangent = line_load.nodal_loads_and_tangent
+    monkeypatch.setattr(line_load, "nodal_loads_and_tangent", lambda *a, **k: calls.append(1) or tangent(*a, **k))
+    problems = [Problem.from_model(model(w)) for w in (True, False)]
+    H = problems[0].system.poses0 @ se3.exp(np.random.default_rng(3).normal(scale=1e-2, size=(5, 6)))
+    e1, e0 = (p.evaluate(H, 0.5, tangent=True) for p in problems)
+    assert not calls
+    assert np.array_equal(e1.r, e0.r) and np.array_equal(e1.kvals, e0.kvals)
+    problems[0].evaluate(H, 1.5, tangent=True)
+    assert calls
