@@ -139,6 +139,18 @@ def _tv(D, O, pu, pw, ou, ow):
 
 
 @jit_callee
+def _point_load(Da, vq, vm, q, m, follower, pu, pw):
+    """The load per unit length at a Gauss point in its section frame, ``pu``, ``pw`` (3,): the follower's own
+    ``q``, ``m``, or the dead load's ``vq``, ``vm`` turned by the point's ``Da``."""
+    for i in range(3):
+        if follower:
+            pu[i], pw[i] = q[i], m[i]
+        else:
+            pu[i] = Da[i, 0] * vq[0] + Da[i, 1] * vq[1] + Da[i, 2] * vq[2]
+            pw[i] = Da[i, 0] * vm[0] + Da[i, 1] * vm[1] + Da[i, 2] * vm[2]
+
+
+@jit_callee
 def _element(vq, vm, h, L, q, m, follower, rotation, f, G, w6, XI, WEIGHTS):
     """``f`` (12,) = ``line_load._loads`` of one element (twist ``h``, real or complex; ``vq, vm`` the load in node
     A's frame, ``q, m`` as given); with ``rotation`` also ``G`` (12, 3), d f / d w_A at fixed ``h`` (real ``h``).
@@ -158,12 +170,7 @@ def _element(vq, vm, h, L, q, m, follower, rotation, f, G, w6, XI, WEIGHTS):
         for i in range(6):
             hx[i] = x * h[i]
         _gauss_operators(hx, Da, Oa, Dx, Ox, s)
-        for i in range(3):
-            if follower:
-                pu[i], pw[i] = q[i], m[i]
-            else:
-                pu[i] = Da[i, 0] * vq[0] + Da[i, 1] * vq[1] + Da[i, 2] * vq[2]
-                pw[i] = Da[i, 0] * vm[0] + Da[i, 1] * vm[1] + Da[i, 2] * vm[2]
+        _point_load(Da, vq, vm, q, m, follower, pu, pw)
         _tv(Dx, Ox, pu, pw, yu, yw)
         for i in range(3):
             yu[i] *= x
@@ -240,12 +247,7 @@ def _u_columns(vq, vm, h, L, q, m, follower, D, w6, XI, WEIGHTS):
             for i in range(3):
                 hx[i], hx[3 + i] = (x if i == k else 0.0), x * h[3 + i]
             _gauss_operators(hx, Da, Oa, Dx, Ox, s)
-            for i in range(3):
-                if follower:
-                    pu[i], pw[i] = q[i], m[i]
-                else:
-                    pu[i] = Da[i, 0] * vq[0] + Da[i, 1] * vq[1] + Da[i, 2] * vq[2]
-                    pw[i] = Da[i, 0] * vm[0] + Da[i, 1] * vm[1] + Da[i, 2] * vm[2]
+            _point_load(Da, vq, vm, q, m, follower, pu, pw)
             for i in range(3):
                 a, c = 0.0, 0.0
                 for j in range(3):
