@@ -120,7 +120,15 @@ def _start(folder, checkpoint, steps=STEPS, restart=False):
     if restart:
         cmd += ["--restart", str(folder)]
     env = dict(os.environ, PYTHONPATH=str(ROOT))
-    return subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=_interruptible)
+
+
+def _interruptible():
+    """In the child before ``exec``: SIGINT back to its default, so that Python raises ``KeyboardInterrupt`` on it as
+    at a terminal.  A test run started in the background of a non-interactive shell (``pytest &``) ignores SIGINT, its
+    children inherit that, and the run went on after the test's SIGINT (returncode 0, or a timeout)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def _wait_for_steps(proc, folder, n, timeout=120.0):
