@@ -273,8 +273,8 @@ def _axial_c(model, opts, mu, slave):
     if mu == 0.0 or "penalty_t" in opts or opts.get("stick", "exact") != "exact" or not _copts.EXACT_C_AXIAL > 0:
         return opts
     x = model.poses0[slave.nodes, :3, 3]
-    n = len(x) - 1
-    Le = float(np.median(np.linalg.norm(np.diff(x, axis=0), axis=1)))
+    n = len(slave.elements)
+    Le = float(np.median(np.linalg.norm(np.diff(x, axis=0), axis=1))) * ((len(x) - 1) // n)   # nodes per element
     return dict(opts, penalty_t=_copts.axial_c(slave.section.C[0, 0], Le, n))
 
 

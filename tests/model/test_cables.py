@@ -76,8 +76,8 @@ def test_strand_contacts_take_exact_stick_s_c_from_the_wires_axial_stiffness():
     st = cables.build_strand(layers, 0.2, E=2e11, elements_per_lay=12, mu=0.3, fit_core=True)
     wire = st.wires[1][0]
     x = st.model.poses0[wire.nodes, :3, 3]
-    Le = np.median(np.linalg.norm(np.diff(x, axis=0), axis=1))
-    n = len(wire.nodes) - 1
+    n = len(wire.elements)
+    Le = np.median(np.linalg.norm(np.diff(x, axis=0), axis=1))       # two-node elements
     EA = 2e11 * np.pi * 1e-6
     c = co.EXACT_C_AXIAL * EA / (Le * n * Le / co.EXACT_N)
     assert len(st.contacts) == 7                     # the core, and the closed layer's neighbours
