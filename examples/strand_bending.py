@@ -239,11 +239,16 @@ def compare(res, EI_frictionless=None):
     rows.append(("Masing branch: max |M - M_Masing| / M_f", 0.0, err.max()))
     rows.append(("Masing branch at -k: |M - M_Masing| / M_f", 0.0, err[-1]))
     # Masing's rule on the model's own virgin curve and reversal point: the two rows above measure the theory's
-    # reversal point, so they repeat the model's M_f error; these measure the rule itself
+    # reversal point, so they repeat the model's M_f error; these measure the rule itself, at the points of the
+    # branch whose half-distance to the reversal is a computed state of the virgin branch (interpolating the virgin
+    # curve between steps of 1.25 kappa_b instead errs by 6 % of M_f on the theory's own curves)
     xs = np.concatenate([[0.0], kap[up]])
     fs = np.concatenate([[0.0], M[up] - th["EI_min"] * kap[up]])
-    own = th["EI_min"] * kap[down] + fs[-1] - 2 * np.interp((kr - kap[down]) / 2, xs, fs)
-    err_own = np.abs(M[down] - own) / th["M_f"]
+    half = (kr - kap[down]) / 2
+    near = np.abs(xs[None, :] - half[:, None]).argmin(axis=1)
+    hit = np.abs(xs[near] - half) <= 1e-9 * abs(kr)
+    own = th["EI_min"] * kap[down][hit] + fs[-1] - 2 * fs[near[hit]]
+    err_own = np.abs(M[down][hit] - own) / th["M_f"]
     rows.append(("Masing on the model's virgin curve: max |M - M_Masing| / M_f", 0.0, err_own.max()))
     rows.append(("Masing on the model's virgin curve at -k: |M - M_Masing| / M_f", 0.0, err_own[-1]))
     last = t >= 2.0 - 1e-9

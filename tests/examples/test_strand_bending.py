@@ -65,6 +65,24 @@ def test_masing_on_the_model_s_own_virgin_curve_separates_the_rule_from_M_f():
     assert got["Masing on the model's virgin curve: max |M - M_Masing| / M_f"] < 1e-3
 
 
+def test_masing_on_the_model_s_own_virgin_curve_at_the_example_s_steps_is_not_an_interpolation():
+    """At the example's 4 steps per unit t the virgin branch is sampled every 1.25 kappa_b: the theory's own loop,
+    sampled so, obeys Masing's rule exactly, and the rows on the model's virgin curve say so (interpolating the
+    virgin curve between the samples measured 6.1 % of M_f there: the sampling, not the rule)."""
+    k = 5 * TH["kappa_b"]
+    t = np.linspace(1.0, 4.0, 13)[1:]                      # 4 steps per unit t, as the example
+    up = t <= 2.0 + 1e-12
+    kap = np.where(up, k * (t - 1.0), k * (3.0 - t))
+    rev = (k, sb.friction_moment(k, TH)[0])
+    M = np.where(up, np.ravel(sb.moment(kap, TH)), np.ravel(sb.moment(kap, TH, rev)))
+    res = dict(F=TH["F"], times=t, kappa=kap, M=M, k=k, share=np.where(kap > TH["kappa_b"], 1.0, 0.0))
+    _, rows = sb.compare(res)
+    got = {name: b for name, a, b, e in rows}
+    assert got["Masing on the model's virgin curve: max |M - M_Masing| / M_f"] < 1e-12
+    assert got["Masing on the model's virgin curve at -k: |M - M_Masing| / M_f"] < 1e-12
+    assert got["Masing branch: max |M - M_Masing| / M_f"] < 1e-12      # the theory's reversal point is the model's here
+
+
 def test_full_slip_and_full_stick_stiffness_of_the_beam_model():
     (EI0, F0), (EIt, Ft) = sb.stiffness_checks(lays=1, elements_per_lay=16)     # one step per unit t (elastic)
     assert EI0 == pytest.approx(sb.theory(F0)["EI_min"], rel=0.01)       # measured -0.6 %
