@@ -28,7 +28,7 @@ docs/theory_mortar.md), whose stick state does not depend on a penalty; ``cables
 contacts exact stick's ``c`` from the wires' axial stiffness (slip in a strand runs along the wires).  The issue's
 size (``--lays 4 --elements 48 --onset``): the cycle in 221 Newton iterations, no cut-back, 31 s; ``EI_min`` -0.8 %,
 ``M_f`` -1.3 % (friction part -0.7 %), first slip 1.04 ``kappa_b`` on the fine ramp (24 el/lay: 1.03), the Masing
-branch at -k 0.02 % of ``M_f`` from the model's own virgin curve, the loop energy -3.5 %, the wires tied to the core
+branch within 0.02 % of ``M_f`` of Masing's rule on the model's own virgin curve, the loop energy -3.5 %, the wires tied to the core
 ``EI_max`` -0.07 % (docs/benchmarks.md, "Strand bending, session 10").
 
 The stick branch of a beam model is softer than plane sections: the wires stick at their surface, a lever arm
