@@ -53,9 +53,9 @@ MAX_OUTER = 100            # outer iterations of a step (Problem.repeat_step) be
 UNDAMPED_MARGIN = 2.0      # an undamped residual up to this times the damped one Newton accepted is equilibrium
 STEP_ZERO_ITERATIONS = 4   # Newton budget at t_start / max_iter (no cut-back there; docs/theory.md section 17)
 STEP_ZERO_STALL = 10       # step 0 with exact stick's friction: given up after this many iterations without progress
-SETTLE_FRICTIONLESS = True  # step 0 moved by contact alone (a touching start's settling): without exact stick's
-#                             friction from the outset (``Run._solve_start``; issue 30, session 11: the 19-wire strand
-#                             twin's attempt with it cycled for 14 iterations before the fallback, 10.5 of 15.4 s)
+STEP_ZERO_CYCLE = 2        # ... or after this many Newton directions running that reverse the one before (a two-state
+#                            cycle, ``newton.CYCLE_COS``; 0: off.  The 19-wire strand twin: given up at iteration 5
+#                            instead of 13; issue 30, session 11)
 
 
 def growth(iterations, easy):
@@ -215,7 +215,7 @@ class Run:
             # no slip before t_start: friction's multipliers stay out of the Newton unknowns at step 0
             problem.multipliers_in_newton(False)
             try:
-                H, ev0, stats = self._solve_start(t_start, settling=not acts)
+                H, ev0, stats = self._solve_start(t_start)
             except StepFailed as e:
                 raise self._start_failure(e, pushed, H, t_start) from None
             finally:
@@ -243,24 +243,16 @@ class Run:
         if self.writer is not None:
             self.writer.write(self.sol, 0)
 
-    def _solve_start(self, t_start, settling=False):
+    def _solve_start(self, t_start):
         """Newton at ``t_start`` (step 0): ``(H, ev, stats)``.  Exact stick's friction has no history at
-        ``t_start`` (no slip before it).  ``settling``: contact alone moves the given poses (touching wires under the
-        smoothed normal law, nothing else acts): that motion, of the order of the law's smoothing width, is not a
-        slip, so it is solved without exact stick's friction, which starts from zero traction at the state found
-        (``SETTLE_FRICTIONLESS``; docs/theory_mortar.md 3b).  Otherwise, if the equilibrium is not found with that
-        friction, it is found without it and friction starts from zero traction there, with a warning in the stats
-        (the touching wires of a 1+6+12 strand under their contact pre-stress)."""
+        ``t_start``: if the equilibrium is not found with it, it is found without it and friction starts from zero
+        traction there, with a warning in the stats (the touching wires of a 1+6+12 strand under their contact
+        pre-stress: docs/theory_mortar.md 3b)."""
         newton = self.newton
-        if settling and SETTLE_FRICTIONLESS and self.problem.exact_friction(False):
-            newton.start = True
-            try:
-                return self.newton_step(t_start)
-            finally:
-                newton.start = False
         # with exact stick's friction, an attempt that stalls (the multipliers' updates alternating between two
         # states, a rope piece: 0.30 / 0.34 for 80 iterations) gives up early: the fallback below solves it
         newton.stall_window = STEP_ZERO_STALL if self.problem.exact_friction(True) else None
+        newton.cycle_window = (STEP_ZERO_CYCLE or None) if newton.stall_window else None
         newton.start = True                 # the normal law's active set and secant from the first iteration
         try:
             try:
@@ -270,7 +262,7 @@ class Run:
                     raise
                 failed = e
             finally:
-                newton.stall_window = None
+                newton.stall_window = newton.cycle_window = None
             H, ev0, stats = self.newton_step(t_start)
         finally:
             newton.start = False
