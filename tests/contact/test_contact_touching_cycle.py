@@ -59,3 +59,21 @@ def test_a_strand_whose_step_zero_converges_with_friction_is_untouched(monkeypat
     assert not after.stats[0].get("warnings")
     for k in range(len(before)):
         assert np.array_equal(after.poses[k], before.poses[k])
+
+
+def test_step_zero_s_attempt_with_friction_is_given_up_after_its_update_budget(monkeypatch):
+    """``steps.STEP_ZERO_UPDATES``: the attempt with friction may take that many augmented-Lagrangian updates (the
+    37-wire strand twin's took 17, 46 s); the 1+6 strand's needs 2: with a budget of 1 it falls back, and says why,
+    with the default budget it is untouched (the same bits as without a budget)."""
+    monkeypatch.setattr(steps, "STEP_ZERO_UPDATES", 0)
+    free, _ = _solve(1, monkeypatch, 2)
+    assert free.stats[0]["augmentations"] == 2
+    monkeypatch.setattr(steps, "STEP_ZERO_UPDATES", 4)
+    default, _ = _solve(1, monkeypatch, 2)
+    for k in range(len(free)):
+        assert np.array_equal(default.poses[k], free.poses[k])
+    monkeypatch.setattr(steps, "STEP_ZERO_UPDATES", 1)
+    short, _ = _solve(1, monkeypatch, 2)
+    warned = [w for w in short.stats[0].get("warnings", []) if "exact stick's friction" in w]
+    assert warned and "1 augmented-Lagrangian updates" in warned[0]
+    assert short.converged
