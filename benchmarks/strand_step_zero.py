@@ -4,11 +4,13 @@ friction given up by the stall rule alone, ``STEP_ZERO_STALL`` iterations withou
 updates up to ``MAX_OUTER``) and at their defaults ("on": also given up after that many Newton directions running that
 reverse the one before, or after that many updates), the fallback without that friction after a give-up.
 
-    python benchmarks/strand_step_zero.py [--scenes 19 37] [--rounds 2]
+    python benchmarks/strand_step_zero.py [--scenes 19 37 rope-40] [--rounds 2]
 
-The scenes are ``scaling_scenes.strand_model`` (the overlap-free twins of the scaling bundles: ``build_strand(...,
-fit_core=True, touch_tol=-0.5)``, bottom clamped), every top end stretched by ``scaling_scenes.STRAIN`` over one step,
-as ``benchmarks/scaling.py``'s "loaded step".  CPU by ``time.process_time`` between the Newton callbacks (step 0: up
+``rope-40``: ``rope_loaded_step.py``'s rope piece of 40 mm with exact stick
+(``tests/nonlinear/test_rope_loaded_step.py``'s scene, ``min_step_ratio=1``).  The other scenes are
+``scaling_scenes.strand_model`` (the overlap-free twins of the scaling bundles: ``build_strand(..., fit_core=True,
+touch_tol=-0.5)``, bottom clamped), every top end stretched by ``scaling_scenes.STRAIN`` over one step, as
+``benchmarks/scaling.py``'s "loaded step".  CPU by ``time.process_time`` between the Newton callbacks (step 0: up
 to the first callback at t = 1, including the fallback's second attempt; step 1: the rest), the settings alternating,
 least of the rounds; also printed: the iterations each step counts, the callbacks at t = 0 (the failed attempt's
 iterations too), whether step 0 warned, and the largest difference of the poses between the settings.
@@ -38,12 +40,17 @@ def loaded_step(name, on):
     for k, v in RULES.items():
         setattr(steps, k, v if on else 0)
     try:
-        m, wires, length = strand_model(name)
-        for w in wires:
-            m.prescribe(w.last, bs.motion.translation(lambda t: (0.0, 0.0, STRAIN * length * t)))
+        if name.startswith("rope-"):            # rope_loaded_step.py's piece (its test's: one step, no cut-back)
+            from rope_loaded_step import rope
+            m, floor = rope(float(name.split("-")[1]) * 1e-3, "exact"), 1.0
+        else:
+            m, wires, length = strand_model(name)
+            for w in wires:
+                m.prescribe(w.last, bs.motion.translation(lambda t: (0.0, 0.0, STRAIN * length * t)))
+            floor = STEP_FLOOR
         stamps = []
         t0 = clock()
-        sol = bs.solve(m, steps=1, verbose=False, min_step_ratio=STEP_FLOOR,
+        sol = bs.solve(m, steps=1, verbose=False, min_step_ratio=floor,
                        callback=lambda d: stamps.append((d["t"], clock())))
         total = clock() - t0
     finally:
