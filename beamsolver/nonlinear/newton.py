@@ -82,6 +82,10 @@ START_SWITCH_LIMIT = 1               # ... and at t_start one such direction aga
                                      # took 7 iterations either way, 21.1 s with 4 against 11.5 s with 1; 9.3 s and
                                      # 10 iterations without the start's switches; the unloaded touching pair's step 0:
                                      # 26 iterations against 10 with 4 and 44 without)
+CYCLE_COS = -0.9                     # with ``Newton.cycle_window`` (step 0 with exact stick's friction): a Newton
+                                     # direction whose cosine with the one before is below this reverses it; that many
+                                     # reversals running fail the step (a two-state cycle: every sliding group's slip,
+                                     # hence its traction, reversing at every iteration, the touching strands' step 0)
 NORMAL_NEAR = True                   # ... only near the solution (``near``: the residual cut LS_NEAR-fold)
 INNER_UNSETTLED = "last"             # branches still changing after INNER_SWITCHES: "last" solve or "plain" Newton's
                                      # (an option: twisted pair 244 -> 195, shear lag 39 -> 22 iterations with 8, but
@@ -198,6 +202,9 @@ class Newton:
         self.t_evaluated = None               # t of the last evaluation (failure messages)
         self.stall_window = None              # a step fails after this many iterations without a new lowest residual
         self.least_inc = (np.inf, 0)          # ... or a new shortest full Newton increment (``_verdict``)
+        self.cycle_window = None              # ... or after this many Newton directions running reverse the one
+        #                                       before (``CYCLE_COS``, ``_cycling``)
+        self.reversals = (None, 0)            # the last direction (scaled) and the reversals running up to it
         self.status = None                    # exact stick: (keys, stick flags) of the groups at the last iterate
         self.last_evaluation = None           # of the last converged state
         self.start = False                    # solving at t_start (step 0: ``START_SWITCHES``, ``START_SECANT``)
@@ -520,6 +527,7 @@ class Newton:
         residuals = []
         self.crawl, self.full_taken = 0, False
         self.least_inc = (np.inf, 0)         # the shortest full Newton increment of the step and its iteration
+        self.reversals = (None, 0)
         self.secant_done = None
         if constraint.watch_sign:
             self.indefinite_seen = False
@@ -552,6 +560,8 @@ class Newton:
             if constraint.moves:
                 H, t, last_inc = constraint.move(self, H, t, dzf)
                 continue
+            if self.cycle_window:
+                self._cycling(dzf, ratio, residuals)
             dz = self.full(dzf)
             if not damping:
                 H, ahead, last_inc = self._undamped(H, dz, ev, scales, ratio, t, plain)
@@ -628,6 +638,23 @@ class Newton:
             raise NotConverged(f"no progress in {self.stall_window} iterations (scaled residual {ratio:.3g}, "
                                f"lowest {min(residuals):.3g})", ratio)
         return verdict
+
+    def _cycling(self, dzf, ratio, residuals):
+        """Count the Newton direction ``dzf`` of the iterate (scaled residual ``ratio``) as a reversal of the one
+        before (cosine below ``CYCLE_COS``, translations in units of the model size); ``cycle_window`` of them running
+        fail the step (``NotConverged``): the iterates alternate between two states, as the touching strands' step 0
+        with exact stick's friction did (docs/benchmarks.md, "Step 0 of touching strands, session 11")."""
+        v = dzf.copy()
+        v[self.fu] /= self.L_ref
+        last, running = self.reversals
+        nv = float(np.linalg.norm(v))
+        if last is not None and len(last) == len(v) and nv > 0.0:
+            cos = float(last @ v) / (float(np.linalg.norm(last)) * nv)
+            running = running + 1 if cos < CYCLE_COS else 0
+        self.reversals = (v, running)
+        if running >= self.cycle_window:
+            raise NotConverged(f"cycling: {running} Newton directions running reverse the one before (scaled residual "
+                               f"{ratio:.3g}, lowest {min(residuals):.3g})", ratio)
 
     @staticmethod
     def converging(residuals, extra):

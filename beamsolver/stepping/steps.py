@@ -53,6 +53,13 @@ MAX_OUTER = 100            # outer iterations of a step (Problem.repeat_step) be
 UNDAMPED_MARGIN = 2.0      # an undamped residual up to this times the damped one Newton accepted is equilibrium
 STEP_ZERO_ITERATIONS = 4   # Newton budget at t_start / max_iter (no cut-back there; docs/theory.md section 17)
 STEP_ZERO_STALL = 10       # step 0 with exact stick's friction: given up after this many iterations without progress
+STEP_ZERO_CYCLE = 2        # ... or after this many Newton directions running that reverse the one before (a two-state
+#                            cycle, ``newton.CYCLE_COS``; 0: off.  The 19-wire strand twin: given up at iteration 5
+#                            instead of 13; issue 30, session 11)
+STEP_ZERO_UPDATES = 4      # ... or after this many augmented-Lagrangian updates of its multipliers (outer iterations,
+#                            ``MAX_OUTER`` elsewhere; 0: no limit): the 37-wire strand twin's converged after 17, each
+#                            re-solve's first residual 0.87 times the last one's (46 of the loaded step's 60 s); the
+#                            1+6 strand's converges after 2, the contact examples' step 0 needs none
 
 
 def growth(iterations, easy):
@@ -131,6 +138,7 @@ class Run:
         self.step_negative = None     # the same of the step being tried, if the stable-branch rule counted them
         self.stability = stability.StepCheck(problem, options.check_stability, options.stabilizer)
         self.branch_tries = 0         # LeftStableBranch failures since a step converged at its first try
+        self.outer_limit = None       # outer iterations a step may take (step 0 with friction: STEP_ZERO_UPDATES)
         newton.watch_sign = self._watches_branch(problem, options)
 
     @staticmethod
@@ -249,6 +257,8 @@ class Run:
         # with exact stick's friction, an attempt that stalls (the multipliers' updates alternating between two
         # states, a rope piece: 0.30 / 0.34 for 80 iterations) gives up early: the fallback below solves it
         newton.stall_window = STEP_ZERO_STALL if self.problem.exact_friction(True) else None
+        newton.cycle_window = (STEP_ZERO_CYCLE or None) if newton.stall_window else None
+        self.outer_limit = (STEP_ZERO_UPDATES or None) if newton.stall_window else None
         newton.start = True                 # the normal law's active set and secant from the first iteration
         try:
             try:
@@ -258,7 +268,7 @@ class Run:
                     raise
                 failed = e
             finally:
-                newton.stall_window = None
+                newton.stall_window = newton.cycle_window = self.outer_limit = None
             H, ev0, stats = self.newton_step(t_start)
         finally:
             newton.start = False
@@ -442,8 +452,12 @@ class Run:
         """Re-solve the step converged at ``t`` while the problem asks (``Problem.repeat_step``, e.g.
         augmented-Lagrangian updates), at most ``MAX_OUTER`` times: ``state`` a tuple whose first
         item is the converged poses, ``again(state)`` -> ``(state, more stats)``; the iterations and
-        residuals are added to ``stats``.  Returns the last state."""
+        residuals are added to ``stats``.  Returns the last state.  ``AugmentationFailed`` after ``outer_limit``
+        of them if set (step 0's attempt with exact stick's friction), else after ``MAX_OUTER``."""
         while self.problem.repeat_step(state[0]):
+            if self.outer_limit and stats.get("augmentations", 0) >= self.outer_limit:
+                raise AugmentationFailed(f"{self.outer_limit} augmented-Lagrangian updates did not meet the "
+                                         "tolerances")
             if stats.get("augmentations", 0) >= MAX_OUTER:
                 raise AugmentationFailed(f"the outer iterations (augmented-Lagrangian updates) still ask to re-solve "
                                          f"the step at t = {t:.6g} after MAX_OUTER = {MAX_OUTER}")
