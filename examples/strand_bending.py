@@ -48,9 +48,9 @@ reversal at the neutral axis over an element (``M_f`` 6 % low at 8 el/lay).
 library's default 0.005 the strand does not stick at all).
 ``tied=True`` ties the wires rigidly to the core (no contact) to measure the beam model's own
 full-stick stiffness (shear and torsion of the wires included) against ``EI_max``; ``--onset`` adds the first slip on
-a ramp in steps of 0.01 ``kappa_b`` (``first_slip``).
+a ramp in steps of 0.01 ``kappa_b`` (``first_slip``; on by default, ``--no-onset`` skips it).
 
-    python examples/strand_bending.py [--lays 2] [--elements 24] [--amplitude 3] [--steps 8] [--lay 229.2] [--onset]
+    python examples/strand_bending.py [--lays 4] [--elements 24] [--amplitude 3] [--steps 8] [--lay 229.2] [--no-onset]
 """
 import argparse
 import time
@@ -67,7 +67,9 @@ LAY_UJ = 114.6e-3                 # Utting & Jones' lay (11.9 deg)
 LAY = 229.2e-3                    # the example's: their wires on a lay ratio of 20 (6.0 deg), as a conductor's steel core
 STRAIN = 1e-3                     # axial strain of the strand under the pull
 
-LAYS, ELEMENTS, AMPLITUDE, STEPS = 2, 24, 5.0, 4   # default size: about 20 s of CPU (2 lays: the cut in the middle)
+LAYS, ELEMENTS, AMPLITUDE, STEPS = 4, 24, 5.0, 4   # default size: the issue's 4 lays (the cut at mid-length 2 lays from
+#                                                   the plates, on the long strand's plateau; 2 lays have none: their
+#                                                   full-slip slope read -4.8 % of EI_min), about 40 s of CPU
 solve_options = dict(steps=6 * STEPS, t_end=6.0)   # for `beamsolver run examples/strand_bending.py`
 
 
@@ -226,7 +228,8 @@ def compare(res, EI_frictionless=None):
         rows.append(("M_f, friction part M - EI_frictionless kappa [N m]", th["M_f"],
                      float(np.mean(Ms - EI_frictionless * ks)) if len(ks) else np.nan))
     onset = np.flatnonzero(up & (res["share"] > 0))
-    rows.append(("kappa first slip [1/m]", th["kappa_b"], kap[onset[0]] if len(onset) else np.nan))
+    rows.append((f"kappa first slip, on the cycle's steps of {kap[first] / th['kappa_b']:.3g} kappa_b [1/m]",
+                 th["kappa_b"], kap[onset[0]] if len(onset) else np.nan))
     mid = up & (kap > th["kappa_b"]) & (kap < th["kappa_t"])
     if mid.any():
         j = np.flatnonzero(mid)[-1]
@@ -429,8 +432,9 @@ if __name__ == "__main__":
     ap.add_argument("--stick", default=STICK, choices=("exact", "penalty"))
     ap.add_argument("--lay", type=float, default=LAY * 1e3,
                     help="lay length [mm] (default 229.2: lay ratio 20; Utting & Jones' own lay: 114.6)")
-    ap.add_argument("--onset", action="store_true",
-                    help="also the first slip on a fine ramp (steps of 0.01 kappa_b from 0.9 kappa_b)")
+    ap.add_argument("--onset", action=argparse.BooleanOptionalAction, default=True,
+                    help="also the first slip on a fine ramp (steps of 0.01 kappa_b from 0.9 kappa_b; the cycle's "
+                         "steps are amplitude / steps kappa_b apart); --no-onset skips it")
     ap.add_argument("--plot", default=None, help="PNG of the loop against the theory (needs matplotlib)")
     ap.add_argument("--map", default=None, help="PNG of the stick/slip map where slip spreads (needs pyvista)")
     a = ap.parse_args()
