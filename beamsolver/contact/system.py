@@ -983,12 +983,14 @@ class ContactSystem(Contribution):
         their forces: the mortar kernel's point data alone (``kernel_jit.mortar_data``, the same bits as
         ``mortar_forces``'), the groups, ``mortar.nodal_state`` and ``_point_data`` into ``out`` as there.  What
         ``commit`` stores (frames, slips, tractions, the groups' slips, multipliers and status) and ``results``
-        reports; the dict of ``_mortar`` without ``f``, ``K`` and the multiplier blocks."""
+        reports; the dict of ``_mortar`` without ``f``, ``K`` and the multiplier blocks (and without ``members`` unless
+        the groups were kept with them)."""
         n_nodes, n = len(H), len(sel)
         idx = np.arange(n)
         X = H[P.nodes[sel]]
+        # the groups without their members and slots (kept so: the next evaluation of these pairs builds those)
         G = self._groups(P.nodes[sel, :2], p["xi1"], self.el_master[P.m[sel]], P.decl[sel], P.nodes[sel], n_nodes,
-                         self.n_beams, self._held_slip(P.nodes[sel]))
+                         self.n_beams, self._held_slip(P.nodes[sel]), full=False)
         gdecl = G["key"] // (np.int64(n_nodes) * self.n_beams)
         R = H[G["node"], :3, :3]
         Lam = self.iterate_multipliers(G["key"])
@@ -999,15 +1001,15 @@ class ContactSystem(Contribution):
         d = kernel_jit.mortar_data(X, p, law)
         out.update(d.pop("pairs")[1], active=d["active"], lam_t=np.zeros((n, 2)), stick=np.ones(n, dtype=bool),
                    slip=np.zeros((n, 2)))
-        m = self._nodal_weights(G, P.e[sel])
+        m = self._nodal_weights(G, P.e[sel]) if "members" in G else self._nodal_weights_of(G, P.e[sel])
         touch = np.bincount(G["g"].ravel(), weights=np.repeat(d["active"].astype(float), 2), minlength=len(m))
         hold = np.where(touch > 0, mu * PENALTY_T_MIN * self._decl_penalty[gdecl], 0.0)
         st = mortar.nodal_state(G, p["weight"], d["S"], d["lam_n"], d["n"], R, Lam, eps, mu, m, None, hold=hold, RL=RL)
         st["T"] = T_pts
         _point_data(out, idx, n, G, d, st)
-        mult = dict(C=RL - st["lam"], m=m, members=G["members"], R=R, Lam=Lam, key=G["key"], stick=st["stick"],
+        mult = dict(C=RL - st["lam"], m=m, members=G.get("members"), R=R, Lam=Lam, key=G["key"], stick=st["stick"],
                     u=st["u"], tol=self._decl_stick_tol[gdecl], cap=mu * np.maximum(st["lamN"], 0.0))
-        return dict(members=G["members"], f=None, K=None, key=G["key"], decl=gdecl, lam=RL, u=st["u"],
+        return dict(members=G.get("members"), f=None, K=None, key=G["key"], decl=gdecl, lam=RL, u=st["u"],
                     stick=st["stick"], R=R, m=m, lamN=st["lamN"], mult=mult, folded=None, f_own=None, pair_f=None)
 
     def _mortar_law(self, gdecl):

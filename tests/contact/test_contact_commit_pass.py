@@ -115,3 +115,28 @@ def test_mortar_data_is_mortar_forces_point_data(monkeypatch):
         assert _bits(pair0[k], pair1[k]), k
     active = d1["active"]
     assert active.any() and not active.all()
+
+
+def test_groups_kept_without_members_build_them_when_asked():
+    """``mortar.groups(full=False)``: the keys, nodes, point groups and shape functions of a full build, nothing
+    else; ``Groups`` keeps such a build for the same points and builds the members and slots when a call asks."""
+    from beamsolver.contact import mortar
+    rng = np.random.default_rng(3)
+    P, n_nodes = 40, 12
+    slave = np.sort(rng.choice(n_nodes, (P, 2)), axis=1)
+    nodes = np.concatenate([slave, rng.integers(0, n_nodes, (P, 2))], axis=1)
+    beam, decl, held = rng.integers(0, 2, P), np.zeros(P, int), rng.random((P, 2)) < 0.2
+    xi = rng.uniform(0.01, 0.99, P)
+    args = (slave, xi, beam, decl, nodes, n_nodes, 2, held)
+    ref, part = mortar.groups(*args), mortar.groups(*args, full=False)
+    assert sorted(part) == ["g", "key", "node", "phi"]
+    for k in part:
+        assert _bits(ref[k], part[k]), k
+    keep = mortar.Groups()
+    assert sorted(keep(*args, full=False)) == sorted(part) and keep.builds == 1
+    assert sorted(keep(*args, full=False)) == sorted(part) and keep.builds == 1      # kept
+    out = keep(*args)
+    assert keep.builds == 2 and sorted(out) == sorted(ref)
+    for k in ref:
+        assert _bits(ref[k], out[k]), k
+    assert sorted(keep(*args, full=False)) == sorted(ref) and keep.builds == 2       # the full build serves both
