@@ -1116,6 +1116,8 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
     tangents at ``T = 0`` and at the point's traction ``Tp`` less the first (``mortar_terms(T=)``: the tangent at
     fixed traction ``sum_k T_k dK_k`` by linearity, two tangents instead of four); the unit tractions' forces
     then without tangent.  ``K`` ``(1, P, 24, 24)``: the whole tangent at ``Tp`` (``mortar_terms(whole=True)``).
+    An empty ``f`` ``(0, P, 4, 6)`` (and ``K``): the point data alone, no traction's pass (``mortar_data``; its
+    ``lam_t``, ``stick`` and force ``F`` are zeros and True, not the last pass's).
     ``spare``: an empty ``(0, 0)`` and a ``(4, 6)`` scratch.  A template (``make_kernel``)."""
     S, v, G, cache = ws
     side1, side2 = _element_side(Xp, 0, S[0], cache[0]), _element_side(Xp, 2, S[1], cache[1])
