@@ -1116,6 +1116,8 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
     tangents at ``T = 0`` and at the point's traction ``Tp`` less the first (``mortar_terms(T=)``: the tangent at
     fixed traction ``sum_k T_k dK_k`` by linearity, two tangents instead of four); the unit tractions' forces
     then without tangent.  ``K`` ``(1, P, 24, 24)``: the whole tangent at ``Tp`` (``mortar_terms(whole=True)``).
+    An empty ``f`` ``(0, P, 4, 6)`` (and ``K``): the point data alone, no traction's pass (``mortar_data``; its
+    ``lam_t``, ``stick`` and force ``F`` are zeros and True, not the last pass's).
     ``spare``: an empty ``(0, 0)`` and a ``(4, 6)`` scratch.  A template (``make_kernel``)."""
     S, v, G, cache = ws
     side1, side2 = _element_side(Xp, 0, S[0], cache[0]), _element_side(Xp, 2, S[1], cache[1])
@@ -1127,9 +1129,10 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
     RF, xF, _, _ = _section_co(RA2, xA2, u2, w2, xi2, co2[0], co2[1])
     S1, S2 = S[0], S[1]
     tangent = K.shape[2] > 0
+    data = f.shape[0] == 0          # point data only (``mortar_data``: no forces, no tangent)
     if tangent:
         _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, G)
-    else:       # forces only (``mortar_forces``: an empty ``K``): the Jacobians, no variations, no gradient rows
+    elif not data:       # forces only (``mortar_forces``: an empty ``K``): the Jacobians, no variations, no gradient rows
         _jacobians(u1, w1, xi1, co1[0], co1[1], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB], S1[S_TMP])
         _jacobians(u2, w2, xi2, co2[0], co2[1], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB], S2[S_TMP])
     n, t1, t2, dist = _axes(RC, xC, RF, xF, G)
@@ -1159,7 +1162,7 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
     contracted = tangent and K.shape[0] < 4       # 2: at T = 0 and at Tp; 1: at Tp only
     _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2)     # (the geometry's: once, not per traction)
     F, lt, stick = (0.0, 0.0, 0.0), (0.0, 0.0), True
-    for step in range(5 if contracted else 4):
+    for step in range(0 if data else 5 if contracted else 4):
         q = step if not contracted else (0, 4, 1, 2, 3)[step]         # the unit tractions last (the point data)
         lamp = (1.0 if q == 1 else 0.0, 1.0 if q == 2 else 0.0, 1.0 if q == 3 else 0.0) if q < 4 else \
             (Tp[0], Tp[1], Tp[2])
@@ -1207,7 +1210,7 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
         vec[0, i], vec[1, i], vec[2, i], vec[3, i], vec[4, i], vec[5, i] = n[i], t1[i], t2[i], xC[i], xF[i], F[i]
     two[0, 0], two[0, 1], two[1, 0], two[1, 1] = lt[0], lt[1], slip[0], slip[1]
     flags[0], flags[1] = active, stick
-    for q in range(1, 4):               # the differences to T = 0: the friction's parts (``mortar_terms``)
+    for q in range(1, 1 if data else 4):     # the differences to T = 0: the friction's parts (``mortar_terms``)
         fq, f0 = f[q, p], f[0, p]
         for i in range(4):
             for j in range(6):
@@ -1517,6 +1520,30 @@ def mortar_forces(X, p, law=None, pairs=False):
              HL=frames[:, 0], HK=frames[:, 1], active=flags[:, 0].copy(), xi1=sc[:, 2].copy(), xi2=sc[:, 3].copy())
     if pairs:
         d["pairs"] = _pair_data(f, sc, vec, par)
+    return d
+
+
+def mortar_data(X, p, law=None):
+    """``mortar_forces``' point data without its forces (a commit's: ``ContactSystem.commit`` stores frames, slips and
+    the groups' state, no force): ``S``, ``lam_n``, ``n``, ``t1``, ``t2``, ``slip``, ``HL``, ``HK``, ``active``,
+    ``xi1``, ``xi2`` and ``d["pairs"]``' point data (``gap``, ``lam_n``, ``n``, ``t1``, ``t2``, ``xC``, ``xF``, ``xi1``,
+    ``xi2``, ``F_slave``), the same bits as ``mortar_forces(pairs=True)``'s: the mortar kernel with an empty ``f``
+    (the geometry, projection, normal law, slip and frames of each point; not the four tractions' wrenches and nodal
+    forces, nor the Jacobians they take)."""
+    X = np.ascontiguousarray(X, dtype=float)
+    P = X.shape[0]
+    kind, par, has, (HCL, HFK, HLKp), _ = _table(X, p)
+    kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar=True)
+    f, K = np.empty((0, P, 4, 6)), np.empty((4, P, 0, 0))
+    sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
+    flags, frames, rows = np.empty((P, 2), dtype=np.bool_), _FRAMES_POOL.take((P, 4, 4, 4)), np.empty((P, 0, 0))
+    kern(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows, np.zeros((1, 3)))
+    n, t1, t2, s = vec[:, 0], vec[:, 1], vec[:, 2], two[:, 1]
+    d = dict(S=s[:, :1] * t1 + s[:, 1:] * t2, lam_n=sc[:, 1].copy(), n=n, t1=t1, t2=t2, slip=s.copy(),
+             HL=frames[:, 0], HK=frames[:, 1], active=flags[:, 0].copy(), xi1=sc[:, 2].copy(), xi2=sc[:, 3].copy())
+    lam = sc[:, 1]
+    d["pairs"] = (None, dict(gap=sc[:, 0], lam_n=lam, n=n, t1=t1, t2=t2, xC=vec[:, 3], xF=vec[:, 4], xi1=sc[:, 2],
+                             xi2=sc[:, 3], F_slave=(-par[:, WEIGHT] * lam)[:, None] * n))
     return d
 
 

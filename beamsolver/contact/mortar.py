@@ -62,7 +62,7 @@ def fold_of(slave_nodes, xi1, master_beam, decl, n_nodes, n_beams, held=None):
     return slivers(key, sn, xi1)
 
 
-def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=None, fold=None):
+def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=None, fold=None, full=True):
     """Nodal groups (one slave node against one master beam) of ``P`` points.
 
     ``held`` ``(P, 2)``: whether the point's slave node A, B has a prescribed slip (every increment
@@ -77,6 +77,8 @@ def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=No
     the shape functions, ``members`` ``(G, k)`` the nodes of each group (padded with its first node)
     and ``pos`` ``(P, 2, 4)`` the slot of each pair node in the group of its node A and B.  Sliver groups
     (``slivers``; ``fold`` ``(P, 2)`` if already known) are folded into their neighbour as held nodes are.
+    ``full`` False: ``key``, ``node``, ``g`` and ``phi`` only (the groups' state, ``nodal_state``; not the members and
+    slots the forces and tangents scatter by: a commit's, ``ContactSystem._commit_mortar``).
     """
     P = len(xi1)
     slave_nodes = _held_moved(slave_nodes, held)
@@ -90,6 +92,9 @@ def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=No
     ukey, g = np.unique(key.ravel(), return_inverse=True)
     g = g.reshape(P, 2)
     node = (ukey // n_beams) % n_nodes
+    if not full:
+        return dict(key=ukey, node=node, g=np.ascontiguousarray(g, dtype=np.int64),
+                    phi=np.stack([1.0 - xi1, xi1], axis=1))
     # the nodes of each group: every pair node of every member point
     gn = np.repeat(g[:, :, None], 4, axis=2)                       # (P, 2, 4)
     nn = np.repeat(nodes[:, None, :], 2, axis=1)
@@ -161,15 +166,16 @@ class Groups:
         self._last = None
         self.builds = 0          # ``groups`` calls (tests)
 
-    def __call__(self, slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=None):
+    def __call__(self, slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=None, full=True):
+        """``groups(...)`` (``full``: as there; kept without the members, a call asking for them builds them)."""
         fold = fold_of(slave_nodes, xi1, master_beam, decl, n_nodes, n_beams, held)
         args = (slave_nodes, master_beam, decl, nodes, held, fold)
         last = self._last
-        if last is not None and last[0] == (n_nodes, n_beams) and all(
+        if last is not None and last[0] == (n_nodes, n_beams) and ("members" in last[2] or not full) and all(
                 (a is None and b is None) or (a is not None and b is not None and np.array_equal(a, b))
                 for a, b in zip(last[1], args)):
             return dict(last[2], phi=np.stack([1.0 - xi1, xi1], axis=1))
-        G = groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held, fold)
+        G = groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held, fold, full)
         self._last = ((n_nodes, n_beams), tuple(None if a is None else np.array(a) for a in args), G)
         self.builds += 1
         return G

@@ -85,6 +85,8 @@ CHAIN_C = True           # exact stick: c's slave length is its chain's (beams j
 HOLD_CROSSINGS = True    # exact stick: an element pair's line / crossing decision kept in a step (``step_crossings``)
 HOLD_BAND = float(np.radians(5.0))   # ... remembered from pairs this close to line_angle on (cheaper on bundles)
 CHAIN_GROUPS = True      # exact stick: a mortar group is a slave node against a master chain, not a master beam
+LIGHT_COMMIT = True      # exact stick: commit's pass computes the point data and groups' state alone, not the forces
+#                          (``ContactSystem._commit_mortar``; False: the evaluation without tangent, as before)
 SKIP_OPEN = True         # exact stick: Newton's evaluations leave out the points of certainly open groups (``_open_points``)
 SKIP_MARGIN = 1e-2       # ... whose gap exceeds the normal law's band by SKIP_MARGIN (R1 + R2) at least
 SKIP_MIN = 64            # ... when at least this many points are that far (fewer: the test costs what it saves; the main
@@ -795,6 +797,14 @@ class ContactSystem(Contribution):
             return c[1]
         c = None                   # (its tangent buffer may serve this evaluation: ``_tangent_out``)
         asked, tangent = tangent, tangent or self.kernel is kernel_jit
+        chosen = self._chosen(H)
+        if chosen is None:
+            return None
+        return self._kernel_blocks(H, *chosen, asked, tangent)
+
+    def _chosen(self, H):
+        """``_local_blocks``' pairs ``P`` at ``H``, the active ones ``sel`` it evaluates and their kernel parameters ``p``:
+        ``(P, sel, p)``, or None without active pairs (``_blocks`` then says so for ``H``)."""
         P = self.pairs(H)
         self._lap()
         sel = np.zeros(0, dtype=int)
@@ -815,6 +825,11 @@ class ContactSystem(Contribution):
         p = self._params(P, sel, H)
         self._lap("params")
         self._blocks = None        # its tangent buffer may be reused (``_tangent_out``)
+        return P, sel, p
+
+    def _kernel_blocks(self, H, P, sel, p, asked, tangent):
+        """``_local_blocks``' kernels on the pairs ``_chosen`` gave (``asked``: the tangent asked for, ``tangent``:
+        computed)."""
         mort = self._decl_exact[P.decl[sel]] & (p["kind"] == LINE) & (p["mu"] > 0)
         # every pair a mortar pair whose whole tangent the mortar kernel gives (``_mortar``: points integration,
         # multipliers as unknowns): the pairs' kernel without tangent (its forces: the same bits)
@@ -961,6 +976,41 @@ class ContactSystem(Contribution):
         return dict(members=G["members"], f=f, K=K, key=G["key"], decl=gdecl,
                     lam=v if ssn else st["lam"], u=st["u"], stick=st["stick"], R=R, m=m, lamN=st["lamN"],
                     mult=mult, folded=folded, f_own=own, pair_f=f_pairs.reshape(-1, 4, 6) if f_pairs is not None else None)
+
+    def _commit_mortar(self, H, P, sel, p, out):
+        """``_mortar``'s point data and groups' state (multipliers as Newton unknowns) on the active pairs ``sel``, every
+        one a mortar pair, as the evaluation without tangent computes them (``_kernel_blocks``' whole path), without
+        their forces: the mortar kernel's point data alone (``kernel_jit.mortar_data``, the same bits as
+        ``mortar_forces``'), the groups, ``mortar.nodal_state`` and ``_point_data`` into ``out`` as there.  What
+        ``commit`` stores (frames, slips, tractions, the groups' slips, multipliers and status) and ``results``
+        reports; the dict of ``_mortar`` without ``f``, ``K`` and the multiplier blocks (and without ``members`` unless
+        the groups were kept with them)."""
+        n_nodes, n = len(H), len(sel)
+        idx = np.arange(n)
+        X = H[P.nodes[sel]]
+        # the groups without their members and slots (kept so: the next evaluation of these pairs builds those)
+        G = self._groups(P.nodes[sel, :2], p["xi1"], self.el_master[P.m[sel]], P.decl[sel], P.nodes[sel], n_nodes,
+                         self.n_beams, self._held_slip(P.nodes[sel]), full=False)
+        gdecl = G["key"] // (np.int64(n_nodes) * self.n_beams)
+        R = H[G["node"], :3, :3]
+        Lam = self.iterate_multipliers(G["key"])
+        eps, mu = self._balanced_c(G["key"], self._decl_eps_t[gdecl]), self._decl_mu[gdecl]
+        law = self._mortar_law(gdecl)
+        RL = np.einsum("gij,gj->gi", R, Lam)
+        T_pts = np.einsum("pa,pai->pi", G["phi"], RL[G["g"]])
+        d = kernel_jit.mortar_data(X, p, law)
+        out.update(d.pop("pairs")[1], active=d["active"], lam_t=np.zeros((n, 2)), stick=np.ones(n, dtype=bool),
+                   slip=np.zeros((n, 2)))
+        m = self._nodal_weights(G, P.e[sel]) if "members" in G else self._nodal_weights_of(G, P.e[sel])
+        touch = np.bincount(G["g"].ravel(), weights=np.repeat(d["active"].astype(float), 2), minlength=len(m))
+        hold = np.where(touch > 0, mu * PENALTY_T_MIN * self._decl_penalty[gdecl], 0.0)
+        st = mortar.nodal_state(G, p["weight"], d["S"], d["lam_n"], d["n"], R, Lam, eps, mu, m, None, hold=hold, RL=RL)
+        st["T"] = T_pts
+        _point_data(out, idx, n, G, d, st)
+        mult = dict(C=RL - st["lam"], m=m, members=G.get("members"), R=R, Lam=Lam, key=G["key"], stick=st["stick"],
+                    u=st["u"], tol=self._decl_stick_tol[gdecl], cap=mu * np.maximum(st["lamN"], 0.0))
+        return dict(members=G.get("members"), f=None, K=None, key=G["key"], decl=gdecl, lam=RL, u=st["u"],
+                    stick=st["stick"], R=R, m=m, lamN=st["lamN"], mult=mult, folded=None, f_own=None, pair_f=None)
 
     def _mortar_law(self, gdecl):
         """The one contact law of the declarations ``gdecl`` of the mortar groups (``InputError`` if they differ)."""
@@ -1375,13 +1425,34 @@ class ContactSystem(Contribution):
             vals[np.isin(k1, self._slid)] *= SLID_START
         self.history.update_multipliers(None, (k1, vals))
 
-    def _state(self, H):
+    def _state(self, H, commit=False):
+        """``(P, sel, (p, out))`` at ``H``: the pairs, the active ones (every one: the points ``_open_points`` leaves out
+        of Newton's evaluations too) and their kernel parameters and point data (exact stick's: ``out["mortar"]``),
+        for ``commit`` and ``augment``; ``(None, None, None)`` without pairs.  ``commit`` (``LIGHT_COMMIT``): where
+        every active pair is a mortar pair of the compiled kernel (``_kernel_blocks``' whole path), their point data
+        and the groups' state without the forces (``_commit_mortar``), the same bits as the evaluation's; no blocks
+        are kept for ``H`` then (the next step's ``begin_step`` clears them; the stepping drivers evaluate nothing
+        between).  ``augment`` takes the evaluation: its blocks at ``H`` serve the evaluations that may follow there
+        before the commit (a stability check)."""
         if self._decl_exact.any():      # the mortar pass: through the evaluation (kept for these poses)
             if self._skipped:           # an evaluation that left points out (``_open_points``): every point
                 self._blocks, self._cache = None, None
             self._full = True
             try:
-                self._local_blocks(H, False)
+                if commit and LIGHT_COMMIT and self._blocks is None and self.kernel is kernel_jit and \
+                        self.newton_multipliers and not self.n_slots:
+                    chosen = self._chosen(H)
+                    if chosen is not None:
+                        P, sel, p = chosen
+                        if (self._decl_exact[P.decl[sel]] & (p["kind"] == LINE) & (p["mu"] > 0)).all():
+                            out = {}
+                            out["mortar"] = self._commit_mortar(H, P, sel, p, out)
+                            self._lap("kernel")
+                            self._cache = (H.copy(), P, sel, p, out)
+                            return P, sel, (p, out)
+                        self._kernel_blocks(H, P, sel, p, False, True)
+                else:
+                    self._local_blocks(H, False)
             finally:
                 self._full = False
         cache = getattr(self, "_cache", None)
@@ -1461,7 +1532,7 @@ class ContactSystem(Contribution):
     def commit(self, H):
         """Store friction history and multipliers of the converged state (``ContactHistory.commit``)."""
         self._blocks = None
-        P, sel, po = self._state(H)
+        P, sel, po = self._state(H, commit=True)
         if P is None or len(sel) == 0:
             self.history.commit(self._decl_mu)
             self._last = self._last_mortar = None
