@@ -111,9 +111,12 @@ def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=No
     g = np.ascontiguousarray(g, dtype=np.int64)
     # kept with the groups (``Groups``): the points' slots (``_slots``), their rows (``_trial_rows``) and the
     # columns of each group's own node rotation (``_turn``)
+    # (``rows2`` a view of ``slot_rows``: one copy of the (P, 2, 24) rows, 79 MB at the commit pass's 206 000 points
+    # of the 61-wire strand; ``trial_rows`` makes it contiguous when it needs it)
     own = np.argmax(members == node[:, None], axis=1)
+    slot_rows = np.ascontiguousarray(rows2.transpose(1, 0, 2))
     return dict(key=ukey, node=node, g=g, phi=np.stack([1.0 - xi1, xi1], axis=1), members=members, pos=pos,
-                rows2=rows2, slot_groups=np.ascontiguousarray(g.T), slot_rows=np.ascontiguousarray(rows2.transpose(1, 0, 2)),
+                rows2=slot_rows.transpose(1, 0, 2), slot_groups=np.ascontiguousarray(g.T), slot_rows=slot_rows,
                 rot=6 * own[:, None] + np.arange(3, 6))
 
 

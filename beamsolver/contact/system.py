@@ -934,8 +934,12 @@ class ContactSystem(Contribution):
         # with multipliers as Newton unknowns, the points' tractions: the multipliers interpolated
         T_pts = np.einsum("pa,pai->pi", G["phi"], RL[G["g"]]) if ssn else None
         d, K_pairs = self._mortar_kernel(X, pm, law, T_pts, tangent, f_pairs is None, K_pairs, G)
+        if not tangent:     # forces only (a trial, the commit's pass over every point): the poses not needed past the
+            X = None        # kernel, nor ``A`` past the forces (below): 0.2 GB at the 61-wire strand's commit
         if f_pairs is None and "pairs" in d:    # the pairs' own kernel (``_local_blocks``: every pair a mortar pair)
             f_pairs, pair_out = d.pop("pairs")
+            if not tangent:                     # (a view of the kernel's (4, P, 4, 6) forces, as ``A``)
+                f_pairs = f_pairs.copy()
             np.negative(f_pairs, out=f_pairs)
             out.update(pair_out, active=d["active"], lam_t=np.zeros((len(idx), 2)), stick=np.ones(len(idx), dtype=bool),
                        slip=np.zeros((len(idx), 2)))
@@ -954,6 +958,8 @@ class ContactSystem(Contribution):
         if ssn:       # the multiplier itself is the traction (its complementarity function is an equation)
             st["T"] = T_pts
         d["f"] = np.einsum("pij,pj->pi", d["A"], st["T"])
+        if not tangent:
+            del d["A"]
         if tangent:
             f, K, mult = self._mortar_tangent(P, sel, idx, X, pm, G, d, st, R, Lam, eps, mu, law, v, K_pairs)
         else:

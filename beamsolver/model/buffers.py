@@ -14,24 +14,30 @@ import weakref
 
 import numpy as np
 
-__all__ = ["REUSE_BUFFERS", "BufferPool", "release_idle", "RELEASE_MIN_VALUES", "MMAP_THRESHOLD"]
+__all__ = ["REUSE_BUFFERS", "BufferPool", "release_idle", "RELEASE_MIN_VALUES", "RELEASE_AT_COMMIT", "MMAP_THRESHOLD"]
 
 REUSE_BUFFERS = sys.implementation.name == "cpython" and sys.version_info < (3, 14)
 RELEASE_MIN_VALUES = 4_000_000  # tangent values of an evaluation from which ``Evaluation.drop_tangent`` calls
 #                                 ``release_idle`` (~28 000 elements: the rope pieces of 0.3 m and more, not the bundles)
+RELEASE_AT_COMMIT = True       # ``Problem.commit`` lets the pools' idle buffers go at every accepted step, before the
+#                                 contributions' commit pass, and step 0 when it starts again without exact stick's
+#                                 friction (``release_idle(fix_threshold=False)``): a step's buffers (step 0's settling:
+#                                 the 61-wire strand's 0.66 GB) are not kept through the next (docs/benchmarks.md,
+#                                 "Memory of the strand's loaded step, session 12")
 MMAP_THRESHOLD = 4 << 20        # bytes: glibc's mmap threshold fixed there by ``release_idle`` (None: left alone)
 _POOLS = weakref.WeakSet()
 _MMAP_SET = []
 
 
-def release_idle():
+def release_idle(fix_threshold=True):
     """Memory over speed for large models (issue 30, the 0.6 m rope within 8 GB): every pool drops the buffers
     nothing else references (the groups' tangent blocks and the kernel's point terms while a line search's
     residual-only trial runs: 1.3 GB on that rope; the next evaluation with tangent takes fresh memory), and,
     once per process on glibc, its mmap threshold is fixed at ``MMAP_THRESHOLD`` (its default grows up to 32 MB
     as large arrays are freed, and freed arrays below it stay in the heap).  Values do not change: a pool's
-    buffer is filled by its caller.  Returns the bytes dropped."""
-    if MMAP_THRESHOLD is not None and not _MMAP_SET:
+    buffer is filled by its caller.  Returns the bytes dropped.  ``fix_threshold=False``: the buffers alone
+    (``RELEASE_AT_COMMIT``; glibc's threshold as it is)."""
+    if fix_threshold and MMAP_THRESHOLD is not None and not _MMAP_SET:
         _MMAP_SET.append(True)
         if sys.platform.startswith("linux") and platform.libc_ver()[0] == "glibc":
             try:

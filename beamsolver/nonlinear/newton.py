@@ -52,6 +52,10 @@ DAMPING_MIN = 1.0 / 64.0             # shortest damped Newton step (smooth probl
 STALL_RATIO = 1.5                    # undamped fallback if the shortest damped step grows the correction less
 DROP_BEFORE_SOLVE = True             # exact stick (augmented): the tangent dropped once K' and A are built, before the
 #                                      factorisation (issue 30: the groups' blocks freed first, 1.3 GB on the 0.6 m rope)
+DROP_FACTOR = True                   # an iteration's factorisation dropped once its direction is taken (``iterate``),
+#                                      before the line search's and the next iterate's evaluations: PARDISO's numerical
+#                                      factor freed then, where no lagged ``Solver`` keeps it (``linsolve.FREE_DROPPED``;
+#                                      docs/benchmarks.md, "Memory of the strand's loaded step, session 12")
 FORCES_ONLY_TRIALS = True            # semi-smooth problems: the line search's full-step trial without tangent ...
 FULL_AFTER_FULL = True               # ... but with it after a full step was accepted (``backtrack``)
 LM_SHIFT = 1e-3                      # exact stick: after LM_AFTER backtracked iterations in a row, away from the
@@ -555,6 +559,8 @@ class Newton:
             if it == 0 and self.watch_sign and constraint.watch_sign:
                 self._watch_first_tangent(lu)
             self.release(ev, lu)
+            if DROP_FACTOR:
+                lu = None
             if ev.mult is not None:
                 problem.multiplier_trial(1.0)
             if constraint.moves:

@@ -560,6 +560,8 @@ class Problem:
         """Accept the step at ``H``; returns the contributions' record of it (or ``None``).  Their per-step
         values of other shapes (exact stick's nodal table) are in ``extras`` then."""
         record, self.extras = None, {}
+        if buffers.RELEASE_AT_COMMIT:        # the step's work arrays: not kept through the commit pass and the next step
+            buffers.release_idle(fix_threshold=False)
         for c in self.contributions:
             c.commit(H)
             res = c.results(H)

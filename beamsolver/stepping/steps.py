@@ -29,7 +29,7 @@ import warnings
 import numpy as np
 
 from . import branching, diagnosis, kinks, stability, stable_branch
-from ..model import motion_path
+from ..model import buffers, motion_path
 from ..errors import ConvergenceError, InputError, StabilityWarning, StabilizationWarning
 from ..failures import AugmentationFailed, LeftStableBranch, MotionTooFast, NonFinite, StepFailed
 from .progress import Progress
@@ -269,6 +269,8 @@ class Run:
                 failed = e
             finally:
                 newton.stall_window = newton.cycle_window = self.outer_limit = None
+            if buffers.RELEASE_AT_COMMIT:      # the failed attempt's work arrays (exact stick's point terms) go
+                buffers.release_idle(fix_threshold=False)
             H, ev0, stats = self.newton_step(t_start)
         finally:
             newton.start = False

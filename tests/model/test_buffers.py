@@ -80,8 +80,8 @@ def test_released_buffers_give_the_same_bits(monkeypatch):
     calls = []
     release = buffers.release_idle
 
-    def counted():
-        calls.append(release())
+    def counted(**kw):
+        calls.append(release(**kw))
         return calls[-1]
     kept = shear_lag.main(n_wire=20)[0]
     assert not calls
@@ -91,3 +91,41 @@ def test_released_buffers_give_the_same_bits(monkeypatch):
     assert len(calls) >= 30 and sum(calls) > 0
     assert [s["iterations"] for s in released.stats] == [s["iterations"] for s in kept.stats]
     assert np.array_equal(released.poses, kept.poses)
+
+
+def _bits(sol):
+    """Poses, iterations, contact tables and exact stick's nodal multipliers (``extra``) of every step, as bytes."""
+    out = [np.asarray(sol.poses).tobytes(), repr([s["iterations"] for s in sol.stats])]
+    for c in sol.contacts:
+        out += [k + np.asarray(v).tobytes().hex() for k, v in sorted(c.items())]
+    for k, steps in sorted(sol.extra.items()):
+        out += [k + ("-" if v is None else np.asarray(v).tobytes().hex()) for v in steps]
+    return out
+
+
+@pytest.mark.parametrize("scene", ["twisted_pair", "shear_lag"])
+def test_release_at_commit_gives_the_same_bits(monkeypatch, scene):
+    """``buffers.RELEASE_AT_COMMIT`` (issue 30: the pools' idle buffers let go at every accepted step, before the
+    contributions' commit pass): the twisted pair (exact stick, the augmented path, 4 steps) and the shear lag
+    (exact stick, 4 steps) give the same iterations, poses, contact tables and nodal multipliers, bit for bit, as
+    with the buffers kept; and the release ran with buffers to drop."""
+    from beamsolver.model import buffers
+    if scene == "twisted_pair":
+        import twisted_pair as ex
+        run = lambda: ex.main(steps=4, turns=1.0, n_elements=32, check_stability=False)[0]   # noqa: E731
+    else:
+        import shear_lag as ex
+        run = lambda: ex.main(n_wire=20)[0]      # noqa: E731
+    monkeypatch.setattr(buffers, "RELEASE_AT_COMMIT", False)
+    kept = _bits(run())
+    calls = []
+    release = buffers.release_idle
+
+    def counted(**kw):
+        calls.append(release(**kw))
+        return calls[-1]
+    monkeypatch.setattr(buffers, "RELEASE_AT_COMMIT", True)
+    monkeypatch.setattr(buffers, "release_idle", counted)
+    released = _bits(run())
+    assert len(calls) >= 4 and (sum(calls) > 0 or not REUSE_BUFFERS)
+    assert released == kept

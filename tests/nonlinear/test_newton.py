@@ -183,12 +183,14 @@ def test_factorised_tangent_memory_serves_the_next_evaluation(monkeypatch):
     tangent, takes the same memory from the contact's tangent pool.  A 1+6 strand stretched in one
     step (clamped ends, no transformed nodes: the blocks reach ``extra`` as views of the pool's
     memory): the step's Newton iterations on one buffer, besides the start's (held by its
-    converged evaluation)."""
+    converged evaluation).  (Without ``buffers.RELEASE_AT_COMMIT``, which lets the start's idle buffer go at its
+    commit: ``tests/model/test_buffers.py``.)"""
     from beamsolver.driver import Convergence, Newton
     from beamsolver.nonlinear.problem import Problem
     from beamsolver.stepping.steps import Run
 
     monkeypatch.setattr("beamsolver.model.contact_options.EXACT_C_AXIAL", 0.0)   # the library's c: this path's buffers
+    monkeypatch.setattr("beamsolver.model.buffers.RELEASE_AT_COMMIT", False)
     L = bs.cables.Layer
     st = bs.cables.build_strand([L(1e-3), L(1e-3, 6, lay_length=0.1)], 0.1, E=2e11, elements_per_lay=8, mu=0.3,
                                 fit_core=True)
