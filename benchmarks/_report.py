@@ -28,6 +28,22 @@ def single_thread():
         os.environ[var] = "1"
 
 
+def memory_status():
+    """``{"VmHWM": MB, "VmRSS": MB}`` of this process (Linux ``/proc/self/status``): peak and resident memory."""
+    out = {}
+    with open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith(("VmHWM:", "VmRSS:")):
+                out[line[:5]] = int(line.split()[1]) / 1024.0
+    return out
+
+
+def reset_peak():
+    """Reset this process's ``VmHWM`` (and so ``ru_maxrss``) to its resident memory (Linux ``clear_refs``)."""
+    with open("/proc/self/clear_refs", "w") as f:
+        f.write("5")
+
+
 def machine():
     """One line describing the machine and the date of the run."""
     return (f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "

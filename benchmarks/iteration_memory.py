@@ -17,25 +17,11 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _report import machine, single_thread, table  # noqa: E402
+from _report import machine, memory_status, reset_peak, single_thread, table  # noqa: E402
 
 single_thread()
 
 import numpy as np  # noqa: E402
-
-
-def _status():
-    out = {}
-    with open("/proc/self/status") as f:
-        for line in f:
-            if line.startswith(("VmHWM:", "VmRSS:")):
-                out[line[:5]] = int(line.split()[1]) / 1024.0
-    return out
-
-
-def _reset_peak():
-    with open("/proc/self/clear_refs", "w") as f:
-        f.write("5")
 
 
 def main(argv):
@@ -54,9 +40,9 @@ def main(argv):
     rows = []
 
     def mark(label):
-        s = _status()
+        s = memory_status()
         rows.append([label, f"{s['VmRSS']:.0f}", f"{s['VmHWM']:.0f}"])
-        _reset_peak()
+        reset_peak()
 
     warm_up()
     mark("imports, warm-up")

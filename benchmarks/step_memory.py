@@ -21,25 +21,11 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _report import machine, single_thread, table  # noqa: E402
+from _report import machine, memory_status, reset_peak, single_thread, table  # noqa: E402
 
 single_thread()
 
 import numpy as np  # noqa: E402
-
-
-def _status():
-    out = {}
-    with open("/proc/self/status") as f:
-        for line in f:
-            if line.startswith(("VmHWM:", "VmRSS:")):
-                out[line[:5]] = int(line.split()[1]) / 1024.0
-    return out
-
-
-def _reset_peak():
-    with open("/proc/self/clear_refs", "w") as f:
-        f.write("5")
 
 
 class _Meter:
@@ -57,7 +43,7 @@ class _Meter:
             self.tm = tracemalloc
 
     def charge(self):
-        s = _status()
+        s = memory_status()
         key = (self.phase, self.stack[-1])
         row = self.peak.setdefault(key, dict(peak=0.0, rss=0.0, n=0, traced=0.0))
         if s["VmHWM"] > row["peak"]:
@@ -65,7 +51,7 @@ class _Meter:
         if self.traced:
             row["traced"] = max(row["traced"], self.tm.get_traced_memory()[1] / 2 ** 20)
             self.tm.reset_peak()
-        _reset_peak()
+        reset_peak()
         return s["VmRSS"]
 
     def enter(self, name):

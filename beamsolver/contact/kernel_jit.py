@@ -1495,10 +1495,29 @@ def _mortar_chunks(X, table, kern, T, pairs, sink):
 def _pair_data(f, sc, vec, par):
     """The pairs' kernel without friction (``contact_kernel(X, p, friction=False)``) from the mortar kernel's pass
     at ``T = 0``: forces ``f[0]`` ``(P, 4, 6)`` and its point data (the same bits up to the signs of zeros: the
-    unit tractions' terms of that pass are zeros)."""
+    unit tractions' terms of that pass are zeros; ``f`` None: no forces, ``mortar_data``'s)."""
     n, lam = vec[:, 0], sc[:, 1]
-    return f[0], dict(gap=sc[:, 0], lam_n=lam, n=n, t1=vec[:, 1], t2=vec[:, 2], xC=vec[:, 3], xF=vec[:, 4],
-                      xi1=sc[:, 2], xi2=sc[:, 3], F_slave=(-par[:, WEIGHT] * lam)[:, None] * n)
+    data = dict(gap=sc[:, 0], lam_n=lam, n=n, t1=vec[:, 1], t2=vec[:, 2], xC=vec[:, 3], xF=vec[:, 4], xi1=sc[:, 2],
+                xi2=sc[:, 3], F_slave=(-par[:, WEIGHT] * lam)[:, None] * n)
+    return (None if f is None else f[0]), data
+
+
+def _mortar_pass(X, p, law, n_forces):
+    """The mortar kernel without tangent over the points ``X`` (``mortar_forces``, ``mortar_data``): ``n_forces``
+    (4: the four tractions' forces; 0: none) -> ``(f, par, sc, vec, d)``, ``d`` the point data ``S``, ``lam_n``,
+    ``n``, ``t1``, ``t2``, ``slip``, ``HL``, ``HK``, ``active``, ``xi1``, ``xi2``."""
+    X = np.ascontiguousarray(X, dtype=float)
+    P = X.shape[0]
+    kind, par, has, (HCL, HFK, HLKp), _ = _table(X, p)
+    kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar=True)
+    f, K = np.empty((n_forces, P, 4, 6)), np.empty((4, P, 0, 0))
+    sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
+    flags, frames, rows = np.empty((P, 2), dtype=np.bool_), _FRAMES_POOL.take((P, 4, 4, 4)), np.empty((P, 0, 0))
+    kern(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows, np.zeros((1, 3)))
+    n, t1, t2, s = vec[:, 0], vec[:, 1], vec[:, 2], two[:, 1]
+    d = dict(S=s[:, :1] * t1 + s[:, 1:] * t2, lam_n=sc[:, 1].copy(), n=n, t1=t1, t2=t2, slip=s.copy(),
+             HL=frames[:, 0], HK=frames[:, 1], active=flags[:, 0].copy(), xi1=sc[:, 2].copy(), xi2=sc[:, 3].copy())
+    return f, par, sc, vec, d
 
 
 def mortar_forces(X, p, law=None, pairs=False):
@@ -1506,18 +1525,9 @@ def mortar_forces(X, p, law=None, pairs=False):
     ``lam_n``, ``n``, ``t1``, ``t2``, ``slip``, ``HL``, ``HK``, ``active``, ``xi1``, ``xi2``, the same bits as
     ``mortar_terms``' (the mortar kernel with an empty tangent: no frame variations, no gradient rows); ``pairs``:
     as ``mortar_terms``'."""
-    X = np.ascontiguousarray(X, dtype=float)
-    P = X.shape[0]
-    kind, par, has, (HCL, HFK, HLKp), _ = _table(X, p)
-    kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar=True)
-    f, K = np.empty((4, P, 4, 6)), np.empty((4, P, 0, 0))
-    sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
-    flags, frames, rows = np.empty((P, 2), dtype=np.bool_), _FRAMES_POOL.take((P, 4, 4, 4)), np.empty((P, 0, 0))
-    kern(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows, np.zeros((1, 3)))
-    A = np.transpose(f[1:], (1, 2, 3, 0)).reshape(P, 24, 3)
-    n, t1, t2, s = vec[:, 0], vec[:, 1], vec[:, 2], two[:, 1]
-    d = dict(A=A, S=s[:, :1] * t1 + s[:, 1:] * t2, lam_n=sc[:, 1].copy(), n=n, t1=t1, t2=t2, slip=s.copy(),
-             HL=frames[:, 0], HK=frames[:, 1], active=flags[:, 0].copy(), xi1=sc[:, 2].copy(), xi2=sc[:, 3].copy())
+    P = len(X)
+    f, par, sc, vec, d = _mortar_pass(X, p, law, 4)
+    d["A"] = np.transpose(f[1:], (1, 2, 3, 0)).reshape(P, 24, 3)
     if pairs:
         d["pairs"] = _pair_data(f, sc, vec, par)
     return d
@@ -1530,20 +1540,8 @@ def mortar_data(X, p, law=None):
     ``xi2``, ``F_slave``), the same bits as ``mortar_forces(pairs=True)``'s: the mortar kernel with an empty ``f``
     (the geometry, projection, normal law, slip and frames of each point; not the four tractions' wrenches and nodal
     forces, nor the Jacobians they take)."""
-    X = np.ascontiguousarray(X, dtype=float)
-    P = X.shape[0]
-    kind, par, has, (HCL, HFK, HLKp), _ = _table(X, p)
-    kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar=True)
-    f, K = np.empty((0, P, 4, 6)), np.empty((4, P, 0, 0))
-    sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
-    flags, frames, rows = np.empty((P, 2), dtype=np.bool_), _FRAMES_POOL.take((P, 4, 4, 4)), np.empty((P, 0, 0))
-    kern(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows, np.zeros((1, 3)))
-    n, t1, t2, s = vec[:, 0], vec[:, 1], vec[:, 2], two[:, 1]
-    d = dict(S=s[:, :1] * t1 + s[:, 1:] * t2, lam_n=sc[:, 1].copy(), n=n, t1=t1, t2=t2, slip=s.copy(),
-             HL=frames[:, 0], HK=frames[:, 1], active=flags[:, 0].copy(), xi1=sc[:, 2].copy(), xi2=sc[:, 3].copy())
-    lam = sc[:, 1]
-    d["pairs"] = (None, dict(gap=sc[:, 0], lam_n=lam, n=n, t1=t1, t2=t2, xC=vec[:, 3], xF=vec[:, 4], xi1=sc[:, 2],
-                             xi2=sc[:, 3], F_slave=(-par[:, WEIGHT] * lam)[:, None] * n))
+    _, par, sc, vec, d = _mortar_pass(X, p, law, 0)
+    d["pairs"] = _pair_data(None, sc, vec, par)
     return d
 
 
