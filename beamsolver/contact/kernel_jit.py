@@ -1415,6 +1415,7 @@ _FRAMES_POOL = BufferPool(keep=3)   # the contact frames ``mortar_terms`` and ``
 MORTAR_CHUNK = 2048              # points per pass of ``mortar_terms`` with a ``sink`` (its tangent and rows buffers)
 _CHUNK_POOL = BufferPool()       # the passes' tangent and gradient rows (``MORTAR_CHUNK`` points: 14 MB)
 _CHUNK_ROWS_POOL = BufferPool()
+_CHUNK4_POOL = BufferPool()      # the four tractions' tangents of a pass (``mortar_terms(sink=)`` without ``T``: 38 MB)
 
 
 def mortar_terms(X, p, law=None, T=None, whole=False, pairs=False, sink=None):
@@ -1438,12 +1439,14 @@ def mortar_terms(X, p, law=None, T=None, whole=False, pairs=False, sink=None):
     points ``a .. b - 1``, in order, and ``d`` has no ``dfdq``: the kernel runs over ``MORTAR_CHUNK`` points at a
     time (``_mortar_chunks``; the same operations per point: the same bits), so neither the ``(P, 24, 24)`` tangents
     nor the ``(P, N_ROWS, 24)`` gradient rows are held at once (7 kB a point: 0.5 GB on the 61-wire bundle).
+    ``sink`` without ``T`` (the four tractions): ``sink(a, b, dK)`` takes ``dK`` ``(b - a, 3, 24, 24)`` of those
+    points, pass by pass, and ``d`` has no ``dK`` (20 kB a point at once: 0.4 GB at the 61-wire strand's step 0).
     """
     X = np.ascontiguousarray(X, dtype=float)
     P = X.shape[0]
     kind, par, has, (HCL, HFK, HLKp), _ = _table(X, p)
     kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar=True)
-    if sink is not None and T is not None and whole:
+    if sink is not None and (T is None or whole):
         return _mortar_chunks(X, (kind, par, has, HCL, HFK, HLKp), kern, T, pairs, sink)
     # the tangents into kept memory (4.6 kB a point and traction; fresh memory's page faults cost about as much
     # as the kernel on the 19-wire bundle), a contiguous (4, P, 24, 24) prefix as ``np.empty`` would give
@@ -1465,28 +1468,34 @@ def mortar_terms(X, p, law=None, T=None, whole=False, pairs=False, sink=None):
 
 def _mortar_chunks(X, table, kern, T, pairs, sink):
     """``mortar_terms(X, p, law, T, whole=True, pairs, sink)``: the kernel ``kern`` and the point terms over
-    ``MORTAR_CHUNK`` points at a time, each pass's tangents handed to ``sink`` (``table``: ``_table``'s arrays)."""
+    ``MORTAR_CHUNK`` points at a time, each pass's tangents handed to ``sink`` (``table``: ``_table``'s arrays);
+    ``T`` None: the four tractions' (``mortar_terms(X, p, law, sink=)``), ``sink`` given their ``dK``."""
     P = X.shape[0]
     C = max(1, min(P, MORTAR_CHUNK))
-    f = np.empty((1, P, 4, 6))       # the forces at T = 0 (the pairs'); those of the unit tractions: ``A``
+    nK = 4 if T is None else 1
+    # the forces at T = 0 (the pairs'); those of the unit tractions: ``A`` (without ``T`` kept, ``A`` their view as
+    # ``mortar_terms``' whole pass gives it: its products, ``einsum``, take the same loops, the same bits)
+    f = np.empty((1 if T is not None else 4, P, 4, 6))
     sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
     flags, frames = np.empty((P, 2), dtype=np.bool_), _FRAMES_POOL.take((P, 4, 4, 4))
     terms = tuple(pool.take(shape) for pool, shape in zip(mortar_jit._TERMS_POOLS, ((P, 24, 3), (P, 3, 24),
                                                                                        (P, 3, 24), (P, 24))))
-    Tc = np.ascontiguousarray(T, dtype=float)
-    fbuf, Kbuf = np.empty(4 * C * 24), _CHUNK_POOL.take((C * 576,))
+    Tc = np.zeros((1, 3)) if T is None else np.ascontiguousarray(T, dtype=float)
+    fbuf, Kbuf = np.empty(4 * C * 24), (_CHUNK_POOL if nK == 1 else _CHUNK4_POOL).take((nK * C * 576,))
     rbuf = _CHUNK_ROWS_POOL.take((C * N_ROWS * 24,))
     for a in range(0, P, C):
         b = min(a + C, P)
         n = b - a
-        fc, Kc = fbuf[:4 * n * 24].reshape(4, n, 4, 6), Kbuf[:n * 576].reshape(1, n, 24, 24)
+        fc, Kc = fbuf[:4 * n * 24].reshape(4, n, 4, 6), Kbuf[:nK * n * 576].reshape(nK, n, 24, 24)
         rows = rbuf[:n * N_ROWS * 24].reshape(n, N_ROWS, 24)
         kern(X[a:b], *(t[a:b] for t in table), fc, Kc, sc[a:b], vec[a:b], two[a:b], flags[a:b], frames[a:b], rows,
-             Tc[a:b])
-        f[0, a:b] = fc[0]
+             Tc if T is None else Tc[a:b])
+        f[:, a:b] = fc[:len(f)]
         mortar_jit.point_terms_into(fc[1:], rows, vec[a:b, 1], vec[a:b, 2], two[a:b, 1], *(t[a:b] for t in terms))
-        sink(a, b, Kc[0])
+        sink(a, b, Kc[0] if T is not None else np.transpose(Kc[1:], (1, 0, 2, 3)))
     d = _mortar_terms(P, None, None, sc, vec, two, flags, frames, None, terms=terms)
+    if T is None:
+        d["A"] = np.transpose(f[1:], (1, 2, 3, 0)).reshape(P, 24, 3)
     if pairs:
         d["pairs"] = _pair_data(f, sc, vec, table[1])
     return d

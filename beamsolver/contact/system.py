@@ -933,7 +933,11 @@ class ContactSystem(Contribution):
         RL = np.einsum("gij,gj->gi", R, Lam)        # the multipliers' tractions (global)
         # with multipliers as Newton unknowns, the points' tractions: the multipliers interpolated
         T_pts = np.einsum("pa,pai->pi", G["phi"], RL[G["g"]]) if ssn else None
-        d, K_pairs = self._mortar_kernel(X, pm, law, T_pts, tangent, f_pairs is None, K_pairs, G)
+        # with the updates, the four tractions' tangents pass by pass once the points' tractions are known
+        # (``_mortar_passes``): not ``(4, P, 24, 24)`` at once
+        defer = tangent and not ssn and CHUNKED and f_pairs is not None and not self.n_slots and \
+            (K_pairs is None or len(K_pairs) == len(sel))
+        d, K_pairs = self._mortar_kernel(X, pm, law, T_pts, tangent, f_pairs is None, K_pairs, G, defer)
         if not tangent:     # forces only (a trial, the commit's pass over every point): the poses not needed past the
             X = None        # kernel, nor ``A`` past the forces (below): 0.2 GB at the 61-wire strand's commit
         if f_pairs is None and "pairs" in d:    # the pairs' own kernel (``_local_blocks``: every pair a mortar pair)
@@ -957,6 +961,8 @@ class ContactSystem(Contribution):
         mult = None
         if ssn:       # the multiplier itself is the traction (its complementarity function is an equation)
             st["T"] = T_pts
+        if defer:
+            K_pairs = self._mortar_passes(X, pm, law, d, st["T"], G, K_pairs, idx)
         d["f"] = np.einsum("pij,pj->pi", d["A"], st["T"])
         if not tangent:
             del d["A"]
@@ -1027,15 +1033,20 @@ class ContactSystem(Contribution):
                              f"got {len(laws)}")
         return next(iter(laws.values()))
 
-    def _mortar_kernel(self, X, pm, law, T_pts, tangent, pairs, K_pairs, G=None):
+    def _mortar_kernel(self, X, pm, law, T_pts, tangent, pairs, K_pairs, G=None, defer=False):
         """``(d, K_pairs)``: the mortar kernel's point terms of ``_mortar`` (forces only without ``tangent``; with the
         multipliers as Newton unknowns, ``T_pts`` given, the tangent at the points' tractions) and the pairs' own
         blocks still to fold in (None where the kernel's ``dfdq`` holds them); ``pairs``: the pairs' own forces
         and point data too (``kernel_jit.mortar_terms(pairs=True)``).  With the whole tangent at ``T_pts`` and the
         groups ``G`` (``CHUNKED``), the points' tangents go to the groups' blocks pass by pass (``mortar.block_sink``,
-        ``d["Kqq"]``) instead of ``d["dfdq"]`` ``(P, 24, 24)``."""
+        ``d["Kqq"]``) instead of ``d["dfdq"]`` ``(P, 24, 24)``.  ``defer`` (the updates, ``T_pts`` None): the point
+        data alone (``kernel_jit.mortar_data``, the same bits); ``_mortar_passes`` adds the tangent's terms."""
         if not tangent:
             return kernel_jit.mortar_forces(X, pm, law, pairs=pairs), K_pairs
+        if T_pts is None and defer:
+            d = kernel_jit.mortar_data(X, pm, law)
+            del d["pairs"]
+            return d, K_pairs
         if T_pts is None:
             return kernel_jit.mortar_terms(X, pm, law), K_pairs
         # the points' tractions are known (the multipliers): the tangent at them, two not four (one, the normal
@@ -1046,6 +1057,26 @@ class ContactSystem(Contribution):
         if sink is not None:
             d["Kqq"] = Kqq
         return d, (None if whole and (d.get("dfdq") is not None or "Kqq" in d) else K_pairs)
+
+    def _mortar_passes(self, X, pm, law, d, T, G, K_pairs, idx):
+        """The tangent's terms of ``_mortar`` with the updates (``defer``: ``d`` the point data of
+        ``kernel_jit.mortar_data``, ``T`` ``(P, 3)`` the points' tractions of ``mortar.nodal_state``): the mortar
+        kernel at the four tractions ``kernel_jit.MORTAR_CHUNK`` points at a time (``mortar_terms(sink=)``), each
+        pass's ``dfdq = sum_k T_k dK_k`` less the pairs' own blocks ``K_pairs`` (rows ``idx``) into the groups'
+        blocks (``mortar.block_sink``: ``d["Kqq"]``), and ``A``, ``G``, ``dS``, ``dn``, ``dlam_n`` into ``d``: the
+        same operations per point as ``mortar_terms`` and ``_mortar_tangent`` on the whole arrays, the same bits,
+        without the ``(4, P, 24, 24)`` tangents (0.4 GB at the 61-wire strand's step 0) nor ``dfdq``.  Returns None
+        (the pairs' blocks folded in)."""
+        Kqq, sink = mortar.block_sink(G)
+
+        def passed(a, b, dK):
+            dfdq = np.einsum("pk,pkij->pij", T[a:b], dK)
+            if K_pairs is not None:
+                mortar_jit.subtract_indexed(dfdq, K_pairs, idx[a:b])
+            sink(a, b, dfdq)
+        terms = kernel_jit.mortar_terms(X, pm, law, sink=passed)
+        d.update({k: terms[k] for k in ("A", "G", "dS", "dn", "dlam_n")}, Kqq=Kqq)
+        return None
 
     def _nodal_weights(self, G, e):
         """``m`` ``(n,)`` of the groups ``G`` (``mortar.nodal_state``), their points on the slave elements ``e``:

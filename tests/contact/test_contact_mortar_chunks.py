@@ -56,3 +56,51 @@ def test_passes_give_the_bits_of_one_array(monkeypatch, chunk):
         assert np.array_equal(x, y)
     for k in ref[3]:
         assert np.array_equal(ref[3][k], out[3][k]), k
+
+
+def _updates(monkeypatch, chunked, chunk):
+    """The slid slave of ``_parallel`` (sliding and sticking groups) evaluated with the tangent by the multiplier
+    updates (``newton_multipliers`` off: step 0's first attempt, the four tractions' tangents): ``(residual,
+    tangent values, passes)``, ``passes`` the ``(a, b, len)`` the sink got."""
+    monkeypatch.setattr(csys, "CHUNKED", chunked)
+    monkeypatch.setattr(kernel_jit, "MORTAR_CHUNK", chunk)
+    passes = []
+    terms = TERMS
+
+    def spy(*a, sink=None, **k):
+        if sink is not None:
+            def counted(a0, b0, vals, _sink=sink):
+                passes.append((a0, b0, len(vals), vals.shape))
+                _sink(a0, b0, vals)
+            return terms(*a, sink=counted, **k)
+        return terms(*a, **k)
+    monkeypatch.setattr(kernel_jit, "mortar_terms", spy)
+    model, slave, _ = _parallel(0.05, n_slave=8, penalty_t=1e7)
+    problem = Problem.from_model(model, check_rigid_modes=False)
+    c = problem.contact
+    c.newton_multipliers = False
+    H = _pressed(problem, slave, 2e-3 * R)
+    c.begin_step(H, 0.0)
+    c.commit(H)
+    slide = 8e-5 * R                       # (the groups of the deeper end stick, the others slide)
+    H = _move(H, slave.nodes, se3.exp(np.array([slide, slide, 0.0, slide, 0.0, 0.5 * slide])))
+    ev = problem.evaluate(H, 0.0, tangent=True)
+    blocks = c._local_blocks(H, True)[5]["mortar"]
+    assert ev.mult is None and not blocks["stick"].all() and blocks["stick"].any()   # both branches
+    return ev.r.copy(), np.array(ev.extra[2]), np.array(blocks["K"]), passes
+
+
+@pytest.mark.parametrize("chunk", [1, 7, 1 << 20])
+def test_the_updates_passes_give_the_bits_of_the_four_tractions_array(monkeypatch, chunk):
+    """With the multiplier updates the four tractions' tangents ``(4, P, 24, 24)`` are not held at once either
+    (``ContactSystem._mortar_passes``: the point data first, the tangent's passes at the points' tractions then;
+    0.4 GB at the 61-wire strand's step 0): the same residual, tangent and groups' blocks bit for bit."""
+    ref = _updates(monkeypatch, False, chunk)
+    out = _updates(monkeypatch, True, chunk)
+    assert not ref[3]
+    P = out[3][-1][1]
+    assert P > 7
+    assert [(a, b) for a, b, *_ in out[3]] == [(a, min(a + chunk, P)) for a in range(0, P, chunk)]
+    assert all(shape == (b - a, 3, 24, 24) for a, b, _, shape in out[3])
+    for x, y in zip(ref[:3], out[:3]):
+        assert np.array_equal(x, y)
