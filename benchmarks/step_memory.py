@@ -3,7 +3,7 @@
 ``python benchmarks/step_memory.py [--scene strand-61] [--hold True] [--tracemalloc]``
 
 Runs the step of ``step_parts.py`` (the scene of ``scaling_scenes``, stretched in one step, ``bs.solve(steps=1)``,
-``linsolve.LAGGED = False``, ``System.hold_pattern`` ``--hold``; ``strand-N``: the overlap-free strands, the whole
+``linsolve.LAGGED = False``, or ``--lagged auto`` (the default solver's), ``System.hold_pattern`` ``--hold``; ``strand-N``: the overlap-free strands, the whole
 step; ``19``/``37``/``61``: the bundles' first ``step_parts.BUNDLE_ITERATIONS`` iterations) with its stages wrapped:
 ``Problem.evaluate`` (with tangent / residual only), ``Problem.augmented_system`` (``K'``, ``A``),
 ``Problem.tangent`` / ``linear_system`` (other paths), PARDISO's phases (``linsolve._Pardiso._call``: 11 analysis,
@@ -89,6 +89,8 @@ def main(argv):
     ap.add_argument("--scene", default="strand-61")
     ap.add_argument("--hold", default="True", choices=("True", "False", "auto"))
     ap.add_argument("--tracemalloc", action="store_true")
+    ap.add_argument("--lagged", default="off", choices=("off", "auto", "on"),
+                    help="linsolve.LAGGED for the run (off: step_parts' mode, the issue-30 target's; auto: the default)")
     ap.add_argument("--set", action="append", default=[], metavar="MODULE.NAME=VALUE",
                     help="a knob of beamsolver for the run (A/B), e.g. model.buffers.RELEASE_AT_COMMIT=False")
     a = ap.parse_args(argv)
@@ -106,7 +108,7 @@ def main(argv):
     from beamsolver.nonlinear.problem import Problem
     warm_up()
     system_mod.HOLD_PATTERN = {"True": True, "False": False, "auto": "auto"}[a.hold]
-    linsolve.LAGGED = False
+    linsolve.LAGGED = {"off": False, "auto": "auto", "on": True}[a.lagged]
     strand = a.scene.startswith("strand")
     m, wires, length = ss.strand_model(a.scene.split("-")[1]) if strand else ss.scene_model(a.scene)
     for w in wires:
@@ -167,7 +169,8 @@ def main(argv):
     if a.tracemalloc:
         head.append("traced peak (MB)")
     sets = "".join(f" --set {x}" for x in a.set)
-    print(f"`python benchmarks/step_memory.py --scene {a.scene} --hold {a.hold}{sets}"
+    lag = f" --lagged {a.lagged}" if a.lagged != "off" else ""
+    print(f"`python benchmarks/step_memory.py --scene {a.scene} --hold {a.hold}{lag}{sets}"
           f"{' --tracemalloc' if a.tracemalloc else ''}` ({machine()}; status {status}, "
           f"{sum(1 for t in calls if t > 0)} callbacks in the loaded step; peak of the run {top:.0f} MB)\n")
     print(table(head, rows))
