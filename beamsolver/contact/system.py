@@ -1254,11 +1254,13 @@ class ContactSystem(Contribution):
         return b, info
 
     # ------------------------------------------------------------ the normal law's branches (an option)
-    def pressed_points(self, H, law=False):
+    def pressed_points(self, H, law=False, tangent=False):
         """Sorted keys of the points whose normal law presses at poses ``H`` (``lam_n > 0``); with ``law``,
         ``(keys, lam_n, gap, parabola)`` in that order, ``parabola`` where the traction is on the smoothing parabola
-        (``0 < lam_n < penalty smoothing``, docs/theory/contact_laws.md 7.2)."""
-        blocks = self._local_blocks(H, False)
+        (``0 < lam_n < penalty smoothing``, docs/theory/contact_laws.md 7.2).  ``tangent``: the blocks behind them
+        (``_local_blocks``, kept for an ``evaluate`` of the same poses) with the tangent, as ``evaluate(H, True)``
+        asks for it (``newton.TANGENT_AT_PRESSED``: the line search's trial then needs no second pass)."""
+        blocks = self._local_blocks(H, tangent)
         if blocks is None:
             e = np.zeros(0, dtype=np.int64)
             return (e, np.zeros(0), np.zeros(0), np.zeros(0, dtype=bool)) if law else e

@@ -71,7 +71,10 @@ NORMAL_SWITCHES = 4                  # exact stick: Newton directions again with
                                      # The rope pieces' loaded steps 31 -> 14 and failed -> 19 iterations, the contact
                                      # examples and the strand cycle within 1 %: docs/theory_mortar.md 3d)
 PRESSED_AT_TRIAL = True              # ... the full step's pressed points evaluated with the line search's multipliers
-                                     # (its forces-only evaluation reused by the trial; issue 30, session 9)
+                                     # (its forces-only evaluation reused by the trial; issue 30, session 9) ...
+TANGENT_AT_PRESSED = True            # ... and with the tangent where that trial asks for it (``_trial_tangent``): exact
+                                     # stick's mortar kernel once there, not a forces-only pass and the tangent's
+                                     # (the 37-wire strand's near iterations, docs/benchmarks.md, session 12)
 START_SWITCHES = True                # ... at t_start (step 0, ``Newton.start``) from the first iteration, with or
                                      # without multipliers (a touching start's lift-off front: main job's step 0
                                      # 10 -> 8 iterations, 4 with START_SECANT)
@@ -363,11 +366,16 @@ class Newton:
         # Newton's own steps finish (a beam held by contact alone keeps the stiffness that leaves it)
         done = self.secant_done if self.secant_done is not None else on_secant
         try:
-            for _ in range(min(NORMAL_SWITCHES, START_SWITCH_LIMIT) if self.start else NORMAL_SWITCHES):
+            for switch in range(min(NORMAL_SWITCHES, START_SWITCH_LIMIT) if self.start else NORMAL_SWITCHES):
                 # the multipliers of the line search's full step: the normal law does not depend on them, and the
-                # full step's evaluation (forces only) then serves the line search's first trial when nothing opens
+                # full step's evaluation (forces only) then serves the line search's first trial when nothing opens;
+                # the first one (no point forced yet) with the tangent if that trial asks for it (``TANGENT_AT_PRESSED``;
+                # ``ev``'s tangent, solved, is released first, as ``iterate`` does before the line search)
                 problem.multiplier_trial(1.0 if PRESSED_AT_TRIAL else 0.0)
-                then = problem.pressed_points(problem.update(H, self.full(dzf)), law=secant)
+                tangent = PRESSED_AT_TRIAL and TANGENT_AT_PRESSED and switch == 0 and self._trial_tangent(ev)
+                if tangent:
+                    self.release(ev, lu)
+                then = problem.pressed_points(problem.update(H, self.full(dzf)), law=secant, tangent=tangent)
                 then_keys = [(b[0] if secant else b) if b is not None else None for b in then]
                 opened = [np.setdiff1d(np.setdiff1d(np.setdiff1d(a, b), f), s) if a is not None else f[:0]
                           for a, b, f, s in zip(keys, then_keys, forced, on_secant)]
@@ -763,6 +771,12 @@ class Newton:
                 raise DampingStalled(f"damped Newton stalled: no step length down to {DAMPING_MIN:g} of the "
                                      "Newton increment reduces the Newton correction")
 
+    def _trial_tangent(self, ev0):
+        """Whether the line search's full-step trial from the iterate ``ev0`` is evaluated with the tangent
+        (``backtrack``: not for semi-smooth problems with multipliers, ``FORCES_ONLY_TRIALS``, unless the step's last
+        line search kept the full step, ``FULL_AFTER_FULL``)."""
+        return ev0.mult is None or not FORCES_ONLY_TRIALS or (FULL_AFTER_FULL and self.full_taken)
+
     def backtrack(self, H, dz, ev0, scales, t):
         """Backtracking on the scaled residual (problems that are not smooth; the others use the
         damped Newton of ``_damped``: a piecewise smooth residual made its natural-monotonicity
@@ -796,8 +810,7 @@ class Newton:
                 # the full step is nearly always accepted: evaluated with the tangent the next
                 # iteration needs; the backtracked trials need the residual only.  Semi-smooth (bordered)
                 # problems reject many full steps (Armijo): residuals only there too, unless the last one was kept
-                ev1 = self.evaluate(H1, t, tangent=alpha == 1.0 and (ev0.mult is None or not FORCES_ONLY_TRIALS
-                                                                     or (FULL_AFTER_FULL and self.full_taken)))
+                ev1 = self.evaluate(H1, t, tangent=alpha == 1.0 and self._trial_tangent(ev0))
                 phi = self._merit(ev1, scales)
             except StepFailed:
                 phi = np.inf

@@ -498,11 +498,12 @@ class Problem:
             if f is not None:
                 f()
 
-    def pressed_points(self, H, law=False):
+    def pressed_points(self, H, law=False, tangent=False):
         """Per contribution, the sorted keys of its points whose normal law presses at poses ``H`` (None where it has
         no such points): for ``Newton``'s active set of the normal law (``newton.NORMAL_SWITCHES``); with ``law``,
-        ``(keys, lam_n, gap, parabola)`` (``ContactSystem.pressed_points``)."""
-        return [(c.pressed_points(H, law) if law else c.pressed_points(H)) if hasattr(c, "pressed_points") else None
+        ``(keys, lam_n, gap, parabola)`` (``ContactSystem.pressed_points``); with ``tangent``, the evaluation behind
+        them (kept for an evaluation of the same poses) computes the contact's tangent too."""
+        return [c.pressed_points(H, law, tangent) if hasattr(c, "pressed_points") else None
                 for c in self.contributions]
 
     def force_secant(self, keys, gaps=None, reach=1.0):

@@ -12,27 +12,34 @@ from beamsolver.nonlinear import newton
 import shear_lag
 
 
-def _solve(monkeypatch, reuse):
-    """The shear lag with or without the reuse: ``(solution, contact evaluations computed)``."""
+def _solve(monkeypatch, reuse, with_tangent=True):
+    """The shear lag with or without the reuse (``with_tangent``: ``newton.TANGENT_AT_PRESSED``): ``(solution, contact
+    evaluations computed, exact stick's forces-only passes)``."""
     monkeypatch.setattr(newton, "PRESSED_AT_TRIAL", reuse)
-    computed = [0]
-    params = contact_system.ContactSystem._params
+    monkeypatch.setattr(newton, "TANGENT_AT_PRESSED", with_tangent)
+    computed, forces_only = [0], [0]
+    params, mortar = contact_system.ContactSystem._params, contact_system.ContactSystem._mortar
 
     def counted(self, P, sel, H):
         computed[0] += 1
         return params(self, P, sel, H)
 
+    def counted_mortar(self, H, P, sel, p, idx, out, tangent=True, *a, **k):
+        forces_only[0] += not tangent
+        return mortar(self, H, P, sel, p, idx, out, tangent, *a, **k)
+
     with monkeypatch.context() as m:
         m.setattr(contact_system.ContactSystem, "_params", counted)
+        m.setattr(contact_system.ContactSystem, "_mortar", counted_mortar)
         sol = bs.solve(shear_lag.build()[0], **shear_lag.solve_options)
-    return sol, computed[0]
+    return sol, computed[0], forces_only[0]
 
 
 def test_the_full_step_s_pressed_points_serve_the_line_search_s_first_trial(monkeypatch):
     """The shear lag: the same iterates, residuals and poses bit for bit with and without the reuse, and fewer contact
     evaluations computed (70 -> 64 when written)."""
-    before, n_before = _solve(monkeypatch, False)
-    after, n_after = _solve(monkeypatch, True)
+    before, n_before, _ = _solve(monkeypatch, False)
+    after, n_after, _ = _solve(monkeypatch, True)
     assert [s["residuals"] for s in after.stats] == [s["residuals"] for s in before.stats]
     assert np.array_equal(np.array(after.poses), np.array(before.poses))
     assert n_after < n_before
@@ -44,7 +51,7 @@ def test_the_pressed_points_do_not_depend_on_the_multipliers_trial_length(monkey
     points = contact_system.ContactSystem.pressed_points
     seen = []
 
-    def both(self, H, law=False):
+    def both(self, H, law=False, tangent=False):
         ms = self._ms
         self.multiplier_trial(0.0)
         a = points(self, H)
@@ -52,9 +59,22 @@ def test_the_pressed_points_do_not_depend_on_the_multipliers_trial_length(monkey
         b = points(self, H)
         self.multiplier_trial(ms)
         seen.append((self._mstep is not None and len(self._mstep[0]) > 0, np.array_equal(a, b)))
-        return points(self, H, law)
+        return points(self, H, law, tangent)
 
     monkeypatch.setattr(contact_system.ContactSystem, "pressed_points", both)
     sol = bs.solve(shear_lag.build()[0], **shear_lag.solve_options)
     assert sol.converged and all(equal for _, equal in seen)
     assert sum(step for step, _ in seen) > 5          # with a Newton step of the multipliers to move
+
+
+def test_the_full_step_s_pressed_points_carry_the_tangent_the_trial_asks_for(monkeypatch):
+    """The shear lag: where the line search's full-step trial asks for the tangent (``newton.FULL_AFTER_FULL``), the
+    pressed points' evaluation it reuses computes it (``newton.TANGENT_AT_PRESSED``): exact stick's mortar kernel
+    runs once at those poses, not a forces-only pass and then the tangent's; the same residuals and poses bit for
+    bit, the same contact evaluations, fewer forces-only passes."""
+    before, n_before, lazy_before = _solve(monkeypatch, True, False)
+    after, n_after, lazy_after = _solve(monkeypatch, True, True)
+    assert [s["residuals"] for s in after.stats] == [s["residuals"] for s in before.stats]
+    assert np.array_equal(np.array(after.poses), np.array(before.poses))
+    assert n_after == n_before
+    assert lazy_after < lazy_before
