@@ -318,7 +318,9 @@ class Newton:
         lu, dzf = constraint.direction(self, ev, H, t)
         if NORMAL_SWITCHES and constraint.final and not constraint.moves and \
                 ((ev.mult is not None and (self.near or not NORMAL_NEAR)) or (self.start and START_SWITCHES)):
-            lu, dzf = self._normal_branches(ev, H, t, lu, dzf)
+            held = [lu]
+            lu = None                 # (held by ``held`` alone: ``_normal_branches`` may let it go)
+            lu, dzf = self._normal_branches(ev, H, t, held, dzf)
         return lu, dzf
 
     def _levenberg(self, ev, H, t, constraint):
@@ -346,15 +348,20 @@ class Newton:
         if isinstance(lu, augmented_.Augmented):
             lu.drop_tangent()
 
-    def _normal_branches(self, ev, H, t, lu, dzf):
+    def _normal_branches(self, ev, H, t, held, dzf):
         """The Newton direction ``(lu, dzf)`` at ``(H, t)`` with the points that press at ``H`` but not at the full
         step linearised on the normal law's open branch (``Problem.force_open``), again until no more open (at most
         ``NORMAL_SWITCHES`` times): a lift-off front moves by several nodes in one Newton iteration.  At t_start
         (``START_SECANT``) the points on the smoothing parabola that press at both but whose traction the full step
         cuts to ``SECANT_SHARE`` or less are linearised, once in the step, on the parabola's secant to ``SECANT_REACH``
         of the way to its zero-force end (``Problem.force_secant``): the parabola's tangent only halves their distance
-        to that double root per iteration.  The residual, line search and convergence test are the exact law's."""
+        to that double root per iteration.  The residual, line search and convergence test are the exact law's.
+        ``held``: ``[lu]``, the factorised tangent's only reference (``_direction``), dropped before the full step's
+        contact tangent is computed (``TANGENT_AT_PRESSED``; ``DROP_FACTOR``, as ``iterate`` drops it before the line
+        search: the factor of ``A`` freed then where no lagged ``Solver`` keeps it) unless the first tangent's sign
+        is read (``watch_sign``); the returned ``lu`` is then None."""
         problem = self.problem
+        lu = held.pop()
         secant = self.start and START_SECANT
         now = problem.pressed_points(H, law=secant)
         keys = [(k[0] if secant else k) if k is not None else None for k in now]
@@ -375,6 +382,8 @@ class Newton:
                 tangent = PRESSED_AT_TRIAL and TANGENT_AT_PRESSED and switch == 0 and self._trial_tangent(ev)
                 if tangent:
                     self.release(ev, lu)
+                    if DROP_FACTOR and not self.watch_sign:
+                        lu = None
                 then = problem.pressed_points(problem.update(H, self.full(dzf)), law=secant, tangent=tangent)
                 then_keys = [(b[0] if secant else b) if b is not None else None for b in then]
                 opened = [np.setdiff1d(np.setdiff1d(np.setdiff1d(a, b), f), s) if a is not None else f[:0]
