@@ -14,8 +14,7 @@ import weakref
 
 import numpy as np
 
-__all__ = ["REUSE_BUFFERS", "BufferPool", "release_idle", "trim", "RELEASE_MIN_VALUES", "RELEASE_AT_COMMIT", "MMAP_THRESHOLD",
-           "TRIM_AT_RELEASE"]
+__all__ = ["REUSE_BUFFERS", "BufferPool", "release_idle", "RELEASE_MIN_VALUES", "RELEASE_AT_COMMIT", "MMAP_THRESHOLD"]
 
 REUSE_BUFFERS = sys.implementation.name == "cpython" and sys.version_info < (3, 14)
 RELEASE_MIN_VALUES = 4_000_000  # tangent values of an evaluation from which ``Evaluation.drop_tangent`` calls
@@ -26,30 +25,8 @@ RELEASE_AT_COMMIT = True       # ``Problem.commit`` lets the pools' idle buffers
 #                                 the 61-wire strand's 0.66 GB) are not kept through the next (docs/benchmarks.md,
 #                                 "Memory of the strand's loaded step, session 12")
 MMAP_THRESHOLD = 4 << 20        # bytes: glibc's mmap threshold fixed there by ``release_idle`` (None: left alone)
-TRIM_AT_RELEASE = True         # ``release_idle(fix_threshold=False)`` (``RELEASE_AT_COMMIT``) returns glibc's free heap
-#                                 pages to the system too (``malloc_trim(0)``): the 4-32 MB arrays freed below the mmap
-#                                 threshold stay resident otherwise, and where glibc placed them set the 61-wire strand's
-#                                 commit peak (docs/benchmarks.md, "Memory of the strand's solve, session 13")
 _POOLS = weakref.WeakSet()
 _MMAP_SET = []
-_LIBC = []
-
-
-def trim():
-    """glibc's ``malloc_trim(0)``: its free heap pages back to the system (values unchanged); False elsewhere."""
-    if not _LIBC:
-        libc = None
-        if sys.platform.startswith("linux") and platform.libc_ver()[0] == "glibc":
-            try:
-                libc = ctypes.CDLL(None)
-                libc.malloc_trim
-            except (OSError, AttributeError):
-                libc = None
-        _LIBC.append(libc)
-    if _LIBC[0] is None:
-        return False
-    _LIBC[0].malloc_trim(0)
-    return True
 
 
 def release_idle(fix_threshold=True):
@@ -59,7 +36,7 @@ def release_idle(fix_threshold=True):
     once per process on glibc, its mmap threshold is fixed at ``MMAP_THRESHOLD`` (its default grows up to 32 MB
     as large arrays are freed, and freed arrays below it stay in the heap).  Values do not change: a pool's
     buffer is filled by its caller.  Returns the bytes dropped.  ``fix_threshold=False``: the buffers alone
-    (``RELEASE_AT_COMMIT``; glibc's threshold as it is), and its free heap pages trimmed (``TRIM_AT_RELEASE``)."""
+    (``RELEASE_AT_COMMIT``; glibc's threshold as it is)."""
     if fix_threshold and MMAP_THRESHOLD is not None and not _MMAP_SET:
         _MMAP_SET.append(True)
         if sys.platform.startswith("linux") and platform.libc_ver()[0] == "glibc":
@@ -67,10 +44,7 @@ def release_idle(fix_threshold=True):
                 ctypes.CDLL(None).mallopt(-3, int(MMAP_THRESHOLD))       # M_MMAP_THRESHOLD
             except (OSError, AttributeError):
                 pass
-    freed = sum(p.release() for p in list(_POOLS))
-    if not fix_threshold and TRIM_AT_RELEASE:
-        trim()
-    return freed
+    return sum(p.release() for p in list(_POOLS))
 
 
 class BufferPool:
