@@ -74,6 +74,7 @@ OVERLAP_REPORT = 1e-4    # penetration / (R1 + R2) in the given poses that step 
 SWITCH_TOL = 1e-12        # a step ending within this (relative) of active_from / friction_from ends before it
 TIMED = ("search", "rules", "projection", "params", "kernel", "blocks")   # parts of ``ContactSystem.timings``
 LAZY_MORTAR = True       # exact stick: the multiplier blocks only when the tangent is asked for (False: benchmarks)
+HISTORY_FRAMES = ("H_CL", "H_FK", "H_LK_prev")   # the kernel parameters of the friction history's frames (P, 4, 4)
 CHUNKED = True           # exact stick: the mortar kernel's tangents into the groups' blocks pass by pass
 #                          (``kernel_jit.MORTAR_CHUNK`` points; False: the whole (P, 24, 24) array, then scattered)
 SLIP_C = True            # exact stick: a group's c for the next step scaled by its last step's slip over the largest
@@ -996,7 +997,8 @@ class ContactSystem(Contribution):
         ``mortar_forces``'), the groups, ``mortar.nodal_state`` and ``_point_data`` into ``out`` as there.  What
         ``commit`` stores (frames, slips, tractions, the groups' slips, multipliers and status) and ``results``
         reports; the dict of ``_mortar`` without ``f``, ``K`` and the multiplier blocks (and without ``members`` unless
-        the groups were kept with them)."""
+        the groups were kept with them).  The history's frames ``HISTORY_FRAMES`` are taken out of ``p`` after the
+        kernel (``commit``, ``augment`` and ``results`` read none of them)."""
         n_nodes, n = len(H), len(sel)
         idx = np.arange(n)
         # the groups without their members and slots (kept so: the next evaluation of these pairs builds those)
@@ -1011,6 +1013,8 @@ class ContactSystem(Contribution):
         T_pts = np.einsum("pa,pai->pi", G["phi"], RL[G["g"]])
         d = kernel_jit.mortar_data(H[P.nodes[sel]], p, law)   # (its poses not held past it: 0.1 GB at the
         #                                                          61-wire strand's commit)
+        for k in HISTORY_FRAMES:    # the kernel's alone: not kept with ``p`` (``_cache``, ``_last``; 79 MB there)
+            p.pop(k, None)
         out.update(d.pop("pairs")[1], active=d["active"], lam_t=np.zeros((n, 2)), stick=np.ones(n, dtype=bool),
                    slip=np.zeros((n, 2)))
         m = self._nodal_weights(G, P.e[sel]) if "members" in G else self._nodal_weights_of(G, P.e[sel])
