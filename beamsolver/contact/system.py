@@ -918,22 +918,10 @@ class ContactSystem(Contribution):
         None (``_local_blocks``: every active pair a mortar pair): the pairs' forces and point data are the mortar
         kernel's at zero traction (``kernel_jit.mortar_terms(pairs=True)``), written to ``out``, the forces returned
         as ``pair_f``."""
-        n_nodes = len(H)
         X = H[P.nodes[sel[idx]]]
         pm = p if len(idx) == len(sel) else {k: (v[idx] if np.ndim(v) else v) for k, v in p.items()}
-        G = self._groups(P.nodes[sel[idx], :2], pm["xi1"], self.el_master[P.m[sel[idx]]], P.decl[sel[idx]],
-                          P.nodes[sel[idx]], n_nodes, self.n_beams, self._held_slip(P.nodes[sel[idx]]))
-        gdecl = G["key"] // (np.int64(n_nodes) * self.n_beams)
-        R = H[G["node"], :3, :3]
         ssn = self.newton_multipliers
-        Lam = self.iterate_multipliers(G["key"]) if ssn else self.history.tangential_multipliers(G["key"])
-        eps, mu = (self._decl_eps_t if ssn else self._decl_aug_t)[gdecl], self._decl_mu[gdecl]
-        if ssn:
-            eps = self._balanced_c(G["key"], eps)
-        law = self._mortar_law(gdecl)
-        RL = np.einsum("gij,gj->gi", R, Lam)        # the multipliers' tractions (global)
-        # with multipliers as Newton unknowns, the points' tractions: the multipliers interpolated
-        T_pts = np.einsum("pa,pai->pi", G["phi"], RL[G["g"]]) if ssn else None
+        G, gdecl, R, Lam, eps, mu, law, RL, T_pts = self._group_state(H, P, sel[idx], pm, ssn)
         # with the updates, the four tractions' tangents pass by pass once the points' tractions are known
         # (``_mortar_passes``): not ``(4, P, 24, 24)`` at once
         defer = tangent and not ssn and CHUNKED and f_pairs is not None and not self.n_slots and \
@@ -951,10 +939,7 @@ class ContactSystem(Contribution):
         m = self._nodal_weights(G, P.e[sel[idx]])
         hold = v = None
         if ssn:
-            # groups with a point in the normal law's band: the point law's stiffness floor (mortar.py)
-            touch = np.bincount(G["g"].ravel(), weights=np.repeat(d["active"].astype(float), 2), minlength=len(m))
-            hold = np.where(touch > 0, mu * PENALTY_T_MIN * self._decl_penalty[gdecl], 0.0)
-            v = RL
+            hold, v = self._hold(G, d, m, mu, gdecl), RL
         # with the updates, the slip is integrated where the normal law acts (the kernel applies the traction
         # there); as Newton unknowns the traction field acts on every point of the overlap
         st = mortar.nodal_state(G, pm["weight"], d["S"], d["lam_n"], d["n"], R, Lam, eps, mu, m,
@@ -975,9 +960,7 @@ class ContactSystem(Contribution):
         if ssn:
             if tangent:
                 mult["B"] = mortar.multiplier_basis(st)
-            mult = dict(mult or {}, C=v - st["lam"], m=m, members=G["members"], R=R, Lam=Lam,
-                        key=G["key"], stick=st["stick"], u=st["u"], tol=self._decl_stick_tol[gdecl],
-                        cap=mu * np.maximum(st["lamN"], 0.0))
+            mult = dict(mult or {}, **self._multiplier_state(G, st, v, m, R, Lam, mu, gdecl))
         np.negative(f, out=f)
         if K is not None:
             np.negative(K, out=K)
@@ -999,18 +982,10 @@ class ContactSystem(Contribution):
         reports; the dict of ``_mortar`` without ``f``, ``K`` and the multiplier blocks (and without ``members`` unless
         the groups were kept with them).  The history's frames ``HISTORY_FRAMES`` are taken out of ``p`` after the
         kernel (``commit``, ``augment`` and ``results`` read none of them)."""
-        n_nodes, n = len(H), len(sel)
+        n = len(sel)
         idx = np.arange(n)
         # the groups without their members and slots (kept so: the next evaluation of these pairs builds those)
-        G = self._groups(P.nodes[sel, :2], p["xi1"], self.el_master[P.m[sel]], P.decl[sel], P.nodes[sel], n_nodes,
-                         self.n_beams, self._held_slip(P.nodes[sel]), full=False)
-        gdecl = G["key"] // (np.int64(n_nodes) * self.n_beams)
-        R = H[G["node"], :3, :3]
-        Lam = self.iterate_multipliers(G["key"])
-        eps, mu = self._balanced_c(G["key"], self._decl_eps_t[gdecl]), self._decl_mu[gdecl]
-        law = self._mortar_law(gdecl)
-        RL = np.einsum("gij,gj->gi", R, Lam)
-        T_pts = np.einsum("pa,pai->pi", G["phi"], RL[G["g"]])
+        G, gdecl, R, Lam, eps, mu, law, RL, T_pts = self._group_state(H, P, sel, p, True, full=False)
         d = kernel_jit.mortar_data(H[P.nodes[sel]], p, law)   # (its poses not held past it: 0.1 GB at the
         #                                                          61-wire strand's commit)
         for k in HISTORY_FRAMES:    # the kernel's alone: not kept with ``p`` (``_cache``, ``_last``; 79 MB there)
@@ -1018,15 +993,45 @@ class ContactSystem(Contribution):
         out.update(d.pop("pairs")[1], active=d["active"], lam_t=np.zeros((n, 2)), stick=np.ones(n, dtype=bool),
                    slip=np.zeros((n, 2)))
         m = self._nodal_weights(G, P.e[sel]) if "members" in G else self._nodal_weights_of(G, P.e[sel])
-        touch = np.bincount(G["g"].ravel(), weights=np.repeat(d["active"].astype(float), 2), minlength=len(m))
-        hold = np.where(touch > 0, mu * PENALTY_T_MIN * self._decl_penalty[gdecl], 0.0)
+        hold = self._hold(G, d, m, mu, gdecl)
         st = mortar.nodal_state(G, p["weight"], d["S"], d["lam_n"], d["n"], R, Lam, eps, mu, m, None, hold=hold, RL=RL)
         st["T"] = T_pts
         _point_data(out, idx, n, G, d, st)
-        mult = dict(C=RL - st["lam"], m=m, members=G.get("members"), R=R, Lam=Lam, key=G["key"], stick=st["stick"],
-                    u=st["u"], tol=self._decl_stick_tol[gdecl], cap=mu * np.maximum(st["lamN"], 0.0))
+        mult = self._multiplier_state(G, st, RL, m, R, Lam, mu, gdecl)
         return dict(members=G.get("members"), f=None, K=None, key=G["key"], decl=gdecl, lam=RL, u=st["u"],
                     stick=st["stick"], R=R, m=m, lamN=st["lamN"], mult=mult, folded=None, f_own=None, pair_f=None)
+
+    def _group_state(self, H, P, rows, p, ssn, full=True):
+        """The nodal groups of the pairs ``rows`` of ``P`` (point data ``p``; ``full``: with members and slots) and
+        their state: ``(G, gdecl, R, Lam, eps, mu, law, RL, T_pts)``: declarations, node rotations, multipliers (the
+        iterate's as Newton unknowns (``ssn``), else the updates' history), ``c``, ``mu``, the law, the multipliers'
+        global tractions ``R Lam`` and, with ``ssn``, the points' tractions (the multipliers interpolated)."""
+        n_nodes = len(H)
+        nodes = P.nodes[rows]
+        G = self._groups(nodes[:, :2], p["xi1"], self.el_master[P.m[rows]], P.decl[rows], nodes, n_nodes,
+                         self.n_beams, self._held_slip(nodes), **({} if full else dict(full=False)))
+        gdecl = G["key"] // (np.int64(n_nodes) * self.n_beams)
+        R = H[G["node"], :3, :3]
+        Lam = self.iterate_multipliers(G["key"]) if ssn else self.history.tangential_multipliers(G["key"])
+        eps, mu = (self._decl_eps_t if ssn else self._decl_aug_t)[gdecl], self._decl_mu[gdecl]
+        if ssn:
+            eps = self._balanced_c(G["key"], eps)
+        law = self._mortar_law(gdecl)
+        RL = np.einsum("gij,gj->gi", R, Lam)        # the multipliers' tractions (global)
+        T_pts = np.einsum("pa,pai->pi", G["phi"], RL[G["g"]]) if ssn else None
+        return G, gdecl, R, Lam, eps, mu, law, RL, T_pts
+
+    def _hold(self, G, d, m, mu, gdecl):
+        """Groups with a point in the normal law's band (kernel data ``d``): the point law's stiffness floor
+        (mortar.py); 0 elsewhere."""
+        touch = np.bincount(G["g"].ravel(), weights=np.repeat(d["active"].astype(float), 2), minlength=len(m))
+        return np.where(touch > 0, mu * PENALTY_T_MIN * self._decl_penalty[gdecl], 0.0)
+
+    def _multiplier_state(self, G, st, RL, m, R, Lam, mu, gdecl):
+        """What Newton keeps of the groups with multipliers as unknowns: complementarity residual ``C``, weights,
+        members, frames, multipliers, keys, status, slips, tolerances and Coulomb caps."""
+        return dict(C=RL - st["lam"], m=m, members=G.get("members"), R=R, Lam=Lam, key=G["key"], stick=st["stick"],
+                    u=st["u"], tol=self._decl_stick_tol[gdecl], cap=mu * np.maximum(st["lamN"], 0.0))
 
     def _mortar_law(self, gdecl):
         """The one contact law of the declarations ``gdecl`` of the mortar groups (``InputError`` if they differ)."""
