@@ -120,10 +120,13 @@ def closest_points(H, A1, h1, A2, h2, iterations=8):
 # exponential's coefficients by their series (``se3_jit.coefficient`` below its switch; a lane at or
 # above it is redone by the scalar iteration), both kinds' updates computed and one selected.
 # A lane stops at the first update ``|xi_k - xi_(k-1)| <= _step_tol`` (its ``xi_k`` kept: the iterate of
-# ``_project_from`` after ``k`` iterations, bit for bit), a block when all its lanes stopped; a lane
-# that has not stopped after ``iterations`` (the cap) is not converged: its row gets a nan distance
-# (``gauss_projections``: the owners reject it) instead of its last iterate.
+# ``_project_from`` after ``k`` iterations, bit for bit), a block when all its lanes stopped.  A lane
+# that has not stopped after the block's ``iterations`` goes on alone (``_go_on``, the same operations)
+# up to ``MAX_ITERATIONS`` where its iterate lies in the owners' window (``gauss_projections(window=)``;
+# outside it, as before, no owner would take it); one that does not converge gets a nan distance (the
+# owners reject it) instead of its last iterate being accepted.
 LANES = 64
+MAX_ITERATIONS = 64     # a lane's Newton iterations at most (the slow ones: near-degenerate roots)
 # Convergence of a lane: its update ``|d xi| <= STEP_TOL (1 + |x_A| / |u|)`` (``_step_tol``; ``x_A`` the
 # master's first node, ``|u| = |x'|`` its arc length).  The section point moves by less than
 # ``STEP_TOL (|u| + |x_A|)``: ~4500 ulps of its coordinates (eps = 2.2e-16) and of the element, where
@@ -229,6 +232,19 @@ def _iterate(S, line, xi, nxt, ang, tol, done, n, iterations):
             xi[l] = nxt[l]
             left += not done[l]
         if left == 0:
+            return
+
+
+@jit_callee
+def _go_on(S, line, xi, tol, done, l, iterations):
+    """Lane ``l`` not converged after ``iterations``: its Newton updates (``_step``, those of the lanes) go on
+    until one is within ``tol[l]`` (``done[l]``), at most ``MAX_ITERATIONS`` in all."""
+    RA, xA, u, w, x1, e1 = _lane(S, l)
+    for _ in range(iterations, MAX_ITERATIONS):
+        nxt = _step(line[l], x1, e1, RA, xA, u, w, xi[l])
+        done[l] = abs(nxt - xi[l]) <= tol[l]
+        xi[l] = nxt
+        if done[l]:
             return
 
 
@@ -350,11 +366,15 @@ def _gauss_project(H, enodes, h, e, m, xg, line, c2, reach, iterations, overhang
             if l == LANES:
                 _iterate(S, ln, xi, nxt, ang, tol, done, l, iterations)
                 for j in range(l):
+                    if not done[j] and (not cull or (xi[j] >= lo and xi[j] <= hi)):
+                        _go_on(S, ln, xi, tol, done, j, iterations)
                     mj = m[row[lane_row[j]]]
                     _finish(H, enodes[mj, 0], h, mj, S, j, xi[j], done[j], out2, dist, lane_row[j])
                 l = 0
     _iterate(S, ln, xi, nxt, ang, tol, done, l, iterations)
     for j in range(l):
+        if not done[j] and (not cull or (xi[j] >= lo and xi[j] <= hi)):
+            _go_on(S, ln, xi, tol, done, j, iterations)
         mj = m[row[lane_row[j]]]
         _finish(H, enodes[mj, 0], h, mj, S, j, xi[j], done[j], out2, dist, lane_row[j])
     return n
@@ -368,9 +388,10 @@ def gauss_projections(H, enodes, h, e, m, xg, kind, c2, reach, iterations=8, win
     A Gauss point whose centre lies farther than ``reach[k]`` from
     ``c2[k]`` ``(n, 3)`` (the master's bounding sphere grown by the slave radius) cannot touch the
     master and is skipped.  The others are projected as ``project_points`` does (from the master
-    chord, Newton iterations until the update is within ``_step_tol``, at most ``iterations``).  Returns,
-    over the rows kept in the order ``(k, g)``: pair ``row``, Gauss point ``gp``, ``xi2`` and centre
-    distance (nan where the projection did not converge within ``iterations``: no owner takes the row).
+    chord, Newton iterations until the update is within ``_step_tol``: ``iterations`` in lockstep, then a
+    lane alone up to ``MAX_ITERATIONS`` where its iterate is in the window).  Returns, over the rows kept in
+    the order ``(k, g)``: pair ``row``, Gauss point ``gp``, ``xi2`` and centre distance (nan where the
+    projection did not converge: no owner takes the row).
 
     ``window``: the overhang past the master's nodes of the projections the ownership accepts
     (``rules.XI_OVERHANG``); given, a ``LINE`` row whose slave section plane cannot meet the master
@@ -484,6 +505,8 @@ def _project_points(H, line, A1, h1, xi1, A2, B2, h2, iterations, out2, dist):
             ln[l] = line[k]
         _iterate(S, ln, xi, nxt, ang, tol, done, m, iterations)
         for l in range(m):
+            if not done[l]:
+                _go_on(S, ln, xi, tol, done, l, iterations)
             _finish(H, A2[lo + l], h2, lo + l, S, l, xi[l], done[l], out2, dist, lo + l)
 
 
@@ -491,7 +514,8 @@ def project_points(H, kind, A1, h1, xi1, A2, B2, h2, iterations=8):
     """Master parameter ``xi2`` and centre distance of slave sections ``xi1`` projected onto master
     elements (nodes ``A2``, ``B2``; ``kind`` ``LINE`` or ``ORTHOGONAL``), started on the master chord
     (the iterations of ``kernel_jit._project_from``, lanes in lockstep, each until its update is within
-    ``_step_tol``, at most ``iterations``; the distance is nan where it did not converge)."""
+    ``_step_tol``: ``iterations`` in lockstep, then alone up to ``MAX_ITERATIONS``; the distance is nan where
+    it did not converge)."""
     n = len(A1)
     out2, dist = np.empty(n), np.empty(n)
     c = np.ascontiguousarray
