@@ -94,7 +94,7 @@ def test_gauss_projections_stop_once_converged_and_reject_the_unconverged(seed):
     """Each lane stops at its first Newton update within ``projection._step_tol`` (~1e-12 of the element):
     its ``xi2`` is that iterate of the kernel's projection (bit for bit), within the tolerance of the fixed
     number of iterations done before (8, ``kernel_jit.project``), after far fewer.  A lane not converged
-    after the block's ``iterations`` goes on alone, up to ``MAX_ITERATIONS`` (where its iterate is in the
+    after the block's ``iterations`` goes on (its block), up to ``MAX_ITERATIONS`` (where its iterate is in the
     window); one that does not converge is not accepted silently: its distance is nan (no owner takes it)."""
     rng = np.random.default_rng(seed)
     angles = rng.uniform(1e-3, 2.5, 70)
@@ -120,7 +120,7 @@ def test_gauss_projections_stop_once_converged_and_reject_the_unconverged(seed):
     xA, u = H[A2[rep], :3, 3], h2[rep, :3]
     tol = projection.STEP_TOL * (1 + np.linalg.norm(xA, axis=1) / np.linalg.norm(u, axis=1))
     assert np.all(np.abs(got[2] - full)[its <= 8] <= tol[its <= 8])
-    # fewer iterations in lockstep: the lanes going on alone give the same floats
+    # fewer iterations before the window check: the lanes going on give the same floats
     short = projection.gauss_projections(*args, iterations=3)
     assert (its > 3).sum() > 0
     for x, y in zip(short, got):
