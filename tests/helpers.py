@@ -157,6 +157,26 @@ def kernel_pairs(rng, P, angles):
     return X, kinds, xi1, xi2
 
 
+def projection_until_converged(kind, HA1, h1, xi1, HA2, h2, start, cap=8):
+    """The oracle of ``projection``'s lanes: per row the iterate of ``kernel_jit.project`` (from ``start``) at
+    the first Newton update within ``projection._step_tol`` (``STEP_TOL (1 + |x_A2| / |u2|)``, the same
+    operations), at most ``cap`` iterations.  Returns ``xi2``, the iterations taken and whether it converged."""
+    from beamsolver.contact import kernel_jit, projection
+    xA, u = HA2[:, :3, 3], h2[:, :3]
+    lu = np.sqrt((u[:, 0] * u[:, 0] + u[:, 1] * u[:, 1]) + u[:, 2] * u[:, 2])
+    tol = projection.STEP_TOL * (1.0 + np.sqrt((xA[:, 0] * xA[:, 0] + xA[:, 1] * xA[:, 1]) + xA[:, 2] * xA[:, 2]) / lu)
+    prev = np.asarray(start, dtype=float)
+    xi2, its, done = prev.copy(), np.full(len(prev), cap), np.zeros(len(prev), dtype=bool)
+    for k in range(1, cap + 1):
+        cur = kernel_jit.project(kind, HA1, h1, xi1, HA2, h2, start, k)[1]
+        stop = ~done & (np.abs(cur - prev) <= tol)
+        xi2[stop], its[stop] = cur[stop], k
+        xi2[~done & ~stop] = cur[~done & ~stop]
+        done |= stop
+        prev = cur
+    return xi2, its, done
+
+
 def kernel_scene(seed, friction, smoothing, multiplier, history, elastic_slip, angles=None):
     """Node poses ``(P, 4, 4, 4)`` and kernel parameters of ``kernel_pairs`` (12 by default) with the
     given friction, smoothing gap, multiplier, history and elastic slip."""

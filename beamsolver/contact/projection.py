@@ -11,7 +11,7 @@ follow the constant-strain interpolation ``H_A exp(xi h)`` with the element twis
   reduced-Hessian ratio ``(H11 - H12^2 / H22) / |x1'|^2`` of the search's rule 2;
 - ``gauss_projections``: the slave Gauss points of element pairs, their sphere filter and
   their projections onto the master element (``LINE`` or ``ORTHOGONAL``), started from the
-  projection on the master chord, in one pass; ``project_points``: the same projections of
+  projection on the master chord, each until converged (``STEP_TOL``), in one pass; ``project_points``: the same projections of
   given slave sections.
 
 The Gauss-point projections run in lockstep over blocks of ``LANES`` (SIMD; the same
@@ -118,9 +118,25 @@ def closest_points(H, A1, h1, A2, h2, iterations=8):
 # compiler runs it in SIMD registers (measured 3x faster).  The lanes compute the same operations
 # as ``kernel_jit._project_from``'s ``LINE`` / ``ORTHOGONAL`` iterations, bit for bit: the
 # exponential's coefficients by their series (``se3_jit.coefficient`` below its switch; a lane at or
-# above it is redone by the scalar iteration), both kinds' updates computed and one selected, all
-# iterations done (``_project_from`` stops at an exact fixed point, which fixes all later iterates).
+# above it is redone by the scalar iteration), both kinds' updates computed and one selected.
+# A lane stops at the first update ``|xi_k - xi_(k-1)| <= _step_tol`` (its ``xi_k`` kept: the iterate of
+# ``_project_from`` after ``k`` iterations, bit for bit), a block when all its lanes stopped.  The lanes
+# not converged after ``iterations`` go on (the block, its converged lanes frozen) up to
+# ``MAX_ITERATIONS`` where their iterate lies in the owners' window (``gauss_projections(window=)``;
+# outside it, as before, no owner would take it); one that does not converge gets a nan distance (the
+# owners reject it) instead of its last iterate being accepted.  (Going on lane by lane, the scalar
+# ``_step`` in a second loop, made every call ~12 % slower: the code the compiler inlines.)
 LANES = 64
+MAX_ITERATIONS = 64     # a lane's Newton iterations at most (the slow ones: near-degenerate roots)
+# Convergence of a lane: its update ``|d xi| <= STEP_TOL (1 + |x_A| / |u|)`` (``_step_tol``; ``x_A`` the
+# master's first node, ``|u| = |x'|`` its arc length).  The section point moves by less than
+# ``STEP_TOL (|u| + |x_A|)``: ~4500 ulps of its coordinates (eps = 2.2e-16) and of the element, where
+# the update's round-off is a few ulps of ``|x_A| / |u|`` (measured <= 2.7e-14 on the 19-wire strand,
+# at least 37x below the tolerance there).  Newton converges quadratically from the chord start
+# (the scenes: update ~1e-5 at the 2nd iteration, ~1e-13 at the 3rd), so the kept iterate's error is
+# ~ C d xi^2, at the iterate's round-off, far below anything the owners (``XI_TOL = 1e-9``) or the
+# kernel (two more Newton iterations from it, ``kernel_jit._project``) can see.
+STEP_TOL = 1e-12
 _SA, _SB, _SC = (tuple(float(v) for v in _SERIES_TABLE[k]) for k in (A_, B_, C_))
 _SWITCH_ABC = float(min(_SWITCH[A_], _SWITCH[B_], _SWITCH[C_]))
 # fields of a lane: master node pose RA2 (row-major), xA2, twist u2, w2, slave centre x1, axis e1
@@ -189,18 +205,40 @@ def _step(line, x1, e1, RA, xA, u, w, xi2):
 
 
 @jit_callee
-def _iterate(S, line, xi, nxt, ang, n, iterations):
-    """``iterations`` Newton updates of ``xi[:n]`` for the lanes ``S[:, :n]`` (``line[l]``: kind ``LINE``,
-    else ``ORTHOGONAL``); ``nxt``, ``ang`` scratch ``(LANES,)``."""
-    for _ in range(iterations):
+def _step_tol(xA, u):
+    """A lane's convergence tolerance on its update ``d xi``: ``STEP_TOL (1 + |x_A| / |u|)`` (see ``STEP_TOL``)."""
+    lu = np.sqrt(dot(u, u))
+    return STEP_TOL * (1.0 + np.sqrt(dot(xA, xA)) / lu) if lu > 0.0 else STEP_TOL
+
+
+@jit_callee
+def _iterate(S, line, xi, nxt, ang, tol, done, ok, n, iterations, window, lo, hi):
+    """Newton updates of ``xi[:n]`` for the lanes ``S[:, :n]`` (``line[l]``: kind ``LINE``, else
+    ``ORTHOGONAL``) until each lane's update is within ``tol[l]`` (``ok[l]``): ``iterations``, then on for the
+    lanes not converged, up to ``MAX_ITERATIONS``, where ``window`` is false or their iterate is within
+    ``[lo, hi]`` (the others stop there, ``done[l]`` and not ``ok[l]``); ``nxt``, ``ang`` scratch ``(LANES,)``."""
+    for l in range(n):
+        done[l] = ok[l] = False
+    for it in range(MAX_ITERATIONS):
+        if it == iterations:            # the lanes left: on only within the window
+            for l in range(n):
+                if not done[l] and window and not (xi[l] >= lo and xi[l] <= hi):
+                    done[l] = True
         for l in range(n):
             RA, xA, u, w, x1, e1 = _lane(S, l)
             nxt[l], ang[l] = _step_series(line[l], x1, e1, RA, xA, u, w, xi[l])
+        left = 0
         for l in range(n):
+            if done[l]:
+                continue
             if ang[l] >= _SWITCH_ABC:
                 RA, xA, u, w, x1, e1 = _lane(S, l)
                 nxt[l] = _step(line[l], x1, e1, RA, xA, u, w, xi[l])
+            done[l] = ok[l] = abs(nxt[l] - xi[l]) <= tol[l]
             xi[l] = nxt[l]
+            left += not done[l]
+        if left == 0:
+            return
 
 
 @jit_callee
@@ -225,13 +263,13 @@ def _chord_start(xc, xA2, xB2):
 
 
 @jit_callee
-def _finish(H, a2, h2, k, S, l, xi2, out2, dist, r):
+def _finish(H, a2, h2, k, S, l, xi2, ok, out2, dist, r):
     """Master parameter and centre distance of lane ``l`` (master first node ``a2``, twist ``h2[k]``)
-    into row ``r``."""
+    into row ``r``; ``ok``: the lane converged, else the distance is nan (no projection)."""
     RA2, xA2 = _pose_of(H, a2)
     _, xf, _, _ = _section_inline(RA2, xA2, (h2[k, 0], h2[k, 1], h2[k, 2]), (h2[k, 3], h2[k, 4], h2[k, 5]), xi2)
     out2[r] = xi2
-    dist[r] = np.sqrt((xf[0] - S[_X1, l]) ** 2 + (xf[1] - S[_X1 + 1, l]) ** 2 + (xf[2] - S[_X1 + 2, l]) ** 2)
+    dist[r] = np.sqrt((xf[0] - S[_X1, l]) ** 2 + (xf[1] - S[_X1 + 1, l]) ** 2 + (xf[2] - S[_X1 + 2, l]) ** 2) if ok else np.nan
 
 
 # ``gauss_projections(window=)``: the cull's window is widened by ``CULL_PAD`` element lengths and its
@@ -268,8 +306,8 @@ def _gauss_project(H, enodes, h, e, m, xg, line, c2, reach, iterations, overhang
     # |x(xi) - chord(xi)| <= |x''| |xi (xi - 1)| / 2 for xi in and beyond [0, 1]; |x''| = |w x u|
     quad = 0.5 * max(0.25, -lo * hi)
     S = np.empty((N_FIELDS, LANES))
-    xi, nxt, ang = np.empty(LANES), np.empty(LANES), np.empty(LANES)
-    ln = np.empty(LANES, dtype=np.bool_)
+    xi, nxt, ang, tol = np.empty(LANES), np.empty(LANES), np.empty(LANES), np.empty(LANES)
+    ln, done, ok = np.empty(LANES, dtype=np.bool_), np.empty(LANES, dtype=np.bool_), np.empty(LANES, dtype=np.bool_)
     lane_row = np.empty(LANES, dtype=np.int64)
     slot = np.full(len(enodes), -1, dtype=np.int64)
     sec = np.empty((len(e) + 1, max(len(xg), len(xs)), 6))   # per slave element: centre and axis of each point
@@ -313,20 +351,21 @@ def _gauss_project(H, enodes, h, e, m, xg, line, c2, reach, iterations, overhang
                 continue
             _fill(S, l, RA2, xA2, h, m[k], xc, (sec[s, g, 3], sec[s, g, 4], sec[s, g, 5]))
             xi[l] = _chord_start(xc, xA2, xB2)
+            tol[l] = _step_tol(xA2, (h[m[k], 0], h[m[k], 1], h[m[k], 2]))
             ln[l] = line[k]
             row[n], gp[n], lane_row[l] = k, g, n
             n += 1
             l += 1
             if l == LANES:
-                _iterate(S, ln, xi, nxt, ang, l, iterations)
+                _iterate(S, ln, xi, nxt, ang, tol, done, ok, l, iterations, cull, lo, hi)
                 for j in range(l):
                     mj = m[row[lane_row[j]]]
-                    _finish(H, enodes[mj, 0], h, mj, S, j, xi[j], out2, dist, lane_row[j])
+                    _finish(H, enodes[mj, 0], h, mj, S, j, xi[j], ok[j], out2, dist, lane_row[j])
                 l = 0
-    _iterate(S, ln, xi, nxt, ang, l, iterations)
+    _iterate(S, ln, xi, nxt, ang, tol, done, ok, l, iterations, cull, lo, hi)
     for j in range(l):
         mj = m[row[lane_row[j]]]
-        _finish(H, enodes[mj, 0], h, mj, S, j, xi[j], out2, dist, lane_row[j])
+        _finish(H, enodes[mj, 0], h, mj, S, j, xi[j], ok[j], out2, dist, lane_row[j])
     return n
 
 
@@ -338,8 +377,10 @@ def gauss_projections(H, enodes, h, e, m, xg, kind, c2, reach, iterations=8, win
     A Gauss point whose centre lies farther than ``reach[k]`` from
     ``c2[k]`` ``(n, 3)`` (the master's bounding sphere grown by the slave radius) cannot touch the
     master and is skipped.  The others are projected as ``project_points`` does (from the master
-    chord, ``iterations`` Newton iterations).  Returns, over the rows kept in the order ``(k, g)``:
-    pair ``row``, Gauss point ``gp``, ``xi2`` and centre distance.
+    chord, Newton iterations until the update is within ``_step_tol``: ``iterations``, then on for the lanes
+    left, up to ``MAX_ITERATIONS``, where their iterate is in the window).  Returns, over the rows kept in
+    the order ``(k, g)``: pair ``row``, Gauss point ``gp``, ``xi2`` and centre distance (nan where the
+    projection did not converge: no owner takes the row).
 
     ``window``: the overhang past the master's nodes of the projections the ownership accepts
     (``rules.XI_OVERHANG``); given, a ``LINE`` row whose slave section plane cannot meet the master
@@ -435,8 +476,8 @@ def segment_bounds(H, enodes, h, e, m, seg, iterations=8):
 @jit
 def _project_points(H, line, A1, h1, xi1, A2, B2, h2, iterations, out2, dist):
     S = np.empty((N_FIELDS, LANES))
-    xi, nxt, ang = np.empty(LANES), np.empty(LANES), np.empty(LANES)
-    ln = np.empty(LANES, dtype=np.bool_)
+    xi, nxt, ang, tol = np.empty(LANES), np.empty(LANES), np.empty(LANES), np.empty(LANES)
+    ln, done, ok = np.empty(LANES, dtype=np.bool_), np.empty(LANES, dtype=np.bool_), np.empty(LANES, dtype=np.bool_)
     n = len(A1)
     for lo in range(0, n, LANES):
         m = min(LANES, n - lo)
@@ -449,16 +490,19 @@ def _project_points(H, line, A1, h1, xi1, A2, B2, h2, iterations, out2, dist):
                                            xi1[k])
             _fill(S, l, RA2, xA2, h2, k, xc, (R1[0][0], R1[1][0], R1[2][0]))
             xi[l] = _chord_start(xc, xA2, xB2)
+            tol[l] = _step_tol(xA2, (h2[k, 0], h2[k, 1], h2[k, 2]))
             ln[l] = line[k]
-        _iterate(S, ln, xi, nxt, ang, m, iterations)
+        _iterate(S, ln, xi, nxt, ang, tol, done, ok, m, iterations, False, 0.0, 1.0)
         for l in range(m):
-            _finish(H, A2[lo + l], h2, lo + l, S, l, xi[l], out2, dist, lo + l)
+            _finish(H, A2[lo + l], h2, lo + l, S, l, xi[l], ok[l], out2, dist, lo + l)
 
 
 def project_points(H, kind, A1, h1, xi1, A2, B2, h2, iterations=8):
     """Master parameter ``xi2`` and centre distance of slave sections ``xi1`` projected onto master
     elements (nodes ``A2``, ``B2``; ``kind`` ``LINE`` or ``ORTHOGONAL``), started on the master chord
-    (the iterations of ``kernel_jit._project_from``, lanes in lockstep)."""
+    (the iterations of ``kernel_jit._project_from``, lanes in lockstep, each until its update is within
+    ``_step_tol``: ``iterations``, then on for the lanes left up to ``MAX_ITERATIONS``; the distance is nan
+    where it did not converge)."""
     n = len(A1)
     out2, dist = np.empty(n), np.empty(n)
     c = np.ascontiguousarray

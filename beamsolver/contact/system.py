@@ -564,9 +564,10 @@ class ContactSystem(Contribution):
         # a slave Gauss point outside the master element's sphere (grown by R1) cannot touch that
         # element: no projection for it, nor for a line row whose section plane misses the master on
         # the overhang the owners accept (``window``: projections per slave point bounded as elements
-        # get finer); the others from the projection on the master chord, 8 Newton iterations
-        # (compiled, projection.py; the kernel polishes the point with 2 more and needs it converged
-        # for an exact tangent)
+        # get finer); the others from the projection on the master chord, Newton iterations until
+        # converged (compiled, projection.py: ``STEP_TOL``; 8, then on in the window up to
+        # ``MAX_ITERATIONS``; not converged: nan distance, no owner; the kernel polishes the point with
+        # 2 more and needs it converged for an exact tangent)
         segments = slot = None
         if d.segments:
             seg, slot = self._segments(e, m, kind)

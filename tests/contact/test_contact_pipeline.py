@@ -13,7 +13,7 @@ from beamsolver.contact import frames, kernel_jit, projection
 from beamsolver.contact.system import TIMED
 from beamsolver.model.buffers import REUSE_BUFFERS
 
-from helpers import kernel_pairs as _pairs
+from helpers import kernel_pairs as _pairs, projection_until_converged
 
 import rolling
 
@@ -72,7 +72,8 @@ def test_gauss_point_projection_equals_the_numpy_projection_from_the_chord():
 
 def test_gauss_point_projection_equals_the_compiled_projection_bit_for_bit():
     """``project_points`` hands its slave section to the Newton iterations (``kernel_jit._project_from``):
-    the same floats as ``kernel_jit.project`` from the same chord start."""
+    the same floats as ``kernel_jit.project`` from the same chord start, stopped at the same iteration
+    (the first update within the lanes' tolerance, ``projection_until_converged``)."""
     rng, H, kinds, A1, A2, h1, h2 = _poses(4)
     kinds = np.where(kinds == frames.POINT, frames.ORTHOGONAL, kinds)
     xi1 = rng.uniform(0.1, 0.9, len(A1))
@@ -81,9 +82,11 @@ def test_gauss_point_projection_equals_the_compiled_projection_bit_for_bit():
     rel, chord = xc - xa, xb - xa
     start = np.clip((rel[:, 0] * chord[:, 0] + rel[:, 1] * chord[:, 1] + rel[:, 2] * chord[:, 2])
                     / (chord[:, 0] ** 2 + chord[:, 1] ** 2 + chord[:, 2] ** 2), 0.0, 1.0)
-    _, x2 = kernel_jit.project(kinds, H[A1], h1, xi1, H[A2], h2, start, 8)
-    y2, _ = projection.project_points(H, kinds, A1, h1, xi1, A2, A2 + 1, h2)
+    x2, _, ok = projection_until_converged(kinds, H[A1], h1, xi1, H[A2], h2, start, 8)
+    y2, ydist = projection.project_points(H, kinds, A1, h1, xi1, A2, A2 + 1, h2)
+    assert ok.all()
     np.testing.assert_array_equal(y2, x2)
+    assert np.isfinite(ydist).all()
 
 
 def _residual(contact, H, tangent):

@@ -13,7 +13,7 @@ from beamsolver.contact import frames, kernel_jit, projection, rules, search
 from beamsolver.contact.ownership import gauss_owners
 from beamsolver.contact.search import broad_phase, element_spheres
 
-from helpers import kernel_pairs as _pairs
+from helpers import kernel_pairs as _pairs, projection_until_converged
 
 ANGLES = np.tile([1e-3, 0.1, 0.5, 0.7, 1.2, np.pi / 2, 2.5], 11)      # 77 pairs: more than one block of lanes
 
@@ -43,9 +43,11 @@ def test_element_spheres_equal_the_numpy_formula():
     np.testing.assert_array_equal(radius, 0.5 * np.sqrt(np.sum(h[el, :3] ** 2, axis=1)) + radii[el] + 0.03)
 
 
-def _gauss_reference(H, A1, h1, xg, kind, A2, B2, h2, c2, reach):
+def _gauss_reference(H, A1, h1, xg, kind, A2, B2, h2, c2, reach, cap=8):
     """The numpy steps ``gauss_projections`` replaces: every Gauss point's section, the sphere filter,
-    the chord start and the Newton iterations of the kernel (``kernel_jit.project``)."""
+    the chord start and the Newton iterations of the kernel (``kernel_jit.project``) until the update is
+    within the lanes' tolerance (``projection_until_converged``; the distance nan where not converged);
+    also the iterations taken."""
     rep, g = np.repeat(np.arange(len(A1)), len(xg)), np.tile(np.arange(len(xg)), len(A1))
     xc, _ = projection.section_points(H, A1[rep], h1[rep], xg[g])
     near = np.sum((xc - c2[rep]) ** 2, axis=1) <= reach[rep] ** 2
@@ -55,11 +57,11 @@ def _gauss_reference(H, A1, h1, xg, kind, A2, B2, h2, c2, reach):
     start = np.clip((rel[:, 0] * chord[:, 0] + rel[:, 1] * chord[:, 1] + rel[:, 2] * chord[:, 2])
                     / np.maximum(chord[:, 0] * chord[:, 0] + chord[:, 1] * chord[:, 1] + chord[:, 2] * chord[:, 2], 1e-300),
                     0.0, 1.0)
-    _, xi2 = kernel_jit.project(kind[rep], H[A1[rep]], h1[rep], xg[g], H[A2[rep]], h2[rep], start, 8)
+    xi2, its, ok = projection_until_converged(kind[rep], H[A1[rep]], h1[rep], xg[g], H[A2[rep]], h2[rep], start, cap)
     xf, _ = projection.section_points(H, A2[rep], h2[rep], xi2)
     d = xf - xc
-    dist = np.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2 + d[:, 2] ** 2)
-    return rep, g, xi2, dist, start
+    dist = np.where(ok, np.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2 + d[:, 2] ** 2), np.nan)
+    return rep, g, xi2, dist, start, its
 
 
 @pytest.mark.slow
@@ -75,6 +77,7 @@ def test_gauss_projections_equal_the_kernel_projection_bit_for_bit():
     assert 0 < len(got[0]) < len(A1) * len(xg)
     for a, b in zip(got, ref[:4]):
         np.testing.assert_array_equal(a, b)
+    assert np.isfinite(got[3]).all()
     # lanes at and above the series switch of the exponential's coefficients were taken (scalar redo)
     angle = np.abs(ref[2]) * np.linalg.norm(h2[ref[0], 3:], axis=1)
     assert (angle >= projection._SWITCH_ABC).sum() >= 3 and (angle < projection._SWITCH_ABC).sum() >= 3
@@ -84,6 +87,56 @@ def test_gauss_projections_equal_the_kernel_projection_bit_for_bit():
                                           A2[ref[0]] + 1, h2[ref[0]])
     np.testing.assert_array_equal(y2, ref[2])
     np.testing.assert_array_equal(ydist, ref[3])
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_gauss_projections_stop_once_converged_and_reject_the_unconverged(seed):
+    """Each lane stops at its first Newton update within ``projection._step_tol`` (~1e-12 of the element):
+    its ``xi2`` is that iterate of the kernel's projection (bit for bit), within the tolerance of the fixed
+    number of iterations done before (8, ``kernel_jit.project``), after far fewer.  A lane not converged
+    after the block's ``iterations`` goes on (its block), up to ``MAX_ITERATIONS`` (where its iterate is in the
+    window); one that does not converge is not accepted silently: its distance is nan (no owner takes it)."""
+    rng = np.random.default_rng(seed)
+    angles = rng.uniform(1e-3, 2.5, 70)
+    rng, H, kind, enodes, h = _poses(20 + seed, angles)
+    A1, A2 = enodes[0::2, 0], enodes[1::2, 0]
+    h1, h2 = h[0::2], h[1::2]
+    xg = np.polynomial.legendre.leggauss(5)[0] * 0.5 + 0.5
+    c2, _ = projection.section_points(H, A2, h2, np.full(len(A2), 0.5))
+    reach = np.full(len(A1), 10.0)
+    cap = projection.MAX_ITERATIONS
+    rep, g, xi2, dist, start, its = _gauss_reference(H, A1, h1, xg, kind, A2, A2 + 1, h2, c2, reach, cap)
+    args = (H, enodes, h, A1 // 2, A2 // 2, xg, kind, c2, reach)
+    got = projection.gauss_projections(*args)
+    np.testing.assert_array_equal(got[0], rep)
+    np.testing.assert_array_equal(got[2], xi2)
+    np.testing.assert_array_equal(got[3], dist)
+    ok = np.isfinite(dist)
+    assert ok.mean() > 0.95 and np.median(its) <= 4 and (its[ok] > 8).any() == (seed < 3)
+    # not converged: orthogonal projections of points far from a strongly bent master (a few, diverging or
+    # cycling), which the fixed 8 iterations accepted with a finite distance
+    assert (kind[rep][~ok] == frames.ORTHOGONAL).all() and (~ok).sum() <= 8 and (~ok).any() == (seed < 3)
+    full = kernel_jit.project(kind[rep], H[A1[rep]], h1[rep], xg[g], H[A2[rep]], h2[rep], start, 8)[1]
+    xA, u = H[A2[rep], :3, 3], h2[rep, :3]
+    tol = projection.STEP_TOL * (1 + np.linalg.norm(xA, axis=1) / np.linalg.norm(u, axis=1))
+    assert np.all(np.abs(got[2] - full)[its <= 8] <= tol[its <= 8])
+    # fewer iterations before the window check: the lanes going on give the same floats
+    short = projection.gauss_projections(*args, iterations=3)
+    assert (its > 3).sum() > 0
+    for x, y in zip(short, got):
+        np.testing.assert_array_equal(x, y)
+    # with the owners' window: a lane not converged after the lockstep and outside it stops there (nan)
+    w = projection.gauss_projections(*args, iterations=3, window=10.0)
+    after3 = kernel_jit.project(kind[rep], H[A1[rep]], h1[rep], xg[g], H[A2[rep]], h2[rep], start, 3)[1]
+    out = (its > 3) & ((after3 < -10.0 - projection.CULL_PAD) | (after3 > 11.0 + projection.CULL_PAD))
+    np.testing.assert_array_equal(w[0], rep)
+    assert out.any() == (seed < 3)
+    assert np.isnan(w[3][out]).all() and np.array_equal(w[2][~out], xi2[~out]) and np.array_equal(w[3][~out], dist[~out], equal_nan=True)
+    # project_points: the same lanes
+    y2, ydist = projection.project_points(H, kind[rep], A1[rep], h1[rep], xg[g], A2[rep], A2[rep] + 1, h2[rep],
+                                          iterations=3)
+    np.testing.assert_array_equal(y2, xi2)
+    np.testing.assert_array_equal(ydist, dist)
 
 
 def _owner_rows(rng, n_el, n_rows, n_beams):
