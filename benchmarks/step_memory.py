@@ -2,7 +2,7 @@
 
 ``python benchmarks/step_memory.py [--scene strand-61] [--hold True] [--tracemalloc]``
 
-Runs the step of ``step_parts.py`` (the scene of ``scaling_scenes``, stretched in one step, ``bs.solve(steps=1)``,
+Runs the step of ``step_parts.py`` (the scene of ``scaling_scenes``, stretched in one step, ``bs.solve(steps=1)``, or ``--steps N``, each loaded step its own phase,
 ``linsolve.LAGGED = False``, or ``--lagged auto`` (the default solver's), ``System.hold_pattern`` ``--hold``; ``strand-N``: the overlap-free strands, the whole
 step; ``19``/``37``/``61``: the bundles' first ``step_parts.BUNDLE_ITERATIONS`` iterations) with its stages wrapped:
 ``Problem.evaluate`` (with tangent / residual only), ``Problem.augmented_system`` (``K'``, ``A``),
@@ -16,6 +16,7 @@ gives, per stage, its largest peak, the resident memory ``VmRSS`` at its start t
 ``beamsolver`` for the run (before / after).  (The resets of ``VmHWM`` reset ``ru_maxrss`` too: the run's peak is the
 largest of the stages'.)  One thread (MKL pinned).  Linux only.
 """
+import math
 import os
 import sys
 from pathlib import Path
@@ -91,6 +92,8 @@ def main(argv):
     ap.add_argument("--tracemalloc", action="store_true")
     ap.add_argument("--lagged", default="off", choices=("off", "auto", "on"),
                     help="linsolve.LAGGED for the run (off: step_parts' mode, the issue-30 target's; auto: the default)")
+    ap.add_argument("--steps", type=int, default=1,
+                    help="loaded steps of the stretch (bs.solve(steps=)); with more than one, each its own phase")
     ap.add_argument("--set", action="append", default=[], metavar="MODULE.NAME=VALUE",
                     help="a knob of beamsolver for the run (A/B), e.g. model.buffers.RELEASE_AT_COMMIT=False")
     a = ap.parse_args(argv)
@@ -124,7 +127,10 @@ def main(argv):
     Problem.exact_friction = exact_friction_
 
     def on_t(t):
-        meter.phase = ("step 0" if friction[0] else "step 0, no exact friction") if t == 0.0 else "loaded step"
+        if t == 0.0:
+            meter.phase = "step 0" if friction[0] else "step 0, no exact friction"
+        else:
+            meter.phase = "loaded step" if a.steps == 1 else f"loaded step {max(1, math.ceil(t * a.steps - 1e-9))}"
 
     def ev_name(self, H, t, tangent=True):
         on_t(t)
@@ -151,7 +157,7 @@ def main(argv):
             raise _Stop
     status = "ok"
     try:
-        bs.solve(m, steps=1, verbose=False, callback=callback, min_step_ratio=ss.STEP_FLOOR)
+        bs.solve(m, steps=a.steps, verbose=False, callback=callback, min_step_ratio=ss.STEP_FLOOR)
     except _Stop:
         status = f"first {BUNDLE_ITERATIONS}"
     meter.enter("end")
@@ -170,6 +176,7 @@ def main(argv):
         head.append("traced peak (MB)")
     sets = "".join(f" --set {x}" for x in a.set)
     lag = f" --lagged {a.lagged}" if a.lagged != "off" else ""
+    lag += f" --steps {a.steps}" if a.steps != 1 else ""
     print(f"`python benchmarks/step_memory.py --scene {a.scene} --hold {a.hold}{lag}{sets}"
           f"{' --tracemalloc' if a.tracemalloc else ''}` ({machine()}; status {status}, "
           f"{sum(1 for t in calls if t > 0)} callbacks in the loaded step; peak of the run {top:.0f} MB)\n")

@@ -26,7 +26,10 @@ from ..errors import InputError
 from .frames import LINE
 from .state import check_state
 
-__all__ = ["ContactHistory", "lookup", "empty_friction"]
+__all__ = ["ContactHistory", "lookup", "empty_friction", "SHARED_STATE"]
+
+SHARED_STATE = True     # ``state()`` (``Solution.contact_state``, every step) gives the committed friction history's arrays
+#                         themselves, read-only, not copies (the 61-wire strand: 88 MB held twice through a step)
 
 
 def lookup(keys_sorted, keys):
@@ -87,6 +90,9 @@ class ContactHistory:
         self.mult_committed = self.mult
         self.mu_committed = mu
         self.friction = empty_friction() if friction is None else friction
+        if SHARED_STATE:          # replaced at the next commit, never written: ``state`` hands them out as they are
+            for v in self.friction.values():
+                v.setflags(write=False)
         self.tmult_committed = self.tmult = _no_tmult() if tmult is None else tmult
 
     def start_friction(self, mu):
@@ -215,7 +221,8 @@ class ContactHistory:
         ``prev_points``/``prev_owners``: the point pairs and Gauss-point owners of the last
         evaluation (the hysteresis of the ownership rules).  ``restore`` takes it back.
         """
-        out = {f"history.{k}": np.array(v) for k, v in self.friction.items()}
+        out = {f"history.{k}": v if SHARED_STATE and not v.flags.writeable else np.array(v)
+               for k, v in self.friction.items()}
         out["mult_keys"], out["mult_values"] = (np.array(a) for a in self.mult_committed)
         out["tmult_keys"], out["tmult_values"] = (np.array(a) for a in self.tmult_committed)
         out["prev_points"] = np.array(self.prev_points)

@@ -1511,17 +1511,19 @@ def _pair_data(f, sc, vec, par):
     return (None if f is None else f[0]), data
 
 
-def _mortar_pass(X, p, law, n_forces):
+def _mortar_pass(X, p, law, n_forces, pooled=True):
     """The mortar kernel without tangent over the points ``X`` (``mortar_forces``, ``mortar_data``): ``n_forces``
     (4: the four tractions' forces; 0: none) -> ``(f, par, sc, vec, d)``, ``d`` the point data ``S``, ``lam_n``,
-    ``n``, ``t1``, ``t2``, ``slip``, ``HL``, ``HK``, ``active``, ``xi1``, ``xi2``."""
+    ``n``, ``t1``, ``t2``, ``slip``, ``HL``, ``HK``, ``active``, ``xi1``, ``xi2``; ``pooled``: the frames in a buffer
+    of ``_FRAMES_POOL`` (else their own, freed with the last of their views)."""
     X = np.ascontiguousarray(X, dtype=float)
     P = X.shape[0]
     kind, par, has, (HCL, HFK, HLKp), _ = _table(X, p)
     kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar=True)
     f, K = np.empty((n_forces, P, 4, 6)), np.empty((4, P, 0, 0))
     sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
-    flags, frames, rows = np.empty((P, 2), dtype=np.bool_), _FRAMES_POOL.take((P, 4, 4, 4)), np.empty((P, 0, 0))
+    frames = _FRAMES_POOL.take((P, 4, 4, 4)) if pooled else np.empty((P, 4, 4, 4))
+    flags, rows = np.empty((P, 2), dtype=np.bool_), np.empty((P, 0, 0))
     kern(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows, np.zeros((1, 3)))
     n, t1, t2, s = vec[:, 0], vec[:, 1], vec[:, 2], two[:, 1]
     d = dict(S=s[:, :1] * t1 + s[:, 1:] * t2, lam_n=sc[:, 1].copy(), n=n, t1=t1, t2=t2, slip=s.copy(),
@@ -1542,14 +1544,15 @@ def mortar_forces(X, p, law=None, pairs=False):
     return d
 
 
-def mortar_data(X, p, law=None):
+def mortar_data(X, p, law=None, pooled=True):
     """``mortar_forces``' point data without its forces (a commit's: ``ContactSystem.commit`` stores frames, slips and
     the groups' state, no force): ``S``, ``lam_n``, ``n``, ``t1``, ``t2``, ``slip``, ``HL``, ``HK``, ``active``,
     ``xi1``, ``xi2`` and ``d["pairs"]``' point data (``gap``, ``lam_n``, ``n``, ``t1``, ``t2``, ``xC``, ``xF``, ``xi1``,
     ``xi2``, ``F_slave``), the same bits as ``mortar_forces(pairs=True)``'s: the mortar kernel with an empty ``f``
     (the geometry, projection, normal law, slip and frames of each point; not the four tractions' wrenches and nodal
-    forces, nor the Jacobians they take)."""
-    _, par, sc, vec, d = _mortar_pass(X, p, law, 0)
+    forces, nor the Jacobians they take).  ``pooled``: ``_mortar_pass``'s (the commit's every point: its own frames,
+    not a pool buffer kept through the next step)."""
+    _, par, sc, vec, d = _mortar_pass(X, p, law, 0, pooled)
     d["pairs"] = _pair_data(None, sc, vec, par)
     return d
 

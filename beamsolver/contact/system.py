@@ -88,6 +88,10 @@ HOLD_BAND = float(np.radians(5.0))   # ... remembered from pairs this close to l
 CHAIN_GROUPS = True      # exact stick: a mortar group is a slave node against a master chain, not a master beam
 LIGHT_COMMIT = True      # exact stick: commit's pass computes the point data and groups' state alone, not the forces
 #                          (``ContactSystem._commit_mortar``; False: the evaluation without tangent, as before)
+LEAN_COMMIT = True       # commit holds every point's data no longer than it needs it: the last step's (``_last``) goes
+#                          before the pass, the pass's frames (``HL``, ``HK``: ``mortar_data``'s own buffer, not the
+#                          pool's) and its ``_cache`` once the history took them, the section poses once ``results``
+#                          read them (the 61-wire strand's second step: ~0.3 GB of the first's commit held through it)
 SKIP_OPEN = True         # exact stick: Newton's evaluations leave out the points of certainly open groups (``_open_points``)
 SKIP_MARGIN = 1e-2       # ... whose gap exceeds the normal law's band by SKIP_MARGIN (R1 + R2) at least
 SKIP_MIN = 64            # ... when at least this many points are that far (fewer: the test costs what it saves; the main
@@ -987,8 +991,8 @@ class ContactSystem(Contribution):
         idx = np.arange(n)
         # the groups without their members and slots (kept so: the next evaluation of these pairs builds those)
         G, gdecl, R, Lam, eps, mu, law, RL, T_pts = self._group_state(H, P, sel, p, True, full=False)
-        d = kernel_jit.mortar_data(H[P.nodes[sel]], p, law)   # (its poses not held past it: 0.1 GB at the
-        #                                                          61-wire strand's commit)
+        d = kernel_jit.mortar_data(H[P.nodes[sel]], p, law, pooled=not LEAN_COMMIT)   # (its poses not held past it:
+        #                                                          0.1 GB at the 61-wire strand's commit)
         for k in HISTORY_FRAMES:    # the kernel's alone: not kept with ``p`` (``_cache``, ``_last``; 79 MB there)
             p.pop(k, None)
         out.update(d.pop("pairs")[1], active=d["active"], lam_t=np.zeros((n, 2)), stick=np.ones(n, dtype=bool),
@@ -1581,6 +1585,8 @@ class ContactSystem(Contribution):
     def commit(self, H):
         """Store friction history and multipliers of the converged state (``ContactHistory.commit``)."""
         self._blocks = None
+        if LEAN_COMMIT:       # the last step's point data (its table is the Solution's): not held through this pass
+            self._last = None
         P, sel, po = self._state(H, commit=True)
         if P is None or len(sel) == 0:
             self.history.commit(self._decl_mu)
@@ -1603,6 +1609,12 @@ class ContactSystem(Contribution):
                         e=P.e[sel][order], m=P.m[sel][order], xi1=out["xi1"][order],
                         xi2=out["xi2"][order], lam_t=lam_vec[order])
         self.history.commit(self._decl_mu, friction, tmult)
+        if LEAN_COMMIT:       # the frames are the history's now (``results`` reads none); nothing evaluates at ``H``
+            out.pop("HL", None)       # before the next ``begin_step``, whose evaluations make their own ``_cache``
+            out.pop("HK", None)
+            self._cache = None
+        if LEAN_COMMIT:       # of every point's kernel parameters ``results`` reads five
+            p = {k: p[k] for k in _RESULTS_PARAMS}
         self._last = (P, sel, p, out, (np.array(H), HC, HF))
         self._commits = [] if tmult is None else (self._commits + [(self._t_step, tmult)])[-2:]
         self._slide_c = None if m is None else self._sliding_c(m)
@@ -1652,8 +1664,10 @@ class ContactSystem(Contribution):
         w = p["weight"]
         lam_t = out["lam_t"]
         ft = (w * lam_t[:, 0])[:, None] * out["t1"] + (w * lam_t[:, 1])[:, None] * out["t2"]
-        if not np.array_equal(H_c, H):        # the section poses of commit are those at its poses
+        if HC is None or not np.array_equal(H_c, H):   # the section poses of commit are those at its poses
             HC, HF = self._pose_at(H, P.e[sel], out["xi1"]), self._pose_at(H, P.m[sel], out["xi2"])
+        elif LEAN_COMMIT:                     # read once (``Problem.commit``): not held through the next step
+            self._last = (P, sel, p, out, (H_c, None, None))
         e1s, e1m = HC[:, :3, 0], HF[:, :3, 0]
         ang = np.degrees(np.arccos(np.clip(np.abs(np.sum(e1s * e1m, axis=1)), 0.0, 1.0)))
         active = out["lam_n"] > 0
@@ -1663,7 +1677,11 @@ class ContactSystem(Contribution):
                     gap=out["gap"], normal_force=w * out["lam_n"], tangential_force=ft,
                     stick=stick, status=status, slip_increment=out["slip"], kind=p["kind"],
                     angle=ang, slave_element=P.e[sel], master_element=P.m[sel],
-                    xi1=out["xi1"], xi2=out["xi2"], weight=w, normal=out["n"])
+                    xi1=out["xi1"], xi2=out["xi2"], weight=w, normal=np.array(out["n"]))   # (a copy: the Solution
+        #                                                           keeps it, not the kernel's (P, 6, 3) vectors)
+
+
+_RESULTS_PARAMS = ("weight", "R1", "R2", "mu", "kind")     # the kernel parameters ``ContactSystem.results`` reads
 
 
 def _frames(out):

@@ -93,6 +93,9 @@ LAG_FLOPS_PER_ENTRY = 20.0     # "auto": a GMRES iteration costs a re-factorisat
 LAG_ANALYSIS_ITERATIONS = 16   # "auto": PARDISO's symbolic analysis costs this many GMRES iterations
 LAG_MAX_BACKOFF = 8            # failed lagged solves in a row: 0, 1, 2, 4, .. this many fresh factorisations between tries
 LAG_REFRESH_SHARE = 0.5        # a lagged solve over this share of its budget: the next tangent is factorised afresh
+DROP_BASE_AT_COMMIT = True     # the stepping drops the lagged solves' base at every accepted step (``Solver.drop_base``:
+#                                PARDISO's numerical factor not held through the commit and the next step's first
+#                                evaluations; that step's first tangent is then factorised afresh, not lagged)
 
 
 class SingularMatrixError(RuntimeError):
@@ -311,6 +314,12 @@ class Solver:
             self.stats["lag_failures"] += 1
             self._skip, self._backoff = self._backoff, min(max(2 * self._backoff, 1), LAG_MAX_BACKOFF)
         self._refresh = iterations > LAG_REFRESH_SHARE * budget
+
+    def drop_base(self):
+        """Let the lagged solves' base go (PARDISO frees its numerical factor, ``FREE_DROPPED``, the analysis kept):
+        the next ``factorize`` is fresh."""
+        self._base = None
+        self._refresh = True
 
     def _factorize(self, K, saddle=False):
         self.stats["factorizations"] += 1

@@ -30,6 +30,7 @@ import numpy as np
 
 from . import branching, diagnosis, kinks, stability, stable_branch
 from ..model import buffers, motion_path
+from ..nonlinear import linsolve
 from ..errors import ConvergenceError, InputError, StabilityWarning, StabilizationWarning
 from ..failures import AugmentationFailed, LeftStableBranch, MotionTooFast, NonFinite, StepFailed
 from .progress import Progress
@@ -490,6 +491,9 @@ class Run:
             if stab.settle and not balance["equilibrium"] and t_next >= self.grid[-1] - 1e-12 * self.dt_user:
                 H, ev, balance = self._settle(stab, t_next, H, ev, stats, balance)
         t_next, H, ev = self._stability(stats, t_next, H, ev)
+        solver = getattr(self.newton, "linsolver", None)
+        if linsolve.DROP_BASE_AT_COMMIT and solver is not None:
+            solver.drop_base()
         record = problem.commit(H)
         if stab is not None:
             stats["stabilization"] = dict(stab.record(damped, t_next), **balance)

@@ -129,3 +129,57 @@ def test_release_at_commit_gives_the_same_bits(monkeypatch, scene):
     released = _bits(run())
     assert len(calls) >= 4 and (sum(calls) > 0 or not REUSE_BUFFERS)
     assert released == kept
+
+
+@pytest.mark.parametrize("scene", ["twisted_pair", "shear_lag"])
+def test_lean_commit_gives_the_same_bits_and_holds_no_point_data_past_it(monkeypatch, scene):
+    """Issue 30, the 61-wire strand in two steps: ``system.LEAN_COMMIT`` (the last step's point data let go before the
+    commit's pass, its frames, ``_cache``, section poses and the kernel parameters ``results`` does not read after
+    it), ``history.SHARED_STATE`` (``Solution.contact_state``: the history's own arrays, read-only, not copies) and
+    ``linsolve.DROP_BASE_AT_COMMIT`` (the lagged solves' base let go at every accepted step): the twisted pair
+    (exact stick, the augmented path, 4 steps) and the shear lag (exact stick, 4 steps) give the same iterations,
+    poses, contact tables, nodal multipliers and contact state, bit for bit, as with all three off; and with them on,
+    after every step the contact system holds no frames nor ``_cache``, five kernel parameters, no section poses
+    once the table is read, and the state's history is the history's, read-only."""
+    from beamsolver.contact import history, system
+    from beamsolver.nonlinear import linsolve
+    if scene == "twisted_pair":
+        import twisted_pair as ex
+        run = lambda: ex.main(steps=4, turns=1.0, n_elements=32, check_stability=False)[0]   # noqa: E731
+    else:
+        import shear_lag as ex
+        run = lambda: ex.main(n_wire=20)[0]      # noqa: E731
+
+    def state_bits(sol):
+        return [k + np.asarray(v).tobytes().hex() for k, v in sorted(sol.contact_state.items())]
+    knobs = ((system, "LEAN_COMMIT"), (history, "SHARED_STATE"), (linsolve, "DROP_BASE_AT_COMMIT"))
+    for mod, name in knobs:
+        monkeypatch.setattr(mod, name, False)
+    sol = run()
+    kept = _bits(sol) + state_bits(sol)
+    for mod, name in knobs:
+        monkeypatch.setattr(mod, name, True)
+    seen, drops = [], []
+    commit, results, drop = system.ContactSystem.commit, system.ContactSystem.results, linsolve.Solver.drop_base
+
+    def commit_(self, H):
+        commit(self, H)
+        P, sel, p, out, _ = self._last
+        seen.append((self, "HL" not in out and "HK" not in out and self._cache is None and sorted(p) ==
+                     sorted(system._RESULTS_PARAMS)))
+
+    def results_(self, H):
+        table = results(self, H)
+        seen.append((self, self._last is None or self._last[4][1] is None))
+        return table
+    monkeypatch.setattr(system.ContactSystem, "commit", commit_)
+    monkeypatch.setattr(system.ContactSystem, "results", results_)
+    monkeypatch.setattr(linsolve.Solver, "drop_base", lambda self: (drops.append(1), drop(self))[1])
+    sol = run()
+    assert _bits(sol) + state_bits(sol) == kept
+    assert len(seen) >= 8 and all(ok for _, ok in seen) and len(drops) >= 4
+    cs = seen[-1][0]
+    state = cs.get_state()
+    for k, v in cs.history.friction.items():
+        assert state[f"history.{k}"] is v and not v.flags.writeable
+    assert len(cs.history.friction["key"]) > 0

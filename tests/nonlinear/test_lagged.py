@@ -209,3 +209,28 @@ def test_a_factor_of_another_kind_does_not_precondition():
     assert not isinstance(s.factorize(perturbed(A, 3e-4)), lagged.LaggedFactor)
     assert s.stats["factorizations"] == 3 and s.stats["lagged"] == 1
     s.close()
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_a_dropped_base_is_let_go_and_the_next_matrix_factorised_afresh(backend):
+    """``Solver.drop_base`` (the stepping's, at every accepted step: ``DROP_BASE_AT_COMMIT``): the base is no longer
+    referenced (PARDISO frees its numerical factor), the next matrix, near the old base's, is factorised afresh
+    (its solve exact), and that factor preconditions the one after."""
+    import gc
+    import weakref
+    A = matrix()
+    b = np.ones(A.shape[0])
+    s = linsolve.Solver(backend, lagged=True)
+    s.factorize(A).solve(b)
+    base = weakref.ref(s._base)
+    s.drop_base()
+    gc.collect()
+    assert base() is None
+    B = perturbed(A, 1e-4)
+    f = s.factorize(B)
+    assert not isinstance(f, lagged.LaggedFactor) and s.stats["factorizations"] == 2
+    assert_close(f.solve(b), np.linalg.solve(B.toarray(), b), 1e-10)
+    g = s.factorize(perturbed(B, 1e-4))
+    g.solve(b)
+    assert isinstance(g, lagged.LaggedFactor) and g.direct is None and s.stats["factorizations"] == 2
+    s.close()
