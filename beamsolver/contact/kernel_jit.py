@@ -1416,6 +1416,7 @@ MORTAR_CHUNK = 2048              # points per pass of ``mortar_terms`` with a ``
 _CHUNK_POOL = BufferPool()       # the passes' tangent and gradient rows (``MORTAR_CHUNK`` points: 14 MB)
 _CHUNK_ROWS_POOL = BufferPool()
 _CHUNK4_POOL = BufferPool()      # the four tractions' tangents of a pass (``mortar_terms(sink=)`` without ``T``: 38 MB)
+COMMIT_CHUNK = 8192              # points per pass of ``mortar_data_of`` (a commit's: their poses and four frames, 8 MB)
 
 
 def mortar_terms(X, p, law=None, T=None, whole=False, pairs=False, sink=None):
@@ -1511,19 +1512,17 @@ def _pair_data(f, sc, vec, par):
     return (None if f is None else f[0]), data
 
 
-def _mortar_pass(X, p, law, n_forces, pooled=True):
+def _mortar_pass(X, p, law, n_forces):
     """The mortar kernel without tangent over the points ``X`` (``mortar_forces``, ``mortar_data``): ``n_forces``
     (4: the four tractions' forces; 0: none) -> ``(f, par, sc, vec, d)``, ``d`` the point data ``S``, ``lam_n``,
-    ``n``, ``t1``, ``t2``, ``slip``, ``HL``, ``HK``, ``active``, ``xi1``, ``xi2``; ``pooled``: the frames in a buffer
-    of ``_FRAMES_POOL`` (else their own, freed with the last of their views)."""
+    ``n``, ``t1``, ``t2``, ``slip``, ``HL``, ``HK``, ``active``, ``xi1``, ``xi2``."""
     X = np.ascontiguousarray(X, dtype=float)
     P = X.shape[0]
     kind, par, has, (HCL, HFK, HLKp), _ = _table(X, p)
     kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar=True)
     f, K = np.empty((n_forces, P, 4, 6)), np.empty((4, P, 0, 0))
     sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
-    frames = _FRAMES_POOL.take((P, 4, 4, 4)) if pooled else np.empty((P, 4, 4, 4))
-    flags, rows = np.empty((P, 2), dtype=np.bool_), np.empty((P, 0, 0))
+    flags, frames, rows = np.empty((P, 2), dtype=np.bool_), _FRAMES_POOL.take((P, 4, 4, 4)), np.empty((P, 0, 0))
     kern(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows, np.zeros((1, 3)))
     n, t1, t2, s = vec[:, 0], vec[:, 1], vec[:, 2], two[:, 1]
     d = dict(S=s[:, :1] * t1 + s[:, 1:] * t2, lam_n=sc[:, 1].copy(), n=n, t1=t1, t2=t2, slip=s.copy(),
@@ -1544,15 +1543,39 @@ def mortar_forces(X, p, law=None, pairs=False):
     return d
 
 
-def mortar_data(X, p, law=None, pooled=True):
+def mortar_data_of(H, nodes, p, law=None, chunk=None):
+    """``mortar_data(H[nodes], p, law)``, the same bits, over ``COMMIT_CHUNK`` (``chunk``) points at a time: a pass's
+    points' poses gathered for it alone, and of the kernel's four frames of a point ``HL`` and ``HK`` kept ``(P, 2, 4,
+    4)`` (a commit's every point: 206 304 on the 61-wire strand, whose ``H[nodes]`` and four frames are 0.1 GB each)."""
+    P = len(nodes)
+    C = max(1, min(P, COMMIT_CHUNK if chunk is None else chunk))
+    kind, par, has, (HCL, HFK, HLKp), _ = _table(nodes, p)
+    kern = make_kernel(PENALTY_COULOMB if law is None else law, mortar=True)
+    sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
+    flags, HLK, frames = np.empty((P, 2), dtype=np.bool_), np.empty((P, 2, 4, 4)), np.empty((C, 4, 4, 4))
+    for a in range(0, P, C):
+        b = min(a + C, P)
+        n = b - a
+        X = np.ascontiguousarray(H[nodes[a:b]], dtype=float)
+        kern(X, kind[a:b], par[a:b], has[a:b], HCL[a:b], HFK[a:b], HLKp[a:b], np.empty((0, n, 4, 6)),
+             np.empty((4, n, 0, 0)), sc[a:b], vec[a:b], two[a:b], flags[a:b], frames[:n], np.empty((n, 0, 0)),
+             np.zeros((1, 3)))
+        HLK[a:b] = frames[:n, :2]
+    n, t1, t2, s = vec[:, 0], vec[:, 1], vec[:, 2], two[:, 1]
+    d = dict(S=s[:, :1] * t1 + s[:, 1:] * t2, lam_n=sc[:, 1].copy(), n=n, t1=t1, t2=t2, slip=s.copy(),
+             HL=HLK[:, 0], HK=HLK[:, 1], active=flags[:, 0].copy(), xi1=sc[:, 2].copy(), xi2=sc[:, 3].copy())
+    d["pairs"] = _pair_data(None, sc, vec, par)
+    return d
+
+
+def mortar_data(X, p, law=None):
     """``mortar_forces``' point data without its forces (a commit's: ``ContactSystem.commit`` stores frames, slips and
     the groups' state, no force): ``S``, ``lam_n``, ``n``, ``t1``, ``t2``, ``slip``, ``HL``, ``HK``, ``active``,
     ``xi1``, ``xi2`` and ``d["pairs"]``' point data (``gap``, ``lam_n``, ``n``, ``t1``, ``t2``, ``xC``, ``xF``, ``xi1``,
     ``xi2``, ``F_slave``), the same bits as ``mortar_forces(pairs=True)``'s: the mortar kernel with an empty ``f``
     (the geometry, projection, normal law, slip and frames of each point; not the four tractions' wrenches and nodal
-    forces, nor the Jacobians they take).  ``pooled``: ``_mortar_pass``'s (the commit's every point: its own frames,
-    not a pool buffer kept through the next step)."""
-    _, par, sc, vec, d = _mortar_pass(X, p, law, 0, pooled)
+    forces, nor the Jacobians they take)."""
+    _, par, sc, vec, d = _mortar_pass(X, p, law, 0)
     d["pairs"] = _pair_data(None, sc, vec, par)
     return d
 

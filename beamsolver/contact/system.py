@@ -89,8 +89,9 @@ CHAIN_GROUPS = True      # exact stick: a mortar group is a slave node against a
 LIGHT_COMMIT = True      # exact stick: commit's pass computes the point data and groups' state alone, not the forces
 #                          (``ContactSystem._commit_mortar``; False: the evaluation without tangent, as before)
 LEAN_COMMIT = True       # commit holds every point's data no longer than it needs it: the last step's (``_last``) goes
-#                          before the pass, the pass's frames (``HL``, ``HK``: ``mortar_data``'s own buffer, not the
-#                          pool's) and its ``_cache`` once the history took them, the section poses once ``results``
+#                          before the pass, which runs in chunks (``kernel_jit.mortar_data_of``: a chunk's poses,
+#                          ``HL`` and ``HK`` in their own buffer, not the pool's), its frames and ``_cache`` once the
+#                          history took them, the section poses once ``results``
 #                          read them (the 61-wire strand's second step: ~0.3 GB of the first's commit held through it)
 SKIP_OPEN = True         # exact stick: Newton's evaluations leave out the points of certainly open groups (``_open_points``)
 SKIP_MARGIN = 1e-2       # ... whose gap exceeds the normal law's band by SKIP_MARGIN (R1 + R2) at least
@@ -991,8 +992,11 @@ class ContactSystem(Contribution):
         idx = np.arange(n)
         # the groups without their members and slots (kept so: the next evaluation of these pairs builds those)
         G, gdecl, R, Lam, eps, mu, law, RL, T_pts = self._group_state(H, P, sel, p, True, full=False)
-        d = kernel_jit.mortar_data(H[P.nodes[sel]], p, law, pooled=not LEAN_COMMIT)   # (its poses not held past it:
-        #                                                          0.1 GB at the 61-wire strand's commit)
+        if LEAN_COMMIT:       # a pass's poses, two frames of a point kept (0.1 GB each at the 61-wire strand's commit)
+            d = kernel_jit.mortar_data_of(H, P.nodes[sel], p, law)
+        else:
+            d = kernel_jit.mortar_data(H[P.nodes[sel]], p, law)   # (its poses not held past it: 0.1 GB at the
+        #                                                          61-wire strand's commit)
         for k in HISTORY_FRAMES:    # the kernel's alone: not kept with ``p`` (``_cache``, ``_last``; 79 MB there)
             p.pop(k, None)
         out.update(d.pop("pairs")[1], active=d["active"], lam_t=np.zeros((n, 2)), stick=np.ones(n, dtype=bool),

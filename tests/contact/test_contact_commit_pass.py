@@ -75,24 +75,25 @@ def test_commit_stores_the_same_bits_as_the_full_pass(monkeypatch):
 
 
 def test_commit_runs_no_force_pass(monkeypatch):
-    """The commits call the mortar kernel for point data only (``mortar_data``, every active point once), no
-    kernel that computes forces (``mortar_forces``, ``mortar_terms``, the pairs' kernels); Newton's evaluations
-    took fewer points (the open groups' left out), the commit all of them."""
+    """The commits call the mortar kernel for point data only (``mortar_data``, or chunk by chunk ``mortar_data_of``
+    with ``LEAN_COMMIT``: every active point once), no kernel that computes forces (``mortar_forces``,
+    ``mortar_terms``, the pairs' kernels); Newton's evaluations took fewer points (the open groups' left out), the
+    commit all of them."""
     inside, calls = [], []
-    names = ("mortar_forces", "mortar_terms", "contact_kernel", "kernel_and_tangent", "mortar_data")
+    names = ("mortar_forces", "mortar_terms", "contact_kernel", "kernel_and_tangent", "mortar_data", "mortar_data_of")
     for name in names:
         f = getattr(kernel_jit, name, None)
         if f is None:
             continue
 
         def counted(X, *args, _f=f, _name=name, **kw):
-            calls.append((_name, inside[-1] if inside else None, len(X)))
+            calls.append((_name, inside[-1] if inside else None, len(args[0] if _name == "mortar_data_of" else X)))
             return _f(X, *args, **kw)
         monkeypatch.setattr(kernel_jit, name, counted)
     _, records = _solve(monkeypatch, True, inside)
     # the loaded steps' commits (step 0's commits the state before friction acts: the pairs' kernel)
     at_commit = [c for c in calls if c[1] is not None and c[1] >= 1]
-    assert [c for c in at_commit if c[0] != "mortar_data"] == []
+    assert [c for c in at_commit if c[0] != ("mortar_data_of" if csys.LEAN_COMMIT else "mortar_data")] == []
     sizes = [len(r[1]["gap"]) for r in records[1:]]
     assert [c[2] for c in at_commit] == sizes
     evaluated = max(c[2] for c in calls if c[1] is None and c[0] in ("mortar_forces", "mortar_terms"))
@@ -140,3 +141,26 @@ def test_groups_kept_without_members_build_them_when_asked():
     for k in ref:
         assert _bits(ref[k], out[k]), k
     assert sorted(keep(*args, full=False)) == sorted(ref) and keep.builds == 2       # the full build serves both
+
+
+@pytest.mark.parametrize("chunk", [1, 7, None, 1 << 20])
+def test_mortar_data_of_chunks_is_mortar_data(monkeypatch, chunk):
+    """``kernel_jit.mortar_data_of(H, nodes, p, chunk=)`` (the commit's pass, ``system.LEAN_COMMIT``: the points'
+    poses gathered chunk by chunk, ``HL`` and ``HK`` kept of the kernel's four frames): ``mortar_data(H[nodes], p)``,
+    the same bits, for chunks of 1, 7, ``COMMIT_CHUNK`` and more than every point."""
+    _, records = _solve(monkeypatch, True)
+    X, p = records[-1][3]
+    p = dict(p, has_history=p["has_history"] & (np.arange(len(X)) % 3 > 0))
+    rng = np.random.default_rng(5)
+    order = rng.permutation(4 * len(X))                     # the poses of every node, shuffled
+    H = np.empty((4 * len(X), 4, 4))
+    H[order] = X.reshape(-1, 4, 4)
+    nodes = order.reshape(-1, 4)
+    d0, d1 = kernel_jit.mortar_data(X, p), kernel_jit.mortar_data_of(H, nodes, p, chunk=chunk)
+    (_, pair0), (_, pair1) = d0.pop("pairs"), d1.pop("pairs")
+    assert sorted(d0) == sorted(d1) and sorted(pair0) == sorted(pair1)
+    for k in d1:
+        assert _bits(d0[k], d1[k]), k
+    for k in pair1:
+        assert _bits(pair0[k], pair1[k]), k
+    assert d1["HL"].base.shape == (len(X), 2, 4, 4)
