@@ -51,6 +51,19 @@ def _pressed(problem, slave, depth):
     return H
 
 
+def _updates_committed(n_slave=4, **options):
+    """``_parallel(0.05, **options)`` pressed ``2e-3 R`` with the multiplier updates (``newton_multipliers`` off) and
+    committed at t = 0: ``(problem, slave, H)``."""
+    model, slave, _ = _parallel(0.05, n_slave=n_slave, **options)
+    problem = Problem.from_model(model, check_rigid_modes=False)
+    c = problem.contact
+    c.newton_multipliers = False
+    H = _pressed(problem, slave, 2e-3 * R)
+    c.begin_step(H, 0.0)
+    c.commit(H)
+    return problem, slave, H
+
+
 def _committed(model, slave, turned=False):
     """``(problem, H)``: ``model``'s slave pressed into its master (``_pressed``), the contact's step begun and
     committed there (``turned``: the committed multipliers replaced by random ones)."""
@@ -144,13 +157,8 @@ def test_exact_stick_updates_tangent_matches_finite_differences(integration):
     sliding groups against central differences of the residual; with segments the moving ends' terms
     of the nodal sums (``segment_tangent.mortar_end_terms``): measured 2.2e-9 (points 2.2e-9; without
     the terms 5.4e-7)."""
-    model, slave, master = _parallel(0.05, integration=integration, penalty_t=1e7)
-    problem = Problem.from_model(model, check_rigid_modes=False)
+    problem, slave, H = _updates_committed(integration=integration, penalty_t=1e7)
     c = problem.contact
-    c.newton_multipliers = False
-    H = _pressed(problem, slave, 2e-3 * R)
-    c.begin_step(H, 0.0)
-    c.commit(H)
     slide = 2e-3 * R
     H = _move(H, slave.nodes, se3.exp(np.array([slide, slide, 0.0, slide, 0.0, 0.5 * slide])))
     ev = problem.evaluate(H, 0.0, tangent=True)

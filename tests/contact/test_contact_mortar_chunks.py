@@ -8,14 +8,14 @@ import pytest
 from beamsolver import se3
 from beamsolver.contact import kernel_jit, system as csys
 from beamsolver.nonlinear.problem import Problem
-from test_contact_exact_stick import R, _move, _parallel, _pressed
+from test_contact_exact_stick import R, _move, _parallel, _pressed, _updates_committed
 
 TERMS = kernel_jit.mortar_terms
 
 
-def _evaluated(monkeypatch, chunked, chunk):
-    """The pressed, slid slave of ``_parallel`` evaluated with the tangent and its augmented Newton matrix:
-    ``(residual, tangent values, A's values, multiplier blocks, passes)``, ``passes`` the ``(a, b)`` the sink got."""
+def _spied(monkeypatch, chunked, chunk, shapes=False):
+    """``CHUNKED`` and ``MORTAR_CHUNK`` set, ``kernel_jit.mortar_terms`` spied on: the list the passes its sink gets
+    are appended to, ``(a, b, len)`` (and the values' shape with ``shapes``)."""
     monkeypatch.setattr(csys, "CHUNKED", chunked)
     monkeypatch.setattr(kernel_jit, "MORTAR_CHUNK", chunk)
     passes = []
@@ -24,11 +24,18 @@ def _evaluated(monkeypatch, chunked, chunk):
     def spy(*a, sink=None, **k):
         if sink is not None:
             def counted(a0, b0, vals, _sink=sink):
-                passes.append((a0, b0, len(vals)))
+                passes.append((a0, b0, len(vals)) + ((vals.shape,) if shapes else ()))
                 _sink(a0, b0, vals)
             return terms(*a, sink=counted, **k)
         return terms(*a, **k)
     monkeypatch.setattr(kernel_jit, "mortar_terms", spy)
+    return passes
+
+
+def _evaluated(monkeypatch, chunked, chunk):
+    """The pressed, slid slave of ``_parallel`` evaluated with the tangent and its augmented Newton matrix:
+    ``(residual, tangent values, A's values, multiplier blocks, passes)``, ``passes`` the ``(a, b)`` the sink got."""
+    passes = _spied(monkeypatch, chunked, chunk)
     model, slave, _ = _parallel(0.5, n_slave=8)
     problem = Problem.from_model(model, check_rigid_modes=False)
     H = _pressed(problem, slave, 2e-3 * R)
@@ -62,26 +69,9 @@ def _updates(monkeypatch, chunked, chunk):
     """The slid slave of ``_parallel`` (sliding and sticking groups) evaluated with the tangent by the multiplier
     updates (``newton_multipliers`` off: step 0's first attempt, the four tractions' tangents): ``(residual,
     tangent values, passes)``, ``passes`` the ``(a, b, len)`` the sink got."""
-    monkeypatch.setattr(csys, "CHUNKED", chunked)
-    monkeypatch.setattr(kernel_jit, "MORTAR_CHUNK", chunk)
-    passes = []
-    terms = TERMS
-
-    def spy(*a, sink=None, **k):
-        if sink is not None:
-            def counted(a0, b0, vals, _sink=sink):
-                passes.append((a0, b0, len(vals), vals.shape))
-                _sink(a0, b0, vals)
-            return terms(*a, sink=counted, **k)
-        return terms(*a, **k)
-    monkeypatch.setattr(kernel_jit, "mortar_terms", spy)
-    model, slave, _ = _parallel(0.05, n_slave=8, penalty_t=1e7)
-    problem = Problem.from_model(model, check_rigid_modes=False)
+    passes = _spied(monkeypatch, chunked, chunk, shapes=True)
+    problem, slave, H = _updates_committed(n_slave=8, penalty_t=1e7)
     c = problem.contact
-    c.newton_multipliers = False
-    H = _pressed(problem, slave, 2e-3 * R)
-    c.begin_step(H, 0.0)
-    c.commit(H)
     slide = 8e-5 * R                       # (the groups of the deeper end stick, the others slide)
     H = _move(H, slave.nodes, se3.exp(np.array([slide, slide, 0.0, slide, 0.0, 0.5 * slide])))
     ev = problem.evaluate(H, 0.0, tangent=True)
