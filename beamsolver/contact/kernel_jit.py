@@ -1524,10 +1524,15 @@ def _mortar_pass(X, p, law, n_forces):
     sc, vec, two = np.empty((P, 4)), np.empty((P, 6, 3)), np.empty((P, 2, 2))
     flags, frames, rows = np.empty((P, 2), dtype=np.bool_), _FRAMES_POOL.take((P, 4, 4, 4)), np.empty((P, 0, 0))
     kern(X, kind, par, has, HCL, HFK, HLKp, f, K, sc, vec, two, flags, frames, rows, np.zeros((1, 3)))
+    return f, par, sc, vec, _point_dict(sc, vec, two, flags, frames[:, 0], frames[:, 1])
+
+
+def _point_dict(sc, vec, two, flags, HL, HK):
+    """The point data of a mortar kernel pass without tangent (its ``sc``, ``vec``, ``two``, ``flags`` and frames
+    ``HL``, ``HK``): ``S``, ``lam_n``, ``n``, ``t1``, ``t2``, ``slip``, ``HL``, ``HK``, ``active``, ``xi1``, ``xi2``."""
     n, t1, t2, s = vec[:, 0], vec[:, 1], vec[:, 2], two[:, 1]
-    d = dict(S=s[:, :1] * t1 + s[:, 1:] * t2, lam_n=sc[:, 1].copy(), n=n, t1=t1, t2=t2, slip=s.copy(),
-             HL=frames[:, 0], HK=frames[:, 1], active=flags[:, 0].copy(), xi1=sc[:, 2].copy(), xi2=sc[:, 3].copy())
-    return f, par, sc, vec, d
+    return dict(S=s[:, :1] * t1 + s[:, 1:] * t2, lam_n=sc[:, 1].copy(), n=n, t1=t1, t2=t2, slip=s.copy(),
+                HL=HL, HK=HK, active=flags[:, 0].copy(), xi1=sc[:, 2].copy(), xi2=sc[:, 3].copy())
 
 
 def mortar_forces(X, p, law=None, pairs=False):
@@ -1561,9 +1566,7 @@ def mortar_data_of(H, nodes, p, law=None, chunk=None):
              np.empty((4, n, 0, 0)), sc[a:b], vec[a:b], two[a:b], flags[a:b], frames[:n], np.empty((n, 0, 0)),
              np.zeros((1, 3)))
         HLK[a:b] = frames[:n, :2]
-    n, t1, t2, s = vec[:, 0], vec[:, 1], vec[:, 2], two[:, 1]
-    d = dict(S=s[:, :1] * t1 + s[:, 1:] * t2, lam_n=sc[:, 1].copy(), n=n, t1=t1, t2=t2, slip=s.copy(),
-             HL=HLK[:, 0], HK=HLK[:, 1], active=flags[:, 0].copy(), xi1=sc[:, 2].copy(), xi2=sc[:, 3].copy())
+    d = _point_dict(sc, vec, two, flags, HLK[:, 0], HLK[:, 1])
     d["pairs"] = _pair_data(None, sc, vec, par)
     return d
 

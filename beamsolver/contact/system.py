@@ -1018,7 +1018,7 @@ class ContactSystem(Contribution):
         n_nodes = len(H)
         nodes = P.nodes[rows]
         G = self._groups(nodes[:, :2], p["xi1"], self.el_master[P.m[rows]], P.decl[rows], nodes, n_nodes,
-                         self.n_beams, self._held_slip(nodes), **({} if full else dict(full=False)))
+                         self.n_beams, self._held_slip(nodes), full=full)
         gdecl = G["key"] // (np.int64(n_nodes) * self.n_beams)
         R = H[G["node"], :3, :3]
         Lam = self.iterate_multipliers(G["key"]) if ssn else self.history.tangential_multipliers(G["key"])
@@ -1617,8 +1617,7 @@ class ContactSystem(Contribution):
             out.pop("HL", None)       # before the next ``begin_step``, whose evaluations make their own ``_cache``
             out.pop("HK", None)
             self._cache = None
-        if LEAN_COMMIT:       # of every point's kernel parameters ``results`` reads five
-            p = {k: p[k] for k in _RESULTS_PARAMS}
+            p = {k: p[k] for k in _RESULTS_PARAMS}    # of every point's kernel parameters ``results`` reads five
         self._last = (P, sel, p, out, (np.array(H), HC, HF))
         self._commits = [] if tmult is None else (self._commits + [(self._t_step, tmult)])[-2:]
         self._slide_c = None if m is None else self._sliding_c(m)
