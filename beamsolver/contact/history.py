@@ -176,6 +176,13 @@ class ContactHistory:
             self.cross_keys, self.cross_values = k[order], v[order]
         return cross
 
+    def kept_kinds(self, decl, e, m):
+        """The kinds ``step_kinds`` keeps for the element pairs (declaration ``decl``, slave ``e``, master ``m``) of
+        this step: ``(n,)``, ``-1`` where none is kept yet."""
+        n_el = np.int64(self.layout.n_el)
+        idx, found = lookup(self.kind_keys, (np.int64(decl) * n_el + e) * n_el + m)
+        return np.where(found, self.kind_values[idx] if len(self.kind_values) else -1, -1)
+
     def step_kinds(self, decl, e, m, kinds):
         """Kinds of crossing element pairs kept within a step: a pair (declaration ``decl``, slave
         ``e``, master ``m``) that was a point or orthogonal pair at an earlier evaluation of the

@@ -58,7 +58,7 @@ from . import kernel_jit, mortar, mortar_jit, segment_tangent
 from .chains import beam_chains
 from .options import (ADJUST, EXACT_C, EXACT_N, GAUSS_POINTS, SEGMENT_POINTS, SMOOTHING, STICK_TOLERANCE,
                       ContactOptions, declaration_table)
-from .frames import LINE, NORMAL_TOL, POINT, no_normal, touch_tolerance
+from .frames import LINE, NORMAL_TOL, ORTHOGONAL, POINT, no_normal, touch_tolerance
 from .frames_jit import material_frames
 from .record import OPEN, SLIP, STICK, Candidates, PairSet
 from .ownership import gauss_owners, gauss_record
@@ -85,6 +85,9 @@ SLIP_C_FLOOR = 1e-3      # ... but not below SLIP_C_FLOOR x the declaration's c 
 CHAIN_C = True           # exact stick: c's slave length is its chain's (beams joined end to end, ``beam_chains``)
 HOLD_CROSSINGS = True    # exact stick: an element pair's line / crossing decision kept in a step (``step_crossings``)
 HOLD_BAND = float(np.radians(5.0))   # ... remembered from pairs this close to line_angle on (cheaper on bundles)
+KEPT_KINDS_SKIP = True   # the search computes no closest points for a crossing whose kind the step keeps as orthogonal
+#                          (``history.step_kinds`` overwrites it, an orthogonal pair reads no closest point): the same
+#                          kinds and points, bit for bit (``_candidates``); False: every crossing's, as before
 CHAIN_GROUPS = True      # exact stick: a mortar group is a slave node against a master chain, not a master beam
 LIGHT_COMMIT = True      # exact stick: commit's pass computes the point data and groups' state alone, not the forces
 #                          (``ContactSystem._commit_mortar``; False: the evaluation without tangent, as before)
@@ -514,14 +517,32 @@ class ContactSystem(Contribution):
         b = np.flatnonzero(cross)
         if len(b):
             self._lap("rules")
-            x1, x2, ratio = closest_points(H, en[e[b], 0], h[e[b]], en[m[b], 0], h[m[b]])
+            kept = self.history.kept_kinds(d.index, e[b], m[b]) if KEPT_KINDS_SKIP else None
+            run = b if kept is None else b[kept != ORTHOGONAL]
+            x1, x2, ratio = closest_points(H, en[e[run], 0], h[e[run]], en[m[run], 0], h[m[run]])
+            kinds[b] = ORTHOGONAL       # (those left out: their kept kind, ``step_kinds`` below sets it anyway)
+            kinds[run] = rules.point_or_orthogonal(ratio, d.point_ratio)
+            xi1[run], xi2[run] = x1, x2
+            if len(run) < len(b) and self._wrap_may_change(kinds, xi1, run, kept[kept != ORTHOGONAL]):
+                rest = b[kept == ORTHOGONAL]       # ``extend_wrap`` reads every crossing's fresh kind: compute them all
+                x1, x2, ratio = closest_points(H, en[e[rest], 0], h[e[rest]], en[m[rest], 0], h[m[rest]])
+                kinds[rest] = rules.point_or_orthogonal(ratio, d.point_ratio)
+                xi1[rest], xi2[rest] = x1, x2
             self._lap("projection")
-            kinds[b] = rules.point_or_orthogonal(ratio, d.point_ratio)
-            xi1[b], xi2[b] = x1, x2
             kinds = rules.extend_wrap(en, self.el_beam[m], self.n_beams, e, m, kinds, xi1)
             kinds = self.history.step_kinds(d.index, e, m, kinds)
         self._lap("rules")
         return Candidates(e=e, m=m, kind=kinds, xi1=xi1, xi2=xi2, c2=c2, reach=reach, swept=swept)
+
+    @staticmethod
+    def _wrap_may_change(kinds, xi1, run, kept):
+        """Whether ``rules.extend_wrap`` could turn a crossing of ``run`` that the step does not keep yet (``kept``
+        ``-1``) into an orthogonal pair: a point pair with its slave closest point at an element end (``WRAP_END``).
+        Where none is, the crossings left out of ``_candidates``' closest points (their kind kept as orthogonal) change
+        nothing through ``extend_wrap``: it turns point pairs only, and every kept kind is set by ``step_kinds``."""
+        new = run[kept < 0]
+        x = xi1[new]
+        return bool(np.any((kinds[new] == POINT) & ((x < rules.WRAP_END) | (x > 1.0 - rules.WRAP_END))))
 
     def _record(self, d, kind, e, m, xi1, xi2, weight, key, gp):
         en = self.sys.enodes

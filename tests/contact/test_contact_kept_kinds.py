@@ -1,0 +1,93 @@
+"""The search leaves out the closest points of crossings whose kind the step keeps as orthogonal
+(``system.KEPT_KINDS_SKIP``): ``history.step_kinds`` overwrites their kind and an orthogonal pair reads no
+closest point, so the pairs are those of every crossing's closest points, bit for bit; where
+``rules.extend_wrap`` could read the fresh kinds (a new point pair at a slave element's end), all are computed.
+"""
+import dataclasses
+
+import numpy as np
+import pytest
+
+import beamsolver as bs
+from beamsolver.contact import system
+from beamsolver.contact.frames import ORTHOGONAL, POINT
+from beamsolver.nonlinear.problem import Problem
+
+
+def _scene():
+    """A straight master crossed by a slave at 30 degrees (orthogonal, ratio sin^2 < 1/2) and one at 70 (a
+    point pair), both a little above it."""
+    m = bs.Model()
+    sec = bs.Section.circular(radius=0.05, E=1e7)
+    master = m.add_beam(bs.geometry.straight((-1, 0, 0), (1, 0, 0), 6), sec)
+    for angle, x in ((30.0, -0.4), (70.0, 0.45)):
+        a = np.deg2rad(angle)
+        d = np.array([np.cos(a), np.sin(a), 0.0])
+        c = np.array([x, 0.0, 0.099])
+        m.add_contact(m.add_beam(bs.geometry.straight(c - 0.6 * d, c + 0.6 * d, 4), sec), master)
+    return m
+
+
+def _moved(H, seed):
+    H = H.copy()
+    H[:, :3, 3] += 1e-3 * np.random.default_rng(seed).standard_normal((len(H), 3))
+    return H
+
+
+def _search(monkeypatch, skip, force_all=False):
+    """The pairs of a step's evaluations at three poses, and the closest-point rows computed at each."""
+    monkeypatch.setattr(system, "KEPT_KINDS_SKIP", skip)
+    if force_all:
+        monkeypatch.setattr(system.ContactSystem, "_wrap_may_change", staticmethod(lambda *a: True))
+    rows = []
+    real = system.closest_points
+
+    def counted(H, A1, *a, **k):
+        rows.append(len(A1))
+        return real(H, A1, *a, **k)
+    monkeypatch.setattr(system, "closest_points", counted)
+    problem = Problem.from_model(_scene(), check_rigid_modes=False)
+    contact = problem.contact
+    H0 = problem.system.poses0.copy()
+    contact.begin_step(H0, 0.1)
+    out, per_call = [], []
+    for H in (H0, _moved(H0, 1), _moved(H0, 2)):
+        n = len(rows)
+        out.append(contact.pairs(H))
+        per_call.append(sum(rows[n:]))
+    return out, per_call
+
+
+def _same(P, Q):
+    for f in dataclasses.fields(P):
+        a, b = getattr(P, f.name), getattr(Q, f.name)
+        assert a.dtype == b.dtype and np.array_equal(a, b), f.name
+        if a.dtype.kind == "f":
+            assert np.array_equal(a.view(np.int64), b.view(np.int64)), f.name
+
+
+@pytest.mark.parametrize("force_all", [False, True])
+def test_kept_orthogonal_crossings_skip_their_closest_points_with_the_same_pairs(monkeypatch, force_all):
+    before, rows_before = _search(monkeypatch, False)
+    after, rows_after = _search(monkeypatch, True, force_all)
+    assert {POINT, ORTHOGONAL} <= set(before[0].kind.tolist())
+    for P, Q in zip(before, after):
+        _same(P, Q)
+    # the first evaluation of the step computes every crossing's closest points; the later ones the point pairs'
+    # alone (the orthogonal crossing's kept kind), unless extend_wrap could read them (``force_all``)
+    assert rows_after[0] == rows_before[0] > 0
+    if force_all:
+        assert rows_after == rows_before
+    else:
+        n_point = sum(1 for k in before[0].kind if k == POINT)
+        assert all(0 < r < rows_before[0] for r in rows_after[1:])
+        assert all(r >= n_point for r in rows_after[1:])
+
+
+def test_wrap_may_change_reads_new_point_pairs_at_an_end():
+    kinds = np.array([POINT, POINT, ORTHOGONAL, POINT])
+    xi1 = np.array([0.5, 0.01, 0.99, 1.2])
+    run = np.array([0, 1, 2, 3])
+    assert not system.ContactSystem._wrap_may_change(kinds, xi1, run, np.array([-1, POINT, -1, POINT]))
+    assert system.ContactSystem._wrap_may_change(kinds, xi1, run, np.array([-1, -1, -1, POINT]))
+    assert system.ContactSystem._wrap_may_change(kinds, xi1, run, np.array([-1, POINT, -1, -1]))
