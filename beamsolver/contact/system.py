@@ -62,7 +62,7 @@ from .frames import LINE, NORMAL_TOL, ORTHOGONAL, POINT, no_normal, touch_tolera
 from .frames_jit import material_frames
 from .record import OPEN, SLIP, STICK, Candidates, PairSet
 from .ownership import gauss_owners, gauss_record
-from .projection import closest_points, element_twists, gauss_projections, section_points, segment_bounds
+from .projection import closest_points, element_points, element_twists, gauss_projections, segment_bounds
 from .search import broad_pairs, element_spheres
 from .history import ContactHistory, lookup as history_lookup
 from .state import KeyLayout
@@ -408,9 +408,8 @@ class ContactSystem(Contribution):
 
     def _centres(self, H, P, prev=False):
         """Centre points ``x_C``, ``x_F`` ``(P, 3)`` of the pairs ``P`` at ``H`` (``prev``: at the last
-        converged poses), one compiled call for both."""
-        x = self._points(H, np.concatenate([P.e, P.m]), np.concatenate([P.xi1, P.xi2]), prev)
-        return x[:len(P)], x[len(P):]
+        converged poses), compiled, reading the elements' nodes and twists in place."""
+        return self._points(H, P.e, P.xi1, prev), self._points(H, P.m, P.xi2, prev)
 
     def _prev_twists(self):
         """Twists ``(n_elements, 6)`` of all elements at the last converged poses (once per step)."""
@@ -435,7 +434,7 @@ class ContactSystem(Contribution):
             Hc, h = self._H_prev, self._prev_twists()
         else:
             Hc, h = self._twists(H)
-        return section_points(Hc, self.sys.enodes[e, 0], h[e], xi)[0]
+        return element_points(Hc, self.sys.enodes, h, e, xi)
 
     # ------------------------------------------------------------ search
     def pairs(self, H):

@@ -32,6 +32,17 @@ def _poses(seed, angles=ANGLES):
     return rng, H, np.where(kinds == frames.POINT, frames.ORTHOGONAL, kinds), enodes, h
 
 
+def test_element_points_equal_the_gathered_section_points():
+    """``projection.element_points`` (elements' nodes and twists read in place: ``ContactSystem._points``) gives
+    ``section_points``' centres of the gathered elements, bit for bit (angles past every series switch)."""
+    rng, H, _, enodes, h = _poses(4)
+    el = rng.integers(0, len(enodes), 300)
+    xi = rng.uniform(-0.3, 1.3, 300)
+    x = projection.element_points(H, enodes, h, el, xi)
+    ref, _ = projection.section_points(H, enodes[el, 0], h[el], xi)
+    assert x.shape == (300, 3) and np.array_equal(x.view(np.int64), ref.view(np.int64))
+
+
 def test_element_spheres_equal_the_numpy_formula():
     _, H, _, enodes, h = _poses(1)
     radii = np.linspace(0.01, 0.1, len(enodes))
