@@ -282,12 +282,16 @@ def _chord_start(xc, xA2, xB2):
 
 
 @jit_callee
-def _finish(H, a2, h2, k, S, l, xi2, ok, out2, dist, r):
+def _finish(H, a2, h2, k, S, l, xi2, ok, out2, dist, r, xF):
     """Master parameter and centre distance of lane ``l`` (master first node ``a2``, twist ``h2[k]``)
-    into row ``r``; ``ok``: the lane converged, else the distance is nan (no projection)."""
+    into row ``r``; ``ok``: the lane converged, else the distance is nan (no projection).  The master's
+    centre point into ``xF[r]`` (if ``xF`` has rows)."""
     RA2, xA2 = _pose_of(H, a2)
     _, xf, _, _ = _section_inline(RA2, xA2, (h2[k, 0], h2[k, 1], h2[k, 2]), (h2[k, 3], h2[k, 4], h2[k, 5]), xi2)
     out2[r] = xi2
+    if xF.shape[0] > 0:
+        for i in range(3):
+            xF[r, i] = xf[i]
     dist[r] = np.sqrt((xf[0] - S[_X1, l]) ** 2 + (xf[1] - S[_X1 + 1, l]) ** 2 + (xf[2] - S[_X1 + 2, l]) ** 2) if ok else np.nan
 
 
@@ -314,12 +318,13 @@ def _misses(xc, e1, xA2, xB2, lo, hi, bow):
 
 @jit
 def _gauss_project(H, enodes, h, e, m, xg, line, c2, reach, iterations, overhang, seg, lo_seg, hi_seg, xs, row, gp,
-                   out2, dist):
+                   out2, dist, xC, xF):
     """Slave Gauss points ``xg`` of element pairs ``k`` (slave ``e[k]``, master ``m[k]``) within ``reach[k]``
     of ``c2[k]``, projected on the master; rows in the order ``(k, g)``, returns their number.  A slave
     element's sections are computed once.  ``overhang >= 0``: ``LINE`` rows whose plane misses the master
     on ``[-overhang, 1 + overhang]`` (``_misses``) are culled.  ``seg[k]``: the points of pair ``k`` are
-    ``lo_seg[k] + (hi_seg[k] - lo_seg[k]) xs`` (its segment; none if empty), their sections its own."""
+    ``lo_seg[k] + (hi_seg[k] - lo_seg[k]) xs`` (its segment; none if empty), their sections its own.  ``xC``,
+    ``xF`` ``(rows, 3)`` (or ``(0, 3)``: not written): the slave and master centre points of each row."""
     cull = overhang >= 0.0
     lo, hi = -overhang - CULL_PAD, 1.0 + overhang + CULL_PAD
     # |x(xi) - chord(xi)| <= |x''| |xi (xi - 1)| / 2 for xi in and beyond [0, 1]; |x''| = |w x u|
@@ -373,22 +378,25 @@ def _gauss_project(H, enodes, h, e, m, xg, line, c2, reach, iterations, overhang
             tol[l] = _step_tol(xA2, (h[m[k], 0], h[m[k], 1], h[m[k], 2]))
             ln[l] = line[k]
             row[n], gp[n], lane_row[l] = k, g, n
+            if xC.shape[0] > 0:
+                for i in range(3):
+                    xC[n, i] = xc[i]
             n += 1
             l += 1
             if l == LANES:
                 _iterate(S, ln, xi, nxt, ang, tol, done, ok, l, iterations, cull, lo, hi)
                 for j in range(l):
                     mj = m[row[lane_row[j]]]
-                    _finish(H, enodes[mj, 0], h, mj, S, j, xi[j], ok[j], out2, dist, lane_row[j])
+                    _finish(H, enodes[mj, 0], h, mj, S, j, xi[j], ok[j], out2, dist, lane_row[j], xF)
                 l = 0
     _iterate(S, ln, xi, nxt, ang, tol, done, ok, l, iterations, cull, lo, hi)
     for j in range(l):
         mj = m[row[lane_row[j]]]
-        _finish(H, enodes[mj, 0], h, mj, S, j, xi[j], ok[j], out2, dist, lane_row[j])
+        _finish(H, enodes[mj, 0], h, mj, S, j, xi[j], ok[j], out2, dist, lane_row[j], xF)
     return n
 
 
-def gauss_projections(H, enodes, h, e, m, xg, kind, c2, reach, iterations=8, window=None, segments=None):
+def gauss_projections(H, enodes, h, e, m, xg, kind, c2, reach, iterations=8, window=None, segments=None, centres=False):
     """Slave Gauss points ``xg`` ``(g,)`` of element pairs ``(n,)`` projected on their master elements.
 
     Pair ``k``: slave element ``e[k]`` (its sections are computed once), master element ``m[k]``,
@@ -410,6 +418,9 @@ def gauss_projections(H, enodes, h, e, m, xg, kind, c2, reach, iterations=8, win
 
     ``segments``: ``(seg, lo, hi)`` ``(n,)`` (``segment_bounds``) and ``xs`` ``(s,)``: the points of a pair
     with ``seg`` are ``lo + (hi - lo) xs`` (none where ``hi <= lo``); the others' are ``xg``.
+
+    ``centres``: also the rows' slave and master centre points ``(rows, 3)`` (the sections at the slave point and at
+    ``xi2``: ``element_points``' floats, bit for bit).
     """
     c = np.ascontiguousarray
     n = len(e) * (len(xg) if segments is None else max(len(xg), len(segments[3])))
@@ -419,9 +430,12 @@ def gauss_projections(H, enodes, h, e, m, xg, kind, c2, reach, iterations=8, win
         seg, lo, hi, xs = np.zeros(len(e), dtype=np.bool_), np.zeros(len(e)), np.ones(len(e)), c(xg, dtype=float)
     else:
         seg, lo, hi, xs = (c(a) for a in segments)
+    xC, xF = (np.empty((n, 3)), np.empty((n, 3))) if centres else (np.empty((0, 3)), np.empty((0, 3)))
     k = _gauss_project(H, enodes, c(h, dtype=float), c(e), c(m), c(xg, dtype=float), c(np.asarray(kind) == LINE),
                        c(c2, dtype=float), c(reach, dtype=float), int(iterations),
-                       -1.0 if window is None else float(window), seg, lo, hi, xs, row, gp, out2, dist)
+                       -1.0 if window is None else float(window), seg, lo, hi, xs, row, gp, out2, dist, xC, xF)
+    if centres:
+        return row[:k], gp[:k], out2[:k], dist[:k], xC[:k], xF[:k]
     return row[:k], gp[:k], out2[:k], dist[:k]
 
 
@@ -497,6 +511,7 @@ def _project_points(H, line, A1, h1, xi1, A2, B2, h2, iterations, out2, dist):
     S = np.empty((N_FIELDS, LANES))
     xi, nxt, ang, tol = np.empty(LANES), np.empty(LANES), np.empty(LANES), np.empty(LANES)
     ln, done, ok = np.empty(LANES, dtype=np.bool_), np.empty(LANES, dtype=np.bool_), np.empty(LANES, dtype=np.bool_)
+    no_points = np.empty((0, 3))
     n = len(A1)
     for lo in range(0, n, LANES):
         m = min(LANES, n - lo)
@@ -513,7 +528,7 @@ def _project_points(H, line, A1, h1, xi1, A2, B2, h2, iterations, out2, dist):
             ln[l] = line[k]
         _iterate(S, ln, xi, nxt, ang, tol, done, ok, m, iterations, False, 0.0, 1.0)
         for l in range(m):
-            _finish(H, A2[lo + l], h2, lo + l, S, l, xi[l], ok[l], out2, dist, lo + l)
+            _finish(H, A2[lo + l], h2, lo + l, S, l, xi[l], ok[l], out2, dist, lo + l, no_points)
 
 
 def project_points(H, kind, A1, h1, xi1, A2, B2, h2, iterations=8):

@@ -97,12 +97,12 @@ def extend_wrap(enodes, master_beam, n_beams, e, m, kind, xi1=None):
     orth = kind == ORTHOGONAL
     if not orth.any() or orth.all():
         return kind
-    wrap = np.unique((enodes[e[orth]] * n_beams + master_beam[orth, None]).ravel())
     pt = np.flatnonzero(kind == POINT)
     if xi1 is not None:
         pt = pt[(xi1[pt] < WRAP_END) | (xi1[pt] > 1.0 - WRAP_END)]
-    if not len(pt):
+    if not len(pt):               # (no point pair to extend to: the wraps' node keys not needed)
         return kind
+    wrap = np.unique((enodes[e[orth]] * n_beams + master_beam[orth, None]).ravel())
     ids = enodes[e[pt]] * n_beams + master_beam[pt, None]
     near = (wrap[np.minimum(np.searchsorted(wrap, ids), len(wrap) - 1)] == ids).any(axis=1)    # np.isin, wrap sorted
     kind = kind.copy()

@@ -85,6 +85,10 @@ SLIP_C_FLOOR = 1e-3      # ... but not below SLIP_C_FLOOR x the declaration's c 
 CHAIN_C = True           # exact stick: c's slave length is its chain's (beams joined end to end, ``beam_chains``)
 HOLD_CROSSINGS = True    # exact stick: an element pair's line / crossing decision kept in a step (``step_crossings``)
 HOLD_BAND = float(np.radians(5.0))   # ... remembered from pairs this close to line_angle on (cheaper on bundles)
+PREV_POINTS_KEPT = True  # the last centre points at the step's start poses kept for the same elements and sections (the
+#                          slave points of ``_check_sides``: the Gauss points of the same elements from one iterate to the next)
+SEARCH_CENTRES = True    # the centre points of the Gauss-point pairs taken from their projections (``_centres``), not
+#                          computed again: the same sections, the same floats
 KEPT_KINDS_SKIP = True   # the search computes no closest points for a crossing whose kind the step keeps as orthogonal
 #                          (``history.step_kinds`` overwrites it, an orthogonal pair reads no closest point): the same
 #                          kinds and points, bit for bit (``_candidates``); False: every crossing's, as before
@@ -278,6 +282,9 @@ class ContactSystem(Contribution):
         self._sweepable = {}       # per declaration: whether the last search found no crossing (``_candidates``)
         self._H_prev = None        # last converged poses (start of the step)
         self._geo = self._geo_prev = None    # (poses, element twists) of the last evaluation / of H_prev
+        self._prev_points = None             # ``_points(prev=True)``'s last sections (``PREV_POINTS_KEPT``)
+        self._part_centres = {}              # ``pairs``: centre points of its Gauss-point records (``SEARCH_CENTRES``)
+        self._pair_centres = None            # (P, twists, x_C, x_F) of the last ``pairs`` (``_centres``)
         self._blocks = None        # (poses, local blocks) of the last evaluation, for the same state
         self._forced = None        # keys of points linearised on the normal law's open branch (``force_open``)
         self._secant = None        # (keys, gaps, reach): points linearised on the parabola's secant (``force_secant``)
@@ -408,7 +415,11 @@ class ContactSystem(Contribution):
 
     def _centres(self, H, P, prev=False):
         """Centre points ``x_C``, ``x_F`` ``(P, 3)`` of the pairs ``P`` at ``H`` (``prev``: at the last
-        converged poses), compiled, reading the elements' nodes and twists in place."""
+        converged poses), compiled, reading the elements' nodes and twists in place; those ``pairs(H)`` found
+        with ``P`` (``SEARCH_CENTRES``: the same floats) where ``P`` is its record."""
+        c = self._pair_centres
+        if not prev and c is not None and c[0] is P and self._twists(H) is c[1]:
+            return c[2], c[3]
         return self._points(H, P.e, P.xi1, prev), self._points(H, P.m, P.xi2, prev)
 
     def _prev_twists(self):
@@ -432,9 +443,16 @@ class ContactSystem(Contribution):
         last converged poses, whose twists are kept for the step)."""
         if prev:
             Hc, h = self._H_prev, self._prev_twists()
+            c = self._prev_points     # (the step's twists, e, xi, points) of the last call: the same sections again
+            if c is not None and c[0] is self._geo_prev and np.array_equal(c[1], e) and _same_bits(c[2], xi):
+                return c[3]
         else:
             Hc, h = self._twists(H)
-        return element_points(Hc, self.sys.enodes, h, e, xi)
+        x = element_points(Hc, self.sys.enodes, h, e, xi)
+        if prev and PREV_POINTS_KEPT:
+            x.flags.writeable = False
+            self._prev_points = (self._geo_prev, np.array(e), np.array(xi), x)
+        return x
 
     # ------------------------------------------------------------ search
     def pairs(self, H):
@@ -447,6 +465,7 @@ class ContactSystem(Contribution):
         out, chosen, owners = [], [], []
         self._lap()
         geo = self._twists(H)
+        self._part_centres, self._pair_centres = {}, None
         for d in self.decls:
             if not self._decl_on[d.index]:
                 continue
@@ -468,6 +487,13 @@ class ContactSystem(Contribution):
         hist.prev_owners = np.concatenate(owners) if owners else np.zeros(0, dtype=np.int64)
         out = [p for p in out if p is not None and len(p)]
         P = (out[0] if len(out) == 1 else PairSet.concatenate(out)) if out else None
+        if SEARCH_CENTRES and P is not None:
+            # the centre points of the Gauss-point rows as their projections computed them (``_centres``)
+            xy = [self._part_centres.get(id(p)) for p in out]
+            xy = [c[1:] if c is not None and c[0] is p else (self._points(H, p.e, p.xi1), self._points(H, p.m, p.xi2))
+                  for p, c in zip(out, xy)]
+            self._pair_centres = (P, geo, np.concatenate([c[0] for c in xy]), np.concatenate([c[1] for c in xy]))
+        self._part_centres = {}
         if P is not None and len(self._adjusted[0]):
             P.R1, P.R2 = adjust.apply(P.key, P.R1, P.R2, self._adjusted)
         return P
@@ -598,8 +624,10 @@ class ContactSystem(Contribution):
             seg, slot = self._segments(e, m, kind)
             # n_seg points on every segment (a count depending on its length would make the forces jump)
             segments = (seg,) + segment_bounds(H, en, h, e, m, seg) + d.seg_gauss
-        r, g, xi2, dist = gauss_projections(H, en, h, e, m, xg, kind, c2, reach, iterations=8,
-                                            window=rules.XI_OVERHANG, segments=None if segments is None else segments[:4])
+        r, g, xi2, dist, *xCF = gauss_projections(H, en, h, e, m, xg, kind, c2, reach, iterations=8,
+                                                  window=rules.XI_OVERHANG,
+                                                  segments=None if segments is None else segments[:4],
+                                                  centres=SEARCH_CENTRES)
         self._lap("projection")
         gk = g if slot is None else g + self.max_gp * slot[r]
         s, key, tied = gauss_owners(d.index, len(en), self.key_gp, self.n_beams, e, m, gk, xi2, dist, self.el_first,
@@ -607,6 +635,8 @@ class ContactSystem(Contribution):
         f, ids = gauss_record(s, key, r, g, xi2, e, m, kind, xg, wg, self.sys.L, en, self.el_radius,
                               segments)
         rec = PairSet(key=key, decl=np.full(len(s), d.index), **f)
+        if SEARCH_CENTRES:
+            self._part_centres[id(rec)] = (rec, xCF[0][s], xCF[1][s])     # (the record held: its id not reused)
         self._lap("rules")
         return rec, ids, tied
 
@@ -1764,6 +1794,12 @@ def _kernel(kernel, X, p, friction, law, tangent, K=None):
         return kernel.kernel_and_tangent(X, p, friction=friction, **kw)
     f, out = kernel.contact_kernel(X, p, friction=friction, **({} if law is None else dict(law=law)))
     return f, None, out
+
+
+def _same_bits(a, b):
+    """Float arrays ``a``, ``b`` equal bit for bit (signed zeros and nans told apart)."""
+    a, b = np.ascontiguousarray(a, dtype=float), np.ascontiguousarray(b, dtype=float)
+    return a.shape == b.shape and np.array_equal(a.view(np.int64), b.view(np.int64))
 
 
 def _member(a, b_sorted):

@@ -91,3 +91,58 @@ def test_wrap_may_change_reads_new_point_pairs_at_an_end():
     assert not system.ContactSystem._wrap_may_change(kinds, xi1, run, np.array([-1, POINT, -1, POINT]))
     assert system.ContactSystem._wrap_may_change(kinds, xi1, run, np.array([-1, -1, -1, POINT]))
     assert system.ContactSystem._wrap_may_change(kinds, xi1, run, np.array([-1, POINT, -1, -1]))
+
+
+def _line_scene(integration):
+    """A slave lying along a bent master (line pairs; ``integration`` "points" or "segments") and a crossing slave
+    (a point pair)."""
+    m = bs.Model()
+    sec = bs.Section.circular(radius=0.05, E=1e7)
+    master = m.add_beam(bs.geometry.straight((-1, 0, 0), (1, 0, 0), 8), sec)
+    m.add_contact(m.add_beam(bs.geometry.straight((-0.83, 0.0, 0.0999), (0.61, 0.02, 0.0995), 5), sec), master,
+                  integration=integration)
+    a = np.deg2rad(70.0)
+    d = np.array([np.cos(a), np.sin(a), 0.0])
+    c = np.array([0.45, 0.0, -0.099])
+    m.add_contact(m.add_beam(bs.geometry.straight(c - 0.6 * d, c + 0.6 * d, 4), sec), master)
+    return m
+
+
+@pytest.mark.parametrize("integration", ["points", "segments"])
+def test_search_centres_equal_the_computed_sections(monkeypatch, integration):
+    """``SEARCH_CENTRES``: the centre points ``_centres`` gives for the pairs of ``pairs(H)`` (the Gauss-point rows'
+    from their projections, the point pairs' computed) are the sections computed afresh, bit for bit."""
+    monkeypatch.setattr(system, "SEARCH_CENTRES", True)
+    problem = Problem.from_model(_line_scene(integration), check_rigid_modes=False)
+    contact = problem.contact
+    H0 = problem.system.poses0.copy()
+    contact.begin_step(H0, 0.1)
+    for H in (H0, _moved(H0, 3)):
+        P = contact.pairs(H)
+        assert {POINT, system.LINE} <= set(P.kind.tolist())
+        xC, xF = contact._centres(H, P)
+        assert contact._pair_centres[0] is P
+        rC, rF = contact._points(H, P.e, P.xi1), contact._points(H, P.m, P.xi2)
+        for a, b in ((xC, rC), (xF, rF)):
+            assert a.shape == b.shape and np.array_equal(a.view(np.int64), b.view(np.int64))
+
+
+def test_prev_points_kept_for_the_same_sections_and_renewed_at_a_step(monkeypatch):
+    """``PREV_POINTS_KEPT``: the centre points at the step's start poses of the same elements and sections are the
+    last call's (the same floats), computed afresh for other sections and after ``begin_step``."""
+    monkeypatch.setattr(system, "PREV_POINTS_KEPT", True)
+    problem = Problem.from_model(_line_scene("points"), check_rigid_modes=False)
+    contact = problem.contact
+    H0 = problem.system.poses0.copy()
+    contact.begin_step(H0, 0.1)
+    P = contact.pairs(H0)
+    x = contact._points(H0, P.e, P.xi1, prev=True)
+    assert contact._points(H0, P.e.copy(), P.xi1.copy(), prev=True) is x
+    xi = P.xi1.copy()
+    xi[0] = np.nextafter(xi[0], 2.0)
+    assert contact._points(H0, P.e, xi, prev=True) is not x
+    H1 = _moved(H0, 5)
+    contact.begin_step(H1, 0.2)
+    y = contact._points(H1, P.e, P.xi1, prev=True)
+    ref = contact._points(H1, P.e, P.xi1)
+    assert y is not x and np.array_equal(y.view(np.int64), ref.view(np.int64))
