@@ -282,7 +282,7 @@ class ContactSystem(Contribution):
         self._sweepable = {}       # per declaration: whether the last search found no crossing (``_candidates``)
         self._H_prev = None        # last converged poses (start of the step)
         self._geo = self._geo_prev = None    # (poses, element twists) of the last evaluation / of H_prev
-        self._prev_points = None             # ``_points(prev=True)``'s last sections (``PREV_POINTS_KEPT``)
+        self._prev_points = []               # ``_points(prev=True)``'s last two sections (``PREV_POINTS_KEPT``)
         self._part_centres = {}              # ``pairs``: centre points of its Gauss-point records (``SEARCH_CENTRES``)
         self._pair_centres = None            # (P, twists, x_C, x_F) of the last ``pairs`` (``_centres``)
         self._blocks = None        # (poses, local blocks) of the last evaluation, for the same state
@@ -443,15 +443,15 @@ class ContactSystem(Contribution):
         last converged poses, whose twists are kept for the step)."""
         if prev:
             Hc, h = self._H_prev, self._prev_twists()
-            c = self._prev_points     # (the step's twists, e, xi, points) of the last call: the same sections again
-            if c is not None and c[0] is self._geo_prev and np.array_equal(c[1], e) and _same_bits(c[2], xi):
-                return c[3]
+            for c in self._prev_points:     # (the step's twists, e, xi, points) of the last two calls (the slave's
+                if c[0] is self._geo_prev and np.array_equal(c[1], e) and _same_bits(c[2], xi):    # and master's)
+                    return c[3]
         else:
             Hc, h = self._twists(H)
         x = element_points(Hc, self.sys.enodes, h, e, xi)
         if prev and PREV_POINTS_KEPT:
             x.flags.writeable = False
-            self._prev_points = (self._geo_prev, np.array(e), np.array(xi), x)
+            self._prev_points = self._prev_points[-1:] + [(self._geo_prev, np.array(e), np.array(xi), x)]
         return x
 
     # ------------------------------------------------------------ search
