@@ -183,7 +183,7 @@ class ContactHistory:
         idx, found = lookup(self.kind_keys, (np.int64(decl) * n_el + e) * n_el + m)
         return np.where(found, self.kind_values[idx] if len(self.kind_values) else -1, -1)
 
-    def step_kinds(self, decl, e, m, kinds):
+    def step_kinds(self, decl, e, m, kinds, kept=None):
         """Kinds of crossing element pairs kept within a step: a pair (declaration ``decl``, slave
         ``e``, master ``m``) that was a point or orthogonal pair at an earlier evaluation of the
         step keeps that kind while it is a crossing; the others are remembered as decided now.
@@ -191,15 +191,21 @@ class ContactHistory:
         The choice (the reduced-Hessian ratio of the closest points, ``rules.extend_wrap``) is
         not continuous: decided afresh at every iterate it may flip between two iterates, and
         the contact force with it (a point pair at the crossing against Gauss points around
-        it), so that Newton cycles (docs/theory.md, kind of a crossing within a step)."""
+        it), so that Newton cycles (docs/theory.md, kind of a crossing within a step).  ``kept``: ``kept_kinds`` of
+        the pairs ``kinds != LINE`` if known (no second look-up)."""
         n_el = np.int64(self.layout.n_el)
         cross = np.flatnonzero(kinds != LINE)
         if not len(cross):
             return kinds
         keys = (np.int64(decl) * n_el + e[cross]) * n_el + m[cross]
-        idx, found = lookup(self.kind_keys, keys)
+        if kept is None:
+            idx, found = lookup(self.kind_keys, keys)
+            kept = self.kind_values[idx[found]]
+        else:           # ``kept_kinds`` of the crossings ``cross`` (``ContactSystem._candidates``): no second look-up
+            found = kept >= 0
+            kept = kept[found]
         kinds = kinds.copy()
-        kinds[cross[found]] = self.kind_values[idx[found]]
+        kinds[cross[found]] = kept
         if not found.all():
             k = np.concatenate([self.kind_keys, keys[~found]])
             v = np.concatenate([self.kind_values, kinds[cross[~found]]])

@@ -555,7 +555,7 @@ class ContactSystem(Contribution):
                 xi1[rest], xi2[rest] = x1, x2
             self._lap("projection")
             kinds = rules.extend_wrap(en, self.el_beam[m], self.n_beams, e, m, kinds, xi1)
-            kinds = self.history.step_kinds(d.index, e, m, kinds)
+            kinds = self.history.step_kinds(d.index, e, m, kinds, kept)
         self._lap("rules")
         return Candidates(e=e, m=m, kind=kinds, xi1=xi1, xi2=xi2, c2=c2, reach=reach, swept=swept)
 
