@@ -419,6 +419,7 @@ class ContactSystem(Contribution):
         with ``P`` (``SEARCH_CENTRES``: the same floats) where ``P`` is its record."""
         c = self._pair_centres
         if not prev and c is not None and c[0] is P and self._twists(H) is c[1]:
+            self._pair_centres = None       # (handed out once: not held through the kernels)
             return c[2], c[3]
         return self._points(H, P.e, P.xi1, prev), self._points(H, P.m, P.xi2, prev)
 
@@ -1504,6 +1505,7 @@ class ContactSystem(Contribution):
         self.history.begin_step()
         self._H_prev = np.array(H, dtype=float)
         self._geo_prev = None
+        self._prev_points = []
         self._augments = 0
         self._mstep, self._ms = None, 0.0
         self._first = True

@@ -120,8 +120,9 @@ def test_search_centres_equal_the_computed_sections(monkeypatch, integration):
     for H in (H0, _moved(H0, 3)):
         P = contact.pairs(H)
         assert {POINT, system.LINE} <= set(P.kind.tolist())
-        xC, xF = contact._centres(H, P)
         assert contact._pair_centres[0] is P
+        xC, xF = contact._centres(H, P)
+        assert contact._pair_centres is None         # handed out once
         rC, rF = contact._points(H, P.e, P.xi1), contact._points(H, P.m, P.xi2)
         for a, b in ((xC, rC), (xF, rF)):
             assert a.shape == b.shape and np.array_equal(a.view(np.int64), b.view(np.int64))
