@@ -742,10 +742,13 @@ class ContactSystem(Contribution):
         given = self._decl_smoothing[P.decl[sel]]
         return np.where(np.isnan(given), np.where(P.kind[sel] == LINE, SMOOTHING * rsum, 0.0), given)
 
-    def _active(self, P, H, centres=None):
-        """Pairs whose trial normal traction is positive (``centres``: ``_centres(H, P)`` if known)."""
-        xC, xF = self._centres(H, P) if centres is None else centres
-        gap = np.linalg.norm(xF - xC, axis=1) - P.R1 - P.R2
+    def _active(self, P, H, centres=None, dist=None):
+        """Pairs whose trial normal traction is positive (``centres``: ``_centres(H, P)`` if known; ``dist``: their
+        distances ``|x_F - x_C|``, if known)."""
+        if dist is None:
+            xC, xF = self._centres(H, P) if centres is None else centres
+            dist = np.linalg.norm(xF - xC, axis=1)
+        gap = dist - P.R1 - P.R2
         pen = self._decl_penalty[P.decl]
         mult = self.history.normal_multipliers(P.key)
         # the smoothing zone plus a small band keeps the projection-updated gap consistent
@@ -798,11 +801,14 @@ class ContactSystem(Contribution):
     def _pair_label(self, e, m):
         return f"{self.element_label(e)} (global {e}) against {self.element_label(m)} (global {m})"
 
-    def _check_normals(self, P, sel, H, centres):
+    def _check_normals(self, P, sel, H, centres, dist=None):
         """Refuse (a step failure: cut back) pairs whose centre lines intersect: no normal
-        (``centres``: ``_centres(H, P)``)."""
-        xC, xF = centres[0][sel], centres[1][sel]
-        bad = np.flatnonzero(no_normal(np.linalg.norm(xF - xC, axis=1), P.R1[sel], P.R2[sel]))
+        (``centres``: ``_centres(H, P)``; ``dist``: all pairs' ``|x_F - x_C|``, if known)."""
+        if dist is None:
+            dist = np.linalg.norm(centres[1][sel] - centres[0][sel], axis=1)
+        else:
+            dist = dist[sel]      # (the same floats: a row's norm is its own)
+        bad = np.flatnonzero(no_normal(dist, P.R1[sel], P.R2[sel]))
         if len(bad):
             k = sel[bad[0]]
             msg = (f"add_contact no. {int(P.decl[k])}: the centre lines of {self._pair_label(P.e[k], P.m[k])} "
@@ -811,7 +817,7 @@ class ContactSystem(Contribution):
                 raise InputError(msg + " in the given poses: do two beams share a centre line? Separate them")
             raise NoContactNormal(msg)
 
-    def _check_sides(self, P, H, centres):
+    def _check_sides(self, P, H, centres, d=None):
         """Tunnelling: refuse (cut back) a step over which a pair changed sides.
 
         The centre-line distance vector ``d = x_F - x_C`` of each candidate pair (same
@@ -821,7 +827,7 @@ class ContactSystem(Contribution):
         """
         if self._H_prev is None or self._H_prev.shape != H.shape or np.array_equal(self._H_prev, H):
             return              # (at the step's start, the first iterate: d_prev = d, no pair changed sides)
-        d = centres[1] - centres[0]
+        d = centres[1] - centres[0] if d is None else d
         x0C, x0F = self._centres(H, P, prev=True)
         d0 = x0F - x0C
         rsum = P.R1 + P.R2
@@ -868,12 +874,14 @@ class ContactSystem(Contribution):
         sel = np.zeros(0, dtype=int)
         if P is not None:
             centres = self._centres(H, P)
-            self._check_sides(P, H, centres)
-            sel = self._active(P, H, centres)
+            d = centres[1] - centres[0]
+            dist = np.linalg.norm(d, axis=1)
+            self._check_sides(P, H, centres, d)
+            sel = self._active(P, H, centres, dist)
         if len(sel) == 0:
             self._blocks = (np.array(H), None)
             return None
-        self._check_normals(P, sel, H, centres)
+        self._check_normals(P, sel, H, centres, dist)
         self._skipped = 0
         if SKIP_OPEN and not self._full and self.newton_multipliers and not self.n_slots and self._decl_exact.any():
             sel = self._open_points(P, H, sel)
