@@ -85,8 +85,8 @@ SLIP_C_FLOOR = 1e-3      # ... but not below SLIP_C_FLOOR x the declaration's c 
 CHAIN_C = True           # exact stick: c's slave length is its chain's (beams joined end to end, ``beam_chains``)
 HOLD_CROSSINGS = True    # exact stick: an element pair's line / crossing decision kept in a step (``step_crossings``)
 HOLD_BAND = float(np.radians(5.0))   # ... remembered from pairs this close to line_angle on (cheaper on bundles)
-PREV_POINTS_KEPT = True  # the last centre points at the step's start poses kept for the same elements and sections (the
-#                          slave points of ``_check_sides``: the Gauss points of the same elements from one iterate to the next)
+PREV_POINTS_KEPT = True  # the slave centre points at the step's start poses kept for the same elements and sections
+#                          (``_check_sides``: the same Gauss points from one iterate to the next)
 SEARCH_CENTRES = True    # the centre points of the Gauss-point pairs taken from their projections (``_centres``), not
 #                          computed again: the same sections, the same floats
 KEPT_KINDS_SKIP = True   # the search computes no closest points for a crossing whose kind the step keeps as orthogonal
@@ -282,7 +282,7 @@ class ContactSystem(Contribution):
         self._sweepable = {}       # per declaration: whether the last search found no crossing (``_candidates``)
         self._H_prev = None        # last converged poses (start of the step)
         self._geo = self._geo_prev = None    # (poses, element twists) of the last evaluation / of H_prev
-        self._prev_points = []               # ``_points(prev=True)``'s last two sections (``PREV_POINTS_KEPT``)
+        self._prev_points = None             # ``_points(prev=True, keep=True)``'s last sections (``PREV_POINTS_KEPT``)
         self._part_centres = {}              # ``pairs``: centre points of its Gauss-point records (``SEARCH_CENTRES``)
         self._pair_centres = None            # (P, twists, x_C, x_F) of the last ``pairs`` (``_centres``)
         self._blocks = None        # (poses, local blocks) of the last evaluation, for the same state
@@ -421,7 +421,8 @@ class ContactSystem(Contribution):
         if not prev and c is not None and c[0] is P and self._twists(H) is c[1]:
             self._pair_centres = None       # (handed out once: not held through the kernels)
             return c[2], c[3]
-        return self._points(H, P.e, P.xi1, prev), self._points(H, P.m, P.xi2, prev)
+        # (at the step's start poses the slave points are kept: the same Gauss points from one iterate to the next)
+        return self._points(H, P.e, P.xi1, prev, keep=prev), self._points(H, P.m, P.xi2, prev)
 
     def _prev_twists(self):
         """Twists ``(n_elements, 6)`` of all elements at the last converged poses (once per step)."""
@@ -439,20 +440,20 @@ class ContactSystem(Contribution):
         Hc, h = self._twists(H)
         return se3_twin.exp_compose(Hc, self.sys.enodes[e, 0], h[e], xi)       # se3.interpolate's bits
 
-    def _points(self, H, e, xi, prev=False):
+    def _points(self, H, e, xi, prev=False, keep=False):
         """Centre points ``(k, 3)`` of the sections ``xi`` of elements ``e`` at ``H`` (``prev``: at the
         last converged poses, whose twists are kept for the step)."""
         if prev:
             Hc, h = self._H_prev, self._prev_twists()
-            for c in self._prev_points:     # (the step's twists, e, xi, points) of the last two calls (the slave's
-                if c[0] is self._geo_prev and np.array_equal(c[1], e) and _same_bits(c[2], xi):    # and master's)
-                    return c[3]
+            c = self._prev_points     # (the step's twists, e, xi, points) of the last call with ``keep``
+            if keep and c is not None and c[0] is self._geo_prev and np.array_equal(c[1], e) and _same_bits(c[2], xi):
+                return c[3]
         else:
             Hc, h = self._twists(H)
         x = element_points(Hc, self.sys.enodes, h, e, xi)
-        if prev and PREV_POINTS_KEPT:
+        if prev and keep and PREV_POINTS_KEPT:
             x.flags.writeable = False
-            self._prev_points = self._prev_points[-1:] + [(self._geo_prev, np.array(e), np.array(xi), x)]
+            self._prev_points = (self._geo_prev, np.array(e), np.array(xi), x)
         return x
 
     # ------------------------------------------------------------ search
@@ -1513,7 +1514,7 @@ class ContactSystem(Contribution):
         self.history.begin_step()
         self._H_prev = np.array(H, dtype=float)
         self._geo_prev = None
-        self._prev_points = []
+        self._prev_points = None
         self._augments = 0
         self._mstep, self._ms = None, 0.0
         self._first = True

@@ -137,13 +137,14 @@ def test_prev_points_kept_for_the_same_sections_and_renewed_at_a_step(monkeypatc
     H0 = problem.system.poses0.copy()
     contact.begin_step(H0, 0.1)
     P = contact.pairs(H0)
-    x = contact._points(H0, P.e, P.xi1, prev=True)
-    assert contact._points(H0, P.e.copy(), P.xi1.copy(), prev=True) is x
+    x = contact._centres(H0, P, prev=True)[0]
+    assert contact._points(H0, P.e.copy(), P.xi1.copy(), prev=True, keep=True) is x
+    assert contact._points(H0, P.e, P.xi1, prev=True) is not x       # (kept for the slave points alone)
     xi = P.xi1.copy()
     xi[0] = np.nextafter(xi[0], 2.0)
-    assert contact._points(H0, P.e, xi, prev=True) is not x
+    assert contact._points(H0, P.e, xi, prev=True, keep=True) is not x
     H1 = _moved(H0, 5)
     contact.begin_step(H1, 0.2)
-    y = contact._points(H1, P.e, P.xi1, prev=True)
+    y = contact._centres(H1, P, prev=True)[0]
     ref = contact._points(H1, P.e, P.xi1)
     assert y is not x and np.array_equal(y.view(np.int64), ref.view(np.int64))
