@@ -71,6 +71,9 @@ TAIL_RATIO = 1e-5                    # ... at a stick / slip corner (slip's shar
 TAIL_CORNER = 0.1                    # ... times the disk) start on the stick rows, kept where the linearised trial
 #                                      stays in the disk, at most TAIL_SWITCHES solves (``_corner_groups``; 0: off);
 TAIL_ROWS = 1e-3                     # ... the evaluations' branch rows asked for once the scaled residual is below this
+TAIL_MAX_UNKNOWNS = 10000            # ... with at most so many free unknowns (the bordered system is factorised
+#                                      uncondensed there: the 19-wire strand's, 17 898, one corner direction in its last
+#                                      iteration, peak RSS 630 -> 730 MB for the same iterations)
 NORMAL_SWITCHES = 4                  # exact stick: Newton directions again with the points the full step opens
                                      # linearised open (the normal law's active set, ``_normal_branches``; 0: off.
                                      # The rope pieces' loaded steps 31 -> 14 and failed -> 19 iterations, the contact
@@ -295,7 +298,7 @@ class Newton:
         if ev.mult is not None and "Tq" in ev.mult and (dz_c is None or INNER_PREDICTOR):
             if INNER_SWITCHES:
                 return self._active_set_direction(ev, dz_c)
-            if TAIL_SWITCHES and self.ratio_now <= TAIL_RATIO:
+            if TAIL_SWITCHES and self.ratio_now <= TAIL_RATIO and self.sys.n_free <= TAIL_MAX_UNKNOWNS:
                 corner = self._corner_groups(ev)
                 if corner.any():
                     return self._active_set_direction(ev, dz_c, TAIL_SWITCHES, corner)
@@ -607,7 +610,8 @@ class Newton:
             self._record(ev, ratio, residuals, stats_extra, it, t, H)
             self.ratio_now = ratio
             if TAIL_SWITCHES and not INNER_SWITCHES and ev.mult is not None:
-                problem.want_branch_rows(ratio <= TAIL_ROWS)     # (their cost: only where the tail may need them)
+                # (their cost: only where the tail may need them)
+                problem.want_branch_rows(ratio <= TAIL_ROWS and self.sys.n_free <= TAIL_MAX_UNKNOWNS)
             verdict = self._verdict(residuals, last_inc, it, floor, constraint)
             if verdict is CONVERGED:
                 if damped_its:
