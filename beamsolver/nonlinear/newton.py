@@ -589,6 +589,7 @@ class Newton:
         conv, problem = self.conv, self.problem
         residuals = []
         self.crawl, self.full_taken = 0, False
+        self.ratio_now = np.inf              # (``_record``'s; ``direction``'s tail test)
         self.least_inc = (np.inf, 0)         # the shortest full Newton increment of the step and its iteration
         self.reversals = (None, 0)
         self.secant_done = None
