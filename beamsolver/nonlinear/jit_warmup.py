@@ -315,6 +315,7 @@ def _scene(model, worker):
     geo = c._twists(H)
     for d in c.decls:
         c._candidates(d, geo, sweep=False)
+    c._points(H, np.zeros(0, dtype=np.int64), np.zeros(0))     # ``projection.element_points``: a later iterate's centres
     en = problem.system.enodes
     closest_points(H, en[:0, 0], np.zeros((0, 6)), en[:0, 0], np.zeros((0, 6)))
     if worker is not None and worker.running():
