@@ -199,13 +199,10 @@ class ContactHistory:
             return kinds
         keys = (np.int64(decl) * n_el + e[cross]) * n_el + m[cross]
         if kept is None:
-            idx, found = lookup(self.kind_keys, keys)
-            kept = self.kind_values[idx[found]]
-        else:           # ``kept_kinds`` of the crossings ``cross`` (``ContactSystem._candidates``): no second look-up
-            found = kept >= 0
-            kept = kept[found]
+            kept = self.kept_kinds(decl, e[cross], m[cross])
+        found = kept >= 0
         kinds = kinds.copy()
-        kinds[cross[found]] = kept
+        kinds[cross[found]] = kept[found]
         if not found.all():
             k = np.concatenate([self.kind_keys, keys[~found]])
             v = np.concatenate([self.kind_values, kinds[cross[~found]]])
