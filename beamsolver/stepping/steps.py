@@ -4,7 +4,7 @@
 shortened where a prescribed rotation would be ambiguous
 (``motion_path.limit_step``); a step whose Newton iterations fail with a
 retryable ``failures.StepFailed`` is halved down to ``dt_min`` (compared with a
-relative tolerance ``STEP_TOLERANCE``, and a grown step cut back below
+relative tolerance ``STEP_TOLERANCE`` and ``FLOOR_ULPS`` ulps of ``t``, and a grown step cut back below
 ``dt_min`` tries ``dt_min`` itself); after two easy steps running the next one
 grows (``growth``), never past the user's step (easy: no cut-back and at most ``easy_limit``
 Newton iterations, the more of ``EASY_ITERATIONS`` and the iterations of the last step taken at
@@ -38,12 +38,13 @@ from .options import RunOptions
 from ..model.material_range import RangeCheck
 from ..results.solution import Solution, describe_model
 
-__all__ = ["Run", "growth", "easy_limit", "steady", "next_step", "after_failure", "STEP_TOLERANCE", "EASY_ITERATIONS", "WAIT_MAX",
+__all__ = ["Run", "growth", "easy_limit", "steady", "next_step", "after_failure", "STEP_TOLERANCE", "FLOOR_ULPS", "EASY_ITERATIONS", "WAIT_MAX",
            "STEP_ZERO_ITERATIONS", "STEP_ZERO_STALL", "STEADY_GROWTH", "STEADY_SHARE"]
 
 log = logging.getLogger("beamsolver")
 
 STEP_TOLERANCE = 1e-9      # relative rounding allowed when comparing step sizes
+FLOOR_ULPS = 4.0           # ... and ulps of t allowed when comparing a step with the smallest one (``Run._slack``)
 LANDING = 0.1              # a step ending within this fraction of a step before a grid point lands on it
 EASY_ITERATIONS = 6        # a step converging within these iterations is easy (growth)
 EASY_RUN = 2               # easy steps running before the step grows (growth)
@@ -341,7 +342,7 @@ class Run:
         while True:
             self.step_negative = None
             t_try, rot = motion_path.limit_step(self.sys, t, t_next)
-            if t_try < t_next and t_try - t < self.dt_min * (1.0 - STEP_TOLERANCE):
+            if t_try < t_next and t_try - t < self.dt_min - self._slack(t_try):
                 self._stop(MotionTooFast(f"a prescribed rotation turns by {rot:.3g} rad over a step of "
                                       f"{t_try - t:.3g}, more than MAX_MOTION_ROTATION = "
                                       f"{motion_path.MAX_MOTION_ROTATION:.3g} rad, even at the smallest step"),
@@ -363,12 +364,15 @@ class Run:
                 if isinstance(e, NonFinite):
                     self._name_nonfinite(t_try)
                 h = 0.5 * (t_try - t)
-                if self.dt_min * (1.0 + STEP_TOLERANCE) < t_try - t and h < self.dt_min:
+                # the smallest step failed: ``t + dt_min - t`` is ``dt_min`` only up to the round-off of ``t``
+                # (1e7 ulps of t = 0.94 in a 2e-9 step: 5e-8 of it, above STEP_TOLERANCE), so the test has that slack
+                at_floor = t_try - t <= self.dt_min + self._slack(t_try)
+                if not at_floor and h < self.dt_min:
                     h = self.dt_min             # a grown step cut back: the smallest step is still tried
                 if isinstance(e, LeftStableBranch):
                     branch_here, self.branch_tries = branch_here + 1, self.branch_tries + 1
                     if branch_here > stable_branch.RETRIES or self.branch_tries > stable_branch.RETRIES_RUN or \
-                            h < self.dt_min * (1.0 - STEP_TOLERANCE):
+                            at_floor:
                         return self._keep_unstable(e)
                 cutbacks += 1
                 failed_sizes.append(t_try - t)
@@ -376,10 +380,15 @@ class Run:
                 if e.rotation:
                     rotation_limit = str(e)
                 log.info("t = %.6g: step %.3g failed (%s); cutting back to %.3g", t_try, t_try - t, e, h)
-                if not e.retry or h < self.dt_min * (1.0 - STEP_TOLERANCE):
+                if not e.retry or at_floor:
                     self._stop(e, rotation_limit)
                 t_next = t + h
                 self.easy = 0
+
+    def _slack(self, t):
+        """Absolute slack of a comparison with the smallest step ending at ``t``: ``STEP_TOLERANCE`` of it and
+        ``FLOOR_ULPS`` ulps of ``t`` (a step's length ``t_try - t`` carries the rounding of ``t + dt``)."""
+        return STEP_TOLERANCE * self.dt_min + FLOOR_ULPS * np.spacing(abs(t))
 
     def _negative_before(self):
         """``before()`` of ``stable_branch.verdict`` for a step from the current state: its

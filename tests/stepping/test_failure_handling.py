@@ -308,3 +308,28 @@ def test_a_motion_too_fast_for_the_smallest_step_is_refused_at_once():
     with pytest.raises(bs.ConvergenceError, match="MAX_MOTION_ROTATION") as err:
         bs.solve(m, steps=1, verbose=False)
     assert isinstance(err.value.failure, failures.MotionTooFast) and err.value.solution.n_steps == 0
+
+
+@pytest.mark.parametrize("t_fail", [0.5, 0.7, 0.9, 0.99])
+def test_a_failure_at_the_smallest_step_stops_whatever_the_round_off_of_t(monkeypatch, t_fail):
+    """Every step past ``t_fail`` fails: the halvings reach the smallest step and, when that fails too, the run
+    stops with ``ConvergenceError``.  A smallest step of 2e-9 at t ~ 0.9 is 2e7 ulps of t: ``t + dt - t``
+    differs from ``dt`` by up to ~5e-8 of it, more than ``STEP_TOLERANCE``; where it rounded up, the failed
+    smallest step was taken for a longer one and tried again forever (the plectoneme's five-turn run with
+    a dense LU at t = 0.939147036)."""
+    from beamsolver.nonlinear import newton
+    m, b, _ = _rod(4)
+    m.add_load(b.last, force=(0, 0, 10.0), scale=lambda t: t)
+    step, tries = newton.Newton.step, []
+
+    def failing(self, H, t, H_target, t_prev=None):
+        if t > t_fail:
+            tries.append(t)
+            if len(tries) > 200:
+                raise RuntimeError(f"the same failed step is retried: {len(tries)} tries at t = {t!r}")
+            raise failures.NotConverged("no convergence (test)", 1.0)
+        return step(self, H, t, H_target, t_prev)
+    monkeypatch.setattr(newton.Newton, "step", failing)
+    with pytest.raises(bs.ConvergenceError, match="step fell below"):
+        bs.solve(m, steps=1, min_step_ratio=2e-9, verbose=False)
+    assert len(tries) <= 80 and t_fail < tries[-1] <= t_fail + 2e-9 * (1 + 1e-6)
