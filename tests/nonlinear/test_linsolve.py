@@ -10,7 +10,7 @@ from beamsolver.errors import InputError
 HAVE_PARDISO = "pardiso" in linsolve.available()
 BACKENDS = ["splu", "splu-rcm", pytest.param("pardiso", marks=pytest.mark.skipif(not HAVE_PARDISO,
                                                                                  reason="pypardiso not installed")),
-            "auto"]
+            "dense", "auto"]
 
 
 def spd_matrix(n=60, seed=0):
@@ -78,7 +78,8 @@ def test_missing_pardiso_is_an_input_error(monkeypatch):
     monkeypatch.setattr(linsolve, "_pypardiso", lambda: None)
     with pytest.raises(InputError, match="pypardiso"):
         linsolve.Solver("pardiso")
-    assert linsolve.Solver("auto").backend_for(spd_matrix()) == "splu"
+    assert linsolve.Solver("auto").backend_for(spd_matrix()) == "dense"
+    assert linsolve.Solver("auto").backend_for(spd_matrix(linsolve.DENSE_MAX_UNKNOWNS + 1)) == "splu"
     assert "pardiso" not in linsolve.available()
     assert linsolve.Solver("auto").backend_for(coupled_matrix()) == "splu-rcm"
 
@@ -93,7 +94,7 @@ def coupled_matrix(n=2000, half_band=20):
 
 def test_auto_choice():
     small, coupled = spd_matrix(), coupled_matrix()
-    assert linsolve.Solver("auto").backend_for(small) == "splu"
+    assert linsolve.Solver("auto").backend_for(small) == "dense"
     assert linsolve.Solver("auto").backend_for(coupled) == ("pardiso" if HAVE_PARDISO else "splu-rcm")
     b = np.ones(coupled.shape[0])
     np.testing.assert_allclose(linsolve.factorize(coupled, "auto").solve(b),
@@ -229,6 +230,24 @@ def test_saddle_point(backend, make):
     np.testing.assert_allclose(f.solve(b), x_dense, rtol=1e-9, atol=1e-11 * np.abs(x_dense).max())
     if hasattr(f, "det_sign"):
         assert f.det_sign() == np.sign(np.linalg.det(A.toarray()))
+
+
+def test_auto_factorises_small_systems_dense():
+    """``auto`` up to ``DENSE_MAX_UNKNOWNS`` unknowns: LAPACK's dense LU (the small scenes' condensed tangents fill in,
+    SuperLU costs 2.6x); above: SuperLU.  The dense factor solves one and several right-hand sides as splu does, to
+    round-off, and its determinant sign is the dense determinant's also with an odd number of row interchanges."""
+    n = linsolve.DENSE_MAX_UNKNOWNS
+    for size, backend in ((n, "dense"), (n + 1, "splu")):
+        A = nonsymmetric_matrix(size)
+        assert linsolve.Solver("auto").backend_for(A) == backend
+        f = linsolve.Solver("auto").factorize(A)
+        assert f.backend == backend
+        B = np.random.default_rng(3).standard_normal((size, 3))
+        np.testing.assert_allclose(f.solve(B), linsolve.factorize(A, "splu").solve(B), rtol=1e-12, atol=1e-14)
+    P = sp.csc_matrix(np.eye(5)[[1, 0, 2, 3, 4]] * 2.0 + np.triu(np.ones((5, 5)), 1) * 0.1)
+    f = linsolve.factorize(P, "dense")
+    assert f.det_sign() == np.sign(np.linalg.det(P.toarray())) == -1
+    assert f.factor_nnz == 25
 
 
 def test_saddle_point_auto_coupled():
