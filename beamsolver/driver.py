@@ -96,11 +96,11 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     t_end, steps + 1)`` with its stepping state and contact history, so the
     same arguments give the same final state as a run never interrupted.
     ``linear_solver``: sparse direct solver of the Newton systems, ``"auto"``
-    (default: LAPACK's dense LU, ``"dense"``, up to 256 unknowns; scipy ``"splu"`` for beams and small
-    scenes; for large bundles
+    (default: scipy ``"splu"`` for beams and small scenes; for large bundles
     of wires in contact ``"pardiso"`` if pypardiso is installed, ``pip install
     "beamsolver[fast]"``, else ``"splu-rcm"``, scipy after an RCM ordering),
-    or one of those by name (see ``beamsolver.nonlinear.linsolve``).
+    or one of those by name, or ``"dense"`` (LAPACK's LU of the matrix made dense: faster on small
+    contact scenes' condensed systems, less accurate on a slender beam's; see ``beamsolver.nonlinear.linsolve``).
     ``allow_unmet_tolerance``: accept a step whose contact penetration still
     exceeds ``add_contact(tolerance=)`` after the augmented-Lagrangian updates,
     with a warning in ``stats[k]["warnings"]`` and ``Solution.message``

@@ -78,8 +78,7 @@ def test_missing_pardiso_is_an_input_error(monkeypatch):
     monkeypatch.setattr(linsolve, "_pypardiso", lambda: None)
     with pytest.raises(InputError, match="pypardiso"):
         linsolve.Solver("pardiso")
-    assert linsolve.Solver("auto").backend_for(spd_matrix()) == "dense"
-    assert linsolve.Solver("auto").backend_for(spd_matrix(linsolve.DENSE_MAX_UNKNOWNS + 1)) == "splu"
+    assert linsolve.Solver("auto").backend_for(spd_matrix()) == "splu"
     assert "pardiso" not in linsolve.available()
     assert linsolve.Solver("auto").backend_for(coupled_matrix()) == "splu-rcm"
 
@@ -94,7 +93,7 @@ def coupled_matrix(n=2000, half_band=20):
 
 def test_auto_choice():
     small, coupled = spd_matrix(), coupled_matrix()
-    assert linsolve.Solver("auto").backend_for(small) == "dense"
+    assert linsolve.Solver("auto").backend_for(small) == "splu"
     assert linsolve.Solver("auto").backend_for(coupled) == ("pardiso" if HAVE_PARDISO else "splu-rcm")
     b = np.ones(coupled.shape[0])
     np.testing.assert_allclose(linsolve.factorize(coupled, "auto").solve(b),
@@ -232,11 +231,13 @@ def test_saddle_point(backend, make):
         assert f.det_sign() == np.sign(np.linalg.det(A.toarray()))
 
 
-def test_auto_factorises_small_systems_dense():
-    """``auto`` up to ``DENSE_MAX_UNKNOWNS`` unknowns: LAPACK's dense LU (the small scenes' condensed tangents fill in,
-    SuperLU costs 2.6x); above: SuperLU.  The dense factor solves one and several right-hand sides as splu does, to
-    round-off, and its determinant sign is the dense determinant's also with an odd number of row interchanges."""
-    n = linsolve.DENSE_MAX_UNKNOWNS
+def test_auto_factorises_small_systems_dense(monkeypatch):
+    """``auto`` up to ``DENSE_MAX_UNKNOWNS`` unknowns (0 by default: never) LAPACK's dense LU; above: SuperLU.  The
+    dense factor solves one and several right-hand sides as splu does, to round-off, and its determinant sign is the
+    dense determinant's also with an odd number of row interchanges."""
+    assert linsolve.DENSE_MAX_UNKNOWNS == 0 and linsolve.Solver("auto").backend_for(nonsymmetric_matrix(5)) == "splu"
+    n = 256
+    monkeypatch.setattr(linsolve, "DENSE_MAX_UNKNOWNS", n)
     for size, backend in ((n, "dense"), (n + 1, "splu")):
         A = nonsymmetric_matrix(size)
         assert linsolve.Solver("auto").backend_for(A) == backend
