@@ -24,8 +24,8 @@ Back-ends (``backend=`` here, ``linear_solver=`` in ``beamsolver.solve``):
 - ``"dense"``: LAPACK's LU with partial pivoting (``dgetrf``/``dgetrs``) of the matrix made dense.
   The condensed tangents of small scenes (the main job: 180-230 unknowns, 5-25 % non-zeros) fill in
   anyway: SuperLU spends 0.86 ms on one where ``dgetrf`` takes 0.33 ms (docs/benchmarks.md, session 14,
-  branch bF); at ~500 unknowns SuperLU is 2x faster again.  By name only (``DENSE_MAX_UNKNOWNS``: its
-  accuracy on a slender beam's band is below SuperLU's).
+  branch bF); at ~500 unknowns SuperLU is 2x faster again.  ``"auto"`` takes it for saddle-point systems of
+  at most ``DENSE_MAX_UNKNOWNS`` unknowns only: on a slender beam's band its accuracy is below SuperLU's.
 - ``"auto"`` (default): the rule of ``Solver.backend_for``.
 
 Evaluated on the bundles' tangents and not used (``benchmarks/linear_solvers.py``, numbers in
@@ -77,13 +77,11 @@ SADDLE_REFINE = 20        # ... and up to 20 steps of iterative refinement (ipar
 SADDLE_SPLU_ORDERING = "MMD_AT_PLUS_A"   # splu on saddle-point systems; "COLAMD" factorises the main job's bordered
                                   # tangents in 0.40 ms against 0.63 (20 % less fill), but its round-off took the
                                   # plectoneme's five-turn run into a crawl at t = 0.6553 (docs/benchmarks.md, session 8)
-DENSE_MAX_UNKNOWNS = 0         # "auto": up to this size "dense" (LAPACK getrf); 0: never.  256 measured: the main job's
-#                                condensed tangents (180-230 unknowns) in 0.33 ms against SuperLU's 0.86, the main job
-#                                9-16 % faster, its poses 2e-13 off; not the default: the slender roll-up (stability.py,
-#                                slenderness 1e3, one beam's band) is then 1.2e-9 off its closed form against SuperLU's
-#                                6.5e-11 (partial pivoting across the band; a refinement step: 7.8e-10), and the shear
-#                                lag's first augmented solve no longer stalls into its fallback (docs/benchmarks.md,
-#                                session 14, branch bF)
+DENSE_MAX_UNKNOWNS = 256       # "auto": saddle-point systems up to this size "dense" (LAPACK getrf): the main job's
+#                                condensed / bordered multiplier systems (180-230 unknowns) in 0.33 ms against SuperLU's
+#                                0.86, the main job 13 % faster, poses 2e-13 off (docs/benchmarks.md, session 14,
+#                                branch bF).  Not plain tangents: a slender beam's band loses accuracy under partial
+#                                pivoting (the roll-up of slenderness 1e3 1.2e-9 off its closed form against 6.5e-11)
 AUTO_MIN_UNKNOWNS = 1_500      # "auto": below this size the default splu is as fast as any
 AUTO_COUPLED_NNZ = 24.0        # "auto": non-zeros per column above which contact couples the beams
 BACKWARD_ERROR = 1e-9          # pardiso, splu-rcm: |K x - b| / (|K| |x| + |b|) above this -> re-analyse / pivot fully
@@ -227,13 +225,13 @@ class Solver:
         self._backoff = 0               # the skip after the next failed lagged solve
         self.stats = dict(factorizations=0, analyses=0, lagged=0, krylov_iterations=0, lag_failures=0)
 
-    def backend_for(self, K):
+    def backend_for(self, K, saddle=False):
         """The back-end ``factorize`` uses for ``K`` (resolves ``"auto"``).
 
         The rule of ``"auto"``, by size and coupling (symmetry plays no part: Newton tangents are
         unsymmetric, module docstring):
 
-        - at most ``DENSE_MAX_UNKNOWNS`` unknowns (0 by default: none): ``"dense"``;
+        - a saddle-point system (``saddle``) of at most ``DENSE_MAX_UNKNOWNS`` unknowns: ``"dense"``;
         - fewer than ``AUTO_MIN_UNKNOWNS`` unknowns, or at most ``AUTO_COUPLED_NNZ`` non-zeros per
           column (a beam or a frame: about 18; no contact coupling many beams): ``"splu"``.  A
           beam's matrix is a band, SuperLU's MMD ordering finds it, and neither PARDISO's analysis
@@ -246,7 +244,7 @@ class Solver:
         if self.requested != "auto":
             return self.requested
         n = K.shape[0]
-        if n <= DENSE_MAX_UNKNOWNS:
+        if saddle and n <= DENSE_MAX_UNKNOWNS:
             return "dense"
         if n >= AUTO_MIN_UNKNOWNS and K.nnz > AUTO_COUPLED_NNZ * n:
             return "pardiso" if _pypardiso() is not None else "splu-rcm"
@@ -338,7 +336,7 @@ class Solver:
 
     def _factorize(self, K, saddle=False):
         self.stats["factorizations"] += 1
-        backend = self.backend_for(K)
+        backend = self.backend_for(K, saddle)
         if backend == "splu":
             return _SpluFactor(K, SADDLE_SPLU_ORDERING if saddle else "MMD_AT_PLUS_A")
         if backend == "splu-rcm":
