@@ -99,7 +99,8 @@ def solve(model, steps=20, t_end=1.0, output=None, *, t_start=0.0, rtol=1e-8, dt
     (default: scipy ``"splu"`` for beams and small scenes; for large bundles
     of wires in contact ``"pardiso"`` if pypardiso is installed, ``pip install
     "beamsolver[fast]"``, else ``"splu-rcm"``, scipy after an RCM ordering),
-    or one of those by name (see ``beamsolver.nonlinear.linsolve``).
+    or one of those by name, or ``"dense"`` (LAPACK's LU of every system made dense: for small systems only,
+    less accurate on a slender beam's band; see ``beamsolver.nonlinear.linsolve``).
     ``allow_unmet_tolerance``: accept a step whose contact penetration still
     exceeds ``add_contact(tolerance=)`` after the augmented-Lagrangian updates,
     with a warning in ``stats[k]["warnings"]`` and ``Solution.message``

@@ -21,6 +21,12 @@ Back-ends (``backend=`` here, ``linear_solver=`` in ``beamsolver.solve``):
   bundles of wires in contact SuperLU's MMD ordering fills in superlinearly;
   the RCM band's fill stays linear in the length (docs/benchmarks.md,
   ``benchmarks/scaling.py``).  On a single beam both give the same factor.
+- ``"dense"``: LAPACK's LU with partial pivoting (``dgetrf``/``dgetrs``) of the matrix made dense.
+  The condensed tangents of small scenes (the main job: 180-230 unknowns, 5-25 % non-zeros) fill in
+  anyway: SuperLU spends 0.86 ms on one where ``dgetrf`` takes 0.33 ms (docs/benchmarks.md, session 14,
+  branch bF); at ~500 unknowns SuperLU is 2x faster again.  ``"auto"`` takes it for saddle-point systems of
+  at most ``DENSE_MAX_UNKNOWNS`` unknowns only (0 by default: none; on a slender beam's band its accuracy is
+  below SuperLU's, and its round-off sent the plectoneme's five-turn run into a crawl).
 - ``"auto"`` (default): the rule of ``Solver.backend_for``.
 
 Evaluated on the bundles' tangents and not used (``benchmarks/linear_solvers.py``, numbers in
@@ -65,13 +71,20 @@ from .lagged import LaggedFactor
 __all__ = ["factorize", "factorize_tangent", "Solver", "SingularMatrixError", "available", "permutation_sign",
            "BACKENDS", "DEFAULT"]
 
-BACKENDS = ("splu", "splu-rcm", "pardiso", "auto")
+BACKENDS = ("splu", "splu-rcm", "pardiso", "dense", "auto")
 DEFAULT = "auto"          # splu for beams and small scenes; pardiso (else splu-rcm) for coupled ones
 SADDLE_PERTURB = 8        # PARDISO on saddle-point systems: pivots perturbed to 1e-8 |K| (iparm(10))
 SADDLE_REFINE = 20        # ... and up to 20 steps of iterative refinement (iparm(8)); ``Solver.factorize``
 SADDLE_SPLU_ORDERING = "MMD_AT_PLUS_A"   # splu on saddle-point systems; "COLAMD" factorises the main job's bordered
                                   # tangents in 0.40 ms against 0.63 (20 % less fill), but its round-off took the
                                   # plectoneme's five-turn run into a crawl at t = 0.6553 (docs/benchmarks.md, session 8)
+DENSE_MAX_UNKNOWNS = 0         # "auto": saddle-point systems up to this size "dense" (LAPACK getrf); 0: none.  256: the
+#                                main job's condensed / bordered multiplier systems (180-230 unknowns) in 0.33 ms against
+#                                SuperLU's 0.86, the main job 13 % faster, poses 2e-13 off; not the default: with it the
+#                                plectoneme's five-turn run (exact stick, the slow test) had not passed after 9 min CPU
+#                                (46-74 s on SuperLU), as with COLAMD (``SADDLE_SPLU_ORDERING``); plain tangents never
+#                                (a slender beam's band: the roll-up of slenderness 1e3 1.2e-9 off its closed form
+#                                against 6.5e-11).  docs/benchmarks.md, session 14, branch bF
 AUTO_MIN_UNKNOWNS = 1_500      # "auto": below this size the default splu is as fast as any
 AUTO_COUPLED_NNZ = 24.0        # "auto": non-zeros per column above which contact couples the beams
 BACKWARD_ERROR = 1e-9          # pardiso, splu-rcm: |K x - b| / (|K| |x| + |b|) above this -> re-analyse / pivot fully
@@ -215,12 +228,13 @@ class Solver:
         self._backoff = 0               # the skip after the next failed lagged solve
         self.stats = dict(factorizations=0, analyses=0, lagged=0, krylov_iterations=0, lag_failures=0)
 
-    def backend_for(self, K):
+    def backend_for(self, K, saddle=False):
         """The back-end ``factorize`` uses for ``K`` (resolves ``"auto"``).
 
         The rule of ``"auto"``, by size and coupling (symmetry plays no part: Newton tangents are
         unsymmetric, module docstring):
 
+        - a saddle-point system (``saddle``) of at most ``DENSE_MAX_UNKNOWNS`` (0: none) unknowns: ``"dense"``;
         - fewer than ``AUTO_MIN_UNKNOWNS`` unknowns, or at most ``AUTO_COUPLED_NNZ`` non-zeros per
           column (a beam or a frame: about 18; no contact coupling many beams): ``"splu"``.  A
           beam's matrix is a band, SuperLU's MMD ordering finds it, and neither PARDISO's analysis
@@ -233,6 +247,8 @@ class Solver:
         if self.requested != "auto":
             return self.requested
         n = K.shape[0]
+        if saddle and n <= DENSE_MAX_UNKNOWNS:
+            return "dense"
         if n >= AUTO_MIN_UNKNOWNS and K.nnz > AUTO_COUPLED_NNZ * n:
             return "pardiso" if _pypardiso() is not None else "splu-rcm"
         return "splu"
@@ -323,11 +339,13 @@ class Solver:
 
     def _factorize(self, K, saddle=False):
         self.stats["factorizations"] += 1
-        backend = self.backend_for(K)
+        backend = self.backend_for(K, saddle)
         if backend == "splu":
             return _SpluFactor(K, SADDLE_SPLU_ORDERING if saddle else "MMD_AT_PLUS_A")
         if backend == "splu-rcm":
             return _SpluRcmFactor(K)
+        if backend == "dense":
+            return _DenseFactor(K)
         if self._pardiso is None:
             self._pardiso = _Pardiso(_pypardiso())
         return self._pardiso.factorize(K, self.stats, saddle)
@@ -366,6 +384,39 @@ class _SpluFactor:
         two permutations."""
         d = self._lu.U.diagonal()
         return int(np.prod(np.sign(d))) * permutation_sign(self._lu.perm_r) * permutation_sign(self._lu.perm_c)
+
+
+class _DenseFactor:
+    """LAPACK's ``dgetrf`` of ``K`` made dense (``P K = L U``, partial pivoting); ``solve`` by ``dgetrs``."""
+    backend = "dense"
+
+    def __init__(self, K):
+        from scipy.linalg.lapack import dgetrf
+        A = K.toarray() if sp.issparse(K) else np.array(K, dtype=float)
+        self._lu, self._piv, info = dgetrf(np.asfortranarray(A, dtype=float), overwrite_a=1)
+        if info > 0 or not np.all(np.isfinite(self._lu.diagonal())):
+            raise SingularMatrixError("Factor is exactly singular")
+        if info < 0:
+            raise ValueError(f"dgetrf: illegal argument {-info}")
+
+    @property
+    def factor_nnz(self):
+        return int(self._lu.size)
+
+    def solve(self, b):
+        from scipy.linalg.lapack import dgetrs
+        x, info = dgetrs(self._lu, self._piv, np.asarray(b, dtype=float))
+        if info != 0:
+            raise ValueError(f"dgetrs: illegal argument {-info}")
+        return x
+
+    apply = solve          # as a preconditioner (``lagged``): the same solve
+
+    def det_sign(self):
+        """Sign of ``det(K)`` (1, -1; 0 for a zero pivot): that of ``prod diag(U)`` times ``(-1)`` per row
+        interchange (``piv[i] != i``, LAPACK's 0-based pivots in scipy)."""
+        swaps = int(np.count_nonzero(self._piv != np.arange(len(self._piv))))
+        return int(np.prod(np.sign(self._lu.diagonal()))) * (-1 if swaps % 2 else 1)
 
 
 def _same_pattern(f, K):

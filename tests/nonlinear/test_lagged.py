@@ -10,7 +10,8 @@ import rolling
 
 HAVE_PARDISO = "pardiso" in linsolve.available()
 BACKENDS = ["splu", "splu-rcm", pytest.param("pardiso", marks=pytest.mark.skipif(not HAVE_PARDISO,
-                                                                                 reason="pypardiso not installed"))]
+                                                                                 reason="pypardiso not installed")),
+            "dense"]
 
 
 def matrix(n=300, seed=1):

@@ -10,7 +10,7 @@ from beamsolver.errors import InputError
 HAVE_PARDISO = "pardiso" in linsolve.available()
 BACKENDS = ["splu", "splu-rcm", pytest.param("pardiso", marks=pytest.mark.skipif(not HAVE_PARDISO,
                                                                                  reason="pypardiso not installed")),
-            "auto"]
+            "dense", "auto"]
 
 
 def spd_matrix(n=60, seed=0):
@@ -229,6 +229,29 @@ def test_saddle_point(backend, make):
     np.testing.assert_allclose(f.solve(b), x_dense, rtol=1e-9, atol=1e-11 * np.abs(x_dense).max())
     if hasattr(f, "det_sign"):
         assert f.det_sign() == np.sign(np.linalg.det(A.toarray()))
+
+
+def test_auto_factorises_small_saddle_systems_dense(monkeypatch):
+    """``auto``: saddle-point systems up to ``DENSE_MAX_UNKNOWNS`` unknowns (0 by default: none) by LAPACK's dense LU
+    (the small contact scenes' condensed systems fill in, SuperLU costs 2.6x); larger ones, and plain matrices of any
+    size, by SuperLU.
+    The dense factor solves one and several right-hand sides as splu does, to round-off, and its determinant sign is
+    the dense determinant's, also with an odd number of row interchanges."""
+    assert linsolve.DENSE_MAX_UNKNOWNS == 0
+    assert linsolve.Solver("auto").backend_for(saddle_point(nonsymmetric_matrix(40), 12), saddle=True) == "splu"
+    n = 256
+    monkeypatch.setattr(linsolve, "DENSE_MAX_UNKNOWNS", n)
+    for size, saddle, backend in ((n, True, "dense"), (n + 1, True, "splu"), (60, False, "splu")):
+        A = saddle_point(nonsymmetric_matrix(size - 12), 12)
+        assert linsolve.Solver("auto").backend_for(A, saddle=saddle) == backend
+        f = linsolve.Solver("auto").factorize(A, saddle=saddle)
+        assert f.backend == backend
+        B = np.random.default_rng(3).standard_normal((size, 3))
+        np.testing.assert_allclose(f.solve(B), linsolve.factorize(A, "splu").solve(B), rtol=1e-10, atol=1e-12)
+    P = sp.csc_matrix(np.eye(5)[[1, 0, 2, 3, 4]] * 2.0 + np.triu(np.ones((5, 5)), 1) * 0.1)
+    f = linsolve.factorize(P, "dense")
+    assert f.det_sign() == np.sign(np.linalg.det(P.toarray())) == -1
+    assert f.factor_nnz == 25
 
 
 def test_saddle_point_auto_coupled():
