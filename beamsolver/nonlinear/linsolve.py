@@ -25,8 +25,7 @@ Back-ends (``backend=`` here, ``linear_solver=`` in ``beamsolver.solve``):
   The condensed tangents of small scenes (the main job: 180-230 unknowns, 5-25 % non-zeros) fill in
   anyway: SuperLU spends 0.86 ms on one where ``dgetrf`` takes 0.33 ms (docs/benchmarks.md, session 14,
   branch bF); at ~500 unknowns SuperLU is 2x faster again.  ``"auto"`` takes it for saddle-point systems of
-  at most ``DENSE_MAX_UNKNOWNS`` unknowns only (0 by default: none; on a slender beam's band its accuracy is
-  below SuperLU's, and its round-off sent the plectoneme's five-turn run into a crawl).
+  at most ``DENSE_MAX_UNKNOWNS`` (256) unknowns only (on a slender beam's band its accuracy is below SuperLU's).
 - ``"auto"`` (default): the rule of ``Solver.backend_for``.
 
 Evaluated on the bundles' tangents and not used (``benchmarks/linear_solvers.py``, numbers in
@@ -78,13 +77,12 @@ SADDLE_REFINE = 20        # ... and up to 20 steps of iterative refinement (ipar
 SADDLE_SPLU_ORDERING = "MMD_AT_PLUS_A"   # splu on saddle-point systems; "COLAMD" factorises the main job's bordered
                                   # tangents in 0.40 ms against 0.63 (20 % less fill), but its round-off took the
                                   # plectoneme's five-turn run into a crawl at t = 0.6553 (docs/benchmarks.md, session 8)
-DENSE_MAX_UNKNOWNS = 0         # "auto": saddle-point systems up to this size "dense" (LAPACK getrf); 0: none.  256: the
-#                                main job's condensed / bordered multiplier systems (180-230 unknowns) in 0.33 ms against
-#                                SuperLU's 0.86, the main job 13 % faster, poses 2e-13 off; not the default: with it the
-#                                plectoneme's five-turn run (exact stick, the slow test) had not passed after 9 min CPU
-#                                (46-74 s on SuperLU), as with COLAMD (``SADDLE_SPLU_ORDERING``); plain tangents never
-#                                (a slender beam's band: the roll-up of slenderness 1e3 1.2e-9 off its closed form
-#                                against 6.5e-11).  docs/benchmarks.md, session 14, branch bF
+DENSE_MAX_UNKNOWNS = 256       # "auto": saddle-point systems up to this size "dense" (LAPACK getrf); 0: none.  The main
+#                                job's condensed / bordered multiplier systems (180-230 unknowns) in 0.33 ms against
+#                                SuperLU's 0.86, the main job 13 % faster, poses 2e-13 off; plain tangents never (a
+#                                slender beam's band: the roll-up of slenderness 1e3 1.2e-9 off its closed form against
+#                                6.5e-11).  docs/benchmarks.md, session 14, branch bF, and session 15 (the plectoneme's
+#                                five-turn run passes with it: its stall in session 14 was exact stick's tail rule)
 AUTO_MIN_UNKNOWNS = 1_500      # "auto": below this size the default splu is as fast as any
 AUTO_COUPLED_NNZ = 24.0        # "auto": non-zeros per column above which contact couples the beams
 BACKWARD_ERROR = 1e-9          # pardiso, splu-rcm: |K x - b| / (|K| |x| + |b|) above this -> re-analyse / pivot fully
@@ -234,7 +232,7 @@ class Solver:
         The rule of ``"auto"``, by size and coupling (symmetry plays no part: Newton tangents are
         unsymmetric, module docstring):
 
-        - a saddle-point system (``saddle``) of at most ``DENSE_MAX_UNKNOWNS`` (0: none) unknowns: ``"dense"``;
+        - a saddle-point system (``saddle``) of at most ``DENSE_MAX_UNKNOWNS`` (256; 0: none) unknowns: ``"dense"``;
         - fewer than ``AUTO_MIN_UNKNOWNS`` unknowns, or at most ``AUTO_COUPLED_NNZ`` non-zeros per
           column (a beam or a frame: about 18; no contact coupling many beams): ``"splu"``.  A
           beam's matrix is a band, SuperLU's MMD ordering finds it, and neither PARDISO's analysis

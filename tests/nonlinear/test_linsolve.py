@@ -232,14 +232,15 @@ def test_saddle_point(backend, make):
 
 
 def test_auto_factorises_small_saddle_systems_dense(monkeypatch):
-    """``auto``: saddle-point systems up to ``DENSE_MAX_UNKNOWNS`` unknowns (0 by default: none) by LAPACK's dense LU
+    """``auto``: saddle-point systems up to ``DENSE_MAX_UNKNOWNS`` = 256 unknowns (0: none) by LAPACK's dense LU
     (the small contact scenes' condensed systems fill in, SuperLU costs 2.6x); larger ones, and plain matrices of any
     size, by SuperLU.
     The dense factor solves one and several right-hand sides as splu does, to round-off, and its determinant sign is
     the dense determinant's, also with an odd number of row interchanges."""
-    assert linsolve.DENSE_MAX_UNKNOWNS == 0
+    n = linsolve.DENSE_MAX_UNKNOWNS
+    assert n == 256
+    monkeypatch.setattr(linsolve, "DENSE_MAX_UNKNOWNS", 0)
     assert linsolve.Solver("auto").backend_for(saddle_point(nonsymmetric_matrix(40), 12), saddle=True) == "splu"
-    n = 256
     monkeypatch.setattr(linsolve, "DENSE_MAX_UNKNOWNS", n)
     for size, saddle, backend in ((n, True, "dense"), (n + 1, True, "splu"), (60, False, "splu")):
         A = saddle_point(nonsymmetric_matrix(size - 12), 12)
