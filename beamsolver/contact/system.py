@@ -92,6 +92,8 @@ SEARCH_CENTRES = True    # the centre points of the Gauss-point pairs taken from
 KEPT_KINDS_SKIP = True   # the search computes no closest points for a crossing whose kind the step keeps as orthogonal
 #                          (``history.step_kinds`` overwrites it, an orthogonal pair reads no closest point): the same
 #                          kinds and points, bit for bit (``_candidates``); False: every crossing's, as before
+HOLD_POINT_KINDS = True  # a Gauss point's owner keeps its projection kind (line / orthogonal) within a step while a row
+#                          of that kind is accepted (``history.step_point_kinds``; False: decided at each evaluation)
 PIECES = True            # a joint continuing a beam by the next (a wire in pieces) is an inner node of the owners and
 #                          point pairs: projections accepted past it by XI_OVERHANG, one owner per slave point over the
 #                          pieces (``rules.pieces``; False: each piece's ends are beam ends, its points keyed by piece)
@@ -641,9 +643,13 @@ class ContactSystem(Contribution):
                                                   centres=SEARCH_CENTRES)
         self._lap("projection")
         gk = g if slot is None else g + self.max_gp * slot[r]
+        if HOLD_POINT_KINDS and len(r) and len(self.history.point_keys):
+            dist = self._held_point_kinds(d, e, m, kind, r, gk, xi2, dist)
         s, key, tied = gauss_owners(d.index, len(en), self.key_gp, self.n_beams, e, m, gk, xi2, dist, self.el_first_end,
                                     self.el_last_end, self.el_key_beam, self.el_radius, self.history.prev_owners, pair=r,
                                     order=True)
+        if HOLD_POINT_KINDS:
+            self.history.step_point_kinds(key, kind[r[s]])
         f, ids = gauss_record(s, key, r, g, xi2, e, m, kind, xg, wg, self.sys.L, en, self.el_radius,
                               segments)
         rec = PairSet(key=key, decl=np.full(len(s), d.index), **f)
@@ -651,6 +657,31 @@ class ContactSystem(Contribution):
             self._part_centres[id(rec)] = (rec, xCF[0][s], xCF[1][s])     # (the record held: its id not reused)
         self._lap("rules")
         return rec, ids, tied
+
+    def _held_point_kinds(self, d, e, m, kind, r, gk, xi2, dist):
+        """The distances ``dist`` of the projected rows (element pair ``r``, key Gauss point ``gk``) with the rows of a
+        key whose owner kind the step keeps (``history.step_point_kinds``) set to nan where they are of another kind and
+        the key has an accepted row of the kept kind (in ``rules.xi_range``, finite distance): no owner among them.  A
+        key without such a row takes its owner from all (its point does not vanish)."""
+        kept = self.history.point_kinds
+        if len(kind) and (kind == kind[0]).all() and (kept == kind[0]).all():
+            return dist              # (one kind of projection, as on line contact alone: nothing to hold)
+        n_el = np.int64(len(self.sys.enodes))
+        er, mr, kr = e[r], m[r], kind[r]
+        key = ((np.int64(d.index) * n_el + er) * self.key_gp + gk) * self.n_beams + self.el_key_beam[mr]
+        held = self.history.held_point_kinds(key)
+        lo, hi = rules.xi_range(self.el_first_end[mr], self.el_last_end[mr])
+        ok = (xi2 >= lo) & (xi2 <= hi) & np.isfinite(dist) & (kr == held)
+        other = (held >= 0) & (kr != held)
+        if not other.any() or not ok.any():
+            return dist
+        covered = _member(key, np.unique(key[ok]))
+        drop = other & covered
+        if not drop.any():
+            return dist
+        dist = dist.copy()
+        dist[drop] = np.nan
+        return dist
 
     def _segments(self, e, m, kind):
         """Which element pairs are integrated over segments and the key slot of each pair
