@@ -13,7 +13,8 @@ Keyed by material contact point (``state.KeyLayout``: a Gauss point's key, or a 
   keeps it);
 - the friction coefficients of the last accepted step (``mu_committed``: a declaration whose
   friction switches on starts its history afresh, ``start_friction``);
-- the kinds of crossing element pairs decided within the step (``step_kinds``);
+- the kinds of crossing element pairs decided within the step (``step_kinds``), and the projection kind of each
+  Gauss point's owner (``step_point_kinds``);
 - the search's memory: ``prev_points`` (``e n_el + m``) and ``prev_owners`` (``key n_el + m``), the
   point pairs and Gauss-point owners of the last evaluation (the hysteresis of the ownership rules).
 
@@ -150,9 +151,11 @@ class ContactHistory:
 
     # ------------------------------------------------------------ kinds of crossings
     def forget_kinds(self):
-        """Empty the kinds of the step (``step_kinds``, ``step_crossings``): the next evaluation decides them."""
+        """Empty the kinds of the step (``step_kinds``, ``step_crossings``, ``point_kinds``): the next evaluation decides
+        them."""
         self.kind_keys, self.kind_values = np.zeros(0, dtype=np.int64), np.zeros(0, dtype=int)
         self.cross_keys, self.cross_values = np.zeros(0, dtype=np.int64), np.zeros(0, dtype=bool)
+        self.point_keys, self.point_kinds = np.zeros(0, dtype=np.int64), np.zeros(0, dtype=int)
 
     def step_crossings(self, decl, e, m, cross):
         """Line or crossing of element pairs kept within a step (exact stick's declarations): a pair (declaration
@@ -210,16 +213,37 @@ class ContactHistory:
             self.kind_keys, self.kind_values = k[order], v[order]
         return kinds
 
+    def held_point_kinds(self, keys):
+        """The projection kinds ``step_point_kinds`` keeps for the Gauss-point ``keys`` in this step: ``(n,)``, ``-1``
+        where none is kept yet."""
+        idx, found = lookup(self.point_keys, keys)
+        return np.where(found, self.point_kinds[idx] if len(self.point_kinds) else -1, -1)
+
+    def step_point_kinds(self, keys, kinds):
+        """Remember the projection kind (``LINE``, ``ORTHOGONAL``) of the owners of Gauss-point ``keys`` not yet kept in
+        the step: the owners of a later evaluation of the step are of that kind while one of its rows is accepted
+        (``ContactSystem._gauss_pairs``).  The two kinds measure a point differently (the section plane's master point
+        against the orthogonal foot) and act with different laws (line contact's smoothing, exact stick's mortar
+        friction against the point law): a point handed from one kind to the other between Newton iterates changes
+        its force (the plectoneme: 0.5 N at t = 0.566, 96 N at t = 0.797) and Newton cycles at any step size."""
+        idx, found = lookup(self.point_keys, keys)
+        if found.all():
+            return
+        k = np.concatenate([self.point_keys, keys[~found]])
+        v = np.concatenate([self.point_kinds, kinds[~found]])
+        order = np.argsort(k, kind="stable")
+        self.point_keys, self.point_kinds = k[order], v[order]
+
     # ------------------------------------------------------------ the search's memory
     def memory(self):
         """The search's memory (point pairs, owners, kinds and crossings of the step), for ``recall``."""
         return (self.prev_points, self.prev_owners, self.kind_keys, self.kind_values, self.cross_keys,
-                self.cross_values)
+                self.cross_values, self.point_keys, self.point_kinds)
 
     def recall(self, memory):
         """Put back the search's memory saved by ``memory``."""
         (self.prev_points, self.prev_owners, self.kind_keys, self.kind_values, self.cross_keys,
-         self.cross_values) = memory
+         self.cross_values, self.point_keys, self.point_kinds) = memory
 
     # ------------------------------------------------------------ restart
     def state(self):

@@ -19,7 +19,7 @@ from scipy.spatial import cKDTree
 from .frames import ORTHOGONAL, POINT
 from .search import XI_TOL
 
-__all__ = ["joint_nodes", "apart", "crossing", "may_cross", "point_or_orthogonal", "extend_wrap", "xi_range", "owners", "dedupe_points", "XI_OVERHANG", "OWNER_TIE"]
+__all__ = ["joint_nodes", "pieces", "apart", "crossing", "may_cross", "point_or_orthogonal", "extend_wrap", "xi_range", "owners", "dedupe_points", "XI_OVERHANG", "OWNER_TIE"]
 
 XI_OVERHANG = 0.05        # accepted projection past an inner node, in element lengths (kinks of the C0 line)
 WRAP_END = 0.05          # extend_wrap: a slave closest point this close to an element end counts as at the end
@@ -46,6 +46,32 @@ def joint_nodes(group, x, tol):
         return np.arange(n)
     tie = coo_matrix((np.ones(len(ij)), (ij[:, 0], ij[:, 1])), shape=(n, n))
     return connected_components(tie, directed=False)[1]
+
+
+def pieces(joint_enodes, beam, first, last, n_beams):
+    """Beams continued by the next beam at a joint (a wire made of pieces, ``join(a.last, b.first)``): the
+    key's master beam and the ends of the runs of pieces.
+
+    ``joint_enodes`` ``(n_el, 2)``: end nodes merged by ``joint_nodes``; ``beam``, ``first``, ``last`` ``(n_el,)``:
+    each element's beam and whether it is its beam's first / last.  Element ``e``, its beam's last, is continued by
+    element ``e + 1``, the next beam's first, where they meet at a joint (the element ids run on through the
+    joint, as the friction history's re-expression of a material point on the next element needs).  Returns
+    ``(key_beam, first_end, last_end)`` ``(n_el,)``: the first beam of each element's run of pieces (a slave
+    Gauss point has one owner over the run, ``ownership.gauss_owners``' key) and whether the element's first /
+    last node ends its run (a beam end: ``xi_range`` accepts ``XI_TOL`` there, ``XI_OVERHANG`` at a joint
+    inside the run, where the centre line may have a kink as at an inner node).  Without joints: ``beam``,
+    ``first``, ``last``."""
+    e = np.flatnonzero(last[:-1] & first[1:] & (beam[:-1] != beam[1:])
+                       & (joint_enodes[:-1, 1] == joint_enodes[1:, 0]))
+    if not len(e):
+        return beam, first, last
+    root = np.arange(n_beams)
+    for k in e:                     # (once, at set-up: one entry per joint; a run's beams in increasing order)
+        root[beam[k + 1]] = root[beam[k]]
+    first_end, last_end = first.copy(), last.copy()
+    first_end[e + 1] = False
+    last_end[e] = False
+    return root[beam], first_end, last_end
 
 
 def apart(enodes, e, m):

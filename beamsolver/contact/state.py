@@ -38,6 +38,8 @@ class KeyLayout:
     n_decls: int
     el_beam: np.ndarray
     n_beams: int
+    key_beam: np.ndarray = None     # the master beam a Gauss point's key names per element (``rules.pieces``: a wire
+    #                                 in pieces is keyed by its first piece); None: ``el_beam``
 
     @property
     def point_offset(self):
@@ -111,7 +113,9 @@ def check_state(state, layout):
         if "e" in history and "m" in history:
             e, mb, point = layout.decode(key)
             stored = np.where(point, history["m"], layout.el_beam[history["m"]])
-            wrong = np.flatnonzero((e != history["e"]) | (mb != stored))
+            keyed = stored if layout.key_beam is None else np.where(point, history["m"], layout.key_beam[history["m"]])
+            # (keyed by the piece before ``rules.pieces``: an older archive's rows are valid, their keys not looked up)
+            wrong = np.flatnonzero((e != history["e"]) | ((mb != stored) & (mb != keyed)))
             if len(wrong):
                 i = int(wrong[0])
                 raise _bad("history.e", f"and 'history.m' disagree with 'history.key' at {len(wrong)} of {len(key)} "

@@ -92,6 +92,11 @@ SEARCH_CENTRES = True    # the centre points of the Gauss-point pairs taken from
 KEPT_KINDS_SKIP = True   # the search computes no closest points for a crossing whose kind the step keeps as orthogonal
 #                          (``history.step_kinds`` overwrites it, an orthogonal pair reads no closest point): the same
 #                          kinds and points, bit for bit (``_candidates``); False: every crossing's, as before
+HOLD_POINT_KINDS = True  # a Gauss point's owner keeps its projection kind (line / orthogonal) within a step while a row
+#                          of that kind is accepted (``history.step_point_kinds``; False: decided at each evaluation)
+PIECES = True            # a joint continuing a beam by the next (a wire in pieces) is an inner node of the owners and
+#                          point pairs: projections accepted past it by XI_OVERHANG, one owner per slave point over the
+#                          pieces (``rules.pieces``; False: each piece's ends are beam ends, its points keyed by piece)
 CHAIN_GROUPS = True      # exact stick: a mortar group is a slave node against a master chain, not a master beam
 LIGHT_COMMIT = True      # exact stick: commit's pass computes the point data and groups' state alone, not the forces
 #                          (``ContactSystem._commit_mortar``; False: the evaluation without tangent, as before)
@@ -230,6 +235,11 @@ class ContactSystem(Contribution):
         # element end nodes with the nodes of a joint merged: elements meeting there never pair
         self._joint_enodes = rules.joint_nodes(system.rep, system.poses0[:, :3, 3],
                                                JOIN_TOL * system.length_scale)[system.enodes]
+        # a wire in pieces: one owner per slave point over the pieces (the key's master beam), the projections past a
+        # joint between pieces accepted as past an inner node (``rules.pieces``; ``PIECES``)
+        self.el_key_beam, self.el_first_end, self.el_last_end = (
+            rules.pieces(self._joint_enodes, self.el_beam, self.el_first, self.el_last, self.n_beams) if PIECES
+            else (self.el_beam, self.el_first, self.el_last))
         self.decls = [_Decl(k, d, model) for k, d in enumerate(model.contacts)]
         # per-declaration parameters as arrays, indexed by a pair's ``decl`` (no loop over pairs)
         self._decl_penalty = np.array([d.penalty for d in self.decls])
@@ -243,7 +253,7 @@ class ContactSystem(Contribution):
         # and fewer than ``n_slots``), ``n_slots`` for the points of whole elements (other kinds)
         self.n_slots = self._segment_slots(system) if any(d.segments for d in self.decls) else 0
         self.key_gp = self.max_gp * (self.n_slots + 1)
-        layout = KeyLayout(n_el, self.key_gp, len(self.decls), self.el_beam, self.n_beams)
+        layout = KeyLayout(n_el, self.key_gp, len(self.decls), self.el_beam, self.n_beams, self.el_key_beam)
         self.point_offset = layout.point_offset
         self.history = ContactHistory(layout)
         self.exact_friction = True       # exact stick's friction acts (off at step 0: ``Problem.exact_friction``)
@@ -593,7 +603,8 @@ class ContactSystem(Contribution):
         keep = np.arange(len(pt))       # rules.dedupe_points of fewer than two pairs
         if len(pt) > 1:
             keep = rules.dedupe_points(self._points(H, e, x1), self._points(H, m, x2), x1, x2,
-                                       self.el_radius[e] + self.el_radius[m], self.el_beam[e] * self.n_beams + self.el_beam[m],
+                                       self.el_radius[e] + self.el_radius[m],
+                                       self.el_key_beam[e] * self.n_beams + self.el_key_beam[m],
                                        _member(e * n_el + m, self.history.prev_points))
         pt, e, m = pt[keep], e[keep], m[keep]
         key = self.point_offset + (np.int64(d.index) * n_el + e) * n_el + m
@@ -632,8 +643,13 @@ class ContactSystem(Contribution):
                                                   centres=SEARCH_CENTRES)
         self._lap("projection")
         gk = g if slot is None else g + self.max_gp * slot[r]
-        s, key, tied = gauss_owners(d.index, len(en), self.key_gp, self.n_beams, e, m, gk, xi2, dist, self.el_first,
-                                    self.el_last, self.el_beam, self.el_radius, self.history.prev_owners, pair=r, order=True)
+        if HOLD_POINT_KINDS and len(r) and len(self.history.point_keys):
+            dist = self._held_point_kinds(d, e, m, kind, r, gk, xi2, dist)
+        s, key, tied = gauss_owners(d.index, len(en), self.key_gp, self.n_beams, e, m, gk, xi2, dist, self.el_first_end,
+                                    self.el_last_end, self.el_key_beam, self.el_radius, self.history.prev_owners, pair=r,
+                                    order=True)
+        if HOLD_POINT_KINDS:
+            self.history.step_point_kinds(key, kind[r[s]])
         f, ids = gauss_record(s, key, r, g, xi2, e, m, kind, xg, wg, self.sys.L, en, self.el_radius,
                               segments)
         rec = PairSet(key=key, decl=np.full(len(s), d.index), **f)
@@ -641,6 +657,31 @@ class ContactSystem(Contribution):
             self._part_centres[id(rec)] = (rec, xCF[0][s], xCF[1][s])     # (the record held: its id not reused)
         self._lap("rules")
         return rec, ids, tied
+
+    def _held_point_kinds(self, d, e, m, kind, r, gk, xi2, dist):
+        """The distances ``dist`` of the projected rows (element pair ``r``, key Gauss point ``gk``) with the rows of a
+        key whose owner kind the step keeps (``history.step_point_kinds``) set to nan where they are of another kind and
+        the key has an accepted row of the kept kind (in ``rules.xi_range``, finite distance): no owner among them.  A
+        key without such a row takes its owner from all (its point does not vanish)."""
+        kept = self.history.point_kinds
+        if len(kind) and (kind == kind[0]).all() and (kept == kind[0]).all():
+            return dist              # (one kind of projection, as on line contact alone: nothing to hold)
+        n_el = np.int64(len(self.sys.enodes))
+        er, mr, kr = e[r], m[r], kind[r]
+        key = ((np.int64(d.index) * n_el + er) * self.key_gp + gk) * self.n_beams + self.el_key_beam[mr]
+        held = self.history.held_point_kinds(key)
+        lo, hi = rules.xi_range(self.el_first_end[mr], self.el_last_end[mr])
+        ok = (xi2 >= lo) & (xi2 <= hi) & np.isfinite(dist) & (kr == held)
+        other = (held >= 0) & (kr != held)
+        if not other.any() or not ok.any():
+            return dist
+        covered = _member(key, np.unique(key[ok]))
+        drop = other & covered
+        if not drop.any():
+            return dist
+        dist = dist.copy()
+        dist[drop] = np.nan
+        return dist
 
     def _segments(self, e, m, kind):
         """Which element pairs are integrated over segments and the key slot of each pair
@@ -654,8 +695,9 @@ class ContactSystem(Contribution):
         return seg, np.where(seg, m % self.n_slots, self.n_slots)
 
     def _xi_range(self, el):
-        """Accepted projections ``[lo, hi]`` on elements ``el`` (``rules.xi_range``)."""
-        return rules.xi_range(self.el_first[el], self.el_last[el])
+        """Accepted projections ``[lo, hi]`` on elements ``el`` (``rules.xi_range``; a joint between pieces is an
+        inner node: ``rules.pieces``)."""
+        return rules.xi_range(self.el_first_end[el], self.el_last_end[el])
 
     def _params(self, P, sel, H):
         """Kernel parameters for the pairs ``sel`` (history and multipliers looked up)."""
@@ -712,8 +754,9 @@ class ContactSystem(Contribution):
         he, hm = hist["e"][hp], hist["m"][hp]
         hx = self._points(H, he, hist["xi1"][hp])       # the stored material points, now
         hdecl = (hist["key"][hp] - self.point_offset) // (np.int64(len(en)) * len(en))
-        g_new = (P.decl[sel][cand] * nb + self.el_beam[e]) * nb + self.el_beam[m]
-        g_old = (hdecl * nb + self.el_beam[he]) * nb + self.el_beam[hm]
+        kb = self.el_key_beam           # (a wire in pieces: one beam, ``rules.pieces``)
+        g_new = (P.decl[sel][cand] * nb + kb[e]) * nb + kb[m]
+        g_old = (hdecl * nb + kb[he]) * nb + kb[hm]
         k = min(4, len(hp))
         dist, j = cKDTree(hx).query(x, k=k)
         dist, j = dist.reshape(len(cand), k), j.reshape(len(cand), k)

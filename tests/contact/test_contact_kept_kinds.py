@@ -10,7 +10,7 @@ import pytest
 
 import beamsolver as bs
 from beamsolver.contact import system
-from beamsolver.contact.frames import ORTHOGONAL, POINT
+from beamsolver.contact.frames import LINE, ORTHOGONAL, POINT
 from beamsolver.nonlinear.problem import Problem
 
 
@@ -148,3 +148,54 @@ def test_prev_points_kept_for_the_same_sections_and_renewed_at_a_step(monkeypatc
     y = contact._centres(H1, P, prev=True)[0]
     ref = contact._points(H1, P.e, P.xi1)
     assert y is not x and np.array_equal(y.view(np.int64), ref.view(np.int64))
+
+
+def _bend():
+    """A master along ``e_x`` bending up by 30 degrees at x = 0 (``polyline``), a one-element slave along ``e_x`` just
+    above it: its Gauss points have line rows on the straight part (angle 0) and orthogonal rows on the bend's rising
+    element (a crossing of ratio ``sin^2 30 < 1/2``)."""
+    sec = bs.Section.circular(radius=0.05, E=1e7, nu=0.3)
+    m = bs.Model()
+    a = np.deg2rad(30.0)
+    s = np.linspace(0.25, 1.0, 4)
+    pts = np.concatenate([np.stack([np.linspace(-1.0, 0.0, 5), np.zeros(5), np.zeros(5)], 1),
+                          np.stack([s * np.cos(a), 0.0 * s, s * np.sin(a)], 1)])
+    master = m.add_beam(bs.geometry.polyline(pts), sec)
+    slave = m.add_beam(bs.geometry.straight((-0.5, 0, 0.0995), (0.1, 0, 0.0995), 1), sec)
+    m.clamp(master.first)
+    m.clamp(master.last)
+    m.clamp(slave.first)
+    m.add_contact(slave, master, integration="points")
+    return Problem.from_model(m, check_rigid_modes=False), slave
+
+
+def test_a_gauss_points_owner_keeps_its_projection_kind_within_a_step():
+    """Gauss point 3 of the slave: owned by a line row at dx = 0 and, decided afresh, by an orthogonal row at
+    dx = 0.02 (the nearer).  Within a step (no ``begin_step`` between) it keeps the line row while one is accepted
+    (``history.step_point_kinds``): the two kinds measure and load the point differently (the plectoneme's force
+    jumped by 0.5 N and 96 N between Newton iterates); a new step decides afresh."""
+    problem, slave = _bend()
+    cs, H0 = problem.contact, problem.system.poses0
+
+    def kind_of_gp3(dx):
+        H = H0.copy()
+        H[slave.nodes, 0, 3] += dx
+        P = cs.pairs(H)
+        sel = P.gp == 3
+        assert sel.sum() == 1
+        return int(P.kind[sel][0])
+
+    cs.history.begin_step()
+    assert kind_of_gp3(0.0) == LINE
+    assert kind_of_gp3(0.02) == LINE                # held (decided afresh: orthogonal, was so within the step)
+    cs.history.begin_step()
+    assert kind_of_gp3(0.02) == ORTHOGONAL          # a new step decides afresh
+    assert kind_of_gp3(0.0) == ORTHOGONAL           # ... and keeps that (the orthogonal row still accepted)
+    monkey = system.HOLD_POINT_KINDS
+    try:
+        system.HOLD_POINT_KINDS = False
+        cs.history.begin_step()
+        assert kind_of_gp3(0.0) == LINE
+        assert kind_of_gp3(0.02) == ORTHOGONAL      # (without the hold: each evaluation decides)
+    finally:
+        system.HOLD_POINT_KINDS = monkey
