@@ -66,6 +66,14 @@ LM_FAR = True                        # on the displacement block (Levenberg, ``N
                                      # (docs/benchmarks.md, session 9)
 INNER_SWITCHES = 0                   # exact stick: branch switches of the linearised groups per Newton direction ...
 INNER_PREDICTOR = False              # ... also in a load step's first iteration (the prescribed motions' predictor)
+TAIL_SWITCHES = 8                    # exact stick: near the solution (scaled residual <= TAIL_RATIO) the sliding groups
+TAIL_RATIO = 1e-5                    # ... at a stick / slip corner (slip's share of the trial c |Pi u| < TAIL_CORNER
+TAIL_CORNER = 0.1                    # ... times the disk) start on the stick rows, kept where the linearised trial
+#                                      stays in the disk, at most TAIL_SWITCHES solves (``_corner_groups``; 0: off);
+TAIL_ROWS = 1e-3                     # ... the evaluations' branch rows asked for once the scaled residual is below this
+TAIL_MAX_UNKNOWNS = 10000            # ... with at most so many free unknowns (the bordered system is factorised
+#                                      uncondensed there: the 19-wire strand's, 17 898, one corner direction in its last
+#                                      iteration, peak RSS 630 -> 730 MB for the same iterations)
 NORMAL_SWITCHES = 4                  # exact stick: Newton directions again with the points the full step opens
                                      # linearised open (the normal law's active set, ``_normal_branches``; 0: off.
                                      # The rope pieces' loaded steps 31 -> 14 and failed -> 19 iterations, the contact
@@ -200,6 +208,7 @@ class Newton:
         self.rotations = RotationGuard(system)
         self.linsolver = linsolve.Solver()    # solve(linear_solver=...) replaces it
         problem.want_branch_rows(INNER_SWITCHES > 0)
+        self.ratio_now = np.inf               # the scaled residual of the iterate whose direction is computed
         self.stall_ratio = np.inf             # correction growth of the shortest damped trial
         self.indefinite_seen = False          # the step's first tangent had det < 0 (or a back-end that cannot tell)
         self.crawl = 0                        # backtracked line searches in a row (``backtrack``)
@@ -286,8 +295,13 @@ class Newton:
         """``(lu, dzf)``: the factorised tangent of ``ev`` and the Newton increment of the free
         unknowns ``(n_free,)`` (with the prescribed-motion coupling of ``dz_c`` ``(n, 6)``)."""
         problem = self.problem
-        if ev.mult is not None and INNER_SWITCHES and "Tq" in ev.mult and (dz_c is None or INNER_PREDICTOR):
-            return self._active_set_direction(ev, dz_c)
+        if ev.mult is not None and "Tq" in ev.mult and (dz_c is None or INNER_PREDICTOR):
+            if INNER_SWITCHES:
+                return self._active_set_direction(ev, dz_c)
+            if TAIL_SWITCHES and self.ratio_now <= TAIL_RATIO and self.sys.n_free <= TAIL_MAX_UNKNOWNS:
+                corner = self._corner_groups(ev)
+                if corner.any():
+                    return self._active_set_direction(ev, dz_c, TAIL_SWITCHES, corner)
         t0 = time.perf_counter()
         aug = problem.augmented_system(ev, dz_c) if problem.augments(ev) else None
         if aug is None:
@@ -422,7 +436,20 @@ class Newton:
         c = both & pa & (lam1 <= SECANT_SHARE * la)
         return np.union1d(on_secant, np.setdiff1d(ka[c], forced))
 
-    def _active_set_direction(self, ev, dz_c=None):
+    @staticmethod
+    def _corner_groups(ev):
+        """``(g,)``: the sliding groups of ``ev`` (pressed, not weak) at a stick / slip corner: their slip's share of
+        the trial, ``c |Pi u| = |trial - Pi R Lam|``, below ``TAIL_CORNER`` times their disk ``mu lamN``.  There the
+        slide branch's row across the trial, ``(1 - cap / |trial|) dv - c (cap / |trial|) du``, is nearly singular
+        (``|trial| -> cap``, and ``du`` hardly follows ``dv`` where ``c`` is small against the wires' stiffness): each
+        Newton step turned such a traction by 0.1 .. 0.3 rad and the disk's curvature gave back a radial residual of
+        that order squared; the main job's tails crawled (docs/benchmarks.md, session 14, branch bE)."""
+        mu = ev.mult
+        v = np.einsum("gij,gj->gi", mu["R"], mu["Lam"])
+        cu = np.linalg.norm(mu["trial"] - np.einsum("gij,gj->gi", mu["Pi"], v), axis=1)
+        return ~mu["stick"] & ~mu["weak"] & (mu["cap"] > 0.0) & (cu < TAIL_CORNER * mu["cap"])
+
+    def _active_set_direction(self, ev, dz_c=None, switches=None, corner=None):
         """``direction`` with the groups' stick / slip branches decided on the linearised problem (exact stick): the
         Newton system is solved (condensed, as ``direction``), each group's branch predicted at the step's end by its
         linearised trial traction and disk (``Problem.predicted_branches``); groups predicted on the other branch get
@@ -430,11 +457,20 @@ class Newton:
         again, at most ``INNER_SWITCHES`` times, until no group changes (a slip front then moves by several nodes in
         one Newton iteration).  Not in the iteration that carries the prescribed motions (``INNER_PREDICTOR``):
         predicted that far, the branches of a 1+6+12 strand's first step from zero tractions settled with 276 groups
-        switched and Newton crawled (residual 5 after 30 iterations)."""
+        switched and Newton crawled (residual 5 after 30 iterations).  ``switches``: at most so many (default
+        ``INNER_SWITCHES``); ``corner`` ``(g,)`` (``_corner_groups``, Newton's tail): those sliding groups start on the
+        stick rows and only their branches are predicted."""
         problem, mu = self.problem, ev.mult
         n = self.sys.n_free
         used, rows = mu["stick"], None
-        for inner in range(INNER_SWITCHES + 1):
+        switches = INNER_SWITCHES if switches is None else switches
+        start = 0
+        if corner is not None:      # the corner groups start on the stick rows (uncondensed: the rows are switched)
+            problem.uncondense(ev)
+            used = mu["stick"] | corner
+            rows = problem.branch_rows(ev, used, mu["trial"])
+            start = 1
+        for inner in range(start, switches + 1):
             t0 = time.perf_counter()
             K, rhs = problem.linear_system(ev, dz_c, condense=inner == 0, rows=rows)
             t1 = time.perf_counter()
@@ -447,19 +483,25 @@ class Newton:
                 self.timings["linear_solve"] += t2 - t1
             if not np.all(np.isfinite(x)):
                 raise SingularTangent("the linear solve returned non-finite values")
-            if inner == 0:
+            if inner == 0 and rows is None:
                 dzf, dlam = problem.split_solution(ev, x, dz_c)
                 x = np.concatenate([dzf, np.ravel(dlam)])
+            if inner == start:
                 first = (lu, x)
             stick, trial, _ = problem.predicted_branches(ev, x, dz_c)
             stick = np.where(mu["weak"], mu["stick"], stick)
+            if corner is not None:
+                # only the corner groups' branches are predicted (the others': as evaluated; all predicted from the
+                # tail on, the main job's step to t = 0.4375 cycled two directions for 10 iterations): one stays on
+                # the stick rows while its linearised trial stays in its disk
+                stick = np.where(corner, stick, mu["stick"])
             if np.array_equal(stick, used):
                 break
-            if inner == INNER_SWITCHES:
+            if inner == switches:
                 if INNER_UNSETTLED == "plain":
                     lu, x = first
                 break
-            if inner == 0:
+            if rows is None:
                 problem.uncondense(ev)
             used = stick
             rows = problem.branch_rows(ev, used, trial)
@@ -547,6 +589,7 @@ class Newton:
         conv, problem = self.conv, self.problem
         residuals = []
         self.crawl, self.full_taken = 0, False
+        self.ratio_now = np.inf              # (``_record``'s; ``direction``'s tail test)
         self.least_inc = (np.inf, 0)         # the shortest full Newton increment of the step and its iteration
         self.reversals = (None, 0)
         self.secant_done = None
@@ -566,6 +609,10 @@ class Newton:
             ahead = None
             problem.accept_multipliers()        # those the iterate was evaluated with
             self._record(ev, ratio, residuals, stats_extra, it, t, H)
+            self.ratio_now = ratio
+            if TAIL_SWITCHES and not INNER_SWITCHES and ev.mult is not None:
+                # (their cost: only where the tail may need them)
+                problem.want_branch_rows(ratio <= TAIL_ROWS and self.sys.n_free <= TAIL_MAX_UNKNOWNS)
             verdict = self._verdict(residuals, last_inc, it, floor, constraint)
             if verdict is CONVERGED:
                 if damped_its:

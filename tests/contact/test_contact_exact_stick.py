@@ -326,6 +326,25 @@ def test_exact_stick_newton_converges_superlinearly():
     assert pairs >= 4
 
 
+def test_the_main_job_s_tail_converges_without_crawling():
+    """Once the scaled residual of a step of the main job (``examples/twisted_pair.py``, 16 steps; its first three here)
+    is below 1e-6, at most two more iterations.  Before ``newton.TAIL_SWITCHES`` two sliding groups at their disk's edge
+    with a vanishing slip (a stick / slip corner: ``|Lam| / cap`` 1.02 .. 1.0001, slip 1e-8 .. 1e-10 m, across their
+    traction) crawled: the lateral row of the slide branch, ``(1 - cap / |trial|) dv - c du``, is nearly singular
+    there, each Newton step turned the traction by 0.1 .. 0.3 rad and the disk's curvature gave back a radial residual
+    of the same order (t = 0.0625: 1.1e-7, 6.5e-8, 1.1e-7, 1.4e-8, 3.6e-8, 8e-10; 5 and 4 iterations below 1e-6
+    in the first and third steps).  On the stick rows the corner converges in one iteration (1.1e-7, 1.7e-9)."""
+    import twisted_pair
+    model, *_ = twisted_pair.build()
+    sol = bs.solve(model, steps=3, t_end=3 / 16, verbose=False)
+    tails = []
+    for s in sol.stats[1:]:
+        r = np.array(s["residuals"])
+        below = np.flatnonzero(r[1:] < 1e-6) + 1     # (iteration 0: the last step's poses, before the step's motion)
+        tails.append(len(r) - 1 - below[0])
+    assert max(tails) <= 2, (tails, [s["residuals"] for s in sol.stats])
+
+
 def test_touching_group_without_pressure_sheds_its_traction_exactly():
     """Touching without normal traction (a sharp law at zero gap, where the law's band holds the group):
     the group carries nothing, so its complementarity function is ``C = v`` and its rows of the bordered
