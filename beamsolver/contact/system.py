@@ -257,6 +257,7 @@ class ContactSystem(Contribution):
         self.point_offset = layout.point_offset
         self.history = ContactHistory(layout)
         self.exact_friction = True       # exact stick's friction acts (off at step 0: ``Problem.exact_friction``)
+        self.hold_point_kinds = True     # owners keep their projection kind in a step (off at step 0: ``Problem.hold_point_kinds``)
         self._switch_to(-np.inf)
         self.history.mu_committed = self._decl_mu       # friction of the last committed step
         table = declaration_table([d.options for d in self.decls])    # None as each option's kernel_none
@@ -643,12 +644,13 @@ class ContactSystem(Contribution):
                                                   centres=SEARCH_CENTRES)
         self._lap("projection")
         gk = g if slot is None else g + self.max_gp * slot[r]
-        if HOLD_POINT_KINDS and len(r) and len(self.history.point_keys):
+        hold = HOLD_POINT_KINDS and self.hold_point_kinds
+        if hold and len(r) and len(self.history.point_keys):
             dist = self._held_point_kinds(d, e, m, kind, r, gk, xi2, dist)
         s, key, tied = gauss_owners(d.index, len(en), self.key_gp, self.n_beams, e, m, gk, xi2, dist, self.el_first_end,
                                     self.el_last_end, self.el_key_beam, self.el_radius, self.history.prev_owners, pair=r,
                                     order=True)
-        if HOLD_POINT_KINDS:
+        if hold:
             self.history.step_point_kinds(key, kind[r[s]])
         f, ids = gauss_record(s, key, r, g, xi2, e, m, kind, xg, wg, self.sys.L, en, self.el_radius,
                               segments)

@@ -469,6 +469,14 @@ class Problem:
             if hasattr(c, "newton_multipliers"):
                 c.newton_multipliers = bool(flag)
 
+    def hold_point_kinds(self, flag):
+        """Whether a Gauss point's owner keeps its projection kind within a step (``contact.system.HOLD_POINT_KINDS``);
+        ``Run``'s step 0 turns it off: each evaluation decides there (a touching start moves the wires apart over many
+        iterations and cannot be cut back)."""
+        for c in self.contributions:
+            if hasattr(c, "hold_point_kinds"):
+                c.hold_point_kinds = bool(flag)
+
     def exact_friction(self, flag):
         """Whether exact stick's friction acts (``Run``'s step 0 turns it off when the equilibrium at ``t_start``
         is not found with it: friction then starts from zero traction at the state found).  Returns whether a

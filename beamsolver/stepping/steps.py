@@ -262,6 +262,7 @@ class Run:
         newton.cycle_window = (STEP_ZERO_CYCLE or None) if newton.stall_window else None
         self.outer_limit = (STEP_ZERO_UPDATES or None) if newton.stall_window else None
         newton.start = True                 # the normal law's active set and secant from the first iteration
+        self.problem.hold_point_kinds(False)   # each evaluation decides: step 0 moves far and cannot be cut back
         try:
             try:
                 return self.newton_step(t_start)
@@ -276,6 +277,7 @@ class Run:
             H, ev0, stats = self.newton_step(t_start)
         finally:
             newton.start = False
+            self.problem.hold_point_kinds(True)
         note = (f"step 0 (t = {t_start:.6g}): no equilibrium with exact stick's friction ({failed}); found "
                 "without it, friction starts from zero traction at that state")
         log.warning(note)

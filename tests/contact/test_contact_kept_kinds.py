@@ -199,3 +199,19 @@ def test_a_gauss_points_owner_keeps_its_projection_kind_within_a_step():
         assert kind_of_gp3(0.02) == ORTHOGONAL      # (without the hold: each evaluation decides)
     finally:
         system.HOLD_POINT_KINDS = monkey
+
+
+@pytest.mark.parametrize("ends", ["fixed", "free"])
+def test_a_touching_strand_s_step_0_decides_point_kinds_at_each_iterate(ends):
+    """Step 0 of a touching 1+6 strand at 20 degrees (``examples/strand_sweep.py``, the sweep's scene): its wires
+    move apart from the touching start over 14-74 Newton iterations, and a Gauss point's owner must follow them
+    from one projection kind to the other; holding the kind of the first iterate (``history.step_point_kinds``)
+    for step 0 left it without an equilibrium in 120 iterations (scaled residual 1.94 / 0.268).  Step 0 cannot be
+    cut back, so there each evaluation decides (``Problem.hold_point_kinds``, ``Run._solve_start``)."""
+    import sys
+    from pathlib import Path
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "examples"))
+    import strand_sweep
+    model = strand_sweep.build(lay_angle=20.0, ends=ends)[0]
+    sol = bs.solve(model, verbose=False, **strand_sweep.solve_options)
+    assert sol.converged and sol.times[-1] == 1.0
