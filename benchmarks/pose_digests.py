@@ -8,7 +8,8 @@ change of the round-off shows a new digest and then needs its pose differences a
 
 Scenes: ``tp`` (the main job's model, ``examples/twisted_pair.py``, 16 steps), ``strand-N`` (the
 overlap-free N-wire strand of ``benchmarks/scaling_scenes.py``, one loaded step), or the name of a module
-of ``examples/`` with a ``build()`` (its ``solve_options`` if it has them).  CPU time per scene on stderr.
+of ``examples/`` with a ``build()`` (its ``solve_options`` if it has them); a run that stops with
+``ConvergenceError`` gives the digest of the steps that converged and says where.  CPU time per scene on stderr.
 """
 import hashlib
 import importlib
@@ -50,9 +51,13 @@ def solve(scene):
 def main(scenes):
     for scene in scenes:
         t0 = time.process_time()
-        sol = solve(scene)
+        stop = ""
+        try:
+            sol = solve(scene)
+        except bs.ConvergenceError as e:       # the steps that converged, and where it stopped
+            sol, stop = e.solution, f", stopped at t = {e.solution.times[-1]:.6g}"
         its = [s["iterations"] for s in sol.stats]
-        print(f"{scene}: iterations {its} (total {sum(its)}), digest {digest(sol)}", flush=True)
+        print(f"{scene}: iterations {its} (total {sum(its)}), digest {digest(sol)}{stop}", flush=True)
         print(f"{scene}: {time.process_time() - t0:.2f} s CPU", file=sys.stderr)
 
 

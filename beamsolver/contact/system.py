@@ -232,14 +232,7 @@ class ContactSystem(Contribution):
         n_el = system.n_elements
         self.el_beam, self.el_radius, self.el_first, self.el_last = self._element_tables(model, n_el)
         self.n_beams = len(model.beams)
-        # element end nodes with the nodes of a joint merged: elements meeting there never pair
-        self._joint_enodes = rules.joint_nodes(system.rep, system.poses0[:, :3, 3],
-                                               JOIN_TOL * system.length_scale)[system.enodes]
-        # a wire in pieces: one owner per slave point over the pieces (the key's master beam), the projections past a
-        # joint between pieces accepted as past an inner node (``rules.pieces``; ``PIECES``)
-        self.el_key_beam, self.el_first_end, self.el_last_end = (
-            rules.pieces(self._joint_enodes, self.el_beam, self.el_first, self.el_last, self.n_beams) if PIECES
-            else (self.el_beam, self.el_first, self.el_last))
+        self._joint_tables(system)
         self.decls = [_Decl(k, d, model) for k, d in enumerate(model.contacts)]
         # per-declaration parameters as arrays, indexed by a pair's ``decl`` (no loop over pairs)
         self._decl_penalty = np.array([d.penalty for d in self.decls])
@@ -311,6 +304,17 @@ class ContactSystem(Contribution):
         self._adjusted = adjust.EMPTY
         self._adjusted = self._reference_adjustment(system.poses0)
         self.adjusted = adjust.summary(self._adjusted)    # count and largest overlap adjusted away
+
+    def _joint_tables(self, system):
+        """``_joint_enodes`` ``(n_el, 2)``: element end nodes with the nodes of a joint merged (elements meeting there
+        never pair); ``el_key_beam``, ``el_first_end``, ``el_last_end`` ``(n_el,)``: a wire in pieces has one owner per
+        slave point over its pieces (the key's master beam), and a projection past a joint between pieces is accepted
+        as past an inner node (``rules.pieces``; ``PIECES``)."""
+        self._joint_enodes = rules.joint_nodes(system.rep, system.poses0[:, :3, 3],
+                                               JOIN_TOL * system.length_scale)[system.enodes]
+        self.el_key_beam, self.el_first_end, self.el_last_end = (
+            rules.pieces(self._joint_enodes, self.el_beam, self.el_first, self.el_last, self.n_beams) if PIECES
+            else (self.el_beam, self.el_first, self.el_last))
 
     @staticmethod
     def _element_tables(model, n_el):

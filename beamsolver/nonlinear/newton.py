@@ -609,10 +609,6 @@ class Newton:
             ahead = None
             problem.accept_multipliers()        # those the iterate was evaluated with
             self._record(ev, ratio, residuals, stats_extra, it, t, H)
-            self.ratio_now = ratio
-            if TAIL_SWITCHES and not INNER_SWITCHES and ev.mult is not None:
-                # (their cost: only where the tail may need them)
-                problem.want_branch_rows(ratio <= TAIL_ROWS and self.sys.n_free <= TAIL_MAX_UNKNOWNS)
             verdict = self._verdict(residuals, last_inc, it, floor, constraint)
             if verdict is CONVERGED:
                 if damped_its:
@@ -664,9 +660,13 @@ class Newton:
                              "after GRACE_ITER more")
 
     def _record(self, ev, ratio, residuals, stats, it, t, H):
-        """Book an iterate (``ev`` at ``(H, t)``, scaled residual ``ratio``, iteration ``it``): its residual, exact
-        stick's status changes (``_count_changes``), ``near`` for the line search, the log and the callback."""
+        """Book an iterate (``ev`` at ``(H, t)``, scaled residual ``ratio``, iteration ``it``): its residual (``ratio_now``,
+        and the tail's branch rows asked for below ``TAIL_ROWS``), exact stick's status changes (``_count_changes``), ``near`` for the line search, the log and the callback."""
         residuals.append(ratio)
+        self.ratio_now = ratio
+        if TAIL_SWITCHES and not INNER_SWITCHES and ev.mult is not None:
+            # the branch rows of exact stick's tail (their cost: only where the tail may need them)
+            self.problem.want_branch_rows(ratio <= TAIL_ROWS and self.sys.n_free <= TAIL_MAX_UNKNOWNS)
         self._count_changes(ev, stats, it)
         self.near = ratio <= LS_NEAR * max(residuals)
         log.debug("t = %.6g  iteration %d  scaled residual %.3e", t, it, ratio)
