@@ -6,9 +6,9 @@ poses of every recorded step, in order.  Two trees give the same digest only if 
 the same float; a change meant to keep the results (a faster path to the same numbers) shows it here, a
 change of the round-off shows a new digest and then needs its pose differences and iterations reported.
 
-Scenes: ``tp`` (the main job's model, ``examples/twisted_pair.py``, 16 steps), ``strand-N`` (the
-overlap-free N-wire strand of ``benchmarks/scaling_scenes.py``, one loaded step), or the name of a module
-of ``examples/`` with a ``build()`` (its ``solve_options`` if it has them); a run that stops with
+Scenes: ``tp`` (the main job's model, ``examples/twisted_pair.py``, 16 steps; ``tpN``: it at N el/wire),
+``strand-N`` (the overlap-free N-wire strand of ``benchmarks/scaling_scenes.py``, one loaded step), or the
+name of a module of ``examples/`` with a ``build()`` (its ``solve_options`` if it has them); a run that stops with
 ``ConvergenceError`` gives the digest of the steps that converged and says where.  CPU time per scene on stderr.
 """
 import hashlib
@@ -35,9 +35,10 @@ def digest(sol):
 
 def solve(scene):
     """The scene's solution with its default options."""
-    if scene == "tp":
+    if scene == "tp" or scene[:2] == "tp" and scene[2:].isdigit():
         import twisted_pair
-        return bs.solve(twisted_pair.build()[0], steps=16, verbose=False)
+        kw = dict(n_elements=int(scene[2:])) if scene[2:] else {}
+        return bs.solve(twisted_pair.build(**kw)[0], steps=16, verbose=False)
     if scene.startswith("strand-"):
         import scaling_scenes as ss
         model, wires, length = ss.strand_model(scene.split("-", 1)[1])
