@@ -33,6 +33,7 @@ back to the direct saddle solve of ``M`` (``Problem.linear_system``'s), without 
 """
 import numpy as np
 
+from .._jit import jit
 from .lagged import gmres
 from .linsolve import factorize_tangent
 from ..failures import SingularTangent
@@ -95,8 +96,10 @@ class Augmented:
         self.K = self.direct = None
 
     def _Kq(self, y):
-        """``Kq y`` ``(n,)`` for ``y`` ``(u,)``."""
-        return np.bincount(self.rows.ravel(), weights=(self.Kq * y[:, None]).ravel(), minlength=self.n)
+        """``Kq y`` ``(n,)`` for ``y`` ``(u,)`` (``_scatter_rows``)."""
+        out = np.zeros(self.n)
+        _scatter_rows(self.rows, self.Kq, np.ascontiguousarray(y, dtype=float), out)
+        return out
 
     def _Kl(self, x, K=None):
         """``Kl x`` ``(u,)`` for ``x`` ``(n,)``."""
@@ -151,3 +154,13 @@ class Augmented:
         lu = factorize_tangent(M, solver, saddle=True)
         self.factor = lu
         return lu.solve(rhs)
+
+
+@jit
+def _scatter_rows(rows, Kq, y, out):
+    """``out[rows[u, a]] += Kq[u, a] y[u]`` row after row, slot after slot (``rows``, ``Kq`` ``(u, k6)``, ``y``
+    ``(u,)``, ``out`` ``(n,)`` zeros in): ``np.bincount(rows.ravel(), weights=(Kq * y[:, None]).ravel())``, the same
+    products summed in the same order, without the ``(u, k6)`` temporaries."""
+    for u in range(rows.shape[0]):
+        for a in range(rows.shape[1]):
+            out[rows[u, a]] += Kq[u, a] * y[u]

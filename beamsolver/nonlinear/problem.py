@@ -72,7 +72,7 @@ class Evaluation:
         large = self.kvals is not None and self.kvals.size >= buffers.RELEASE_MIN_VALUES
         self.kvals = self.extra = None
         if self.mult is not None:
-            for k in ("Kp", "A"):
+            for k in ("Kp", "A", "K_full"):
                 self.mult.pop(k, None)
         if large:
             buffers.release_idle()
@@ -292,6 +292,7 @@ class Problem:
         if mu is None or not (condense and condense_.ENABLED and mu.get("B") is not None and "offset" in mu):
             return None
         if "split" not in mu:
+            mu.pop("K_full", None)
             mu["split"] = condense_.split(mu["Kql"], mu["Klq"], mu["Kll"], mu["R"], mu["Lam"], mu["C"], mu["B"])
             condense_.add_schur(ev.extra[2], mu["offset"], mu["split"])
         return mu["split"]
@@ -331,12 +332,21 @@ class Problem:
         if mu is not None and sp is not None and "E" in mu:
             return self.augmented_system(ev, dz_c).direct()
         rhs = self._force_rhs(ev, dz_c, sp)
+        if mu is not None and sp is None:
+            return self.bordered(ev, self._full_tangent(ev), rhs, dz_c, rows)
         K = self.tangent(ev)
         if mu is None:
             return K, rhs
-        if sp is None:
-            return self.bordered(ev, K, rhs, dz_c, rows)
         return self._condensed(ev, K, rhs, dz_c)
+
+    def _full_tangent(self, ev):
+        """``tangent(ev)`` of an evaluation whose values hold no Schur terms (the full bordered system), kept in
+        ``ev.mult`` until they change (``_split``, ``uncondense``) or are dropped: the active-set inner loop
+        (``Newton._active_set_direction``) solves several bordered systems on one tangent."""
+        mu = ev.mult
+        if "K_full" not in mu:
+            mu["K_full"] = self.tangent(ev)
+        return mu["K_full"]
 
     def _condensed(self, ev, K, rhs, dz_c):
         """The condensed bordered system on the tangent ``K`` (``linear_system``)."""
@@ -430,7 +440,7 @@ class Problem:
                 w = np.zeros(sp.d.shape)
                 w[g, j] = mu["E"]
                 condense_.add_products(ev.extra[2], mu["offset"], sp, w)
-            for k in ("E", "p22", "A", "Kp"):
+            for k in ("E", "p22", "A", "Kp", "K_full"):
                 mu.pop(k, None)
             condense_.remove_schur(ev.extra[2], mu["offset"], sp)
 

@@ -1,0 +1,46 @@
+"""Compiled kernels of the Newton direction's glue against their numpy forms, bit for bit: ``condense._schur`` (the
+Schur terms of the eliminated components) and ``augmented._scatter_rows`` (``Kq y`` of the augmented solve)."""
+import numpy as np
+
+from beamsolver.nonlinear import augmented, condense
+
+
+def _schur_plain(vals, off, Kql, Klq, w):
+    """The Schur terms component after component over the whole block (the former kernel's order)."""
+    g, k6 = Kql.shape[:2]
+    blocks = vals[off:off + g * k6 * k6].reshape(g, k6, k6)
+    for i in range(g):
+        for j in range(3):
+            if w[i, j] == 0.0:
+                continue
+            for a in range(k6):
+                c = w[i, j] * Kql[i, a, j]
+                if c != 0.0:
+                    blocks[i, a] -= c * Klq[i, j]
+
+
+def test_schur_terms_are_the_component_by_component_sums():
+    """One pass per block row, the components in order (none, one, two or three of them; zero products skipped):
+    the bits of subtracting them one component after the other."""
+    rng = np.random.default_rng(3)
+    g, k6 = 40, 24
+    Kql, Klq = rng.standard_normal((g, k6, 3)), rng.standard_normal((g, 3, k6))
+    w = rng.standard_normal((g, 3))
+    w[rng.random((g, 3)) < 0.4] = 0.0
+    Kql[rng.random((g, k6, 3)) < 0.1] = 0.0
+    vals = rng.standard_normal(7 + g * k6 * k6)
+    ref = vals.copy()
+    _schur_plain(ref, 7, Kql, Klq, w)
+    condense._schur(vals, 7, Kql, Klq, w)
+    assert np.array_equal(vals, ref)
+
+
+def test_scatter_rows_is_numpy_s_bincount():
+    """``Kq y`` on the rows of the kept components' slots (repeated rows summed in order): ``np.bincount``'s bits."""
+    rng = np.random.default_rng(5)
+    u, k6, n = 30, 24, 50
+    rows = rng.integers(0, n, (u, k6))
+    Kq, y = rng.standard_normal((u, k6)), rng.standard_normal(u)
+    out = np.zeros(n)
+    augmented._scatter_rows(rows, Kq, y, out)
+    assert np.array_equal(out, np.bincount(rows.ravel(), weights=(Kq * y[:, None]).ravel(), minlength=n))
