@@ -95,28 +95,28 @@ class Augmented:
         ``solve`` is then an error; the factor of ``A`` (``factor``) stays."""
         self.K = self.direct = None
 
-    def _Kq(self, y):
-        """``Kq y`` ``(n,)`` for ``y`` ``(u,)`` (``_scatter_rows``)."""
-        out = np.zeros(self.n)
-        _scatter_rows(self.rows, self.Kq, np.ascontiguousarray(y, dtype=float), out)
-        return out
-
     def _Kl(self, x, K=None):
         """``Kl x`` ``(u,)`` for ``x`` ``(n,)``."""
         return np.einsum("ua,ua->u", self.Kl if K is None else K, x[self.rows])
 
     def matvec(self, x):
-        """``M x`` for ``x`` ``(n + u,)``."""
+        """``M x`` for ``x`` ``(n + u,)``: ``[K' x_u + Kq x_b; Kl x_u + D x_b]`` (``_join``)."""
         xu, xb = x[:self.n], x[self.n:]
-        return np.concatenate([self.K @ xu + self._Kq(xb), self._Kl(xu) + self.D * xb])
+        out = np.empty(len(x))
+        _join(self.K @ xu, self.rows, self.Kq, np.ascontiguousarray(xb), self._Kl(xu), self.D, out)
+        return out
 
     def precondition(self, v, apply):
-        """``P^-1 v`` with ``apply`` the solve with (a factorisation of) ``A``."""
-        vf, vg = v[:self.n], v[self.n:]
-        db0 = np.where(self.plain, vg / self.p22, 0.0)
-        du = apply(vf + self._Kq(np.where(self.plain, -db0, self.E * vg)))
-        db = np.where(self.plain, db0, self.E * (self._Kl(du, self.Klp) - vg))
-        return np.concatenate([du, db])
+        """``P^-1 v`` with ``apply`` the solve with (a factorisation of) ``A`` (``_precondition_rhs``,
+        ``_precondition_out``: the module's formulas)."""
+        vf, vg = np.ascontiguousarray(v[:self.n]), np.ascontiguousarray(v[self.n:])
+        db0, r = np.empty(len(vg)), np.empty(self.n)
+        _precondition_rhs(vf, vg, self.plain, self.p22, self.E, self.rows, self.Kq, db0, r)
+        du = apply(r)
+        out = np.empty(len(v))
+        du = np.ascontiguousarray(du)
+        _precondition_out(du, self._Kl(du, self.Klp), vg, self.plain, db0, self.E, out)
+        return out
 
     def solve(self, solver):
         """The solution ``x`` ``(n + u,)`` of ``M x = [f; g]`` (``Problem.split_solution`` reads it): GMRES
@@ -164,3 +164,40 @@ def _scatter_rows(rows, Kq, y, out):
     for u in range(rows.shape[0]):
         for a in range(rows.shape[1]):
             out[rows[u, a]] += Kq[u, a] * y[u]
+
+
+@jit
+def _join(top, rows, Kq, xb, kl, D, out):
+    """``out = [top + Kq xb; kl + D xb]`` (``Augmented.matvec``; ``Kq xb`` by ``_scatter_rows``, then added)."""
+    n = len(top)
+    s = np.zeros(n)
+    _scatter_rows(rows, Kq, xb, s)
+    for i in range(n):
+        out[i] = top[i] + s[i]
+    for u in range(len(xb)):
+        out[n + u] = kl[u] + D[u] * xb[u]
+
+
+@jit
+def _precondition_rhs(vf, vg, plain, p22, E, rows, Kq, db0, r):
+    """``P^-1``'s first half (``Augmented.precondition``): ``db0 = vg / p22`` on the plain rows (else 0) and the
+    right-hand side of ``A``, ``r = vf + Kq y`` with ``y = -db0`` on the plain rows, ``E vg`` on the others."""
+    y = np.empty(len(vg))
+    for u in range(len(vg)):
+        db0[u] = vg[u] / p22[u] if plain[u] else 0.0
+        y[u] = -db0[u] if plain[u] else E[u] * vg[u]
+    s = np.zeros(len(vf))
+    _scatter_rows(rows, Kq, y, s)
+    for i in range(len(vf)):
+        r[i] = vf[i] + s[i]
+
+
+@jit
+def _precondition_out(du, kl, vg, plain, db0, E, out):
+    """``P^-1 v = [du; db]`` (``Augmented.precondition``), ``db = db0`` on the plain rows, ``E (kl - vg)`` on the
+    others (``kl = Kl du`` without the idle rows)."""
+    n = len(du)
+    for i in range(n):
+        out[i] = du[i]
+    for u in range(len(vg)):
+        out[n + u] = db0[u] if plain[u] else E[u] * (kl[u] - vg[u])

@@ -328,7 +328,7 @@ def _exact_stick_callees():
     not folded into their groups, where a group's components are eliminated and in the Newton system), on empty
     arrays of the solve's types (``contact.mortar_jit.subtract_indexed``, ``nonlinear.condense._schur``, the bordered
     pattern's passes ``nonlinear.bordered._border_counts``, ``_border_fill``, ``_border_values``, the augmented solve's
-    ``nonlinear.augmented._scatter_rows``)."""
+    ``nonlinear.augmented._join``, ``_precondition_rhs``, ``_precondition_out``)."""
     from ..contact import mortar_jit
     from . import augmented, bordered, condense
     mortar_jit.subtract_indexed(np.zeros((0, 24, 24)), np.zeros((0, 24, 24)), np.zeros(0, dtype=np.int64))
@@ -339,7 +339,10 @@ def _exact_stick_callees():
     bordered._border_fill(kptr, i32, rows, 0, 3, rows, none, rows, ptr, i32, none, none)
     bordered._border_values(np.zeros(0), none, np.zeros((0, 24, 3)), np.zeros((0, 3, 24)), np.zeros((0, 3, 3)), rows,
                             none, kptr, ptr, i32, np.zeros(0), np.zeros(0))
-    augmented._scatter_rows(rows, np.zeros((0, 24)), np.zeros(0), np.zeros(0))
+    f, f2, b = np.zeros(0), np.zeros((0, 24)), np.zeros(0, dtype=bool)
+    augmented._join(f, rows, f2, f, f, f, f)
+    augmented._precondition_rhs(f, f, b, f, f, rows, f2, f, f)
+    augmented._precondition_out(f, f, f, b, f, f, f)
 
 
 def _stand_in(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames):

@@ -44,3 +44,40 @@ def test_scatter_rows_is_numpy_s_bincount():
     out = np.zeros(n)
     augmented._scatter_rows(rows, Kq, y, out)
     assert np.array_equal(out, np.bincount(rows.ravel(), weights=(Kq * y[:, None]).ravel(), minlength=n))
+
+
+def test_augmented_products_and_preconditioner_are_the_numpy_formulas():
+    """``Augmented.matvec`` and ``precondition`` (compiled ``_join``, ``_precondition_rhs``, ``_precondition_out``)
+    give the bits of the module's formulas in numpy (``np.bincount`` for ``Kq y``, ``np.where``), plain, augmented
+    and idle rows, held slots."""
+    import scipy.sparse as sp
+    rng = np.random.default_rng(7)
+    n, u, k6 = 60, 12, 24
+    K = sp.random(n, n, density=0.1, random_state=rng, format="csc") + sp.eye(n, format="csc")
+    rows = rng.integers(-1, n, (u, k6))
+    Kq, Kl = rng.standard_normal((u, k6)), rng.standard_normal((u, k6))
+    idle = np.zeros(u, dtype=bool)
+    idle[2] = True
+    E, p22 = rng.standard_normal(u), rng.standard_normal(u)
+    E[[0, 5]] = 0.0
+    D = rng.standard_normal(u)
+    a = augmented.Augmented(K, K, None, None, Kq, Kl, rows, D, E, p22, idle, direct=None)
+    free = rows >= 0
+    r0, Q, L = np.where(free, rows, 0), np.where(free, Kq, 0.0), np.where(free, Kl, 0.0)
+    Lp = np.where(idle[:, None], 0.0, L)
+
+    def kq(y):
+        return np.bincount(r0.ravel(), weights=(Q * y[:, None]).ravel(), minlength=n)
+
+    def kl(x, M):
+        return np.einsum("ua,ua->u", M, x[r0])
+    x = rng.standard_normal(n + u)
+    ref = np.concatenate([K @ x[:n] + kq(x[n:]), kl(x[:n], L) + D * x[n:]])
+    assert np.array_equal(a.matvec(x), ref)
+    apply = np.sin                                     # any map of the right-hand side
+    plain = E == 0.0
+    vf, vg = x[:n], x[n:]
+    db0 = np.where(plain, vg / p22, 0.0)
+    du = apply(vf + kq(np.where(plain, -db0, E * vg)))
+    ref = np.concatenate([du, np.where(plain, db0, E * (kl(du, Lp) - vg))])
+    assert np.array_equal(a.precondition(x, apply), ref)
