@@ -67,6 +67,7 @@ class Bordered:
         g, k6 = rows_red.shape
         N = nf + c * g
         kptr = np.asarray(K.indptr, dtype=np.int64)
+        rows_red = rows_red.copy()
         rr = np.ascontiguousarray(rows_red, dtype=np.int64)
         gu, ng, rank = np.empty((g, k6), dtype=np.int64), np.empty(g, dtype=np.int64), np.empty((g, k6), dtype=np.int64)
         indptr = np.zeros(N + 1, dtype=np.int32)
@@ -77,7 +78,7 @@ class Bordered:
         _border_fill(kptr, K.indices, rr, nf, c, gu, ng, rank, indptr, indices, posK, bpos)
         self._p = dict(nf=nf, c=c, indptr_out=indptr, indices=indices, nnz=nnz, N=N, posK=posK, bpos=bpos,
                        ll=bpos[len(bpos) - g * c * c:].reshape(g, c, c), kptr=kptr,
-                       indptr=K.indptr, kindices=K.indices, rows_red=rows_red.copy(), rr=rr)
+                       indptr=K.indptr, kindices=K.indices, rows_red=rows_red, rr=rr)
         self.builds += 1
 
     def matrix(self, K, rows_red, Kql, Klq, Kll, R, Lam, C):
@@ -98,9 +99,9 @@ class Bordered:
         g = len(rows_red)
         data = np.empty(p["nnz"])
         free_row = np.zeros(c * g)
-        _border_values(K.data, p["posK"], np.ascontiguousarray(Kql, dtype=float), np.ascontiguousarray(Klq, dtype=float),
-                       np.ascontiguousarray(Kll, dtype=float), p["rr"], p["bpos"], p["kptr"], p["indptr_out"],
-                       p["indices"], data, free_row)
+        Kql, Klq, Kll = (np.ascontiguousarray(x, dtype=float) for x in (Kql, Klq, Kll))
+        _border_values(K.data, p["posK"], Kql, Klq, Kll, p["rr"], p["bpos"], p["kptr"], p["indptr_out"], p["indices"],
+                       data, free_row)
         return self._finish(data, np.sqrt(free_row), p, Kll, R, Lam, C)
 
     @staticmethod

@@ -16,7 +16,7 @@ import numpy as np
 
 from .._jit import jit
 
-__all__ = ["ELIMINATE", "Split", "split", "add_schur", "add_products", "remove_schur"]
+__all__ = ["ELIMINATE", "Split", "split", "add_schur", "add_products", "remove_schur", "scatter_free"]
 
 ELIMINATE = 0.1      # smallest diagonal entry of D eliminated (a sliding group at the cone's edge stays an unknown)
 ENABLED = True       # False: ``Problem.linear_system`` solves the full bordered system (benchmarks: before)
@@ -100,6 +100,16 @@ def rhs_terms(sp):
     """``(g, k6)``: the eliminated components' ``K'_ql C' / D`` on the groups' rows."""
     w = np.where(sp.elim, sp.C / np.where(sp.elim, sp.d, 1.0), 0.0)
     return np.einsum("gaj,gj->ga", sp.Kql, w)
+
+
+@jit
+def scatter_free(rows, vals, out):
+    """``out[rows[i, a]] += vals[i, a]`` over the free slots (``rows >= 0``) in order (``rows``, ``vals`` ``(g, k6)``,
+    ``out`` zeros in): ``np.bincount(rows[free], weights=vals[free])``, the same sums."""
+    for i in range(rows.shape[0]):
+        for a in range(rows.shape[1]):
+            if rows[i, a] >= 0:
+                out[rows[i, a]] += vals[i, a]
 
 
 def recover(sp, x_kept, dz_slots):

@@ -326,13 +326,15 @@ def _scene(model, worker):
 def _exact_stick_callees():
     """The exact stick path's compiled helpers that the stand-in's data do not reach (they run where some pairs are
     not folded into their groups, where a group's components are eliminated and in the Newton system), on empty
-    arrays of the solve's types (``contact.mortar_jit.subtract_indexed``, ``nonlinear.condense._schur``, the bordered
-    pattern's passes ``nonlinear.bordered._border_counts``, ``_border_fill``, ``_border_values``, the augmented solve's
-    ``nonlinear.augmented._join``, ``_precondition_rhs``, ``_precondition_out``)."""
+    arrays of the solve's types (``contact.mortar_jit.subtract_indexed``, ``nonlinear.condense._schur`` and
+    ``scatter_free``, the bordered pattern's passes ``nonlinear.bordered._border_counts``, ``_border_fill``,
+    ``_border_values``, the augmented solve's ``nonlinear.augmented._join``, ``_precondition_rhs``,
+    ``_precondition_out``)."""
     from ..contact import mortar_jit
     from . import augmented, bordered, condense
     mortar_jit.subtract_indexed(np.zeros((0, 24, 24)), np.zeros((0, 24, 24)), np.zeros(0, dtype=np.int64))
     condense._schur(np.zeros(0), 0, np.zeros((0, 24, 3)), np.zeros((0, 3, 24)), np.zeros((0, 3)))
+    condense.scatter_free(np.zeros((0, 24), dtype=np.int64), np.zeros((0, 24)), np.zeros(0))
     none, rows, i32 = np.zeros(0, dtype=np.int64), np.zeros((0, 24), dtype=np.int64), np.zeros(0, dtype=np.int32)
     kptr, ptr = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int32)
     bordered._border_counts(kptr, rows, 0, 3, rows, none, rows, ptr)

@@ -242,7 +242,7 @@ class Problem:
 
     def _group_increments(self, mu, x, dz_c=None):
         """``(g, k6)``: the increments of the groups' slots (free ones from ``x``, prescribed ones from ``dz_c``)."""
-        rows_red = self.system.red[mu["dofs"]]
+        rows_red = self._rows_red(mu)
         dz = np.where(rows_red >= 0, x[:self.system.n_free][np.maximum(rows_red, 0)], 0.0)
         return dz if dz_c is None else dz + self._prescribed_slots(mu, dz_c)
 
@@ -275,8 +275,7 @@ class Problem:
         is set to zero there (row: the traction's component itself).  ``rows``: ``(Klq, Kll, C)`` in place of the
         evaluation's (``branch_rows``)."""
         mu = ev.mult
-        red = self.system.red
-        rows_red = red[mu["dofs"]]
+        rows_red = self._rows_red(mu)
         Klq, Kll, C = (mu["Klq"], mu["Kll"], mu["C"]) if rows is None else rows
         A, rc = self._bordered.matrix(K, rows_red, mu["Kql"], Klq, Kll, mu["R"], mu["Lam"], C)
         if dz_c is not None:
@@ -305,10 +304,9 @@ class Problem:
         if dz_c is not None:
             rhs -= self.coupling(ev, dz_c)
         if sp is not None:
-            rows_red = s.red[ev.mult["dofs"]]
-            corr = condense_.rhs_terms(sp)
-            free = rows_red >= 0
-            rhs += np.bincount(rows_red[free], weights=corr[free], minlength=len(rhs))
+            add = np.zeros(len(rhs))
+            condense_.scatter_free(self._rows_red(ev.mult), condense_.rhs_terms(sp), add)
+            rhs += add
         return rhs
 
     def _kept(self, ev):
@@ -318,7 +316,7 @@ class Problem:
         g, j = sp.kept[:, 0], sp.kept[:, 1]
         d = sp.d[g, j]
         d = np.where(np.abs(d) < bordered_.IDLE, 0.0, d)       # a sticking group's tangential components: zero
-        return g, j, sp.Kql[g, :, j], sp.Klq[g, j], d, self.system.red[mu["dofs"]][g]
+        return g, j, sp.Kql[g, :, j], sp.Klq[g, j], d, self._rows_red(mu)[g]
 
     def linear_system(self, ev, dz_c=None, condense=True, rows=None):
         """``(A, rhs)``: the Newton system of ``ev`` (CSC, free unknowns first; ``dz_c`` ``(n, 6)`` prescribed
@@ -447,7 +445,14 @@ class Problem:
     def _prescribed_slots(self, mu, dz_c):
         """``(g, k6)``: the prescribed increments ``dz_c`` on the groups' held slots (zero on free ones)."""
         dz = np.ravel(dz_c)[mu["dofs"]]
-        return np.where(self.system.red[mu["dofs"]] < 0, dz, 0.0)
+        return np.where(self._rows_red(mu) < 0, dz, 0.0)
+
+    def _rows_red(self, mu):
+        """``(g, k6)``: the free (reduced) row of each group slot of the multipliers ``mu`` (``-1``: held), once per
+        evaluation (kept in ``mu``)."""
+        if "rows_red" not in mu:
+            mu["rows_red"] = self.system.red[mu["dofs"]]
+        return mu["rows_red"]
 
     def split_solution(self, ev, x, dz_c=None):
         """``(dzf, dLam)``: the free increments ``(n_free,)`` and the multipliers' Newton step ``(g, 3)`` (``None``
@@ -459,7 +464,7 @@ class Problem:
         sp = mu.get("split")
         if sp is None:
             return x[:n], x[n:].reshape(-1, 3)
-        rows_red = self.system.red[mu["dofs"]]
+        rows_red = self._rows_red(mu)
         dz = np.where(rows_red >= 0, x[:n][rows_red], 0.0)
         if dz_c is not None:
             dz = dz + self._prescribed_slots(mu, dz_c)

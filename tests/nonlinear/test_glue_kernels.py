@@ -81,3 +81,14 @@ def test_augmented_products_and_preconditioner_are_the_numpy_formulas():
     du = apply(vf + kq(np.where(plain, -db0, E * vg)))
     ref = np.concatenate([du, np.where(plain, db0, E * (kl(du, Lp) - vg))])
     assert np.array_equal(a.precondition(x, apply), ref)
+
+
+def test_scatter_free_is_numpy_s_masked_bincount():
+    """The eliminated components' right-hand side terms on the groups' free rows (held slots ``-1`` skipped, repeated
+    rows summed in order): ``np.bincount(rows[free], weights=vals[free])``'s bits."""
+    rng = np.random.default_rng(6)
+    rows, vals = rng.integers(-1, 40, (25, 24)), rng.standard_normal((25, 24))
+    out = np.zeros(40)
+    condense.scatter_free(rows, vals, out)
+    free = rows >= 0
+    assert np.array_equal(out, np.bincount(rows[free], weights=vals[free], minlength=40))
