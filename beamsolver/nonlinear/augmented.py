@@ -55,19 +55,46 @@ def weights(Kq, Kl, free, kdiag, d, idle):
     """``(E, p22)`` ``(u,)``: the augmentation of each kept row (0: none) and the preconditioner's diagonal
     entry there, from the rows' couplings ``Kq``, ``Kl`` ``(u, k6)`` (columns / rows of the group's slots), the
     slots' freedom ``free`` and the elements' diagonal stiffness ``kdiag`` ``(u, k6)``, ``D``'s entries ``d`` and
-    the idle rows ``idle`` ``(u,)`` (module docstring)."""
-    use = free & (kdiag > 0.0)
-    p = Kq * Kl / np.where(use, kdiag, 1.0)
-    p = np.where(use, p, 0.0)
-    scale = np.abs(p).max(axis=1, initial=0.0)
-    sign = np.sign(p.sum(axis=1))
-    coupled = ~idle & (scale > 0.0) & (sign != 0.0)
-    E = np.where(coupled, sign * RATIO / np.where(coupled, scale, 1.0), 0.0)
-    inv = np.where(coupled, 1.0 / np.where(coupled, E, 1.0), 0.0)
-    p22 = np.where(E * d < 0.0, d - inv, -inv)
-    p22 = np.where(coupled, p22, np.where(idle | (d == 0.0), 1.0, d))
-    E = np.where(coupled, -1.0 / np.where(coupled, p22, 1.0), 0.0)
+    the idle rows ``idle`` ``(u,)`` (module docstring).  Compiled (``_couplings``, ``_weights_of``) but for the rows'
+    sums, numpy's (their sign: the same pairwise sums)."""
+    u = len(d)
+    p, scale = np.empty(np.shape(Kq)), np.empty(u)
+    _couplings(np.ascontiguousarray(Kq, dtype=float), np.ascontiguousarray(Kl, dtype=float),
+               np.ascontiguousarray(free), np.ascontiguousarray(kdiag, dtype=float), p, scale)
+    E, p22 = np.empty(u), np.empty(u)
+    _weights_of(scale, p.sum(axis=1), np.ascontiguousarray(idle), np.ascontiguousarray(d, dtype=float), RATIO, E, p22)
     return E, p22
+
+
+@jit
+def _couplings(Kq, Kl, free, kdiag, p, scale):
+    """``p = Kq Kl / kdiag`` on the free slots with stiffness (else 0) and each row's largest ``|p|`` (``scale``,
+    0 for none; NaN as ``np.max``)."""
+    for i in range(Kq.shape[0]):
+        m = 0.0
+        for a in range(Kq.shape[1]):
+            v = (Kq[i, a] * Kl[i, a]) / kdiag[i, a] if free[i, a] and kdiag[i, a] > 0.0 else 0.0
+            p[i, a] = v
+            if m == m and not (abs(v) <= m):
+                m = abs(v)
+        scale[i] = m
+
+
+@jit
+def _weights_of(scale, total, idle, d, ratio, E, p22):
+    """``(E, p22)`` of ``weights`` from the rows' ``scale`` and coupling sums ``total`` (their sign, as ``np.sign``)."""
+    for i in range(len(scale)):
+        t = total[i]
+        sign = 1.0 if t > 0.0 else (-1.0 if t < 0.0 else (0.0 if t == 0.0 else t))
+        if not idle[i] and scale[i] > 0.0 and sign != 0.0:
+            e = sign * ratio / scale[i]
+            inv = 1.0 / e
+            q = d[i] - inv if e * d[i] < 0.0 else -inv
+            p22[i] = q
+            E[i] = -1.0 / q
+        else:
+            p22[i] = 1.0 if idle[i] or d[i] == 0.0 else d[i]
+            E[i] = 0.0
 
 
 class Augmented:

@@ -329,7 +329,7 @@ def _exact_stick_callees():
     arrays of the solve's types (``contact.mortar_jit.subtract_indexed``, ``nonlinear.condense._schur`` and
     ``scatter_free``, the bordered pattern's passes ``nonlinear.bordered._border_counts``, ``_border_fill``,
     ``_border_values``, the augmented solve's ``nonlinear.augmented._join``, ``_precondition_rhs``,
-    ``_precondition_out``)."""
+    ``_precondition_out``, ``_couplings``, ``_weights_of``)."""
     from ..contact import mortar_jit
     from . import augmented, bordered, condense
     mortar_jit.subtract_indexed(np.zeros((0, 24, 24)), np.zeros((0, 24, 24)), np.zeros(0, dtype=np.int64))
@@ -345,6 +345,8 @@ def _exact_stick_callees():
     augmented._join(f, rows, f2, f, f, f, f)
     augmented._precondition_rhs(f, f, b, f, f, rows, f2, f, f)
     augmented._precondition_out(f, f, f, b, f, f, f)
+    augmented._couplings(f2, f2, np.zeros((0, 24), dtype=bool), f2, f2, f)
+    augmented._weights_of(f, f, b, f, 1.0, f, f)
 
 
 def _stand_in(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames):

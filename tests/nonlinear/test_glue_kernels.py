@@ -92,3 +92,38 @@ def test_scatter_free_is_numpy_s_masked_bincount():
     condense.scatter_free(rows, vals, out)
     free = rows >= 0
     assert np.array_equal(out, np.bincount(rows[free], weights=vals[free], minlength=40))
+
+
+def _weights_numpy(Kq, Kl, free, kdiag, d, idle):
+    """``augmented.weights`` in numpy (its former form, the oracle)."""
+    use = free & (kdiag > 0.0)
+    p = Kq * Kl / np.where(use, kdiag, 1.0)
+    p = np.where(use, p, 0.0)
+    scale = np.abs(p).max(axis=1, initial=0.0)
+    sign = np.sign(p.sum(axis=1))
+    coupled = ~idle & (scale > 0.0) & (sign != 0.0)
+    E = np.where(coupled, sign * augmented.RATIO / np.where(coupled, scale, 1.0), 0.0)
+    inv = np.where(coupled, 1.0 / np.where(coupled, E, 1.0), 0.0)
+    p22 = np.where(E * d < 0.0, d - inv, -inv)
+    p22 = np.where(coupled, p22, np.where(idle | (d == 0.0), 1.0, d))
+    E = np.where(coupled, -1.0 / np.where(coupled, p22, 1.0), 0.0)
+    return E, p22
+
+
+def test_weights_are_the_numpy_formulas():
+    """``augmented.weights`` (compiled but for the rows' sums) gives numpy's bits: coupled rows of either sign, with
+    ``d`` of either sign or zero, idle rows, rows without free slots or stiffness."""
+    rng = np.random.default_rng(9)
+    u, k6 = 40, 24
+    Kq, Kl = rng.standard_normal((u, k6)), rng.standard_normal((u, k6))
+    free = rng.random((u, k6)) < 0.8
+    free[3] = False
+    kdiag = rng.random((u, k6)) * 10.0 ** rng.integers(-3, 3, (u, k6))
+    kdiag[4] = 0.0
+    kdiag[rng.random((u, k6)) < 0.05] = -1.0
+    d = np.where(rng.random(u) < 0.3, 0.0, rng.standard_normal(u) * 0.05)
+    idle = rng.random(u) < 0.1
+    E, p22 = augmented.weights(Kq, Kl, free, kdiag, d, idle)
+    E0, p220 = _weights_numpy(Kq, Kl, free, kdiag, d, idle)
+    assert np.array_equal(E, E0) and np.array_equal(p22, p220)
+    assert (E != 0.0).sum() > u // 2 and (E == 0.0).sum() > 3
