@@ -115,7 +115,9 @@ def _uncovered(node, vals, nfree, nptr, nrow):
 def _values(el_data, el_pos, node, vals, red, nfree, indptr, eoff, nptr, nrow, t_rows, t_cols, t_vals, out):
     """Held-pattern values: element values, plus the blocks ``vals`` ``(m, 6 k, 6 k)`` over ``node``
     ``(m, k)``, plus the tail entries (full numbering, dropped where held); explicit zeros kept.  Returns
-    False if an entry with a free row and column has no place in the pattern."""
+    False if an entry with a free row and column has no place in the pattern.  Each entry sums its terms in
+    block, then slot-pair order; a pair of whole free nodes is the 6 x 6 block at ``indptr[j0] + eoff[e]``
+    with column stride ``L`` (``_node_block``)."""
     out[:] = 0.0
     for s in range(len(el_pos)):
         out[el_pos[s]] += el_data[s]
@@ -123,13 +125,24 @@ def _values(el_data, el_pos, node, vals, red, nfree, indptr, eoff, nptr, nrow, t
     for blk in range(node.shape[0]):
         for t in range(k):
             b = node[blk, t]
+            if nfree[b] == 0:
+                continue
             for s in range(k):
                 a = node[blk, s]
+                if nfree[a] == 0:
+                    continue
                 e = _find(nptr, nrow, a, b)
                 if e < 0:
-                    if nfree[a] > 0 and nfree[b] > 0 and not _zero_block(vals, blk, s, t):
+                    if not _zero_block(vals, blk, s, t):
                         return False
-                    continue                     # a or b without free dofs, or a zero block
+                    continue                     # a zero block
+                if nfree[a] == 6 and nfree[b] == 6:
+                    base, L = _node_block(red, indptr, eoff, b, e)
+                    for q in range(6):
+                        col = base + q * L
+                        for p in range(6):
+                            out[col + p] += vals[blk, 6 * s + p, 6 * t + q]
+                    continue
                 for q in range(6):
                     j = red[6 * b + q]
                     if j < 0:
@@ -155,48 +168,124 @@ def _values(el_data, el_pos, node, vals, red, nfree, indptr, eoff, nptr, nrow, t
     return True
 
 
+@jit_callee
+def _node_block(red, indptr, eoff, b, e):
+    """``(base, L)``: the entry of (row dof 0 of the pair's row node, column dof 0 of node ``b``) for the node
+    pair ``e`` and the stride between ``b``'s six columns (they hold the same rows: ``_expand``), ``b`` free."""
+    j0 = red[6 * b]
+    return indptr[j0] + eoff[e], indptr[j0 + 1] - indptr[j0]
+
+
 @jit
-def _add_products(node, Kq, Kl, w, red, indptr, eoff, nptr, nrow, out):
+def _add_products(node, Kq, Kl, w, red, nfree, indptr, eoff, nptr, nrow, out):
     """``out += sum_u w_u Kq_u Kl_u^T`` on the held pattern, ``Kq``, ``Kl`` ``(m, 6 k)`` over the nodes ``node``
-    ``(m, k)`` (rank-one blocks; held rows and columns dropped).  Returns False (``out`` partly changed) if a
+    ``(m, k)`` (rank-one blocks; held rows and columns dropped), each entry's terms added row after row.  A
+    group's consecutive rows (the same nodes) share one pass over its blocks (its node pairs found once); a
+    group with a repeated node, row by row (``_row_products``).  Returns False (``out`` partly changed) if a
     node pair with an entry has no place in the pattern."""
-    k = node.shape[1]
-    place = np.empty((k, k), dtype=np.int64)       # the node pairs' places of the last row's nodes (a group's rows
-    last = -1                                      # are consecutive: found once per group, the same sums)
-    for u in range(node.shape[0]):
-        if w[u] == 0.0:
+    k, m = node.shape[1], node.shape[0]
+    place = np.empty((k, k), dtype=np.int64)
+    u = 0
+    while u < m:
+        end = u + 1
+        while end < m and _same_nodes(node, u, end):
+            end += 1
+        for t in range(k):
+            for s in range(k):
+                place[s, t] = _find(nptr, nrow, node[u, s], node[u, t])
+        if _repeated(node, u):
+            for v in range(u, end):
+                if not _row_products(node, Kq, Kl, w, red, indptr, eoff, place, v, out):
+                    return False
+            u = end
             continue
-        same = last >= 0
-        if same:
-            for t in range(k):
-                if node[u, t] != node[last, t]:
-                    same = False
-                    break
-        if not same:
-            for t in range(k):
-                for s in range(k):
-                    place[s, t] = _find(nptr, nrow, node[u, s], node[u, t])
-            last = u
         for t in range(k):
             b = node[u, t]
+            if nfree[b] == 0:
+                continue
             for s in range(k):
                 a = node[u, s]
                 e = place[s, t]
+                if nfree[a] == 0:
+                    continue
+                if e >= 0 and nfree[a] == 6 and nfree[b] == 6:
+                    base, L = _node_block(red, indptr, eoff, b, e)
+                    for q in range(6):
+                        col = base + q * L
+                        for v in range(u, end):
+                            c = w[v] * Kl[v, 6 * t + q]
+                            if w[v] == 0.0 or c == 0.0:
+                                continue
+                            for p in range(6):
+                                out[col + p] += Kq[v, 6 * s + p] * c
+                    continue
                 for q in range(6):
                     j = red[6 * b + q]
-                    c = w[u] * Kl[u, 6 * t + q]
-                    if j < 0 or c == 0.0:
+                    if j < 0:
                         continue
-                    r = 0
-                    for p in range(6):
-                        if red[6 * a + p] >= 0:
-                            v = Kq[u, 6 * s + p] * c
-                            if e < 0:
-                                if v != 0.0:
-                                    return False
-                            else:
-                                out[indptr[j] + eoff[e] + r] += v
-                            r += 1
+                    for v in range(u, end):
+                        c = w[v] * Kl[v, 6 * t + q]
+                        if w[v] == 0.0 or c == 0.0:
+                            continue
+                        r = 0
+                        for p in range(6):
+                            if red[6 * a + p] >= 0:
+                                x = Kq[v, 6 * s + p] * c
+                                if e < 0:
+                                    if x != 0.0:
+                                        return False
+                                else:
+                                    out[indptr[j] + eoff[e] + r] += x
+                                r += 1
+        u = end
+    return True
+
+
+@jit_callee
+def _same_nodes(node, u, v):
+    """Whether rows ``u`` and ``v`` of ``node`` ``(m, k)`` are over the same nodes."""
+    for t in range(node.shape[1]):
+        if node[u, t] != node[v, t]:
+            return False
+    return True
+
+
+@jit_callee
+def _repeated(node, u):
+    """Whether row ``u`` of ``node`` ``(m, k)`` names a node twice."""
+    for t in range(node.shape[1]):
+        for s in range(t):
+            if node[u, s] == node[u, t]:
+                return True
+    return False
+
+
+@jit_callee
+def _row_products(node, Kq, Kl, w, red, indptr, eoff, place, u, out):
+    """``out += w_u Kq_u Kl_u^T`` of the one row ``u`` (``_add_products``; ``place`` its node pairs' places)."""
+    if w[u] == 0.0:
+        return True
+    k = node.shape[1]
+    for t in range(k):
+        b = node[u, t]
+        for s in range(k):
+            a = node[u, s]
+            e = place[s, t]
+            for q in range(6):
+                j = red[6 * b + q]
+                c = w[u] * Kl[u, 6 * t + q]
+                if j < 0 or c == 0.0:
+                    continue
+                r = 0
+                for p in range(6):
+                    if red[6 * a + p] >= 0:
+                        x = Kq[u, 6 * s + p] * c
+                        if e < 0:
+                            if x != 0.0:
+                                return False
+                        else:
+                            out[indptr[j] + eoff[e] + r] += x
+                        r += 1
     return True
 
 
@@ -274,7 +363,7 @@ class HeldPattern:
         pattern (``data`` is then partly changed)."""
         return bool(_add_products(np.ascontiguousarray(node, dtype=np.int64), np.ascontiguousarray(Kq),
                                   np.ascontiguousarray(Kl), np.ascontiguousarray(w, dtype=float), self.red,
-                                  self.indptr, self.eoff, self.nptr, self.nrow, data))
+                                  self.nfree, self.indptr, self.eoff, self.nptr, self.nrow, data))
 
     def grown(self, node, vals):
         """The pattern holding the node pairs of the blocks ``vals`` over ``node`` too (``covers``): this reserve

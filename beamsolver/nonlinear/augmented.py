@@ -33,6 +33,7 @@ back to the direct saddle solve of ``M`` (``Problem.linear_system``'s), without 
 """
 import numpy as np
 
+from .._jit import jit
 from .lagged import gmres
 from .linsolve import factorize_tangent
 from ..failures import SingularTangent
@@ -54,19 +55,46 @@ def weights(Kq, Kl, free, kdiag, d, idle):
     """``(E, p22)`` ``(u,)``: the augmentation of each kept row (0: none) and the preconditioner's diagonal
     entry there, from the rows' couplings ``Kq``, ``Kl`` ``(u, k6)`` (columns / rows of the group's slots), the
     slots' freedom ``free`` and the elements' diagonal stiffness ``kdiag`` ``(u, k6)``, ``D``'s entries ``d`` and
-    the idle rows ``idle`` ``(u,)`` (module docstring)."""
-    use = free & (kdiag > 0.0)
-    p = Kq * Kl / np.where(use, kdiag, 1.0)
-    p = np.where(use, p, 0.0)
-    scale = np.abs(p).max(axis=1, initial=0.0)
-    sign = np.sign(p.sum(axis=1))
-    coupled = ~idle & (scale > 0.0) & (sign != 0.0)
-    E = np.where(coupled, sign * RATIO / np.where(coupled, scale, 1.0), 0.0)
-    inv = np.where(coupled, 1.0 / np.where(coupled, E, 1.0), 0.0)
-    p22 = np.where(E * d < 0.0, d - inv, -inv)
-    p22 = np.where(coupled, p22, np.where(idle | (d == 0.0), 1.0, d))
-    E = np.where(coupled, -1.0 / np.where(coupled, p22, 1.0), 0.0)
+    the idle rows ``idle`` ``(u,)`` (module docstring).  Compiled (``_couplings``, ``_weights_of``) but for the rows'
+    sums, numpy's (their sign: the same pairwise sums)."""
+    u = len(d)
+    p, scale = np.empty(np.shape(Kq)), np.empty(u)
+    _couplings(np.ascontiguousarray(Kq, dtype=float), np.ascontiguousarray(Kl, dtype=float),
+               np.ascontiguousarray(free), np.ascontiguousarray(kdiag, dtype=float), p, scale)
+    E, p22 = np.empty(u), np.empty(u)
+    _weights_of(scale, p.sum(axis=1), np.ascontiguousarray(idle), np.ascontiguousarray(d, dtype=float), RATIO, E, p22)
     return E, p22
+
+
+@jit
+def _couplings(Kq, Kl, free, kdiag, p, scale):
+    """``p = Kq Kl / kdiag`` on the free slots with stiffness (else 0) and each row's largest ``|p|`` (``scale``,
+    0 for none; NaN as ``np.max``)."""
+    for i in range(Kq.shape[0]):
+        m = 0.0
+        for a in range(Kq.shape[1]):
+            v = (Kq[i, a] * Kl[i, a]) / kdiag[i, a] if free[i, a] and kdiag[i, a] > 0.0 else 0.0
+            p[i, a] = v
+            if m == m and not (abs(v) <= m):
+                m = abs(v)
+        scale[i] = m
+
+
+@jit
+def _weights_of(scale, total, idle, d, ratio, E, p22):
+    """``(E, p22)`` of ``weights`` from the rows' ``scale`` and coupling sums ``total`` (their sign, as ``np.sign``)."""
+    for i in range(len(scale)):
+        t = total[i]
+        sign = 1.0 if t > 0.0 else (-1.0 if t < 0.0 else (0.0 if t == 0.0 else t))
+        if not idle[i] and scale[i] > 0.0 and sign != 0.0:
+            e = sign * ratio / scale[i]
+            inv = 1.0 / e
+            q = d[i] - inv if e * d[i] < 0.0 else -inv
+            p22[i] = q
+            E[i] = -1.0 / q
+        else:
+            p22[i] = 1.0 if idle[i] or d[i] == 0.0 else d[i]
+            E[i] = 0.0
 
 
 class Augmented:
@@ -94,26 +122,28 @@ class Augmented:
         ``solve`` is then an error; the factor of ``A`` (``factor``) stays."""
         self.K = self.direct = None
 
-    def _Kq(self, y):
-        """``Kq y`` ``(n,)`` for ``y`` ``(u,)``."""
-        return np.bincount(self.rows.ravel(), weights=(self.Kq * y[:, None]).ravel(), minlength=self.n)
-
     def _Kl(self, x, K=None):
         """``Kl x`` ``(u,)`` for ``x`` ``(n,)``."""
         return np.einsum("ua,ua->u", self.Kl if K is None else K, x[self.rows])
 
     def matvec(self, x):
-        """``M x`` for ``x`` ``(n + u,)``."""
+        """``M x`` for ``x`` ``(n + u,)``: ``[K' x_u + Kq x_b; Kl x_u + D x_b]`` (``_join``)."""
         xu, xb = x[:self.n], x[self.n:]
-        return np.concatenate([self.K @ xu + self._Kq(xb), self._Kl(xu) + self.D * xb])
+        out = np.empty(len(x))
+        _join(self.K @ xu, self.rows, self.Kq, np.ascontiguousarray(xb), self._Kl(xu), self.D, out)
+        return out
 
     def precondition(self, v, apply):
-        """``P^-1 v`` with ``apply`` the solve with (a factorisation of) ``A``."""
-        vf, vg = v[:self.n], v[self.n:]
-        db0 = np.where(self.plain, vg / self.p22, 0.0)
-        du = apply(vf + self._Kq(np.where(self.plain, -db0, self.E * vg)))
-        db = np.where(self.plain, db0, self.E * (self._Kl(du, self.Klp) - vg))
-        return np.concatenate([du, db])
+        """``P^-1 v`` with ``apply`` the solve with (a factorisation of) ``A`` (``_precondition_rhs``,
+        ``_precondition_out``: the module's formulas)."""
+        vf, vg = np.ascontiguousarray(v[:self.n]), np.ascontiguousarray(v[self.n:])
+        db0, r = np.empty(len(vg)), np.empty(self.n)
+        _precondition_rhs(vf, vg, self.plain, self.p22, self.E, self.rows, self.Kq, db0, r)
+        du = apply(r)
+        out = np.empty(len(v))
+        du = np.ascontiguousarray(du)
+        _precondition_out(du, self._Kl(du, self.Klp), vg, self.plain, db0, self.E, out)
+        return out
 
     def solve(self, solver):
         """The solution ``x`` ``(n + u,)`` of ``M x = [f; g]`` (``Problem.split_solution`` reads it): GMRES
@@ -151,3 +181,50 @@ class Augmented:
         lu = factorize_tangent(M, solver, saddle=True)
         self.factor = lu
         return lu.solve(rhs)
+
+
+@jit
+def _scatter_rows(rows, Kq, y, out):
+    """``out[rows[u, a]] += Kq[u, a] y[u]`` row after row, slot after slot (``rows``, ``Kq`` ``(u, k6)``, ``y``
+    ``(u,)``, ``out`` ``(n,)`` zeros in): ``np.bincount(rows.ravel(), weights=(Kq * y[:, None]).ravel())``, the same
+    products summed in the same order, without the ``(u, k6)`` temporaries."""
+    for u in range(rows.shape[0]):
+        for a in range(rows.shape[1]):
+            out[rows[u, a]] += Kq[u, a] * y[u]
+
+
+@jit
+def _join(top, rows, Kq, xb, kl, D, out):
+    """``out = [top + Kq xb; kl + D xb]`` (``Augmented.matvec``; ``Kq xb`` by ``_scatter_rows``, then added)."""
+    n = len(top)
+    s = np.zeros(n)
+    _scatter_rows(rows, Kq, xb, s)
+    for i in range(n):
+        out[i] = top[i] + s[i]
+    for u in range(len(xb)):
+        out[n + u] = kl[u] + D[u] * xb[u]
+
+
+@jit
+def _precondition_rhs(vf, vg, plain, p22, E, rows, Kq, db0, r):
+    """``P^-1``'s first half (``Augmented.precondition``): ``db0 = vg / p22`` on the plain rows (else 0) and the
+    right-hand side of ``A``, ``r = vf + Kq y`` with ``y = -db0`` on the plain rows, ``E vg`` on the others."""
+    y = np.empty(len(vg))
+    for u in range(len(vg)):
+        db0[u] = vg[u] / p22[u] if plain[u] else 0.0
+        y[u] = -db0[u] if plain[u] else E[u] * vg[u]
+    s = np.zeros(len(vf))
+    _scatter_rows(rows, Kq, y, s)
+    for i in range(len(vf)):
+        r[i] = vf[i] + s[i]
+
+
+@jit
+def _precondition_out(du, kl, vg, plain, db0, E, out):
+    """``P^-1 v = [du; db]`` (``Augmented.precondition``), ``db = db0`` on the plain rows, ``E (kl - vg)`` on the
+    others (``kl = Kl du`` without the idle rows)."""
+    n = len(du)
+    for i in range(n):
+        out[i] = du[i]
+    for u in range(len(vg)):
+        out[n + u] = db0[u] if plain[u] else E[u] * (kl[u] - vg[u])

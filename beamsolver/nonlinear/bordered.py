@@ -3,8 +3,11 @@
 ``Bordered.matrix`` keeps the pattern (indices, indptr and where each block's entries go) while the tangent's
 pattern and the multiplier groups' rows hold (a Newton step of exact stick keeps both), so an iteration only
 places values: no COO/CSC constructions and no ``sp.bmat`` (about 1.2 ms an iteration on the twisted pair,
-issue 26).  Duplicate entries (a group's padded slots, joined nodes) are summed in their COO order.  ``bmat``
-is its numpy/scipy oracle (the former ``Problem.bordered``): the same pattern and values to round-off.
+issue 26).  Duplicate entries (a group's padded slots, joined nodes) are summed in their COO order.  The pattern
+is built and the values placed by compiled passes (``_border_counts``, ``_border_fill``, ``_border_values``: about
+0.26 -> 0.05 ms a build on the main job, whose condensed border changes most iterations, issue 30 session 16);
+``merged`` is their numpy oracle (the pattern by ``np.unique``, the values by ``np.bincount``: the same bits), ``bmat``
+the numpy/scipy oracle (the former ``Problem.bordered``): the same pattern and values to round-off.
 """
 import numpy as np
 import scipy.sparse as sp
@@ -12,7 +15,7 @@ import scipy.sparse as sp
 from .._jit import jit
 from ..assembly.csc import canonical_csc
 
-__all__ = ["Bordered", "bmat", "use_bmat", "IDLE"]
+__all__ = ["Bordered", "bmat", "merged", "use_bmat", "IDLE"]
 
 IDLE = 1e-12        # a multiplier row with no free coupling and no own entry below this share of the largest
 
@@ -58,48 +61,24 @@ class Bordered:
         return True
 
     def _build(self, K, rows_red, nf, c):
-        """The pattern of ``matrix``.  ``K``'s entries (canonical: sorted, no duplicates) and the border's (a row or a
-        column of a multiplier: never at one of ``K``'s) are merged by their sorted keys; only the border's are
-        sorted and made unique (``_build_unique``: the same pattern by one ``np.unique`` over all the entries)."""
-        g = rows_red.shape[0]
+        """The pattern of ``matrix`` (compiled: ``_border_counts``, ``_border_fill``): the output's ``indptr``,
+        ``indices``, where ``K``'s entries go (``posK``) and where each border entry goes (``bpos``, ``_coo``'s
+        order: ``K_ql``'s kept entries, ``K_lq``'s, then ``K_ll``'s), duplicates at one place."""
+        g, k6 = rows_red.shape
         N = nf + c * g
-        rb, cb, iq, il = _coo(rows_red, nf, c)
-        kc = np.repeat(np.arange(nf, dtype=np.int64), np.diff(K.indptr))
-        kkeys = kc * N + K.indices.astype(np.int64)
-        ubk, inv = np.unique(cb * N + rb, return_inverse=True)
-        inv = inv.ravel()
-        posK, ub = np.empty(len(kkeys), dtype=np.int64), np.empty(len(ubk), dtype=np.int64)
-        u = np.empty(len(kkeys) + len(ubk), dtype=np.int64)
-        _merge(kkeys, ubk, posK, ub, u)
-        self._store(K, rows_red, nf, c, g, N, u, posK, ub, inv, iq, il)
-
-    def _build_unique(self, K, rows_red, nf, c):
-        """``_build`` by one ``np.unique`` over every entry (its oracle: the same pattern)."""
-        g = rows_red.shape[0]
-        N = nf + c * g
-        rb, cb, iq, il = _coo(rows_red, nf, c)
-        kc = np.repeat(np.arange(nf, dtype=np.int64), np.diff(K.indptr))
-        rows = np.concatenate([K.indices.astype(np.int64), rb])
-        cols = np.concatenate([kc, cb])
-        u, pos = np.unique(cols * N + rows, return_inverse=True)
-        pos = pos.ravel()
-        nk = K.nnz
-        ub, inv = np.unique(pos[nk:], return_inverse=True)      # the border's entries (apart from K's)
-        self._store(K, rows_red, nf, c, g, N, u, pos[:nk], ub, inv.ravel(), iq, il)
-
-    def _store(self, K, rows_red, nf, c, g, N, u, posK, ub, inv, iq, il):
-        """Keep the pattern: ``u`` the sorted keys ``col N + row`` of the entries, ``posK`` where ``K``'s go, ``ub``
-        where the border's distinct ones go and ``inv`` which of them each border entry (``_coo``'s order) is."""
-        indptr, indices = np.zeros(N + 1, dtype=np.int32), np.empty(len(u), dtype=np.int32)
-        _split_keys(u, N, indptr, indices)
-        nlq = len(iq) + len(il)
-        lq = inv[len(iq):nlq]
-        ulq, lq_inv = np.unique(lq, return_inverse=True)
-        self._p = dict(nf=nf, c=c, indptr_out=indptr, indices=indices, nnz=len(u), N=N,
-                       posK=posK, border=ub, inv=inv, iq=iq, il=il,
-                       lq_rows=indices[ub[ulq]].astype(np.int64) - nf, lq_entries=ub[ulq],
-                       ll=ub[inv[nlq:]].reshape(g, c, c), n_border=len(inv),
-                       indptr=K.indptr, kindices=K.indices, rows_red=rows_red.copy())
+        kptr = np.asarray(K.indptr, dtype=np.int64)
+        rows_red = rows_red.copy()
+        rr = np.ascontiguousarray(rows_red, dtype=np.int64)
+        gu, ng, rank = np.empty((g, k6), dtype=np.int64), np.empty(g, dtype=np.int64), np.empty((g, k6), dtype=np.int64)
+        indptr = np.zeros(N + 1, dtype=np.int32)
+        nnz = _border_counts(kptr, rr, nf, c, gu, ng, rank, indptr)
+        indices = np.empty(nnz, dtype=np.int32)
+        posK = np.empty(K.nnz, dtype=np.int64)
+        bpos = np.empty(2 * c * int((rr >= 0).sum()) + g * c * c, dtype=np.int64)
+        _border_fill(kptr, K.indices, rr, nf, c, gu, ng, rank, indptr, indices, posK, bpos)
+        self._p = dict(nf=nf, c=c, indptr_out=indptr, indices=indices, nnz=nnz, N=N, posK=posK, bpos=bpos,
+                       ll=bpos[len(bpos) - g * c * c:].reshape(g, c, c), kptr=kptr,
+                       indptr=K.indptr, kindices=K.indices, rows_red=rows_red, rr=rr)
         self.builds += 1
 
     def matrix(self, K, rows_red, Kql, Klq, Kll, R, Lam, C):
@@ -117,14 +96,21 @@ class Bordered:
         if not self._same(K, rows_red, nf, c):
             self._build(K, rows_red, nf, c)
         p = self._p
-        data = np.empty(p["nnz"])
-        data[p["posK"]] = K.data
-        vals = np.concatenate([np.ravel(Kql)[p["iq"]], np.ravel(Klq)[p["il"]], np.ravel(Kll)])
-        data[p["border"]] = np.bincount(p["inv"], weights=vals, minlength=len(p["border"]))
-        rc = -np.ravel(C).copy()
-        # a multiplier direction no free unknown can slip in: its row is the traction's component itself (bmat)
         g = len(rows_red)
-        free_row = np.sqrt(np.bincount(p["lq_rows"], weights=data[p["lq_entries"]] ** 2, minlength=c * g))
+        data = np.empty(p["nnz"])
+        free_row = np.zeros(c * g)
+        Kql, Klq, Kll = (np.ascontiguousarray(x, dtype=float) for x in (Kql, Klq, Kll))
+        _border_values(K.data, p["posK"], Kql, Klq, Kll, p["rr"], p["bpos"], p["kptr"], p["indptr_out"], p["indices"],
+                       data, free_row)
+        return self._finish(data, np.sqrt(free_row), p, Kll, R, Lam, C)
+
+    @staticmethod
+    def _finish(data, free_row, p, Kll, R, Lam, C):
+        """``(A, rc)`` of ``matrix`` from the placed values ``data`` and the border rows' norms ``free_row``
+        ``(c g,)`` on free columns: a multiplier direction no free unknown can slip in takes the traction's
+        component itself as its row (``bmat``)."""
+        c = Kll.shape[1]
+        rc = -np.ravel(C).copy()
         own = np.linalg.norm(Kll, axis=2).ravel()
         idle = (free_row <= IDLE * max(free_row.max(initial=0.0), 1e-300)) & \
             (own <= IDLE * max(own.max(initial=0.0), 1e-300))
@@ -136,34 +122,159 @@ class Bordered:
 
 
 @jit
-def _merge(a, b, pa, pb, u):
-    """Merge the sorted, disjoint keys ``a`` and ``b`` into ``u``; ``pa``, ``pb``: where each of them goes (the
-    positions ``np.arange(len(a)) + np.searchsorted(b, a)`` and alike, in one linear pass: the two searches took 0.12 ms
-    of a build's 0.26 on the main job's bordered tangents)."""
-    i = j = 0
-    n, m = len(a), len(b)
-    for k in range(n + m):
-        if j >= m or (i < n and a[i] < b[j]):
-            pa[i] = k
-            u[k] = a[i]
-            i += 1
-        else:
-            pb[j] = k
-            u[k] = b[j]
-            j += 1
+def _border_counts(kptr, rows_red, nf, c, gu, ng, rank, indptr):
+    """First pass of ``Bordered._build``: per group ``i`` its distinct free rows ``gu[i, :ng[i]]`` (sorted) and the
+    rank of each slot's row among them (``rank`` ``(g, k6)``, ``-1``: held), and the output's column pointers
+    ``indptr`` ``(nf + c g + 1,)`` (zeros in): a column ``j < nf`` holds ``K``'s rows, then ``c`` multiplier rows per
+    group with a slot on ``j``; a multiplier column its group's free rows, then its ``c`` multiplier rows.  Returns
+    the number of entries."""
+    g, k6 = rows_red.shape
+    for i in range(g):
+        n = 0
+        for a in range(k6):
+            r = rows_red[i, a]
+            if r < 0:
+                continue
+            x = 0
+            while x < n and gu[i, x] < r:
+                x += 1
+            if x < n and gu[i, x] == r:
+                continue
+            for y in range(n, x, -1):
+                gu[i, y] = gu[i, y - 1]
+            gu[i, x] = r
+            n += 1
+        ng[i] = n
+        for a in range(k6):
+            r = rows_red[i, a]
+            rank[i, a] = -1
+            if r >= 0:
+                x = 0
+                while gu[i, x] != r:
+                    x += 1
+                rank[i, a] = x
+        for x in range(n):
+            indptr[gu[i, x] + 1] += c
+        for jc in range(c):
+            indptr[nf + c * i + jc + 1] = n + c
+    for j in range(nf):
+        indptr[j + 1] += kptr[j + 1] - kptr[j]
+    for j in range(len(indptr) - 1):
+        indptr[j + 1] += indptr[j]
+    return indptr[len(indptr) - 1]
 
 
 @jit
-def _split_keys(u, N, indptr, indices):
-    """The CSC pattern of the sorted keys ``u`` (``col N + row``): ``indices`` the rows ``u % N`` and ``indptr``
-    ``(N + 1,)`` (zeros in) the columns' starts, in one pass (``np.bincount(u // N)`` and ``u % N``: 0.08 ms of a
-    build's 0.22 on the main job's bordered tangents, issue 30 session 9)."""
-    for k in range(len(u)):
-        col = u[k] // N
-        indices[k] = u[k] - col * N
-        indptr[col + 1] += 1
-    for j in range(N):
-        indptr[j + 1] += indptr[j]
+def _border_fill(kptr, kind, rows_red, nf, c, gu, ng, rank, indptr, indices, posK, bpos):
+    """Second pass of ``Bordered._build`` (``_border_counts``'s arrays): the rows ``indices`` of every column (sorted:
+    groups and components in order), ``K``'s entries' places ``posK`` and the border entries' ``bpos`` in ``_coo``'s
+    order (``K_ql`` ``(g, k6, c)`` and ``K_lq`` ``(g, c, k6)`` on free slots, ``K_ll`` ``(g, c, c)``)."""
+    g, k6 = rows_red.shape
+    fill = np.empty(nf, dtype=np.int64)
+    for j in range(nf):
+        s0 = indptr[j]
+        for s in range(kptr[j], kptr[j + 1]):
+            indices[s0 + s - kptr[j]] = kind[s]
+            posK[s] = s0 + s - kptr[j]
+        fill[j] = s0 + kptr[j + 1] - kptr[j]
+    lq = np.empty((g, k6, c), dtype=np.int64)          # K_lq's place of (group, distinct row, component)
+    for i in range(g):
+        for x in range(ng[i]):
+            j = gu[i, x]
+            for jc in range(c):
+                indices[fill[j]] = nf + c * i + jc
+                lq[i, x, jc] = fill[j]
+                fill[j] += 1
+        for jc in range(c):
+            s0 = indptr[nf + c * i + jc]
+            for x in range(ng[i]):
+                indices[s0 + x] = gu[i, x]
+            for r in range(c):
+                indices[s0 + ng[i] + r] = nf + c * i + r
+    e = 0
+    for i in range(g):
+        for a in range(k6):
+            if rank[i, a] >= 0:
+                for jc in range(c):
+                    bpos[e] = indptr[nf + c * i + jc] + rank[i, a]
+                    e += 1
+    for i in range(g):
+        for jc in range(c):
+            for a in range(k6):
+                if rank[i, a] >= 0:
+                    bpos[e] = lq[i, rank[i, a], jc]
+                    e += 1
+    for i in range(g):
+        for r in range(c):
+            for jc in range(c):
+                bpos[e] = indptr[nf + c * i + jc] + ng[i] + r
+                e += 1
+
+
+@jit
+def _border_values(Kdata, posK, Kql, Klq, Kll, rows_red, bpos, kptr, indptr, indices, data, free_row):
+    """Values of ``Bordered.matrix``: ``K``'s at ``posK``, each border place the sum of its entries in ``_coo``'s order
+    (from zero, as ``np.bincount``), and ``free_row`` ``(c g,)`` (zeros in) the sums of squares of each multiplier row's
+    entries on free columns, in the order of their places."""
+    data[:] = 0.0
+    for s in range(len(posK)):
+        data[posK[s]] = Kdata[s]
+    g, k6, c = Kql.shape
+    e = 0
+    for i in range(g):
+        for a in range(k6):
+            if rows_red[i, a] >= 0:
+                for jc in range(c):
+                    data[bpos[e]] += Kql[i, a, jc]
+                    e += 1
+    for i in range(g):
+        for jc in range(c):
+            for a in range(k6):
+                if rows_red[i, a] >= 0:
+                    data[bpos[e]] += Klq[i, jc, a]
+                    e += 1
+    for i in range(g):
+        for r in range(c):
+            for jc in range(c):
+                data[bpos[e]] += Kll[i, r, jc]
+                e += 1
+    nf = len(kptr) - 1
+    for j in range(nf):
+        for s in range(indptr[j] + kptr[j + 1] - kptr[j], indptr[j + 1]):
+            free_row[indices[s] - nf] += data[s] * data[s]
+
+
+def merged(K, rows_red, Kql, Klq, Kll, R, Lam, C):
+    """``Bordered.matrix`` by numpy (the oracle of its compiled passes): the pattern by ``np.unique`` over every
+    entry, the border's values by ``np.bincount`` in ``_coo``'s order, the border rows' norms by ``np.bincount`` over
+    their places in order.  The same bits."""
+    nf = K.shape[0]
+    rows_red = np.asarray(rows_red)
+    K = sp.csc_matrix(K)
+    K.sum_duplicates()
+    g = rows_red.shape[0]
+    c = Kll.shape[1]
+    N = nf + c * g
+    rb, cb, iq, il = _coo(rows_red, nf, c)
+    kc = np.repeat(np.arange(nf, dtype=np.int64), np.diff(K.indptr))
+    u, pos = np.unique(np.concatenate([kc, cb]) * N + np.concatenate([K.indices.astype(np.int64), rb]),
+                       return_inverse=True)
+    pos = pos.ravel()
+    border, inv = np.unique(pos[K.nnz:], return_inverse=True)
+    inv = inv.ravel()
+    indptr = np.zeros(N + 1, dtype=np.int32)
+    np.cumsum(np.bincount(u // N, minlength=N), out=indptr[1:])
+    indices = (u % N).astype(np.int32)
+    nlq = len(iq) + len(il)
+    lq = np.unique(inv[len(iq):nlq])
+    data = np.empty(len(u))
+    data[pos[:K.nnz]] = K.data
+    vals = np.concatenate([np.ravel(Kql)[iq], np.ravel(Klq)[il], np.ravel(Kll)])
+    data[border] = np.bincount(inv, weights=vals, minlength=len(border))
+    free_row = np.sqrt(np.bincount(indices[border[lq]].astype(np.int64) - nf, weights=data[border[lq]] ** 2,
+                                   minlength=c * g))
+    p = dict(indices=indices, indptr_out=indptr, N=N, ll=border[inv[nlq:]].reshape(g, c, c))
+    return Bordered._finish(data, free_row, p, Kll, R, Lam, C)
 
 
 def bmat(K, rows_red, Kql, Klq, Kll, R, Lam, C):

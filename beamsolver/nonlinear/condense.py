@@ -16,7 +16,7 @@ import numpy as np
 
 from .._jit import jit
 
-__all__ = ["ELIMINATE", "Split", "split", "add_schur", "add_products", "remove_schur"]
+__all__ = ["ELIMINATE", "Split", "split", "add_schur", "add_products", "remove_schur", "scatter_free"]
 
 ELIMINATE = 0.1      # smallest diagonal entry of D eliminated (a sliding group at the cone's edge stays an unknown)
 ENABLED = True       # False: ``Problem.linear_system`` solves the full bordered system (benchmarks: before)
@@ -48,21 +48,34 @@ def split(Kql, Klq, Kll, R, Lam, C, B):
 
 @jit
 def _schur(vals, off, Kql, Klq, w):
-    """``vals[off:]`` as ``(g, k6, k6)`` blocks ``-= Kql diag(w) Klq`` per group, in place."""
+    """``vals[off:]`` as ``(g, k6, k6)`` blocks ``-= Kql diag(w) Klq`` per group, in place: each entry's terms
+    subtracted component after component (those with ``w`` or the product ``w Kql`` zero skipped), in one pass
+    over the block."""
     g, k6 = Kql.shape[0], Kql.shape[1]
+    js = np.empty(3, dtype=np.int64)
+    cs = np.empty(3)
     for i in range(g):
         base = off + i * k6 * k6
-        for j in range(3):
-            s = w[i, j]
-            if s == 0.0:
-                continue
-            for a in range(k6):
-                c = s * Kql[i, a, j]
-                if c == 0.0:
-                    continue
-                row = base + a * k6
+        for a in range(k6):
+            n = 0
+            for j in range(3):
+                c = w[i, j] * Kql[i, a, j]
+                if w[i, j] != 0.0 and c != 0.0:
+                    js[n], cs[n] = j, c
+                    n += 1
+            row = base + a * k6
+            if n == 1:
+                j0, c0 = js[0], cs[0]
                 for b in range(k6):
-                    vals[row + b] -= c * Klq[i, j, b]
+                    vals[row + b] -= c0 * Klq[i, j0, b]
+            elif n == 2:
+                j0, c0, j1, c1 = js[0], cs[0], js[1], cs[1]
+                for b in range(k6):
+                    vals[row + b] = (vals[row + b] - c0 * Klq[i, j0, b]) - c1 * Klq[i, j1, b]
+            elif n == 3:
+                c0, c1, c2 = cs[0], cs[1], cs[2]
+                for b in range(k6):
+                    vals[row + b] = ((vals[row + b] - c0 * Klq[i, 0, b]) - c1 * Klq[i, 1, b]) - c2 * Klq[i, 2, b]
 
 
 def add_schur(vals, off, sp):
@@ -87,6 +100,16 @@ def rhs_terms(sp):
     """``(g, k6)``: the eliminated components' ``K'_ql C' / D`` on the groups' rows."""
     w = np.where(sp.elim, sp.C / np.where(sp.elim, sp.d, 1.0), 0.0)
     return np.einsum("gaj,gj->ga", sp.Kql, w)
+
+
+@jit
+def scatter_free(rows, vals, out):
+    """``out[rows[i, a]] += vals[i, a]`` over the free slots (``rows >= 0``) in order (``rows``, ``vals`` ``(g, k6)``,
+    ``out`` zeros in): ``np.bincount(rows[free], weights=vals[free])``, the same sums."""
+    for i in range(rows.shape[0]):
+        for a in range(rows.shape[1]):
+            if rows[i, a] >= 0:
+                out[rows[i, a]] += vals[i, a]
 
 
 def recover(sp, x_kept, dz_slots):

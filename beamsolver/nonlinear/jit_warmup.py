@@ -326,15 +326,27 @@ def _scene(model, worker):
 def _exact_stick_callees():
     """The exact stick path's compiled helpers that the stand-in's data do not reach (they run where some pairs are
     not folded into their groups, where a group's components are eliminated and in the Newton system), on empty
-    arrays of the solve's types (``contact.mortar_jit.subtract_indexed``, ``nonlinear.condense._schur``, the bordered
-    pattern's merge and split ``nonlinear.bordered._merge``, ``_split_keys``)."""
+    arrays of the solve's types (``contact.mortar_jit.subtract_indexed``, ``nonlinear.condense._schur`` and
+    ``scatter_free``, the bordered pattern's passes ``nonlinear.bordered._border_counts``, ``_border_fill``,
+    ``_border_values``, the augmented solve's ``nonlinear.augmented._join``, ``_precondition_rhs``,
+    ``_precondition_out``, ``_couplings``, ``_weights_of``)."""
     from ..contact import mortar_jit
-    from . import bordered, condense
+    from . import augmented, bordered, condense
     mortar_jit.subtract_indexed(np.zeros((0, 24, 24)), np.zeros((0, 24, 24)), np.zeros(0, dtype=np.int64))
     condense._schur(np.zeros(0), 0, np.zeros((0, 24, 3)), np.zeros((0, 3, 24)), np.zeros((0, 3)))
-    none = np.zeros(0, dtype=np.int64)
-    bordered._merge(none, none, none, none, none)
-    bordered._split_keys(none, 1, np.zeros(2, dtype=np.int32), np.zeros(0, dtype=np.int32))
+    condense.scatter_free(np.zeros((0, 24), dtype=np.int64), np.zeros((0, 24)), np.zeros(0))
+    none, rows, i32 = np.zeros(0, dtype=np.int64), np.zeros((0, 24), dtype=np.int64), np.zeros(0, dtype=np.int32)
+    kptr, ptr = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int32)
+    bordered._border_counts(kptr, rows, 0, 3, rows, none, rows, ptr)
+    bordered._border_fill(kptr, i32, rows, 0, 3, rows, none, rows, ptr, i32, none, none)
+    bordered._border_values(np.zeros(0), none, np.zeros((0, 24, 3)), np.zeros((0, 3, 24)), np.zeros((0, 3, 3)), rows,
+                            none, kptr, ptr, i32, np.zeros(0), np.zeros(0))
+    f, f2, b = np.zeros(0), np.zeros((0, 24)), np.zeros(0, dtype=bool)
+    augmented._join(f, rows, f2, f, f, f, f)
+    augmented._precondition_rhs(f, f, b, f, f, rows, f2, f, f)
+    augmented._precondition_out(f, f, f, b, f, f, f)
+    augmented._couplings(f2, f2, np.zeros((0, 24), dtype=bool), f2, f2, f)
+    augmented._weights_of(f, f, b, f, 1.0, f, f)
 
 
 def _stand_in(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, two, flags, frames):

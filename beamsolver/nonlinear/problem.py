@@ -72,7 +72,7 @@ class Evaluation:
         large = self.kvals is not None and self.kvals.size >= buffers.RELEASE_MIN_VALUES
         self.kvals = self.extra = None
         if self.mult is not None:
-            for k in ("Kp", "A"):
+            for k in ("Kp", "A", "K_full"):
                 self.mult.pop(k, None)
         if large:
             buffers.release_idle()
@@ -242,7 +242,7 @@ class Problem:
 
     def _group_increments(self, mu, x, dz_c=None):
         """``(g, k6)``: the increments of the groups' slots (free ones from ``x``, prescribed ones from ``dz_c``)."""
-        rows_red = self.system.red[mu["dofs"]]
+        rows_red = self._rows_red(mu)
         dz = np.where(rows_red >= 0, x[:self.system.n_free][np.maximum(rows_red, 0)], 0.0)
         return dz if dz_c is None else dz + self._prescribed_slots(mu, dz_c)
 
@@ -275,8 +275,7 @@ class Problem:
         is set to zero there (row: the traction's component itself).  ``rows``: ``(Klq, Kll, C)`` in place of the
         evaluation's (``branch_rows``)."""
         mu = ev.mult
-        red = self.system.red
-        rows_red = red[mu["dofs"]]
+        rows_red = self._rows_red(mu)
         Klq, Kll, C = (mu["Klq"], mu["Kll"], mu["C"]) if rows is None else rows
         A, rc = self._bordered.matrix(K, rows_red, mu["Kql"], Klq, Kll, mu["R"], mu["Lam"], C)
         if dz_c is not None:
@@ -292,6 +291,7 @@ class Problem:
         if mu is None or not (condense and condense_.ENABLED and mu.get("B") is not None and "offset" in mu):
             return None
         if "split" not in mu:
+            mu.pop("K_full", None)
             mu["split"] = condense_.split(mu["Kql"], mu["Klq"], mu["Kll"], mu["R"], mu["Lam"], mu["C"], mu["B"])
             condense_.add_schur(ev.extra[2], mu["offset"], mu["split"])
         return mu["split"]
@@ -304,10 +304,9 @@ class Problem:
         if dz_c is not None:
             rhs -= self.coupling(ev, dz_c)
         if sp is not None:
-            rows_red = s.red[ev.mult["dofs"]]
-            corr = condense_.rhs_terms(sp)
-            free = rows_red >= 0
-            rhs += np.bincount(rows_red[free], weights=corr[free], minlength=len(rhs))
+            add = np.zeros(len(rhs))
+            condense_.scatter_free(self._rows_red(ev.mult), condense_.rhs_terms(sp), add)
+            rhs += add
         return rhs
 
     def _kept(self, ev):
@@ -317,7 +316,7 @@ class Problem:
         g, j = sp.kept[:, 0], sp.kept[:, 1]
         d = sp.d[g, j]
         d = np.where(np.abs(d) < bordered_.IDLE, 0.0, d)       # a sticking group's tangential components: zero
-        return g, j, sp.Kql[g, :, j], sp.Klq[g, j], d, self.system.red[mu["dofs"]][g]
+        return g, j, sp.Kql[g, :, j], sp.Klq[g, j], d, self._rows_red(mu)[g]
 
     def linear_system(self, ev, dz_c=None, condense=True, rows=None):
         """``(A, rhs)``: the Newton system of ``ev`` (CSC, free unknowns first; ``dz_c`` ``(n, 6)`` prescribed
@@ -331,12 +330,21 @@ class Problem:
         if mu is not None and sp is not None and "E" in mu:
             return self.augmented_system(ev, dz_c).direct()
         rhs = self._force_rhs(ev, dz_c, sp)
+        if mu is not None and sp is None:
+            return self.bordered(ev, self._full_tangent(ev), rhs, dz_c, rows)
         K = self.tangent(ev)
         if mu is None:
             return K, rhs
-        if sp is None:
-            return self.bordered(ev, K, rhs, dz_c, rows)
         return self._condensed(ev, K, rhs, dz_c)
+
+    def _full_tangent(self, ev):
+        """``tangent(ev)`` of an evaluation whose values hold no Schur terms (the full bordered system), kept in
+        ``ev.mult`` until they change (``_split``, ``uncondense``) or are dropped: the active-set inner loop
+        (``Newton._active_set_direction``) solves several bordered systems on one tangent."""
+        mu = ev.mult
+        if "K_full" not in mu:
+            mu["K_full"] = self.tangent(ev)
+        return mu["K_full"]
 
     def _condensed(self, ev, K, rhs, dz_c):
         """The condensed bordered system on the tangent ``K`` (``linear_system``)."""
@@ -430,14 +438,21 @@ class Problem:
                 w = np.zeros(sp.d.shape)
                 w[g, j] = mu["E"]
                 condense_.add_products(ev.extra[2], mu["offset"], sp, w)
-            for k in ("E", "p22", "A", "Kp"):
+            for k in ("E", "p22", "A", "Kp", "K_full"):
                 mu.pop(k, None)
             condense_.remove_schur(ev.extra[2], mu["offset"], sp)
 
     def _prescribed_slots(self, mu, dz_c):
         """``(g, k6)``: the prescribed increments ``dz_c`` on the groups' held slots (zero on free ones)."""
         dz = np.ravel(dz_c)[mu["dofs"]]
-        return np.where(self.system.red[mu["dofs"]] < 0, dz, 0.0)
+        return np.where(self._rows_red(mu) < 0, dz, 0.0)
+
+    def _rows_red(self, mu):
+        """``(g, k6)``: the free (reduced) row of each group slot of the multipliers ``mu`` (``-1``: held), once per
+        evaluation (kept in ``mu``)."""
+        if "rows_red" not in mu:
+            mu["rows_red"] = self.system.red[mu["dofs"]]
+        return mu["rows_red"]
 
     def split_solution(self, ev, x, dz_c=None):
         """``(dzf, dLam)``: the free increments ``(n_free,)`` and the multipliers' Newton step ``(g, 3)`` (``None``
@@ -449,7 +464,7 @@ class Problem:
         sp = mu.get("split")
         if sp is None:
             return x[:n], x[n:].reshape(-1, 3)
-        rows_red = self.system.red[mu["dofs"]]
+        rows_red = self._rows_red(mu)
         dz = np.where(rows_red >= 0, x[:n][rows_red], 0.0)
         if dz_c is not None:
             dz = dz + self._prescribed_slots(mu, dz_c)

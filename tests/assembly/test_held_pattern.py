@@ -261,3 +261,40 @@ def test_add_products_sums_row_by_row_in_order():
                         if i >= 0:
                             ref[where[i, j]] += Kq[r, 6 * s + pp] * c
     assert np.array_equal(data, ref)
+
+
+def test_values_sum_block_after_block_in_order():
+    """``HeldPattern.matrix`` (a pair of whole free nodes placed as one 6 x 6 block) sums each entry's terms as the
+    plain loop does: element value first, then the blocks in order, slot pair by slot pair (clamped, partly fixed and
+    repeated nodes), then the tail: the same bits as those sums done one by one here."""
+    rng = np.random.default_rng(8)
+    n_nodes = 50
+    red, n = _reduction(rng, n_nodes, 3, 3)
+    el = _element_matrix(rng, n, 0.03)
+    d = _node_blocks(rng, n_nodes, 40, 3)
+    node = _nodes(d)
+    vals = rng.standard_normal((len(d), 18, 18))
+    vals[3] = 0.0
+    g = rng.choice(n_nodes, 2, replace=False)
+    t_rows, t_cols = np.repeat(6 * g, 6) + np.tile(np.arange(6), 2), np.repeat(6 * g + 3, 6)
+    t_vals = rng.standard_normal(len(t_rows))
+    p = HeldPattern(red, n, el.indptr, el.indices).grown(node, np.ones_like(vals))
+    K = p.matrix(el.data, node, vals, (t_rows, t_cols, t_vals))
+    ref = p.matrix(el.data).data                      # element values alone (zeros elsewhere)
+    where = {}
+    for j in range(n):
+        for s in range(K.indptr[j], K.indptr[j + 1]):
+            where[K.indices[s], j] = s
+    for blk in range(len(node)):
+        for t in range(3):
+            for s in range(3):
+                for q in range(6):
+                    j = red[6 * node[blk, t] + q]
+                    for pp in range(6):
+                        i = red[6 * node[blk, s] + pp]
+                        if i >= 0 and j >= 0:
+                            ref[where[i, j]] += vals[blk, 6 * s + pp, 6 * t + q]
+    for r, c, v in zip(t_rows, t_cols, t_vals):
+        if red[r] >= 0 and red[c] >= 0:
+            ref[where[red[r], red[c]]] += v
+    assert np.array_equal(K.data, ref)

@@ -783,3 +783,22 @@ def test_a_touching_start_crawling_to_the_normal_law_s_double_root_is_progress_n
     assert sol.converged and st["iterations"] > steps.STEP_ZERO_STALL
     assert np.ptp(np.log10(st["residuals"])) < 1e-6                       # no new lowest residual on the way
     assert not [w for w in st.get("warnings", []) if "exact stick's friction" in w]
+
+
+def test_the_full_bordered_systems_of_one_evaluation_share_its_tangent():
+    """``linear_system(condense=False)`` keeps the tangent of the values without Schur terms (``Problem._full_tangent``:
+    the active-set inner loop's bordered solves on one evaluation): the same bits as a fresh ``tangent``, built once,
+    dropped when the condensed system puts its Schur terms into the values (and with the evaluation's tangent)."""
+    problem, H, ev = _slid_evaluation()
+    A, rhs = problem.linear_system(ev, condense=False)
+    K = ev.mult["K_full"]
+    assert np.array_equal(K.data, problem.tangent(ev).data)
+    B, rhs2 = problem.linear_system(ev, condense=False)
+    assert ev.mult["K_full"] is K and np.array_equal(A.data, B.data) and np.array_equal(rhs, rhs2)
+    problem.linear_system(ev)
+    assert "K_full" not in ev.mult
+    problem.uncondense(ev)
+    problem.linear_system(ev, condense=False)
+    assert np.array_equal(ev.mult["K_full"].data, problem.tangent(ev).data)
+    ev.drop_tangent()
+    assert "K_full" not in ev.mult

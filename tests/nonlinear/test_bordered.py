@@ -68,36 +68,24 @@ def test_one_component_groups_are_the_bmat_of_their_blocks():
     assert A.shape[0] == K.shape[0] + 7 and rc[3] == -Lam[3, 0]
 
 
-def test_the_merged_pattern_is_the_one_of_a_sort_of_every_entry():
-    """``_build`` (``K``'s sorted entries merged with the border's, only those sorted) keeps what ``_build_unique``
-    (one ``np.unique`` over every entry) keeps, array for array; so the matrix is the same bits."""
+def test_the_compiled_passes_are_numpy_s_bit_for_bit():
+    """``Bordered.matrix`` (pattern and values by the compiled passes ``_border_counts``, ``_border_fill``,
+    ``_border_values``) gives the bits of its numpy oracle ``merged`` (``np.unique``, ``np.bincount``): every
+    component or one (``c`` = 1), an idle group, held slots and repeated rows, columns without border entries, a
+    group without free slots, and again on the kept pattern with new values."""
     rng = np.random.default_rng(4)
-    for c, idle in ((3, None), (3, 1), (1, None)):
-        K, rows, Kql, Klq, Kll, R, Lam, C = _case(rng, idle_group=idle)
+    for c, idle, g in ((3, None, 6), (3, 1, 6), (1, None, 7), (3, None, 1), (1, None, 40)):
+        K, rows, Kql, Klq, Kll, R, Lam, C = _case(rng, g=g, idle_group=idle)
         if c == 1:
             Kql, Klq, Kll, R, Lam, C = Kql[:, :, :1], Klq[:, :1], Kll[:, :1, :1], R[:, :1, :1], Lam[:, :1], C[:, :1]
-        a, b = bordered.Bordered(), bordered.Bordered()
-        a._build(K, rows, K.shape[0], c)
-        b._build_unique(K, rows, K.shape[0], c)
-        assert a._p.keys() == b._p.keys()
-        for key in a._p:
-            assert np.array_equal(a._p[key], b._p[key]), key
-        b._build = b._build_unique
-        A, rc = a.matrix(K, rows, Kql, Klq, Kll, R, Lam, C)
-        B, rc0 = b.matrix(K, rows, Kql, Klq, Kll, R, Lam, C)
-        assert np.array_equal(A.indices, B.indices) and np.array_equal(A.data, B.data) and np.array_equal(rc, rc0)
-
-
-def test_the_pattern_s_split_of_sorted_keys_is_numpy_s():
-    """``_split_keys`` (one compiled pass) gives the rows ``u % N`` and the columns' starts ``cumsum(bincount(u //
-    N))`` of sorted keys ``col N + row``, empty columns (first, inner, last) and no keys included."""
-    rng = np.random.default_rng(5)
-    for N, n in ((7, 0), (7, 12), (40, 300)):
-        cols = np.sort(rng.integers(1, N - 1, n))
-        u = np.unique(cols * N + rng.integers(0, N, n)).astype(np.int64)
-        indptr, indices = np.zeros(N + 1, dtype=np.int32), np.empty(len(u), dtype=np.int32)
-        bordered._split_keys(u, N, indptr, indices)
-        ref = np.zeros(N + 1, dtype=np.int32)
-        np.cumsum(np.bincount(u // N, minlength=N), out=ref[1:])
-        assert np.array_equal(indptr, ref) and np.array_equal(indices, (u % N).astype(np.int32))
-        assert indptr[1] == 0 and indptr[-1] == indptr[-2] == len(u)
+        b = bordered.Bordered()
+        for _ in range(2):
+            A, rc = b.matrix(K, rows, Kql, Klq, Kll, R, Lam, C)
+            B, rc0 = bordered.merged(K, rows, Kql, Klq, Kll, R, Lam, C)
+            assert np.array_equal(A.indptr, B.indptr) and np.array_equal(A.indices, B.indices)
+            assert A.indices.dtype == A.indptr.dtype == np.int32
+            assert np.array_equal(A.data, B.data) and np.array_equal(rc, rc0)
+            _same(A, rc, *bordered.bmat(K, rows, Kql, Klq, Kll, R, Lam, C))
+            Kql, Klq, Kll = (rng.standard_normal(np.shape(x)) for x in (Kql, Klq, Kll))
+            K = sp.csc_matrix((rng.standard_normal(K.nnz), K.indices, K.indptr), shape=K.shape)
+        assert b.builds == 1
