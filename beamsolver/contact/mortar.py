@@ -24,7 +24,7 @@ to their groups by compiled scatters (``mortar_jit``; ``use_numpy_scatter``: the
 import numpy as np
 
 from ..lie import se3
-from ..model.buffers import BufferPool
+from ..model.buffers import BufferPool, equal
 from . import mortar_jit
 
 __all__ = ["groups", "Groups", "return_mapping", "nodal_state", "multiplier_basis", "group_forces", "blocks",
@@ -94,7 +94,7 @@ def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=No
     node = (ukey // n_beams) % n_nodes
     if not full:
         return dict(key=ukey, node=node, g=np.ascontiguousarray(g, dtype=np.int64),
-                    phi=np.stack([1.0 - xi1, xi1], axis=1))
+                    phi=_shape_functions(xi1))
     # the nodes of each group: every pair node of every member point
     gn = np.repeat(g[:, :, None], 4, axis=2)                       # (P, 2, 4)
     nn = np.repeat(nodes[:, None, :], 2, axis=1)
@@ -115,7 +115,7 @@ def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=No
     # of the 61-wire strand; ``trial_rows`` makes it contiguous when it needs it)
     own = np.argmax(members == node[:, None], axis=1)
     slot_rows = np.ascontiguousarray(rows2.transpose(1, 0, 2))
-    return dict(key=ukey, node=node, g=g, phi=np.stack([1.0 - xi1, xi1], axis=1), members=members, pos=pos,
+    return dict(key=ukey, node=node, g=g, phi=_shape_functions(xi1), members=members, pos=pos,
                 rows2=slot_rows.transpose(1, 0, 2), slot_groups=np.ascontiguousarray(g.T), slot_rows=slot_rows,
                 rot=6 * own[:, None] + np.arange(3, 6))
 
@@ -174,14 +174,29 @@ class Groups:
         fold = fold_of(slave_nodes, xi1, master_beam, decl, n_nodes, n_beams, held)
         args = (slave_nodes, master_beam, decl, nodes, held, fold)
         last = self._last
-        if last is not None and last[0] == (n_nodes, n_beams) and ("members" in last[2] or not full) and all(
-                (a is None and b is None) or (a is not None and b is not None and np.array_equal(a, b))
-                for a, b in zip(last[1], args)):
-            return dict(last[2], phi=np.stack([1.0 - xi1, xi1], axis=1))
+        if last is not None and last[0] == (n_nodes, n_beams) and ("members" in last[2] or not full) and \
+                _same_args(last[1], args):
+            return dict(last[2], phi=_shape_functions(xi1))
         G = groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held, fold, full)
         self._last = ((n_nodes, n_beams), tuple(None if a is None else np.array(a) for a in args), G)
         self.builds += 1
         return G
+
+
+def _same_args(kept, args):
+    """Whether the arrays (or Nones) ``args`` equal the ``kept`` ones, pair by pair (``Groups``)."""
+    for a, b in zip(kept, args):
+        if (a is None) != (b is None) or (a is not None and not equal(a, b)):
+            return False
+    return True
+
+
+def _shape_functions(xi1):
+    """``Phi`` ``(P, 2)``: ``1 - xi1`` and ``xi1`` (``np.stack([1.0 - xi1, xi1], axis=1)``, one array filled)."""
+    phi = np.empty((len(xi1), 2))
+    phi[:, 0] = 1.0 - xi1
+    phi[:, 1] = xi1
+    return phi
 
 
 def return_mapping(trial, cap):

@@ -49,7 +49,7 @@ from scipy.spatial import cKDTree
 
 from ..lie import se3, se3_twin
 from ..model.blocks import Blocks, Contribution
-from ..model.buffers import BufferPool
+from ..model.buffers import BufferPool, equal
 from ..errors import InputError
 from ..failures import ContactTunnelling, NoContactNormal
 from ..model.model import JOIN_TOL
@@ -295,6 +295,7 @@ class ContactSystem(Contribution):
         self._skipped = 0          # points of open groups the last evaluation left out (``_open_points``)
         self._full = False         # evaluate every point (``_state``: commit, updates, results)
         self._far = None           # (pairs, far beyond the normal law's band) of the last ``_active``
+        self._band = None          # (pairs, smoothing gaps, extent, normal multipliers) of the last ``_active``
         self._tangent_pool = BufferPool()     # tangent buffers of the compiled kernel (``_tangent_out``)
         self._mortar_pool = BufferPool()      # tangent blocks of pairs and mortar groups (``_with_mortar``)
         self.timings = dict.fromkeys(TIMED, 0.0)
@@ -424,7 +425,7 @@ class ContactSystem(Contribution):
     def _twists(self, H):
         """Twists ``(n_elements, 6)`` of all elements at ``H`` (compiled; kept for the same poses)."""
         g = self._geo
-        if g is None or g[0].shape != H.shape or not np.array_equal(g[0], H):
+        if g is None or g[0].shape != H.shape or not equal(g[0], H):
             g = self._geo = (np.array(H, dtype=float), element_twists(H, self.sys.enodes))
         return g
 
@@ -443,7 +444,7 @@ class ContactSystem(Contribution):
         """Twists ``(n_elements, 6)`` of all elements at the last converged poses (once per step)."""
         if self._geo_prev is None:
             g = self._geo       # a step starts at the last iterate's poses, whose twists are kept
-            if g is not None and g[0].shape == self._H_prev.shape and np.array_equal(g[0], self._H_prev):
+            if g is not None and g[0].shape == self._H_prev.shape and equal(g[0], self._H_prev):
                 self._geo_prev = (self._H_prev, g[1])
             else:
                 self._geo_prev = (self._H_prev, element_twists(self._H_prev, self.sys.enodes))
@@ -461,7 +462,7 @@ class ContactSystem(Contribution):
         if prev:
             Hc, h = self._H_prev, self._prev_twists()
             c = self._prev_points     # (the step's twists, e, xi, points) of the last call with ``keep``
-            if keep and c is not None and c[0] is self._geo_prev and np.array_equal(c[1], e) and _same_bits(c[2], xi):
+            if keep and c is not None and c[0] is self._geo_prev and equal(c[1], e) and _same_bits(c[2], xi):
                 return c[3]
         else:
             Hc, h = self._twists(H)
@@ -713,12 +714,16 @@ class ContactSystem(Contribution):
                  penalty_t=self._decl_penalty_t[dec], mu=self._decl_mu[dec])
         # elastic slip at the onset of sliding (used where no penalty_t is given)
         p["elastic_slip"] = self._decl_slip_tol[dec] * self.sys.L[P.e[sel]]
-        p["smoothing"] = self._smoothing(P, sel)
-        # round-off gaps touch (reference.touching_gap, the kernels' rule) where the law's smoothing gap does not cover them already
-        touch = touch_tolerance(_extent(H), p["R1"], p["R2"])
-        p["touch"] = np.where(p["smoothing"] >= touch, 0.0, touch)
         key = P.key[sel]
-        p["multiplier"] = self.history.normal_multipliers(key)
+        b, self._band = self._band, None
+        if b is not None and b[0] is P:     # ``_active``'s of these pairs (element by element: the same floats)
+            p["smoothing"], extent, p["multiplier"] = b[1][sel], b[2], b[3][sel]
+        else:
+            p["smoothing"], extent = self._smoothing(P, sel), _extent(H)
+            p["multiplier"] = self.history.normal_multipliers(key)
+        # round-off gaps touch (reference.touching_gap, the kernels' rule) where the law's smoothing gap does not cover them already
+        touch = touch_tolerance(extent, p["R1"], p["R2"])
+        p["touch"] = np.where(p["smoothing"] >= touch, 0.0, touch)
         if self._forced is not None and len(self._forced):     # the normal law's open branch (``force_open``)
             off = _member(key, self._forced)
             p["penalty"] = np.where(off, 0.0, p["penalty"])
@@ -801,8 +806,10 @@ class ContactSystem(Contribution):
         gap = dist - P.R1 - P.R2
         pen = self._decl_penalty[P.decl]
         mult = self.history.normal_multipliers(P.key)
+        smoothing, extent = self._smoothing(P, slice(None)), _extent(H)
+        self._band = (P, smoothing, extent, mult)     # (``_params`` of these pairs: the same values, taken)
         # the smoothing zone plus a small band keeps the projection-updated gap consistent
-        band = self._smoothing(P, slice(None)) + 1e-3 * (P.R1 + P.R2) + touch_tolerance(_extent(H), P.R1, P.R2)
+        band = smoothing + 1e-3 * (P.R1 + P.R2) + touch_tolerance(extent, P.R1, P.R2)
         on = mult - pen * gap > -pen * band
         # (``_open_points``: the pairs far beyond that band, from the same gaps)
         self._far = (P, mult - pen * gap <= -pen * (band + SKIP_MARGIN * (P.R1 + P.R2))) if SKIP_OPEN else None
@@ -875,14 +882,17 @@ class ContactSystem(Contribution):
         one beam passed through the other within the step, where the penalty, seeing
         the other side, would push them further apart and report a converged state.
         """
-        if self._H_prev is None or self._H_prev.shape != H.shape or np.array_equal(self._H_prev, H):
+        if self._H_prev is None or self._H_prev.shape != H.shape or equal(self._H_prev, H):
             return              # (at the step's start, the first iterate: d_prev = d, no pair changed sides)
         d = centres[1] - centres[0] if d is None else d
         x0C, x0F = self._centres(H, P, prev=True)
         d0 = x0F - x0C
         rsum = P.R1 + P.R2
+        back = np.sum(d * d0, axis=1) < -(NORMAL_TOL * rsum) ** 2
+        if not back.any():
+            return              # (no pair turned: the test below finds none)
         seen = ~no_normal(np.linalg.norm(d0, axis=1), P.R1, P.R2)
-        flip = np.flatnonzero(seen & (np.sum(d * d0, axis=1) < -(NORMAL_TOL * rsum) ** 2))
+        flip = np.flatnonzero(seen & back)
         if len(flip):
             k = flip[0]
             raise ContactTunnelling(f"contact: {self._pair_label(P.e[k], P.m[k])} changed sides within the "
@@ -907,7 +917,7 @@ class ContactSystem(Contribution):
         kernel computes the tangent with the forces; the numpy oracle only when asked).
         """
         c = self._blocks
-        if c is not None and np.array_equal(c[0], H) and (c[1] is None or c[1][4] is not None or not tangent):
+        if c is not None and equal(c[0], H) and (c[1] is None or c[1][4] is not None or not tangent):
             return c[1]
         c = None                   # (its tangent buffer may serve this evaluation: ``_tangent_out``)
         asked, tangent = tangent, tangent or self.kernel is kernel_jit
@@ -976,9 +986,10 @@ class ContactSystem(Contribution):
                 out["mortar_pending"] = np.flatnonzero(mort)
         self._lap("kernel")
         # kept for commit/augment at the same poses (the converged iterate): no second pass
+        Hc = np.array(H)           # (read by both: never written)
         if (p["mu"] > 0).all() or not (p["mu"] > 0).any() or mort.any():
-            self._cache = (H.copy(), P, sel, p, out)
-        self._blocks = (np.array(H), (P, sel, p, f, K, out))
+            self._cache = (Hc, P, sel, p, out)
+        self._blocks = (Hc, (P, sel, p, f, K, out))
         return self._blocks[1]
 
     def _segment_ends(self, H, P, sel, p, f, K, friction):
@@ -1209,7 +1220,7 @@ class ContactSystem(Contribution):
         """``m`` ``(n,)`` of the groups ``G`` (``mortar.nodal_state``), their points on the slave elements ``e``:
         half of each element at the node, the whole element beside a held node."""
         c = self._kept_weights              # (kept while the groups, ``mortar.Groups``, and the elements hold)
-        if c is not None and c[0] is G["members"] and np.array_equal(c[1], e):
+        if c is not None and c[0] is G["members"] and equal(c[1], e):
             return c[2]
         m = self._nodal_weights_of(G, e)
         self._kept_weights = (G["members"], np.array(e), m)
@@ -1479,7 +1490,7 @@ class ContactSystem(Contribution):
         sc = self._slide_c
         if sc is None or not len(keys):
             return eps
-        i = np.searchsorted(sc[0], keys).clip(max=len(sc[0]) - 1)
+        i = np.minimum(np.searchsorted(sc[0], keys), len(sc[0]) - 1)
         found = sc[0][i] == keys
         return np.where(found, eps * sc[1][i], eps)
 
@@ -1488,7 +1499,7 @@ class ContactSystem(Contribution):
         step (``history``) plus the trial length times the last Newton step of the multipliers."""
         Lam = self.history.tangential_multipliers(keys)
         if self._mstep is not None and self._ms != 0.0:
-            i = np.searchsorted(self._mstep[0], keys).clip(max=max(len(self._mstep[0]) - 1, 0))
+            i = np.minimum(np.searchsorted(self._mstep[0], keys), max(len(self._mstep[0]) - 1, 0))
             found = (self._mstep[0][i] == keys) if len(self._mstep[0]) else np.zeros(len(keys), dtype=bool)
             Lam[found] += self._ms * self._mstep[1][i[found]]
         return Lam
@@ -1623,7 +1634,7 @@ class ContactSystem(Contribution):
             finally:
                 self._full = False
         cache = getattr(self, "_cache", None)
-        if cache is not None and cache[0].shape == H.shape and np.array_equal(cache[0], H):
+        if cache is not None and cache[0].shape == H.shape and equal(cache[0], H):
             _, P, sel, p, out = cache
             if p["mu"].any() or "HL" not in out:
                 return P, sel, (p, out)
@@ -1777,7 +1788,7 @@ class ContactSystem(Contribution):
         w = p["weight"]
         lam_t = out["lam_t"]
         ft = (w * lam_t[:, 0])[:, None] * out["t1"] + (w * lam_t[:, 1])[:, None] * out["t2"]
-        if HC is None or not np.array_equal(H_c, H):   # the section poses of commit are those at its poses
+        if HC is None or not equal(H_c, H):   # the section poses of commit are those at its poses
             HC, HF = self._pose_at(H, P.e[sel], out["xi1"]), self._pose_at(H, P.m[sel], out["xi2"])
         elif LEAN_COMMIT:                     # read once (``Problem.commit``): not held through the next step
             self._last = (P, sel, p, out, (H_c, None, None))
@@ -1859,7 +1870,7 @@ def _kernel(kernel, X, p, friction, law, tangent, K=None):
 def _same_bits(a, b):
     """Float arrays ``a``, ``b`` equal bit for bit (signed zeros and nans told apart)."""
     a, b = np.ascontiguousarray(a, dtype=float), np.ascontiguousarray(b, dtype=float)
-    return a.shape == b.shape and np.array_equal(a.view(np.int64), b.view(np.int64))
+    return a.shape == b.shape and equal(a.view(np.int64), b.view(np.int64))
 
 
 def _member(a, b_sorted):
