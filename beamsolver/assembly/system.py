@@ -505,8 +505,8 @@ class System:
         """COO of ``[[0, -hat(r_u)], [0, -hat(r_w)]]`` at global-type nodes ``g`` (the dependence of
         ``M`` on ``R``, see the module docstring) for the residual ``r`` of one contribution; the
         index arrays are the same (read-only) arrays while ``g`` is."""
-        rg = r.reshape(-1, 6)[g]
-        vals = -np.concatenate([_hat(rg[:, :3]), _hat(rg[:, 3:])], axis=1)          # (k, 6, 3)
+        vals = np.empty((len(g), 6, 3))           # -[hat(r_u), hat(r_w)] per node (compiled: one call, no stacks)
+        assembly_jit.global_node_values(r, np.ascontiguousarray(g, dtype=np.int64), vals)
         c = getattr(self, "_global_index", None)
         if c is None or not equal(c[0], g):
             rows = np.broadcast_to((6 * g)[:, None, None] + np.arange(6)[:, None], vals.shape).ravel()
@@ -565,10 +565,12 @@ class System:
             if M is not None and len(et):
                 # the generic block transform on the blocks touching a transformed node; the
                 # tangent goes back into kvals
-                ft, Kt = _blocks.transform(M, g.nodes[et], f[et], None if K is None else K[et])
-                f = f.copy()
-                f[et] = ft
-                if K is not None:
+                if K is None:       # (the rows ``et`` of a copy of ``f``: the same per-row transform)
+                    f = _blocks.transform_rows(M, g.nodes, f, None, et)[0]
+                else:
+                    ft, Kt = _blocks.transform(M, g.nodes[et], f[et], K[et])
+                    f = f.copy()
+                    f[et] = ft
                     K[et] = Kt
             if len(self.groups) == 1:
                 return f.ravel(), state, f_level, m_level, M

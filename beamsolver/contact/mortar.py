@@ -415,7 +415,7 @@ def blocks(G, d, st, R, Lam, eps, mu):
     return f, K
 
 
-def multiplier_blocks(G, d, st, R, Lam, c, mu):
+def multiplier_blocks(G, d, st, R, Lam, c, mu, turn=None):
     """Semi-smooth Newton blocks of the nodal multipliers ``Lam`` ``(n, 3)`` (section frame of the node; the
     traction is ``v = R Lam``) with the complementarity function ``C = v - P(Pi (v + c u))`` (``P`` the
     return mapping onto the disk ``mu lamN``; ``d``: point terms at the tractions ``T_p = sum Phi_j v_j``,
@@ -424,10 +424,10 @@ def multiplier_blocks(G, d, st, R, Lam, c, mu):
     Returns ``f`` ``(n, 6 k)`` (contact forces), ``Kqq`` ``(n, 6 k, 6 k)`` = d f / d q at fixed ``Lam``,
     ``Kql`` ``(n, 6 k, 3)`` = d f / d Lam, ``Klq`` ``(n, 3, 6 k)`` = d C / d q, ``Kll`` ``(n, 3, 3)`` = d C / d Lam
     and ``C`` ``(n, 3)``.  Sticking: ``C = nu nu^T v - c Pi u`` (no slip, no normal part); sliding:
-    ``C = v - mu lamN t``.
+    ``C = v - mu lamN t``.  ``turn``: ``_turn(G, R, Lam)`` if known.
     """
     f, Kqq, A = _point_parts(G, d)
-    rot, dv = _turn(G, R, Lam)
+    rot, dv = _turn(G, R, Lam) if turn is None else turn
     _add_columns(Kqq, rot, A @ dv)
     Kql = A @ R
     weak = st["weak"]
@@ -446,18 +446,19 @@ def multiplier_blocks(G, d, st, R, Lam, c, mu):
     return f, Kqq, Kql, Klq, Kll, v - st["lam"]
 
 
-def branch_rows(G, d, st, R, Lam, c, mu):
+def branch_rows(G, d, st, R, Lam, c, mu, turn=None):
     """The linearisation of the groups' trial tractions and disks (the active-set inner loop of Newton's direction,
     ``nonlinear.problem.Problem.branch_rows``): ``Tq`` ``(n, 3, 6 k)`` = d trial / d q (the node's turn of ``R Lam``
     included), ``Vq`` ``(n, 3, 6 k)`` = d (R Lam) / d q (the turn's columns only) and ``capq`` ``(n, 6 k)`` =
-    d (mu lamN) / d q, rows over the groups' slots (``st``: ``nodal_state`` with ``eps = c``)."""
+    d (mu lamN) / d q, rows over the groups' slots (``st``: ``nodal_state`` with ``eps = c``; ``turn``: ``_turn(G, R,
+    Lam)`` if known)."""
     n, k = G["members"].shape
     eye = dict(st, C=np.ascontiguousarray(np.broadcast_to(np.eye(3), (n, 3, 3))), c=np.zeros((n, 3)))
     Tq = _trial_rows(G, d, eye, c, mu)
     e = np.zeros((n, 3))
     e[:, 0] = 1.0
     capq = _trial_rows(G, d, dict(st, C=np.zeros((n, 3, 3)), c=e), c, mu)[:, 0, :].copy()
-    rot, dv = _turn(G, R, Lam)
+    rot, dv = _turn(G, R, Lam) if turn is None else turn
     Vq = np.zeros((n, 3, 6 * k))
     _add_columns(Vq, rot, dv)
     _add_columns(Tq, rot, np.einsum("gij,gjk->gik", st["Pi"], dv))

@@ -296,6 +296,8 @@ class ContactSystem(Contribution):
         self._full = False         # evaluate every point (``_state``: commit, updates, results)
         self._far = None           # (pairs, far beyond the normal law's band) of the last ``_active``
         self._band = None          # (pairs, smoothing gaps, extent, normal multipliers) of the last ``_active``
+        self._held_of = None       # (nodes, held slave nodes) of the last ``_held_slip``
+        self._kept_lam = None      # (keys, history multipliers, theirs, Newton step, its rows) of ``iterate_multipliers``
         self._tangent_pool = BufferPool()     # tangent buffers of the compiled kernel (``_tangent_out``)
         self._mortar_pool = BufferPool()      # tangent blocks of pairs and mortar groups (``_with_mortar``)
         self.timings = dict.fromkeys(TIMED, 0.0)
@@ -1250,10 +1252,11 @@ class ContactSystem(Contribution):
             mortar_jit.subtract_indexed(d["dfdq"], K_pairs, rows)
         mult = None
         if ssn:
-            f, K, Kql, Klq, Kll, C = mortar.multiplier_blocks(G, d, st, R, Lam, eps, mu)
+            turn = mortar._turn(G, R, Lam)      # (the node's turn: one product for both)
+            f, K, Kql, Klq, Kll, C = mortar.multiplier_blocks(G, d, st, R, Lam, eps, mu, turn=turn)
             mult = dict(Kql=-Kql, Klq=Klq, Kll=Kll)
             if self.branch_rows and not self.n_slots:   # the active-set inner loop's rows (not with segments' ends)
-                Tq, Vq, capq = mortar.branch_rows(G, d, st, R, Lam, eps, mu)
+                Tq, Vq, capq = mortar.branch_rows(G, d, st, R, Lam, eps, mu, turn=turn)
                 mult.update(Tq=Tq, Vq=Vq, capq=capq, trial=st["trial"], cap=mu * np.maximum(st["lamN"], 0.0),
                             Pi=st["Pi"], weak=st["weak"] | (st["lamN"] <= 0.0))
         else:
@@ -1300,10 +1303,17 @@ class ContactSystem(Contribution):
 
     def _held_slip(self, nodes):
         """``(P, 2)``: slave nodes A, B of the pairs over ``nodes`` ``(P, 4)`` whose slip is prescribed:
-        every increment fixed, or joined to a node of the master element (``mortar.groups``)."""
+        every increment fixed, or joined to a node of the master element (``mortar.groups``); kept (read only) while
+        ``nodes`` are the same (a Newton step's evaluations)."""
+        c = self._held_of
+        if c is not None and equal(c[0], nodes):
+            return c[1]
         r = self.sys.rep[nodes]
         joined = (r[:, :2, None] == r[:, None, 2:]).any(axis=2)
-        return self._held[nodes[:, :2]] | joined
+        held = self._held[nodes[:, :2]] | joined
+        held.flags.writeable = False
+        self._held_of = (np.array(nodes), held)
+        return held
 
     def kernel_inputs(self, H):
         """Node poses ``(m, 4, 4, 4)`` and kernel parameters (dict of arrays) of the pairs active at
@@ -1497,11 +1507,18 @@ class ContactSystem(Contribution):
     def iterate_multipliers(self, keys):
         """Nodal multipliers ``(k, 3)`` of the groups ``keys`` at the current iterate: the trial ones of the
         step (``history``) plus the trial length times the last Newton step of the multipliers."""
-        Lam = self.history.tangential_multipliers(keys)
-        if self._mstep is not None and self._ms != 0.0:
-            i = np.minimum(np.searchsorted(self._mstep[0], keys), max(len(self._mstep[0]) - 1, 0))
-            found = (self._mstep[0][i] == keys) if len(self._mstep[0]) else np.zeros(len(keys), dtype=bool)
-            Lam[found] += self._ms * self._mstep[1][i[found]]
+        c = self._kept_lam         # (the same groups and multipliers as the last call: the same look-ups)
+        tmult, step = self.history.tmult, self._mstep
+        if c is None or c[1] is not tmult or not equal(c[0], keys):
+            c = self._kept_lam = (np.array(keys), tmult, self.history.tangential_multipliers(keys), None, None)
+        Lam = c[2].copy()
+        if step is not None and self._ms != 0.0:
+            if c[3] is not step:
+                i = np.minimum(np.searchsorted(step[0], keys), max(len(step[0]) - 1, 0))
+                found = (step[0][i] == keys) if len(step[0]) else np.zeros(len(keys), dtype=bool)
+                c = self._kept_lam = c[:3] + (step, (found, i[found]))
+            found, rows = c[4]
+            Lam[found] += self._ms * step[1][rows]
         return Lam
 
     def multiplier_step(self, keys, dLam, stick=None, cap=None):
