@@ -298,6 +298,8 @@ class ContactSystem(Contribution):
         self._band = None          # (pairs, smoothing gaps, extent, normal multipliers) of the last ``_active``
         self._held_of = None       # (nodes, held slave nodes) of the last ``_held_slip``
         self._kept_lam = None      # (keys, history multipliers, theirs, Newton step, its rows) of ``iterate_multipliers``
+        self._kept_terms = None    # (multipliers, mu, keys, masters, kinds, declarations, terms) of ``_point_terms``
+        self._kept_params = None   # (``_kept_terms``, sel, (parameters, keys, elements)) of ``_params``
         self._tangent_pool = BufferPool()     # tangent buffers of the compiled kernel (``_tangent_out``)
         self._mortar_pool = BufferPool()      # tangent blocks of pairs and mortar groups (``_with_mortar``)
         self.timings = dict.fromkeys(TIMED, 0.0)
@@ -710,19 +712,30 @@ class ContactSystem(Contribution):
 
     def _params(self, P, sel, H):
         """Kernel parameters for the pairs ``sel`` (history and multipliers looked up)."""
-        dec = P.decl[sel]
-        p = dict(kind=P.kind[sel], xi1=P.xi1[sel], xi2=P.xi2[sel], R1=P.R1[sel],
-                 R2=P.R2[sel], weight=P.weight[sel], penalty=self._decl_penalty[dec],
-                 penalty_t=self._decl_penalty_t[dec], mu=self._decl_mu[dec])
-        # elastic slip at the onset of sliding (used where no penalty_t is given)
-        p["elastic_slip"] = self._decl_slip_tol[dec] * self.sys.L[P.e[sel]]
-        key = P.key[sel]
         b, self._band = self._band, None
-        if b is not None and b[0] is P:     # ``_active``'s of these pairs (element by element: the same floats)
-            p["smoothing"], extent, p["multiplier"] = b[1][sel], b[2], b[3][sel]
+        same = b is not None and b[0] is P      # ``_active``'s of these pairs (element by element: the same floats)
+        c = self._kept_params
+        if same and c is not None and c[0] is self._kept_terms and equal(c[1], sel):
+            fixed, key, e, m = c[2]         # (the same pairs and state as the last call: its arrays, read only)
         else:
-            p["smoothing"], extent = self._smoothing(P, sel), _extent(H)
-            p["multiplier"] = self.history.normal_multipliers(key)
+            dec, key, e, m = P.decl[sel], P.key[sel], P.e[sel], P.m[sel]
+            fixed = dict(kind=P.kind[sel], R1=P.R1[sel], R2=P.R2[sel], penalty=self._decl_penalty[dec],
+                         penalty_t=self._decl_penalty_t[dec], mu=self._decl_mu[dec],
+                         # elastic slip at the onset of sliding (used where no penalty_t is given)
+                         elastic_slip=self._decl_slip_tol[dec] * self.sys.L[e])
+            if same:
+                fixed.update(smoothing=b[1][sel], multiplier=b[3][sel])
+            else:
+                fixed.update(smoothing=self._smoothing(P, sel), multiplier=self.history.normal_multipliers(key))
+            self._kept_params = None
+            if same:
+                for v in (*fixed.values(), key, e, m):
+                    v.flags.writeable = False
+                self._kept_params = (self._kept_terms, np.array(sel), (fixed, key, e, m))
+        p = dict(kind=fixed["kind"], xi1=P.xi1[sel], xi2=P.xi2[sel], R1=fixed["R1"], R2=fixed["R2"],
+                 weight=P.weight[sel], penalty=fixed["penalty"], penalty_t=fixed["penalty_t"], mu=fixed["mu"],
+                 elastic_slip=fixed["elastic_slip"], smoothing=fixed["smoothing"], multiplier=fixed["multiplier"])
+        extent = b[2] if same else _extent(H)
         # round-off gaps touch (reference.touching_gap, the kernels' rule) where the law's smoothing gap does not cover them already
         touch = touch_tolerance(extent, p["R1"], p["R2"])
         p["touch"] = np.where(p["smoothing"] >= touch, 0.0, touch)
@@ -732,12 +745,12 @@ class ContactSystem(Contribution):
             p["multiplier"] = np.where(off, 0.0, p["multiplier"])
         if self._secant is not None:     # the smoothing parabola's secant to its zero-force end (``force_secant``)
             self._secant_law(key, p)
-        hf = self.history.frictional(p, key, P.e[sel], P.m[sel])
+        hf = self.history.frictional(p, key, e, m)
         hist = self.history.friction
         # a point pair whose crossing moved to a neighbouring element pair keeps the
         # history of the committed point pair of the same two beams next to it
         cand = np.flatnonzero(~hf & (p["kind"] == POINT) & (p["mu"] > 0))
-        hp = np.flatnonzero(hist["key"] >= self.point_offset)
+        hp = np.flatnonzero(hist["key"] >= self.point_offset) if len(cand) else cand
         if len(cand) and len(hp):
             hf = self._inherit_points(P, sel, H, p, hf, cand, hp)
         # a pair without history starts it from the last converged poses: its
@@ -806,20 +819,40 @@ class ContactSystem(Contribution):
             xC, xF = self._centres(H, P) if centres is None else centres
             dist = np.linalg.norm(xF - xC, axis=1)
         gap = dist - P.R1 - P.R2
-        pen = self._decl_penalty[P.decl]
-        mult = self.history.normal_multipliers(P.key)
-        smoothing, extent = self._smoothing(P, slice(None)), _extent(H)
+        pen, mult, smoothing, base, margin, exact = self._point_terms(P)
+        extent = _extent(H)
         self._band = (P, smoothing, extent, mult)     # (``_params`` of these pairs: the same values, taken)
         # the smoothing zone plus a small band keeps the projection-updated gap consistent
-        band = smoothing + 1e-3 * (P.R1 + P.R2) + touch_tolerance(extent, P.R1, P.R2)
-        on = mult - pen * gap > -pen * band
+        band = base + touch_tolerance(extent, P.R1, P.R2)
+        trial = mult - pen * gap
+        on = trial > -pen * band
         # (``_open_points``: the pairs far beyond that band, from the same gaps)
-        self._far = (P, mult - pen * gap <= -pen * (band + SKIP_MARGIN * (P.R1 + P.R2))) if SKIP_OPEN else None
+        self._far = (P, trial <= -pen * (band + margin)) if SKIP_OPEN else None
         if self.newton_multipliers and self._decl_exact.any():
             # exact stick: the nodal traction field acts over the whole overlap the search found (a point
             # that left the normal law keeps its share of the field: no jump in the residual)
-            on |= self._decl_exact[P.decl] & (P.kind == LINE) & (self._decl_mu[P.decl] > 0)
+            on |= exact
         return np.flatnonzero(on)
+
+    def _point_terms(self, P):
+        """``_active``'s terms of the pairs ``P`` that do not depend on the poses, ``(P,)`` each: penalty, normal
+        multiplier, smoothing gap, ``smoothing + 1e-3 (R1 + R2)``, ``SKIP_MARGIN (R1 + R2)`` and the exact-stick line
+        pairs with friction; kept (read only) while the pairs' keys, masters and kinds, the multipliers and the
+        friction coefficients are the same (a Newton step's evaluations)."""
+        c = self._kept_terms
+        if c is not None and c[0] is self.history.mult and c[1] is self._decl_mu and equal(c[2], P.key) and \
+                equal(c[3], P.m) and equal(c[4], P.kind) and equal(c[5], P.decl):
+            return c[6]
+        rsum = P.R1 + P.R2
+        smoothing = self._smoothing(P, slice(None))
+        terms = (self._decl_penalty[P.decl], self.history.normal_multipliers(P.key), smoothing,
+                 smoothing + 1e-3 * rsum, SKIP_MARGIN * rsum,
+                 self._decl_exact[P.decl] & (P.kind == LINE) & (self._decl_mu[P.decl] > 0))
+        for v in terms:
+            v.flags.writeable = False
+        self._kept_terms = (self.history.mult, self._decl_mu, np.array(P.key), np.array(P.m), np.array(P.kind),
+                            np.array(P.decl), terms)
+        return terms
 
     def _open_points(self, P, H, sel):
         """``sel`` without the exact-stick points that certainly act on nothing at ``H`` (``SKIP_OPEN``): a point whose
