@@ -93,6 +93,7 @@ class ContactHistory:
         """The step is accepted: its trial normal multipliers, friction coefficients ``mu`` per
         declaration, friction history ``friction`` (dict of the module docstring's fields, sorted by
         key; ``None``: no rows) and tangential multipliers ``tmult`` (``None``: none) are kept."""
+        self.forget_rows()
         self.mult_committed = self.mult
         self.mu_committed = mu
         self.friction = empty_friction() if friction is None else friction
@@ -118,6 +119,10 @@ class ContactHistory:
         gauss = key < lay.point_offset
         return np.where(gauss, key // np.maximum(n_el * lay.max_gp * lay.n_beams, 1),
                         (key - lay.point_offset) // (n_el * n_el)).astype(int)
+
+    def forget_rows(self):
+        """Let ``frictional``'s kept rows go (a commit's pass drops the points' frames: not held through it)."""
+        self._kept_rows = None
 
     # ------------------------------------------------------------ look-ups
     def normal_multipliers(self, keys):

@@ -1154,6 +1154,7 @@ class ContactSystem(Contribution):
         #                                                          61-wire strand's commit)
         for k in HISTORY_FRAMES:    # the kernel's alone: not kept with ``p`` (``_cache``, ``_last``; 79 MB there)
             p.pop(k, None)
+        self.history.forget_rows()  # (nor with ``frictional``'s kept rows)
         out.update(d.pop("pairs")[1], active=d["active"], lam_t=np.zeros((n, 2)), stick=np.ones(n, dtype=bool),
                    slip=np.zeros((n, 2)))
         m = self._nodal_weights(G, P.e[sel]) if "members" in G else self._nodal_weights_of(G, P.e[sel])
