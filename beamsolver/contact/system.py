@@ -297,7 +297,7 @@ class ContactSystem(Contribution):
         self._far = None           # (pairs, far beyond the normal law's band) of the last ``_active``
         self._band = None          # (pairs, smoothing gaps, extent, normal multipliers) of the last ``_active``
         self._held_of = None       # (nodes, held slave nodes) of the last ``_held_slip``
-        self._kept_lam = None      # (keys, history multipliers, theirs, Newton step, its rows) of ``iterate_multipliers``
+        self._kept_lam = None      # (keys, history multipliers, theirs, Newton step, its rows): ``iterate_multipliers``
         self._kept_terms = None    # (multipliers, mu, keys, masters, kinds, declarations, terms) of ``_point_terms``
         self._kept_params = None   # (``_kept_terms``, sel, (parameters, keys, elements)) of ``_params``
         self._tangent_pool = BufferPool()     # tangent buffers of the compiled kernel (``_tangent_out``)
@@ -514,7 +514,8 @@ class ContactSystem(Contribution):
             xy = [self._part_centres.get(id(p)) for p in out]
             xy = [c[1:] if c is not None and c[0] is p else (self._points(H, p.e, p.xi1), self._points(H, p.m, p.xi2))
                   for p, c in zip(out, xy)]
-            self._pair_centres = (P, geo, np.concatenate([c[0] for c in xy]), np.concatenate([c[1] for c in xy]))
+            self._pair_centres = (P, geo) + ((xy[0][0], xy[0][1]) if len(xy) == 1 else
+                                             (np.concatenate([c[0] for c in xy]), np.concatenate([c[1] for c in xy])))
         self._part_centres = {}
         if P is not None and len(self._adjusted[0]):
             P.R1, P.R2 = adjust.apply(P.key, P.R1, P.R2, self._adjusted)
@@ -991,7 +992,8 @@ class ContactSystem(Contribution):
     def _kernel_blocks(self, H, P, sel, p, asked, tangent):
         """``_local_blocks``' kernels on the pairs ``_chosen`` gave (``asked``: the tangent asked for, ``tangent``:
         computed)."""
-        mort = self._decl_exact[P.decl[sel]] & (p["kind"] == LINE) & (p["mu"] > 0)
+        fric = p["mu"] > 0
+        mort = self._decl_exact[P.decl[sel]] & (p["kind"] == LINE) & fric
         # every pair a mortar pair whose whole tangent the mortar kernel gives (``_mortar``: points integration,
         # multipliers as unknowns): the pairs' kernel without tangent (its forces: the same bits)
         whole = tangent and self.kernel is kernel_jit and self.newton_multipliers and not self.n_slots and mort.all()
@@ -1001,13 +1003,13 @@ class ContactSystem(Contribution):
             f, K, out = None, np.empty((0, 24, 24)), {}   # (``_with_mortar``: every pair's blocks in its group's)
         else:
             f, K, out = self._kernels(H[P.nodes[sel]], p, P.decl[sel], tangent,
-                                      friction=(p["mu"] > 0) & ~mort if mort.any() else None)
+                                      friction=fric & ~mort if mort.any() else None)
             np.negative(f, out=f)
         if K is not None:
             np.negative(K, out=K)
         if K is not None and self.n_slots:
             # the segment ends' tangent terms: now if the tangent is asked for, else when it is (``evaluate``)
-            out["segment_ends"] = (p["mu"] > 0) & ~mort
+            out["segment_ends"] = fric & ~mort
             if asked:
                 self._segment_ends(H, P, sel, p, f, K, out.pop("segment_ends"))
         if mort.any():
@@ -1022,7 +1024,7 @@ class ContactSystem(Contribution):
         self._lap("kernel")
         # kept for commit/augment at the same poses (the converged iterate): no second pass
         Hc = np.array(H)           # (read by both: never written)
-        if (p["mu"] > 0).all() or not (p["mu"] > 0).any() or mort.any():
+        if fric.all() or not fric.any() or mort.any():
             self._cache = (Hc, P, sel, p, out)
         self._blocks = (Hc, (P, sel, p, f, K, out))
         return self._blocks[1]
@@ -1095,8 +1097,10 @@ class ContactSystem(Contribution):
             if not tangent:                     # (a view of the kernel's (4, P, 4, 6) forces, as ``A``)
                 f_pairs = f_pairs.copy()
             np.negative(f_pairs, out=f_pairs)
-            out.update(pair_out, active=d["active"], lam_t=np.zeros((len(idx), 2)), stick=np.ones(len(idx), dtype=bool),
-                       slip=np.zeros((len(idx), 2)))
+            # (every active pair: ``_point_data`` below gives them their own arrays)
+            blank = {} if len(idx) == len(sel) else dict(
+                lam_t=np.zeros((len(idx), 2)), stick=np.ones(len(idx), dtype=bool), slip=np.zeros((len(idx), 2)))
+            out.update(pair_out, active=d["active"], **blank)
         m = self._nodal_weights(G, P.e[sel[idx]])
         hold = v = None
         if ssn:
@@ -1887,10 +1891,13 @@ def _with_mortar(nodes, f, K, m, pool=None):
     levels = None
     if m.get("folded") is not None:          # the mortar pairs' blocks are in their groups' (``_mortar``)
         levels = ((nodes, f), (m["members"], m["f_own"]))      # the force levels of the parts, as unfolded
-        keep = np.ones(len(nodes), dtype=bool)
-        keep[m["folded"]] = False
-        # (an empty ``K``: every pair folded, its tangent never computed, ``_local_blocks``)
-        nodes, f, K = nodes[keep], f[keep], (None if K is None else K[keep] if len(K) else K)
+        if len(m["folded"]) < len(nodes):       # (``folded`` sorted, distinct: else every pair is folded)
+            keep = np.ones(len(nodes), dtype=bool)
+            keep[m["folded"]] = False
+            # (an empty ``K``: every pair folded, its tangent never computed, ``_local_blocks``)
+            nodes, f, K = nodes[keep], f[keep], (None if K is None else K[keep] if len(K) else K)
+        else:
+            nodes = nodes[:0]
     n = len(nodes)
     if n == 0:           # every pair in its group: the groups' blocks themselves (no copy; ``evaluate``)
         return Blocks(m["members"], m["f"], K if K is None else m["K"], levels_of=levels)

@@ -14,7 +14,8 @@ import weakref
 
 import numpy as np
 
-__all__ = ["REUSE_BUFFERS", "BufferPool", "equal", "release_idle", "RELEASE_MIN_VALUES", "RELEASE_AT_COMMIT", "MMAP_THRESHOLD"]
+__all__ = ["REUSE_BUFFERS", "BufferPool", "equal", "release_idle", "RELEASE_MIN_VALUES", "RELEASE_AT_COMMIT",
+           "MMAP_THRESHOLD"]
 
 REUSE_BUFFERS = sys.implementation.name == "cpython" and sys.version_info < (3, 14)
 RELEASE_MIN_VALUES = 4_000_000  # tangent values of an evaluation from which ``Evaluation.drop_tangent`` calls
