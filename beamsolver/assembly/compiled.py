@@ -100,3 +100,19 @@ def scaled_dead_loads(H, nodes, F, M, lf, fb, kb):
                 m_level = m if m_level == m_level else m_level
     dead_loads(H, nodes, Fs, Ms, fb, kb)
     return f_level, m_level
+
+
+@jit
+def global_node_values(r, g, out):
+    """``out[i] = -[hat(r_u), hat(r_w)]`` ``(k, 6, 3)`` (stacked on the rows) of the residual ``r`` ``(6 n,)`` at the
+    nodes ``g`` (``System._global_node_terms``; its numpy form's values, the negated zeros of ``hat`` included)."""
+    for i in range(len(g)):
+        for h in range(2):
+            x, y, w = r[6 * g[i] + 3 * h], r[6 * g[i] + 3 * h + 1], r[6 * g[i] + 3 * h + 2]
+            z = -0.0
+            o = out[i]
+            a = 3 * h
+            o[a, 0], o[a, 1], o[a, 2] = z, w, -y
+            o[a + 1, 0], o[a + 1, 1], o[a + 1, 2] = -w, z, x
+            o[a + 2, 0], o[a + 2, 1], o[a + 2, 2] = y, -x, z
+

@@ -39,6 +39,7 @@ import scipy.sparse as sp
 
 from .._jit import jit, jit_callee
 from .csc import canonical_csc
+from ..model.buffers import equal
 
 __all__ = ["ExtraPattern", "BlockPattern"]
 
@@ -198,7 +199,7 @@ class ExtraPattern:
             return False
         if rows is self.rows and cols is self.cols:
             return True
-        return rows.shape == self.rows.shape and np.array_equal(rows, self.rows) and np.array_equal(cols, self.cols)
+        return rows.shape == self.rows.shape and equal(rows, self.rows) and equal(cols, self.cols)
 
     def matrix(self, el_data, vals):
         """CSC matrix from the element values ``el_data`` (in the element pattern's order) and the
@@ -445,9 +446,9 @@ class BlockPattern:
         if base is not None and any(a is not b for a, b in zip(base, self.base)):
             return False
         if (tail is None) != (self.tail is None) or (tail is not None and not (
-                np.array_equal(tail[0], self.tail[0]) and np.array_equal(tail[1], self.tail[1]))):
+                equal(tail[0], self.tail[0]) and equal(tail[1], self.tail[1]))):
             return False
-        return d is self.d or (d.shape == self.d.shape and np.array_equal(d, self.d))
+        return d is self.d or (d.shape == self.d.shape and equal(d, self.d))
 
     def matrix(self, el_data, vals):
         """CSC matrix from the element values ``el_data`` and the block values ``vals`` (the blocks

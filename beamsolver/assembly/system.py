@@ -25,6 +25,7 @@ from ..model import contributions
 from ..elements import line_load
 from ..lie import se3, se3_twin
 from ..model import blocks as _blocks
+from ..model.buffers import equal
 from ..errors import InputError
 from .csc import canonical_csc
 from .extra_pattern import BlockPattern, ExtraPattern, whole_nodes
@@ -398,7 +399,7 @@ class System:
         g = self.global_nodes
         key = H[g, :3, :3]          # M depends on the poses of the global-type nodes only
         c = getattr(self, "_transforms", None)
-        if c is not None and np.array_equal(c[0], key):
+        if c is not None and equal(c[0], key):
             return c[1]             # read-only: shared by the evaluations at these poses
         M = np.broadcast_to(np.eye(6), (self.n_nodes, 6, 6)).copy()
         if len(g):
@@ -423,11 +424,13 @@ class System:
         ``np.ravel`` them for flat arrays) and the largest transformed nodal force and moment.
         """
         nodes, f, K = blocks.nodes, blocks.f, blocks.K
-        which, Kw = (), None
-        if self.transformed.any() and len(nodes):
+        which, Kw, M = (), None, None
+        transformed = self.any_transformed
+        if transformed and len(nodes):
             which = np.flatnonzero(self.transformed[nodes].any(axis=1))
             if len(which):
-                f, Kw = _blocks.transform_rows(self.node_transforms(H), nodes, f, K, which)
+                M = self.node_transforms(H)
+                f, Kw = _blocks.transform_rows(M, nodes, f, K, which)
         d = _blocks.dofs(self.rep, nodes)
         r = np.bincount(d.ravel(), weights=f.ravel(), minlength=6 * self.n_nodes)
         coo = (np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0))
@@ -451,9 +454,12 @@ class System:
             return (r, coo) + _blocks.levels(f)
         fl, ml = 0.0, 0.0
         for ln, lf in blocks.levels_of:
-            w = np.flatnonzero(self.transformed[ln].any(axis=1)) if self.transformed.any() and len(ln) else ()
+            # (the blocks' own nodes: their transformed rows ``which``, as above)
+            w = which if ln is nodes else \
+                np.flatnonzero(self.transformed[ln].any(axis=1)) if transformed and len(ln) else ()
             if len(w):
-                lf = _blocks.transform_rows(self.node_transforms(H), ln, lf, None, w)[0]
+                M = self.node_transforms(H) if M is None else M
+                lf = _blocks.transform_rows(M, ln, lf, None, w)[0]
             a, b = _blocks.levels(lf)
             fl, ml = max(fl, a), max(ml, b)
         return (r, coo, fl, ml)
@@ -475,7 +481,7 @@ class System:
         ``BlockPattern`` reads ``d``); the same arrays while ``d`` stays the same, which ``matrix``
         recognises at once."""
         c = getattr(self, "_coo_index", None)
-        if c is None or c[0].shape != d.shape or not np.array_equal(c[0], d):
+        if c is None or c[0].shape != d.shape or not equal(c[0], d):
             m, k = d.shape
             small = 6 * self.n_nodes <= np.iinfo(np.int32).max
             dk = np.array(d, dtype=np.int32 if small else np.int64)      # int32: half the memory when raveled
@@ -489,7 +495,7 @@ class System:
         read-only arrays) while ``a``'s are the same arrays and ``b``'s equal."""
         c = getattr(self, "_coo_concat", None)
         if c is None or c[0] is not a_rows or c[1] is not a_cols or not (
-                (c[6] is b_rows and c[7] is b_cols) or (np.array_equal(c[2], b_rows) and np.array_equal(c[3], b_cols))):
+                (c[6] is b_rows and c[7] is b_cols) or (equal(c[2], b_rows) and equal(c[3], b_cols))):
             rows, cols = _ravel_concat(a_rows, b_rows), _ravel_concat(a_cols, b_cols)
             rows.flags.writeable = cols.flags.writeable = False
             c = self._coo_concat = (a_rows, a_cols, np.array(b_rows), np.array(b_cols), rows, cols, b_rows, b_cols)
@@ -499,10 +505,10 @@ class System:
         """COO of ``[[0, -hat(r_u)], [0, -hat(r_w)]]`` at global-type nodes ``g`` (the dependence of
         ``M`` on ``R``, see the module docstring) for the residual ``r`` of one contribution; the
         index arrays are the same (read-only) arrays while ``g`` is."""
-        rg = r.reshape(-1, 6)[g]
-        vals = -np.concatenate([_hat(rg[:, :3]), _hat(rg[:, 3:])], axis=1)          # (k, 6, 3)
+        vals = np.empty((len(g), 6, 3))           # -[hat(r_u), hat(r_w)] per node (compiled: one call, no stacks)
+        assembly_jit.global_node_values(r, np.ascontiguousarray(g, dtype=np.int64), vals)
         c = getattr(self, "_global_index", None)
-        if c is None or not np.array_equal(c[0], g):
+        if c is None or not equal(c[0], g):
             rows = np.broadcast_to((6 * g)[:, None, None] + np.arange(6)[:, None], vals.shape).ravel()
             cols = np.broadcast_to((6 * g)[:, None, None] + 3 + np.arange(3), vals.shape).ravel()
             rows.flags.writeable = cols.flags.writeable = False
@@ -559,10 +565,12 @@ class System:
             if M is not None and len(et):
                 # the generic block transform on the blocks touching a transformed node; the
                 # tangent goes back into kvals
-                ft, Kt = _blocks.transform(M, g.nodes[et], f[et], None if K is None else K[et])
-                f = f.copy()
-                f[et] = ft
-                if K is not None:
+                if K is None:       # (the rows ``et`` of a copy of ``f``: the same per-row transform)
+                    f = _blocks.transform_rows(M, g.nodes, f, None, et)[0]
+                else:
+                    ft, Kt = _blocks.transform(M, g.nodes[et], f[et], K[et])
+                    f = f.copy()
+                    f[et] = ft
                     K[et] = Kt
             if len(self.groups) == 1:
                 return f.ravel(), state, f_level, m_level, M
@@ -715,7 +723,7 @@ class System:
         ``Kq``, ``Kl`` ``(m, 6 k)`` over whole-node dofs ``dofs`` ``(m, 6 k)`` (full numbering), ``w`` ``(m,)``;
         ``None`` where no pattern is held for ``K`` or a block leaves it (then assemble the changed values)."""
         p = self.held_pattern
-        if p is None or K.nnz != p.nnz or not np.array_equal(K.indptr, p.indptr):
+        if p is None or K.nnz != p.nnz or not equal(K.indptr, p.indptr):
             return None
         data = K.data.copy()
         if not p.add_products(data, np.asarray(dofs)[:, 0::6] // 6, Kq, Kl, w):

@@ -26,6 +26,7 @@ import numpy as np
 from ..errors import InputError
 from .frames import LINE
 from .state import check_state
+from ..model.buffers import equal
 
 __all__ = ["ContactHistory", "lookup", "empty_friction", "SHARED_STATE"]
 
@@ -48,6 +49,9 @@ def empty_friction():
                 xi1=np.zeros(0), xi2=np.zeros(0), lam_t=np.zeros((0, 3)))
 
 
+_ROWS = ("H_CL", "H_FK", "H_LK_prev", "xi1_prev", "xi2_prev", "lam_t_prev")   # ``frictional``'s parameters
+
+
 def _no_mult():
     return np.zeros(0, dtype=np.int64), np.zeros(0)
 
@@ -67,6 +71,7 @@ class ContactHistory:
         self.mu_committed = None        # friction per declaration of the last accepted step (None: unknown)
         self.prev_points = np.zeros(0, dtype=np.int64)
         self.prev_owners = np.zeros(0, dtype=np.int64)
+        self._kept_rows = None      # ``frictional``'s last rows where every point had history (its arrays, keys)
         self.forget_kinds()
 
     # ------------------------------------------------------------ steps
@@ -88,6 +93,7 @@ class ContactHistory:
         """The step is accepted: its trial normal multipliers, friction coefficients ``mu`` per
         declaration, friction history ``friction`` (dict of the module docstring's fields, sorted by
         key; ``None``: no rows) and tangential multipliers ``tmult`` (``None``: none) are kept."""
+        self.forget_rows()
         self.mult_committed = self.mult
         self.mu_committed = mu
         self.friction = empty_friction() if friction is None else friction
@@ -114,6 +120,10 @@ class ContactHistory:
         return np.where(gauss, key // np.maximum(n_el * lay.max_gp * lay.n_beams, 1),
                         (key - lay.point_offset) // (n_el * n_el)).astype(int)
 
+    def forget_rows(self):
+        """Let ``frictional``'s kept rows go (a commit's pass drops the points' frames: not held through it)."""
+        self._kept_rows = None
+
     # ------------------------------------------------------------ look-ups
     def normal_multipliers(self, keys):
         """Trial normal multiplier ``(k,)`` of the points ``keys`` (0 where there is none)."""
@@ -133,6 +143,10 @@ class ContactHistory:
         points without history: identities, their own ``xi1``, ``xi2``, zero traction); returns
         ``found`` ``(k,)``, the points with history."""
         hist = self.friction
+        c = self._kept_rows
+        if c is not None and c[0] is hist and equal(c[1], keys) and equal(c[2], e) and equal(c[3], m):
+            p.update(c[4])          # every point found again: the same rows (read only)
+            return c[5]
         hi, hf = lookup(hist["key"], keys)
         n = len(keys)
         if len(hist["key"]):
@@ -143,6 +157,12 @@ class ContactHistory:
             p["xi1_prev"] = np.where(hf, hist["xi1"][hi] + hist["e"][hi] - e, p["xi1"])
             p["xi2_prev"] = np.where(hf, hist["xi2"][hi] + hist["m"][hi] - m, p["xi2"])
             p["lam_t_prev"] = np.where(hf[:, None], hist["lam_t"][hi], 0.0)
+            if every:             # kept for the next look-up of these points (a line search's trials): no gathers
+                rows = {k: p[k] for k in _ROWS}
+                for v in rows.values():
+                    v.flags.writeable = False
+                hf.flags.writeable = False
+                self._kept_rows = (hist, np.array(keys), np.array(e), np.array(m), rows, hf)
         else:
             p.update(H_CL=np.tile(np.eye(4), (n, 1, 1)), H_FK=np.tile(np.eye(4), (n, 1, 1)),
                      H_LK_prev=np.tile(np.eye(4), (n, 1, 1)), xi1_prev=p["xi1"].copy(),

@@ -1342,6 +1342,10 @@ def _readonly(v, shape, dtype):
     return np.ascontiguousarray(np.broadcast_to(v, shape), dtype=dtype)
 
 
+_EYE4, _ZERO3 = np.eye(4), np.zeros(3)     # ``_table``'s defaults (read only)
+_EYE4.flags.writeable = _ZERO3.flags.writeable = False
+
+
 def _table(X, p):
     P = X.shape[0]
     par = np.empty((P, N_PAR))
@@ -1351,9 +1355,8 @@ def _table(X, p):
             np.broadcast_to(np.asarray(v, dtype=float), (P,))
     par[:, XI1P] = p["xi1_prev"] if "xi1_prev" in p else par[:, XI1]
     par[:, XI2P] = p["xi2_prev"] if "xi2_prev" in p else par[:, XI2]
-    eye = np.eye(4)
-    frames = [_readonly(p.get(k, eye), (P, 4, 4), np.float64) for k in ("H_CL", "H_FK", "H_LK_prev")]
-    lamp = _readonly(p.get("lam_t_prev", np.zeros(3)), (P, 3), np.float64)
+    frames = [_readonly(p[k] if k in p else _EYE4, (P, 4, 4), np.float64) for k in ("H_CL", "H_FK", "H_LK_prev")]
+    lamp = _readonly(p["lam_t_prev"] if "lam_t_prev" in p else _ZERO3, (P, 3), np.float64)
     has = _readonly(p.get("has_history", False), (P,), np.bool_)
     kind = _readonly(p["kind"], (P,), np.int64)
     return kind, par, has, frames, lamp

@@ -24,7 +24,7 @@ to their groups by compiled scatters (``mortar_jit``; ``use_numpy_scatter``: the
 import numpy as np
 
 from ..lie import se3
-from ..model.buffers import BufferPool
+from ..model.buffers import BufferPool, equal
 from . import mortar_jit
 
 __all__ = ["groups", "Groups", "return_mapping", "nodal_state", "multiplier_basis", "group_forces", "blocks",
@@ -94,7 +94,7 @@ def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=No
     node = (ukey // n_beams) % n_nodes
     if not full:
         return dict(key=ukey, node=node, g=np.ascontiguousarray(g, dtype=np.int64),
-                    phi=np.stack([1.0 - xi1, xi1], axis=1))
+                    phi=_shape_functions(xi1))
     # the nodes of each group: every pair node of every member point
     gn = np.repeat(g[:, :, None], 4, axis=2)                       # (P, 2, 4)
     nn = np.repeat(nodes[:, None, :], 2, axis=1)
@@ -115,7 +115,7 @@ def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=No
     # of the 61-wire strand; ``trial_rows`` makes it contiguous when it needs it)
     own = np.argmax(members == node[:, None], axis=1)
     slot_rows = np.ascontiguousarray(rows2.transpose(1, 0, 2))
-    return dict(key=ukey, node=node, g=g, phi=np.stack([1.0 - xi1, xi1], axis=1), members=members, pos=pos,
+    return dict(key=ukey, node=node, g=g, phi=_shape_functions(xi1), members=members, pos=pos,
                 rows2=slot_rows.transpose(1, 0, 2), slot_groups=np.ascontiguousarray(g.T), slot_rows=slot_rows,
                 rot=6 * own[:, None] + np.arange(3, 6))
 
@@ -174,14 +174,29 @@ class Groups:
         fold = fold_of(slave_nodes, xi1, master_beam, decl, n_nodes, n_beams, held)
         args = (slave_nodes, master_beam, decl, nodes, held, fold)
         last = self._last
-        if last is not None and last[0] == (n_nodes, n_beams) and ("members" in last[2] or not full) and all(
-                (a is None and b is None) or (a is not None and b is not None and np.array_equal(a, b))
-                for a, b in zip(last[1], args)):
-            return dict(last[2], phi=np.stack([1.0 - xi1, xi1], axis=1))
+        if last is not None and last[0] == (n_nodes, n_beams) and ("members" in last[2] or not full) and \
+                _same_args(last[1], args):
+            return dict(last[2], phi=_shape_functions(xi1))
         G = groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held, fold, full)
         self._last = ((n_nodes, n_beams), tuple(None if a is None else np.array(a) for a in args), G)
         self.builds += 1
         return G
+
+
+def _same_args(kept, args):
+    """Whether the arrays (or Nones) ``args`` equal the ``kept`` ones, pair by pair (``Groups``)."""
+    for a, b in zip(kept, args):
+        if (a is None) != (b is None) or (a is not None and not equal(a, b)):
+            return False
+    return True
+
+
+def _shape_functions(xi1):
+    """``Phi`` ``(P, 2)``: ``1 - xi1`` and ``xi1`` (``np.stack([1.0 - xi1, xi1], axis=1)``, one array filled)."""
+    phi = np.empty((len(xi1), 2))
+    phi[:, 0] = 1.0 - xi1
+    phi[:, 1] = xi1
+    return phi
 
 
 def return_mapping(trial, cap):
@@ -400,7 +415,7 @@ def blocks(G, d, st, R, Lam, eps, mu):
     return f, K
 
 
-def multiplier_blocks(G, d, st, R, Lam, c, mu):
+def multiplier_blocks(G, d, st, R, Lam, c, mu, turn=None):
     """Semi-smooth Newton blocks of the nodal multipliers ``Lam`` ``(n, 3)`` (section frame of the node; the
     traction is ``v = R Lam``) with the complementarity function ``C = v - P(Pi (v + c u))`` (``P`` the
     return mapping onto the disk ``mu lamN``; ``d``: point terms at the tractions ``T_p = sum Phi_j v_j``,
@@ -409,10 +424,10 @@ def multiplier_blocks(G, d, st, R, Lam, c, mu):
     Returns ``f`` ``(n, 6 k)`` (contact forces), ``Kqq`` ``(n, 6 k, 6 k)`` = d f / d q at fixed ``Lam``,
     ``Kql`` ``(n, 6 k, 3)`` = d f / d Lam, ``Klq`` ``(n, 3, 6 k)`` = d C / d q, ``Kll`` ``(n, 3, 3)`` = d C / d Lam
     and ``C`` ``(n, 3)``.  Sticking: ``C = nu nu^T v - c Pi u`` (no slip, no normal part); sliding:
-    ``C = v - mu lamN t``.
+    ``C = v - mu lamN t``.  ``turn``: ``_turn(G, R, Lam)`` if known.
     """
     f, Kqq, A = _point_parts(G, d)
-    rot, dv = _turn(G, R, Lam)
+    rot, dv = _turn(G, R, Lam) if turn is None else turn
     _add_columns(Kqq, rot, A @ dv)
     Kql = A @ R
     weak = st["weak"]
@@ -431,18 +446,19 @@ def multiplier_blocks(G, d, st, R, Lam, c, mu):
     return f, Kqq, Kql, Klq, Kll, v - st["lam"]
 
 
-def branch_rows(G, d, st, R, Lam, c, mu):
+def branch_rows(G, d, st, R, Lam, c, mu, turn=None):
     """The linearisation of the groups' trial tractions and disks (the active-set inner loop of Newton's direction,
     ``nonlinear.problem.Problem.branch_rows``): ``Tq`` ``(n, 3, 6 k)`` = d trial / d q (the node's turn of ``R Lam``
     included), ``Vq`` ``(n, 3, 6 k)`` = d (R Lam) / d q (the turn's columns only) and ``capq`` ``(n, 6 k)`` =
-    d (mu lamN) / d q, rows over the groups' slots (``st``: ``nodal_state`` with ``eps = c``)."""
+    d (mu lamN) / d q, rows over the groups' slots (``st``: ``nodal_state`` with ``eps = c``; ``turn``: ``_turn(G, R,
+    Lam)`` if known)."""
     n, k = G["members"].shape
     eye = dict(st, C=np.ascontiguousarray(np.broadcast_to(np.eye(3), (n, 3, 3))), c=np.zeros((n, 3)))
     Tq = _trial_rows(G, d, eye, c, mu)
     e = np.zeros((n, 3))
     e[:, 0] = 1.0
     capq = _trial_rows(G, d, dict(st, C=np.zeros((n, 3, 3)), c=e), c, mu)[:, 0, :].copy()
-    rot, dv = _turn(G, R, Lam)
+    rot, dv = _turn(G, R, Lam) if turn is None else turn
     Vq = np.zeros((n, 3, 6 * k))
     _add_columns(Vq, rot, dv)
     _add_columns(Tq, rot, np.einsum("gij,gjk->gik", st["Pi"], dv))

@@ -49,7 +49,7 @@ from scipy.spatial import cKDTree
 
 from ..lie import se3, se3_twin
 from ..model.blocks import Blocks, Contribution
-from ..model.buffers import BufferPool
+from ..model.buffers import BufferPool, equal
 from ..errors import InputError
 from ..failures import ContactTunnelling, NoContactNormal
 from ..model.model import JOIN_TOL
@@ -295,6 +295,11 @@ class ContactSystem(Contribution):
         self._skipped = 0          # points of open groups the last evaluation left out (``_open_points``)
         self._full = False         # evaluate every point (``_state``: commit, updates, results)
         self._far = None           # (pairs, far beyond the normal law's band) of the last ``_active``
+        self._band = None          # (pairs, smoothing gaps, extent, normal multipliers) of the last ``_active``
+        self._held_of = None       # (nodes, held slave nodes) of the last ``_held_slip``
+        self._kept_lam = None      # (keys, history multipliers, theirs, Newton step, its rows): ``iterate_multipliers``
+        self._kept_terms = None    # (multipliers, mu, keys, masters, kinds, declarations, terms) of ``_point_terms``
+        self._kept_params = None   # (``_kept_terms``, sel, (parameters, keys, elements)) of ``_params``
         self._tangent_pool = BufferPool()     # tangent buffers of the compiled kernel (``_tangent_out``)
         self._mortar_pool = BufferPool()      # tangent blocks of pairs and mortar groups (``_with_mortar``)
         self.timings = dict.fromkeys(TIMED, 0.0)
@@ -424,7 +429,7 @@ class ContactSystem(Contribution):
     def _twists(self, H):
         """Twists ``(n_elements, 6)`` of all elements at ``H`` (compiled; kept for the same poses)."""
         g = self._geo
-        if g is None or g[0].shape != H.shape or not np.array_equal(g[0], H):
+        if g is None or g[0].shape != H.shape or not equal(g[0], H):
             g = self._geo = (np.array(H, dtype=float), element_twists(H, self.sys.enodes))
         return g
 
@@ -443,7 +448,7 @@ class ContactSystem(Contribution):
         """Twists ``(n_elements, 6)`` of all elements at the last converged poses (once per step)."""
         if self._geo_prev is None:
             g = self._geo       # a step starts at the last iterate's poses, whose twists are kept
-            if g is not None and g[0].shape == self._H_prev.shape and np.array_equal(g[0], self._H_prev):
+            if g is not None and g[0].shape == self._H_prev.shape and equal(g[0], self._H_prev):
                 self._geo_prev = (self._H_prev, g[1])
             else:
                 self._geo_prev = (self._H_prev, element_twists(self._H_prev, self.sys.enodes))
@@ -461,7 +466,7 @@ class ContactSystem(Contribution):
         if prev:
             Hc, h = self._H_prev, self._prev_twists()
             c = self._prev_points     # (the step's twists, e, xi, points) of the last call with ``keep``
-            if keep and c is not None and c[0] is self._geo_prev and np.array_equal(c[1], e) and _same_bits(c[2], xi):
+            if keep and c is not None and c[0] is self._geo_prev and equal(c[1], e) and _same_bits(c[2], xi):
                 return c[3]
         else:
             Hc, h = self._twists(H)
@@ -509,7 +514,8 @@ class ContactSystem(Contribution):
             xy = [self._part_centres.get(id(p)) for p in out]
             xy = [c[1:] if c is not None and c[0] is p else (self._points(H, p.e, p.xi1), self._points(H, p.m, p.xi2))
                   for p, c in zip(out, xy)]
-            self._pair_centres = (P, geo, np.concatenate([c[0] for c in xy]), np.concatenate([c[1] for c in xy]))
+            self._pair_centres = (P, geo) + ((xy[0][0], xy[0][1]) if len(xy) == 1 else
+                                             (np.concatenate([c[0] for c in xy]), np.concatenate([c[1] for c in xy])))
         self._part_centres = {}
         if P is not None and len(self._adjusted[0]):
             P.R1, P.R2 = adjust.apply(P.key, P.R1, P.R2, self._adjusted)
@@ -707,30 +713,45 @@ class ContactSystem(Contribution):
 
     def _params(self, P, sel, H):
         """Kernel parameters for the pairs ``sel`` (history and multipliers looked up)."""
-        dec = P.decl[sel]
-        p = dict(kind=P.kind[sel], xi1=P.xi1[sel], xi2=P.xi2[sel], R1=P.R1[sel],
-                 R2=P.R2[sel], weight=P.weight[sel], penalty=self._decl_penalty[dec],
-                 penalty_t=self._decl_penalty_t[dec], mu=self._decl_mu[dec])
-        # elastic slip at the onset of sliding (used where no penalty_t is given)
-        p["elastic_slip"] = self._decl_slip_tol[dec] * self.sys.L[P.e[sel]]
-        p["smoothing"] = self._smoothing(P, sel)
+        b, self._band = self._band, None
+        same = b is not None and b[0] is P      # ``_active``'s of these pairs (element by element: the same floats)
+        c = self._kept_params
+        if same and c is not None and c[0] is self._kept_terms and equal(c[1], sel):
+            fixed, key, e, m = c[2]         # (the same pairs and state as the last call: its arrays, read only)
+        else:
+            dec, key, e, m = P.decl[sel], P.key[sel], P.e[sel], P.m[sel]
+            fixed = dict(kind=P.kind[sel], R1=P.R1[sel], R2=P.R2[sel], penalty=self._decl_penalty[dec],
+                         penalty_t=self._decl_penalty_t[dec], mu=self._decl_mu[dec],
+                         # elastic slip at the onset of sliding (used where no penalty_t is given)
+                         elastic_slip=self._decl_slip_tol[dec] * self.sys.L[e])
+            if same:
+                fixed.update(smoothing=b[1][sel], multiplier=b[3][sel])
+            else:
+                fixed.update(smoothing=self._smoothing(P, sel), multiplier=self.history.normal_multipliers(key))
+            self._kept_params = None
+            if same:
+                for v in (*fixed.values(), key, e, m):
+                    v.flags.writeable = False
+                self._kept_params = (self._kept_terms, np.array(sel), (fixed, key, e, m))
+        p = dict(kind=fixed["kind"], xi1=P.xi1[sel], xi2=P.xi2[sel], R1=fixed["R1"], R2=fixed["R2"],
+                 weight=P.weight[sel], penalty=fixed["penalty"], penalty_t=fixed["penalty_t"], mu=fixed["mu"],
+                 elastic_slip=fixed["elastic_slip"], smoothing=fixed["smoothing"], multiplier=fixed["multiplier"])
+        extent = b[2] if same else _extent(H)
         # round-off gaps touch (reference.touching_gap, the kernels' rule) where the law's smoothing gap does not cover them already
-        touch = touch_tolerance(_extent(H), p["R1"], p["R2"])
+        touch = touch_tolerance(extent, p["R1"], p["R2"])
         p["touch"] = np.where(p["smoothing"] >= touch, 0.0, touch)
-        key = P.key[sel]
-        p["multiplier"] = self.history.normal_multipliers(key)
         if self._forced is not None and len(self._forced):     # the normal law's open branch (``force_open``)
             off = _member(key, self._forced)
             p["penalty"] = np.where(off, 0.0, p["penalty"])
             p["multiplier"] = np.where(off, 0.0, p["multiplier"])
         if self._secant is not None:     # the smoothing parabola's secant to its zero-force end (``force_secant``)
             self._secant_law(key, p)
-        hf = self.history.frictional(p, key, P.e[sel], P.m[sel])
+        hf = self.history.frictional(p, key, e, m)
         hist = self.history.friction
         # a point pair whose crossing moved to a neighbouring element pair keeps the
         # history of the committed point pair of the same two beams next to it
         cand = np.flatnonzero(~hf & (p["kind"] == POINT) & (p["mu"] > 0))
-        hp = np.flatnonzero(hist["key"] >= self.point_offset)
+        hp = np.flatnonzero(hist["key"] >= self.point_offset) if len(cand) else cand
         if len(cand) and len(hp):
             hf = self._inherit_points(P, sel, H, p, hf, cand, hp)
         # a pair without history starts it from the last converged poses: its
@@ -799,18 +820,40 @@ class ContactSystem(Contribution):
             xC, xF = self._centres(H, P) if centres is None else centres
             dist = np.linalg.norm(xF - xC, axis=1)
         gap = dist - P.R1 - P.R2
-        pen = self._decl_penalty[P.decl]
-        mult = self.history.normal_multipliers(P.key)
+        pen, mult, smoothing, base, margin, exact = self._point_terms(P)
+        extent = _extent(H)
+        self._band = (P, smoothing, extent, mult)     # (``_params`` of these pairs: the same values, taken)
         # the smoothing zone plus a small band keeps the projection-updated gap consistent
-        band = self._smoothing(P, slice(None)) + 1e-3 * (P.R1 + P.R2) + touch_tolerance(_extent(H), P.R1, P.R2)
-        on = mult - pen * gap > -pen * band
+        band = base + touch_tolerance(extent, P.R1, P.R2)
+        trial = mult - pen * gap
+        on = trial > -pen * band
         # (``_open_points``: the pairs far beyond that band, from the same gaps)
-        self._far = (P, mult - pen * gap <= -pen * (band + SKIP_MARGIN * (P.R1 + P.R2))) if SKIP_OPEN else None
+        self._far = (P, trial <= -pen * (band + margin)) if SKIP_OPEN else None
         if self.newton_multipliers and self._decl_exact.any():
             # exact stick: the nodal traction field acts over the whole overlap the search found (a point
             # that left the normal law keeps its share of the field: no jump in the residual)
-            on |= self._decl_exact[P.decl] & (P.kind == LINE) & (self._decl_mu[P.decl] > 0)
+            on |= exact
         return np.flatnonzero(on)
+
+    def _point_terms(self, P):
+        """``_active``'s terms of the pairs ``P`` that do not depend on the poses, ``(P,)`` each: penalty, normal
+        multiplier, smoothing gap, ``smoothing + 1e-3 (R1 + R2)``, ``SKIP_MARGIN (R1 + R2)`` and the exact-stick line
+        pairs with friction; kept (read only) while the pairs' keys, masters and kinds, the multipliers and the
+        friction coefficients are the same (a Newton step's evaluations)."""
+        c = self._kept_terms
+        if c is not None and c[0] is self.history.mult and c[1] is self._decl_mu and equal(c[2], P.key) and \
+                equal(c[3], P.m) and equal(c[4], P.kind) and equal(c[5], P.decl):
+            return c[6]
+        rsum = P.R1 + P.R2
+        smoothing = self._smoothing(P, slice(None))
+        terms = (self._decl_penalty[P.decl], self.history.normal_multipliers(P.key), smoothing,
+                 smoothing + 1e-3 * rsum, SKIP_MARGIN * rsum,
+                 self._decl_exact[P.decl] & (P.kind == LINE) & (self._decl_mu[P.decl] > 0))
+        for v in terms:
+            v.flags.writeable = False
+        self._kept_terms = (self.history.mult, self._decl_mu, np.array(P.key), np.array(P.m), np.array(P.kind),
+                            np.array(P.decl), terms)
+        return terms
 
     def _open_points(self, P, H, sel):
         """``sel`` without the exact-stick points that certainly act on nothing at ``H`` (``SKIP_OPEN``): a point whose
@@ -875,14 +918,17 @@ class ContactSystem(Contribution):
         one beam passed through the other within the step, where the penalty, seeing
         the other side, would push them further apart and report a converged state.
         """
-        if self._H_prev is None or self._H_prev.shape != H.shape or np.array_equal(self._H_prev, H):
+        if self._H_prev is None or self._H_prev.shape != H.shape or equal(self._H_prev, H):
             return              # (at the step's start, the first iterate: d_prev = d, no pair changed sides)
         d = centres[1] - centres[0] if d is None else d
         x0C, x0F = self._centres(H, P, prev=True)
         d0 = x0F - x0C
         rsum = P.R1 + P.R2
+        back = np.sum(d * d0, axis=1) < -(NORMAL_TOL * rsum) ** 2
+        if not back.any():
+            return              # (no pair turned: the test below finds none)
         seen = ~no_normal(np.linalg.norm(d0, axis=1), P.R1, P.R2)
-        flip = np.flatnonzero(seen & (np.sum(d * d0, axis=1) < -(NORMAL_TOL * rsum) ** 2))
+        flip = np.flatnonzero(seen & back)
         if len(flip):
             k = flip[0]
             raise ContactTunnelling(f"contact: {self._pair_label(P.e[k], P.m[k])} changed sides within the "
@@ -907,7 +953,7 @@ class ContactSystem(Contribution):
         kernel computes the tangent with the forces; the numpy oracle only when asked).
         """
         c = self._blocks
-        if c is not None and np.array_equal(c[0], H) and (c[1] is None or c[1][4] is not None or not tangent):
+        if c is not None and equal(c[0], H) and (c[1] is None or c[1][4] is not None or not tangent):
             return c[1]
         c = None                   # (its tangent buffer may serve this evaluation: ``_tangent_out``)
         asked, tangent = tangent, tangent or self.kernel is kernel_jit
@@ -946,7 +992,8 @@ class ContactSystem(Contribution):
     def _kernel_blocks(self, H, P, sel, p, asked, tangent):
         """``_local_blocks``' kernels on the pairs ``_chosen`` gave (``asked``: the tangent asked for, ``tangent``:
         computed)."""
-        mort = self._decl_exact[P.decl[sel]] & (p["kind"] == LINE) & (p["mu"] > 0)
+        fric = p["mu"] > 0
+        mort = self._decl_exact[P.decl[sel]] & (p["kind"] == LINE) & fric
         # every pair a mortar pair whose whole tangent the mortar kernel gives (``_mortar``: points integration,
         # multipliers as unknowns): the pairs' kernel without tangent (its forces: the same bits)
         whole = tangent and self.kernel is kernel_jit and self.newton_multipliers and not self.n_slots and mort.all()
@@ -956,13 +1003,13 @@ class ContactSystem(Contribution):
             f, K, out = None, np.empty((0, 24, 24)), {}   # (``_with_mortar``: every pair's blocks in its group's)
         else:
             f, K, out = self._kernels(H[P.nodes[sel]], p, P.decl[sel], tangent,
-                                      friction=(p["mu"] > 0) & ~mort if mort.any() else None)
+                                      friction=fric & ~mort if mort.any() else None)
             np.negative(f, out=f)
         if K is not None:
             np.negative(K, out=K)
         if K is not None and self.n_slots:
             # the segment ends' tangent terms: now if the tangent is asked for, else when it is (``evaluate``)
-            out["segment_ends"] = (p["mu"] > 0) & ~mort
+            out["segment_ends"] = fric & ~mort
             if asked:
                 self._segment_ends(H, P, sel, p, f, K, out.pop("segment_ends"))
         if mort.any():
@@ -976,9 +1023,10 @@ class ContactSystem(Contribution):
                 out["mortar_pending"] = np.flatnonzero(mort)
         self._lap("kernel")
         # kept for commit/augment at the same poses (the converged iterate): no second pass
-        if (p["mu"] > 0).all() or not (p["mu"] > 0).any() or mort.any():
-            self._cache = (H.copy(), P, sel, p, out)
-        self._blocks = (np.array(H), (P, sel, p, f, K, out))
+        Hc = np.array(H)           # (read by both: never written)
+        if fric.all() or not fric.any() or mort.any():
+            self._cache = (Hc, P, sel, p, out)
+        self._blocks = (Hc, (P, sel, p, f, K, out))
         return self._blocks[1]
 
     def _segment_ends(self, H, P, sel, p, f, K, friction):
@@ -1049,8 +1097,10 @@ class ContactSystem(Contribution):
             if not tangent:                     # (a view of the kernel's (4, P, 4, 6) forces, as ``A``)
                 f_pairs = f_pairs.copy()
             np.negative(f_pairs, out=f_pairs)
-            out.update(pair_out, active=d["active"], lam_t=np.zeros((len(idx), 2)), stick=np.ones(len(idx), dtype=bool),
-                       slip=np.zeros((len(idx), 2)))
+            # (every active pair: ``_point_data`` below gives them their own arrays)
+            blank = {} if len(idx) == len(sel) else dict(
+                lam_t=np.zeros((len(idx), 2)), stick=np.ones(len(idx), dtype=bool), slip=np.zeros((len(idx), 2)))
+            out.update(pair_out, active=d["active"], **blank)
         m = self._nodal_weights(G, P.e[sel[idx]])
         hold = v = None
         if ssn:
@@ -1108,6 +1158,7 @@ class ContactSystem(Contribution):
         #                                                          61-wire strand's commit)
         for k in HISTORY_FRAMES:    # the kernel's alone: not kept with ``p`` (``_cache``, ``_last``; 79 MB there)
             p.pop(k, None)
+        self.history.forget_rows()  # (nor with ``frictional``'s kept rows)
         out.update(d.pop("pairs")[1], active=d["active"], lam_t=np.zeros((n, 2)), stick=np.ones(n, dtype=bool),
                    slip=np.zeros((n, 2)))
         m = self._nodal_weights(G, P.e[sel]) if "members" in G else self._nodal_weights_of(G, P.e[sel])
@@ -1209,7 +1260,7 @@ class ContactSystem(Contribution):
         """``m`` ``(n,)`` of the groups ``G`` (``mortar.nodal_state``), their points on the slave elements ``e``:
         half of each element at the node, the whole element beside a held node."""
         c = self._kept_weights              # (kept while the groups, ``mortar.Groups``, and the elements hold)
-        if c is not None and c[0] is G["members"] and np.array_equal(c[1], e):
+        if c is not None and c[0] is G["members"] and equal(c[1], e):
             return c[2]
         m = self._nodal_weights_of(G, e)
         self._kept_weights = (G["members"], np.array(e), m)
@@ -1239,10 +1290,11 @@ class ContactSystem(Contribution):
             mortar_jit.subtract_indexed(d["dfdq"], K_pairs, rows)
         mult = None
         if ssn:
-            f, K, Kql, Klq, Kll, C = mortar.multiplier_blocks(G, d, st, R, Lam, eps, mu)
+            turn = mortar._turn(G, R, Lam)      # (the node's turn: one product for both)
+            f, K, Kql, Klq, Kll, C = mortar.multiplier_blocks(G, d, st, R, Lam, eps, mu, turn=turn)
             mult = dict(Kql=-Kql, Klq=Klq, Kll=Kll)
             if self.branch_rows and not self.n_slots:   # the active-set inner loop's rows (not with segments' ends)
-                Tq, Vq, capq = mortar.branch_rows(G, d, st, R, Lam, eps, mu)
+                Tq, Vq, capq = mortar.branch_rows(G, d, st, R, Lam, eps, mu, turn=turn)
                 mult.update(Tq=Tq, Vq=Vq, capq=capq, trial=st["trial"], cap=mu * np.maximum(st["lamN"], 0.0),
                             Pi=st["Pi"], weak=st["weak"] | (st["lamN"] <= 0.0))
         else:
@@ -1289,10 +1341,17 @@ class ContactSystem(Contribution):
 
     def _held_slip(self, nodes):
         """``(P, 2)``: slave nodes A, B of the pairs over ``nodes`` ``(P, 4)`` whose slip is prescribed:
-        every increment fixed, or joined to a node of the master element (``mortar.groups``)."""
+        every increment fixed, or joined to a node of the master element (``mortar.groups``); kept (read only) while
+        ``nodes`` are the same (a Newton step's evaluations)."""
+        c = self._held_of
+        if c is not None and equal(c[0], nodes):
+            return c[1]
         r = self.sys.rep[nodes]
         joined = (r[:, :2, None] == r[:, None, 2:]).any(axis=2)
-        return self._held[nodes[:, :2]] | joined
+        held = self._held[nodes[:, :2]] | joined
+        held.flags.writeable = False
+        self._held_of = (np.array(nodes), held)
+        return held
 
     def kernel_inputs(self, H):
         """Node poses ``(m, 4, 4, 4)`` and kernel parameters (dict of arrays) of the pairs active at
@@ -1479,18 +1538,25 @@ class ContactSystem(Contribution):
         sc = self._slide_c
         if sc is None or not len(keys):
             return eps
-        i = np.searchsorted(sc[0], keys).clip(max=len(sc[0]) - 1)
+        i = np.minimum(np.searchsorted(sc[0], keys), len(sc[0]) - 1)
         found = sc[0][i] == keys
         return np.where(found, eps * sc[1][i], eps)
 
     def iterate_multipliers(self, keys):
         """Nodal multipliers ``(k, 3)`` of the groups ``keys`` at the current iterate: the trial ones of the
         step (``history``) plus the trial length times the last Newton step of the multipliers."""
-        Lam = self.history.tangential_multipliers(keys)
-        if self._mstep is not None and self._ms != 0.0:
-            i = np.searchsorted(self._mstep[0], keys).clip(max=max(len(self._mstep[0]) - 1, 0))
-            found = (self._mstep[0][i] == keys) if len(self._mstep[0]) else np.zeros(len(keys), dtype=bool)
-            Lam[found] += self._ms * self._mstep[1][i[found]]
+        c = self._kept_lam         # (the same groups and multipliers as the last call: the same look-ups)
+        tmult, step = self.history.tmult, self._mstep
+        if c is None or c[1] is not tmult or not equal(c[0], keys):
+            c = self._kept_lam = (np.array(keys), tmult, self.history.tangential_multipliers(keys), None, None)
+        Lam = c[2].copy()
+        if step is not None and self._ms != 0.0:
+            if c[3] is not step:
+                i = np.minimum(np.searchsorted(step[0], keys), max(len(step[0]) - 1, 0))
+                found = (step[0][i] == keys) if len(step[0]) else np.zeros(len(keys), dtype=bool)
+                c = self._kept_lam = c[:3] + (step, (found, i[found]))
+            found, rows = c[4]
+            Lam[found] += self._ms * step[1][rows]
         return Lam
 
     def multiplier_step(self, keys, dLam, stick=None, cap=None):
@@ -1623,7 +1689,7 @@ class ContactSystem(Contribution):
             finally:
                 self._full = False
         cache = getattr(self, "_cache", None)
-        if cache is not None and cache[0].shape == H.shape and np.array_equal(cache[0], H):
+        if cache is not None and cache[0].shape == H.shape and equal(cache[0], H):
             _, P, sel, p, out = cache
             if p["mu"].any() or "HL" not in out:
                 return P, sel, (p, out)
@@ -1777,7 +1843,7 @@ class ContactSystem(Contribution):
         w = p["weight"]
         lam_t = out["lam_t"]
         ft = (w * lam_t[:, 0])[:, None] * out["t1"] + (w * lam_t[:, 1])[:, None] * out["t2"]
-        if HC is None or not np.array_equal(H_c, H):   # the section poses of commit are those at its poses
+        if HC is None or not equal(H_c, H):   # the section poses of commit are those at its poses
             HC, HF = self._pose_at(H, P.e[sel], out["xi1"]), self._pose_at(H, P.m[sel], out["xi2"])
         elif LEAN_COMMIT:                     # read once (``Problem.commit``): not held through the next step
             self._last = (P, sel, p, out, (H_c, None, None))
@@ -1825,10 +1891,13 @@ def _with_mortar(nodes, f, K, m, pool=None):
     levels = None
     if m.get("folded") is not None:          # the mortar pairs' blocks are in their groups' (``_mortar``)
         levels = ((nodes, f), (m["members"], m["f_own"]))      # the force levels of the parts, as unfolded
-        keep = np.ones(len(nodes), dtype=bool)
-        keep[m["folded"]] = False
-        # (an empty ``K``: every pair folded, its tangent never computed, ``_local_blocks``)
-        nodes, f, K = nodes[keep], f[keep], (None if K is None else K[keep] if len(K) else K)
+        if len(m["folded"]) < len(nodes):       # (``folded`` sorted, distinct: else every pair is folded)
+            keep = np.ones(len(nodes), dtype=bool)
+            keep[m["folded"]] = False
+            # (an empty ``K``: every pair folded, its tangent never computed, ``_local_blocks``)
+            nodes, f, K = nodes[keep], f[keep], (None if K is None else K[keep] if len(K) else K)
+        else:
+            nodes = nodes[:0]
     n = len(nodes)
     if n == 0:           # every pair in its group: the groups' blocks themselves (no copy; ``evaluate``)
         return Blocks(m["members"], m["f"], K if K is None else m["K"], levels_of=levels)
@@ -1859,7 +1928,7 @@ def _kernel(kernel, X, p, friction, law, tangent, K=None):
 def _same_bits(a, b):
     """Float arrays ``a``, ``b`` equal bit for bit (signed zeros and nans told apart)."""
     a, b = np.ascontiguousarray(a, dtype=float), np.ascontiguousarray(b, dtype=float)
-    return a.shape == b.shape and np.array_equal(a.view(np.int64), b.view(np.int64))
+    return a.shape == b.shape and equal(a.view(np.int64), b.view(np.int64))
 
 
 def _member(a, b_sorted):

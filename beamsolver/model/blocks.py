@@ -137,7 +137,26 @@ def dofs(rep, nodes):
 
 
 def levels(f):
-    """Largest nodal force and moment ``(f_level, m_level)`` of blocks ``f`` ``(m, 6k)``."""
+    """Largest nodal force and moment ``(f_level, m_level)`` of blocks ``f`` ``(m, 6k)``: ``levels_numpy``'s maxima,
+    compiled (exact: a maximum rounds nothing; nan if there is one), several calls an evaluation."""
+    return _levels(np.ascontiguousarray(f, dtype=float).reshape(-1, 6))
+
+
+@jit
+def _levels(x):
+    fl, ml = 0.0, 0.0
+    for i in range(x.shape[0]):
+        for c in range(3):
+            v, w = abs(x[i, c]), abs(x[i, c + 3])
+            if v > fl or v != v:
+                fl = v
+            if w > ml or w != w:
+                ml = w
+    return fl, ml
+
+
+def levels_numpy(f):
+    """``levels`` in numpy (its test oracle)."""
     fb = np.abs(f.reshape(len(f), f.shape[1] // 6, 2, 3))
     return fb[:, :, 0].max(initial=0.0), fb[:, :, 1].max(initial=0.0)
 

@@ -14,7 +14,8 @@ import weakref
 
 import numpy as np
 
-__all__ = ["REUSE_BUFFERS", "BufferPool", "release_idle", "RELEASE_MIN_VALUES", "RELEASE_AT_COMMIT", "MMAP_THRESHOLD"]
+__all__ = ["REUSE_BUFFERS", "BufferPool", "equal", "release_idle", "RELEASE_MIN_VALUES", "RELEASE_AT_COMMIT",
+           "MMAP_THRESHOLD"]
 
 REUSE_BUFFERS = sys.implementation.name == "cpython" and sys.version_info < (3, 14)
 RELEASE_MIN_VALUES = 4_000_000  # tangent values of an evaluation from which ``Evaluation.drop_tangent`` calls
@@ -27,6 +28,12 @@ RELEASE_AT_COMMIT = True       # ``Problem.commit`` lets the pools' idle buffers
 MMAP_THRESHOLD = 4 << 20        # bytes: glibc's mmap threshold fixed there by ``release_idle`` (None: left alone)
 _POOLS = weakref.WeakSet()
 _MMAP_SET = []
+
+
+def equal(a, b):
+    """``np.array_equal(a, b)`` of two arrays (same shape, equal elements, nan unequal) without its argument
+    handling: the test of the caches kept for the same poses or pairs, several per evaluation (2 us less each)."""
+    return a.shape == b.shape and bool((a == b).all())
 
 
 def release_idle(fix_threshold=True):

@@ -100,6 +100,25 @@ def test_scatter_equals_bincount():
     np.testing.assert_allclose(data, np.bincount(pos, weights=vals, minlength=51), rtol=1e-13, atol=1e-13)
 
 
+def _hat_numpy(v):
+    """``assembly.System._global_node_terms``' former ``hat`` of real 3-vectors ``(k, 3)``: one stack."""
+    z = np.zeros(len(v))
+    x, y, w = v[:, 0], v[:, 1], v[:, 2]
+    return np.stack([z, -w, y, w, z, -x, -y, x, z], axis=1).reshape(-1, 3, 3)
+
+
+def test_global_node_values_give_the_bits_of_the_numpy_form():
+    rng = np.random.default_rng(3)
+    r = rng.standard_normal(6 * 9)
+    r[6 * 4:6 * 5] = [0.0, -0.0, 1.0, -2.0, 0.0, -0.0]            # signed zeros
+    g = np.array([1, 4, 7])
+    rg = r.reshape(-1, 6)[g]
+    want = -np.concatenate([_hat_numpy(rg[:, :3]), _hat_numpy(rg[:, 3:])], axis=1)
+    got = np.empty((3, 6, 3))
+    assembly_jit.global_node_values(r, g, got)
+    assert np.array_equal(got.view(np.int64), want.view(np.int64))     # bit for bit, the signs of zeros too
+
+
 def test_compose_exp_equals_se3():
     rng = np.random.default_rng(2)
     H = random_pose(rng, angle=3.0, shape=(6,))

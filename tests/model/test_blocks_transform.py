@@ -32,3 +32,14 @@ def test_transform_rows_gives_the_bits_of_numpy(k):
     rest = np.setdiff1d(np.arange(m), which)
     assert np.array_equal(ft[rest], f[rest]) and np.array_equal(Kt[rest], K[rest])
     assert_same_bits(Kt[which], want[1])
+
+
+@pytest.mark.parametrize("k", [1, 2, 4])
+def test_levels_gives_the_maxima_of_numpy(k):
+    rng = np.random.default_rng(10 + k)
+    f = rng.standard_normal((7, 6 * k)) * np.repeat([1.0, 1e3], 3 * k).reshape(1, -1)[:, :6 * k]
+    assert blocks.levels(f) == blocks.levels_numpy(f)
+    assert blocks.levels(f[:0]) == blocks.levels_numpy(f[:0]) == (0.0, 0.0)
+    f[3, 6 * (k - 1) + 4] = np.nan                        # a nan moment: nan, as numpy's maximum
+    got, want = blocks.levels(f), blocks.levels_numpy(f)
+    assert got[0] == want[0] and np.isnan(got[1]) and np.isnan(want[1])
