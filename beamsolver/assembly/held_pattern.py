@@ -227,17 +227,26 @@ def _add_products(node, Kq, Kl, w, red, nfree, indptr, eoff, nptr, nrow, out):
                         c = w[v] * Kl[v, 6 * t + q]
                         if w[v] == 0.0 or c == 0.0:
                             continue
-                        r = 0
-                        for p in range(6):
-                            if red[6 * a + p] >= 0:
-                                x = Kq[v, 6 * s + p] * c
-                                if e < 0:
-                                    if x != 0.0:
-                                        return False
-                                else:
-                                    out[indptr[j] + eoff[e] + r] += x
-                                r += 1
+                        if not _column_terms(Kq, v, s, a, c, red, indptr, eoff, j, e, out):
+                            return False
         u = end
+    return True
+
+
+@jit_callee
+def _column_terms(Kq, v, s, a, c, red, indptr, eoff, j, e, out):
+    """``out`` += ``Kq[v, 6 s + p] c`` over the free dofs ``p`` of node ``a`` (the ``s``-th of row ``v``), in column
+    ``j`` at the node pair ``e``'s entries; ``e < 0`` (no place): False if a term is not zero."""
+    r = 0
+    for p in range(6):
+        if red[6 * a + p] >= 0:
+            x = Kq[v, 6 * s + p] * c
+            if e < 0:
+                if x != 0.0:
+                    return False
+            else:
+                out[indptr[j] + eoff[e] + r] += x
+            r += 1
     return True
 
 
@@ -276,16 +285,8 @@ def _row_products(node, Kq, Kl, w, red, indptr, eoff, place, u, out):
                 c = w[u] * Kl[u, 6 * t + q]
                 if j < 0 or c == 0.0:
                     continue
-                r = 0
-                for p in range(6):
-                    if red[6 * a + p] >= 0:
-                        x = Kq[u, 6 * s + p] * c
-                        if e < 0:
-                            if x != 0.0:
-                                return False
-                        else:
-                            out[indptr[j] + eoff[e] + r] += x
-                        r += 1
+                if not _column_terms(Kq, u, s, a, c, red, indptr, eoff, j, e, out):
+                    return False
     return True
 
 
