@@ -283,6 +283,18 @@ class ContactSystem(Contribution):
         self._slide_c = None       # (keys, factor) of the groups' c for the next step (``_balanced_c``)
         self._commits = []         # (t, (keys, Lam)) of the last two converged steps' multipliers (``_extrapolate``)
         self._slid = None          # keys (sorted) of the groups that slid in the last converged step (``_extrapolate``)
+        self._evaluation_memory()
+        self.timings = dict.fromkeys(TIMED, 0.0)
+        self._clock = time.process_time()
+        self._penalties = conditioning.penalty_ratios(model, system)
+        conditioning.warn_ill_conditioned(self._penalties)
+        self._adjusted = adjust.EMPTY
+        self._adjusted = self._reference_adjustment(system.poses0)
+        self.adjusted = adjust.summary(self._adjusted)    # count and largest overlap adjusted away
+
+    def _evaluation_memory(self):
+        """What the evaluations keep from one call to the next (``__init__``): the search's and projections'
+        results at the same poses, the pose-free terms of the same pairs, the kernels' buffers."""
         self._sweepable = {}       # per declaration: whether the last search found no crossing (``_candidates``)
         self._H_prev = None        # last converged poses (start of the step)
         self._geo = self._geo_prev = None    # (poses, element twists) of the last evaluation / of H_prev
@@ -302,13 +314,6 @@ class ContactSystem(Contribution):
         self._kept_params = None   # (``_kept_terms``, sel, (parameters, keys, elements)) of ``_params``
         self._tangent_pool = BufferPool()     # tangent buffers of the compiled kernel (``_tangent_out``)
         self._mortar_pool = BufferPool()      # tangent blocks of pairs and mortar groups (``_with_mortar``)
-        self.timings = dict.fromkeys(TIMED, 0.0)
-        self._clock = time.process_time()
-        self._penalties = conditioning.penalty_ratios(model, system)
-        conditioning.warn_ill_conditioned(self._penalties)
-        self._adjusted = adjust.EMPTY
-        self._adjusted = self._reference_adjustment(system.poses0)
-        self.adjusted = adjust.summary(self._adjusted)    # count and largest overlap adjusted away
 
     def _joint_tables(self, system):
         """``_joint_enodes`` ``(n_el, 2)``: element end nodes with the nodes of a joint merged (elements meeting there
