@@ -22,7 +22,9 @@ the contact kernel (``contact.kernel_jit``).  ``warm_up(model)``, run by ``solve
 miss, numba's ``numba:compile`` event; loading from the cache is silent) prints one line on
 stderr, ``beamsolver: compiling the compiled kernels, first run only, ~N s`` (``estimate``), then
 a tqdm bar of the elapsed seconds against that estimate, refreshed four times a second and naming the
-function being compiled (or the second process waited for), while compilations go on.
+function being compiled (or the second process waited for), while compilations go on; past the estimate,
+the seconds and that they are past it.  A batch compiled after the warm-up (a larger model's solver path, met
+mid-solve) shows a bar of its own seconds, without an estimate.
 """
 import logging
 import os
@@ -48,6 +50,9 @@ ESTIMATE = dict(kernel=18.0, contact=24.5, elements=7.5)
 log = logging.getLogger("beamsolver")
 _REFRESH = 0.25         # seconds between refreshes of the bar
 _IDLE = 3.0             # seconds without compilation that close it (imports between two compilations)
+_AGAINST = "{desc}: {percentage:3.0f}%|{bar}| {n:.0f}/{total} s {postfix}"    # the first batch, against ``estimate``
+_PAST = "{{desc}}: {{n:.0f}} s (longer than the ~{estimate} s estimate) {{postfix}}"   # ... once past it
+_ELAPSED = "{desc}: {n:.0f} s {postfix}"        # a batch after the warm-up (no estimate)
 WAIT_MAX = 600.0        # seconds this process waits for the second one at most (then kills it and compiles)
 
 
@@ -65,7 +70,8 @@ class _Announcer(event.Listener):
         self.stream, self.package = stream, package
         self.depth, self.bar, self.name, self.said = 0, None, "", False
         self.waiting = False        # for the second process: the bar stays
-        self.t0 = self.idle = 0.0
+        self.t0 = self.t_bar = self.idle = 0.0
+        self.total, self.ended = 1, False     # the announced estimate [s]; ``close`` ran
         self.lock = threading.Lock()
 
     def on_start(self, event):
@@ -85,12 +91,16 @@ class _Announcer(event.Listener):
     def _open(self):
         from tqdm import tqdm
         stream = self.stream or sys.stderr
-        total = max(1, int(round(estimate())))
         if not self.said:
-            print(f"beamsolver: compiling the compiled kernels, first run only, ~{total} s", file=stream, flush=True)
+            self.total = max(1, int(round(estimate())))
+            print(f"beamsolver: compiling the compiled kernels, first run only, ~{self.total} s", file=stream,
+                  flush=True)
             self.said, self.t0 = True, time.perf_counter()
-        self.bar = tqdm(total=total, file=stream, desc="compiling", leave=False, mininterval=0.0,
-                        bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.0f}/{total} s {postfix}")
+        if self.ended:      # after the warm-up (a larger model's solver path): its own clock, no estimate
+            total, fmt, self.t_bar = None, _ELAPSED, time.perf_counter()
+        else:               # the warm-up's batches count on against the announced estimate
+            total, fmt, self.t_bar = self.total, _AGAINST, self.t0
+        self.bar = tqdm(total=total, file=stream, desc="compiling", leave=False, mininterval=0.0, bar_format=fmt)
         threading.Thread(target=self._tick, args=(self.bar,), daemon=True).start()
 
     def _tick(self, bar):
@@ -104,7 +114,10 @@ class _Announcer(event.Listener):
                         bar.close()
                         self.bar = None
                         return
-                    bar.n = min(time.perf_counter() - self.t0, 0.99 * bar.total)
+                    bar.n = time.perf_counter() - self.t_bar
+                    if bar.total is not None and bar.n > bar.total:     # past the estimate: say so, not 99 %
+                        bar.bar_format = _PAST.format(estimate=bar.total)
+                        bar.total = None
                     bar.set_postfix_str(self.name, refresh=False)
                     bar.refresh()
                 except (ValueError, OSError):        # the stream was closed (a test's captured stderr)
@@ -114,6 +127,7 @@ class _Announcer(event.Listener):
     def close(self):
         """Clear the bar now (the warm-up is done: nothing more compiles before the solve prints)."""
         with self.lock:
+            self.ended = self.said
             if self.bar is not None and self.depth == 0:
                 try:
                     self.bar.close()

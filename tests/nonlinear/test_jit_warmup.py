@@ -222,6 +222,51 @@ def test_the_bar_is_cleared_when_the_warm_up_ends():
     assert len(out.getvalue()) == n            # the refresh thread has stopped
 
 
+
+@pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
+def test_the_bar_says_when_it_is_past_the_estimate(monkeypatch):
+    """Past the announced estimate the bar shows the seconds and says so (it used to stop at 99 % of it)."""
+    monkeypatch.setattr(jit_warmup, "estimate", lambda: 0.1)        # announced as ~1 s
+    out = io.StringIO()
+
+    @numba.njit
+    def f(x):
+        return x + 1
+
+    a = jit_warmup._Announcer(out, package=__name__)
+    with event.install_listener("numba:compile", a):
+        f(1)
+    time.sleep(1.0 + 4 * jit_warmup._REFRESH)          # the bar stays _IDLE s after the last compilation
+    a.close()
+    assert "s (longer than the ~1 s estimate)" in out.getvalue()
+
+
+@pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
+def test_a_compilation_after_the_warm_up_counts_its_own_seconds():
+    """A batch compiled after the warm-up (a larger model's solver path, mid-solve) gets a bar of its own seconds, not
+    the warm-up's estimate with the seconds since the first announcement (which sat at 99 % from its start)."""
+    out = io.StringIO()
+
+    @numba.njit
+    def f(x):
+        return x + 1
+
+    @numba.njit
+    def g(x):
+        return x - 1
+
+    a = jit_warmup._Announcer(out, package=__name__)
+    with event.install_listener("numba:compile", a):
+        f(1)
+        a.close()                                      # the warm-up's end
+        n = len(out.getvalue())
+        g(1)
+    later = out.getvalue()[n:]
+    a.close()
+    assert "compiling: 0 s" in later and "%|" not in later
+    assert out.getvalue().count("first run only") == 1
+
+
 SHARE = """
 import numpy as np
 from beamsolver.contact import kernel_jit as kj
