@@ -8,6 +8,7 @@ top-level name (``contact.system`` is in ``contact``); a new sub-package or top-
 module must be given a layer here, which is the point: its place is decided once.
 """
 import ast
+import functools
 from pathlib import Path
 
 import pytest
@@ -89,6 +90,7 @@ def _parents(target):
     return [".".join(parts[:i]) for i in range(1, len(parts))]
 
 
+@functools.lru_cache(maxsize=1)          # one walk of the package for the tests below (read only)
 def _edges():
     modules = _modules()
     edges = []
@@ -101,7 +103,7 @@ def _edges():
                     for t in [target] + [p for p in _parents(target) if not mod.startswith(p + ".")]:
                         if t != mod:
                             edges.append((mod, t, id(node) not in top))
-    return modules, edges
+    return modules, tuple(edges)
 
 
 def test_every_module_has_a_layer():

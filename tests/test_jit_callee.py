@@ -58,6 +58,7 @@ def _functions(body):
             yield from _functions(n.body)
 
 
+@pytest.mark.slow
 def test_callees_are_called_from_compiled_code_only():
     """No plain-Python function of the package calls a ``jit_callee`` (through its name or module): such a
     call would compile the function a second time, with the wrapper (``python_twin``).  Fails when a

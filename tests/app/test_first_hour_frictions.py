@@ -121,6 +121,7 @@ def _script(tmp_path, text):
     return subprocess.run([sys.executable, "s.py"], cwd=tmp_path, capture_output=True, text=True, timeout=300)
 
 
+@pytest.mark.slow
 def test_sweep_without_the_main_guard_says_so_at_once(tmp_path):
     """A sweep script without ``if __name__ == "__main__":`` fails before the local cluster starts, with the
     script's line in the message (it printed ~500 lines of Dask tracebacks first: each spawned worker

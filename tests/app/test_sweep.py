@@ -73,6 +73,7 @@ def test_local_workers_single_threaded_with_one_blas_thread(client):
     assert os.getpid() not in pids.values() and len(set(pids.values())) == 2   # worker processes
 
 
+@pytest.mark.slow
 def test_two_workers_give_the_serial_results_and_record_failures(client, tmp_path):
     grid = study.points({"turns": [0.25, 1.0], "n_elements": [2, 8]})
     grid.append(dict(turns=0.25, n_elements=4, radius=-1.0))                    # bad input
@@ -103,6 +104,7 @@ def test_two_workers_give_the_serial_results_and_record_failures(client, tmp_pat
     assert abs(rows[3]["tip_x"]) < 1e-9 and abs(rows[0]["tip_x"] - 20 / np.pi) < 1e-9   # full circle, quarter
 
 
+@pytest.mark.slow
 def test_a_dying_worker_is_retried_once_then_recorded(client, tmp_path):
     grid = [dict(mode="always", marker=str(tmp_path / "a")), dict(mode="once", marker=str(tmp_path / "b"))]
     rows = bs.sweep(fragile, grid, client=client, output=tmp_path / "s", solve_options=OPTIONS, verbose=False)
@@ -256,6 +258,7 @@ def test_strand_sweep_example_against_strand_theory(client, tmp_path):
     assert strand_sweep.plot(table, tmp_path / "p.png").stat().st_size > 0
 
 
+@pytest.mark.slow
 def test_sweep_overhead_benchmark_pieces(client, tmp_path):
     import cloudpickle
     import sweep_overhead as so

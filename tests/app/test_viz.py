@@ -25,6 +25,7 @@ def roll_up():
     return bs.solve(m, steps=2), b
 
 
+@pytest.mark.slow
 def test_core_never_imports_pictures():
     import subprocess
     import sys

@@ -1,6 +1,7 @@
 """``extra_pattern.ExtraPattern``: the tangent with contact COO entries on a cached pattern is
 scipy's ``K_el + csc_matrix((v, (r, c)))`` bit for bit (values, stored entries, their order)."""
 import numpy as np
+import pytest
 import scipy.sparse as sp
 
 from beamsolver.assembly.extra_pattern import ExtraPattern
@@ -125,6 +126,7 @@ def test_entries_only_on_constrained_unknowns():
     assert _identical(K, _scipy(el, rows, cols, vals, red)) and K.nnz == 4
 
 
+@pytest.mark.slow
 def test_solve_bit_identical_to_the_scipy_assembly(monkeypatch):
     """A frictional contact solve (the twisted pair, reduced) with the cached pattern gives the
     poses, reactions and contact forces of the same solve assembled by scipy, bit for bit."""

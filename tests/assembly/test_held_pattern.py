@@ -130,6 +130,7 @@ def test_hold_rule_and_its_input():
         s.holds_pattern()
 
 
+@pytest.mark.slow
 def test_newton_steps_keep_one_pattern_and_the_same_results(monkeypatch):
     """The main job (two wires twisted, 16 steps) solved with the held pattern and with the exact one: the
     same Newton iterations in every step and the same poses; the held tangents keep one pattern over the

@@ -58,6 +58,7 @@ def _bits(a, b):
     return a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes()
 
 
+@pytest.mark.slow
 def test_commit_stores_the_same_bits_as_the_full_pass(monkeypatch):
     """Every array of the committed contact state (friction history, multipliers, extrapolation and c data, the
     search's memory), of the point table and of the nodal table after each step: the same bits with the light

@@ -56,6 +56,7 @@ def _run(script):
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
+@pytest.mark.slow
 def test_scene_without_contact_never_imports_the_contact_system():
     out = _run(SCRIPT)
     assert out == dict(system=False, search=False, pairs=False, oracle=False, contact=[0, 0, 0])

@@ -201,6 +201,7 @@ def test_a_gauss_points_owner_keeps_its_projection_kind_within_a_step():
         system.HOLD_POINT_KINDS = monkey
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("ends", ["fixed", "free"])
 def test_a_touching_strand_s_step_0_decides_point_kinds_at_each_iterate(ends):
     """Step 0 of a touching 1+6 strand at 20 degrees (``examples/strand_sweep.py``, the sweep's scene): its wires

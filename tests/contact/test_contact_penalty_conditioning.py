@@ -80,6 +80,7 @@ def test_a_failed_solve_names_the_penalty_not_large_rotations():
     assert "large rotations" not in msg
 
 
+@pytest.mark.slow
 def test_no_equilibrium_at_t_start_names_the_penalty():
     """The 20 mm twisted pair (4 elements) with penalty 1e18 (5e6 x its default) finds no first state."""
     m = twisted_pair.build(turns=0.25, n_elements=4)[0]

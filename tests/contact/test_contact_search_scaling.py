@@ -48,6 +48,7 @@ def search_counts(model, monkeypatch):
     return done[-1] / n_points, uncut[-1] / n_points, len(P) / n_points
 
 
+@pytest.mark.slow
 def test_projections_per_slave_point_bounded_under_refinement(monkeypatch):
     # the point path (Gauss points fixed per slave element, projected one by one)
     rows = {n: search_counts(two_ply(n, integration="points"), monkeypatch) for n in (8, 32, 128, 512)}

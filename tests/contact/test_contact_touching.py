@@ -36,6 +36,7 @@ def test_touching_long_pair_finds_its_first_equilibrium(mu):
     assert on.any() and np.all(c["gap"][on] < 1e-3 * 2 * 0.5e-3)   # inside the smoothing gap
 
 
+@pytest.mark.slow
 def test_three_touching_wires_with_default_options_find_their_first_equilibrium():
     """``examples/three_wires.py`` (default contact options) at 0.1 m (step 0 needed 50 iterations when written)."""
     model, plate, wires = three_wires.build(length=L, n_elements=24, turns=0.5, mu=0.3, pull=PULL)

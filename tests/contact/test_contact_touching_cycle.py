@@ -35,6 +35,7 @@ def _solve(n_layers, monkeypatch, cycle):
     return sol, sum(1 for t in calls if t == 0.0)
 
 
+@pytest.mark.slow
 def test_a_touching_strand_s_cycling_attempt_with_friction_is_given_up_at_once(monkeypatch):
     """1+6+12 wires, 12 elements a lay: the attempt with friction took 14 iterations (its lowest residual at the 4th)
     and the fallback 8; now the attempt stops at the cycle, and the states (step 0 and the stretched step) are the
@@ -50,6 +51,7 @@ def test_a_touching_strand_s_cycling_attempt_with_friction_is_given_up_at_once(m
         assert np.array_equal(after.poses[k], before.poses[k])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("n_layers", [1])
 def test_a_strand_whose_step_zero_converges_with_friction_is_untouched(monkeypatch, n_layers):
     """1+6 wires: step 0 converges with friction (7 iterations and two augmented-Lagrangian re-solves): no Newton
@@ -61,6 +63,7 @@ def test_a_strand_whose_step_zero_converges_with_friction_is_untouched(monkeypat
         assert np.array_equal(after.poses[k], before.poses[k])
 
 
+@pytest.mark.slow
 def test_step_zero_s_attempt_with_friction_is_given_up_after_its_update_budget(monkeypatch):
     """``steps.STEP_ZERO_UPDATES``: the attempt with friction may take that many augmented-Lagrangian updates (the
     37-wire strand twin's took 17, 46 s); the 1+6 strand's needs 2: with a budget of 1 it falls back, and says why,

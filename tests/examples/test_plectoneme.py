@@ -69,6 +69,7 @@ def test_wires_in_pieces_have_self_contact_between_every_two_pieces():
         plectoneme.build(n_elements=8, pieces=3)
 
 
+@pytest.mark.slow
 def test_extension_control_buckles_the_pair_at_its_euler_load():
     """Shortened by 1.2 mm of 60 mm with a tenth of a turn, the clamped-clamped pair buckles: the
     axial force (the support's reaction, tension positive) sits on the Euler load

@@ -103,6 +103,7 @@ def test_slave_master_symmetry(runs):
     assert rows_s[-1][4] == pytest.approx(rows[-1][4], rel=1e-9)
 
 
+@pytest.mark.slow
 def test_halved_steps_agree(runs):
     """4 steps of a quarter turn are cut (``motion_path``, cut-backs; the steps then regrow,
     ``stepping.steady``); 16 steps take the user's size: the path's friction history changes

@@ -103,6 +103,7 @@ def _bits(sol):
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("scene", ["twisted_pair", "shear_lag"])
 def test_release_at_commit_gives_the_same_bits(monkeypatch, scene):
     """``buffers.RELEASE_AT_COMMIT`` (issue 30: the pools' idle buffers let go at every accepted step, before the
@@ -131,6 +132,7 @@ def test_release_at_commit_gives_the_same_bits(monkeypatch, scene):
     assert released == kept
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("scene", ["twisted_pair", "shear_lag"])
 def test_lean_commit_gives_the_same_bits_and_holds_no_point_data_past_it(monkeypatch, scene):
     """Issue 30, the 61-wire strand in two steps: ``system.LEAN_COMMIT`` (the last step's point data let go before the

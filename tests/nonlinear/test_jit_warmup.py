@@ -38,6 +38,7 @@ def _signatures():
     return {i: (name, len(d.overloads)) for i, (name, d) in _dispatchers().items()}
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
 def test_nothing_compiles_after_the_warm_up():
     """After the warm-up of the main job's scene, its whole solve (crossings of the wires from about
@@ -95,6 +96,7 @@ def test_nothing_is_announced_without_compilation():
     assert out.getvalue() == ""
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
 def test_kernel_process_runs(monkeypatch):
     """The second process where there is no fork (``python -m beamsolver.nonlinear.jit_warmup``) compiles or
@@ -236,7 +238,8 @@ def test_the_bar_says_when_it_is_past_the_estimate(monkeypatch):
     a = jit_warmup._Announcer(out, package=__name__)
     with event.install_listener("numba:compile", a):
         f(1)
-    time.sleep(1.0 + 4 * jit_warmup._REFRESH)          # the bar stays _IDLE s after the last compilation
+        a.t_bar -= 2.0                                 # as if compiling had begun 2 s ago
+    time.sleep(3 * jit_warmup._REFRESH)                # the bar stays _IDLE s after the last compilation
     a.close()
     assert "s (longer than the ~1 s estimate)" in out.getvalue()
 

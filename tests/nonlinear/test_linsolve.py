@@ -396,6 +396,7 @@ def test_pardiso_keeps_its_one_based_indices_per_pattern(monkeypatch):
     np.testing.assert_allclose(out[True][3], np.linalg.solve(B.toarray(), b), rtol=1e-10)
 
 
+@pytest.mark.slow
 def test_pardiso_frees_a_dropped_factor_and_keeps_the_bits():
     """``FREE_DROPPED``: once the caller drops a PARDISO factorisation (a ``Solver(lagged=False)``: nothing else
     keeps it), PARDISO's numerical factor is freed (phase 0) and its analysis kept: three matrices of one pattern,

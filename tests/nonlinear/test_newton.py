@@ -177,6 +177,7 @@ def test_check_fails_without_the_load_stiffness(monkeypatch):
     assert _fails_quadratic_check(model)           # ... and fails the check
 
 
+@pytest.mark.slow
 def test_factorised_tangent_memory_serves_the_next_evaluation(monkeypatch):
     """Once an iterate's tangent is factorised its contact blocks are dropped
     (``Evaluation.drop_tangent``): the trial evaluation of the next iterate, which computes the next

@@ -25,6 +25,7 @@ def _calls(attr):
     return out
 
 
+@pytest.mark.slow
 def test_only_the_newton_loop_decides_and_only_the_wrapper_factorises():
     """A second Newton loop would call ``Convergence.decide``; a second factorise wrapper would call a
     back-end's ``factorize`` and catch ``SingularMatrixError`` itself."""

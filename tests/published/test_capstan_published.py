@@ -34,6 +34,7 @@ def test_full_wrap_on_a_helix_touching_the_post():
     assert _ratio(sol, rope, t_out, 1.0) == pytest.approx(np.exp(0.1 * 2.0 * np.pi), rel=3.5e-3)   # 0.17 %
 
 
+@pytest.mark.slow
 def test_polyline_cutting_into_the_post_is_adjusted_and_slides_at_the_capstan_ratio():
     m, rope, t_out = capstan(**CHORDS)
     sol = bs.solve(m, steps=8, verbose=False)
@@ -43,6 +44,7 @@ def test_polyline_cutting_into_the_post_is_adjusted_and_slides_at_the_capstan_ra
     assert _ratio(sol, rope, t_out, 10.0) == pytest.approx(exact, rel=2e-3)   # 2.158
 
 
+@pytest.mark.slow
 def test_an_overlap_deeper_than_adjust_keeps_the_clear_error():
     m, rope, t_out = capstan(**CHORDS, adjust=1e-5)
     with pytest.raises(bs.ConvergenceError, match=r"no equilibrium at t_start = 0, where contact forces already "

@@ -90,6 +90,7 @@ def test_unknown_member_and_lying_sizes_are_refused(saved, tmp_path):
         bs.load(liar)
 
 
+@pytest.mark.slow
 def test_cli_info_refuses_a_bomb(saved, tmp_path):
     bomb = _rewrite(saved, tmp_path / "bomb.npz", {"poses.npy": _zeros("poses.npy", 300 * 2**20)})
     out = subprocess.run([sys.executable, "-m", "beamsolver.app.cli", "info", str(bomb)], capture_output=True,

@@ -79,6 +79,7 @@ def test_load_control_snaps_past_the_truss_limit_onto_the_inverted_truss(truss_p
 
 
 # ------------------------------------------------------------------ DaDeppo & Schmidt's deep arch
+@pytest.mark.slow
 def test_deep_arch_limit_load_within_one_percent_of_dadeppo_schmidt():
     """DaDeppo & Schmidt (1975), J. Appl. Mech. 42, 894-896: the clamped-hinged 215-degree arch's
     limit load ``8.97 EI / R^2`` (``examples/limit_points.deep_arch``); 40 elements."""
@@ -395,6 +396,7 @@ def test_output_and_archive_keep_the_path_order(tmp_path):
     assert back.converged and back.resume["path"] == "arc-length"
 
 
+@pytest.mark.slow
 def test_history_plot_and_info_of_an_arc_length_run(tmp_path):
     """``viz.plot_history`` draws the path in step order (t back and forth); ``beamsolver info``
     reports the finished run as converged."""

@@ -34,6 +34,7 @@ def _solve(m, **kw):
     return sol, [w for w in caught if issubclass(w.category, bs.StabilizationWarning)]
 
 
+@pytest.mark.slow
 def test_damping_carrying_the_load_is_not_a_converged_equilibrium(tmp_path):
     m, b = loaded()
     sol, warned = _solve(m, steps=4, stabilize=dict(factor=1e3), output=tmp_path / "out")

@@ -103,6 +103,7 @@ def test_easy_limit_is_the_users_steps_iterations_when_more():
     assert easy_limit(21) == 21
 
 
+@pytest.mark.slow
 def test_contact_steps_regrow_after_a_cut_back():
     """Three touching wires (examples/three_wires.py) with E one ulp above its default: step 2
     (0.25 -> 0.375 turns) fails twice and the rest ran at 1/4 of the user's step (29 steps,
@@ -155,6 +156,7 @@ def test_slip_steps_regrow_after_a_forced_cut_back():
     assert sol.times[first_full] >= 1.0 / 16
 
 
+@pytest.mark.slow
 def test_a_restart_keeps_the_previous_iterations_of_steady():
     """The forced twisted pair stopped after its third step (half size, one steady step running):
     the restart needs the previous step's iterations (``resume["previous"]``) to regrow where
