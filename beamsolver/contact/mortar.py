@@ -109,14 +109,13 @@ def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=No
     pos = slot[inv].reshape(P, 2, 4)
     rows2 = (6 * pos[:, :, :, None] + np.arange(6)).reshape(P, 2, 24)
     g = np.ascontiguousarray(g, dtype=np.int64)
-    # kept with the groups (``Groups``): the points' slots (``_slots``), their rows (``_trial_rows``) and the
-    # columns of each group's own node rotation (``_turn``)
-    # (``rows2`` a view of ``slot_rows``: one copy of the (P, 2, 24) rows, 79 MB at the commit pass's 206 000 points
-    # of the 61-wire strand; ``trial_rows`` makes it contiguous when it needs it)
+    # kept with the groups (``Groups``): the points' slots and rows (``_slots``, ``_slot_rows``: one copy of the
+    # (2, P, 24) rows, 79 MB at the commit pass's 206 000 points of the 61-wire strand) and the columns of each group's
+    # own node rotation (``_turn``)
     own = np.argmax(members == node[:, None], axis=1)
     slot_rows = np.ascontiguousarray(rows2.transpose(1, 0, 2))
     return dict(key=ukey, node=node, g=g, phi=_shape_functions(xi1), members=members, pos=pos,
-                rows2=slot_rows.transpose(1, 0, 2), slot_groups=np.ascontiguousarray(g.T), slot_rows=slot_rows,
+                slot_groups=np.ascontiguousarray(g.T), slot_rows=slot_rows,
                 rot=6 * own[:, None] + np.arange(3, 6))
 
 
@@ -366,9 +365,8 @@ def _trial_rows(G, d, st, eps, mu):
     n, k = G["members"].shape
     B = np.zeros((n, 3, 6 * k))
     if _SCATTER["rows"] is mortar_jit.scatter_rows:
-        rows2 = G["rows2"] if "rows2" in G else (6 * G["pos"][:, :, :, None] + np.arange(6)).reshape(len(G["g"]), 2, 24)
-        return mortar_jit.trial_rows(B, G["g"], rows2, st["wphi"], st["wn"], st["m"], eps, mu, st["Pi"], st["Q"],
-                                     st["C"], st["c"], d["dS"], d["dn"], d["dlam_n"])
+        return mortar_jit.trial_rows(B, G["g"], _slot_rows(G), st["wphi"], st["wn"], st["m"], eps, mu, st["Pi"],
+                                     st["Q"], st["C"], st["c"], d["dS"], d["dn"], d["dlam_n"])
     for a in range(2):
         g, rows = _slots(G, a)
         wg, wgn = st["wphi"][:, a] / st["m"][g], st["wn"][:, a] / st["m"][g]
@@ -378,6 +376,13 @@ def _trial_rows(G, d, st, eps, mu):
             (mu[g] * wg)[:, None, None] * st["c"][g][:, :, None] * d["dlam_n"][:, None, :]
         _SCATTER["columns"](B, g, rows, dlam)
     return B
+
+
+def _slot_rows(G):
+    """``(2, P, 24)``: the points' rows in the groups of their node A, B (``_slots``, both at once)."""
+    if "slot_rows" in G:
+        return G["slot_rows"]
+    return (6 * G["pos"].transpose(1, 0, 2)[:, :, :, None] + np.arange(6)).reshape(2, len(G["g"]), 24)
 
 
 def _turn(G, R, Lam):
@@ -453,11 +458,16 @@ def branch_rows(G, d, st, R, Lam, c, mu, turn=None):
     d (mu lamN) / d q, rows over the groups' slots (``st``: ``nodal_state`` with ``eps = c``; ``turn``: ``_turn(G, R,
     Lam)`` if known)."""
     n, k = G["members"].shape
-    eye = dict(st, C=np.ascontiguousarray(np.broadcast_to(np.eye(3), (n, 3, 3))), c=np.zeros((n, 3)))
-    Tq = _trial_rows(G, d, eye, c, mu)
-    e = np.zeros((n, 3))
-    e[:, 0] = 1.0
-    capq = _trial_rows(G, d, dict(st, C=np.zeros((n, 3, 3)), c=e), c, mu)[:, 0, :].copy()
+    if _SCATTER["rows"] is mortar_jit.scatter_rows:     # both in one pass (the same sums, no zero products)
+        Tq, capq = mortar_jit.branch_rows(np.zeros((n, 3, 6 * k)), np.zeros((n, 6 * k)), G["g"], _slot_rows(G),
+                                          st["wphi"], st["wn"], st["m"], c, mu, st["Pi"], st["Q"], d["dS"], d["dn"],
+                                          d["dlam_n"])
+    else:
+        eye = dict(st, C=np.ascontiguousarray(np.broadcast_to(np.eye(3), (n, 3, 3))), c=np.zeros((n, 3)))
+        Tq = _trial_rows(G, d, eye, c, mu)
+        e = np.zeros((n, 3))
+        e[:, 0] = 1.0
+        capq = _trial_rows(G, d, dict(st, C=np.zeros((n, 3, 3)), c=e), c, mu)[:, 0, :].copy()
     rot, dv = _turn(G, R, Lam) if turn is None else turn
     Vq = np.zeros((n, 3, 6 * k))
     _add_columns(Vq, rot, dv)

@@ -15,7 +15,7 @@ from ..model.buffers import BufferPool
 
 __all__ = ["scatter_rows", "scatter_block", "scatter_columns", "scatter_rows_numpy", "scatter_block_numpy",
            "scatter_columns_numpy", "trial_rows", "subtract_indexed", "point_terms", "point_terms_into",
-           "nodal_state", "point_data", "multiplier_basis", "slivers"]
+           "nodal_state", "point_data", "multiplier_basis", "slivers", "branch_rows"]
 
 
 @jit
@@ -58,23 +58,63 @@ def _columns(out, g, cols, vals):
 
 
 @jit
-def _trial_rows(B, g2, rows2, wphi, wn, m, eps, mu, Pi, Q, C, c, dS, dn, dlam_n):
+def _trial_rows(B, g2, slot_rows, wphi, wn, m, eps, mu, Pi, Q, C, c, dS, dn, dlam_n):
     for p in range(g2.shape[0]):
         for a in range(2):
             g = g2[p, a]
             wg, wgn = wphi[p, a] / m[g], wn[p, a] / m[g]
             se, sm = eps[g] * wg, mu[g] * wg
-            o = B[g]
+            # the group's matrices in registers (the stores to ``B`` may alias them: reloaded per column otherwise)
+            P00, P01, P02, P10, P11, P12, P20, P21, P22 = _entries(Pi, g)
+            Q00, Q01, Q02, Q10, Q11, Q12, Q20, Q21, Q22 = _entries(Q, g)
+            C00, C01, C02, C10, C11, C12, C20, C21, C22 = _entries(C, g)
+            s0, s1, s2 = sm * c[g, 0], sm * c[g, 1], sm * c[g, 2]
+            o, rows = B[g], slot_rows[a, p]
             for k in range(24):
-                t0 = se * (Pi[g, 0, 0] * dS[p, 0, k] + Pi[g, 0, 1] * dS[p, 1, k] + Pi[g, 0, 2] * dS[p, 2, k]) + \
-                    wgn * (Q[g, 0, 0] * dn[p, 0, k] + Q[g, 0, 1] * dn[p, 1, k] + Q[g, 0, 2] * dn[p, 2, k])
-                t1 = se * (Pi[g, 1, 0] * dS[p, 0, k] + Pi[g, 1, 1] * dS[p, 1, k] + Pi[g, 1, 2] * dS[p, 2, k]) + \
-                    wgn * (Q[g, 1, 0] * dn[p, 0, k] + Q[g, 1, 1] * dn[p, 1, k] + Q[g, 1, 2] * dn[p, 2, k])
-                t2 = se * (Pi[g, 2, 0] * dS[p, 0, k] + Pi[g, 2, 1] * dS[p, 1, k] + Pi[g, 2, 2] * dS[p, 2, k]) + \
-                    wgn * (Q[g, 2, 0] * dn[p, 0, k] + Q[g, 2, 1] * dn[p, 1, k] + Q[g, 2, 2] * dn[p, 2, k])
-                r = rows2[p, a, k]
-                for i in range(3):
-                    o[i, r] += C[g, i, 0] * t0 + C[g, i, 1] * t1 + C[g, i, 2] * t2 + sm * c[g, i] * dlam_n[p, k]
+                t0, t1, t2 = _trial_column(se, wgn, P00, P01, P02, P10, P11, P12, P20, P21, P22,
+                                           Q00, Q01, Q02, Q10, Q11, Q12, Q20, Q21, Q22, dS, dn, p, k)
+                r, dl = rows[k], dlam_n[p, k]
+                o[0, r] += C00 * t0 + C01 * t1 + C02 * t2 + s0 * dl
+                o[1, r] += C10 * t0 + C11 * t1 + C12 * t2 + s1 * dl
+                o[2, r] += C20 * t0 + C21 * t1 + C22 * t2 + s2 * dl
+
+
+@jit
+def _entries(M, g):
+    """The nine entries of ``M[g]`` ``(3, 3)``, row by row."""
+    return M[g, 0, 0], M[g, 0, 1], M[g, 0, 2], M[g, 1, 0], M[g, 1, 1], M[g, 1, 2], M[g, 2, 0], M[g, 2, 1], M[g, 2, 2]
+
+
+@jit
+def _trial_column(se, wgn, P00, P01, P02, P10, P11, P12, P20, P21, P22, Q00, Q01, Q02, Q10, Q11, Q12, Q20, Q21, Q22,
+                  dS, dn, p, k):
+    """Column ``k`` of ``se Pi dS_p + wgn Q dn_p`` ``(3,)`` (each product summed left to right)."""
+    d0, d1, d2 = dS[p, 0, k], dS[p, 1, k], dS[p, 2, k]
+    n0, n1, n2 = dn[p, 0, k], dn[p, 1, k], dn[p, 2, k]
+    t0 = se * (P00 * d0 + P01 * d1 + P02 * d2) + wgn * (Q00 * n0 + Q01 * n1 + Q02 * n2)
+    t1 = se * (P10 * d0 + P11 * d1 + P12 * d2) + wgn * (Q10 * n0 + Q11 * n1 + Q12 * n2)
+    t2 = se * (P20 * d0 + P21 * d1 + P22 * d2) + wgn * (Q20 * n0 + Q21 * n1 + Q22 * n2)
+    return t0, t1, t2
+
+
+@jit
+def _branch_rows(Tq, capq, g2, slot_rows, wphi, wn, m, eps, mu, Pi, Q, dS, dn, dlam_n):
+    for p in range(g2.shape[0]):
+        for a in range(2):
+            g = g2[p, a]
+            wg, wgn = wphi[p, a] / m[g], wn[p, a] / m[g]
+            se, sm = eps[g] * wg, mu[g] * wg
+            P00, P01, P02, P10, P11, P12, P20, P21, P22 = _entries(Pi, g)
+            Q00, Q01, Q02, Q10, Q11, Q12, Q20, Q21, Q22 = _entries(Q, g)
+            o, oc, rows = Tq[g], capq[g], slot_rows[a, p]
+            for k in range(24):
+                t0, t1, t2 = _trial_column(se, wgn, P00, P01, P02, P10, P11, P12, P20, P21, P22,
+                                           Q00, Q01, Q02, Q10, Q11, Q12, Q20, Q21, Q22, dS, dn, p, k)
+                r = rows[k]
+                o[0, r] += t0
+                o[1, r] += t1
+                o[2, r] += t2
+                oc[r] += sm * dlam_n[p, k]
 
 
 # ``point_terms``' outputs in kept memory (fresh memory's page faults cost as much as the pass on the 19-wire bundle)
@@ -259,13 +299,23 @@ def _sub_indexed(out, vals, idx):
                 o[i, j] -= v[i, j]
 
 
-def trial_rows(B, g2, rows2, wphi, wn, m, eps, mu, Pi, Q, C, c, dS, dn, dlam_n):
+def trial_rows(B, g2, slot_rows, wphi, wn, m, eps, mu, Pi, Q, C, c, dS, dn, dlam_n):
     """``mortar._trial_rows`` compiled: ``B[g] (3, 6 k) += C (Pi eps w du + Q w dnbar) + c mu w dlamN`` over the
-    points' groups ``g2`` ``(P, 2)`` (of their nodes A, B) and slot rows ``rows2`` ``(P, 2, 24)``, in place; the
-    per-point products summed in registers (no ``(P, 3, 24)`` temporaries), equal to the numpy form to round-off."""
-    _trial_rows(B, _c(g2, np.int64), _c(rows2, np.int64), _c(wphi), _c(wn), _c(m), _c(eps), _c(mu), _c(Pi), _c(Q),
-                _c(C), _c(c), _c(dS), _c(dn), _c(dlam_n))
+    points' groups ``g2`` ``(P, 2)`` (of their nodes A, B) and slot rows ``slot_rows`` ``(2, P, 24)`` (node A's, node
+    B's), in place; the per-point products summed in registers (no ``(P, 3, 24)`` temporaries), equal to the numpy
+    form to round-off."""
+    _trial_rows(B, _c(g2, np.int64), _c(slot_rows, np.int64), _c(wphi), _c(wn), _c(m), _c(eps), _c(mu), _c(Pi),
+                _c(Q), _c(C), _c(c), _c(dS), _c(dn), _c(dlam_n))
     return B
+
+
+def branch_rows(Tq, capq, g2, slot_rows, wphi, wn, m, eps, mu, Pi, Q, dS, dn, dlam_n):
+    """``trial_rows`` at ``C = I, c = 0`` into ``Tq`` ``(n, 3, 6 k)`` and at ``C = 0, c = e_1`` (its first row) into
+    ``capq`` ``(n, 6 k)``, in place, in one pass: the same sums without the zero products (``1 t0 + 0 t1 + 0 t2 +
+    0 dl`` is ``t0``; the rows start at +0, which a zero of either sign leaves +0), the bits for finite terms."""
+    _branch_rows(Tq, capq, _c(g2, np.int64), _c(slot_rows, np.int64), _c(wphi), _c(wn), _c(m), _c(eps), _c(mu),
+                 _c(Pi), _c(Q), _c(dS), _c(dn), _c(dlam_n))
+    return Tq, capq
 
 
 def subtract_indexed(out, vals, idx):
