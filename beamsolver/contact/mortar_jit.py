@@ -15,7 +15,8 @@ from ..model.buffers import BufferPool
 
 __all__ = ["scatter_rows", "scatter_block", "scatter_columns", "scatter_rows_numpy", "scatter_block_numpy",
            "scatter_columns_numpy", "trial_rows", "subtract_indexed", "point_terms", "point_terms_into",
-           "nodal_state", "point_data", "multiplier_basis", "slivers", "branch_rows"]
+           "nodal_state", "point_data", "multiplier_basis", "slivers", "branch_rows",
+           "point_forces", "interpolate"]
 
 
 @jit
@@ -153,6 +154,52 @@ def point_terms_into(df, rows, t1, t2, s, A, dS, dn, dlam):
     """``point_terms`` into the given C-contiguous outputs ``A`` ``(P, 24, 3)``, ``dS``, ``dn`` ``(P, 3, 24)``,
     ``dlam`` ``(P, 24)`` (``kernel_jit._mortar_chunks``: one pass's points)."""
     _point_terms(_c(df), rows, _c(t1), _c(t2), _c(s), A, dS, dn, dlam)
+
+
+@jit
+def _point_forces(A, T, swap, out):
+    for p in range(A.shape[0]):
+        t0, t1, t2 = T[p, 0], T[p, 1], T[p, 2]
+        for i in range(A.shape[1]):
+            x0, x1, x2 = A[p, i, 0] * t0, A[p, i, 1] * t1, A[p, i, 2] * t2
+            out[p, i] = (x0 + x2) + x1 if swap else (x0 + x1) + x2
+
+
+def point_forces(A, T):
+    """``np.einsum("pij,pj->pi", A, T)`` ``(P, 24)`` of ``A`` ``(P, 24, 3)``, ``T`` ``(P, 3)`` (the points' forces at
+    their tractions, ``ContactSystem._mortar``) in one compiled pass, in einsum's order of the layouts it meets: ``A``
+    C-contiguous ``(x0 + x2) + x1`` (its two-lane sum), ``A`` the kernel's ``(P, 24)`` rows by force (the view
+    ``kernel_jit.mortar_forces`` gives, the last axis outermost) ``(x0 + x1) + x2``; numpy itself for any other."""
+    P = A.shape[0]
+    ok = A.dtype == np.float64 and A.ndim == 3 and A.shape[2] == 3 and T.dtype == np.float64 and \
+        T.flags.c_contiguous and P > 1          # (one point: numba would see the view as another layout)
+    s = A.strides
+    if ok and A.flags.c_contiguous:
+        swap = True
+    elif ok and s[1] == 8 and s[0] == 8 * A.shape[1] and s[2] >= s[0] * P:
+        swap = False
+    else:
+        return np.einsum("pij,pj->pi", A, T)
+    out = np.empty(A.shape[:2])
+    _point_forces(A, T, swap, out)
+    return out
+
+
+@jit
+def _interpolate(phi, V, g2, out):
+    for p in range(g2.shape[0]):
+        a, b = g2[p, 0], g2[p, 1]
+        for i in range(V.shape[1]):
+            out[p, i] = phi[p, 0] * V[a, i] + phi[p, 1] * V[b, i]
+
+
+def interpolate(phi, V, g2):
+    """``np.einsum("pa,pai->pi", phi, V[g2])`` ``(P, 3)``: the groups' vectors ``V`` ``(G, 3)`` at the points by their
+    shape functions ``phi`` ``(P, 2)`` over their groups ``g2`` ``(P, 2)``, without the ``(P, 2, 3)`` gather (a sum of
+    two products: the same bits in either order)."""
+    out = np.empty((len(g2), V.shape[1]))
+    _interpolate(_c(phi), _c(V), _c(g2, np.int64), out)
+    return out
 
 
 @jit

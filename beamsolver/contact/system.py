@@ -1119,7 +1119,7 @@ class ContactSystem(Contribution):
             st["T"] = T_pts
         if defer:
             K_pairs = self._mortar_passes(X, pm, law, d, st["T"], G, K_pairs, idx)
-        d["f"] = np.einsum("pij,pj->pi", d["A"], st["T"])
+        d["f"] = mortar_jit.point_forces(d["A"], st["T"])
         if not tangent:
             del d["A"]
         if tangent:
@@ -1192,7 +1192,7 @@ class ContactSystem(Contribution):
             eps = self._balanced_c(G["key"], eps)
         law = self._mortar_law(gdecl)
         RL = np.einsum("gij,gj->gi", R, Lam)        # the multipliers' tractions (global)
-        T_pts = np.einsum("pa,pai->pi", G["phi"], RL[G["g"]]) if ssn else None
+        T_pts = mortar_jit.interpolate(G["phi"], RL, G["g"]) if ssn else None
         return G, gdecl, R, Lam, eps, mu, law, RL, T_pts
 
     def _hold(self, G, d, m, mu, gdecl):

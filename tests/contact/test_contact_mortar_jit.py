@@ -302,3 +302,24 @@ def test_compiled_branch_rows_are_the_trial_rows_at_the_identity_and_the_cap(see
     out = mortar_jit.branch_rows(np.zeros((n, 3, k6)), np.zeros((n, k6)), g2, rows2.transpose(1, 0, 2), *b.values())
     assert np.array_equal(out[0], Tq) and np.array_equal(out[1], cap[:, 0]) and np.any(Tq) and np.any(cap)
     assert not np.signbit(out[0][out[0] == 0]).any() and not np.signbit(cap[cap == 0]).any()
+
+
+@pytest.mark.parametrize("P", [0, 1, 2, 7, 640])
+def test_compiled_point_forces_are_numpy_s_einsum(P):
+    """``mortar_jit.point_forces``: ``np.einsum("pij,pj->pi", A, T)``'s bits for ``A`` C-contiguous (the mortar terms')
+    and for the view of the kernel's ``(4, P, 4, 6)`` forces ``mortar_forces`` gives, and numpy's own elsewhere."""
+    rng = np.random.default_rng(P)
+    f, T = rng.standard_normal((4, P, 4, 6)), rng.standard_normal((P, 3))
+    for A in (rng.standard_normal((P, 24, 3)), np.transpose(f[1:], (1, 2, 3, 0)).reshape(P, 24, 3),
+              rng.standard_normal((P, 3, 24)).transpose(0, 2, 1)):
+        A[rng.random(A.shape) < 0.05] = 0.0
+        assert np.array_equal(mortar_jit.point_forces(A, T), np.einsum("pij,pj->pi", A, T))
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_compiled_interpolation_is_numpy_s_einsum(seed):
+    """``mortar_jit.interpolate``: ``np.einsum("pa,pai->pi", phi, V[g2])``'s bits."""
+    rng = np.random.default_rng(seed)
+    P, G = 300, 40
+    phi, V, g2 = rng.uniform(0, 1, (P, 2)), rng.standard_normal((G, 3)), rng.integers(0, G, (P, 2))
+    assert np.array_equal(mortar_jit.interpolate(phi, V, g2), np.einsum("pa,pai->pi", phi, V[g2]))
