@@ -53,13 +53,22 @@ def _held_moved(slave_nodes, held):
     return slave_nodes
 
 
-def fold_of(slave_nodes, xi1, master_beam, decl, n_nodes, n_beams, held=None):
-    """``slivers`` of the groups ``groups`` makes from these arguments."""
-    sn = _held_moved(slave_nodes, held)
-    key = (np.asarray(decl, dtype=np.int64)[:, None] * n_nodes + sn) * n_beams + master_beam[:, None]
+def fold_of(slave_nodes, xi1, master_beam, decl, n_nodes, n_beams, held=None, base=None):
+    """``slivers`` of the groups ``groups`` makes from these arguments (``base``: their ``_sliver_base`` if kept)."""
+    sn, key, order = _sliver_base(slave_nodes, master_beam, decl, n_nodes, n_beams, held) if base is None else base
     if SLIVER is not None and _SCATTER["rows"] is mortar_jit.scatter_rows:
-        return mortar_jit.slivers(key, sn, xi1, SLIVER)        # compiled, the same flags (``slivers`` its oracle)
+        if not order:            # compiled, the same flags (``slivers`` its oracle)
+            order.append(mortar_jit.sliver_groups(key))
+        return mortar_jit.slivers(key, sn, xi1, SLIVER, order[0])
     return slivers(key, sn, xi1)
+
+
+def _sliver_base(slave_nodes, master_beam, decl, n_nodes, n_beams, held):
+    """``(sn, key, order)`` of ``fold_of``, what does not follow ``xi1``: the slave nodes with held ones moved, the
+    keys ``(P, 2)`` and ``[mortar_jit.sliver_groups(key)]`` (a list filled at the first compiled ``fold_of``)."""
+    sn = np.array(_held_moved(slave_nodes, held))      # (its own: ``Groups`` keeps it)
+    key = (np.asarray(decl, dtype=np.int64)[:, None] * n_nodes + sn) * n_beams + master_beam[:, None]
+    return sn, key, []
 
 
 def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=None, fold=None, full=True):
@@ -169,15 +178,17 @@ class Groups:
         self.builds = 0          # ``groups`` calls (tests)
 
     def __call__(self, slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=None, full=True):
-        """``groups(...)`` (``full``: as there; kept without the members, a call asking for them builds them)."""
-        fold = fold_of(slave_nodes, xi1, master_beam, decl, n_nodes, n_beams, held)
-        args = (slave_nodes, master_beam, decl, nodes, held, fold)
+        """``groups(...)`` (``full``: as there; kept without the members, a call asking for them builds them).
+        The sliver folds' keys and their sort are kept with the pairs too (``_sliver_base``)."""
         last = self._last
-        if last is not None and last[0] == (n_nodes, n_beams) and ("members" in last[2] or not full) and \
-                _same_args(last[1], args):
+        args = (slave_nodes, master_beam, decl, nodes, held)
+        same = last is not None and last[0] == (n_nodes, n_beams) and _same_args(last[1][:5], args)
+        base = last[3] if same else _sliver_base(slave_nodes, master_beam, decl, n_nodes, n_beams, held)
+        fold = fold_of(slave_nodes, xi1, master_beam, decl, n_nodes, n_beams, held, base=base)
+        if same and ("members" in last[2] or not full) and equal(last[1][5], fold):
             return dict(last[2], phi=_shape_functions(xi1))
         G = groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held, fold, full)
-        self._last = ((n_nodes, n_beams), tuple(None if a is None else np.array(a) for a in args), G)
+        self._last = ((n_nodes, n_beams), tuple(None if a is None else np.array(a) for a in args + (fold,)), G, base)
         self.builds += 1
         return G
 

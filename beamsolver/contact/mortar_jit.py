@@ -15,7 +15,7 @@ from ..model.buffers import BufferPool
 
 __all__ = ["scatter_rows", "scatter_block", "scatter_columns", "scatter_rows_numpy", "scatter_block_numpy",
            "scatter_columns_numpy", "trial_rows", "subtract_indexed", "point_terms", "point_terms_into",
-           "nodal_state", "point_data", "multiplier_basis", "slivers", "branch_rows",
+           "nodal_state", "point_data", "multiplier_basis", "slivers", "sliver_groups", "branch_rows",
            "point_forces", "interpolate"]
 
 
@@ -403,30 +403,46 @@ def scatter_columns(out, g, cols, vals):
     return out
 
 
-def slivers(key, slave_nodes, xi1, sliver):
+def slivers(key, slave_nodes, xi1, sliver, groups=None):
     """``mortar.slivers`` compiled (its numpy form the oracle): ``(P, 2)`` bool, the points' nodes whose group
     (``key`` ``(P, 2)``) is a sliver at the ratio ``sliver`` (``mortar.SLIVER``).  The groups from a stable sort of
     the keys, each group's shape functions summed in the order of the points as ``np.bincount`` does (the same
-    bits); 70 us of numpy a call on the main job's 80 points (two ``np.unique``, six ``np.bincount``)."""
+    bits); 70 us of numpy a call on the main job's 80 points (two ``np.unique``, six ``np.bincount``).  ``groups``:
+    ``sliver_groups(key)`` if kept (the same keys: ``mortar.Groups``)."""
     P = len(xi1)
     fold = np.zeros((P, 2), dtype=np.bool_)
     if P:
-        _slivers(_c(key, np.int64), _c(slave_nodes, np.int64), _c(xi1), float(sliver), fold)
+        key = _c(key, np.int64)
+        order, start = sliver_groups(key) if groups is None else groups
+        _sliver_fold(key, _c(slave_nodes, np.int64), _c(xi1), float(sliver), order, start, fold)
     return fold
 
 
-@jit
-def _slivers(key, sn, xi1, sliver, fold):
-    P = key.shape[0]
-    k = key.ravel()
+def sliver_groups(key):
+    """``(order, start)``: the stable sort of the keys ``(P, 2)`` raveled and where each group starts in it,
+    ``(n + 1,)`` (``slivers``: they depend on the keys alone)."""
+    k = _c(key, np.int64).ravel()
     order = np.argsort(k, kind="mergesort")          # stable: a group's entries in the points' order
+    start = np.empty(len(k) + 1, dtype=np.int64)
+    n = _group_starts(k, order, start)
+    return order, start[:n + 1]
+
+
+@jit
+def _group_starts(k, order, start):
     n = 0
-    start = np.empty(2 * P + 1, dtype=np.int64)
-    for i in range(2 * P):
+    for i in range(len(k)):
         if i == 0 or k[order[i]] != k[order[i - 1]]:
             start[n] = i
             n += 1
-    start[n] = 2 * P
+    start[n] = len(k)
+    return n
+
+
+@jit
+def _sliver_fold(key, sn, xi1, sliver, order, start, fold):
+    k = key.ravel()
+    n = len(start) - 1
     uk = np.empty(n, dtype=np.int64)
     npts = np.empty(n, dtype=np.int64)
     pk = np.empty(n, dtype=np.int64)
