@@ -162,7 +162,8 @@ def _point_forces(A, T, swap, out):
         t0, t1, t2 = T[p, 0], T[p, 1], T[p, 2]
         for i in range(A.shape[1]):
             x0, x1, x2 = A[p, i, 0] * t0, A[p, i, 1] * t1, A[p, i, 2] * t2
-            out[p, i] = (x0 + x2) + x1 if swap else (x0 + x1) + x2
+            # (+ 0.0: einsum sums into zeros, so products all -0 give +0)
+            out[p, i] = ((x0 + x2) + x1 if swap else (x0 + x1) + x2) + 0.0
 
 
 def point_forces(A, T):
@@ -190,13 +191,13 @@ def _interpolate(phi, V, g2, out):
     for p in range(g2.shape[0]):
         a, b = g2[p, 0], g2[p, 1]
         for i in range(V.shape[1]):
-            out[p, i] = phi[p, 0] * V[a, i] + phi[p, 1] * V[b, i]
+            out[p, i] = (phi[p, 0] * V[a, i] + phi[p, 1] * V[b, i]) + 0.0    # (einsum's +0 from -0 products)
 
 
 def interpolate(phi, V, g2):
     """``np.einsum("pa,pai->pi", phi, V[g2])`` ``(P, 3)``: the groups' vectors ``V`` ``(G, 3)`` at the points by their
     shape functions ``phi`` ``(P, 2)`` over their groups ``g2`` ``(P, 2)``, without the ``(P, 2, 3)`` gather (a sum of
-    two products: the same bits in either order)."""
+    two products: the same bits in either order, signed zeros as einsum's)."""
     out = np.empty((len(g2), V.shape[1]))
     _interpolate(_c(phi), _c(V), _c(g2, np.int64), out)
     return out
