@@ -404,6 +404,8 @@ def _turn(G, R, Lam):
     else:
         own = np.argmax(G["members"] == G["node"][:, None], axis=1)
         cols = 6 * own[:, None] + np.arange(3, 6)
+    if _SCATTER["rows"] is mortar_jit.scatter_rows and R.flags.c_contiguous:
+        return cols, mortar_jit.turn(R, Lam)      # (compiled: einsum's bits on a contiguous R)
     return cols, -np.einsum("gij,gjk->gik", R, se3.skew(Lam))
 
 

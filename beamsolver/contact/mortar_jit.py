@@ -16,7 +16,7 @@ from ..model.buffers import BufferPool
 __all__ = ["scatter_rows", "scatter_block", "scatter_columns", "scatter_rows_numpy", "scatter_block_numpy",
            "scatter_columns_numpy", "trial_rows", "subtract_indexed", "point_terms", "point_terms_into",
            "nodal_state", "point_data", "multiplier_basis", "slivers", "sliver_groups", "branch_rows",
-           "point_forces", "interpolate"]
+           "point_forces", "interpolate", "turn"]
 
 
 @jit
@@ -183,6 +183,26 @@ def point_forces(A, T):
         return np.einsum("pij,pj->pi", A, T)
     out = np.empty(A.shape[:2])
     _point_forces(A, T, swap, out)
+    return out
+
+
+@jit
+def _turn(R, Lam, out):
+    for g in range(R.shape[0]):
+        l0, l1, l2 = Lam[g, 0], Lam[g, 1], Lam[g, 2]
+        for k in range(3):          # column k of ``se3.skew(Lam[g])``
+            s0 = 0.0 if k == 0 else -l2 if k == 1 else l1
+            s1 = l2 if k == 0 else 0.0 if k == 1 else -l0
+            s2 = -l1 if k == 0 else l0 if k == 1 else 0.0
+            for i in range(3):
+                out[g, i, k] = -(((R[g, i, 0] * s0 + R[g, i, 1] * s1) + R[g, i, 2] * s2) + 0.0)
+
+
+def turn(R, Lam):
+    """``-np.einsum("gij,gjk->gik", R, se3.skew(Lam))`` ``(G, 3, 3)`` (``mortar._turn``: ``d(R Lam) / dtheta``) in one
+    pass: einsum's sums on contiguous arrays, ``(x0 + x1) + x2`` into zeros (+ 0.0: -0 products give +0)."""
+    out = np.empty((len(R), 3, 3))
+    _turn(_c(R), _c(Lam), out)
     return out
 
 

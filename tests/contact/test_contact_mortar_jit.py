@@ -332,3 +332,18 @@ def test_compiled_interpolation_is_numpy_s_einsum(seed):
 def _bits(a, b):
     """Equal to the bit (signed zeros told apart)."""
     return a.shape == b.shape and np.array_equal(a.view(np.int64), b.view(np.int64))
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_compiled_turn_is_numpy_s_einsum(seed):
+    """``mortar_jit.turn``: ``-np.einsum("gij,gjk->gik", R, se3.skew(Lam))``'s bits, zero multipliers (a step's
+    start) and signed zeros included."""
+    from beamsolver.lie import se3
+    rng = np.random.default_rng(seed)
+    G = 50
+    R, Lam = rng.standard_normal((G, 3, 3)), rng.standard_normal((G, 3))
+    Lam[:10] = 0.0
+    Lam[10:20] = -0.0
+    Lam[rng.random(Lam.shape) < 0.2] = -0.0
+    R[rng.random(R.shape) < 0.1] = 0.0
+    assert _bits(mortar_jit.turn(R, Lam), -np.einsum("gij,gjk->gik", R, se3.skew(Lam)))
