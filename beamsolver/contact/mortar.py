@@ -449,7 +449,7 @@ def multiplier_blocks(G, d, st, R, Lam, c, mu, turn=None):
     _add_columns(Kqq, rot, A @ dv)
     Kql = A @ R
     weak = st["weak"]
-    MP = np.einsum("gij,gjk->gik", st["C"], st["Pi"])                  # d P / d v
+    MP = mortar_jit.products(st["C"], st["Pi"])                  # d P / d v (einsum's bits)
     B = _trial_rows(G, d, st, c, mu)
     # a touching group without normal traction: C = v exactly (its traction goes to zero in one step); the
     # hold stiffness acts on its slip in the displacement rows only, a tangent-only term like the point law's
@@ -460,7 +460,7 @@ def multiplier_blocks(G, d, st, R, Lam, c, mu, turn=None):
     Klq = np.negative(B, out=B)         # (in place: B is not used again; a fresh (n, 3, 6 k) array's page faults)
     _add_columns(Klq, rot, dv - MP @ dv)
     Kll = R - MP @ R
-    v = np.einsum("gij,gj->gi", R, Lam)
+    v = mortar_jit.rotate(R, Lam)
     return f, Kqq, Kql, Klq, Kll, v - st["lam"]
 
 
@@ -484,5 +484,5 @@ def branch_rows(G, d, st, R, Lam, c, mu, turn=None):
     rot, dv = _turn(G, R, Lam) if turn is None else turn
     Vq = np.zeros((n, 3, 6 * k))
     _add_columns(Vq, rot, dv)
-    _add_columns(Tq, rot, np.einsum("gij,gjk->gik", st["Pi"], dv))
+    _add_columns(Tq, rot, mortar_jit.products(st["Pi"], dv))
     return Tq, Vq, capq

@@ -16,7 +16,7 @@ from ..model.buffers import BufferPool
 __all__ = ["scatter_rows", "scatter_block", "scatter_columns", "scatter_rows_numpy", "scatter_block_numpy",
            "scatter_columns_numpy", "trial_rows", "subtract_indexed", "point_terms", "point_terms_into",
            "nodal_state", "point_data", "multiplier_basis", "slivers", "sliver_groups", "branch_rows",
-           "point_forces", "interpolate", "turn"]
+           "point_forces", "interpolate", "turn", "products", "rotate"]
 
 
 @jit
@@ -203,6 +203,41 @@ def turn(R, Lam):
     pass: einsum's sums on contiguous arrays, ``(x0 + x1) + x2`` into zeros (+ 0.0: -0 products give +0)."""
     out = np.empty((len(R), 3, 3))
     _turn(_c(R), _c(Lam), out)
+    return out
+
+
+@jit
+def _products(A, B, out):
+    for g in range(A.shape[0]):
+        for i in range(3):
+            for k in range(3):
+                out[g, i, k] = ((A[g, i, 0] * B[g, 0, k] + A[g, i, 1] * B[g, 1, k]) + A[g, i, 2] * B[g, 2, k]) + 0.0
+
+
+def products(A, B):
+    """``np.einsum("gij,gjk->gik", A, B)`` ``(G, 3, 3)``: einsum's ``(x0 + x1) + x2`` into zeros on C-contiguous
+    arrays (compiled), numpy itself on others."""
+    if not (A.flags.c_contiguous and B.flags.c_contiguous and A.dtype == B.dtype == np.float64):
+        return np.einsum("gij,gjk->gik", A, B)
+    out = np.empty((len(A), 3, 3))
+    _products(A, B, out)
+    return out
+
+
+@jit
+def _rotate(R, v, out):
+    for g in range(R.shape[0]):
+        for i in range(3):
+            out[g, i] = ((R[g, i, 0] * v[g, 0] + R[g, i, 2] * v[g, 2]) + R[g, i, 1] * v[g, 1]) + 0.0
+
+
+def rotate(R, v):
+    """``np.einsum("gij,gj->gi", R, v)`` ``(G, 3)``: einsum's two-lane ``(x0 + x2) + x1`` into zeros on C-contiguous
+    arrays (compiled, as ``nodal_state``'s), numpy itself on others."""
+    if not (R.flags.c_contiguous and v.flags.c_contiguous and R.dtype == v.dtype == np.float64):
+        return np.einsum("gij,gj->gi", R, v)
+    out = np.empty((len(R), 3))
+    _rotate(R, v, out)
     return out
 
 

@@ -1191,7 +1191,7 @@ class ContactSystem(Contribution):
         if ssn:
             eps = self._balanced_c(G["key"], eps)
         law = self._mortar_law(gdecl)
-        RL = np.einsum("gij,gj->gi", R, Lam)        # the multipliers' tractions (global)
+        RL = mortar_jit.rotate(R, Lam)        # the multipliers' tractions (global; einsum's bits)
         T_pts = mortar_jit.interpolate(G["phi"], RL, G["g"]) if ssn else None
         return G, gdecl, R, Lam, eps, mu, law, RL, T_pts
 

@@ -347,3 +347,17 @@ def test_compiled_turn_is_numpy_s_einsum(seed):
     Lam[rng.random(Lam.shape) < 0.2] = -0.0
     R[rng.random(R.shape) < 0.1] = 0.0
     assert _bits(mortar_jit.turn(R, Lam), -np.einsum("gij,gjk->gik", R, se3.skew(Lam)))
+
+
+@pytest.mark.parametrize("G", [0, 1, 2, 127])
+def test_compiled_products_and_rotations_are_numpy_s_einsum(G):
+    """``mortar_jit.products`` and ``rotate``: ``np.einsum("gij,gjk->gik")``'s and ``np.einsum("gij,gj->gi")``'s
+    bits on contiguous arrays (signed zeros included), numpy's own on others."""
+    rng = np.random.default_rng(G)
+    A, B, v = rng.standard_normal((G, 3, 3)), rng.standard_normal((G, 3, 3)), rng.standard_normal((G, 3))
+    for a in (A, B, v):
+        a[rng.random(a.shape) < 0.2] = -0.0
+        a[rng.random(a.shape) < 0.1] = 0.0
+    for X in (A, np.swapaxes(A, 1, 2)):
+        assert _bits(mortar_jit.products(X, B), np.einsum("gij,gjk->gik", X, B))
+        assert _bits(mortar_jit.rotate(X, v), np.einsum("gij,gj->gi", X, v))
