@@ -454,9 +454,10 @@ def multiplier_blocks(G, d, st, R, Lam, c, mu, turn=None):
     # a touching group without normal traction: C = v exactly (its traction goes to zero in one step); the
     # hold stiffness acts on its slip in the displacement rows only, a tangent-only term like the point law's
     # floor (putting it in d C / d v made the multiplier overshoot and the residual stall: twisted pair)
-    Kqq[weak] += A[weak] @ B[weak]
-    B[weak] = 0.0
-    MP[weak] = 0.0
+    if weak.any():
+        Kqq[weak] += A[weak] @ B[weak]
+        B[weak] = 0.0
+        MP[weak] = 0.0
     Klq = np.negative(B, out=B)         # (in place: B is not used again; a fresh (n, 3, 6 k) array's page faults)
     _add_columns(Klq, rot, dv - MP @ dv)
     Kll = R - MP @ R
