@@ -53,13 +53,22 @@ def _held_moved(slave_nodes, held):
     return slave_nodes
 
 
-def fold_of(slave_nodes, xi1, master_beam, decl, n_nodes, n_beams, held=None):
-    """``slivers`` of the groups ``groups`` makes from these arguments."""
-    sn = _held_moved(slave_nodes, held)
-    key = (np.asarray(decl, dtype=np.int64)[:, None] * n_nodes + sn) * n_beams + master_beam[:, None]
+def fold_of(slave_nodes, xi1, master_beam, decl, n_nodes, n_beams, held=None, base=None):
+    """``slivers`` of the groups ``groups`` makes from these arguments (``base``: their ``_sliver_base`` if kept)."""
+    sn, key, order = _sliver_base(slave_nodes, master_beam, decl, n_nodes, n_beams, held) if base is None else base
     if SLIVER is not None and _SCATTER["rows"] is mortar_jit.scatter_rows:
-        return mortar_jit.slivers(key, sn, xi1, SLIVER)        # compiled, the same flags (``slivers`` its oracle)
+        if not order:            # compiled, the same flags (``slivers`` its oracle)
+            order.append(mortar_jit.sliver_groups(key))
+        return mortar_jit.slivers(key, sn, xi1, SLIVER, order[0])
     return slivers(key, sn, xi1)
+
+
+def _sliver_base(slave_nodes, master_beam, decl, n_nodes, n_beams, held):
+    """``(sn, key, order)`` of ``fold_of``, what does not follow ``xi1``: the slave nodes with held ones moved, the
+    keys ``(P, 2)`` and ``[mortar_jit.sliver_groups(key)]`` (a list filled at the first compiled ``fold_of``)."""
+    sn = np.array(_held_moved(slave_nodes, held))      # (its own: ``Groups`` keeps it)
+    key = (np.asarray(decl, dtype=np.int64)[:, None] * n_nodes + sn) * n_beams + master_beam[:, None]
+    return sn, key, []
 
 
 def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=None, fold=None, full=True):
@@ -109,14 +118,13 @@ def groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=No
     pos = slot[inv].reshape(P, 2, 4)
     rows2 = (6 * pos[:, :, :, None] + np.arange(6)).reshape(P, 2, 24)
     g = np.ascontiguousarray(g, dtype=np.int64)
-    # kept with the groups (``Groups``): the points' slots (``_slots``), their rows (``_trial_rows``) and the
-    # columns of each group's own node rotation (``_turn``)
-    # (``rows2`` a view of ``slot_rows``: one copy of the (P, 2, 24) rows, 79 MB at the commit pass's 206 000 points
-    # of the 61-wire strand; ``trial_rows`` makes it contiguous when it needs it)
+    # kept with the groups (``Groups``): the points' slots and rows (``_slots``, ``_slot_rows``: one copy of the
+    # (2, P, 24) rows, 79 MB at the commit pass's 206 000 points of the 61-wire strand) and the columns of each group's
+    # own node rotation (``_turn``)
     own = np.argmax(members == node[:, None], axis=1)
     slot_rows = np.ascontiguousarray(rows2.transpose(1, 0, 2))
     return dict(key=ukey, node=node, g=g, phi=_shape_functions(xi1), members=members, pos=pos,
-                rows2=slot_rows.transpose(1, 0, 2), slot_groups=np.ascontiguousarray(g.T), slot_rows=slot_rows,
+                slot_groups=np.ascontiguousarray(g.T), slot_rows=slot_rows,
                 rot=6 * own[:, None] + np.arange(3, 6))
 
 
@@ -170,15 +178,17 @@ class Groups:
         self.builds = 0          # ``groups`` calls (tests)
 
     def __call__(self, slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held=None, full=True):
-        """``groups(...)`` (``full``: as there; kept without the members, a call asking for them builds them)."""
-        fold = fold_of(slave_nodes, xi1, master_beam, decl, n_nodes, n_beams, held)
-        args = (slave_nodes, master_beam, decl, nodes, held, fold)
+        """``groups(...)`` (``full``: as there; kept without the members, a call asking for them builds them).
+        The sliver folds' keys and their sort are kept with the pairs too (``_sliver_base``)."""
         last = self._last
-        if last is not None and last[0] == (n_nodes, n_beams) and ("members" in last[2] or not full) and \
-                _same_args(last[1], args):
+        args = (slave_nodes, master_beam, decl, nodes, held)
+        same = last is not None and last[0] == (n_nodes, n_beams) and _same_args(last[1][:5], args)
+        base = last[3] if same else _sliver_base(slave_nodes, master_beam, decl, n_nodes, n_beams, held)
+        fold = fold_of(slave_nodes, xi1, master_beam, decl, n_nodes, n_beams, held, base=base)
+        if same and ("members" in last[2] or not full) and equal(last[1][5], fold):
             return dict(last[2], phi=_shape_functions(xi1))
         G = groups(slave_nodes, xi1, master_beam, decl, nodes, n_nodes, n_beams, held, fold, full)
-        self._last = ((n_nodes, n_beams), tuple(None if a is None else np.array(a) for a in args), G)
+        self._last = ((n_nodes, n_beams), tuple(None if a is None else np.array(a) for a in args + (fold,)), G, base)
         self.builds += 1
         return G
 
@@ -366,9 +376,8 @@ def _trial_rows(G, d, st, eps, mu):
     n, k = G["members"].shape
     B = np.zeros((n, 3, 6 * k))
     if _SCATTER["rows"] is mortar_jit.scatter_rows:
-        rows2 = G["rows2"] if "rows2" in G else (6 * G["pos"][:, :, :, None] + np.arange(6)).reshape(len(G["g"]), 2, 24)
-        return mortar_jit.trial_rows(B, G["g"], rows2, st["wphi"], st["wn"], st["m"], eps, mu, st["Pi"], st["Q"],
-                                     st["C"], st["c"], d["dS"], d["dn"], d["dlam_n"])
+        return mortar_jit.trial_rows(B, G["g"], _slot_rows(G), st["wphi"], st["wn"], st["m"], eps, mu, st["Pi"],
+                                     st["Q"], st["C"], st["c"], d["dS"], d["dn"], d["dlam_n"])
     for a in range(2):
         g, rows = _slots(G, a)
         wg, wgn = st["wphi"][:, a] / st["m"][g], st["wn"][:, a] / st["m"][g]
@@ -380,6 +389,13 @@ def _trial_rows(G, d, st, eps, mu):
     return B
 
 
+def _slot_rows(G):
+    """``(2, P, 24)``: the points' rows in the groups of their node A, B (``_slots``, both at once)."""
+    if "slot_rows" in G:
+        return G["slot_rows"]
+    return (6 * G["pos"].transpose(1, 0, 2)[:, :, :, None] + np.arange(6)).reshape(2, len(G["g"]), 24)
+
+
 def _turn(G, R, Lam):
     """Columns ``(n, 3)`` of the node's rotation increment in each group's block and ``d(R Lam) / dtheta``
     ``(n, 3, 3)`` = ``-R hat(Lam)`` (body increment of the node)."""
@@ -388,6 +404,8 @@ def _turn(G, R, Lam):
     else:
         own = np.argmax(G["members"] == G["node"][:, None], axis=1)
         cols = 6 * own[:, None] + np.arange(3, 6)
+    if _SCATTER["rows"] is mortar_jit.scatter_rows and R.flags.c_contiguous:
+        return cols, mortar_jit.turn(R, Lam)      # (compiled: einsum's bits on a contiguous R)
     return cols, -np.einsum("gij,gjk->gik", R, se3.skew(Lam))
 
 
@@ -431,18 +449,19 @@ def multiplier_blocks(G, d, st, R, Lam, c, mu, turn=None):
     _add_columns(Kqq, rot, A @ dv)
     Kql = A @ R
     weak = st["weak"]
-    MP = np.einsum("gij,gjk->gik", st["C"], st["Pi"])                  # d P / d v
+    MP = mortar_jit.products(st["C"], st["Pi"])                  # d P / d v (einsum's bits)
     B = _trial_rows(G, d, st, c, mu)
     # a touching group without normal traction: C = v exactly (its traction goes to zero in one step); the
     # hold stiffness acts on its slip in the displacement rows only, a tangent-only term like the point law's
     # floor (putting it in d C / d v made the multiplier overshoot and the residual stall: twisted pair)
-    Kqq[weak] += A[weak] @ B[weak]
-    B[weak] = 0.0
-    MP[weak] = 0.0
+    if weak.any():
+        Kqq[weak] += A[weak] @ B[weak]
+        B[weak] = 0.0
+        MP[weak] = 0.0
     Klq = np.negative(B, out=B)         # (in place: B is not used again; a fresh (n, 3, 6 k) array's page faults)
     _add_columns(Klq, rot, dv - MP @ dv)
     Kll = R - MP @ R
-    v = np.einsum("gij,gj->gi", R, Lam)
+    v = mortar_jit.rotate(R, Lam)
     return f, Kqq, Kql, Klq, Kll, v - st["lam"]
 
 
@@ -453,13 +472,18 @@ def branch_rows(G, d, st, R, Lam, c, mu, turn=None):
     d (mu lamN) / d q, rows over the groups' slots (``st``: ``nodal_state`` with ``eps = c``; ``turn``: ``_turn(G, R,
     Lam)`` if known)."""
     n, k = G["members"].shape
-    eye = dict(st, C=np.ascontiguousarray(np.broadcast_to(np.eye(3), (n, 3, 3))), c=np.zeros((n, 3)))
-    Tq = _trial_rows(G, d, eye, c, mu)
-    e = np.zeros((n, 3))
-    e[:, 0] = 1.0
-    capq = _trial_rows(G, d, dict(st, C=np.zeros((n, 3, 3)), c=e), c, mu)[:, 0, :].copy()
+    if _SCATTER["rows"] is mortar_jit.scatter_rows:     # both in one pass (the same sums, no zero products)
+        Tq, capq = mortar_jit.branch_rows(np.zeros((n, 3, 6 * k)), np.zeros((n, 6 * k)), G["g"], _slot_rows(G),
+                                          st["wphi"], st["wn"], st["m"], c, mu, st["Pi"], st["Q"], d["dS"], d["dn"],
+                                          d["dlam_n"])
+    else:
+        eye = dict(st, C=np.ascontiguousarray(np.broadcast_to(np.eye(3), (n, 3, 3))), c=np.zeros((n, 3)))
+        Tq = _trial_rows(G, d, eye, c, mu)
+        e = np.zeros((n, 3))
+        e[:, 0] = 1.0
+        capq = _trial_rows(G, d, dict(st, C=np.zeros((n, 3, 3)), c=e), c, mu)[:, 0, :].copy()
     rot, dv = _turn(G, R, Lam) if turn is None else turn
     Vq = np.zeros((n, 3, 6 * k))
     _add_columns(Vq, rot, dv)
-    _add_columns(Tq, rot, np.einsum("gij,gjk->gik", st["Pi"], dv))
+    _add_columns(Tq, rot, mortar_jit.products(st["Pi"], dv))
     return Tq, Vq, capq

@@ -15,7 +15,8 @@ from ..model.buffers import BufferPool
 
 __all__ = ["scatter_rows", "scatter_block", "scatter_columns", "scatter_rows_numpy", "scatter_block_numpy",
            "scatter_columns_numpy", "trial_rows", "subtract_indexed", "point_terms", "point_terms_into",
-           "nodal_state", "point_data", "multiplier_basis", "slivers"]
+           "nodal_state", "point_data", "multiplier_basis", "slivers", "sliver_groups", "branch_rows",
+           "point_forces", "interpolate", "turn", "products", "rotate"]
 
 
 @jit
@@ -58,23 +59,63 @@ def _columns(out, g, cols, vals):
 
 
 @jit
-def _trial_rows(B, g2, rows2, wphi, wn, m, eps, mu, Pi, Q, C, c, dS, dn, dlam_n):
+def _trial_rows(B, g2, slot_rows, wphi, wn, m, eps, mu, Pi, Q, C, c, dS, dn, dlam_n):
     for p in range(g2.shape[0]):
         for a in range(2):
             g = g2[p, a]
             wg, wgn = wphi[p, a] / m[g], wn[p, a] / m[g]
             se, sm = eps[g] * wg, mu[g] * wg
-            o = B[g]
+            # the group's matrices in registers (the stores to ``B`` may alias them: reloaded per column otherwise)
+            P00, P01, P02, P10, P11, P12, P20, P21, P22 = _entries(Pi, g)
+            Q00, Q01, Q02, Q10, Q11, Q12, Q20, Q21, Q22 = _entries(Q, g)
+            C00, C01, C02, C10, C11, C12, C20, C21, C22 = _entries(C, g)
+            s0, s1, s2 = sm * c[g, 0], sm * c[g, 1], sm * c[g, 2]
+            o, rows = B[g], slot_rows[a, p]
             for k in range(24):
-                t0 = se * (Pi[g, 0, 0] * dS[p, 0, k] + Pi[g, 0, 1] * dS[p, 1, k] + Pi[g, 0, 2] * dS[p, 2, k]) + \
-                    wgn * (Q[g, 0, 0] * dn[p, 0, k] + Q[g, 0, 1] * dn[p, 1, k] + Q[g, 0, 2] * dn[p, 2, k])
-                t1 = se * (Pi[g, 1, 0] * dS[p, 0, k] + Pi[g, 1, 1] * dS[p, 1, k] + Pi[g, 1, 2] * dS[p, 2, k]) + \
-                    wgn * (Q[g, 1, 0] * dn[p, 0, k] + Q[g, 1, 1] * dn[p, 1, k] + Q[g, 1, 2] * dn[p, 2, k])
-                t2 = se * (Pi[g, 2, 0] * dS[p, 0, k] + Pi[g, 2, 1] * dS[p, 1, k] + Pi[g, 2, 2] * dS[p, 2, k]) + \
-                    wgn * (Q[g, 2, 0] * dn[p, 0, k] + Q[g, 2, 1] * dn[p, 1, k] + Q[g, 2, 2] * dn[p, 2, k])
-                r = rows2[p, a, k]
-                for i in range(3):
-                    o[i, r] += C[g, i, 0] * t0 + C[g, i, 1] * t1 + C[g, i, 2] * t2 + sm * c[g, i] * dlam_n[p, k]
+                t0, t1, t2 = _trial_column(se, wgn, P00, P01, P02, P10, P11, P12, P20, P21, P22,
+                                           Q00, Q01, Q02, Q10, Q11, Q12, Q20, Q21, Q22, dS, dn, p, k)
+                r, dl = rows[k], dlam_n[p, k]
+                o[0, r] += C00 * t0 + C01 * t1 + C02 * t2 + s0 * dl
+                o[1, r] += C10 * t0 + C11 * t1 + C12 * t2 + s1 * dl
+                o[2, r] += C20 * t0 + C21 * t1 + C22 * t2 + s2 * dl
+
+
+@jit
+def _entries(M, g):
+    """The nine entries of ``M[g]`` ``(3, 3)``, row by row."""
+    return M[g, 0, 0], M[g, 0, 1], M[g, 0, 2], M[g, 1, 0], M[g, 1, 1], M[g, 1, 2], M[g, 2, 0], M[g, 2, 1], M[g, 2, 2]
+
+
+@jit
+def _trial_column(se, wgn, P00, P01, P02, P10, P11, P12, P20, P21, P22, Q00, Q01, Q02, Q10, Q11, Q12, Q20, Q21, Q22,
+                  dS, dn, p, k):
+    """Column ``k`` of ``se Pi dS_p + wgn Q dn_p`` ``(3,)`` (each product summed left to right)."""
+    d0, d1, d2 = dS[p, 0, k], dS[p, 1, k], dS[p, 2, k]
+    n0, n1, n2 = dn[p, 0, k], dn[p, 1, k], dn[p, 2, k]
+    t0 = se * (P00 * d0 + P01 * d1 + P02 * d2) + wgn * (Q00 * n0 + Q01 * n1 + Q02 * n2)
+    t1 = se * (P10 * d0 + P11 * d1 + P12 * d2) + wgn * (Q10 * n0 + Q11 * n1 + Q12 * n2)
+    t2 = se * (P20 * d0 + P21 * d1 + P22 * d2) + wgn * (Q20 * n0 + Q21 * n1 + Q22 * n2)
+    return t0, t1, t2
+
+
+@jit
+def _branch_rows(Tq, capq, g2, slot_rows, wphi, wn, m, eps, mu, Pi, Q, dS, dn, dlam_n):
+    for p in range(g2.shape[0]):
+        for a in range(2):
+            g = g2[p, a]
+            wg, wgn = wphi[p, a] / m[g], wn[p, a] / m[g]
+            se, sm = eps[g] * wg, mu[g] * wg
+            P00, P01, P02, P10, P11, P12, P20, P21, P22 = _entries(Pi, g)
+            Q00, Q01, Q02, Q10, Q11, Q12, Q20, Q21, Q22 = _entries(Q, g)
+            o, oc, rows = Tq[g], capq[g], slot_rows[a, p]
+            for k in range(24):
+                t0, t1, t2 = _trial_column(se, wgn, P00, P01, P02, P10, P11, P12, P20, P21, P22,
+                                           Q00, Q01, Q02, Q10, Q11, Q12, Q20, Q21, Q22, dS, dn, p, k)
+                r = rows[k]
+                o[0, r] += t0
+                o[1, r] += t1
+                o[2, r] += t2
+                oc[r] += sm * dlam_n[p, k]
 
 
 # ``point_terms``' outputs in kept memory (fresh memory's page faults cost as much as the pass on the 19-wire bundle)
@@ -113,6 +154,108 @@ def point_terms_into(df, rows, t1, t2, s, A, dS, dn, dlam):
     """``point_terms`` into the given C-contiguous outputs ``A`` ``(P, 24, 3)``, ``dS``, ``dn`` ``(P, 3, 24)``,
     ``dlam`` ``(P, 24)`` (``kernel_jit._mortar_chunks``: one pass's points)."""
     _point_terms(_c(df), rows, _c(t1), _c(t2), _c(s), A, dS, dn, dlam)
+
+
+@jit
+def _point_forces(A, T, swap, out):
+    for p in range(A.shape[0]):
+        t0, t1, t2 = T[p, 0], T[p, 1], T[p, 2]
+        for i in range(A.shape[1]):
+            x0, x1, x2 = A[p, i, 0] * t0, A[p, i, 1] * t1, A[p, i, 2] * t2
+            # (+ 0.0: einsum sums into zeros, so products all -0 give +0)
+            out[p, i] = ((x0 + x2) + x1 if swap else (x0 + x1) + x2) + 0.0
+
+
+def point_forces(A, T):
+    """``np.einsum("pij,pj->pi", A, T)`` ``(P, 24)`` of ``A`` ``(P, 24, 3)``, ``T`` ``(P, 3)`` (the points' forces at
+    their tractions, ``ContactSystem._mortar``) in one compiled pass, in einsum's order of the layouts it meets: ``A``
+    C-contiguous ``(x0 + x2) + x1`` (its two-lane sum), ``A`` the kernel's ``(P, 24)`` rows by force (the view
+    ``kernel_jit.mortar_forces`` gives, the last axis outermost) ``(x0 + x1) + x2``; numpy itself for any other."""
+    P = A.shape[0]
+    ok = A.dtype == np.float64 and A.ndim == 3 and A.shape[2] == 3 and T.dtype == np.float64 and \
+        T.flags.c_contiguous and P > 1          # (one point: numba would see the view as another layout)
+    s = A.strides
+    if ok and A.flags.c_contiguous:
+        swap = True
+    elif ok and s[1] == 8 and s[0] == 8 * A.shape[1] and s[2] >= s[0] * P:
+        swap = False
+    else:
+        return np.einsum("pij,pj->pi", A, T)
+    out = np.empty(A.shape[:2])
+    _point_forces(A, T, swap, out)
+    return out
+
+
+@jit
+def _turn(R, Lam, out):
+    for g in range(R.shape[0]):
+        l0, l1, l2 = Lam[g, 0], Lam[g, 1], Lam[g, 2]
+        for k in range(3):          # column k of ``se3.skew(Lam[g])``
+            s0 = 0.0 if k == 0 else -l2 if k == 1 else l1
+            s1 = l2 if k == 0 else 0.0 if k == 1 else -l0
+            s2 = -l1 if k == 0 else l0 if k == 1 else 0.0
+            for i in range(3):
+                out[g, i, k] = -(((R[g, i, 0] * s0 + R[g, i, 1] * s1) + R[g, i, 2] * s2) + 0.0)
+
+
+def turn(R, Lam):
+    """``-np.einsum("gij,gjk->gik", R, se3.skew(Lam))`` ``(G, 3, 3)`` (``mortar._turn``: ``d(R Lam) / dtheta``) in one
+    pass: einsum's sums on contiguous arrays, ``(x0 + x1) + x2`` into zeros (+ 0.0: -0 products give +0)."""
+    out = np.empty((len(R), 3, 3))
+    _turn(_c(R), _c(Lam), out)
+    return out
+
+
+@jit
+def _products(A, B, out):
+    for g in range(A.shape[0]):
+        for i in range(3):
+            for k in range(3):
+                out[g, i, k] = ((A[g, i, 0] * B[g, 0, k] + A[g, i, 1] * B[g, 1, k]) + A[g, i, 2] * B[g, 2, k]) + 0.0
+
+
+def products(A, B):
+    """``np.einsum("gij,gjk->gik", A, B)`` ``(G, 3, 3)``: einsum's ``(x0 + x1) + x2`` into zeros on C-contiguous
+    arrays (compiled), numpy itself on others."""
+    if not (A.flags.c_contiguous and B.flags.c_contiguous and A.dtype == B.dtype == np.float64):
+        return np.einsum("gij,gjk->gik", A, B)
+    out = np.empty((len(A), 3, 3))
+    _products(A, B, out)
+    return out
+
+
+@jit
+def _rotate(R, v, out):
+    for g in range(R.shape[0]):
+        for i in range(3):
+            out[g, i] = ((R[g, i, 0] * v[g, 0] + R[g, i, 2] * v[g, 2]) + R[g, i, 1] * v[g, 1]) + 0.0
+
+
+def rotate(R, v):
+    """``np.einsum("gij,gj->gi", R, v)`` ``(G, 3)``: einsum's two-lane ``(x0 + x2) + x1`` into zeros on C-contiguous
+    arrays (compiled, as ``nodal_state``'s), numpy itself on others."""
+    if not (R.flags.c_contiguous and v.flags.c_contiguous and R.dtype == v.dtype == np.float64):
+        return np.einsum("gij,gj->gi", R, v)
+    out = np.empty((len(R), 3))
+    _rotate(R, v, out)
+    return out
+
+
+@jit
+def _interpolate(phi, V, g2, out):
+    for p in range(g2.shape[0]):
+        a, b = g2[p, 0], g2[p, 1]
+        for i in range(V.shape[1]):
+            out[p, i] = (phi[p, 0] * V[a, i] + phi[p, 1] * V[b, i]) + 0.0    # (einsum's +0 from -0 products)
+
+
+def interpolate(phi, V, g2):
+    """``np.einsum("pa,pai->pi", phi, V[g2])`` ``(P, 3)``: the groups' vectors ``V`` ``(G, 3)`` at the points by their
+    shape functions ``phi`` ``(P, 2)`` over their groups ``g2`` ``(P, 2)``, without the ``(P, 2, 3)`` gather (a sum of
+    two products: the same bits in either order, signed zeros as einsum's)."""
+    out = np.empty((len(g2), V.shape[1]))
+    _interpolate(_c(phi), _c(V), _c(g2, np.int64), out)
+    return out
 
 
 @jit
@@ -259,13 +402,23 @@ def _sub_indexed(out, vals, idx):
                 o[i, j] -= v[i, j]
 
 
-def trial_rows(B, g2, rows2, wphi, wn, m, eps, mu, Pi, Q, C, c, dS, dn, dlam_n):
+def trial_rows(B, g2, slot_rows, wphi, wn, m, eps, mu, Pi, Q, C, c, dS, dn, dlam_n):
     """``mortar._trial_rows`` compiled: ``B[g] (3, 6 k) += C (Pi eps w du + Q w dnbar) + c mu w dlamN`` over the
-    points' groups ``g2`` ``(P, 2)`` (of their nodes A, B) and slot rows ``rows2`` ``(P, 2, 24)``, in place; the
-    per-point products summed in registers (no ``(P, 3, 24)`` temporaries), equal to the numpy form to round-off."""
-    _trial_rows(B, _c(g2, np.int64), _c(rows2, np.int64), _c(wphi), _c(wn), _c(m), _c(eps), _c(mu), _c(Pi), _c(Q),
-                _c(C), _c(c), _c(dS), _c(dn), _c(dlam_n))
+    points' groups ``g2`` ``(P, 2)`` (of their nodes A, B) and slot rows ``slot_rows`` ``(2, P, 24)`` (node A's, node
+    B's), in place; the per-point products summed in registers (no ``(P, 3, 24)`` temporaries), equal to the numpy
+    form to round-off."""
+    _trial_rows(B, _c(g2, np.int64), _c(slot_rows, np.int64), _c(wphi), _c(wn), _c(m), _c(eps), _c(mu), _c(Pi),
+                _c(Q), _c(C), _c(c), _c(dS), _c(dn), _c(dlam_n))
     return B
+
+
+def branch_rows(Tq, capq, g2, slot_rows, wphi, wn, m, eps, mu, Pi, Q, dS, dn, dlam_n):
+    """``trial_rows`` at ``C = I, c = 0`` into ``Tq`` ``(n, 3, 6 k)`` and at ``C = 0, c = e_1`` (its first row) into
+    ``capq`` ``(n, 6 k)``, in place, in one pass: the same sums without the zero products (``1 t0 + 0 t1 + 0 t2 +
+    0 dl`` is ``t0``; the rows start at +0, which a zero of either sign leaves +0), the bits for finite terms."""
+    _branch_rows(Tq, capq, _c(g2, np.int64), _c(slot_rows, np.int64), _c(wphi), _c(wn), _c(m), _c(eps), _c(mu),
+                 _c(Pi), _c(Q), _c(dS), _c(dn), _c(dlam_n))
+    return Tq, capq
 
 
 def subtract_indexed(out, vals, idx):
@@ -306,30 +459,46 @@ def scatter_columns(out, g, cols, vals):
     return out
 
 
-def slivers(key, slave_nodes, xi1, sliver):
+def slivers(key, slave_nodes, xi1, sliver, groups=None):
     """``mortar.slivers`` compiled (its numpy form the oracle): ``(P, 2)`` bool, the points' nodes whose group
     (``key`` ``(P, 2)``) is a sliver at the ratio ``sliver`` (``mortar.SLIVER``).  The groups from a stable sort of
     the keys, each group's shape functions summed in the order of the points as ``np.bincount`` does (the same
-    bits); 70 us of numpy a call on the main job's 80 points (two ``np.unique``, six ``np.bincount``)."""
+    bits); 70 us of numpy a call on the main job's 80 points (two ``np.unique``, six ``np.bincount``).  ``groups``:
+    ``sliver_groups(key)`` if kept (the same keys: ``mortar.Groups``)."""
     P = len(xi1)
     fold = np.zeros((P, 2), dtype=np.bool_)
     if P:
-        _slivers(_c(key, np.int64), _c(slave_nodes, np.int64), _c(xi1), float(sliver), fold)
+        key = _c(key, np.int64)
+        order, start = sliver_groups(key) if groups is None else groups
+        _sliver_fold(key, _c(slave_nodes, np.int64), _c(xi1), float(sliver), order, start, fold)
     return fold
 
 
-@jit
-def _slivers(key, sn, xi1, sliver, fold):
-    P = key.shape[0]
-    k = key.ravel()
+def sliver_groups(key):
+    """``(order, start)``: the stable sort of the keys ``(P, 2)`` raveled and where each group starts in it,
+    ``(n + 1,)`` (``slivers``: they depend on the keys alone)."""
+    k = _c(key, np.int64).ravel()
     order = np.argsort(k, kind="mergesort")          # stable: a group's entries in the points' order
+    start = np.empty(len(k) + 1, dtype=np.int64)
+    n = _group_starts(k, order, start)
+    return order, start[:n + 1]
+
+
+@jit
+def _group_starts(k, order, start):
     n = 0
-    start = np.empty(2 * P + 1, dtype=np.int64)
-    for i in range(2 * P):
+    for i in range(len(k)):
         if i == 0 or k[order[i]] != k[order[i - 1]]:
             start[n] = i
             n += 1
-    start[n] = 2 * P
+    start[n] = len(k)
+    return n
+
+
+@jit
+def _sliver_fold(key, sn, xi1, sliver, order, start, fold):
+    k = key.ravel()
+    n = len(start) - 1
     uk = np.empty(n, dtype=np.int64)
     npts = np.empty(n, dtype=np.int64)
     pk = np.empty(n, dtype=np.int64)

@@ -244,6 +244,8 @@ def _iterate(S, line, xi, nxt, ang, tol, done, ok, n, iterations, window, lo, hi
                 if not done[l] and window and not (xi[l] >= lo and xi[l] <= hi):
                     done[l] = True
         for l in range(n):
+            if done[l]:             # (its update is not read)
+                continue
             RA, xA, u, w, x1, e1 = _lane(S, l)
             nxt[l], ang[l] = _step_series(line[l], x1, e1, RA, xA, u, w, xi[l])
         left = 0

@@ -342,13 +342,19 @@ def _scene(model, worker):
 def _exact_stick_callees():
     """The exact stick path's compiled helpers that the stand-in's data do not reach (they run where some pairs are
     not folded into their groups, where a group's components are eliminated and in the Newton system), on empty
-    arrays of the solve's types (``contact.mortar_jit.subtract_indexed``, ``nonlinear.condense._schur`` and
+    arrays of the solve's types (``contact.mortar_jit.subtract_indexed``, ``branch_rows`` and ``point_forces``, ``nonlinear.condense._schur`` and
     ``scatter_free``, the bordered pattern's passes ``nonlinear.bordered._border_counts``, ``_border_fill``,
     ``_border_values``, the augmented solve's ``nonlinear.augmented._join``, ``_precondition_rhs``,
     ``_precondition_out``, ``_couplings``, ``_weights_of``)."""
     from ..contact import mortar_jit
     from . import augmented, bordered, condense
     mortar_jit.subtract_indexed(np.zeros((0, 24, 24)), np.zeros((0, 24, 24)), np.zeros(0, dtype=np.int64))
+    v, m3 = np.zeros((0, 3, 24)), np.zeros((0, 3, 3))
+    mortar_jit.branch_rows(np.zeros((0, 3, 24)), np.zeros((0, 24)), np.zeros((0, 2), dtype=np.int64),
+                           np.zeros((2, 0, 24), dtype=np.int64), np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0),
+                           np.zeros(0), np.zeros(0), m3, m3, v, v, np.zeros((0, 24)))
+    for A in (np.zeros((2, 24, 3)), np.transpose(np.zeros((3, 2, 4, 6)), (1, 2, 3, 0)).reshape(2, 24, 3)):
+        mortar_jit.point_forces(A, np.zeros((2, 3)))        # (the tangent's terms, a trial's forces: two layouts)
     condense._schur(np.zeros(0), 0, np.zeros((0, 24, 3)), np.zeros((0, 3, 24)), np.zeros((0, 3)))
     condense.scatter_free(np.zeros((0, 24), dtype=np.int64), np.zeros((0, 24)), np.zeros(0))
     none, rows, i32 = np.zeros(0, dtype=np.int64), np.zeros((0, 24), dtype=np.int64), np.zeros(0, dtype=np.int32)

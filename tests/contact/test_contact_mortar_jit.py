@@ -243,3 +243,121 @@ def test_compiled_slivers_see_every_kind_of_fold():
     assert folds > 20 and ties == 40
     assert mortar_jit.slivers(np.zeros((0, 2), dtype=np.int64), np.zeros((0, 2), dtype=np.int64), np.zeros(0),
                               mortar.SLIVER).shape == (0, 2)
+
+
+def _trial_rows_plain(B, g2, rows2, wphi, wn, m, eps, mu, Pi, Q, C, c, dS, dn, dlam_n):
+    """The former compiled ``_trial_rows`` in Python: every entry read where it is used (its order of operations)."""
+    for p in range(g2.shape[0]):
+        for a in range(2):
+            g = g2[p, a]
+            wg, wgn = wphi[p, a] / m[g], wn[p, a] / m[g]
+            se, sm = eps[g] * wg, mu[g] * wg
+            o = B[g]
+            for k in range(24):
+                t = [se * (Pi[g, i, 0] * dS[p, 0, k] + Pi[g, i, 1] * dS[p, 1, k] + Pi[g, i, 2] * dS[p, 2, k]) +
+                     wgn * (Q[g, i, 0] * dn[p, 0, k] + Q[g, i, 1] * dn[p, 1, k] + Q[g, i, 2] * dn[p, 2, k])
+                     for i in range(3)]
+                r = rows2[p, a, k]
+                for i in range(3):
+                    o[i, r] += C[g, i, 0] * t[0] + C[g, i, 1] * t[1] + C[g, i, 2] * t[2] + sm * c[g, i] * dlam_n[p, k]
+
+
+def _trial_case(seed, P=30, n=7, k6=36):
+    rng = np.random.default_rng(seed)
+    g2 = rng.integers(0, n, (P, 2))
+    rows2 = rng.integers(0, k6, (P, 2, 24))
+    f = rng.standard_normal
+    args = dict(wphi=f((P, 2)), wn=f((P, 2)), m=rng.uniform(0.5, 2, n), eps=f(n), mu=f(n), Pi=f((n, 3, 3)),
+                Q=f((n, 3, 3)), C=f((n, 3, 3)), c=f((n, 3)), dS=f((P, 3, 24)), dn=f((P, 3, 24)), dlam_n=f((P, 24)))
+    for a in ("dS", "dn", "dlam_n"):                # zeros of both signs among the terms
+        args[a][rng.random(args[a].shape) < 0.1] = 0.0
+        args[a][rng.random(args[a].shape) < 0.05] = -0.0
+    return g2, rows2, args, n, k6
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_compiled_trial_rows_are_the_former_loops(seed):
+    """``mortar_jit.trial_rows`` (the group's matrices held in registers, the rows ``(2, P, 24)``): the bits of the
+    loops that read every entry where it is used."""
+    from beamsolver.contact import mortar_jit
+    g2, rows2, a, n, k6 = _trial_case(seed)
+    ref = np.zeros((n, 3, k6))
+    _trial_rows_plain(ref, g2, rows2, *a.values())
+    out = mortar_jit.trial_rows(np.zeros((n, 3, k6)), g2, rows2.transpose(1, 0, 2), *a.values())
+    assert _bits(out, ref) and np.any(ref)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_compiled_branch_rows_are_the_trial_rows_at_the_identity_and_the_cap(seed):
+    """``mortar_jit.branch_rows``: the bits of the trial rows at ``C = I, c = 0`` (``Tq``) and the first row at
+    ``C = 0, c = e_1`` (``capq``), zero products and signed zeros among the terms included."""
+    from beamsolver.contact import mortar_jit
+    g2, rows2, a, n, k6 = _trial_case(seed)
+    Tq, cap = np.zeros((n, 3, k6)), np.zeros((n, 3, k6))
+    _trial_rows_plain(Tq, g2, rows2, *dict(a, C=np.broadcast_to(np.eye(3), (n, 3, 3)), c=np.zeros((n, 3))).values())
+    e = np.zeros((n, 3))
+    e[:, 0] = 1.0
+    _trial_rows_plain(cap, g2, rows2, *dict(a, C=np.zeros((n, 3, 3)), c=e).values())
+    b = {k: v for k, v in a.items() if k not in ("C", "c")}
+    out = mortar_jit.branch_rows(np.zeros((n, 3, k6)), np.zeros((n, k6)), g2, rows2.transpose(1, 0, 2), *b.values())
+    assert _bits(out[0], Tq) and _bits(out[1], np.ascontiguousarray(cap[:, 0])) and np.any(Tq) and np.any(cap)
+    assert not np.signbit(out[0][out[0] == 0]).any() and not np.signbit(cap[cap == 0]).any()
+
+
+@pytest.mark.parametrize("P", [0, 1, 2, 7, 640])
+def test_compiled_point_forces_are_numpy_s_einsum(P):
+    """``mortar_jit.point_forces``: ``np.einsum("pij,pj->pi", A, T)``'s bits for ``A`` C-contiguous (the mortar terms')
+    and for the view of the kernel's ``(4, P, 4, 6)`` forces ``mortar_forces`` gives, and numpy's own elsewhere."""
+    rng = np.random.default_rng(P)
+    f, T = rng.standard_normal((4, P, 4, 6)), rng.standard_normal((P, 3))
+    T[rng.random(T.shape) < 0.3] = -0.0             # signed zeros: products all -0 sum to +0 as einsum's
+    T[rng.random(T.shape) < 0.2] = 0.0
+    for A in (rng.standard_normal((P, 24, 3)), np.transpose(f[1:], (1, 2, 3, 0)).reshape(P, 24, 3),
+              rng.standard_normal((P, 3, 24)).transpose(0, 2, 1)):
+        A[rng.random(A.shape) < 0.05] = 0.0
+        assert _bits(mortar_jit.point_forces(A, T), np.einsum("pij,pj->pi", A, T))
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_compiled_interpolation_is_numpy_s_einsum(seed):
+    """``mortar_jit.interpolate``: ``np.einsum("pa,pai->pi", phi, V[g2])``'s bits."""
+    rng = np.random.default_rng(seed)
+    P, G = 300, 40
+    phi, V, g2 = rng.uniform(-1, 1, (P, 2)), rng.standard_normal((G, 3)), rng.integers(0, G, (P, 2))
+    V[rng.random(V.shape) < 0.3] = 0.0
+    phi[rng.random(phi.shape) < 0.3] = -0.0
+    assert _bits(mortar_jit.interpolate(phi, V, g2), np.einsum("pa,pai->pi", phi, V[g2]))
+
+
+def _bits(a, b):
+    """Equal to the bit (signed zeros told apart)."""
+    return a.shape == b.shape and np.array_equal(a.view(np.int64), b.view(np.int64))
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_compiled_turn_is_numpy_s_einsum(seed):
+    """``mortar_jit.turn``: ``-np.einsum("gij,gjk->gik", R, se3.skew(Lam))``'s bits, zero multipliers (a step's
+    start) and signed zeros included."""
+    from beamsolver.lie import se3
+    rng = np.random.default_rng(seed)
+    G = 50
+    R, Lam = rng.standard_normal((G, 3, 3)), rng.standard_normal((G, 3))
+    Lam[:10] = 0.0
+    Lam[10:20] = -0.0
+    Lam[rng.random(Lam.shape) < 0.2] = -0.0
+    R[rng.random(R.shape) < 0.1] = 0.0
+    assert _bits(mortar_jit.turn(R, Lam), -np.einsum("gij,gjk->gik", R, se3.skew(Lam)))
+
+
+@pytest.mark.parametrize("G", [0, 1, 2, 127])
+def test_compiled_products_and_rotations_are_numpy_s_einsum(G):
+    """``mortar_jit.products`` and ``rotate``: ``np.einsum("gij,gjk->gik")``'s and ``np.einsum("gij,gj->gi")``'s
+    bits on contiguous arrays (signed zeros included), numpy's own on others."""
+    rng = np.random.default_rng(G)
+    A, B, v = rng.standard_normal((G, 3, 3)), rng.standard_normal((G, 3, 3)), rng.standard_normal((G, 3))
+    for a in (A, B, v):
+        a[rng.random(a.shape) < 0.2] = -0.0
+        a[rng.random(a.shape) < 0.1] = 0.0
+    for X in (A, np.swapaxes(A, 1, 2)):
+        assert _bits(mortar_jit.products(X, B), np.einsum("gij,gjk->gik", X, B))
+        assert _bits(mortar_jit.rotate(X, v), np.einsum("gij,gj->gi", X, v))
