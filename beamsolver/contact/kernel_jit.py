@@ -258,6 +258,7 @@ def _adjoint_inv(R, x, A):
 # ---------------------------------------------------------------- one side of a pair: scratch slots
 # 6x6 slots of a side's scratch ``S`` (N_SIDE, 6, 6)
 (S_TI, S_AH, S_TS, S_AS, S_JA, S_JB, S_TMP, S_DA, S_DB, S_TMH, S_TIAH) = range(11)
+assert S_JB == S_JA + 1      # (``_nodal_forces``)
 N_SIDE = 11
 # 6-vector slots of a side's ``v`` (N_VEC, 6)
 (V_WR, V_DB, V_DA) = range(3)
@@ -531,12 +532,13 @@ C_POSE, C_U, C_W, C_T2, C_A, C_B, C_CO, N_CACHE = 0, 24, 27, 30, 31, 32, 33, 39
 
 
 @jit_callee
-def _element_side(Xp, j0, S, c):
+def _element_side(Xp, j0, S, c, need=2):
     """Twist ``h = log(H_A^-1 H_B)`` of the element of nodes ``j0, j0 + 1`` and the element's quantities:
     ``T(h)^-1``, ``Ad(exp(-h))``, ``T(h)^-1 Ad(exp(-h))``, ``T(-h)`` into ``S[S_TI], S[S_AH], S[S_TIAH],
     S[S_TMH]`` and the coefficients of ``F(h, .)`` into ``c``.  Kept while the node poses are those of the last
     point on this side, bit for bit (the Gauss points of a slave element, consecutive points on one master
-    element): the same floats."""
+    element): the same floats.  ``need`` (one value for a whole batch: the kept quantities are those it asks
+    for): 2 all, 1 the node Jacobians' ``T(h)^-1``, ``Ad(exp(-h))`` (forces only), 0 the twist alone (point data)."""
     hit = True
     for a in range(2):
         for i in range(3):
@@ -551,15 +553,19 @@ def _element_side(Xp, j0, S, c):
         return RA, xA, (c[C_U], c[C_U + 1], c[C_U + 2]), (c[C_W], c[C_W + 1], c[C_W + 2])
     RB, xB = _pose_of(Xp, j0 + 1)
     u, w, _, _ = log_relative(RA, xA, RB, xB)
+    for i in range(3):
+        c[C_U + i], c[C_W + i] = u[i], w[i]
+    if need == 0:
+        return RA, xA, u, w
     _side(u, w, S)
+    if need == 1:
+        return RA, xA, u, w
     _mm_ut(S[S_TI], S[S_AH], S[S_TIAH])
     _tangent(scale(-1.0, u), scale(-1.0, w), S[S_TMH])
     t2 = dot(w, w)
     t = np.sqrt(t2)
     co = (coefficient(C_, t), coefficient(Q2_, t), coefficient(Q3_, t), coefficient(CP_, t), coefficient(Q2P_, t),
           coefficient(Q3P_, t))
-    for i in range(3):
-        c[C_U + i], c[C_W + i] = u[i], w[i]
     c[C_T2] = t2
     c[C_A], c[C_B] = coefficient(A_, t), coefficient(B_, t)
     for i in range(6):
@@ -847,20 +853,26 @@ def _wrench(R, F, neg, m, sm, G, V, DW, w):
 
 
 @jit_callee
+def _nodal_forces(S, v, f, j0):
+    """``f_j = J_j^T wr`` (``wr = v[V_WR]``, ``J`` in ``S[S_JA]``, ``S[S_JB]``) of the two nodes of one side, rows
+    ``j0, j0 + 1`` of ``f`` ``(4, 6)``: ``_nodal``'s forces only, small enough to be inlined (no views)."""
+    for s in range(2):
+        for i in range(6):
+            acc = 0.0
+            for l in range(6):
+                acc += S[S_JA + s, l, i] * v[V_WR, l]
+            f[j0 + s, i] = acc
+
+
+@jit_callee
 def _nodal(u, w, xi, t2, co, S, v, c, G, DW, DH, DXI, f, K, j0):
     """``f_j = J_j^T wr`` (``wr = v[V_WR]``) for the two nodes of one side and their rows of the tangent:
     ``J^T dwr + d(J^T wr)/dh dh + d(J^T wr)/dxi dxi`` (rows ``DW``, ``DH``, ``DXI`` of ``G``; ``dh`` is zero
     outside the side's columns); forces only for an empty ``K`` (``contact_kernel``)."""
-    wr = v[V_WR]
     if K.shape[1] == 0:
-        for s in range(2):
-            J = S[S_JA] if s == 0 else S[S_JB]
-            for i in range(6):
-                acc = 0.0
-                for l in range(6):
-                    acc += J[l, i] * wr[l]
-                f[j0 + s, i] = acc
+        _nodal_forces(S, v, f, j0)
         return
+    wr = v[V_WR]
     _jacobian_derivatives(u, w, xi, t2, co, S, v, c)
     for s in range(2):
         J, D, dd = (S[S_JA], S[S_DA], v[V_DA]) if s == 0 else (S[S_JB], S[S_DB], v[V_DB])
@@ -1105,6 +1117,21 @@ def _evaluate_rows(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, 
     own[0][0, 0, 0, 0] = 0.0
 
 
+@jit_callee
+def _copy_rows(G, rows):
+    """The gradient rows a mortar evaluation exports (``_evaluate_rows``) from ``G`` into ``rows`` ``(N_ROWS, 24)``,
+    row by row (contiguous writes: a column at a time wrote 12 streams of cache lines, 1000 cycles a point)."""
+    for i in range(9):
+        for k in range(24):
+            rows[i, k] = G[(G_DN + i) * W + k]
+    for k in range(24):
+        rows[9, k] = G[G_DSLIP * W + k]
+    for k in range(24):
+        rows[10, k] = G[(G_DSLIP + 1) * W + k]
+    for k in range(24):
+        rows[11, k] = G[G_DLAM * W + k]
+
+
 def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, flags, frames, ws, rows, Tp, spare):
     """``_point`` of the mortar kernel at the four given tractions ``T = 0, e_x, e_y, e_z`` (``mortar_terms``):
     the geometry, projection, slip and their gradients once, then per traction what depends on it (the
@@ -1120,7 +1147,10 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
     ``lam_t``, ``stick`` and force ``F`` are zeros and True, not the last pass's).
     ``spare``: an empty ``(0, 0)`` and a ``(4, 6)`` scratch.  A template (``make_kernel``)."""
     S, v, G, cache = ws
-    side1, side2 = _element_side(Xp, 0, S[0], cache[0]), _element_side(Xp, 2, S[1], cache[1])
+    tangent = K.shape[2] > 0
+    data = f.shape[0] == 0          # point data only (``mortar_data``: no forces, no tangent)
+    need = 2 if tangent else 0 if data else 1
+    side1, side2 = _element_side(Xp, 0, S[0], cache[0], need), _element_side(Xp, 2, S[1], cache[1], need)
     RA1, xA1, u1, w1 = side1
     RA2, xA2, u2, w2 = side2
     xi1, xi2 = _project(kind, RA1, xA1, u1, w1, par[XI1], RA2, xA2, u2, w2, par[XI2])
@@ -1128,8 +1158,6 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
     RC, xC, _, _ = _section_co(RA1, xA1, u1, w1, xi1, co1[0], co1[1])
     RF, xF, _, _ = _section_co(RA2, xA2, u2, w2, xi2, co2[0], co2[1])
     S1, S2 = S[0], S[1]
-    tangent = K.shape[2] > 0
-    data = f.shape[0] == 0          # point data only (``mortar_data``: no forces, no tangent)
     if tangent:
         _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, G)
     elif not data:       # forces only (``mortar_forces``: an empty ``K``): the Jacobians, no variations, no gradient rows
@@ -1153,12 +1181,7 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
             for k in range(24):
                 G[(G_DSLIP + a) * W + k] = 0.0
     if tangent:
-        for k in range(24):
-            for i in range(9):
-                rows[i, k] = G[(G_DN + i) * W + k]
-            rows[9, k] = G[G_DSLIP * W + k]
-            rows[10, k] = G[(G_DSLIP + 1) * W + k]
-            rows[11, k] = G[G_DLAM * W + k]
+        _copy_rows(G, rows)
     contracted = tangent and K.shape[0] < 4       # 2: at T = 0 and at Tp; 1: at Tp only
     _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2)     # (the geometry's: once, not per traction)
     F, lt, stick = (0.0, 0.0, 0.0), (0.0, 0.0), True
@@ -1191,6 +1214,8 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
             mF = cross(n, F)
             _wrench_value(RC, F, scale(R1, mF), v[0, V_WR])
             _wrench_value(RF, scale(-1.0, F), scale(R2, mF), v[1, V_WR])
+            _nodal_forces(S1, v[0], fq, 0)
+            _nodal_forces(S2, v[1], fq, 2)
         else:
             F = scale(-wgt * lam, n)
             for k in range(24):
@@ -1202,8 +1227,8 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
             _moment_gradient(n, F, G)
             _wrench(RC, F, False, scale(R1, mF), R1, G, G_VC, G_DWC, v[0, V_WR])
             _wrench(RF, scale(-1.0, F), True, scale(R2, mF), R2, G, G_VF, G_DWF, v[1, V_WR])
-        _nodal(u1, w1, xi1, co1[0], co1[1], S1, v[0], cache[0], G, G_DWC, G_DH1, G_DXI1, fq, Kq, 0)
-        _nodal(u2, w2, xi2, co2[0], co2[1], S2, v[1], cache[1], G, G_DWF, G_DH2, G_DXI2, fq, Kq, 2)
+            _nodal(u1, w1, xi1, co1[0], co1[1], S1, v[0], cache[0], G, G_DWC, G_DH1, G_DXI1, fq, Kq, 0)
+            _nodal(u2, w2, xi2, co2[0], co2[1], S2, v[1], cache[1], G, G_DWF, G_DH2, G_DXI2, fq, Kq, 2)
     # the point data as the last traction's pass left them (written once)
     sc[0], sc[1], sc[2], sc[3] = gap, lam, xi1, xi2
     for i in range(3):
