@@ -733,6 +733,34 @@ def _slip_rows(row1, row2, R, xt, sign, prev, xip, S, D, c0):
 
 
 @jit_callee
+def _section_pose_prev(RA, xA, u, w, xi, R, x, xip):
+    """``_section_prev``'s section pose ``(R, x)`` at ``xip`` alone (the same operations; ``_slip_value``: no
+    Jacobian factors, whose coefficients and ``T(s)`` a call that is not inlined computes all the same)."""
+    if _same(xip, xi):
+        return R, x
+    su, sw = scale(xip, u), scale(xip, w)
+    t2 = dot(sw, sw)
+    t = np.sqrt(t2)
+    Rs, xs = _exp_abc(su, sw, t2, coefficient(A_, t), coefficient(B_, t), coefficient(C_, t))
+    return mm(RA, Rs), add(mv(RA, xs), xA)
+
+
+@jit_callee
+def _material_frames(R1, x1, R2, x2, HCL, HFK, HLKp):
+    """``H_CL``, ``H_FK``, ``H_LK`` now and ``dy = log(H_LK_prev^-1 H_LK)`` (its ``u``, ``w``) from the sections
+    ``(R1, x1)``, ``(R2, x2)`` at ``xi_prev``."""
+    RCL, xCL = _pose4(HCL)
+    RFK, xFK = _pose4(HFK)
+    RL, xL = _compose(R1, x1, RCL, xCL)
+    RK, xK = _compose(R2, x2, RFK, xFK)
+    RLt = transpose(RL)
+    RLK, xLK = mm(RLt, RK), mv(RLt, add(xK, scale(-1.0, xL)))
+    RP, xP = _pose4(HLKp)
+    dyu, dyw, _, _ = log_relative(RP, xP, RLK, xLK)
+    return RCL, xCL, RFK, xFK, RLK, xLK, dyu, dyw
+
+
+@jit_callee
 def _slip_frames(side1, side2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp):
     """The material frames of ``_slip``: the sections at ``xi_prev`` (``prev1``, ``prev2``), ``H_CL``, ``H_FK``,
     ``H_LK`` now and ``dy = log(H_LK_prev^-1 H_LK)`` (its ``u``, ``w``)."""
@@ -742,15 +770,7 @@ def _slip_frames(side1, side2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp):
     xi2, RF, xF = sec2
     prev1 = _section_prev(RA1, xA1, u1, w1, xi1, RC, xC, xi1p)
     prev2 = _section_prev(RA2, xA2, u2, w2, xi2, RF, xF, xi2p)
-    RCL, xCL = _pose4(HCL)
-    RFK, xFK = _pose4(HFK)
-    RL, xL = _compose(prev1[1], prev1[2], RCL, xCL)
-    RK, xK = _compose(prev2[1], prev2[2], RFK, xFK)
-    RLt = transpose(RL)
-    RLK, xLK = mm(RLt, RK), mv(RLt, add(xK, scale(-1.0, xL)))
-    RP, xP = _pose4(HLKp)
-    dyu, dyw, _, _ = log_relative(RP, xP, RLK, xLK)
-    return prev1, prev2, RCL, xCL, RFK, xFK, RLK, xLK, dyu, dyw
+    return (prev1, prev2) + _material_frames(prev1[1], prev1[2], prev2[1], prev2[2], HCL, HFK, HLKp)
 
 
 @jit_callee
@@ -773,7 +793,13 @@ def _slip(side1, side2, S1, S2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp, D):
 @jit_callee
 def _slip_value(side1, side2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp):
     """``_slip``'s value alone (the same operations, no gradient)."""
-    dyu = _slip_frames(side1, side2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp)[8]
+    RA1, xA1, u1, w1 = side1
+    RA2, xA2, u2, w2 = side2
+    xi1, RC, xC = sec1
+    xi2, RF, xF = sec2
+    R1, x1 = _section_pose_prev(RA1, xA1, u1, w1, xi1, RC, xC, xi1p)
+    R2, x2 = _section_pose_prev(RA2, xA2, u2, w2, xi2, RF, xF, xi2p)
+    dyu = _material_frames(R1, x1, R2, x2, HCL, HFK, HLKp)[6]
     return (dyu[1], dyu[2])
 
 
