@@ -446,12 +446,23 @@ def _project(kind, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations=2):
 @jit_callee
 def _project_from(kind, sec1, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations):
     """``_project`` given the slave section ``sec1 = _section(RA1, xA1, u1, w1, xi1)`` (a caller that has it)."""
+    return _project_kept(kind, sec1, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations)[:2]
+
+
+@jit_callee
+def _project_kept(kind, sec1, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations):
+    """``_project_from`` and the last sections it computed: ``(xi1, xi2, sec1, sec2, at1, at2)``; ``at1``, ``at2``:
+    ``sec1``, ``sec2`` are the sections at the returned ``xi1``, ``xi2`` (computed at them, bit for bit: the same
+    floats as a new ``_section`` there)."""
     moving = kind != LINE and kind != ORTHOGONAL
     R1, x1, x1p, x1pp = sec1
+    sec2, at1, at2 = sec1, xi1, np.nan        # (``sec2``: a placeholder until the first iteration)
     for it in range(iterations):
         if moving and it > 0:
-            R1, x1, x1p, x1pp = _section_inline(RA1, xA1, u1, w1, xi1)
-        R2, x2, x2p, x2pp = _section_inline(RA2, xA2, u2, w2, xi2)
+            sec1, at1 = _section_inline(RA1, xA1, u1, w1, xi1), xi1
+            R1, x1, x1p, x1pp = sec1
+        sec2, at2 = _section_inline(RA2, xA2, u2, w2, xi2), xi2
+        R2, x2, x2p, x2pp = sec2
         d = add(x2, scale(-1.0, x1))
         e1 = _col(R1, 0)
         xi1_new, xi2_new = xi1, xi2
@@ -471,9 +482,9 @@ def _project_from(kind, sec1, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iter
             xi1_new = xi1 - (a22 * g1 - a12 * g2) / det
             xi2_new = xi2 - (-a21 * g1 + a11 * g2) / det
         if _same(xi1_new, xi1) and _same(xi2_new, xi2):
-            return xi1_new, xi2_new
+            return xi1_new, xi2_new, sec1, sec2, _same(at1, xi1_new), _same(at2, xi2_new)
         xi1, xi2 = xi1_new, xi2_new
-    return xi1, xi2
+    return xi1, xi2, sec1, sec2, _same(at1, xi1), _same(at2, xi2)
 
 
 @jit_callee
@@ -1179,10 +1190,12 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
     side1, side2 = _element_side(Xp, 0, S[0], cache[0], need), _element_side(Xp, 2, S[1], cache[1], need)
     RA1, xA1, u1, w1 = side1
     RA2, xA2, u2, w2 = side2
-    xi1, xi2 = _project(kind, RA1, xA1, u1, w1, par[XI1], RA2, xA2, u2, w2, par[XI2])
+    xi1, xi2, sec1, sec2, at1, at2 = _project_kept(kind, _section_inline(RA1, xA1, u1, w1, par[XI1]), RA1, xA1, u1,
+                                                   w1, par[XI1], RA2, xA2, u2, w2, par[XI2], 2)
     co1, co2 = _coefficients(scale(xi1, w1)), _coefficients(scale(xi2, w2))
-    RC, xC, _, _ = _section_co(RA1, xA1, u1, w1, xi1, co1[0], co1[1])
-    RF, xF, _, _ = _section_co(RA2, xA2, u2, w2, xi2, co2[0], co2[1])
+    # the projection's last sections where they are at the projected point (the same operations as ``_section_co``)
+    RC, xC, _, _ = sec1 if at1 else _section_co(RA1, xA1, u1, w1, xi1, co1[0], co1[1])
+    RF, xF, _, _ = sec2 if at2 else _section_co(RA2, xA2, u2, w2, xi2, co2[0], co2[1])
     S1, S2 = S[0], S[1]
     if tangent:
         _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, G)
