@@ -126,12 +126,6 @@ def _section_inline(RA, xA, u, w, xi):
 
 
 @jit_callee
-def _exp(u, w):
-    """``_exp_inline`` as a function of its own (one copy of the maths, called where not inlined)."""
-    return _exp_inline(u, w)
-
-
-@jit_callee
 def _section(RA, xA, u, w, xi):
     """Pose of ``H_A exp(xi h)``, ``x' = R u`` and ``x'' = R (w x u)`` (``frames.section``)."""
     return _section_inline(RA, xA, u, w, xi)
@@ -149,7 +143,7 @@ def _coefficients(w):
 
 @jit_callee
 def _exp_co(u, w, t2, co):
-    """``_exp`` with the coefficients of ``_coefficients(w)``."""
+    """``exp(hat(u, w))`` (``_exp_inline``) with the coefficients of ``_coefficients(w)``."""
     return _exp_abc(u, w, t2, co[0], co[1], co[2])
 
 
@@ -201,18 +195,16 @@ def _mm_ut(A, B, out):
 
 
 @jit_callee
+def _exp(u, w):
+    """``_exp_inline`` as a function of its own (one copy of the maths, called where not inlined)."""
+    return _exp_inline(u, w)
+
+
+@jit_callee
 def _tangent(u, w, T):
     """``T = T(h) = [[T3, Q(-u, -w)], [0, T3]]`` (``se3.tangent``), ``(6, 6)``."""
-    t2 = dot(w, w)
-    t = np.sqrt(t2)
-    b, c = coefficient(B_, t), coefficient(C_, t)
-    T3 = add_outer(mat(scale(-b, w), 1.0 - c * t2), scale(c, w), w)
-    Q = q_matrix(scale(-1.0, u), scale(-1.0, w), dot(w, u), cross(w, u), t2, c, coefficient(Q2_, t),
-                 coefficient(Q3_, t))
-    _put3(T, 0, 0, T3)
-    _put3(T, 3, 3, T3)
-    _put3(T, 0, 3, Q)
-    _zero3(T, 3, 0)
+    t2, co = _coefficients_exp_tangent(w)
+    _tangent_co(u, w, T, t2, co)
 
 
 @jit_callee
@@ -232,10 +224,14 @@ def _tangent_inv(u, w, T):
     """``T = T(h)^-1 = [[Ti, -Ti Q(-u, -w) Ti], [0, Ti]]`` (``se3.tangent_inv``), ``(6, 6)``."""
     t2 = dot(w, w)
     t = np.sqrt(t2)
-    c = coefficient(C_, t)
-    Ti = ti_matrix(w, coefficient(D_, t), t2)
-    Q = q_matrix(scale(-1.0, u), scale(-1.0, w), dot(w, u), cross(w, u), t2, c, coefficient(Q2_, t),
-                 coefficient(Q3_, t))
+    _tangent_inv_co(u, w, T, t2, coefficient(C_, t), coefficient(D_, t), coefficient(Q2_, t), coefficient(Q3_, t))
+
+
+@jit_callee
+def _tangent_inv_co(u, w, T, t2, c, d, q2, q3):
+    """``_tangent_inv`` given ``t2 = |w|^2`` and the coefficients ``c, d, q2, q3`` at ``|w|``."""
+    Ti = ti_matrix(w, d, t2)
+    Q = q_matrix(scale(-1.0, u), scale(-1.0, w), dot(w, u), cross(w, u), t2, c, q2, q3)
     X = mm(mm(Ti, Q), Ti)
     _put3(T, 0, 0, Ti)
     _put3(T, 3, 3, Ti)
@@ -279,10 +275,11 @@ N_G = sum(_SIZES.values())
 
 
 @jit_callee
-def _side(u, w, S):
-    """``T(h)^-1`` and ``Ad(exp(-h))`` of an element twist into ``S[S_TI]``, ``S[S_AH]``."""
-    _tangent_inv(u, w, S[S_TI])
-    Rh, xh = _exp(u, w)
+def _side(u, w, S, t2, co, d):
+    """``T(h)^-1`` and ``Ad(exp(-h))`` of an element twist into ``S[S_TI]``, ``S[S_AH]``; ``t2, co = _coefficients(w)``,
+    ``d`` the coefficient ``d`` at ``|w|``."""
+    _tangent_inv_co(u, w, S[S_TI], t2, co[2], d, co[3], co[4])
+    Rh, xh = _exp_co(u, w, t2, co)
     _adjoint_inv(Rh, xh, S[S_AH])
 
 
@@ -521,19 +518,30 @@ def _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, G):
     a22 = dot(x2p, x2p) + dot(d, x2pp)
     det = a11 * a22 - a12 * a21
     det = det if det != 0.0 else 1.0
-    for k in range(24):
-        dxC, dxF = _rot_col(RC, G, G_VC, k), _rot_col(RF, G, G_VF, k)     # position variations
-        rel = (dxF[0] - dxC[0], dxF[1] - dxC[1], dxF[2] - dxC[2])
-        # g2 = d . x2' (orthogonal / point), at fixed xi
-        g2 = dot(x2p, rel) + _col_dot(c2, G, G_VF + 3, k) + _col_dot(dF, G, G_DH2, k)
-        if kind == LINE:
+    # one loop over the columns per kind (branch-free: vectorised; a kind's loop computes only what it uses)
+    if kind == LINE:
+        for k in range(24):
+            rel = _relative_col(RC, RF, G, k)
             g = dot(e1, rel) - dC[2] * G[(G_VC + 4) * W + k] + dC[1] * G[(G_VC + 5) * W + k]
             G[G_DXI1 * W + k], G[G_DXI2 * W + k] = 0.0, -g / jl
-        elif kind == ORTHOGONAL:
+    elif kind == ORTHOGONAL:
+        for k in range(24):
+            rel = _relative_col(RC, RF, G, k)
+            g2 = dot(x2p, rel) + _col_dot(c2, G, G_VF + 3, k) + _col_dot(dF, G, G_DH2, k)
             G[G_DXI1 * W + k], G[G_DXI2 * W + k] = 0.0, -g2 / jo
-        else:
+    else:
+        for k in range(24):
+            rel = _relative_col(RC, RF, G, k)
+            g2 = dot(x2p, rel) + _col_dot(c2, G, G_VF + 3, k) + _col_dot(dF, G, G_DH2, k)
             g1 = dot(x1p, rel) + _col_dot(c1, G, G_VC + 3, k) + _col_dot(dC, G, G_DH1, k)
             G[G_DXI1 * W + k], G[G_DXI2 * W + k] = -(a22 * g1 - a12 * g2) / det, -(-a21 * g1 + a11 * g2) / det
+
+
+@jit_callee
+def _relative_col(RC, RF, G, k):
+    """Column ``k`` of the variation of ``d = x_F - x_C`` at fixed ``xi`` (rows ``G_VC``, ``G_VF`` of ``G``)."""
+    dxC, dxF = _rot_col(RC, G, G_VC, k), _rot_col(RF, G, G_VF, k)
+    return (dxF[0] - dxC[0], dxF[1] - dxC[1], dxF[2] - dxC[2])
 
 
 # ---------------------------------------------------------------- one side of a pair: element, section, Jacobians
@@ -563,24 +571,21 @@ def _element_side(Xp, j0, S, c, need=2):
     if hit:
         return RA, xA, (c[C_U], c[C_U + 1], c[C_U + 2]), (c[C_W], c[C_W + 1], c[C_W + 2])
     RB, xB = _pose_of(Xp, j0 + 1)
-    u, w, _, _ = log_relative(RA, xA, RB, xB)
+    u, w, _, d = log_relative(RA, xA, RB, xB)        # (``d`` at ``|w|``, as ``T(h)^-1`` takes it)
     for i in range(3):
         c[C_U + i], c[C_W + i] = u[i], w[i]
     if need == 0:
         return RA, xA, u, w
-    _side(u, w, S)
+    t2, co = _coefficients(w)       # each coefficient once (``T(h)^-1``, ``exp(h)``, ``T(-h)``, ``F(h, .)`` share them)
+    _side(u, w, S, t2, co, d)
     if need == 1:
         return RA, xA, u, w
     _mm_ut(S[S_TI], S[S_AH], S[S_TIAH])
-    _tangent(scale(-1.0, u), scale(-1.0, w), S[S_TMH])
-    t2 = dot(w, w)
-    t = np.sqrt(t2)
-    co = (coefficient(C_, t), coefficient(Q2_, t), coefficient(Q3_, t), coefficient(CP_, t), coefficient(Q2P_, t),
-          coefficient(Q3P_, t))
+    _tangent_co(scale(-1.0, u), scale(-1.0, w), S[S_TMH], t2, co)     # (|-w|^2 = |w|^2: the same floats)
     c[C_T2] = t2
-    c[C_A], c[C_B] = coefficient(A_, t), coefficient(B_, t)
+    c[C_A], c[C_B] = co[0], co[1]
     for i in range(6):
-        c[C_CO + i] = co[i]
+        c[C_CO + i] = co[2 + i]
     return RA, xA, u, w
 
 
