@@ -267,10 +267,10 @@ N_VEC = 3
 # is a constant; a variable index is a branch that stops the vectorisation).
 W = 24
 _SIZES = dict(VC=6, VF=6, DH1=6, DH2=6, DWC=6, DWF=6, DN=3, DT1=3, DT2=3, DF=3, DMF=3, DSLIP=2, DLP=2, DPREV=2,
-              DTR=2, DXI1=1, DXI2=1, DDIST=1, DLAM=1, DPT=1)
+              DTR=2, DXI1=1, DXI2=1, DDIST=1, DLAM=1, DPT=1, WQ=2)
 _OFFSETS = dict(zip(_SIZES, np.cumsum([0] + list(_SIZES.values()))[:-1].tolist()))
 (G_VC, G_VF, G_DH1, G_DH2, G_DWC, G_DWF, G_DN, G_DT1, G_DT2, G_DF, G_DMF, G_DSLIP, G_DLP, G_DPREV, G_DTR, G_DXI1,
- G_DXI2, G_DDIST, G_DLAM, G_DPT) = _OFFSETS.values()
+ G_DXI2, G_DDIST, G_DLAM, G_DPT, G_WQ) = _OFFSETS.values()
 N_G = sum(_SIZES.values())
 
 
@@ -608,18 +608,26 @@ def _variations(S, c0, G, DH, V):
 
 # ---------------------------------------------------------------- 3-vectors with gradients (3, 24)
 @jit_callee
-def _axes(RC, xC, RF, xF, G):
-    """``n, t1, t2`` (``frames.axes``), centre distance, and the gradients of ``n, t1, t2, dist``
-    into ``G`` (rows ``G_DN``, ``G_DT1``, ``G_DT2``, ``G_DDIST``; one pass over the 24 columns)."""
+def _axes_value(RC, xC, RF, xF):
+    """``n, t1, t2`` (``frames.axes``), centre distance, ``c = e1 . n`` and ``|e1 - c n|`` (``_axes`` without the
+    gradients)."""
     d = add(xF, scale(-1.0, xC))
     dist = np.sqrt(dot(d, d))
     n = scale(1.0 / dist, d)
-    e1, e2, e3 = _col(RC, 0), _col(RC, 1), _col(RC, 2)
+    e1 = _col(RC, 0)
     c = dot(e1, n)
     t1r = add(e1, scale(-c, n))
     lt = np.sqrt(dot(t1r, t1r))
     t1 = scale(1.0 / lt, t1r)
-    t2 = cross(n, t1)
+    return n, t1, cross(n, t1), dist, c, lt
+
+
+@jit_callee
+def _axes(RC, xC, RF, xF, G):
+    """``n, t1, t2`` (``frames.axes``), centre distance, and the gradients of ``n, t1, t2, dist``
+    into ``G`` (rows ``G_DN``, ``G_DT1``, ``G_DT2``, ``G_DDIST``; one pass over the 24 columns)."""
+    n, t1, t2, dist, c, lt = _axes_value(RC, xC, RF, xF)
+    e1, e2, e3 = _col(RC, 0), _col(RC, 1), _col(RC, 2)
     for k in range(24):
         dF = mv(RF, (G[G_VF * W + k], G[(G_VF + 1) * W + k], G[(G_VF + 2) * W + k]))
         dC = mv(RC, (G[G_VC * W + k], G[(G_VC + 1) * W + k], G[(G_VC + 2) * W + k]))
@@ -968,10 +976,9 @@ def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, G, DXI, DW,
 
 @jit_callee
 def _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2):
-    """``HL, HK, HC, HF`` (``frames.contact_frames``)."""
+    """``HL, HK, HC, HF`` (``frames.contact_frames``); each entry written once."""
     for k in range(4):
-        frames[k, :, :] = 0.0
-        frames[k, 3, 3] = 1.0
+        frames[k, 3, 0], frames[k, 3, 1], frames[k, 3, 2], frames[k, 3, 3] = 0.0, 0.0, 0.0, 1.0
     for i in range(3):
         for k in range(2):
             frames[k, i, 0], frames[k, i, 1], frames[k, i, 2] = n[i], t1[i], t2[i]
@@ -1174,6 +1181,38 @@ def _copy_rows(G, rows):
         rows[11, k] = G[G_DLAM * W + k]
 
 
+@jit_callee
+def _forces_four(n, t1, t2, lam, wgt, RC, RF, R1, R2, S1, S2, f, p, G):
+    """``f[q, p]`` ``(4, 6)`` at the four tractions ``T = 0, e_x, e_y, e_z`` without tangent, the operations of each
+    traction's forces-only pass of ``_point_mortar`` (``_wrench_value``, ``_nodal_forces``) side by side: the four
+    wrenches into the rows ``G_WQ`` of ``G`` (``[side, l, q]``, the tractions innermost), then each nodal force's four
+    sums at once (vectorised; each lane its traction's sum, in its order).  ``(F, lt)`` of the last, ``e_z``."""
+    RCt, RFt = transpose(RC), transpose(RF)
+    F, lt = (0.0, 0.0, 0.0), (0.0, 0.0)
+    for q in range(4):
+        lamp = (1.0 if q == 1 else 0.0, 1.0 if q == 2 else 0.0, 1.0 if q == 3 else 0.0)
+        lt = (dot(lamp, t1), dot(lamp, t2))
+        F = add(scale(-wgt * lam, n), add(scale(wgt * lt[0], t1), scale(wgt * lt[1], t2)))
+        mF = cross(n, F)
+        for side in range(2):
+            Rt, Fs, m = (RCt, F, scale(R1, mF)) if side == 0 else (RFt, scale(-1.0, F), scale(R2, mF))
+            bF, bm = mv(Rt, Fs), mv(Rt, m)
+            for i in range(3):
+                G[G_WQ * W + (6 * side + i) * 4 + q] = bF[i]
+                G[G_WQ * W + (6 * side + 3 + i) * 4 + q] = bm[i]
+    for side in range(2):
+        S = S1 if side == 0 else S2
+        for s in range(2):
+            for i in range(6):
+                a0, a1, a2, a3 = 0.0, 0.0, 0.0, 0.0
+                for l in range(6):
+                    j, r = S[S_JA + s, l, i], G_WQ * W + (6 * side + l) * 4
+                    a0, a1, a2, a3 = a0 + j * G[r], a1 + j * G[r + 1], a2 + j * G[r + 2], a3 + j * G[r + 3]
+                f[0, p, 2 * side + s, i], f[1, p, 2 * side + s, i] = a0, a1
+                f[2, p, 2 * side + s, i], f[3, p, 2 * side + s, i] = a2, a3
+    return F, lt
+
+
 def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, flags, frames, ws, rows, Tp, spare):
     """``_point`` of the mortar kernel at the four given tractions ``T = 0, e_x, e_y, e_z`` (``mortar_terms``):
     the geometry, projection, slip and their gradients once, then per traction what depends on it (the
@@ -1207,13 +1246,15 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
     elif not data:       # forces only (``mortar_forces``: an empty ``K``): the Jacobians, no variations, no gradient rows
         _jacobians(u1, w1, xi1, co1[0], co1[1], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB], S1[S_TMP])
         _jacobians(u2, w2, xi2, co2[0], co2[1], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB], S2[S_TMP])
-    n, t1, t2, dist = _axes(RC, xC, RF, xF, G)
+    # (without the tangent no pass reads the gradient rows: the axes' and the normal law's are not formed)
+    n, t1, t2, dist = _axes(RC, xC, RF, xF, G) if tangent else _axes_value(RC, xC, RF, xF)[:4]
     R1, R2, wgt = par[R1_], par[R2_], par[WEIGHT]
     gap = dist - R1 - R2
     touching = 0.0 < gap <= par[TOUCH]          # round-off of a touching pair's gap: touching (reference.touching_gap)
     lam, dlam, active = _normal_law(0.0 if touching else gap, par[PENALTY], par[MULT], par[SMOOTH])  # make_kernel
-    for k in range(24):
-        G[G_DLAM * W + k] = dlam * G[G_DDIST * W + k]
+    if tangent:
+        for k in range(24):
+            G[G_DLAM * W + k] = dlam * G[G_DDIST * W + k]
     slip = (0.0, 0.0)
     if has and not tangent:
         slip = _slip_value(side1, side2, (xi1, RC, xC), (xi2, RF, xF), par[XI1P], par[XI2P], HCL, HFK, HLKp)
@@ -1229,8 +1270,11 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
     contracted = tangent and K.shape[0] < 4       # 2: at T = 0 and at Tp; 1: at Tp only
     _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2)     # (the geometry's: once, not per traction)
     F, lt, stick = (0.0, 0.0, 0.0), (0.0, 0.0), True
+    four = not data and (not tangent or K.shape[0] == 1)      # the four tractions' forces without tangent
     for step in range(0 if data else 5 if contracted else 4):
         q = step if not contracted else (0, 4, 1, 2, 3)[step]         # the unit tractions last (the point data)
+        if four and q < 4:          # (after the loop, side by side)
+            continue
         lamp = (1.0 if q == 1 else 0.0, 1.0 if q == 2 else 0.0, 1.0 if q == 3 else 0.0) if q < 4 else \
             (Tp[0], Tp[1], Tp[2])
         fq = f[q, p] if q < 4 else spare[1]
@@ -1273,6 +1317,9 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
             _wrench(RF, scale(-1.0, F), True, scale(R2, mF), R2, G, G_VF, G_DWF, v[1, V_WR])
             _nodal(u1, w1, xi1, co1[0], co1[1], S1, v[0], cache[0], G, G_DWC, G_DH1, G_DXI1, fq, Kq, 0)
             _nodal(u2, w2, xi2, co2[0], co2[1], S2, v[1], cache[1], G, G_DWF, G_DH2, G_DXI2, fq, Kq, 2)
+    if four:
+        F, lt = _forces_four(n, t1, t2, lam, wgt, RC, RF, R1, R2, S1, S2, f, p, G)
+        stick = True
     # the point data as the last traction's pass left them (written once)
     sc[0], sc[1], sc[2], sc[3] = gap, lam, xi1, xi2
     for i in range(3):
