@@ -926,52 +926,57 @@ def _nodal(u, w, xi, t2, co, S, v, c, G, DW, DH, DXI, f, K, j0):
     _jacobian_derivatives(u, w, xi, t2, co, S, v, c)
     for s in range(2):
         J, D, dd = (S[S_JA], S[S_DA], v[V_DA]) if s == 0 else (S[S_JB], S[S_DB], v[V_DB])
-        r0 = 6 * (j0 + s)
         for i in range(3):                      # force rows: J[3:, :3] == 0 (block upper triangular)
             f[j0 + s, i] = J[0, i] * wr[0] + J[1, i] * wr[1] + J[2, i] * wr[2]
-            _tangent_row(J[0, i], J[1, i], J[2, i], 0.0, 0.0, 0.0, D[i, 0], D[i, 1], D[i, 2], D[i, 3], D[i, 4],
-                         D[i, 5], dd[i], G, DXI, DW, DH, True, K[r0 + i])
         for i in range(3, 6):                   # moment rows
             acc = 0.0
             for l in range(6):
                 acc += J[l, i] * wr[l]
             f[j0 + s, i] = acc
-            _tangent_row(J[0, i], J[1, i], J[2, i], J[3, i], J[4, i], J[5, i], D[i, 0], D[i, 1], D[i, 2], D[i, 3],
-                         D[i, 4], D[i, 5], dd[i], G, DXI, DW, DH, False, K[r0 + i])
+        _node_rows(J, D, dd, G, DXI, DW, DH, K, 6 * (j0 + s))
 
 
 @jit_callee
-def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, G, DXI, DW, DH, force, out):
-    """One row of the tangent: ``out[c] = di dxi[c] + sum_l (j_l Dw[l, c] + d_l Dh[l, c])``, summed in this
-    order (``dxi``, ``Dw``, ``Dh``: the rows ``DXI``, ``DW``, ``DH`` of ``G``).  ``force`` (a constant at each
-    call): a force row, whose ``j3, j4, j5`` (``J[3:, :3] == 0``) and ``d0, d1, d2`` (the zero upper-left block
-    of ``d(J^T wr)/dh``, ``_jacobian_derivatives``) are structural zeros: their terms, exact zeros, are
-    skipped.  ``Dh`` is zero outside the side's columns: its terms there, exact zeros, change a sum only
-    in the sign of a zero result (``_mm_ut``), and keep the loop branch-free over all 24 columns, which the
-    compiler vectorises (with a runtime check that ``out`` and ``G`` do not overlap, refused in loops of fewer
-    than 16 iterations)."""
+def _node_rows(J, D, dd, G, DXI, DW, DH, K, r0):
+    """The six rows ``K[r0:r0+6]`` of one node's tangent, ``J``, ``D``, ``dd`` its ``J``, ``d(J^T wr)/dh``,
+    ``d(J^T wr)/dxi``: ``K[r0 + i, c] = dd[i] dxi[c] + sum_l (J[l, i] Dw[l, c] + D[i, l] Dh[l, c])``, summed in this
+    order (``dxi``, ``Dw``, ``Dh``: the rows ``DXI``, ``DW``, ``DH`` of ``G``; one function for the six rows: a call
+    per row cost about as much as its sums).  A force row's ``J[3:, i]`` (``J[3:, :3] == 0``) and ``D[i, :3]`` (the
+    zero upper-left block of ``d(J^T wr)/dh``, ``_jacobian_derivatives``) are structural zeros: their terms, exact
+    zeros, are skipped.  ``Dh`` is zero outside the side's columns: its terms there, exact zeros, change a sum only
+    in the sign of a zero result (``_mm_ut``), and keep the loops branch-free over all 24 columns, which the
+    compiler vectorises (with a runtime check that ``K`` and ``G`` do not overlap, refused in loops of fewer than
+    16 iterations)."""
     x, w, h = DXI * W, DW * W, DH * W           # first entries of the rows
-    for c in range(24):
-        acc = di * G[x + c]
-        acc += j0 * G[w + c]
-        if not force:
+    for i in range(3):                          # force rows
+        di, j0, j1, j2, d3, d4, d5 = dd[i], J[0, i], J[1, i], J[2, i], D[i, 3], D[i, 4], D[i, 5]
+        for c in range(24):
+            acc = di * G[x + c]
+            acc += j0 * G[w + c]
+            acc += j1 * G[w + W + c]
+            acc += j2 * G[w + 2 * W + c]
+            acc += d3 * G[h + 3 * W + c]
+            acc += d4 * G[h + 4 * W + c]
+            acc += d5 * G[h + 5 * W + c]
+            K[r0 + i, c] = acc
+    for i in range(3, 6):                       # moment rows
+        di, j0, j1, j2, j3, j4, j5 = dd[i], J[0, i], J[1, i], J[2, i], J[3, i], J[4, i], J[5, i]
+        d0, d1, d2, d3, d4, d5 = D[i, 0], D[i, 1], D[i, 2], D[i, 3], D[i, 4], D[i, 5]
+        for c in range(24):
+            acc = di * G[x + c]
+            acc += j0 * G[w + c]
             acc += d0 * G[h + c]
-        acc += j1 * G[w + W + c]
-        if not force:
+            acc += j1 * G[w + W + c]
             acc += d1 * G[h + W + c]
-        acc += j2 * G[w + 2 * W + c]
-        if not force:
+            acc += j2 * G[w + 2 * W + c]
             acc += d2 * G[h + 2 * W + c]
-        if not force:
             acc += j3 * G[w + 3 * W + c]
-        acc += d3 * G[h + 3 * W + c]
-        if not force:
+            acc += d3 * G[h + 3 * W + c]
             acc += j4 * G[w + 4 * W + c]
-        acc += d4 * G[h + 4 * W + c]
-        if not force:
+            acc += d4 * G[h + 4 * W + c]
             acc += j5 * G[w + 5 * W + c]
-        acc += d5 * G[h + 5 * W + c]
-        out[c] = acc
+            acc += d5 * G[h + 5 * W + c]
+            K[r0 + i, c] = acc
 
 
 @jit_callee
