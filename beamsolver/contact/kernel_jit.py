@@ -1191,7 +1191,9 @@ def _forces_four(n, t1, t2, lam, wgt, RC, RF, R1, R2, S1, S2, f, p, G):
     """``f[q, p]`` ``(4, 6)`` at the four tractions ``T = 0, e_x, e_y, e_z`` without tangent, the operations of each
     traction's forces-only pass of ``_point_mortar`` (``_wrench_value``, ``_nodal_forces``) side by side: the four
     wrenches into the rows ``G_WQ`` of ``G`` (``[side, l, q]``, the tractions innermost), then each nodal force's four
-    sums at once (vectorised; each lane its traction's sum, in its order).  ``(F, lt)`` of the last, ``e_z``."""
+    sums at once (vectorised; each lane its traction's sum, in its order), stored as ``mortar_terms``' differences
+    ``f[q] - f[0]`` for ``q`` = 1, 2, 3 (the subtraction of ``_point_mortar``'s end, done here).  ``(F, lt)`` of the
+    last, ``e_z``."""
     RCt, RFt = transpose(RC), transpose(RF)
     F, lt = (0.0, 0.0, 0.0), (0.0, 0.0)
     for q in range(4):
@@ -1213,8 +1215,8 @@ def _forces_four(n, t1, t2, lam, wgt, RC, RF, R1, R2, S1, S2, f, p, G):
                 for l in range(6):
                     j, r = S[S_JA + s, l, i], G_WQ * W + (6 * side + l) * 4
                     a0, a1, a2, a3 = a0 + j * G[r], a1 + j * G[r + 1], a2 + j * G[r + 2], a3 + j * G[r + 3]
-                f[0, p, 2 * side + s, i], f[1, p, 2 * side + s, i] = a0, a1
-                f[2, p, 2 * side + s, i], f[3, p, 2 * side + s, i] = a2, a3
+                f[0, p, 2 * side + s, i], f[1, p, 2 * side + s, i] = a0, a1 - a0
+                f[2, p, 2 * side + s, i], f[3, p, 2 * side + s, i] = a2 - a0, a3 - a0
     return F, lt
 
 
@@ -1249,8 +1251,11 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
     if tangent:
         _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, G)
     elif not data:       # forces only (``mortar_forces``: an empty ``K``): the Jacobians, no variations, no gradient rows
-        _jacobians(u1, w1, xi1, co1[0], co1[1], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB], S1[S_TMP])
-        _jacobians(u2, w2, xi2, co2[0], co2[1], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB], S2[S_TMP])
+        # (the five coefficients they take: the others' sums are left out)
+        _jacobians(u1, w1, xi1, co1[0], co1[1][:5], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB],
+                   S1[S_TMP])
+        _jacobians(u2, w2, xi2, co2[0], co2[1][:5], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB],
+                   S2[S_TMP])
     # (without the tangent no pass reads the gradient rows: the axes' and the normal law's are not formed)
     n, t1, t2, dist = _axes(RC, xC, RF, xF, G) if tangent else _axes_value(RC, xC, RF, xF)[:4]
     R1, R2, wgt = par[R1_], par[R2_], par[WEIGHT]
@@ -1332,10 +1337,11 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
     two[0, 0], two[0, 1], two[1, 0], two[1, 1] = lt[0], lt[1], slip[0], slip[1]
     flags[0], flags[1] = active, stick
     for q in range(1, 1 if data else 4):     # the differences to T = 0: the friction's parts (``mortar_terms``)
-        fq, f0 = f[q, p], f[0, p]
-        for i in range(4):
-            for j in range(6):
-                fq[i, j] -= f0[i, j]
+        if not four:        # (``_forces_four`` stores them)
+            fq, f0 = f[q, p], f[0, p]
+            for i in range(4):
+                for j in range(6):
+                    fq[i, j] -= f0[i, j]
         if tangent and ((q == 1 and K.shape[0] == 2) or not contracted):
             Kq, K0 = K[q, p], K[0, p]
             for i in range(24):
