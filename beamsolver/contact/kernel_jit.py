@@ -201,6 +201,28 @@ def _exp(u, w):
 
 
 @jit_callee
+def _mm_ut_scaled(A, B, x, out):
+    """``out = (A @ B) x`` (``_mm_ut``'s sums, each times ``x``)."""
+    for i in range(6):
+        for j in range(6):
+            acc = 0.0
+            for l in range(3 if i >= 3 else 0, 3 if j < 3 else 6):
+                acc += A[i, l] * B[l, j]
+            out[i, j] = acc * x
+
+
+@jit_callee
+def _minus_mm_ut(C, A, B, out):
+    """``out = C - A @ B`` (``_mm_ut``'s sums)."""
+    for i in range(6):
+        for j in range(6):
+            acc = 0.0
+            for l in range(3 if i >= 3 else 0, 3 if j < 3 else 6):
+                acc += A[i, l] * B[l, j]
+            out[i, j] = C[i, j] - acc
+
+
+@jit_callee
 def _tangent(u, w, T):
     """``T = T(h) = [[T3, Q(-u, -w)], [0, T3]]`` (``se3.tangent``), ``(6, 6)``."""
     t2, co = _coefficients_exp_tangent(w)
@@ -253,9 +275,9 @@ def _adjoint_inv(R, x, A):
 
 # ---------------------------------------------------------------- one side of a pair: scratch slots
 # 6x6 slots of a side's scratch ``S`` (N_SIDE, 6, 6)
-(S_TI, S_AH, S_TS, S_AS, S_JA, S_JB, S_TMP, S_DA, S_DB, S_TMH, S_TIAH) = range(11)
+(S_TI, S_AH, S_TS, S_AS, S_JA, S_JB, S_DA, S_DB, S_TMH, S_TIAH) = range(10)
 assert S_JB == S_JA + 1      # (``_nodal_forces``)
-N_SIDE = 11
+N_SIDE = 10
 # 6-vector slots of a side's ``v`` (N_VEC, 6)
 (V_WR, V_DB, V_DA) = range(3)
 N_VEC = 3
@@ -284,21 +306,15 @@ def _side(u, w, S, t2, co, d):
 
 
 @jit_callee
-def _jacobians(u, w, xi, t2, co, Ti, Ah, Ts, As, JA, JB, tmp):
+def _jacobians(u, w, xi, t2, co, Ti, Ah, Ts, As, JA, JB):
     """``J_A, J_B`` of ``H_C = H_A exp(xi h)`` (``frames.node_jacobians``); ``Ti = T(h)^-1``,
     ``Ah = Ad(exp(-h))``; also ``Ts = T(xi h)`` and ``As = Ad(exp(-xi h))``; ``t2, co = _coefficients(xi w)``."""
     su, sw = scale(xi, u), scale(xi, w)
     _tangent_co(su, sw, Ts, t2, co)
-    _mm_ut(Ts, Ti, JB)
-    for i in range(6):
-        for j in range(6):
-            JB[i, j] *= xi
+    _mm_ut_scaled(Ts, Ti, xi, JB)
     Rs, xs = _exp_co(su, sw, t2, co)
     _adjoint_inv(Rs, xs, As)
-    _mm_ut(JB, Ah, tmp)
-    for i in range(6):
-        for j in range(6):
-            JA[i, j] = As[i, j] - tmp[i, j]
+    _minus_mm_ut(As, JB, Ah, JA)
 
 
 @jit_callee
@@ -1000,8 +1016,8 @@ def _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, d, S1, S
     gradients (``G_DXI1``, ``G_DXI2``) and the section-frame variations (``G_VC``, ``G_VF``, 6 rows each);
     ``S1``, ``S2`` hold the elements' ``T(h)^-1``, ``Ad(exp(-h))`` (``_element_side``); ``co1``, ``co2``:
     ``_coefficients(xi w)`` of the sides."""
-    _jacobians(u1, w1, xi1, co1[0], co1[1], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB], S1[S_TMP])
-    _jacobians(u2, w2, xi2, co2[0], co2[1], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB], S2[S_TMP])
+    _jacobians(u1, w1, xi1, co1[0], co1[1], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB])
+    _jacobians(u2, w2, xi2, co2[0], co2[1], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB])
     _variations(S1, 0, G, G_DH1, G_VC)
     _variations(S2, 12, G, G_DH2, G_VF)
     _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, G)
@@ -1049,8 +1065,8 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
     if K.shape[1] > 0:
         _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, G)
     else:       # forces only (``contact_kernel``: an empty ``K``): the Jacobians, no variations (their rows stay 0)
-        _jacobians(u1, w1, xi1, co1[0], co1[1], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB], S1[S_TMP])
-        _jacobians(u2, w2, xi2, co2[0], co2[1], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB], S2[S_TMP])
+        _jacobians(u1, w1, xi1, co1[0], co1[1], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB])
+        _jacobians(u2, w2, xi2, co2[0], co2[1], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB])
     n, t1, t2, dist = _axes(RC, xC, RF, xF, G)
     R1, R2, wgt = par[R1_], par[R2_], par[WEIGHT]
     gap = dist - R1 - R2
@@ -1252,10 +1268,8 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
         _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, G)
     elif not data:       # forces only (``mortar_forces``: an empty ``K``): the Jacobians, no variations, no gradient rows
         # (the five coefficients they take: the others' sums are left out)
-        _jacobians(u1, w1, xi1, co1[0], co1[1][:5], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB],
-                   S1[S_TMP])
-        _jacobians(u2, w2, xi2, co2[0], co2[1][:5], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB],
-                   S2[S_TMP])
+        _jacobians(u1, w1, xi1, co1[0], co1[1][:5], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB])
+        _jacobians(u2, w2, xi2, co2[0], co2[1][:5], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB])
     # (without the tangent no pass reads the gradient rows: the axes' and the normal law's are not formed)
     n, t1, t2, dist = _axes(RC, xC, RF, xF, G) if tangent else _axes_value(RC, xC, RF, xF)[:4]
     R1, R2, wgt = par[R1_], par[R2_], par[WEIGHT]
