@@ -567,7 +567,7 @@ C_POSE, C_U, C_W, C_T2, C_A, C_B, C_CO, N_CACHE = 0, 24, 27, 30, 31, 32, 33, 39
 
 
 @jit_callee
-def _element_side(Xp, j0, S, c, need=2):
+def _element_side(Xp, j0, S, c, need):
     """Twist ``h = log(H_A^-1 H_B)`` of the element of nodes ``j0, j0 + 1`` and the element's quantities:
     ``T(h)^-1``, ``Ad(exp(-h))``, ``T(h)^-1 Ad(exp(-h))``, ``T(-h)`` into ``S[S_TI], S[S_AH], S[S_TIAH],
     S[S_TMH]`` and the coefficients of ``F(h, .)`` into ``c``.  Kept while the node poses are those of the last
@@ -1054,7 +1054,8 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
     """Forces ``f (4, 6)``, tangent ``K (24, 24)`` and point data of one contact point; ``ws``: the
     scratch arrays of ``_scratch``."""
     S, v, G, cache = ws
-    side1, side2 = _element_side(Xp, 0, S[0], cache[0]), _element_side(Xp, 2, S[1], cache[1])
+    need = 2 if friction or K.shape[1] > 0 else 1       # (the slip's gradient rows take ``T(h)^-1 Ad(exp(-h))``)
+    side1, side2 = _element_side(Xp, 0, S[0], cache[0], need), _element_side(Xp, 2, S[1], cache[1], need)
     RA1, xA1, u1, w1 = side1
     RA2, xA2, u2, w2 = side2
     xi1, xi2 = _project(kind, RA1, xA1, u1, w1, par[XI1], RA2, xA2, u2, w2, par[XI2])
