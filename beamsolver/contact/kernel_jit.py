@@ -126,12 +126,6 @@ def _section_inline(RA, xA, u, w, xi):
 
 
 @jit_callee
-def _exp(u, w):
-    """``_exp_inline`` as a function of its own (one copy of the maths, called where not inlined)."""
-    return _exp_inline(u, w)
-
-
-@jit_callee
 def _section(RA, xA, u, w, xi):
     """Pose of ``H_A exp(xi h)``, ``x' = R u`` and ``x'' = R (w x u)`` (``frames.section``)."""
     return _section_inline(RA, xA, u, w, xi)
@@ -149,7 +143,7 @@ def _coefficients(w):
 
 @jit_callee
 def _exp_co(u, w, t2, co):
-    """``_exp`` with the coefficients of ``_coefficients(w)``."""
+    """``exp(hat(u, w))`` (``_exp_inline``) with the coefficients of ``_coefficients(w)``."""
     return _exp_abc(u, w, t2, co[0], co[1], co[2])
 
 
@@ -201,18 +195,38 @@ def _mm_ut(A, B, out):
 
 
 @jit_callee
+def _exp(u, w):
+    """``_exp_inline`` as a function of its own (one copy of the maths, called where not inlined)."""
+    return _exp_inline(u, w)
+
+
+@jit_callee
+def _mm_ut_scaled(A, B, x, out):
+    """``out = (A @ B) x`` (``_mm_ut``'s sums, each times ``x``)."""
+    for i in range(6):
+        for j in range(6):
+            acc = 0.0
+            for l in range(3 if i >= 3 else 0, 3 if j < 3 else 6):
+                acc += A[i, l] * B[l, j]
+            out[i, j] = acc * x
+
+
+@jit_callee
+def _minus_mm_ut(C, A, B, out):
+    """``out = C - A @ B`` (``_mm_ut``'s sums)."""
+    for i in range(6):
+        for j in range(6):
+            acc = 0.0
+            for l in range(3 if i >= 3 else 0, 3 if j < 3 else 6):
+                acc += A[i, l] * B[l, j]
+            out[i, j] = C[i, j] - acc
+
+
+@jit_callee
 def _tangent(u, w, T):
     """``T = T(h) = [[T3, Q(-u, -w)], [0, T3]]`` (``se3.tangent``), ``(6, 6)``."""
-    t2 = dot(w, w)
-    t = np.sqrt(t2)
-    b, c = coefficient(B_, t), coefficient(C_, t)
-    T3 = add_outer(mat(scale(-b, w), 1.0 - c * t2), scale(c, w), w)
-    Q = q_matrix(scale(-1.0, u), scale(-1.0, w), dot(w, u), cross(w, u), t2, c, coefficient(Q2_, t),
-                 coefficient(Q3_, t))
-    _put3(T, 0, 0, T3)
-    _put3(T, 3, 3, T3)
-    _put3(T, 0, 3, Q)
-    _zero3(T, 3, 0)
+    t2, co = _coefficients_exp_tangent(w)
+    _tangent_co(u, w, T, t2, co)
 
 
 @jit_callee
@@ -232,10 +246,14 @@ def _tangent_inv(u, w, T):
     """``T = T(h)^-1 = [[Ti, -Ti Q(-u, -w) Ti], [0, Ti]]`` (``se3.tangent_inv``), ``(6, 6)``."""
     t2 = dot(w, w)
     t = np.sqrt(t2)
-    c = coefficient(C_, t)
-    Ti = ti_matrix(w, coefficient(D_, t), t2)
-    Q = q_matrix(scale(-1.0, u), scale(-1.0, w), dot(w, u), cross(w, u), t2, c, coefficient(Q2_, t),
-                 coefficient(Q3_, t))
+    _tangent_inv_co(u, w, T, t2, coefficient(C_, t), coefficient(D_, t), coefficient(Q2_, t), coefficient(Q3_, t))
+
+
+@jit_callee
+def _tangent_inv_co(u, w, T, t2, c, d, q2, q3):
+    """``_tangent_inv`` given ``t2 = |w|^2`` and the coefficients ``c, d, q2, q3`` at ``|w|``."""
+    Ti = ti_matrix(w, d, t2)
+    Q = q_matrix(scale(-1.0, u), scale(-1.0, w), dot(w, u), cross(w, u), t2, c, q2, q3)
     X = mm(mm(Ti, Q), Ti)
     _put3(T, 0, 0, Ti)
     _put3(T, 3, 3, Ti)
@@ -257,8 +275,9 @@ def _adjoint_inv(R, x, A):
 
 # ---------------------------------------------------------------- one side of a pair: scratch slots
 # 6x6 slots of a side's scratch ``S`` (N_SIDE, 6, 6)
-(S_TI, S_AH, S_TS, S_AS, S_JA, S_JB, S_TMP, S_DA, S_DB, S_TMH, S_TIAH) = range(11)
-N_SIDE = 11
+(S_TI, S_AH, S_TS, S_AS, S_JA, S_JB, S_DA, S_DB, S_TMH, S_TIAH) = range(10)
+assert S_JB == S_JA + 1      # (``_nodal_forces``)
+N_SIDE = 10
 # 6-vector slots of a side's ``v`` (N_VEC, 6)
 (V_WR, V_DB, V_DA) = range(3)
 N_VEC = 3
@@ -270,37 +289,32 @@ N_VEC = 3
 # is a constant; a variable index is a branch that stops the vectorisation).
 W = 24
 _SIZES = dict(VC=6, VF=6, DH1=6, DH2=6, DWC=6, DWF=6, DN=3, DT1=3, DT2=3, DF=3, DMF=3, DSLIP=2, DLP=2, DPREV=2,
-              DTR=2, DXI1=1, DXI2=1, DDIST=1, DLAM=1, DPT=1)
+              DTR=2, DXI1=1, DXI2=1, DDIST=1, DLAM=1, DPT=1, WQ=2)
 _OFFSETS = dict(zip(_SIZES, np.cumsum([0] + list(_SIZES.values()))[:-1].tolist()))
 (G_VC, G_VF, G_DH1, G_DH2, G_DWC, G_DWF, G_DN, G_DT1, G_DT2, G_DF, G_DMF, G_DSLIP, G_DLP, G_DPREV, G_DTR, G_DXI1,
- G_DXI2, G_DDIST, G_DLAM, G_DPT) = _OFFSETS.values()
+ G_DXI2, G_DDIST, G_DLAM, G_DPT, G_WQ) = _OFFSETS.values()
 N_G = sum(_SIZES.values())
 
 
 @jit_callee
-def _side(u, w, S):
-    """``T(h)^-1`` and ``Ad(exp(-h))`` of an element twist into ``S[S_TI]``, ``S[S_AH]``."""
-    _tangent_inv(u, w, S[S_TI])
-    Rh, xh = _exp(u, w)
+def _side(u, w, S, t2, co, d):
+    """``T(h)^-1`` and ``Ad(exp(-h))`` of an element twist into ``S[S_TI]``, ``S[S_AH]``; ``t2, co = _coefficients(w)``,
+    ``d`` the coefficient ``d`` at ``|w|``."""
+    _tangent_inv_co(u, w, S[S_TI], t2, co[2], d, co[3], co[4])
+    Rh, xh = _exp_co(u, w, t2, co)
     _adjoint_inv(Rh, xh, S[S_AH])
 
 
 @jit_callee
-def _jacobians(u, w, xi, t2, co, Ti, Ah, Ts, As, JA, JB, tmp):
+def _jacobians(u, w, xi, t2, co, Ti, Ah, Ts, As, JA, JB):
     """``J_A, J_B`` of ``H_C = H_A exp(xi h)`` (``frames.node_jacobians``); ``Ti = T(h)^-1``,
     ``Ah = Ad(exp(-h))``; also ``Ts = T(xi h)`` and ``As = Ad(exp(-xi h))``; ``t2, co = _coefficients(xi w)``."""
     su, sw = scale(xi, u), scale(xi, w)
     _tangent_co(su, sw, Ts, t2, co)
-    _mm_ut(Ts, Ti, JB)
-    for i in range(6):
-        for j in range(6):
-            JB[i, j] *= xi
+    _mm_ut_scaled(Ts, Ti, xi, JB)
     Rs, xs = _exp_co(su, sw, t2, co)
     _adjoint_inv(Rs, xs, As)
-    _mm_ut(JB, Ah, tmp)
-    for i in range(6):
-        for j in range(6):
-            JA[i, j] = As[i, j] - tmp[i, j]
+    _minus_mm_ut(As, JB, Ah, JA)
 
 
 @jit_callee
@@ -445,12 +459,23 @@ def _project(kind, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations=2):
 @jit_callee
 def _project_from(kind, sec1, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations):
     """``_project`` given the slave section ``sec1 = _section(RA1, xA1, u1, w1, xi1)`` (a caller that has it)."""
+    return _project_kept(kind, sec1, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations)[:2]
+
+
+@jit_callee
+def _project_kept(kind, sec1, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iterations):
+    """``_project_from`` and the last sections it computed: ``(xi1, xi2, sec1, sec2, at1, at2)``; ``at1``, ``at2``:
+    ``sec1``, ``sec2`` are the sections at the returned ``xi1``, ``xi2`` (computed at them, bit for bit: the same
+    floats as a new ``_section`` there)."""
     moving = kind != LINE and kind != ORTHOGONAL
     R1, x1, x1p, x1pp = sec1
+    sec2, at1, at2 = sec1, xi1, np.nan        # (``sec2``: a placeholder until the first iteration)
     for it in range(iterations):
         if moving and it > 0:
-            R1, x1, x1p, x1pp = _section_inline(RA1, xA1, u1, w1, xi1)
-        R2, x2, x2p, x2pp = _section_inline(RA2, xA2, u2, w2, xi2)
+            sec1, at1 = _section_inline(RA1, xA1, u1, w1, xi1), xi1
+            R1, x1, x1p, x1pp = sec1
+        sec2, at2 = _section_inline(RA2, xA2, u2, w2, xi2), xi2
+        R2, x2, x2p, x2pp = sec2
         d = add(x2, scale(-1.0, x1))
         e1 = _col(R1, 0)
         xi1_new, xi2_new = xi1, xi2
@@ -470,9 +495,9 @@ def _project_from(kind, sec1, RA1, xA1, u1, w1, xi1, RA2, xA2, u2, w2, xi2, iter
             xi1_new = xi1 - (a22 * g1 - a12 * g2) / det
             xi2_new = xi2 - (-a21 * g1 + a11 * g2) / det
         if _same(xi1_new, xi1) and _same(xi2_new, xi2):
-            return xi1_new, xi2_new
+            return xi1_new, xi2_new, sec1, sec2, _same(at1, xi1_new), _same(at2, xi2_new)
         xi1, xi2 = xi1_new, xi2_new
-    return xi1, xi2
+    return xi1, xi2, sec1, sec2, _same(at1, xi1), _same(at2, xi2)
 
 
 @jit_callee
@@ -509,19 +534,30 @@ def _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, G):
     a22 = dot(x2p, x2p) + dot(d, x2pp)
     det = a11 * a22 - a12 * a21
     det = det if det != 0.0 else 1.0
-    for k in range(24):
-        dxC, dxF = _rot_col(RC, G, G_VC, k), _rot_col(RF, G, G_VF, k)     # position variations
-        rel = (dxF[0] - dxC[0], dxF[1] - dxC[1], dxF[2] - dxC[2])
-        # g2 = d . x2' (orthogonal / point), at fixed xi
-        g2 = dot(x2p, rel) + _col_dot(c2, G, G_VF + 3, k) + _col_dot(dF, G, G_DH2, k)
-        if kind == LINE:
+    # one loop over the columns per kind (branch-free: vectorised; a kind's loop computes only what it uses)
+    if kind == LINE:
+        for k in range(24):
+            rel = _relative_col(RC, RF, G, k)
             g = dot(e1, rel) - dC[2] * G[(G_VC + 4) * W + k] + dC[1] * G[(G_VC + 5) * W + k]
             G[G_DXI1 * W + k], G[G_DXI2 * W + k] = 0.0, -g / jl
-        elif kind == ORTHOGONAL:
+    elif kind == ORTHOGONAL:
+        for k in range(24):
+            rel = _relative_col(RC, RF, G, k)
+            g2 = dot(x2p, rel) + _col_dot(c2, G, G_VF + 3, k) + _col_dot(dF, G, G_DH2, k)
             G[G_DXI1 * W + k], G[G_DXI2 * W + k] = 0.0, -g2 / jo
-        else:
+    else:
+        for k in range(24):
+            rel = _relative_col(RC, RF, G, k)
+            g2 = dot(x2p, rel) + _col_dot(c2, G, G_VF + 3, k) + _col_dot(dF, G, G_DH2, k)
             g1 = dot(x1p, rel) + _col_dot(c1, G, G_VC + 3, k) + _col_dot(dC, G, G_DH1, k)
             G[G_DXI1 * W + k], G[G_DXI2 * W + k] = -(a22 * g1 - a12 * g2) / det, -(-a21 * g1 + a11 * g2) / det
+
+
+@jit_callee
+def _relative_col(RC, RF, G, k):
+    """Column ``k`` of the variation of ``d = x_F - x_C`` at fixed ``xi`` (rows ``G_VC``, ``G_VF`` of ``G``)."""
+    dxC, dxF = _rot_col(RC, G, G_VC, k), _rot_col(RF, G, G_VF, k)
+    return (dxF[0] - dxC[0], dxF[1] - dxC[1], dxF[2] - dxC[2])
 
 
 # ---------------------------------------------------------------- one side of a pair: element, section, Jacobians
@@ -531,12 +567,13 @@ C_POSE, C_U, C_W, C_T2, C_A, C_B, C_CO, N_CACHE = 0, 24, 27, 30, 31, 32, 33, 39
 
 
 @jit_callee
-def _element_side(Xp, j0, S, c):
+def _element_side(Xp, j0, S, c, need):
     """Twist ``h = log(H_A^-1 H_B)`` of the element of nodes ``j0, j0 + 1`` and the element's quantities:
     ``T(h)^-1``, ``Ad(exp(-h))``, ``T(h)^-1 Ad(exp(-h))``, ``T(-h)`` into ``S[S_TI], S[S_AH], S[S_TIAH],
     S[S_TMH]`` and the coefficients of ``F(h, .)`` into ``c``.  Kept while the node poses are those of the last
     point on this side, bit for bit (the Gauss points of a slave element, consecutive points on one master
-    element): the same floats."""
+    element): the same floats.  ``need`` (one value for a whole batch: the kept quantities are those it asks
+    for): 2 all, 1 the node Jacobians' ``T(h)^-1``, ``Ad(exp(-h))`` (forces only), 0 the twist alone (point data)."""
     hit = True
     for a in range(2):
         for i in range(3):
@@ -550,20 +587,21 @@ def _element_side(Xp, j0, S, c):
     if hit:
         return RA, xA, (c[C_U], c[C_U + 1], c[C_U + 2]), (c[C_W], c[C_W + 1], c[C_W + 2])
     RB, xB = _pose_of(Xp, j0 + 1)
-    u, w, _, _ = log_relative(RA, xA, RB, xB)
-    _side(u, w, S)
-    _mm_ut(S[S_TI], S[S_AH], S[S_TIAH])
-    _tangent(scale(-1.0, u), scale(-1.0, w), S[S_TMH])
-    t2 = dot(w, w)
-    t = np.sqrt(t2)
-    co = (coefficient(C_, t), coefficient(Q2_, t), coefficient(Q3_, t), coefficient(CP_, t), coefficient(Q2P_, t),
-          coefficient(Q3P_, t))
+    u, w, _, d = log_relative(RA, xA, RB, xB)        # (``d`` at ``|w|``, as ``T(h)^-1`` takes it)
     for i in range(3):
         c[C_U + i], c[C_W + i] = u[i], w[i]
+    if need == 0:
+        return RA, xA, u, w
+    t2, co = _coefficients(w)       # each coefficient once (``T(h)^-1``, ``exp(h)``, ``T(-h)``, ``F(h, .)`` share them)
+    _side(u, w, S, t2, co, d)
+    if need == 1:
+        return RA, xA, u, w
+    _mm_ut(S[S_TI], S[S_AH], S[S_TIAH])
+    _tangent_co(scale(-1.0, u), scale(-1.0, w), S[S_TMH], t2, co)     # (|-w|^2 = |w|^2: the same floats)
     c[C_T2] = t2
-    c[C_A], c[C_B] = coefficient(A_, t), coefficient(B_, t)
+    c[C_A], c[C_B] = co[0], co[1]
     for i in range(6):
-        c[C_CO + i] = co[i]
+        c[C_CO + i] = co[2 + i]
     return RA, xA, u, w
 
 
@@ -586,18 +624,26 @@ def _variations(S, c0, G, DH, V):
 
 # ---------------------------------------------------------------- 3-vectors with gradients (3, 24)
 @jit_callee
-def _axes(RC, xC, RF, xF, G):
-    """``n, t1, t2`` (``frames.axes``), centre distance, and the gradients of ``n, t1, t2, dist``
-    into ``G`` (rows ``G_DN``, ``G_DT1``, ``G_DT2``, ``G_DDIST``; one pass over the 24 columns)."""
+def _axes_value(RC, xC, RF, xF):
+    """``n, t1, t2`` (``frames.axes``), centre distance, ``c = e1 . n`` and ``|e1 - c n|`` (``_axes`` without the
+    gradients)."""
     d = add(xF, scale(-1.0, xC))
     dist = np.sqrt(dot(d, d))
     n = scale(1.0 / dist, d)
-    e1, e2, e3 = _col(RC, 0), _col(RC, 1), _col(RC, 2)
+    e1 = _col(RC, 0)
     c = dot(e1, n)
     t1r = add(e1, scale(-c, n))
     lt = np.sqrt(dot(t1r, t1r))
     t1 = scale(1.0 / lt, t1r)
-    t2 = cross(n, t1)
+    return n, t1, cross(n, t1), dist, c, lt
+
+
+@jit_callee
+def _axes(RC, xC, RF, xF, G):
+    """``n, t1, t2`` (``frames.axes``), centre distance, and the gradients of ``n, t1, t2, dist``
+    into ``G`` (rows ``G_DN``, ``G_DT1``, ``G_DT2``, ``G_DDIST``; one pass over the 24 columns)."""
+    n, t1, t2, dist, c, lt = _axes_value(RC, xC, RF, xF)
+    e1, e2, e3 = _col(RC, 0), _col(RC, 1), _col(RC, 2)
     for k in range(24):
         dF = mv(RF, (G[G_VF * W + k], G[(G_VF + 1) * W + k], G[(G_VF + 2) * W + k]))
         dC = mv(RC, (G[G_VC * W + k], G[(G_VC + 1) * W + k], G[(G_VC + 2) * W + k]))
@@ -727,6 +773,34 @@ def _slip_rows(row1, row2, R, xt, sign, prev, xip, S, D, c0):
 
 
 @jit_callee
+def _section_pose_prev(RA, xA, u, w, xi, R, x, xip):
+    """``_section_prev``'s section pose ``(R, x)`` at ``xip`` alone (the same operations; ``_slip_value``: no
+    Jacobian factors, whose coefficients and ``T(s)`` a call that is not inlined computes all the same)."""
+    if _same(xip, xi):
+        return R, x
+    su, sw = scale(xip, u), scale(xip, w)
+    t2 = dot(sw, sw)
+    t = np.sqrt(t2)
+    Rs, xs = _exp_abc(su, sw, t2, coefficient(A_, t), coefficient(B_, t), coefficient(C_, t))
+    return mm(RA, Rs), add(mv(RA, xs), xA)
+
+
+@jit_callee
+def _material_frames(R1, x1, R2, x2, HCL, HFK, HLKp):
+    """``H_CL``, ``H_FK``, ``H_LK`` now and ``dy = log(H_LK_prev^-1 H_LK)`` (its ``u``, ``w``) from the sections
+    ``(R1, x1)``, ``(R2, x2)`` at ``xi_prev``."""
+    RCL, xCL = _pose4(HCL)
+    RFK, xFK = _pose4(HFK)
+    RL, xL = _compose(R1, x1, RCL, xCL)
+    RK, xK = _compose(R2, x2, RFK, xFK)
+    RLt = transpose(RL)
+    RLK, xLK = mm(RLt, RK), mv(RLt, add(xK, scale(-1.0, xL)))
+    RP, xP = _pose4(HLKp)
+    dyu, dyw, _, _ = log_relative(RP, xP, RLK, xLK)
+    return RCL, xCL, RFK, xFK, RLK, xLK, dyu, dyw
+
+
+@jit_callee
 def _slip_frames(side1, side2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp):
     """The material frames of ``_slip``: the sections at ``xi_prev`` (``prev1``, ``prev2``), ``H_CL``, ``H_FK``,
     ``H_LK`` now and ``dy = log(H_LK_prev^-1 H_LK)`` (its ``u``, ``w``)."""
@@ -736,15 +810,7 @@ def _slip_frames(side1, side2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp):
     xi2, RF, xF = sec2
     prev1 = _section_prev(RA1, xA1, u1, w1, xi1, RC, xC, xi1p)
     prev2 = _section_prev(RA2, xA2, u2, w2, xi2, RF, xF, xi2p)
-    RCL, xCL = _pose4(HCL)
-    RFK, xFK = _pose4(HFK)
-    RL, xL = _compose(prev1[1], prev1[2], RCL, xCL)
-    RK, xK = _compose(prev2[1], prev2[2], RFK, xFK)
-    RLt = transpose(RL)
-    RLK, xLK = mm(RLt, RK), mv(RLt, add(xK, scale(-1.0, xL)))
-    RP, xP = _pose4(HLKp)
-    dyu, dyw, _, _ = log_relative(RP, xP, RLK, xLK)
-    return prev1, prev2, RCL, xCL, RFK, xFK, RLK, xLK, dyu, dyw
+    return (prev1, prev2) + _material_frames(prev1[1], prev1[2], prev2[1], prev2[2], HCL, HFK, HLKp)
 
 
 @jit_callee
@@ -767,7 +833,13 @@ def _slip(side1, side2, S1, S2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp, D):
 @jit_callee
 def _slip_value(side1, side2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp):
     """``_slip``'s value alone (the same operations, no gradient)."""
-    dyu = _slip_frames(side1, side2, sec1, sec2, xi1p, xi2p, HCL, HFK, HLKp)[8]
+    RA1, xA1, u1, w1 = side1
+    RA2, xA2, u2, w2 = side2
+    xi1, RC, xC = sec1
+    xi2, RF, xF = sec2
+    R1, x1 = _section_pose_prev(RA1, xA1, u1, w1, xi1, RC, xC, xi1p)
+    R2, x2 = _section_pose_prev(RA2, xA2, u2, w2, xi2, RF, xF, xi2p)
+    dyu = _material_frames(R1, x1, R2, x2, HCL, HFK, HLKp)[6]
     return (dyu[1], dyu[2])
 
 
@@ -847,77 +919,87 @@ def _wrench(R, F, neg, m, sm, G, V, DW, w):
 
 
 @jit_callee
+def _nodal_forces(S, v, f, j0):
+    """``f_j = J_j^T wr`` (``wr = v[V_WR]``, ``J`` in ``S[S_JA]``, ``S[S_JB]``) of the two nodes of one side, rows
+    ``j0, j0 + 1`` of ``f`` ``(4, 6)``: ``_nodal``'s forces only, small enough to be inlined (no views)."""
+    for s in range(2):
+        for i in range(6):
+            acc = 0.0
+            for l in range(6):
+                acc += S[S_JA + s, l, i] * v[V_WR, l]
+            f[j0 + s, i] = acc
+
+
+@jit_callee
 def _nodal(u, w, xi, t2, co, S, v, c, G, DW, DH, DXI, f, K, j0):
     """``f_j = J_j^T wr`` (``wr = v[V_WR]``) for the two nodes of one side and their rows of the tangent:
     ``J^T dwr + d(J^T wr)/dh dh + d(J^T wr)/dxi dxi`` (rows ``DW``, ``DH``, ``DXI`` of ``G``; ``dh`` is zero
     outside the side's columns); forces only for an empty ``K`` (``contact_kernel``)."""
-    wr = v[V_WR]
     if K.shape[1] == 0:
-        for s in range(2):
-            J = S[S_JA] if s == 0 else S[S_JB]
-            for i in range(6):
-                acc = 0.0
-                for l in range(6):
-                    acc += J[l, i] * wr[l]
-                f[j0 + s, i] = acc
+        _nodal_forces(S, v, f, j0)
         return
+    wr = v[V_WR]
     _jacobian_derivatives(u, w, xi, t2, co, S, v, c)
     for s in range(2):
         J, D, dd = (S[S_JA], S[S_DA], v[V_DA]) if s == 0 else (S[S_JB], S[S_DB], v[V_DB])
-        r0 = 6 * (j0 + s)
         for i in range(3):                      # force rows: J[3:, :3] == 0 (block upper triangular)
             f[j0 + s, i] = J[0, i] * wr[0] + J[1, i] * wr[1] + J[2, i] * wr[2]
-            _tangent_row(J[0, i], J[1, i], J[2, i], 0.0, 0.0, 0.0, D[i, 0], D[i, 1], D[i, 2], D[i, 3], D[i, 4],
-                         D[i, 5], dd[i], G, DXI, DW, DH, True, K[r0 + i])
         for i in range(3, 6):                   # moment rows
             acc = 0.0
             for l in range(6):
                 acc += J[l, i] * wr[l]
             f[j0 + s, i] = acc
-            _tangent_row(J[0, i], J[1, i], J[2, i], J[3, i], J[4, i], J[5, i], D[i, 0], D[i, 1], D[i, 2], D[i, 3],
-                         D[i, 4], D[i, 5], dd[i], G, DXI, DW, DH, False, K[r0 + i])
+        _node_rows(J, D, dd, G, DXI, DW, DH, K, 6 * (j0 + s))
 
 
 @jit_callee
-def _tangent_row(j0, j1, j2, j3, j4, j5, d0, d1, d2, d3, d4, d5, di, G, DXI, DW, DH, force, out):
-    """One row of the tangent: ``out[c] = di dxi[c] + sum_l (j_l Dw[l, c] + d_l Dh[l, c])``, summed in this
-    order (``dxi``, ``Dw``, ``Dh``: the rows ``DXI``, ``DW``, ``DH`` of ``G``).  ``force`` (a constant at each
-    call): a force row, whose ``j3, j4, j5`` (``J[3:, :3] == 0``) and ``d0, d1, d2`` (the zero upper-left block
-    of ``d(J^T wr)/dh``, ``_jacobian_derivatives``) are structural zeros: their terms, exact zeros, are
-    skipped.  ``Dh`` is zero outside the side's columns: its terms there, exact zeros, change a sum only
-    in the sign of a zero result (``_mm_ut``), and keep the loop branch-free over all 24 columns, which the
-    compiler vectorises (with a runtime check that ``out`` and ``G`` do not overlap, refused in loops of fewer
-    than 16 iterations)."""
+def _node_rows(J, D, dd, G, DXI, DW, DH, K, r0):
+    """The six rows ``K[r0:r0+6]`` of one node's tangent, ``J``, ``D``, ``dd`` its ``J``, ``d(J^T wr)/dh``,
+    ``d(J^T wr)/dxi``: ``K[r0 + i, c] = dd[i] dxi[c] + sum_l (J[l, i] Dw[l, c] + D[i, l] Dh[l, c])``, summed in this
+    order (``dxi``, ``Dw``, ``Dh``: the rows ``DXI``, ``DW``, ``DH`` of ``G``; one function for the six rows: a call
+    per row cost about as much as its sums).  A force row's ``J[3:, i]`` (``J[3:, :3] == 0``) and ``D[i, :3]`` (the
+    zero upper-left block of ``d(J^T wr)/dh``, ``_jacobian_derivatives``) are structural zeros: their terms, exact
+    zeros, are skipped.  ``Dh`` is zero outside the side's columns: its terms there, exact zeros, change a sum only
+    in the sign of a zero result (``_mm_ut``), and keep the loops branch-free over all 24 columns, which the
+    compiler vectorises (with a runtime check that ``K`` and ``G`` do not overlap, refused in loops of fewer than
+    16 iterations)."""
     x, w, h = DXI * W, DW * W, DH * W           # first entries of the rows
-    for c in range(24):
-        acc = di * G[x + c]
-        acc += j0 * G[w + c]
-        if not force:
+    for i in range(3):                          # force rows
+        di, j0, j1, j2, d3, d4, d5 = dd[i], J[0, i], J[1, i], J[2, i], D[i, 3], D[i, 4], D[i, 5]
+        for c in range(24):
+            acc = di * G[x + c]
+            acc += j0 * G[w + c]
+            acc += j1 * G[w + W + c]
+            acc += j2 * G[w + 2 * W + c]
+            acc += d3 * G[h + 3 * W + c]
+            acc += d4 * G[h + 4 * W + c]
+            acc += d5 * G[h + 5 * W + c]
+            K[r0 + i, c] = acc
+    for i in range(3, 6):                       # moment rows
+        di, j0, j1, j2, j3, j4, j5 = dd[i], J[0, i], J[1, i], J[2, i], J[3, i], J[4, i], J[5, i]
+        d0, d1, d2, d3, d4, d5 = D[i, 0], D[i, 1], D[i, 2], D[i, 3], D[i, 4], D[i, 5]
+        for c in range(24):
+            acc = di * G[x + c]
+            acc += j0 * G[w + c]
             acc += d0 * G[h + c]
-        acc += j1 * G[w + W + c]
-        if not force:
+            acc += j1 * G[w + W + c]
             acc += d1 * G[h + W + c]
-        acc += j2 * G[w + 2 * W + c]
-        if not force:
+            acc += j2 * G[w + 2 * W + c]
             acc += d2 * G[h + 2 * W + c]
-        if not force:
             acc += j3 * G[w + 3 * W + c]
-        acc += d3 * G[h + 3 * W + c]
-        if not force:
+            acc += d3 * G[h + 3 * W + c]
             acc += j4 * G[w + 4 * W + c]
-        acc += d4 * G[h + 4 * W + c]
-        if not force:
+            acc += d4 * G[h + 4 * W + c]
             acc += j5 * G[w + 5 * W + c]
-        acc += d5 * G[h + 5 * W + c]
-        out[c] = acc
+            acc += d5 * G[h + 5 * W + c]
+            K[r0 + i, c] = acc
 
 
 @jit_callee
 def _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2):
-    """``HL, HK, HC, HF`` (``frames.contact_frames``)."""
+    """``HL, HK, HC, HF`` (``frames.contact_frames``); each entry written once."""
     for k in range(4):
-        frames[k, :, :] = 0.0
-        frames[k, 3, 3] = 1.0
+        frames[k, 3, 0], frames[k, 3, 1], frames[k, 3, 2], frames[k, 3, 3] = 0.0, 0.0, 0.0, 1.0
     for i in range(3):
         for k in range(2):
             frames[k, i, 0], frames[k, i, 1], frames[k, i, 2] = n[i], t1[i], t2[i]
@@ -934,8 +1016,8 @@ def _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, d, S1, S
     gradients (``G_DXI1``, ``G_DXI2``) and the section-frame variations (``G_VC``, ``G_VF``, 6 rows each);
     ``S1``, ``S2`` hold the elements' ``T(h)^-1``, ``Ad(exp(-h))`` (``_element_side``); ``co1``, ``co2``:
     ``_coefficients(xi w)`` of the sides."""
-    _jacobians(u1, w1, xi1, co1[0], co1[1], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB], S1[S_TMP])
-    _jacobians(u2, w2, xi2, co2[0], co2[1], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB], S2[S_TMP])
+    _jacobians(u1, w1, xi1, co1[0], co1[1], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB])
+    _jacobians(u2, w2, xi2, co2[0], co2[1], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB])
     _variations(S1, 0, G, G_DH1, G_VC)
     _variations(S2, 12, G, G_DH2, G_VF)
     _projection_gradient(kind, RC, u1, w1, RF, u2, w2, d, G)
@@ -972,7 +1054,8 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
     """Forces ``f (4, 6)``, tangent ``K (24, 24)`` and point data of one contact point; ``ws``: the
     scratch arrays of ``_scratch``."""
     S, v, G, cache = ws
-    side1, side2 = _element_side(Xp, 0, S[0], cache[0]), _element_side(Xp, 2, S[1], cache[1])
+    need = 2 if friction or K.shape[1] > 0 else 1       # (the slip's gradient rows take ``T(h)^-1 Ad(exp(-h))``)
+    side1, side2 = _element_side(Xp, 0, S[0], cache[0], need), _element_side(Xp, 2, S[1], cache[1], need)
     RA1, xA1, u1, w1 = side1
     RA2, xA2, u2, w2 = side2
     xi1, xi2 = _project(kind, RA1, xA1, u1, w1, par[XI1], RA2, xA2, u2, w2, par[XI2])
@@ -983,8 +1066,8 @@ def _point(Xp, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, vec, tw
     if K.shape[1] > 0:
         _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, G)
     else:       # forces only (``contact_kernel``: an empty ``K``): the Jacobians, no variations (their rows stay 0)
-        _jacobians(u1, w1, xi1, co1[0], co1[1], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB], S1[S_TMP])
-        _jacobians(u2, w2, xi2, co2[0], co2[1], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB], S2[S_TMP])
+        _jacobians(u1, w1, xi1, co1[0], co1[1], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB])
+        _jacobians(u2, w2, xi2, co2[0], co2[1], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB])
     n, t1, t2, dist = _axes(RC, xC, RF, xF, G)
     R1, R2, wgt = par[R1_], par[R2_], par[WEIGHT]
     gap = dist - R1 - R2
@@ -1105,6 +1188,55 @@ def _evaluate_rows(X, kind, par, has, HCL, HFK, HLKp, lamp, friction, f, K, sc, 
     own[0][0, 0, 0, 0] = 0.0
 
 
+@jit_callee
+def _copy_rows(G, rows):
+    """The gradient rows a mortar evaluation exports (``_evaluate_rows``) from ``G`` into ``rows`` ``(N_ROWS, 24)``,
+    row by row (contiguous writes: a column at a time wrote 12 streams of cache lines, 1000 cycles a point)."""
+    for i in range(9):
+        for k in range(24):
+            rows[i, k] = G[(G_DN + i) * W + k]
+    for k in range(24):
+        rows[9, k] = G[G_DSLIP * W + k]
+    for k in range(24):
+        rows[10, k] = G[(G_DSLIP + 1) * W + k]
+    for k in range(24):
+        rows[11, k] = G[G_DLAM * W + k]
+
+
+@jit_callee
+def _forces_four(n, t1, t2, lam, wgt, RC, RF, R1, R2, S1, S2, f, p, G):
+    """``f[q, p]`` ``(4, 6)`` at the four tractions ``T = 0, e_x, e_y, e_z`` without tangent, the operations of each
+    traction's forces-only pass of ``_point_mortar`` (``_wrench_value``, ``_nodal_forces``) side by side: the four
+    wrenches into the rows ``G_WQ`` of ``G`` (``[side, l, q]``, the tractions innermost), then each nodal force's four
+    sums at once (vectorised; each lane its traction's sum, in its order), stored as ``mortar_terms``' differences
+    ``f[q] - f[0]`` for ``q`` = 1, 2, 3 (the subtraction of ``_point_mortar``'s end, done here).  ``(F, lt)`` of the
+    last, ``e_z``."""
+    RCt, RFt = transpose(RC), transpose(RF)
+    F, lt = (0.0, 0.0, 0.0), (0.0, 0.0)
+    for q in range(4):
+        lamp = (1.0 if q == 1 else 0.0, 1.0 if q == 2 else 0.0, 1.0 if q == 3 else 0.0)
+        lt = (dot(lamp, t1), dot(lamp, t2))
+        F = add(scale(-wgt * lam, n), add(scale(wgt * lt[0], t1), scale(wgt * lt[1], t2)))
+        mF = cross(n, F)
+        for side in range(2):
+            Rt, Fs, m = (RCt, F, scale(R1, mF)) if side == 0 else (RFt, scale(-1.0, F), scale(R2, mF))
+            bF, bm = mv(Rt, Fs), mv(Rt, m)
+            for i in range(3):
+                G[G_WQ * W + (6 * side + i) * 4 + q] = bF[i]
+                G[G_WQ * W + (6 * side + 3 + i) * 4 + q] = bm[i]
+    for side in range(2):
+        S = S1 if side == 0 else S2
+        for s in range(2):
+            for i in range(6):
+                a0, a1, a2, a3 = 0.0, 0.0, 0.0, 0.0
+                for l in range(6):
+                    j, r = S[S_JA + s, l, i], G_WQ * W + (6 * side + l) * 4
+                    a0, a1, a2, a3 = a0 + j * G[r], a1 + j * G[r + 1], a2 + j * G[r + 2], a3 + j * G[r + 3]
+                f[0, p, 2 * side + s, i], f[1, p, 2 * side + s, i] = a0, a1 - a0
+                f[2, p, 2 * side + s, i], f[3, p, 2 * side + s, i] = a2 - a0, a3 - a0
+    return F, lt
+
+
 def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, flags, frames, ws, rows, Tp, spare):
     """``_point`` of the mortar kernel at the four given tractions ``T = 0, e_x, e_y, e_z`` (``mortar_terms``):
     the geometry, projection, slip and their gradients once, then per traction what depends on it (the
@@ -1120,28 +1252,34 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
     ``lam_t``, ``stick`` and force ``F`` are zeros and True, not the last pass's).
     ``spare``: an empty ``(0, 0)`` and a ``(4, 6)`` scratch.  A template (``make_kernel``)."""
     S, v, G, cache = ws
-    side1, side2 = _element_side(Xp, 0, S[0], cache[0]), _element_side(Xp, 2, S[1], cache[1])
-    RA1, xA1, u1, w1 = side1
-    RA2, xA2, u2, w2 = side2
-    xi1, xi2 = _project(kind, RA1, xA1, u1, w1, par[XI1], RA2, xA2, u2, w2, par[XI2])
-    co1, co2 = _coefficients(scale(xi1, w1)), _coefficients(scale(xi2, w2))
-    RC, xC, _, _ = _section_co(RA1, xA1, u1, w1, xi1, co1[0], co1[1])
-    RF, xF, _, _ = _section_co(RA2, xA2, u2, w2, xi2, co2[0], co2[1])
-    S1, S2 = S[0], S[1]
     tangent = K.shape[2] > 0
     data = f.shape[0] == 0          # point data only (``mortar_data``: no forces, no tangent)
+    need = 2 if tangent else 0 if data else 1
+    side1, side2 = _element_side(Xp, 0, S[0], cache[0], need), _element_side(Xp, 2, S[1], cache[1], need)
+    RA1, xA1, u1, w1 = side1
+    RA2, xA2, u2, w2 = side2
+    xi1, xi2, sec1, sec2, at1, at2 = _project_kept(kind, _section_inline(RA1, xA1, u1, w1, par[XI1]), RA1, xA1, u1,
+                                                   w1, par[XI1], RA2, xA2, u2, w2, par[XI2], 2)
+    co1, co2 = _coefficients(scale(xi1, w1)), _coefficients(scale(xi2, w2))
+    # the projection's last sections where they are at the projected point (the same operations as ``_section_co``)
+    RC, xC, _, _ = sec1 if at1 else _section_co(RA1, xA1, u1, w1, xi1, co1[0], co1[1])
+    RF, xF, _, _ = sec2 if at2 else _section_co(RA2, xA2, u2, w2, xi2, co2[0], co2[1])
+    S1, S2 = S[0], S[1]
     if tangent:
         _frame_variations(u1, w1, xi1, co1, u2, w2, xi2, co2, kind, RC, RF, add(xF, scale(-1.0, xC)), S1, S2, G)
     elif not data:       # forces only (``mortar_forces``: an empty ``K``): the Jacobians, no variations, no gradient rows
-        _jacobians(u1, w1, xi1, co1[0], co1[1], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB], S1[S_TMP])
-        _jacobians(u2, w2, xi2, co2[0], co2[1], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB], S2[S_TMP])
-    n, t1, t2, dist = _axes(RC, xC, RF, xF, G)
+        # (the five coefficients they take: the others' sums are left out)
+        _jacobians(u1, w1, xi1, co1[0], co1[1][:5], S1[S_TI], S1[S_AH], S1[S_TS], S1[S_AS], S1[S_JA], S1[S_JB])
+        _jacobians(u2, w2, xi2, co2[0], co2[1][:5], S2[S_TI], S2[S_AH], S2[S_TS], S2[S_AS], S2[S_JA], S2[S_JB])
+    # (without the tangent no pass reads the gradient rows: the axes' and the normal law's are not formed)
+    n, t1, t2, dist = _axes(RC, xC, RF, xF, G) if tangent else _axes_value(RC, xC, RF, xF)[:4]
     R1, R2, wgt = par[R1_], par[R2_], par[WEIGHT]
     gap = dist - R1 - R2
     touching = 0.0 < gap <= par[TOUCH]          # round-off of a touching pair's gap: touching (reference.touching_gap)
     lam, dlam, active = _normal_law(0.0 if touching else gap, par[PENALTY], par[MULT], par[SMOOTH])  # make_kernel
-    for k in range(24):
-        G[G_DLAM * W + k] = dlam * G[G_DDIST * W + k]
+    if tangent:
+        for k in range(24):
+            G[G_DLAM * W + k] = dlam * G[G_DDIST * W + k]
     slip = (0.0, 0.0)
     if has and not tangent:
         slip = _slip_value(side1, side2, (xi1, RC, xC), (xi2, RF, xF), par[XI1P], par[XI2P], HCL, HFK, HLKp)
@@ -1153,17 +1291,15 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
             for k in range(24):
                 G[(G_DSLIP + a) * W + k] = 0.0
     if tangent:
-        for k in range(24):
-            for i in range(9):
-                rows[i, k] = G[(G_DN + i) * W + k]
-            rows[9, k] = G[G_DSLIP * W + k]
-            rows[10, k] = G[(G_DSLIP + 1) * W + k]
-            rows[11, k] = G[G_DLAM * W + k]
+        _copy_rows(G, rows)
     contracted = tangent and K.shape[0] < 4       # 2: at T = 0 and at Tp; 1: at Tp only
     _store_frames(frames, n, t1, t2, RC, xC, RF, xF, R1, R2)     # (the geometry's: once, not per traction)
     F, lt, stick = (0.0, 0.0, 0.0), (0.0, 0.0), True
+    four = not data and (not tangent or K.shape[0] == 1)      # the four tractions' forces without tangent
     for step in range(0 if data else 5 if contracted else 4):
         q = step if not contracted else (0, 4, 1, 2, 3)[step]         # the unit tractions last (the point data)
+        if four and q < 4:          # (after the loop, side by side)
+            continue
         lamp = (1.0 if q == 1 else 0.0, 1.0 if q == 2 else 0.0, 1.0 if q == 3 else 0.0) if q < 4 else \
             (Tp[0], Tp[1], Tp[2])
         fq = f[q, p] if q < 4 else spare[1]
@@ -1191,6 +1327,8 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
             mF = cross(n, F)
             _wrench_value(RC, F, scale(R1, mF), v[0, V_WR])
             _wrench_value(RF, scale(-1.0, F), scale(R2, mF), v[1, V_WR])
+            _nodal_forces(S1, v[0], fq, 0)
+            _nodal_forces(S2, v[1], fq, 2)
         else:
             F = scale(-wgt * lam, n)
             for k in range(24):
@@ -1202,8 +1340,11 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
             _moment_gradient(n, F, G)
             _wrench(RC, F, False, scale(R1, mF), R1, G, G_VC, G_DWC, v[0, V_WR])
             _wrench(RF, scale(-1.0, F), True, scale(R2, mF), R2, G, G_VF, G_DWF, v[1, V_WR])
-        _nodal(u1, w1, xi1, co1[0], co1[1], S1, v[0], cache[0], G, G_DWC, G_DH1, G_DXI1, fq, Kq, 0)
-        _nodal(u2, w2, xi2, co2[0], co2[1], S2, v[1], cache[1], G, G_DWF, G_DH2, G_DXI2, fq, Kq, 2)
+            _nodal(u1, w1, xi1, co1[0], co1[1], S1, v[0], cache[0], G, G_DWC, G_DH1, G_DXI1, fq, Kq, 0)
+            _nodal(u2, w2, xi2, co2[0], co2[1], S2, v[1], cache[1], G, G_DWF, G_DH2, G_DXI2, fq, Kq, 2)
+    if four:
+        F, lt = _forces_four(n, t1, t2, lam, wgt, RC, RF, R1, R2, S1, S2, f, p, G)
+        stick = True
     # the point data as the last traction's pass left them (written once)
     sc[0], sc[1], sc[2], sc[3] = gap, lam, xi1, xi2
     for i in range(3):
@@ -1211,10 +1352,11 @@ def _point_mortar(Xp, kind, par, has, HCL, HFK, HLKp, f, K, p, sc, vec, two, fla
     two[0, 0], two[0, 1], two[1, 0], two[1, 1] = lt[0], lt[1], slip[0], slip[1]
     flags[0], flags[1] = active, stick
     for q in range(1, 1 if data else 4):     # the differences to T = 0: the friction's parts (``mortar_terms``)
-        fq, f0 = f[q, p], f[0, p]
-        for i in range(4):
-            for j in range(6):
-                fq[i, j] -= f0[i, j]
+        if not four:        # (``_forces_four`` stores them)
+            fq, f0 = f[q, p], f[0, p]
+            for i in range(4):
+                for j in range(6):
+                    fq[i, j] -= f0[i, j]
         if tangent and ((q == 1 and K.shape[0] == 2) or not contracted):
             Kq, K0 = K[q, p], K[0, p]
             for i in range(24):
