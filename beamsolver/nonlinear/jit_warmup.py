@@ -41,12 +41,13 @@ from numba.core import event
 __all__ = ["estimate", "kernel_cached", "listen", "warm_up", "ESTIMATE"]
 
 # CPU seconds of the first run's compilation of the main job (examples/twisted_pair.py) on the project's
-# 2-core x86-64 machines, measured with an empty NUMBA_CACHE_DIR (session 16): elements and assembly ~7.5 s (a
+# 2-core x86-64 machines, measured with an empty NUMBA_CACHE_DIR (session 17): elements and assembly ~7.5 s (a
 # beam scene's first run, examples/roll_up.py), the other contact and exact-stick functions (search, projections,
-# owners, mortar, bordered and augmented systems) ~24.5 s, the contact kernel in the second process ~18 s (one
-# process: 50 s in all; two: 32 s, this process's share the longer).  Session 11's 14 / 6.5 / 5.5 s predate the
+# owners, mortar, bordered and augmented systems) ~27.5 s, the contact kernel in the second process ~21 s (one
+# process: the bar ends at 51 s; two: at 36 s, this process's share the longer; session 16: 50 / 32 s, before the
+# kernel's forces-only passes and the mortar glue's compiled passes).  Session 11's 14 / 6.5 / 5.5 s predate the
 # mortar and saddle-point kernels (docs/benchmarks.md, jit_compile_functions)
-ESTIMATE = dict(kernel=18.0, contact=24.5, elements=7.5)
+ESTIMATE = dict(kernel=21.0, contact=27.5, elements=7.5)
 log = logging.getLogger("beamsolver")
 _REFRESH = 0.25         # seconds between refreshes of the bar
 _IDLE = 3.0             # seconds without compilation that close it (imports between two compilations)
