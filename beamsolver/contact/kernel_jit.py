@@ -201,14 +201,20 @@ def _exp(u, w):
 
 
 @jit_callee
+def _ut_entry(A, B, i, j):
+    """``(A @ B)[i, j]`` of two block upper-triangular 6 x 6 matrices (``_mm_ut``'s sum: its nonzero terms in order)."""
+    acc = 0.0
+    for l in range(3 if i >= 3 else 0, 3 if j < 3 else 6):
+        acc += A[i, l] * B[l, j]
+    return acc
+
+
+@jit_callee
 def _mm_ut_scaled(A, B, x, out):
     """``out = (A @ B) x`` (``_mm_ut``'s sums, each times ``x``)."""
     for i in range(6):
         for j in range(6):
-            acc = 0.0
-            for l in range(3 if i >= 3 else 0, 3 if j < 3 else 6):
-                acc += A[i, l] * B[l, j]
-            out[i, j] = acc * x
+            out[i, j] = _ut_entry(A, B, i, j) * x
 
 
 @jit_callee
@@ -216,10 +222,7 @@ def _minus_mm_ut(C, A, B, out):
     """``out = C - A @ B`` (``_mm_ut``'s sums)."""
     for i in range(6):
         for j in range(6):
-            acc = 0.0
-            for l in range(3 if i >= 3 else 0, 3 if j < 3 else 6):
-                acc += A[i, l] * B[l, j]
-            out[i, j] = C[i, j] - acc
+            out[i, j] = C[i, j] - _ut_entry(A, B, i, j)
 
 
 @jit_callee

@@ -62,9 +62,7 @@ def _columns(out, g, cols, vals):
 def _trial_rows(B, g2, slot_rows, wphi, wn, m, eps, mu, Pi, Q, C, c, dS, dn, dlam_n):
     for p in range(g2.shape[0]):
         for a in range(2):
-            g = g2[p, a]
-            wg, wgn = wphi[p, a] / m[g], wn[p, a] / m[g]
-            se, sm = eps[g] * wg, mu[g] * wg
+            g, wgn, se, sm = _slot_weights(g2, wphi, wn, m, eps, mu, p, a)
             # the group's matrices in registers (the stores to ``B`` may alias them: reloaded per column otherwise)
             P00, P01, P02, P10, P11, P12, P20, P21, P22 = _entries(Pi, g)
             Q00, Q01, Q02, Q10, Q11, Q12, Q20, Q21, Q22 = _entries(Q, g)
@@ -78,6 +76,14 @@ def _trial_rows(B, g2, slot_rows, wphi, wn, m, eps, mu, Pi, Q, C, c, dS, dn, dla
                 o[0, r] += C00 * t0 + C01 * t1 + C02 * t2 + s0 * dl
                 o[1, r] += C10 * t0 + C11 * t1 + C12 * t2 + s1 * dl
                 o[2, r] += C20 * t0 + C21 * t1 + C22 * t2 + s2 * dl
+
+
+@jit
+def _slot_weights(g2, wphi, wn, m, eps, mu, p, a):
+    """Point ``p``'s slot ``a``: its group ``g`` and weights ``w_n / m``, ``eps w / m``, ``mu w / m``."""
+    g = g2[p, a]
+    wg, wgn = wphi[p, a] / m[g], wn[p, a] / m[g]
+    return g, wgn, eps[g] * wg, mu[g] * wg
 
 
 @jit
@@ -102,9 +108,7 @@ def _trial_column(se, wgn, P00, P01, P02, P10, P11, P12, P20, P21, P22, Q00, Q01
 def _branch_rows(Tq, capq, g2, slot_rows, wphi, wn, m, eps, mu, Pi, Q, dS, dn, dlam_n):
     for p in range(g2.shape[0]):
         for a in range(2):
-            g = g2[p, a]
-            wg, wgn = wphi[p, a] / m[g], wn[p, a] / m[g]
-            se, sm = eps[g] * wg, mu[g] * wg
+            g, wgn, se, sm = _slot_weights(g2, wphi, wn, m, eps, mu, p, a)
             P00, P01, P02, P10, P11, P12, P20, P21, P22 = _entries(Pi, g)
             Q00, Q01, Q02, Q10, Q11, Q12, Q20, Q21, Q22 = _entries(Q, g)
             o, oc, rows = Tq[g], capq[g], slot_rows[a, p]

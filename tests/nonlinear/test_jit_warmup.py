@@ -224,20 +224,22 @@ def test_the_bar_is_cleared_when_the_warm_up_ends():
     assert len(out.getvalue()) == n            # the refresh thread has stopped
 
 
+def _fresh():
+    """A new compiled function of this module (its first call is a compilation the announcer sees)."""
+    @numba.njit
+    def f(x):
+        return x + 1
+    return f
+
 
 @pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
 def test_the_bar_says_when_it_is_past_the_estimate(monkeypatch):
     """Past the announced estimate the bar shows the seconds and says so (it used to stop at 99 % of it)."""
     monkeypatch.setattr(jit_warmup, "estimate", lambda: 0.1)        # announced as ~1 s
     out = io.StringIO()
-
-    @numba.njit
-    def f(x):
-        return x + 1
-
     a = jit_warmup._Announcer(out, package=__name__)
     with event.install_listener("numba:compile", a):
-        f(1)
+        _fresh()(1)
         a.t_bar -= 2.0                                 # as if compiling had begun 2 s ago
     time.sleep(3 * jit_warmup._REFRESH)                # the bar stays _IDLE s after the last compilation
     a.close()
@@ -249,21 +251,12 @@ def test_a_compilation_after_the_warm_up_counts_its_own_seconds():
     """A batch compiled after the warm-up (a larger model's solver path, mid-solve) gets a bar of its own seconds, not
     the warm-up's estimate with the seconds since the first announcement (which sat at 99 % from its start)."""
     out = io.StringIO()
-
-    @numba.njit
-    def f(x):
-        return x + 1
-
-    @numba.njit
-    def g(x):
-        return x - 1
-
     a = jit_warmup._Announcer(out, package=__name__)
     with event.install_listener("numba:compile", a):
-        f(1)
+        _fresh()(1)
         a.close()                                      # the warm-up's end
         n = len(out.getvalue())
-        g(1)
+        _fresh()(1)
     later = out.getvalue()[n:]
     a.close()
     assert "compiling: 0 s" in later and "%|" not in later
