@@ -24,6 +24,7 @@ Elements may not turn by more than ``MAX_ELEMENT_ROTATION`` (nor pass pi within 
 ``check_continuity``): such steps fail with a message saying how many elements the beam needs.
 Failures are typed (``beamsolver.failures``).
 """
+import contextlib
 import logging
 import time
 from typing import NamedTuple, Protocol
@@ -66,10 +67,17 @@ LM_FAR = True                        # on the displacement block (Levenberg, ``N
                                      # (docs/benchmarks.md, session 9)
 INNER_SWITCHES = 0                   # exact stick: branch switches of the linearised groups per Newton direction ...
 INNER_PREDICTOR = False              # ... also in a load step's first iteration (the prescribed motions' predictor)
+RETRY_SWITCHES = 8                   # ... and so many in a step's attempts after a failed one (``Newton.retrying``, set by
+#                                      the stepper; 0: off), with at most TAIL_MAX_UNKNOWNS free unknowns: a slip front
+#                                      that Newton moves by a few groups an iteration (the 192 el/wire twisted pair: 581
+#                                      iterations, 9 failed attempts, steps down to 1/256 -> 295; docs/theory_mortar.md 3c)
 TAIL_SWITCHES = 8                    # exact stick: near the solution (scaled residual <= TAIL_RATIO) the sliding groups
 TAIL_RATIO = 1e-5                    # ... at a stick / slip corner (slip's share of the trial c |Pi u| < TAIL_CORNER
 TAIL_CORNER = 0.1                    # ... times the disk) start on the stick rows, kept where the linearised trial
 #                                      stays in the disk, at most TAIL_SWITCHES solves (``_corner_groups``; 0: off);
+SWITCH_CONDENSED = True              # ... the switched groups' rows condensed and solved through A as the plain direction
+#                                      from augmented.MIN_UNKNOWNS free unknowns, not the full bordered system factorised
+#                                      per switch (``Newton._rows_solve``; docs/benchmarks.md, session 18)
 TAIL_ROWS = 1e-3                     # ... the evaluations' branch rows asked for once the scaled residual is below this
 TAIL_MAX_UNKNOWNS = 10000            # ... with at most so many free unknowns (the bordered system is factorised
 #                                      uncondensed there: the 19-wire strand's, 17 898, one corner direction in its last
@@ -209,6 +217,7 @@ class Newton:
         self.linsolver = linsolve.Solver()    # solve(linear_solver=...) replaces it
         problem.want_branch_rows(INNER_SWITCHES > 0)
         self.ratio_now = np.inf               # the scaled residual of the iterate whose direction is computed
+        self.retrying = False                 # the stepper's attempt after a failed one (``RETRY_SWITCHES``)
         self.stall_ratio = np.inf             # correction growth of the shortest damped trial
         self.indefinite_seen = False          # the step's first tangent had det < 0 (or a back-end that cannot tell)
         self.crawl = 0                        # backtracked line searches in a row (``backtrack``)
@@ -296,8 +305,8 @@ class Newton:
         unknowns ``(n_free,)`` (with the prescribed-motion coupling of ``dz_c`` ``(n, 6)``)."""
         problem = self.problem
         if ev.mult is not None and "Tq" in ev.mult and (dz_c is None or INNER_PREDICTOR):
-            if INNER_SWITCHES:
-                return self._active_set_direction(ev, dz_c)
+            if INNER_SWITCHES or self._retry_switches():
+                return self._active_set_direction(ev, dz_c, INNER_SWITCHES or RETRY_SWITCHES)
             if TAIL_SWITCHES and self.ratio_now <= TAIL_RATIO and self.sys.n_free <= TAIL_MAX_UNKNOWNS:
                 corner = self._corner_groups(ev)
                 if corner.any():
@@ -309,18 +318,10 @@ class Newton:
         elif DROP_BEFORE_SOLVE:
             ev.drop_tangent()      # the tangent's values are in K' and A now (the direct fallback needs K' alone)
         t1 = time.perf_counter()
-        try:
-            if aug is not None:                          # the saddle system through A = K' + Kq E Kl
-                lu, dzf = aug, aug.solve(self.linsolver)
-            else:
-                lu = linsolve.factorize_tangent(K, self.linsolver, saddle=ev.mult is not None)
-                dzf = lu.solve(rhs)
-        finally:
-            t2 = time.perf_counter()
-            self.timings["assembly"] += t1 - t0
-            self.timings["linear_solve"] += t2 - t1
-        if not np.all(np.isfinite(dzf)):
-            raise SingularTangent("the linear solve returned non-finite values")
+        if aug is not None:                              # the saddle system through A = K' + Kq E Kl
+            lu, dzf = self._timed(lambda: (aug, aug.solve(self.linsolver)), t0, t1)
+        else:
+            lu, dzf = self._timed(lambda: self._factored(K, rhs, ev.mult is not None), t0, t1)
         if ev.mult is not None:
             dzf, dlam = problem.split_solution(ev, dzf, dz_c)
             problem.multiplier_step(ev, dlam)
@@ -436,6 +437,10 @@ class Newton:
         c = both & pa & (lam1 <= SECANT_SHARE * la)
         return np.union1d(on_secant, np.setdiff1d(ka[c], forced))
 
+    def _retry_switches(self):
+        """Whether Newton's directions predict the groups' branches (a failed step's retry, ``RETRY_SWITCHES``)."""
+        return bool(RETRY_SWITCHES) and self.retrying and self.sys.n_free <= TAIL_MAX_UNKNOWNS
+
     @staticmethod
     def _corner_groups(ev):
         """``(g,)``: the sliding groups of ``ev`` (pressed, not weak) at a stick / slip corner: their slip's share of
@@ -465,27 +470,18 @@ class Newton:
         used, rows = mu["stick"], None
         switches = INNER_SWITCHES if switches is None else switches
         start = 0
-        if corner is not None:      # the corner groups start on the stick rows (uncondensed: the rows are switched)
-            problem.uncondense(ev)
+        condensed = SWITCH_CONDENSED and problem.augments(ev)
+        if corner is not None:      # the corner groups start on the stick rows
+            if not condensed:
+                problem.uncondense(ev)
             used = mu["stick"] | corner
             rows = problem.branch_rows(ev, used, mu["trial"])
             start = 1
         for inner in range(start, switches + 1):
-            t0 = time.perf_counter()
-            K, rhs = problem.linear_system(ev, dz_c, condense=inner == 0, rows=rows)
-            t1 = time.perf_counter()
-            try:
-                lu = linsolve.factorize_tangent(K, self.linsolver, saddle=True)
-                x = lu.solve(rhs)
-            finally:
-                t2 = time.perf_counter()
-                self.timings["assembly"] += t1 - t0
-                self.timings["linear_solve"] += t2 - t1
-            if not np.all(np.isfinite(x)):
-                raise SingularTangent("the linear solve returned non-finite values")
-            if inner == 0 and rows is None:
-                dzf, dlam = problem.split_solution(ev, x, dz_c)
-                x = np.concatenate([dzf, np.ravel(dlam)])
+            if condensed:
+                lu, x = self._rows_solve(ev, dz_c, rows)
+            else:
+                lu, x = self._bordered_solve(ev, dz_c, inner, rows)
             if inner == start:
                 first = (lu, x)
             stick, trial, _ = problem.predicted_branches(ev, x, dz_c)
@@ -501,12 +497,59 @@ class Newton:
                 if INNER_UNSETTLED == "plain":
                     lu, x = first
                 break
-            if rows is None:
+            if rows is None and not condensed:
                 problem.uncondense(ev)
             used = stick
             rows = problem.branch_rows(ev, used, trial)
         problem.multiplier_step(ev, x[n:].reshape(-1, 3))
         return lu, x[:n]
+
+    def _rows_solve(self, ev, dz_c, rows):
+        """``(lu, x)``: the Newton system of ``ev`` with its multipliers' rows ``rows`` (``Problem.branch_rows``;
+        ``None``: the evaluation's) condensed and solved as ``direction`` solves it (through ``A = K' + Kq E Kl``
+        from ``augmented.MIN_UNKNOWNS`` free unknowns), ``x`` ``(n_free + 3 g,)`` the free increments and the
+        multipliers' step."""
+        problem = self.problem
+        with problem.rows_of(ev, rows) if rows is not None else contextlib.nullcontext():
+            t0 = time.perf_counter()
+            if problem.augments(ev):
+                aug = problem.augmented_system(ev, dz_c)
+                lu, x = self._timed(lambda: (aug, aug.solve(self.linsolver)), t0, time.perf_counter())
+            else:
+                K, rhs = problem.linear_system(ev, dz_c)
+                lu, x = self._timed(lambda: self._factored(K, rhs, True), t0, time.perf_counter())
+            dzf, dlam = problem.split_solution(ev, x, dz_c)
+        return lu, np.concatenate([dzf, np.ravel(dlam)])
+
+    def _factored(self, K, rhs, saddle):
+        """``(lu, x)``: ``K`` factorised by the Newton's solver and ``K x = rhs`` solved."""
+        lu = linsolve.factorize_tangent(K, self.linsolver, saddle=saddle)
+        return lu, lu.solve(rhs)
+
+    def _timed(self, solve, t0, t1):
+        """``solve()`` ``-> (lu, x)``, timed as the linear solve (``t0 .. t1``: its system's assembly); a non-finite
+        ``x`` is refused (``SingularTangent``)."""
+        try:
+            lu, x = solve()
+        finally:
+            t2 = time.perf_counter()
+            self.timings["assembly"] += t1 - t0
+            self.timings["linear_solve"] += t2 - t1
+        if not np.all(np.isfinite(x)):
+            raise SingularTangent("the linear solve returned non-finite values")
+        return lu, x
+
+    def _bordered_solve(self, ev, dz_c, inner, rows):
+        """``_rows_solve`` by the full bordered system (``SWITCH_CONDENSED = False``: a factorisation of it per switch;
+        the evaluation's rows condensed at ``inner == 0``)."""
+        problem = self.problem
+        t0 = time.perf_counter()
+        K, rhs = problem.linear_system(ev, dz_c, condense=inner == 0, rows=rows)
+        lu, x = self._timed(lambda: self._factored(K, rhs, True), t0, time.perf_counter())
+        if inner == 0 and rows is None:
+            dzf, dlam = problem.split_solution(ev, x, dz_c)
+            x = np.concatenate([dzf, np.ravel(dlam)])
+        return lu, x
 
     def evaluate(self, H, t, tangent=True):
         """``Problem.evaluate`` timed into ``timings`` and checked (finite residual, element rotations
@@ -664,9 +707,10 @@ class Newton:
         and the tail's branch rows asked for below ``TAIL_ROWS``), exact stick's status changes (``_count_changes``), ``near`` for the line search, the log and the callback."""
         residuals.append(ratio)
         self.ratio_now = ratio
-        if TAIL_SWITCHES and not INNER_SWITCHES and ev.mult is not None:
-            # the branch rows of exact stick's tail (their cost: only where the tail may need them)
-            self.problem.want_branch_rows(ratio <= TAIL_ROWS and self.sys.n_free <= TAIL_MAX_UNKNOWNS)
+        if (TAIL_SWITCHES or RETRY_SWITCHES) and not INNER_SWITCHES and ev.mult is not None:
+            # the branch rows of exact stick's tail and retries (their cost: only where they may be needed)
+            self.problem.want_branch_rows(self._retry_switches() or (
+                TAIL_SWITCHES and ratio <= TAIL_ROWS and self.sys.n_free <= TAIL_MAX_UNKNOWNS))
         self._count_changes(ev, stats, it)
         self.near = ratio <= LS_NEAR * max(residuals)
         log.debug("t = %.6g  iteration %d  scaled residual %.3e", t, it, ratio)

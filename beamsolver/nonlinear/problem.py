@@ -28,6 +28,7 @@ solver uses, and nothing else of the physics:
 prescribed nodes and their targets, reactions).  docs/theory.md section 10
 gives the equations and the data flow of one Newton iteration.
 """
+import contextlib
 import time
 from dataclasses import dataclass, field
 
@@ -266,6 +267,23 @@ class Problem:
         Kll[off] = mu["R"][off]
         C[off] = v[off] - mu["cap"][off][:, None] * t[off]
         return Klq, Kll, C
+
+    @contextlib.contextmanager
+    def rows_of(self, ev, rows):
+        """Inside: ``ev``'s multipliers' rows ``(Klq, Kll, C)`` are ``rows`` (``branch_rows``), so that
+        ``linear_system`` / ``augmented_system`` condense and solve the Newton system of those branches; after: the
+        evaluation's rows again (its tangent values without either's Schur terms, ``uncondense``).  A switched
+        group's rows are diagonal in the evaluation's basis ``B`` (``[nu, t1, t2]``: sticking ``D = diag(1, 0, 0)``,
+        sliding along a fixed direction ``D = I``), so its condensation is exact (``condense``)."""
+        mu = ev.mult
+        saved = mu["Klq"], mu["Kll"], mu["C"]
+        self.uncondense(ev)
+        mu["Klq"], mu["Kll"], mu["C"] = rows
+        try:
+            yield
+        finally:
+            self.uncondense(ev)
+            mu["Klq"], mu["Kll"], mu["C"] = saved
 
     def bordered(self, ev, K, rhs, dz_c=None, rows=None):
         """The Newton system with the multiplier unknowns of ``ev`` appended: ``[[K, K_ql], [K_lq, K_ll]]``

@@ -330,7 +330,10 @@ class Run:
                     t_next = self.t + max(size, self.dt_min)
             t0 = time.perf_counter()
             t_start = self.t
-            t_next, H, ev, stats = self._attempt(t_next)
+            try:
+                t_next, H, ev, stats = self._attempt(t_next)
+            finally:
+                self.newton.retrying = False
             stats.update(wall_time=time.perf_counter() - t0, dt=t_next - t_start)
             if kink:
                 self.kink_size = t_next - t_start
@@ -350,6 +353,7 @@ class Run:
                                       f"{motion_path.MAX_MOTION_ROTATION:.3g} rad, even at the smallest step"),
                            rotation_limit)
             self.newton.reset_timings()
+            self.newton.retrying = cutbacks > 0    # (exact stick's active-set directions, ``newton.RETRY_SWITCHES``)
             try:
                 H, ev, stats = self.newton_step(t_try)
                 self._check_finite(H, ev.r, ev.state, t_try)
