@@ -26,6 +26,7 @@ function being compiled (or the second process waited for), while compilations g
 the seconds and that they are past it.  A batch compiled after the warm-up (a larger model's solver path, met
 mid-solve) shows a bar of its own seconds, without an estimate.
 """
+import atexit
 import logging
 import os
 import signal
@@ -137,6 +138,19 @@ class _Announcer(event.Listener):
                 self.bar = None
 
 
+    def at_exit(self):
+        """Clear a bar still open when the process ends (``leave=False``: its line erased), not leave its last state
+        behind (a test session whose last test compiled: ``compiling: 729 s (longer than ...)`` after pytest's
+        summary, the seconds since the session's first compilation)."""
+        with self.lock:
+            bar, self.bar = self.bar, None
+        if bar is not None:
+            try:
+                bar.close()
+            except (ValueError, OSError):
+                pass
+
+
 _LISTENER = []
 
 
@@ -145,6 +159,7 @@ def listen(stream=None):
     if not _LISTENER and not _disabled():
         _LISTENER.append(_Announcer(stream))
         event.register("numba:compile", _LISTENER[0])
+        atexit.register(_LISTENER[0].at_exit)
 
 
 def estimate():

@@ -1,6 +1,7 @@
 """The first run (issue 29 item 1): compilations announced, a scene's kernels compiled before step 0."""
 import io
 import os
+import re
 import subprocess
 import sys
 import time
@@ -286,3 +287,17 @@ def test_the_jobs_share_of_the_kernel_has_the_kernels_signatures(tmp_path):
     out = subprocess.run([sys.executable, "-c", SHARE], env=env, capture_output=True, text=True)
     assert out.returncode == 0, out.stderr[-2000:]
     assert out.stdout.strip().splitlines()[-1] == "[1, 1, 2] [1, 1, 2]"
+
+
+@pytest.mark.skipif(numba.config.DISABLE_JIT, reason="compiled kernels only")
+def test_a_bar_open_at_exit_is_cleared(tmp_path):
+    """A process that ends while its bar is open (it compiled in its last seconds: a test session's last test)
+    erases the bar's line (``_Announcer.at_exit``), not leaves ``compiling: ...`` after its own last output."""
+    code = ("import beamsolver\nfrom beamsolver.lie import se3_jit\n"
+            "se3_jit.cross((1.0, 0.0, 0.0), (0.0, 1.0, 0.0))\nprint('done', flush=True)\n")
+    env = dict(os.environ, PYTHONPATH=str(ROOT), NUMBA_CACHE_DIR=str(tmp_path))
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert out.returncode == 0 and out.stdout == "done\n", out.stderr[-2000:]
+    assert "compiling:" in out.stderr                       # the bar was shown ...
+    last = [line for line in re.split(r"[\r\n]", out.stderr) if line][-1]
+    assert last.strip() == "", repr(out.stderr[-200:])      # ... and its line cleared at exit (blanks over it)
