@@ -130,25 +130,24 @@ class _Announcer(event.Listener):
         """Clear the bar now (the warm-up is done: nothing more compiles before the solve prints)."""
         with self.lock:
             self.ended = self.said
-            if self.bar is not None and self.depth == 0:
-                try:
-                    self.bar.close()
-                except (ValueError, OSError):
-                    pass
-                self.bar = None
-
+            if self.depth == 0:
+                self._clear()
 
     def at_exit(self):
-        """Clear a bar still open when the process ends (``leave=False``: its line erased), not leave its last state
-        behind (a test session whose last test compiled: ``compiling: 729 s (longer than ...)`` after pytest's
-        summary, the seconds since the session's first compilation)."""
+        """Clear a bar still open when the process ends, not leave its last state behind (a test session whose last
+        test compiled: ``compiling: 729 s (longer than ...)`` after pytest's summary, the seconds since the session's
+        first compilation)."""
         with self.lock:
-            bar, self.bar = self.bar, None
-        if bar is not None:
+            self._clear()
+
+    def _clear(self):
+        """Close the bar, if open (``leave=False``: its line erased; a closed stream ignored); under ``lock``."""
+        if self.bar is not None:
             try:
-                bar.close()
+                self.bar.close()
             except (ValueError, OSError):
                 pass
+            self.bar = None
 
 
 _LISTENER = []
