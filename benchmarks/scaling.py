@@ -633,7 +633,8 @@ def main(argv):
     ap.add_argument("--scenes", default=None,
                     help="instead: the scenes of issue 30, e.g. 19,37,61,rope-20,rope-40 (scaling_scenes.py)")
     ap.add_argument("--write-docs", action="store_true",
-                    help="with --scenes: replace the docs section even if rows of other scenes are dropped")
+                    help="with --scenes or --step-parts: replace the docs section even if rows of other scenes are "
+                         "dropped")
     ap.add_argument("--step-parts", default=None,
                     help="instead: Newton iterations of a loaded step by parts, held pattern off/on, e.g. "
                          "19,37,61,strand-61 (step_parts.py)")
@@ -641,7 +642,7 @@ def main(argv):
     ap.add_argument("--hold", default="False,True", help="with --step-parts: System.hold_pattern values")
     a = ap.parse_args(argv)
     if a.step_parts:
-        return step_parts_rows(a.step_parts.split(","), a.threads.split(","), a.hold.split(","))
+        return step_parts_rows(a.step_parts.split(","), a.threads.split(","), a.hold.split(","), a.write_docs)
     if a.scenes:
         return scenes(a.scenes.split(","), a.write_docs)
     max_elements, cap = int(a.max_elements), int(a.bundle_cap)
@@ -718,13 +719,15 @@ def scenes(names, write_docs=False):
     return rows
 
 
-def _dropped_rows(names):
-    """Scenes of the docs section's table that a run of ``names`` would drop."""
-    return [c for c in section_rows("scaling_scenes") if c not in names]
+def _dropped_rows(names, section="scaling_scenes", doc=None):
+    """Scenes of the docs section's table that a run of ``names`` would drop, once each, in the table's order."""
+    rows = section_rows(section) if doc is None else section_rows(section, doc)
+    return list(dict.fromkeys(c for c in rows if c not in names))
 
 
-def step_parts_rows(names, threads, holds):
-    """``--step-parts``: Newton iterations of a loaded step by parts (``step_parts``), one child per row."""
+def step_parts_rows(names, threads, holds, write_docs=False):
+    """``--step-parts``: Newton iterations of a loaded step by parts (``step_parts``), one child per row.  The docs
+    section is replaced only if no scene of its table is left out, or with ``write_docs`` (as ``scenes``)."""
     import step_parts
     t_start = time.perf_counter()
     rows = []
@@ -747,8 +750,13 @@ def step_parts_rows(names, threads, holds):
     print(text)
     write_csv("scaling_step_parts", [{k: v for k, v in r.items() if not isinstance(v, dict)} for r in rows],
               cell=_csv)
-    write_section("scaling_step_parts", "## Newton iterations of a loaded step by parts, held pattern (issue 30)\n\n"
-                  + text)
+    dropped = _dropped_rows(names, "scaling_step_parts")
+    if dropped and not write_docs:
+        print(f"docs/benchmarks.md: section scaling_step_parts kept (its rows {', '.join(dropped)} were not run; "
+              "--write-docs replaces it)")
+    else:
+        write_section("scaling_step_parts", "## Newton iterations of a loaded step by parts, held pattern (issue 30)"
+                      "\n\n" + text)
     return rows
 
 
