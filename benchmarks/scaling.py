@@ -710,13 +710,20 @@ def scenes(names, write_docs=False):
             + scaling_scenes.report(rows, base["rss_mb"], table))
     print(text)
     write_csv("scaling_scenes", rows, cell=_csv)
-    dropped = _dropped_rows(names)
+    _replace_section("scaling_scenes", "## Bundles of 19, 37, 61 wires and a rope (issue 30)\n\n" + text, names,
+                     write_docs)
+    return rows
+
+
+def _replace_section(section, text, names, write_docs):
+    """Replace the docs ``section`` by ``text`` unless the run of ``names`` left out scenes of its table (then it
+    is kept and they are named), or with ``write_docs``."""
+    dropped = _dropped_rows(names, section)
     if dropped and not write_docs:
-        print(f"docs/benchmarks.md: section scaling_scenes kept (its rows {', '.join(dropped)} were not run; "
+        print(f"docs/benchmarks.md: section {section} kept (its rows {', '.join(dropped)} were not run; "
               "--write-docs replaces it)")
     else:
-        write_section("scaling_scenes", "## Bundles of 19, 37, 61 wires and a rope (issue 30)\n\n" + text)
-    return rows
+        write_section(section, text)
 
 
 def _dropped_rows(names, section="scaling_scenes", doc=None):
@@ -750,13 +757,8 @@ def step_parts_rows(names, threads, holds, write_docs=False):
     print(text)
     write_csv("scaling_step_parts", [{k: v for k, v in r.items() if not isinstance(v, dict)} for r in rows],
               cell=_csv)
-    dropped = _dropped_rows(names, "scaling_step_parts")
-    if dropped and not write_docs:
-        print(f"docs/benchmarks.md: section scaling_step_parts kept (its rows {', '.join(dropped)} were not run; "
-              "--write-docs replaces it)")
-    else:
-        write_section("scaling_step_parts", "## Newton iterations of a loaded step by parts, held pattern (issue 30)"
-                      "\n\n" + text)
+    _replace_section("scaling_step_parts", "## Newton iterations of a loaded step by parts, held pattern (issue 30)"
+                     "\n\n" + text, names, write_docs)
     return rows
 
 
